@@ -1,0 +1,138 @@
+"""Viewer state as plain objects, tested headless (no polyscope import here).
+
+``MeshState`` holds the current mesh and keeps the last good one when a load fails (the error
+is kept as text for the panel). ``CurvatureState`` computes and caches every curvature field for
+the current area / boundary choice and the colour range each one should use.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from meshlap_core import primitives
+from meshlap_core.curvature import curvature_fields
+from meshlap_core.describe import mesh_info
+from meshlap_core.errors import MeshError
+from meshlap_core.io import load_mesh
+from meshlap_core.types import FloatArray, IntArray
+from meshlap_core.validate import validate_mesh
+
+ASSETS_DIR = Path(__file__).resolve().parents[1] / "assets"
+DEFAULT_ASSET = "bumpy.obj"
+
+# field name -> (label shown to users, signed?)
+FIELD_LABELS: dict[str, tuple[str, bool]] = {
+    "uniform": ("mean curvature H (uniform Laplacian)", True),
+    "cotan": ("mean curvature H (cotangent Laplace-Beltrami)", True),
+    "gaussian": ("Gaussian curvature K (angle deficit)", True),
+    "k1": ("principal curvature k1", True),
+    "k2": ("principal curvature k2", True),
+    "difference": ("H uniform - H cotangent", True),
+}
+
+
+def default_mesh_path() -> Path | None:
+    """The bundled default mesh, or ``None`` when ``assets/`` is not beside the package."""
+    path = ASSETS_DIR / DEFAULT_ASSET
+    return path if path.is_file() else None
+
+
+def robust_range(values: FloatArray, signed: bool, percentile: float = 2.0) -> tuple[float, float]:
+    """Colour-map range that one outlier cannot wash out.
+
+    Parameters
+    ----------
+    values : (n,) float
+    signed : bool
+        Symmetric range ``[-r, r]`` around zero (diverging maps) when true.
+    percentile : float
+        Clip this percentage at each end (0 = full range).
+
+    Returns
+    -------
+    lo, hi : float
+        ``lo < hi`` always (a constant field gets a small symmetric range).
+    """
+    v = np.asarray(values, dtype=np.float64)
+    v = v[np.isfinite(v)]
+    if v.size == 0:
+        return -1.0, 1.0
+    p = float(np.clip(percentile, 0.0, 49.0))
+    lo, hi = np.percentile(v, [p, 100.0 - p])
+    if signed:
+        r = max(abs(lo), abs(hi))
+        r = r if r > 0 else 1.0
+        return -float(r), float(r)
+    if hi <= lo:
+        return float(lo) - 0.5, float(lo) + 0.5
+    return float(lo), float(hi)
+
+
+@dataclass
+class MeshState:
+    """The mesh on screen. ``load`` never raises: on failure ``error`` is set and the previous
+    mesh stays.
+    """
+
+    V: FloatArray = field(default_factory=lambda: np.zeros((0, 3)))
+    F: IntArray = field(default_factory=lambda: np.zeros((0, 3), dtype=np.int64))
+    name: str = ""
+    info: dict[str, Any] = field(default_factory=dict)
+    error: str = ""
+    version: int = 0  # bumped on every successful load, so panels know to recompute
+
+    def load(self, path: str | Path | None) -> bool:
+        """Load ``path`` (the bundled default when ``None``). Returns success."""
+        try:
+            if path is None:
+                default = default_mesh_path()
+                if default is not None:
+                    mesh = load_mesh(default)
+                    name = default.name
+                else:  # installed without assets/: generate the same shape
+                    mesh = validate_mesh(*primitives.bumpy_sphere(), source="bumpy (generated)")
+                    name = "bumpy (generated)"
+            else:
+                mesh = load_mesh(path)
+                name = Path(path).name
+        except MeshError as exc:
+            self.error = str(exc)
+            return False
+        except OSError as exc:
+            self.error = f"{path}: {exc.strerror or exc}"
+            return False
+        self.V, self.F, self.name = mesh.V, mesh.F, name
+        self.info = mesh_info(mesh.V, mesh.F, mesh.report, str(path) if path else name)
+        self.error = ""
+        self.version += 1
+        return True
+
+
+@dataclass
+class CurvatureState:
+    """Curvature fields of the current mesh for the chosen area and boundary rule."""
+
+    area: str = "barycentric"
+    boundary: str = "pi"
+    field_name: str = "cotan"
+    percentile: float = 2.0
+    _key: tuple[Any, ...] = ()
+    fields: dict[str, FloatArray] = field(default_factory=dict)
+
+    def update(self, mesh: MeshState) -> bool:
+        """Recompute when the mesh, area or boundary rule changed. Returns whether it did."""
+        key = (mesh.version, self.area, self.boundary)
+        if key == self._key:
+            return False
+        self.fields = curvature_fields(mesh.V, mesh.F, self.area, self.boundary)
+        self._key = key
+        return True
+
+    def color_range(self, name: str | None = None) -> tuple[float, float]:
+        """Robust colour range of a field (symmetric around 0 for signed fields)."""
+        name = name or self.field_name
+        return robust_range(self.fields[name], FIELD_LABELS[name][1], self.percentile)

@@ -1,0 +1,70 @@
+"""Helpers shared by the subcommands: argument parsing, JSON output, statistics."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from typing import Any
+
+import numpy as np
+
+from ..errors import MeshError
+
+
+def parse_list(text: str, kind: type, name: str) -> list[Any]:
+    """Parse ``"5,15,50"`` into ``[5, 15, 50]`` (``kind`` int or float); MeshError names ``name``."""
+    try:
+        values = [kind(t) for t in text.split(",") if t.strip()]
+    except ValueError:
+        raise MeshError(f"expected a comma-separated list of {kind.__name__}s, got {text!r}", name)
+    if not values:
+        raise MeshError("the list is empty", name)
+    if kind is float and not all(math.isfinite(v) for v in values):
+        raise MeshError(f"values must be finite, got {text!r}", name)
+    return values
+
+
+def _jsonable(obj: Any) -> Any:
+    if isinstance(obj, dict):
+        return {str(k): _jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, list | tuple):
+        return [_jsonable(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return _jsonable(obj.tolist())
+    if isinstance(obj, np.bool_):
+        return bool(obj)
+    if isinstance(obj, np.integer):
+        return int(obj)
+    if isinstance(obj, float | np.floating):
+        f = float(obj)
+        return f if math.isfinite(f) else None
+    return obj
+
+
+def emit_json(obj: dict[str, Any]) -> None:
+    """Print exactly one JSON object on stdout (NaN/inf become null, numpy types plain)."""
+    sys.stdout.write(json.dumps(_jsonable(obj)) + "\n")
+
+
+def summary_stats(values: np.ndarray) -> dict[str, float]:
+    """``min, max, mean, median, p01, p99`` of the finite entries of ``values``."""
+    v = np.asarray(values, dtype=np.float64)
+    v = v[np.isfinite(v)]
+    if v.size == 0:
+        return {k: float("nan") for k in ("min", "max", "mean", "median", "p01", "p99")}
+    p01, med, p99 = np.percentile(v, [1, 50, 99])
+    return {
+        "min": float(v.min()),
+        "max": float(v.max()),
+        "mean": float(v.mean()),
+        "median": float(med),
+        "p01": float(p01),
+        "p99": float(p99),
+    }
+
+
+def add_json_flag(p: argparse.ArgumentParser) -> None:
+    """Add the common ``--json`` flag."""
+    p.add_argument("--json", action="store_true", help="print one JSON object on stdout")

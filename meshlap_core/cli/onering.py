@@ -1,0 +1,51 @@
+"""``meshlap onering MESH --vertex I [--reverse] [--json]``: the ordered one-ring of a vertex."""
+
+from __future__ import annotations
+
+import argparse
+
+from ..errors import MeshError
+from ..io import load_mesh
+from ..topology import one_ring
+from ._common import add_json_flag, emit_json
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("onering", help="ordered neighbours of a vertex (counter-clockwise)")
+    p.add_argument("mesh", help="mesh file (OBJ, OFF, PLY, STL)")
+    p.add_argument("--vertex", type=int, required=True, help="vertex index (0-based, after repairs)")
+    p.add_argument("--reverse", action="store_true", help="clockwise instead of counter-clockwise")
+    add_json_flag(p)
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    mesh = load_mesh(args.mesh)
+    n = mesh.n_vertices
+    if not 0 <= args.vertex < n:
+        raise MeshError(f"vertex {args.vertex} is out of range (the mesh has {n} vertices: 0..{n - 1})",
+                        "--vertex")
+    ring = one_ring(mesh.F, n)
+    if args.reverse:
+        ring = ring.reversed()
+    i = args.vertex
+    nbrs = [int(x) for x in ring[i]]
+    result = {
+        "vertex": i,
+        "neighbors": nbrs,
+        "boundary": bool(ring.boundary[i]),
+        "valence": len(nbrs),
+        "order": "clockwise" if args.reverse else "counter-clockwise",
+        "ordered": bool(ring.regular[i]),
+    }
+    if args.json:
+        emit_json(result)
+    else:
+        kind = "boundary (open fan)" if result["boundary"] else "interior (closed cycle)"
+        print(f"vertex {i}: {kind}, valence {len(nbrs)}, {result['order']}")
+        if not result["ordered"]:
+            print("  neighbourhood is not a disk (non-manifold or inconsistently oriented): "
+                  "neighbours listed by index, not in order")
+        for k, j in enumerate(nbrs):
+            print(f"  {k:>3}  {j}")
+    return 0

@@ -1,0 +1,115 @@
+"""Meshes the project generates itself: icosphere, torus, flat grid, cube, bumpy sphere.
+
+Every function returns ``(V, F)`` with ``V : (n,3) float64`` and ``F : (m,3) int64``, faces
+counter-clockwise seen from outside (outward normals) on closed meshes and ``+z`` on the grid.
+The test suite and the bundled ``assets/`` use only these, so a fresh clone needs no data.
+"""
+
+from __future__ import annotations
+
+import igl
+import numpy as np
+
+from .errors import MeshError
+from .types import FloatArray, IntArray
+
+
+def icosphere(subdivisions: int = 2, radius: float = 1.0) -> tuple[FloatArray, IntArray]:
+    """Icosphere: the icosahedron, midpoint-subdivided ``subdivisions`` times, projected on the
+    sphere of the given radius. ``10·4^s + 2`` vertices, ``20·4^s`` faces.
+    """
+    if subdivisions < 0:
+        raise MeshError("must be >= 0", "subdivisions")
+    V, F = igl.icosahedron()
+    V = np.asarray(V, dtype=np.float64)
+    F = np.asarray(F, dtype=np.int64)
+    for _ in range(subdivisions):
+        V, F = igl.upsample(V, F)
+        V = V / np.linalg.norm(V, axis=1, keepdims=True)
+    V = V / np.linalg.norm(V, axis=1, keepdims=True) * radius
+    return np.ascontiguousarray(V, dtype=np.float64), np.ascontiguousarray(F, dtype=np.int64)
+
+
+def _grid_faces(nu: int, nv: int, wrap_u: bool, wrap_v: bool) -> IntArray:
+    """Two triangles per cell of an ``nu × nv`` vertex grid (index ``i*nv + j``), CCW in (u,v)."""
+    cu = nu if wrap_u else nu - 1
+    cv = nv if wrap_v else nv - 1
+    i, j = np.meshgrid(np.arange(cu), np.arange(cv), indexing="ij")
+    i, j = i.ravel(), j.ravel()
+    i1 = (i + 1) % nu
+    j1 = (j + 1) % nv
+    a, b, c, d = i * nv + j, i1 * nv + j, i1 * nv + j1, i * nv + j1
+    return np.concatenate([np.stack([a, b, c], 1), np.stack([a, c, d], 1)]).astype(np.int64)
+
+
+def grid(nx: int = 10, ny: int = 10, size: float = 1.0) -> tuple[FloatArray, IntArray]:
+    """Flat ``nx × ny`` vertex grid in the ``z = 0`` plane covering ``[0,size]²``, normals ``+z``."""
+    if nx < 2 or ny < 2:
+        raise MeshError("a grid needs at least 2 x 2 vertices", "grid")
+    x, y = np.meshgrid(np.linspace(0, size, nx), np.linspace(0, size, ny), indexing="ij")
+    V = np.stack([x.ravel(), y.ravel(), np.zeros(nx * ny)], axis=1)
+    return V, _grid_faces(nx, ny, False, False)
+
+
+def torus(
+    n_major: int = 32, n_minor: int = 16, R: float = 3.0, r: float = 1.0
+) -> tuple[FloatArray, IntArray]:
+    """Torus around the z axis, ``p(u,v) = ((R + r cos v) cos u, (R + r cos v) sin u, r sin v)``,
+    sampled on a regular ``n_major × n_minor`` grid with welded seams (genus 1, χ = 0).
+    """
+    if n_major < 3 or n_minor < 3:
+        raise MeshError("a torus needs at least 3 x 3 samples", "torus")
+    u, v = np.meshgrid(
+        np.linspace(0, 2 * np.pi, n_major, endpoint=False),
+        np.linspace(0, 2 * np.pi, n_minor, endpoint=False),
+        indexing="ij",
+    )
+    u, v = u.ravel(), v.ravel()
+    V = np.stack([(R + r * np.cos(v)) * np.cos(u), (R + r * np.cos(v)) * np.sin(u), r * np.sin(v)], 1)
+    return V, _grid_faces(n_major, n_minor, True, True)
+
+
+def cube(subdivisions: int = 0, size: float = 1.0) -> tuple[FloatArray, IntArray]:
+    """Axis-aligned cube ``[0,size]³`` (8 vertices, 12 faces), optionally midpoint-subdivided.
+
+    Subdivision keeps the vertices on the faces, so the corner angle sums and the volume
+    (``size³``) are unchanged.
+    """
+    V = np.array(
+        [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]],
+        dtype=np.float64,
+    ) * size
+    F = np.array(
+        [
+            [0, 2, 1], [0, 3, 2],  # z = 0 (normal -z)
+            [4, 5, 6], [4, 6, 7],  # z = 1
+            [0, 1, 5], [0, 5, 4],  # y = 0
+            [2, 3, 7], [2, 7, 6],  # y = 1
+            [1, 2, 6], [1, 6, 5],  # x = 1
+            [0, 4, 7], [0, 7, 3],  # x = 0
+        ],
+        dtype=np.int64,
+    )
+    for _ in range(subdivisions):
+        V, F = igl.upsample(V, F)
+    return np.ascontiguousarray(V, dtype=np.float64), np.ascontiguousarray(F, dtype=np.int64)
+
+
+def bumpy_sphere(
+    subdivisions: int = 4, amplitude: float = 0.12, frequency: int = 5
+) -> tuple[FloatArray, IntArray]:
+    """A closed genus-0 surface with bumps of both curvature signs: an icosphere whose radius is
+    ``1 + amplitude · sin(f x) sin(f y) sin(f z)``.
+    """
+    V, F = icosphere(subdivisions)
+    bump = np.sin(frequency * V[:, 0]) * np.sin(frequency * V[:, 1]) * np.sin(frequency * V[:, 2])
+    return V * (1.0 + amplitude * bump)[:, None], F
+
+
+PRIMITIVES = {
+    "icosphere": icosphere,
+    "torus": torus,
+    "grid": grid,
+    "cube": cube,
+    "bumpy": bumpy_sphere,
+}

@@ -1,0 +1,108 @@
+"""CLI: info, curvature, onering (through main() and once through the installed script)."""
+
+import json
+import shutil
+import subprocess
+
+import numpy as np
+import pytest
+
+from meshlap_core import primitives
+from meshlap_core.cli import main
+from meshlap_core.curvature import gaussian_curvature
+from meshlap_core.io import save_mesh
+
+
+def run_cli(capsys, *argv):
+    code = main([str(a) for a in argv])
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+@pytest.fixture
+def cube_obj(tmp_path):
+    path = tmp_path / "cube.obj"
+    save_mesh(path, *primitives.cube())
+    return path
+
+
+@pytest.fixture
+def grid_obj(tmp_path):
+    path = tmp_path / "grid.obj"
+    save_mesh(path, *primitives.grid(5, 5))
+    return path
+
+
+def test_info_json(capsys, tmp_path):
+    path = tmp_path / "torus.obj"
+    save_mesh(path, *primitives.torus(16, 8))
+    code, out, _ = run_cli(capsys, "info", path, "--json")
+    assert code == 0
+    info = json.loads(out)
+    assert info["n_vertices"] == 128 and info["n_faces"] == 256
+    assert info["euler_characteristic"] == 0 and info["genus"] == 1
+    assert info["n_boundary_loops"] == 0 and info["n_components"] == 1
+    assert info["manifold"] is True and info["consistently_oriented"] is True
+    assert info["bbox_diagonal"] == pytest.approx(np.linalg.norm([8, 8, 2]), rel=0.05)
+
+
+def test_info_human(capsys, grid_obj):
+    code, out, _ = run_cli(capsys, "info", grid_obj)
+    assert code == 0 and "boundary loops    1" in out and "genus             0" in out
+
+
+def test_curvature_json_matches_core(capsys, cube_obj):
+    code, out, _ = run_cli(capsys, "curvature", cube_obj, "--method", "gaussian", "--json")
+    assert code == 0
+    stats = json.loads(out)
+    K = gaussian_curvature(*primitives.cube())
+    assert stats["max"] == pytest.approx(K.max()) and stats["min"] == pytest.approx(K.min())
+    assert set(stats) >= {"min", "max", "mean", "median", "p01", "p99"}
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".npy", ".ply"])
+def test_curvature_out_files(capsys, cube_obj, tmp_path, suffix):
+    out_path = tmp_path / f"k{suffix}"
+    code, _, _ = run_cli(capsys, "curvature", cube_obj, "--method", "gaussian", "--out", out_path)
+    assert code == 0 and out_path.stat().st_size > 0
+    if suffix == ".npy":
+        np.testing.assert_allclose(np.load(out_path), gaussian_curvature(*primitives.cube()))
+
+
+def test_onering_json(capsys, grid_obj):
+    # vertex 0 is the corner (0,0): neighbours (1,0)=5, (1,1)=6, (0,1)=1 counter-clockwise
+    code, out, _ = run_cli(capsys, "onering", grid_obj, "--vertex", 0, "--json")
+    assert code == 0
+    r = json.loads(out)
+    assert r == {**r, "vertex": 0, "neighbors": [5, 6, 1], "boundary": True, "valence": 3}
+    code, out, _ = run_cli(capsys, "onering", grid_obj, "--vertex", 0, "--reverse", "--json")
+    assert json.loads(out)["neighbors"] == [1, 6, 5]
+
+
+def test_bad_input_exit_2_one_line(capsys, tmp_path, cube_obj):
+    empty = tmp_path / "empty.obj"
+    empty.write_text("")
+    for argv in (["info", empty], ["info", tmp_path / "missing.obj"], ["info", tmp_path],
+                 ["onering", cube_obj, "--vertex", 99], ["curvature", cube_obj, "--out", tmp_path / "x.txt"]):
+        code, out, err = run_cli(capsys, *argv)
+        assert code == 2, argv
+        assert err.startswith("meshlap: error: ") and err.count("\n") == 1, err
+        assert "Traceback" not in err and out == ""
+
+
+def test_curvature_out_refuses_to_overwrite_input(capsys, tmp_path):
+    path = tmp_path / "m.ply"
+    save_mesh(path, *primitives.cube())
+    before = path.read_bytes()
+    code, _, err = run_cli(capsys, "curvature", path, "--out", path)
+    assert code == 2 and path.read_bytes() == before
+
+
+@pytest.mark.skipif(shutil.which("meshlap") is None, reason="console script not on PATH (not installed)")
+def test_console_script(cube_obj):
+    res = subprocess.run(["meshlap", "info", str(cube_obj), "--json"], capture_output=True, text=True,
+                         timeout=120)
+    assert res.returncode == 0 and json.loads(res.stdout)["n_faces"] == 12
+    res = subprocess.run(["meshlap", "info", str(cube_obj) + ".nope"], capture_output=True, text=True,
+                         timeout=120)
+    assert res.returncode == 2 and "Traceback" not in res.stderr

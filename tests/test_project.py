@@ -1,0 +1,58 @@
+"""Project promises: README's commands, CI in sync, a headless core, ruff clean."""
+
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def readme_commands() -> list[str]:
+    text = (ROOT / "README.md").read_text()
+    block = text.split("```", 2)[1]
+    return [ln for ln in block.splitlines()[1:] if ln.strip() and not ln.startswith("#")]
+
+
+def test_readme_starts_with_the_two_commands_and_ci_runs_the_second():
+    text = (ROOT / "README.md").read_text()
+    assert text.index("```") < 400, "the set-up commands come first"
+    view_cmd, test_cmd = readme_commands()[:2]
+    assert "meshlap view" in view_cmd and "pip install" in view_cmd
+    assert "pytest" in test_cmd and "[test]" in test_cmd
+    ci = (ROOT / ".ci" / "run").read_text().splitlines()
+    assert test_cmd in ci
+
+
+def test_core_never_imports_polyscope():
+    code = (
+        "import importlib, pkgutil, sys, meshlap_core, meshlap_core.cli\n"
+        "for m in pkgutil.walk_packages(meshlap_core.__path__, 'meshlap_core.'):\n"
+        "    importlib.import_module(m.name)\n"
+        "import app.state\n"
+        "assert 'polyscope' not in sys.modules, 'polyscope imported'\n"
+    )
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert res.returncode == 0, res.stderr
+
+
+def test_ruff_clean():
+    ruff = shutil.which("ruff") or str(Path(sys.executable).parent / "ruff")
+    if not Path(ruff).exists():
+        pytest.skip("ruff is not installed (it comes with the [test] extra)")
+    res = subprocess.run([ruff, "check", str(ROOT)], capture_output=True, text=True, timeout=120)
+    assert res.returncode == 0, res.stdout + res.stderr
+
+
+def test_assets_are_what_the_script_makes():
+    import numpy as np
+
+    from meshlap_core import primitives
+    from meshlap_core.io import load_mesh
+
+    mesh = load_mesh(ROOT / "assets" / "bumpy.obj")
+    V, F = primitives.bumpy_sphere(4)
+    assert mesh.F.shape == F.shape
+    np.testing.assert_allclose(mesh.V, V, atol=1e-6)
