@@ -45,8 +45,12 @@ def push_mesh(mesh: MeshState, curv: CurvatureState) -> None:
         label, signed = FIELD_LABELS[name]
         lo, hi = curv.color_range(name)
         sm.add_scalar_quantity(
-            label, values, defined_on="vertices", cmap="coolwarm" if signed else "viridis",
-            vminmax=(lo, hi), enabled=(name == curv.field_name),
+            label,
+            values,
+            defined_on="vertices",
+            cmap="coolwarm" if signed else "viridis",
+            vminmax=(lo, hi),
+            enabled=(name == curv.field_name),
         )
 
 
@@ -61,9 +65,11 @@ class Viewer:
     def callback(self) -> None:
         psim = ps.imgui
         psim.PushItemWidth(260)
-        psim.TextUnformatted(f"{self.mesh.name}: {self.mesh.info.get('n_vertices', 0)} vertices, "
-                             f"{self.mesh.info.get('n_faces', 0)} faces")
-        changed, self.path_text = psim.InputText("mesh path", self.path_text)
+        psim.TextUnformatted(
+            f"{self.mesh.name}: {self.mesh.info.get('n_vertices', 0)} vertices, "
+            f"{self.mesh.info.get('n_faces', 0)} faces"
+        )
+        _, self.path_text = psim.InputText("mesh path", self.path_text)
         if psim.Button("Open") and self.path_text:
             if self.mesh.load(Path(self.path_text).expanduser()):
                 push_mesh(self.mesh, self.curv)
@@ -88,7 +94,9 @@ def run(
     if shot is not None and not shot.parent.is_dir():
         raise MeshError(f"output directory {shot.parent} does not exist", shot)
     if field not in FIELD_LABELS:
-        raise MeshError(f"unknown field {field!r}; choose one of {', '.join(FIELD_LABELS)}", "--field")
+        raise MeshError(
+            f"unknown field {field!r}; choose one of {', '.join(FIELD_LABELS)}", "--field"
+        )
     mesh = MeshState()
     if not mesh.load(path):
         raise MeshError(mesh.error.split(": ", 1)[-1], path) if path else MeshError(mesh.error)
@@ -107,7 +115,7 @@ def run(
     return 0
 
 
-def _write_png(path: Path, rgba) -> None:  # noqa: ANN001 - (h,w,4) uint8 array
+def _write_png(path: Path, rgba) -> None:
     """Write an RGBA buffer as PNG atomically (matplotlib's encoder, no extra dependency)."""
     import matplotlib
 

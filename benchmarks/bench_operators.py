@@ -15,6 +15,7 @@ libigl's ``principal_curvature`` crashes the process on unreferenced vertices.
 from __future__ import annotations
 
 import argparse
+from functools import partial
 
 import igl
 import numpy as np
@@ -48,8 +49,12 @@ def igl_curvatures(V, F):
 
 
 def ours_operators(V, F):
-    return cotan_stiffness(V, F), mass_matrix(V, F, "voronoi"), mass_matrix(V, F, "barycentric"), \
-        uniform_laplacian(F, len(V))
+    return (
+        cotan_stiffness(V, F),
+        mass_matrix(V, F, "voronoi"),
+        mass_matrix(V, F, "barycentric"),
+        uniform_laplacian(F, len(V)),
+    )
 
 
 def main() -> None:
@@ -68,25 +73,54 @@ def main() -> None:
             t_load_i = float("nan")
         else:
             t_load_i, _ = best_of(lambda p=path: igl.read_triangle_mesh(str(p)), args.repeat)
-        t_ops_o, _ = best_of(lambda: ours_operators(V, F), args.repeat)
-        t_ops_i, _ = best_of(lambda: igl_operators(V, F), args.repeat)
-        t_cur_o, fo = best_of(lambda: curvature_fields(V, F), args.repeat)
-        t_cur_i, fi = best_of(lambda: igl_curvatures(V, F), args.repeat)
-        agree = max(np.abs(fo["cotan"] - fi[1]).max() / (np.abs(fi[1]).max() + 1e-300),
-                    np.abs(fo["gaussian"] - fi[2]).max() / (np.abs(fi[2]).max() + 1e-300))
+        t_ops_o, _ = best_of(partial(ours_operators, V, F), args.repeat)
+        t_ops_i, _ = best_of(partial(igl_operators, V, F), args.repeat)
+        t_cur_o, fo = best_of(partial(curvature_fields, V, F), args.repeat)
+        t_cur_i, fi = best_of(partial(igl_curvatures, V, F), args.repeat)
+        agree = max(
+            np.abs(fo["cotan"] - fi[1]).max() / (np.abs(fi[1]).max() + 1e-300),
+            np.abs(fo["gaussian"] - fi[2]).max() / (np.abs(fi[2]).max() + 1e-300),
+        )
         tot_o = t_load_o + t_ops_o + t_cur_o
         tot_i = (t_load_i if np.isfinite(t_load_i) else t_load_o) + t_ops_i + t_cur_i
-        rows.append([name.removesuffix(".obj"), len(V), t_load_o, t_load_i, t_ops_o, t_ops_i,
-                     t_cur_o, t_cur_i, tot_o, tot_i, f"{tot_o / tot_i:.2f}x", f"{agree:.1e}"])
+        rows.append(
+            [
+                name.removesuffix(".obj"),
+                len(V),
+                t_load_o,
+                t_load_i,
+                t_ops_o,
+                t_ops_i,
+                t_cur_o,
+                t_cur_i,
+                tot_o,
+                tot_i,
+                f"{tot_o / tot_i:.2f}x",
+                f"{agree:.1e}",
+            ]
+        )
         if args.quadric:
-            t_q, _ = best_of(lambda: principal_curvature_quadric(V, F), 1)
+            t_q, _ = best_of(partial(principal_curvature_quadric, V, F), 1)
             print(f"{name}: libigl quadric fit {t_q:.2f} s")
     print_table(
-        ["mesh", "vertices", "load ours", "load igl", "ops ours", "ops igl", "curv ours", "curv igl",
-         "total ours", "total igl", "ratio", "max rel diff"],
+        [
+            "mesh",
+            "vertices",
+            "load ours",
+            "load igl",
+            "ops ours",
+            "ops igl",
+            "curv ours",
+            "curv igl",
+            "total ours",
+            "total igl",
+            "ratio",
+            "max rel diff",
+        ],
         rows,
     )
-    print("(seconds, best of %d; dragon: libigl gets our repaired mesh and our load time)" % args.repeat)
+    note = "dragon: libigl gets our repaired mesh and our load time"
+    print(f"(seconds, best of {args.repeat}; {note})")
 
 
 if __name__ == "__main__":

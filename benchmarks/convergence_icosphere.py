@@ -18,11 +18,22 @@ def main() -> None:
         V, F = primitives.icosphere(s)
         row: list[object] = [s, len(V)]
         for area in ("barycentric", "voronoi"):
-            row += [f"{np.abs(mean_curvature_cotan(V, F, area) - 1).max():.2e}",
-                    f"{np.abs(gaussian_curvature(V, F, area) - 1).max():.2e}"]
+            row += [
+                f"{np.abs(mean_curvature_cotan(V, F, area) - 1).max():.2e}",
+                f"{np.abs(gaussian_curvature(V, F, area) - 1).max():.2e}",
+            ]
         rows.append(row)
-    print_table(["subdivisions", "vertices", "cotan H, barycentric", "K, barycentric",
-                 "cotan H, Voronoi", "K, Voronoi"], rows)
+    print_table(
+        [
+            "subdivisions",
+            "vertices",
+            "cotan H, barycentric",
+            "K, barycentric",
+            "cotan H, Voronoi",
+            "K, Voronoi",
+        ],
+        rows,
+    )
 
 
 if __name__ == "__main__":

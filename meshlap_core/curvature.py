@@ -88,7 +88,10 @@ def vertex_normals(V: FloatArray, F: IntArray) -> FloatArray:
     N = np.zeros_like(V)
     for i in range(3):
         N += np.stack(
-            [np.bincount(F[:, i], weights=fn[:, c] * theta[:, i], minlength=len(V)) for c in range(3)],
+            [
+                np.bincount(F[:, i], weights=fn[:, c] * theta[:, i], minlength=len(V))
+                for c in range(3)
+            ],
             axis=1,
         )
     norm = np.linalg.norm(N, axis=1, keepdims=True)

@@ -89,19 +89,36 @@ def format_info(info: dict[str, Any]) -> str:
         f"faces             {info['n_faces']}",
         f"edges             {info['n_edges']}",
         "bounding box      "
-        + " .. ".join("(" + ", ".join(f"{x:.4g}" for x in b) + ")" for b in (info["bbox_min"], info["bbox_max"])),
+        + " .. ".join(
+            "(" + ", ".join(f"{x:.4g}" for x in b) + ")"
+            for b in (info["bbox_min"], info["bbox_max"])
+        ),
         f"bbox diagonal     {info['bbox_diagonal']:.6g}",
         f"surface area      {info['surface_area']:.6g}",
         f"components        {info['n_components']}",
         f"boundary loops    {info['n_boundary_loops']}"
-        + (f" (lengths {info['boundary_loop_lengths']})" if info.get("boundary_loop_lengths") else ""),
+        + (
+            f" (lengths {info['boundary_loop_lengths']})"
+            if info.get("boundary_loop_lengths")
+            else ""
+        ),
         f"Euler char. χ     {info['euler_characteristic']}",
-        f"genus             {info['genus'] if info['genus'] is not None else 'undefined (' + info.get('genus_note', '') + ')'}",
+        "genus             "
+        + (
+            str(info["genus"])
+            if info["genus"] is not None
+            else f"undefined ({info.get('genus_note')})"
+        ),
         f"manifold          {'yes' if info.get('manifold') else 'no'}"
-        + (f" ({info['n_nonmanifold_edges']} non-manifold edges)" if info["n_nonmanifold_edges"] else ""),
+        + (
+            f" ({info['n_nonmanifold_edges']} non-manifold edges)"
+            if info["n_nonmanifold_edges"]
+            else ""
+        ),
     ]
     if "consistently_oriented" in info:
-        lines.append(f"oriented          {'consistently' if info['consistently_oriented'] else 'INCONSISTENTLY'}")
+        how = "consistently" if info["consistently_oriented"] else "INCONSISTENTLY"
+        lines.append(f"oriented          {how}")
     for r in info.get("repairs", []):
         lines.append(f"repaired          {r}")
     for w in info.get("warnings", []):

@@ -43,7 +43,7 @@ def _grid_faces(nu: int, nv: int, wrap_u: bool, wrap_v: bool) -> IntArray:
 
 
 def grid(nx: int = 10, ny: int = 10, size: float = 1.0) -> tuple[FloatArray, IntArray]:
-    """Flat ``nx × ny`` vertex grid in the ``z = 0`` plane covering ``[0,size]²``, normals ``+z``."""
+    """Flat ``nx × ny`` vertex grid in the plane ``z = 0`` over ``[0,size]²``, normals ``+z``."""
     if nx < 2 or ny < 2:
         raise MeshError("a grid needs at least 2 x 2 vertices", "grid")
     x, y = np.meshgrid(np.linspace(0, size, nx), np.linspace(0, size, ny), indexing="ij")
@@ -65,7 +65,9 @@ def torus(
         indexing="ij",
     )
     u, v = u.ravel(), v.ravel()
-    V = np.stack([(R + r * np.cos(v)) * np.cos(u), (R + r * np.cos(v)) * np.sin(u), r * np.sin(v)], 1)
+    V = np.stack(
+        [(R + r * np.cos(v)) * np.cos(u), (R + r * np.cos(v)) * np.sin(u), r * np.sin(v)], 1
+    )
     return V, _grid_faces(n_major, n_minor, True, True)
 
 
@@ -75,18 +77,36 @@ def cube(subdivisions: int = 0, size: float = 1.0) -> tuple[FloatArray, IntArray
     Subdivision keeps the vertices on the faces, so the corner angle sums and the volume
     (``size³``) are unchanged.
     """
-    V = np.array(
-        [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]],
-        dtype=np.float64,
-    ) * size
+    V = (
+        np.array(
+            [
+                [0, 0, 0],
+                [1, 0, 0],
+                [1, 1, 0],
+                [0, 1, 0],
+                [0, 0, 1],
+                [1, 0, 1],
+                [1, 1, 1],
+                [0, 1, 1],
+            ],
+            dtype=np.float64,
+        )
+        * size
+    )
     F = np.array(
         [
-            [0, 2, 1], [0, 3, 2],  # z = 0 (normal -z)
-            [4, 5, 6], [4, 6, 7],  # z = 1
-            [0, 1, 5], [0, 5, 4],  # y = 0
-            [2, 3, 7], [2, 7, 6],  # y = 1
-            [1, 2, 6], [1, 6, 5],  # x = 1
-            [0, 4, 7], [0, 7, 3],  # x = 0
+            [0, 2, 1],
+            [0, 3, 2],  # z = 0 (normal -z)
+            [4, 5, 6],
+            [4, 6, 7],  # z = 1
+            [0, 1, 5],
+            [0, 5, 4],  # y = 0
+            [2, 3, 7],
+            [2, 7, 6],  # y = 1
+            [1, 2, 6],
+            [1, 6, 5],  # x = 1
+            [0, 4, 7],
+            [0, 7, 3],  # x = 0
         ],
         dtype=np.int64,
     )

@@ -22,7 +22,9 @@ def shared_mesh() -> Callable[[str], Path]:
     def get(name: str) -> Path:
         path = SHARED_MESHES / name
         if not path.is_file():
-            pytest.skip(f"../shared/meshes/{name} not present (real meshes live beside the checkout)")
+            pytest.skip(
+                f"../shared/meshes/{name} not present (real meshes live beside the checkout)"
+            )
         return path
 
     return get

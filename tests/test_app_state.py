@@ -46,4 +46,6 @@ def test_robust_range_ignores_one_spike():
     lo, hi = robust_range(v, signed=True, percentile=1.0)
     assert lo == -hi and hi < 2
     assert robust_range(v, signed=False, percentile=0.0) == (-1.0, 1e6)
-    assert robust_range(np.zeros(5), signed=False)[0] < 0 < robust_range(np.zeros(5), signed=False)[1]
+    assert (
+        robust_range(np.zeros(5), signed=False)[0] < 0 < robust_range(np.zeros(5), signed=False)[1]
+    )

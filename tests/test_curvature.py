@@ -32,8 +32,9 @@ def test_regular_tetrahedron_by_hand():
 
 def test_octahedron_uniform_H_by_hand():
     V = np.array([[1.0, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]])
-    F = np.array([[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4],
-                  [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]])
+    F = np.array(
+        [[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]]
+    )
     # L x = -x and n = x at every vertex: H = -1/2 (-x . x) = 1/2
     np.testing.assert_allclose(curv.mean_curvature_uniform(V, F), 0.5)
 
@@ -44,13 +45,22 @@ def test_single_triangle_boundary_rules():
     d = curv.angle_deficit(V, F, "pi")
     np.testing.assert_allclose(d, [np.pi / 2, 3 * np.pi / 4, 3 * np.pi / 4])
     assert d.sum() == pytest.approx(2 * np.pi)  # a disk: chi = 1
-    np.testing.assert_allclose(curv.angle_deficit(V, F, "2pi"), 2 * np.pi - np.array([np.pi / 2, np.pi / 4, np.pi / 4]))
+    np.testing.assert_allclose(
+        curv.angle_deficit(V, F, "2pi"), 2 * np.pi - np.array([np.pi / 2, np.pi / 4, np.pi / 4])
+    )
     np.testing.assert_allclose(curv.angle_deficit(V, F, "zero"), 0)
 
 
-@pytest.mark.parametrize("make", [lambda: primitives.icosphere(3), primitives.torus,
-                                  lambda: primitives.grid(7, 9), primitives.bumpy_sphere,
-                                  lambda: primitives.cube(2)])
+@pytest.mark.parametrize(
+    "make",
+    [
+        lambda: primitives.icosphere(3),
+        primitives.torus,
+        lambda: primitives.grid(7, 9),
+        primitives.bumpy_sphere,
+        lambda: primitives.cube(2),
+    ],
+)
 def test_gauss_bonnet_with_boundary_term(make):
     V, F = make()
     chi = topology.euler_characteristic(F)
@@ -102,13 +112,17 @@ def test_uniform_H_is_not_scale_invariant():
     H1 = curv.mean_curvature_uniform(V, F)
     H2 = curv.mean_curvature_uniform(2 * V, F)
     np.testing.assert_allclose(H2, 2 * H1)  # length units: grows with the mesh
-    np.testing.assert_allclose(curv.mean_curvature_cotan(2 * V, F), curv.mean_curvature_cotan(V, F) / 2)
+    np.testing.assert_allclose(
+        curv.mean_curvature_cotan(2 * V, F), curv.mean_curvature_cotan(V, F) / 2
+    )
 
 
 def test_agreement_with_libigl():
     V, F = primitives.bumpy_sphere(3)
     np.testing.assert_allclose(curv.corner_angles(V, F), igl.internal_angles(V, F), atol=1e-12)
-    np.testing.assert_allclose(curv.angle_deficit(V, F, "2pi"), igl.gaussian_curvature(V, F), atol=1e-10)
+    np.testing.assert_allclose(
+        curv.angle_deficit(V, F, "2pi"), igl.gaussian_curvature(V, F), atol=1e-10
+    )
     N = igl.per_vertex_normals(V, F, igl.PER_VERTEX_NORMALS_WEIGHTING_TYPE_ANGLE)
     np.testing.assert_allclose(curv.vertex_normals(V, F), N, atol=1e-12)
     # libigl's quadric fit and our cotan estimate agree in sign and roughly in size

@@ -32,16 +32,18 @@ def test_right_triangle_by_hand():
 
 def test_uniform_laplacian_by_hand_on_octahedron():
     V = np.array([[1.0, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]])
-    F = np.array([[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4],
-                  [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]])
+    F = np.array(
+        [[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]]
+    )
     L = lap.uniform_laplacian(F, 6)
     # each vertex has 4 neighbours whose mean is the origin: L x = -x
     np.testing.assert_allclose(L @ V, -V, atol=1e-15)
     np.testing.assert_allclose(lap.adjacency_matrix(F, 6).sum(axis=1).A1, 4)
 
 
-@pytest.mark.parametrize("make", [lambda: primitives.icosphere(2), primitives.torus,
-                                  primitives.grid, random_mesh])
+@pytest.mark.parametrize(
+    "make", [lambda: primitives.icosphere(2), primitives.torus, primitives.grid, random_mesh]
+)
 def test_invariants(make):
     V, F = make()
     n = len(V)

@@ -1,5 +1,7 @@
 """Topology: edges, boundary, components, Euler characteristic, genus, ordered one-rings."""
 
+import itertools
+
 import numpy as np
 import pytest
 
@@ -14,6 +16,11 @@ def face_set(F):
         k = f.index(min(f))
         out.add(tuple(f[k:] + f[:k]))
     return out
+
+
+def consecutive(r, closed):
+    """Consecutive pairs of a list, wrapping around when ``closed``."""
+    return list(itertools.pairwise(r + r[:1] if closed else r))
 
 
 def rot(t):
@@ -62,8 +69,15 @@ def test_two_components_and_isolated_vertex():
     assert topology.genus(F) == 0
 
 
-@pytest.mark.parametrize("make", [lambda: primitives.icosphere(2), primitives.torus,
-                                  lambda: primitives.grid(6, 7), lambda: primitives.cube(1)])
+@pytest.mark.parametrize(
+    "make",
+    [
+        lambda: primitives.icosphere(2),
+        primitives.torus,
+        lambda: primitives.grid(6, 7),
+        lambda: primitives.cube(1),
+    ],
+)
 def test_one_ring_follows_face_orientation(make):
     V, F = make()
     n = len(V)
@@ -79,14 +93,13 @@ def test_one_ring_follows_face_orientation(make):
     for i in range(n):
         r = ring[i].tolist()
         assert len(set(r)) == len(r)
-        pairs = zip(r, r[1:] + r[:1], strict=True) if not bmask[i] else zip(r[:-1], r[1:], strict=True)
-        for a, b in pairs:
+        for a, b in consecutive(r, closed=not bmask[i]):
             assert rot([i, a, b]) in faces
         if bmask[i]:  # an open fan runs from one boundary neighbour to the other
             assert bmask[r[0]] and bmask[r[-1]]
         rr = ring.reversed()[i].tolist()
         assert rr == r[::-1]
-        for a, b in zip(rr, rr[1:] + rr[:1], strict=True) if not bmask[i] else zip(rr[:-1], rr[1:], strict=True):
+        for a, b in consecutive(rr, closed=not bmask[i]):
             assert rot([i, b, a]) in faces
 
 

@@ -40,7 +40,7 @@ def test_panels_run_frames_on_mock(mock_backend, tmp_path):
 
 
 def _egl_available() -> bool:
-    code = ("import polyscope as ps; ps.set_allow_headless_backends(True); ps.init('openGL3_egl')")
+    code = "import polyscope as ps; ps.set_allow_headless_backends(True); ps.init('openGL3_egl')"
     try:
         res = subprocess.run([sys.executable, "-c", code], capture_output=True, timeout=120)
     except subprocess.TimeoutExpired:
@@ -55,7 +55,16 @@ def test_screenshot_shows_a_colour_map(tmp_path):
     import matplotlib.image as mpimg
 
     out = tmp_path / "shot.png"
-    cmd = [sys.executable, "-m", "meshlap_core.cli", "view", "--screenshot", str(out), "--field", "cotan"]
+    cmd = [
+        sys.executable,
+        "-m",
+        "meshlap_core.cli",
+        "view",
+        "--screenshot",
+        str(out),
+        "--field",
+        "cotan",
+    ]
     res = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
     assert res.returncode == 0, res.stderr
     img = mpimg.imread(out)[..., :3]

@@ -22,6 +22,9 @@ COMMANDS: tuple[str, ...] = (
     "curvature",
     "onering",
     "view",
+    "surface",
+    "smooth",
+    "denoise_eval",
 )
 
 
@@ -55,7 +58,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 2
     except (OSError, MemoryError) as exc:
         name = getattr(exc, "filename", None)
-        what = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc) or type(exc).__name__
+        what = (
+            exc.strerror
+            if isinstance(exc, OSError) and exc.strerror
+            else str(exc) or type(exc).__name__
+        )
         sys.stderr.write(f"meshlap: error: {name + ': ' if name else ''}{what}\n")
         return 2
     except KeyboardInterrupt:

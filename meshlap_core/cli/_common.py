@@ -14,11 +14,15 @@ from ..errors import MeshError
 
 
 def parse_list(text: str, kind: type, name: str) -> list[Any]:
-    """Parse ``"5,15,50"`` into ``[5, 15, 50]`` (``kind`` int or float); MeshError names ``name``."""
+    """Parse ``"5,15,50"`` into ``[5, 15, 50]`` (``kind`` int or float).
+
+    A bad list raises :class:`MeshError` naming the argument ``name``.
+    """
     try:
         values = [kind(t) for t in text.split(",") if t.strip()]
     except ValueError:
-        raise MeshError(f"expected a comma-separated list of {kind.__name__}s, got {text!r}", name)
+        msg = f"expected a comma-separated list of {kind.__name__}s, got {text!r}"
+        raise MeshError(msg, name) from None
     if not values:
         raise MeshError("the list is empty", name)
     if kind is float and not all(math.isfinite(v) for v in values):

@@ -18,13 +18,27 @@ OUT_SUFFIXES = (".csv", ".npy", ".ply")
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("curvature", help="per-vertex mean / Gaussian / principal curvature")
     p.add_argument("mesh", help="mesh file (OBJ, OFF, PLY, STL)")
-    p.add_argument("--method", choices=METHODS, default="cotan",
-                   help="uniform H, cotangent H, angle-deficit K, or principal k1/k2 (default cotan)")
-    p.add_argument("--area", choices=AREA_KINDS, default="barycentric",
-                   help="vertex area (default barycentric, as in the course; voronoi converges)")
-    p.add_argument("--boundary", choices=BOUNDARY_RULES, default="pi",
-                   help="angle deficit at boundary vertices: pi - sum (default), 2pi - sum, or zero")
-    p.add_argument("--out", help="write the field: .csv, .npy, or .ply (mesh with a 'quality' property)")
+    p.add_argument(
+        "--method",
+        choices=METHODS,
+        default="cotan",
+        help="uniform H, cotangent H, angle-deficit K, or principal k1/k2 (default cotan)",
+    )
+    p.add_argument(
+        "--area",
+        choices=AREA_KINDS,
+        default="barycentric",
+        help="vertex area (default barycentric, as in the course; voronoi converges)",
+    )
+    p.add_argument(
+        "--boundary",
+        choices=BOUNDARY_RULES,
+        default="pi",
+        help="angle deficit at boundary vertices: pi - sum (default), 2pi - sum, or zero",
+    )
+    p.add_argument(
+        "--out", help="write the field: .csv, .npy, or .ply (mesh with a 'quality' property)"
+    )
     add_json_flag(p)
     p.set_defaults(func=run)
 
@@ -32,7 +46,9 @@ def register(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     out = Path(args.out) if args.out else None
     if out is not None and out.suffix.lower() not in OUT_SUFFIXES:
-        raise MeshError(f"unsupported output type {out.suffix!r}; use {', '.join(OUT_SUFFIXES)}", out)
+        raise MeshError(
+            f"unsupported output type {out.suffix!r}; use {', '.join(OUT_SUFFIXES)}", out
+        )
     mesh = load_mesh(args.mesh)
     for r in mesh.report.repairs:
         print(f"meshlap: {args.mesh}: repaired: {r}", file=sys.stderr)
@@ -44,12 +60,23 @@ def run(args: argparse.Namespace) -> int:
             save_scalars(out, values, overwrite_inputs=(args.mesh,))
     stats = summary_stats(values)
     if args.json:
-        emit_json({"file": str(args.mesh), "method": args.method, "area": args.area,
-                   "boundary": args.boundary, "n_vertices": len(values), **stats,
-                   "repairs": mesh.report.repairs, "out": str(out) if out else None})
+        emit_json(
+            {
+                "file": str(args.mesh),
+                "method": args.method,
+                "area": args.area,
+                "boundary": args.boundary,
+                "n_vertices": len(values),
+                **stats,
+                "repairs": mesh.report.repairs,
+                "out": str(out) if out else None,
+            }
+        )
     else:
-        print(f"{args.method} curvature ({args.area} area, boundary rule {args.boundary}) "
-              f"on {len(values)} vertices")
+        print(
+            f"{args.method} curvature ({args.area} area, boundary rule {args.boundary}) "
+            f"on {len(values)} vertices"
+        )
         for k, v in stats.items():
             print(f"  {k:<7}{v: .6g}")
         if out is not None:

@@ -10,7 +10,9 @@ from ._common import add_json_flag, emit_json
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("info", help="counts, bounding box, boundary, components, chi, genus, repairs")
+    p = sub.add_parser(
+        "info", help="counts, bounding box, boundary, components, chi, genus, repairs"
+    )
     p.add_argument("mesh", help="mesh file (OBJ, OFF, PLY, STL)")
     add_json_flag(p)
     p.set_defaults(func=run)

@@ -13,7 +13,9 @@ from ._common import add_json_flag, emit_json
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("onering", help="ordered neighbours of a vertex (counter-clockwise)")
     p.add_argument("mesh", help="mesh file (OBJ, OFF, PLY, STL)")
-    p.add_argument("--vertex", type=int, required=True, help="vertex index (0-based, after repairs)")
+    p.add_argument(
+        "--vertex", type=int, required=True, help="vertex index (0-based, after repairs)"
+    )
     p.add_argument("--reverse", action="store_true", help="clockwise instead of counter-clockwise")
     add_json_flag(p)
     p.set_defaults(func=run)
@@ -23,8 +25,10 @@ def run(args: argparse.Namespace) -> int:
     mesh = load_mesh(args.mesh)
     n = mesh.n_vertices
     if not 0 <= args.vertex < n:
-        raise MeshError(f"vertex {args.vertex} is out of range (the mesh has {n} vertices: 0..{n - 1})",
-                        "--vertex")
+        raise MeshError(
+            f"vertex {args.vertex} is out of range (the mesh has {n} vertices: 0..{n - 1})",
+            "--vertex",
+        )
     ring = one_ring(mesh.F, n)
     if args.reverse:
         ring = ring.reversed()
@@ -44,8 +48,10 @@ def run(args: argparse.Namespace) -> int:
         kind = "boundary (open fan)" if result["boundary"] else "interior (closed cycle)"
         print(f"vertex {i}: {kind}, valence {len(nbrs)}, {result['order']}")
         if not result["ordered"]:
-            print("  neighbourhood is not a disk (non-manifold or inconsistently oriented): "
-                  "neighbours listed by index, not in order")
+            print(
+                "  neighbourhood is not a disk (non-manifold or inconsistently oriented): "
+                "neighbours listed by index, not in order"
+            )
         for k, j in enumerate(nbrs):
             print(f"  {k:>3}  {j}")
     return 0

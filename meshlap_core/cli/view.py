@@ -10,8 +10,11 @@ FIELDS = ("uniform", "cotan", "gaussian", "k1", "k2", "difference")
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("view", help="open the polyscope viewer (default: the bundled mesh)")
     p.add_argument("mesh", nargs="?", help="mesh file (default: assets/bumpy.obj)")
-    p.add_argument("--screenshot", metavar="OUT.png",
-                   help="render one frame headless (EGL) into OUT.png and exit")
+    p.add_argument(
+        "--screenshot",
+        metavar="OUT.png",
+        help="render one frame headless (EGL) into OUT.png and exit",
+    )
     p.add_argument("--field", choices=FIELDS, default="cotan", help="curvature field shown first")
     p.set_defaults(func=run)
 
