@@ -16,6 +16,45 @@ from .errors import MeshError
 from .types import BoolArray, IntArray, as_faces
 
 
+def _edge_count_matrix(F: IntArray, n: int) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+    """Directed half-edge counts ``D`` (``D_ab`` = faces with the half-edge ``a→b``) and the
+    symmetric undirected counts ``U = D + Dᵀ`` (faces per edge), both ``(n,n)`` CSR.
+
+    Summing duplicates while converting COO to CSR is linear in the number of corners, far
+    cheaper than sorting the edge list.
+    """
+    a = F.ravel()
+    b = F[:, [1, 2, 0]].ravel()
+    D = sp.coo_matrix((np.ones(len(a), dtype=np.int64), (a, b)), shape=(n, n)).tocsr()
+    D.sum_duplicates()
+    U = (D + D.T).tocsr()
+    U.sort_indices()
+    return D, U
+
+
+def _n_of(F: IntArray) -> int:
+    return int(F.max()) + 1 if F.size else 0
+
+
+def edge_face_counts(F: IntArray) -> tuple[IntArray, IntArray]:
+    """Unique undirected edges and how many faces share each.
+
+    Returns
+    -------
+    E : (e,2) int
+        Edges with ``i < j``, sorted lexicographically.
+    count : (e,) int
+        1 on a boundary edge, 2 on an interior manifold edge, more on a non-manifold edge.
+    """
+    F = as_faces(F)
+    _, U = _edge_count_matrix(F, _n_of(F))
+    T = sp.triu(U, k=1, format="csr")
+    T.sort_indices()
+    rows = np.repeat(np.arange(T.shape[0], dtype=np.int64), np.diff(T.indptr))
+    E = np.stack([rows, T.indices.astype(np.int64)], axis=1)
+    return E, T.data.astype(np.int64)
+
+
 def edges(F: IntArray) -> IntArray:
     """Unique undirected edges, each as ``(i, j)`` with ``i < j``, sorted lexicographically.
 
@@ -27,27 +66,7 @@ def edges(F: IntArray) -> IntArray:
     -------
     E : (e,2) int
     """
-    F = as_faces(F)
-    E = np.sort(np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]]), axis=1)
-    return np.unique(E, axis=0) if len(E) else E.reshape(0, 2)
-
-
-def edge_face_counts(F: IntArray) -> tuple[IntArray, IntArray]:
-    """Unique undirected edges and how many faces share each.
-
-    Returns
-    -------
-    E : (e,2) int
-        Edges with ``i < j``.
-    count : (e,) int
-        1 on a boundary edge, 2 on an interior manifold edge, more on a non-manifold edge.
-    """
-    F = as_faces(F)
-    E = np.sort(np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]]), axis=1)
-    if len(E) == 0:
-        return E.reshape(0, 2), np.zeros(0, dtype=np.int64)
-    U, count = np.unique(E, axis=0, return_counts=True)
-    return U, count.astype(np.int64)
+    return edge_face_counts(F)[0]
 
 
 def boundary_edges(F: IntArray) -> IntArray:
@@ -58,17 +77,17 @@ def boundary_edges(F: IntArray) -> IntArray:
     Returns
     -------
     B : (b,2) int
+        Sorted by ``a``.
     """
     F = as_faces(F)
-    H = np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]])
-    if len(H) == 0:
-        return H.reshape(0, 2)
-    _, inv, count = np.unique(np.sort(H, axis=1), axis=0, return_inverse=True, return_counts=True)
-    return H[count[inv.ravel()] == 1]
+    D, U = _edge_count_matrix(F, _n_of(F))
+    B = D.multiply(U == 1).tocoo()
+    order = np.lexsort((B.col, B.row))
+    return np.stack([B.row[order], B.col[order]], axis=1).astype(np.int64)
 
 
 def boundary_vertex_mask(F: IntArray, n: int) -> BoolArray:
-    """``True`` for vertices on a boundary edge.
+    """``True`` for vertices on a boundary edge (an edge used by exactly one face).
 
     Parameters
     ----------
@@ -80,8 +99,11 @@ def boundary_vertex_mask(F: IntArray, n: int) -> BoolArray:
     -------
     mask : (n,) bool
     """
+    F = as_faces(F, n)
+    _, U = _edge_count_matrix(F, n)
+    rows = np.repeat(np.arange(n), np.diff(U.indptr))
     mask = np.zeros(n, dtype=bool)
-    mask[boundary_edges(as_faces(F, n)).ravel()] = True
+    mask[rows[U.data == 1]] = True
     return mask
 
 
