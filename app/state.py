@@ -35,6 +35,17 @@ FIELD_LABELS: dict[str, tuple[str, bool]] = {
 }
 
 
+SHARED_MESHES = Path(__file__).resolve().parents[1].parent / "shared" / "meshes"
+
+
+def list_meshes() -> list[tuple[str, Path]]:
+    """Bundled assets and, when present, the meshes of ``../shared/meshes`` (label, path)."""
+    out = [(f"assets/{p.name}", p) for p in sorted(ASSETS_DIR.glob("*.obj"))]
+    if SHARED_MESHES.is_dir():
+        out += [(f"shared/{p.name}", p) for p in sorted(SHARED_MESHES.glob("*.obj"))]
+    return out
+
+
 def default_mesh_path() -> Path | None:
     """The bundled default mesh, or ``None`` when ``assets/`` is not beside the package."""
     path = ASSETS_DIR / DEFAULT_ASSET
@@ -156,8 +167,10 @@ class OneRingState:
     ordered: bool = True
     H: float = float("nan")
     K: float = float("nan")
+    normal: FloatArray = field(default_factory=lambda: np.zeros(3))
     _ring_key: int = -1
     _ring: Any = None
+    _normals: Any = None
     polyline: FloatArray = field(default_factory=lambda: np.zeros((0, 3)))
     edges: IntArray = field(default_factory=lambda: np.zeros((0, 2), dtype=np.int64))
     arrows: FloatArray = field(default_factory=lambda: np.zeros((0, 3)))
@@ -174,8 +187,12 @@ class OneRingState:
         from meshlap_core.topology import one_ring  # local: keeps app.state import light
 
         if self._ring_key != mesh.version:
+            from meshlap_core.curvature import vertex_normals
+
             self._ring = one_ring(mesh.F, len(mesh.V))
+            self._normals = vertex_normals(mesh.V, mesh.F)
             self._ring_key = mesh.version
+        self.normal = self._normals[vertex]
         ring = self._ring.reversed() if self.reverse else self._ring
         nb = ring[vertex]
         self.vertex = int(vertex)
@@ -191,8 +208,8 @@ class OneRingState:
         nxt = np.arange(1, k + 1) % k if closed else np.minimum(np.arange(1, k + 1), k - 1)
         self.edges = np.stack([np.arange(k), nxt], axis=1)[: k if closed else max(k - 1, 0)]
         step = self.polyline[nxt] - self.polyline
-        if not closed and k > 1:
-            step[-1] = self.polyline[-1] - self.polyline[-2]
+        if not closed:
+            step[-1] = 0.0  # an open fan ends at its last neighbour
         self.arrows = step
         self.order_t = np.linspace(0.0, 1.0, k) if k > 1 else np.zeros(k)
         return True

@@ -1,8 +1,8 @@
 """The polyscope layer: frames on the openGL_mock backend, real pixels with EGL (subprocess)."""
 
+import os
 import subprocess
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -11,32 +11,88 @@ ps = pytest.importorskip("polyscope")
 
 
 @pytest.fixture(scope="module")
-def mock_backend():
+def mock_backend(tmp_path_factory):
+    # polyscope writes .polyscope.ini / imgui.ini into the working directory
+    old = os.getcwd()
+    os.chdir(tmp_path_factory.mktemp("polyscope"))
     ps.set_allow_headless_backends(True)
     ps.init("openGL_mock")
     yield ps
     ps.remove_all_structures()
+    os.chdir(old)
 
 
-def test_panels_run_frames_on_mock(mock_backend, tmp_path):
+def test_every_panel_runs_frames_on_mock(mock_backend, tmp_path):
     from app.state import CurvatureState, MeshState
-    from app.viewer import Viewer, push_mesh
+    from app.viewer import PANELS, Viewer, install_extras
 
-    mesh, curv = MeshState(), CurvatureState()
+    mesh = MeshState()
     assert mesh.load(None)
-    push_mesh(mesh, curv)
-    viewer = Viewer(mesh, curv)
+    viewer = Viewer(mesh, CurvatureState())
+    install_extras(viewer)
+    viewer.sync_mesh()
     ps.set_user_callback(viewer.callback)
-    for _ in range(3):
-        ps.frame_tick()
-    sm = ps.get_surface_mesh("mesh")
-    assert sm.n_vertices() == len(mesh.V)
-    # a bad path typed into the panel keeps the mesh and shows the error
-    viewer.path_text = str(tmp_path / "nope.obj")
-    assert not mesh.load(Path(viewer.path_text)) and "nope.obj" in mesh.error
-    ps.frame_tick()
+    for panel in PANELS:
+        viewer.panel = panel
+        viewer.show_panel()
+        for _ in range(3):
+            ps.frame_tick()
     assert ps.get_surface_mesh("mesh").n_vertices() == len(mesh.V)
+    # the one-ring panel draws the ring of a selected vertex, numbered in order
+    viewer.panel = "onering"
+    assert viewer.select_vertex(7)
+    ps.frame_tick()
+    assert ps.has_curve_network("one-ring order")
+    assert viewer.ring.valence == len(viewer.ring.neighbors) > 2
+    # side-by-side curvature registers a second copy of the mesh
+    viewer.panel, viewer.side_by_side = "curvature", True
+    viewer.push_curvature()
+    ps.frame_tick()
+    assert ps.has_surface_mesh("mesh (second estimator)")
+    # the surfaces panel moves its point with (u, v)
+    viewer.panel = "surfaces"
+    viewer.show_panel()
+    assert viewer.surf.set_uv(0.5, 1.0)
+    viewer.push_surface_point()
+    ps.frame_tick()
+    assert ps.has_point_cloud("surface point")
     ps.clear_user_callback()
+
+
+def test_bad_file_in_mesh_panel_keeps_mesh(mock_backend, tmp_path):
+    from app.state import CurvatureState, MeshState
+    from app.viewer import Viewer
+
+    mesh = MeshState()
+    assert mesh.load(None)
+    viewer = Viewer(mesh, CurvatureState())
+    viewer.sync_mesh()
+    n = ps.get_surface_mesh("mesh").n_vertices()
+    bad = tmp_path / "broken.off"
+    bad.write_text("OFF\n10 5 0\n0 0 0\n")
+    assert not viewer.open(bad)
+    assert "broken.off" in mesh.error
+    ps.set_user_callback(viewer.callback)
+    ps.frame_tick()  # the panel shows the error; nothing crashes
+    assert ps.get_surface_mesh("mesh").n_vertices() == n
+    ps.clear_user_callback()
+
+
+def test_export_writes_mesh_and_field(mock_backend, tmp_path):
+    from app.state import CurvatureState, MeshState
+    from app.viewer import Viewer
+    from meshlap_core.io import load_mesh
+
+    mesh = MeshState()
+    assert mesh.load(None)
+    viewer = Viewer(mesh, CurvatureState(field_name="gaussian"))
+    viewer.sync_mesh()
+    msg = viewer.export(tmp_path)
+    assert "wrote" in msg
+    back = load_mesh(tmp_path / "bumpy_gaussian.ply")
+    assert back.n_vertices == len(mesh.V)
+    values = np.loadtxt(tmp_path / "bumpy_gaussian.csv", skiprows=1)
+    np.testing.assert_allclose(values, viewer.curv.fields["gaussian"], rtol=1e-9)
 
 
 def _egl_available() -> bool:
@@ -65,7 +121,7 @@ def test_screenshot_shows_a_colour_map(tmp_path):
         "--field",
         "cotan",
     ]
-    res = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
+    res = subprocess.run(cmd, capture_output=True, text=True, timeout=300, cwd=tmp_path)
     assert res.returncode == 0, res.stderr
     img = mpimg.imread(out)[..., :3]
     bg = img[0, 0]
@@ -73,3 +129,56 @@ def test_screenshot_shows_a_colour_map(tmp_path):
     assert len(fg) > 0.05 * img.shape[0] * img.shape[1]  # the mesh covers part of the frame
     # a diverging colour map: both reddish and bluish pixels on the mesh
     assert np.sum(fg[:, 0] > fg[:, 2] + 0.15) > 100 and np.sum(fg[:, 2] > fg[:, 0] + 0.15) > 100
+
+
+PICK_SCRIPT = """
+import json, sys
+import numpy as np
+import polyscope as ps
+from app.camera import project_to_screen
+from app.state import CurvatureState, MeshState
+from app.viewer import Viewer, _init
+
+mesh = MeshState(); mesh.load(None)
+_init("openGL3_egl")
+viewer = Viewer(mesh, CurvatureState(), panel="onering")
+viewer.sync_mesh()
+ps.set_user_callback(viewer.callback)
+ps.reset_camera_to_home_view()
+ps.frame_tick()
+target = int(sys.argv[1])
+params = ps.get_view_camera_parameters()
+w, h = ps.get_window_size()
+xy, front = project_to_screen(mesh.V[[target]], params.get_view_mat(),
+                              params.get_fov_vertical_deg(), w, h)
+hit = viewer.pick_at((float(xy[0, 0]), float(xy[0, 1])))
+print(json.dumps({"hit": hit, "vertex": viewer.ring.vertex, "front": bool(front[0]),
+                  "dist": float(np.linalg.norm(mesh.V[viewer.ring.vertex] - mesh.V[target]))}))
+"""
+
+
+@pytest.mark.egl
+def test_picking_a_projected_vertex_selects_its_one_ring(tmp_path):
+    if not _egl_available():
+        pytest.skip("polyscope's EGL backend cannot start on this machine (no EGL/Mesa)")
+    import json
+
+    from app.state import MeshState
+    from meshlap_core.curvature import vertex_normals
+
+    mesh = MeshState()
+    mesh.load(None)
+    # a vertex facing the default camera (which looks along +y from the front)
+    N = vertex_normals(mesh.V, mesh.F)
+    target = int(np.argmin(N[:, 1] + 0.2 * np.abs(mesh.V[:, 2]) + 0.2 * np.abs(mesh.V[:, 0])))
+    res = subprocess.run(
+        [sys.executable, "-c", PICK_SCRIPT, str(target)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        cwd=tmp_path,
+    )
+    assert res.returncode == 0, res.stderr
+    out = json.loads(res.stdout.strip().splitlines()[-1])
+    assert out["front"] and out["hit"]
+    assert out["vertex"] == target

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 
 FIELDS = ("uniform", "cotan", "gaussian", "k1", "k2", "difference")
+PANELS = ("curvature", "onering", "spectral", "smoothing", "surfaces")
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -16,10 +17,20 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="render one frame headless (EGL) into OUT.png and exit",
     )
     p.add_argument("--field", choices=FIELDS, default="cotan", help="curvature field shown first")
+    p.add_argument("--panel", choices=PANELS, default="curvature", help="panel shown first")
+    p.add_argument("--vertex", type=int, help="one-ring panel: the selected vertex")
+    p.add_argument("--k", type=int, help="spectral panel: reconstruct from k eigenvectors")
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
     from app.viewer import run as run_viewer  # the core CLI imports the GUI only here
 
-    return run_viewer(args.mesh, screenshot=args.screenshot, field=args.field)
+    return run_viewer(
+        args.mesh,
+        screenshot=args.screenshot,
+        field=args.field,
+        panel=args.panel,
+        vertex=args.vertex,
+        k=args.k,
+    )

@@ -1,0 +1,171 @@
+"""``meshlap surface NAME``: the differential geometry of a parametric surface.
+
+At one point (``--u U --v V``): fundamental forms, curvatures, principal directions and the
+point's class; ``--plot kn.png`` draws the normal curvature ``κₙ(θ)``; ``--mesh out.obj --res N``
+triangulates the surface; ``--convergence`` measures the discrete estimators against the exact
+curvature under refinement.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import MeshError
+from ..surfaces import (
+    SURFACES,
+    check_uv,
+    convergence_study,
+    get_surface,
+    mesh_surface,
+    plot_normal_curvature,
+    point_geometry,
+)
+from ._common import add_json_flag, emit_json, parse_list
+
+DEFAULT_RES = {"grid": "8,16,32,64,128", "icosphere": "1,2,3,4,5"}
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "surface",
+        help="fundamental forms, curvature and meshes of a parametric surface",
+        description="Exact differential geometry of a parametric surface p(u,v) at one point, "
+        "its normal-curvature plot, a mesh of it, or the convergence of the discrete curvature "
+        "estimators on its meshes.",
+    )
+    p.add_argument("name", nargs="?", default="helicoid",
+                   help=f"surface: {', '.join(SURFACES)} (default helicoid)")
+    p.add_argument("--u", type=float, help="parameter u (default: the surface's default point)")
+    p.add_argument("--v", type=float, help="parameter v (default: the surface's default point)")
+    p.add_argument("--param", action="append", default=[], metavar="KEY=VALUE",
+                   help="shape parameter, e.g. --param R=2 --param r=0.5 (repeatable)")
+    p.add_argument("--plot", metavar="PNG", help="save a plot of the normal curvature κn(θ)")
+    p.add_argument("--mesh", metavar="OUT", help="write a triangle mesh of the surface")
+    p.add_argument("--res", help="--mesh: cells per direction N or NU,NV (default 32); "
+                   f"--convergence: list of levels (default {DEFAULT_RES['grid']}, "
+                   f"icosphere {DEFAULT_RES['icosphere']})")
+    p.add_argument("--convergence", action="store_true",
+                   help="table of discrete-vs-exact curvature errors and observed orders")
+    p.add_argument("--mesher", choices=("grid", "icosphere"), default="grid",
+                   help="--convergence meshes: the (u,v) grid (default) or icospheres "
+                   "(sphere only)")
+    p.add_argument("--exclude-poles", action="store_true",
+                   help="--convergence: leave the pole vertices of a grid mesh out")
+    p.add_argument("--list", action="store_true", help="list the surfaces and exit")
+    add_json_flag(p)
+    p.set_defaults(func=run)
+
+
+def _params(items: list[str]) -> dict[str, float]:
+    out: dict[str, float] = {}
+    for item in items:
+        key, sep, val = item.partition("=")
+        try:
+            if not sep or not key.strip():
+                raise ValueError
+            out[key.strip()] = float(val)
+        except ValueError:
+            raise MeshError(f"expected KEY=NUMBER, got {item!r}", "--param") from None
+    return out
+
+
+def _vec(x: Any) -> str:
+    return "(" + ", ".join(f"{c + 0.0:.6g}" for c in np.asarray(x).ravel()) + ")"
+
+
+def _run_list(args: argparse.Namespace) -> int:
+    rows = []
+    for name in SURFACES:
+        s = get_surface(name)
+        rows.append({"name": name, "domain": list(s.domain), "closed_u": s.closed_u,
+                     "closed_v": s.closed_v, "poles": list(s.poles), "params": dict(s.params),
+                     "exact_derivatives": s.derivatives is not None,
+                     "description": s.description})
+    if args.json:
+        emit_json({"surfaces": rows})
+    else:
+        for r in rows:
+            params = ", ".join(f"{k}={v:g}" for k, v in r["params"].items())
+            print(f"{r['name']:<14} {r['description']} [{params}]")
+    return 0
+
+
+def _run_convergence(args: argparse.Namespace, surface: Any) -> int:
+    for flag, val in (("--mesh", args.mesh), ("--plot", args.plot), ("--u", args.u),
+                      ("--v", args.v)):
+        if val is not None:
+            raise MeshError("cannot be combined with --convergence", flag)
+    levels = parse_list(args.res or DEFAULT_RES[args.mesher], int, "--res")
+    study = convergence_study(
+        surface, levels, mesher=args.mesher, exclude_poles=args.exclude_poles,
+        progress=lambda line: print(f"meshlap: {line}", file=sys.stderr, flush=True),
+    )
+    if args.json:
+        emit_json({"params": dict(surface.params), **study.to_dict()})
+    else:
+        print(study.table())
+    return 0
+
+
+def run(args: argparse.Namespace) -> int:
+    if args.list:
+        return _run_list(args)
+    surface = get_surface(args.name, **_params(args.param))
+    if args.convergence:
+        return _run_convergence(args, surface)
+    if args.mesher != "grid" or args.exclude_poles:
+        raise MeshError("only applies with --convergence", "--mesher/--exclude-poles")
+    if args.res is not None and args.mesh is None:
+        raise MeshError("needs --mesh or --convergence", "--res")
+    u = surface.default_uv[0] if args.u is None else args.u
+    v = surface.default_uv[1] if args.v is None else args.v
+    check_uv(surface, u, v, names=("--u", "--v"))
+
+    plot = Path(args.plot) if args.plot else None
+    if plot is not None:
+        geo = plot_normal_curvature(surface, u, v, plot)
+    else:
+        geo = point_geometry(surface, u, v)
+
+    mesh_info = None
+    if args.mesh is not None:
+        from ..io import save_mesh
+
+        res = parse_list(args.res or "32", int, "--res")
+        if len(res) > 2:
+            raise MeshError(f"expected N or NU,NV, got {args.res!r}", "--res")
+        m = mesh_surface(surface, res[0] if len(res) == 1 else (res[0], res[1]))
+        save_mesh(Path(args.mesh), m.V, m.F)
+        mesh_info = {"path": str(args.mesh), "res": list(m.res), "n_vertices": len(m.V),
+                     "n_faces": len(m.F), "n_boundary_vertices": int(m.boundary.sum()),
+                     "n_pole_vertices": int(m.pole.sum())}
+
+    if args.json:
+        emit_json({**geo.to_dict(), "params": dict(surface.params),
+                   "plot": str(plot) if plot else None, "mesh": mesh_info})
+        return 0
+    params = ", ".join(f"{k}={x:g}" for k, x in surface.params.items())
+    print(f"{geo.surface} [{params}] at (u, v) = ({geo.u:.6g}, {geo.v:.6g})")
+    print(f"  p    = {_vec(geo.p)}")
+    print(f"  p_u  = {_vec(geo.p_u)}    p_v  = {_vec(geo.p_v)}")
+    print(f"  p_uu = {_vec(geo.p_uu)}    p_uv = {_vec(geo.p_uv)}    p_vv = {_vec(geo.p_vv)}")
+    print(f"  n    = {_vec(geo.n)}  (p_u x p_v normalized)")
+    print(f"  first form   E = {geo.E:.6g}   F = {geo.F:.6g}   G = {geo.G:.6g}")
+    print(f"  second form  e = {geo.e:.6g}   f = {geo.f:.6g}   g = {geo.g:.6g}")
+    print(f"  K = {geo.K:.6g}   H = {geo.H:.6g}   ({geo.classification})")
+    for k, t, d_uv, d3, what in ((geo.k1, geo.theta_max, geo.dir1_uv, geo.dir1, "max"),
+                                 (geo.k2, geo.theta_min, geo.dir2_uv, geo.dir2, "min")):
+        name = "k1" if what == "max" else "k2"
+        print(f"  {name} = {k:.6g}: κn is {what} at θ = {t:.6g} (and θ + π); "
+              f"direction (u,v) {_vec(d_uv)}, 3-D {_vec(d3)}")
+    if plot is not None:
+        print(f"wrote {plot}")
+    if mesh_info is not None:
+        print(f"wrote {args.mesh}: {mesh_info['n_vertices']} vertices, "
+              f"{mesh_info['n_faces']} faces")
+    return 0

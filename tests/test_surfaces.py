@@ -1,0 +1,498 @@
+"""Parametric surfaces: exact forms and curvature, numeric derivatives, meshing, convergence.
+
+Tier 1: closed-form values (helicoid, sphere, torus, cylinder, saddles, catenoid) worked out by
+hand from p(u, v). Tier 2: invariants (Euler's theorem, extremes of κₙ, k1 + k2 = 2H,
+watertight welded meshes). Tier 3: independent references (exact vs numeric derivatives,
+primitives.torus, the core's discrete estimators converging to the analytic values).
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from scipy.optimize import minimize_scalar
+
+from meshlap_core import primitives, surfaces
+from meshlap_core.curvature import vertex_normals
+from meshlap_core.errors import MeshError
+from meshlap_core.io import load_mesh
+from meshlap_core.surfaces import (
+    ParametricSurface,
+    convergence_study,
+    curvature_fields,
+    get_surface,
+    mesh_surface,
+    normal_curvature,
+    normal_curvature_curve,
+    point_geometry,
+    surface_derivatives,
+)
+from meshlap_core.topology import boundary_loops, edge_face_counts, euler_characteristic
+
+NUMERIC = ("complex-step", "central")
+
+
+def _random_uv(s: ParametricSurface, n: int, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """Random parameters well inside the domain (away from poles)."""
+    rng = np.random.default_rng(seed)
+    u0, u1, v0, v1 = s.domain
+    return (rng.uniform(u0 + 0.05 * (u1 - u0), u1 - 0.05 * (u1 - u0), n),
+            rng.uniform(v0 + 0.05 * (v1 - v0), v1 - 0.05 * (v1 - v0), n))
+
+
+# ------------------------------------------------------------------------------------------
+# tier 1: exact values
+# ------------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("method", ["exact", *NUMERIC])
+@pytest.mark.parametrize("u, v", [(0.0, 0.0), (0.5, 1.0), (1.0, 4.0), (0.25, 2 * np.pi)])
+def test_helicoid_exact_values(u: float, v: float, method: str) -> None:
+    g = point_geometry("helicoid", u, v, method=method)
+    w = 1 + u * u
+    assert g.E == pytest.approx(1, abs=1e-10)
+    assert g.F == pytest.approx(0, abs=1e-10)
+    assert g.G == pytest.approx(w, abs=1e-10)
+    assert g.e == pytest.approx(0, abs=1e-9)
+    assert g.g == pytest.approx(0, abs=1e-9)
+    assert g.f == pytest.approx(-1 / np.sqrt(w), abs=1e-9)
+    assert g.K == pytest.approx(-1 / w**2, abs=1e-9)
+    assert g.H == pytest.approx(0, abs=1e-9)
+    assert g.k1 == pytest.approx(1 / w, abs=1e-9)
+    assert g.k2 == pytest.approx(-1 / w, abs=1e-9)
+    assert g.classification == "hyperbolic"
+    # n = (p_u x p_v)/|.| = (sin v, -cos v, u)/sqrt(1+u²)
+    np.testing.assert_allclose(g.n, np.array([np.sin(v), -np.cos(v), u]) / np.sqrt(w), atol=1e-12)
+
+
+def test_helicoid_origin_normal_curvature_is_minus_sin_2theta() -> None:
+    theta, kn = normal_curvature_curve("helicoid", 0.0, 0.0)
+    assert theta.shape == kn.shape == (361,)
+    assert theta[0] == 0 and theta[-1] == pytest.approx(2 * np.pi)
+    np.testing.assert_allclose(kn, -np.sin(2 * theta), atol=1e-12)
+    g = point_geometry("helicoid", 0.0, 0.0)
+    assert g.theta_max == pytest.approx(3 * np.pi / 4)  # -sin 2θ = +1
+    assert g.theta_min == pytest.approx(np.pi / 4)  # -sin 2θ = -1
+
+
+@pytest.mark.parametrize("r", [0.5, 1.0, 2.0])
+def test_sphere_is_umbilic_with_K_one_over_r2(r: float) -> None:
+    s = get_surface("sphere", r=r)
+    for u, v in [(0.3, 0.1), (np.pi / 2, 3.0), (2.9, 6.0)]:
+        g = point_geometry(s, u, v)
+        assert g.K == pytest.approx(1 / r**2, rel=1e-12)
+        # n points outwards, the surface bends away from it: κ = -1/r (do Carmo's sign)
+        assert g.k1 == pytest.approx(-1 / r, rel=1e-12)
+        assert g.k2 == pytest.approx(-1 / r, rel=1e-12)
+        assert g.H == pytest.approx(-1 / r, rel=1e-12)
+        np.testing.assert_allclose(g.n, g.p / r, atol=1e-12)
+        assert g.classification == "umbilic"
+        _, kn = normal_curvature_curve(s, u, v, 50)
+        np.testing.assert_allclose(kn, -1 / r, rtol=1e-12)
+
+
+def test_torus_sign_of_K_inside_and_outside() -> None:
+    R, r = 3.0, 1.0
+    s = get_surface("torus", R=R, r=r)
+    outside = point_geometry(s, 0.7, 0.0)
+    inside = point_geometry(s, 0.7, np.pi)
+    top = point_geometry(s, 0.7, np.pi / 2)
+    assert outside.K == pytest.approx(1 / (r * (R + r)), rel=1e-12)
+    assert inside.K == pytest.approx(-1 / (r * (R - r)), rel=1e-12)
+    assert outside.classification == "elliptic"
+    assert inside.classification == "hyperbolic"
+    assert top.K == pytest.approx(0, abs=1e-12)
+    assert top.classification == "parabolic"
+    u, v = _random_uv(s, 200)
+    cf = curvature_fields(s, u, v)
+    np.testing.assert_allclose(cf.K, np.cos(v) / (r * (R + r * np.cos(v))), atol=1e-12)
+    # the normal points outwards, away from the tube's core circle
+    core = np.stack([R * np.cos(u), R * np.sin(u), np.zeros_like(u)], axis=1)
+    assert np.all(np.sum(cf.n * (s(u, v) - core), axis=1) > 0)
+
+
+@pytest.mark.parametrize("r", [0.5, 2.0])
+def test_cylinder_is_parabolic(r: float) -> None:
+    g = point_geometry(get_surface("cylinder", r=r), 1.1, 0.4)
+    assert g.K == pytest.approx(0, abs=1e-12)
+    assert g.k1 == pytest.approx(0, abs=1e-12)
+    assert g.k2 == pytest.approx(-1 / r, rel=1e-12)
+    assert g.classification == "parabolic"
+    np.testing.assert_allclose(np.abs(g.dir1), [0, 0, 1], atol=1e-12)  # flat along the axis
+    assert abs(g.dir2[2]) < 1e-12  # curved around it
+
+
+def test_saddles_at_the_origin() -> None:
+    g = point_geometry("saddle", 0.0, 0.0)  # z = u² - v²: e = 2, g = -2
+    assert (g.e, g.f, g.g) == pytest.approx((2, 0, -2), abs=1e-12)
+    assert (g.k1, g.k2, g.K, g.H) == pytest.approx((2, -2, -4, 0), abs=1e-12)
+    np.testing.assert_allclose(np.abs(g.dir1), [1, 0, 0], atol=1e-12)
+    np.testing.assert_allclose(np.abs(g.dir2), [0, 1, 0], atol=1e-12)
+    m = point_geometry("monkey_saddle", 0.0, 0.0)
+    assert (m.e, m.f, m.g) == pytest.approx((0, 0, 0), abs=1e-12)
+    assert m.classification == "planar"
+    assert point_geometry("monkey_saddle", 0.5, 0.2).classification == "hyperbolic"
+
+
+def test_catenoid_numeric_derivatives_give_the_minimal_surface() -> None:
+    c = 1.5
+    s = get_surface("catenoid", c=c)
+    assert s.derivatives is None  # exercises the numeric path
+    u, v = _random_uv(s, 100)
+    cf = curvature_fields(s, u, v)
+    np.testing.assert_allclose(cf.H, 0, atol=1e-9)
+    np.testing.assert_allclose(cf.K, -1 / (c**2 * np.cosh(v / c) ** 4), atol=1e-9)
+
+
+# ------------------------------------------------------------------------------------------
+# tier 2: invariants
+# ------------------------------------------------------------------------------------------
+
+POINTS = [
+    ("helicoid", 0.6, 2.0),
+    ("torus", 0.3, 2.5),
+    ("torus", 1.0, 0.4),
+    ("catenoid", 1.0, 0.5),
+    ("saddle", 0.3, -0.4),
+    ("monkey_saddle", 0.4, 0.7),
+    ("cylinder", 2.0, 1.0),
+]
+
+
+@pytest.mark.parametrize("name, u, v", POINTS)
+def test_euler_theorem(name: str, u: float, v: float) -> None:
+    """κₙ(θ) = κ₁cos²φ + κ₂sin²φ, φ the metric angle from the first principal direction."""
+    g = point_geometry(name, u, v)
+    theta = np.linspace(0, 2 * np.pi, 97)
+    kn = normal_curvature(name, u, v, theta)
+    t = np.cos(theta)[:, None] * g.p_u + np.sin(theta)[:, None] * g.p_v
+    t /= np.linalg.norm(t, axis=1, keepdims=True)
+    cos_phi = t @ g.dir1
+    sin_phi = t @ g.dir2
+    np.testing.assert_allclose(cos_phi**2 + sin_phi**2, 1, atol=1e-10)  # dir1 ⟂ dir2
+    np.testing.assert_allclose(kn, g.k1 * cos_phi**2 + g.k2 * sin_phi**2, atol=1e-10)
+
+
+@pytest.mark.parametrize("name, u, v", POINTS)
+def test_extremes_of_normal_curvature_are_the_principal_curvatures(
+    name: str, u: float, v: float
+) -> None:
+    g = point_geometry(name, u, v)
+    theta, kn = normal_curvature_curve(name, u, v, 2001)
+    for sign, k, t_ext in ((-1, g.k1, g.theta_max), (1, g.k2, g.theta_min)):
+        t0 = theta[np.argmin(sign * kn)]
+        res = minimize_scalar(lambda t, sg=sign: sg * normal_curvature(name, u, v, t),
+                              bounds=(t0 - 0.01, t0 + 0.01), method="bounded",
+                              options={"xatol": 1e-10})
+        assert sign * res.fun == pytest.approx(k, abs=1e-9)
+        assert normal_curvature(name, u, v, t_ext) == pytest.approx(k, abs=1e-12)
+        assert 0 <= t_ext < np.pi
+        # the located extreme is at t_ext or t_ext + π
+        assert min(abs((res.x - t_ext + np.pi / 2) % np.pi - np.pi / 2), 1) < 1e-4
+    assert g.k1 >= g.k2
+    assert g.k1 + g.k2 == pytest.approx(2 * g.H, abs=1e-12)
+    assert g.k1 * g.k2 == pytest.approx(g.K, abs=1e-12)
+    for d in (g.dir1, g.dir2):
+        assert np.linalg.norm(d) == pytest.approx(1)
+        assert abs(d @ g.n) < 1e-12
+    assert g.dir1 @ g.dir2 == pytest.approx(0, abs=1e-12)
+
+
+def test_point_classification_rules() -> None:
+    assert surfaces.classify(0.0, 0.0) == "planar"
+    assert surfaces.classify(2.0, 2.0) == "umbilic"
+    assert surfaces.classify(0.0, -1.0) == "parabolic"
+    assert surfaces.classify(2.0, 1.0) == "elliptic"
+    assert surfaces.classify(-1.0, -2.0) == "elliptic"
+    assert surfaces.classify(1.0, -1.0) == "hyperbolic"
+
+
+# ------------------------------------------------------------------------------------------
+# tier 3: numeric vs exact derivatives
+# ------------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("name", [n for n in surfaces.SURFACES if get_surface(n).derivatives])
+@pytest.mark.parametrize("method", NUMERIC)
+def test_numeric_derivatives_match_exact(name: str, method: str) -> None:
+    s = get_surface(name)
+    u, v = _random_uv(s, 300, seed=1)
+    exact = surface_derivatives(s, u, v, "exact")
+    num = surface_derivatives(s, u, v, method)
+    for k in ("p", "p_u", "p_v", "p_uu", "p_uv", "p_vv"):
+        np.testing.assert_allclose(getattr(num, k), getattr(exact, k), atol=1e-8, err_msg=k)
+
+
+def test_adding_a_surface_needs_only_p() -> None:
+    # elliptic paraboloid z = (a u² + b v²)/2, at the origin k = a, b along the axes
+    a, b = 3.0, 0.5
+    s = ParametricSurface("paraboloid", lambda u, v: np.stack(
+        np.broadcast_arrays(u, v, (a * u * u + b * v * v) / 2), axis=-1), (-1, 1, -1, 1))
+    g = point_geometry(s, 0.0, 0.0)
+    assert (g.k1, g.k2, g.K, g.H) == pytest.approx((a, b, a * b, (a + b) / 2), abs=1e-9)
+    assert g.classification == "elliptic"
+    np.testing.assert_allclose(np.abs(g.dir1), [1, 0, 0], atol=1e-9)
+
+
+def test_non_analytic_p_falls_back_to_central_differences() -> None:
+    # np.real drops the complex step, so "auto" must not use it
+    s = ParametricSurface("flat-z", lambda u, v: np.stack(
+        np.broadcast_arrays(np.real(u), np.real(v), np.real(u * u + v * v) / 2), axis=-1),
+        (-1, 1, -1, 1))
+    g = point_geometry(s, 0.0, 0.0)
+    assert (g.k1, g.k2) == pytest.approx((1, 1), abs=1e-8)
+    assert g.classification == "umbilic"
+    with pytest.raises(MeshError, match="complex"):
+        surface_derivatives(s, 0.0, 0.0, "complex-step")
+
+
+# ------------------------------------------------------------------------------------------
+# bad input
+# ------------------------------------------------------------------------------------------
+
+
+def test_unknown_surface_lists_known_ones() -> None:
+    with pytest.raises(MeshError, match="known surfaces: helicoid, sphere, torus"):
+        get_surface("klein_bottle")
+    with pytest.raises(MeshError, match="no parameter q"):
+        get_surface("torus", q=1.0)
+    assert get_surface("monkey-saddle").name == "monkey_saddle"
+
+
+def test_out_of_domain_names_the_argument() -> None:
+    with pytest.raises(MeshError, match=r"^u: 2 is outside"):
+        point_geometry("helicoid", 2.0, 0.0)
+    with pytest.raises(MeshError, match=r"^v: -1 is outside"):
+        point_geometry("helicoid", 0.5, -1.0)
+    with pytest.raises(MeshError, match=r"^v: nan"):
+        point_geometry("helicoid", 0.5, float("nan"))
+
+
+def test_pole_is_reported_as_singular() -> None:
+    with pytest.raises(MeshError, match="singular"):
+        point_geometry("sphere", 0.0, 1.0)
+
+
+def test_bad_p_shape_and_domain() -> None:
+    s = ParametricSurface("bad", lambda u, v: np.stack([u, v], axis=-1), (0, 1, 0, 1))
+    with pytest.raises(MeshError, match="expected"):
+        point_geometry(s, 0.5, 0.5)
+    with pytest.raises(MeshError, match="u0 < u1"):
+        ParametricSurface("bad", lambda u, v: u, (1, 0, 0, 1))
+    with pytest.raises(MeshError, match="r < R"):
+        get_surface("torus", R=1, r=2)
+
+
+# ------------------------------------------------------------------------------------------
+# meshing
+# ------------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("name, chi", [("sphere", 2), ("torus", 0)])
+def test_closed_surfaces_mesh_watertight(name: str, chi: int) -> None:
+    m = mesh_surface(name, (12, 10))
+    _, count = edge_face_counts(m.F)
+    assert np.all(count == 2)  # every edge shared by exactly two faces
+    assert euler_characteristic(m.F) == chi
+    assert not m.boundary.any()
+    # welded: no two vertices at the same place, no degenerate face
+    d = np.linalg.norm(m.V[:, None] - m.V[None], axis=2) + np.eye(len(m.V))
+    assert d.min() > 1e-6
+    a = np.linalg.norm(np.cross(m.V[m.F[:, 1]] - m.V[m.F[:, 0]], m.V[m.F[:, 2]] - m.V[m.F[:, 0]]),
+                       axis=1)
+    assert a.min() > 1e-6
+    assert len(boundary_loops(m.F)) == 0
+
+
+def test_sphere_poles_collapse_to_single_vertices() -> None:
+    nu, nv = 6, 9
+    m = mesh_surface("sphere", (nu, nv))
+    assert m.pole.sum() == 2
+    assert len(m.V) == (nu - 1) * nv + 2
+    assert len(m.F) == 2 * nu * nv - 2 * nv  # one triangle per cell in the two polar rows
+    for p in np.flatnonzero(m.pole):
+        assert np.sum(np.any(m.F == p, axis=1)) == nv
+    np.testing.assert_allclose(np.sort(m.V[m.pole, 2]), [-1, 1], atol=1e-15)
+
+
+@pytest.mark.parametrize("name", list(surfaces.SURFACES))
+def test_mesh_keeps_uv_and_follows_the_normal(name: str) -> None:
+    s = get_surface(name)
+    m = mesh_surface(s, 10)
+    np.testing.assert_allclose(m.V, s(m.uv[:, 0], m.uv[:, 1]), atol=1e-14)
+    ok = ~m.pole
+    n_exact = curvature_fields(s, m.uv[ok, 0], m.uv[ok, 1]).n
+    n_mesh = vertex_normals(m.V, m.F)[ok]
+    assert np.min(np.sum(n_exact * n_mesh, axis=1)) > 0.8  # same orientation everywhere
+
+
+@pytest.mark.parametrize("name, loops", [("helicoid", 1), ("saddle", 1), ("cylinder", 2),
+                                         ("catenoid", 2)])
+def test_open_surfaces_have_their_boundary(name: str, loops: int) -> None:
+    m = mesh_surface(name, 8)
+    assert len(boundary_loops(m.F)) == loops
+    _, count = edge_face_counts(m.F)
+    assert count.max() == 2
+
+
+def test_torus_mesh_equals_primitives_torus() -> None:
+    V, F = primitives.torus(32, 16)
+    m = mesh_surface("torus", (32, 16))
+    np.testing.assert_allclose(m.V, V, atol=1e-14)
+    np.testing.assert_array_equal(m.F, F)
+
+
+def test_bad_resolution() -> None:
+    with pytest.raises(MeshError, match="res"):
+        mesh_surface("helicoid", 0)
+    with pytest.raises(MeshError, match="at least 3"):
+        mesh_surface("torus", (2, 8))
+
+
+# ------------------------------------------------------------------------------------------
+# convergence of the discrete estimators
+# ------------------------------------------------------------------------------------------
+
+
+def test_exact_reference_values_used_by_the_study() -> None:
+    m = mesh_surface(get_surface("sphere", r=2.0), 6)
+    H, K = surfaces.exact_curvature_at(get_surface("sphere", r=2.0), m.uv, m.pole)
+    np.testing.assert_allclose(H, 0.5, rtol=1e-9)  # the core's sign: H > 0 with outward n
+    np.testing.assert_allclose(K, 0.25, rtol=1e-9)  # including the two pole vertices
+
+
+@pytest.mark.parametrize("name", ["sphere", "torus"])
+def test_voronoi_cotan_H_and_deficit_K_converge(name: str) -> None:
+    st = convergence_study(name, (8, 16, 32))
+    for est in ("H cotan voronoi", "K deficit voronoi"):
+        mx = st.errors[est]["max"]
+        assert mx[1] < 0.4 * mx[0] and mx[2] < 0.4 * mx[1], (est, mx)
+        assert all(o > 1.5 for o in st.errors[est]["order_max"])
+    # the uniform Laplacian is not consistent: its error does not shrink
+    assert st.errors["H uniform"]["max"][2] > 0.5 * st.ref_scale["H"]
+    assert st.errors["H uniform"]["max"][2] >= st.errors["H uniform"]["max"][0]
+
+
+def test_barycentric_area_stalls_on_icospheres() -> None:
+    st = convergence_study("sphere", (2, 3, 4), mesher="icosphere")
+    for q in ("H cotan", "K deficit"):
+        bary = st.errors[f"{q} barycentric"]["max"]
+        vor = st.errors[f"{q} voronoi"]["max"]
+        assert min(bary) > 0.1  # stalls near 15 % (unit sphere: absolute = relative)
+        assert bary[2] > 0.9 * bary[1]
+        assert vor[2] < 0.3 * vor[1] and vor[1] < 0.3 * vor[0]  # ~4x per subdivision
+        assert max(vor) < 0.03
+        # the barycentric mean error still converges: the stall is at a few vertices
+        mean = st.errors[f"{q} barycentric"]["mean"]
+        assert mean[2] < 0.4 * mean[1]
+
+
+def test_barycentric_area_fails_only_at_the_uv_sphere_poles() -> None:
+    st = convergence_study("sphere", (8, 16, 32))
+    bary = st.errors["K deficit barycentric"]
+    assert min(bary["max"][1:]) > 0.2 and all(bary["worst_is_pole"][1:])
+    cut = convergence_study("sphere", (8, 16, 32), exclude_poles=True)
+    mx = cut.errors["K deficit barycentric"]["max"]
+    assert mx[2] < 0.35 * mx[1]
+
+
+def test_barycentric_K_converges_on_the_torus_grid() -> None:
+    st = convergence_study("torus", (8, 16, 32))
+    for est in ("K deficit barycentric", "H cotan barycentric"):
+        mx = st.errors[est]["max"]
+        assert mx[2] < 0.35 * mx[1], (est, mx)
+
+
+def test_study_table_and_dict() -> None:
+    st = convergence_study("torus", (6, 12))
+    text = st.table()
+    for est in surfaces.ESTIMATORS:
+        assert est in text
+    d = st.to_dict()
+    assert json.loads(json.dumps(d))["resolutions"] == [6, 12]
+    assert len(d["errors"]["H uniform"]["order_max"]) == 1
+    with pytest.raises(MeshError, match="only meshes the sphere"):
+        convergence_study("torus", (1,), mesher="icosphere")
+
+
+# ------------------------------------------------------------------------------------------
+# outputs: figure, dict, CLI
+# ------------------------------------------------------------------------------------------
+
+
+def test_plot_is_written_atomically(tmp_path) -> None:
+    out = tmp_path / "kn.png"
+    g = surfaces.plot_normal_curvature("helicoid", 0.0, 0.0, out)
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert [p.name for p in tmp_path.iterdir()] == ["kn.png"]
+    assert g.K == pytest.approx(-1)
+    with pytest.raises(MeshError, match="PNG"):
+        surfaces.plot_normal_curvature("helicoid", 0.0, 0.0, tmp_path / "kn.jpg")
+
+
+def test_point_geometry_to_dict_is_json() -> None:
+    d = point_geometry("torus", 0.2, 0.3).to_dict()
+    back = json.loads(json.dumps(d))
+    for k in ("E", "F", "G", "e", "f", "g", "K", "H", "k1", "k2", "classification",
+              "dir1", "dir2", "dir1_uv", "dir2_uv", "theta_max", "theta_min", "n"):
+        assert k in back
+    assert len(back["dir1"]) == 3 and len(back["dir1_uv"]) == 2
+
+
+def test_core_import_stays_light() -> None:
+    import subprocess
+    import sys
+
+    code = ("import sys, meshlap_core.surfaces; "
+            "print(any(m.split('.')[0] in ('matplotlib', 'polyscope') for m in sys.modules))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "False"
+
+
+def _cli(capsys, *argv: str) -> tuple[int, str, str]:
+    from meshlap_core.cli import main
+
+    code = main(["surface", *argv])
+    cap = capsys.readouterr()
+    return code, cap.out, cap.err
+
+
+def test_cli_point_json(capsys) -> None:
+    code, out, _ = _cli(capsys, "helicoid", "--u", "0.5", "--v", "1", "--json")
+    assert code == 0
+    d = json.loads(out)
+    assert d["G"] == pytest.approx(1.25)
+    assert d["f"] == pytest.approx(-1 / np.sqrt(1.25))
+    assert d["k1"] == pytest.approx(0.8) and d["k2"] == pytest.approx(-0.8)
+    assert d["classification"] == "hyperbolic"
+    assert len(d["dir1"]) == 3 and len(d["dir1_uv"]) == 2
+
+
+def test_cli_errors(capsys) -> None:
+    code, _, err = _cli(capsys, "sphere", "--u", "4")
+    assert code == 2 and "--u" in err and "outside" in err
+    code, _, err = _cli(capsys, "moebius")
+    assert code == 2 and "known surfaces" in err
+
+
+def test_cli_plot_mesh_and_convergence(tmp_path, capsys) -> None:
+    png, obj = tmp_path / "kn.png", tmp_path / "torus.obj"
+    code, out, _ = _cli(capsys, "torus", "--plot", str(png), "--mesh", str(obj), "--res", "12,8",
+                        "--json")
+    assert code == 0
+    d = json.loads(out)
+    assert d["mesh"]["n_vertices"] == 96 and d["mesh"]["n_faces"] == 192
+    assert png.read_bytes()[:4] == b"\x89PNG"
+    back = load_mesh(obj)
+    m = mesh_surface("torus", (12, 8))
+    np.testing.assert_allclose(back.V, m.V, atol=1e-12)
+    np.testing.assert_array_equal(back.F, m.F)
+    code, out, err = _cli(capsys, "sphere", "--convergence", "--res", "1,2", "--mesher",
+                          "icosphere", "--json")
+    assert code == 0
+    d = json.loads(out)
+    assert d["n_vertices"] == [42, 162]
+    assert set(d["errors"]) == set(surfaces.ESTIMATORS)
+    assert "vertices" in err  # progress on stderr, not stdout
