@@ -16,8 +16,9 @@ from typing import Literal
 
 import numpy as np
 
+from .curvature import vertex_normals
 from .errors import MeshError
-from .types import FloatArray, IntArray, as_faces, as_mesh, as_vertices
+from .types import FloatArray, IntArray, as_faces, as_vertices
 
 NoiseMode = Literal["isotropic", "normal"]
 NOISE_MODES: tuple[str, ...] = ("isotropic", "normal")
@@ -66,32 +67,6 @@ def noise_sigma(V: FloatArray, alpha: float) -> float:
     return _check_alpha(alpha) * bbox_diagonal(V)
 
 
-def vertex_normals(V: FloatArray, F: IntArray) -> FloatArray:
-    """Area-weighted unit vertex normals (sum of the unnormalized face normals around a vertex).
-
-    Parameters
-    ----------
-    V : (n,3) float
-    F : (m,3) int
-
-    Returns
-    -------
-    N : (n,3) float
-        Zero rows for unreferenced vertices and where the normals cancel.
-    """
-    V, F = as_mesh(V, F)
-    n = len(V)
-    a = V[F[:, 0]]
-    Nf = np.cross(V[F[:, 1]] - a, V[F[:, 2]] - a)  # 2 × area × unit normal
-    N = np.zeros((n, 3))
-    for k in range(3):
-        N += np.stack(
-            [np.bincount(F[:, k], weights=Nf[:, c], minlength=n) for c in range(3)], axis=1
-        )
-    length = np.linalg.norm(N, axis=1, keepdims=True)
-    return np.divide(N, length, out=np.zeros_like(N), where=length > 1e-300)
-
-
 def add_noise(
     V: FloatArray,
     F: IntArray | None = None,
@@ -113,8 +88,8 @@ def add_noise(
     mode : {"isotropic", "normal"}
         ``isotropic``: ``V + σ Z`` with ``Z`` an ``(n,3)`` standard normal array (every coordinate
         has standard deviation σ). ``normal``: ``V + σ z_i n_i`` with one standard normal ``z_i``
-        per vertex and ``n_i`` the area-weighted unit vertex normal (unreferenced vertices do
-        not move).
+        per vertex and ``n_i`` the unit angle-weighted vertex normal of
+        :func:`meshlap_core.curvature.vertex_normals` (unreferenced vertices do not move).
     seed : int or None
         Seed of ``numpy.random.default_rng``; the same seed gives the same noise. ``None`` draws
         fresh entropy.
