@@ -545,8 +545,9 @@ def run(
         if panel == "onering":
             viewer.focus_ring()
         else:
-            ps.reset_camera_to_home_view()
+            frame_scene_left(viewer)
         ps.frame_tick()
+        ps.frame_tick()  # ImPlot fits its axes on the second frame
         buf = ps.screenshot_to_buffer(transparent_bg=False, include_UI=True)
         _write_png(shot, buf)
         ps.clear_user_callback()
@@ -554,6 +555,45 @@ def run(
         return 0
     ps.show()
     return 0
+
+
+def frame_scene_left(viewer: Viewer, fraction: float = 0.6) -> None:
+    """Look at every enabled structure from the front so the scene fills the left
+    ``fraction`` of the window (the panel sits on the right in screenshots)."""
+    pts = []
+    for name in (MESH, MESH_B, SURFACE, "reconstruction", "smoothed"):
+        if ps.has_surface_mesh(name) and ps.get_surface_mesh(name).is_enabled():
+            pts.append(_structure_points(viewer, name))
+    if not pts:
+        ps.reset_camera_to_home_view()
+        return
+    P = np.vstack(pts)
+    lo, hi = P.min(axis=0), P.max(axis=0)
+    c = 0.5 * (lo + hi)
+    w, h = ps.get_window_size()
+    fov = np.radians(ps.get_view_camera_parameters().get_fov_vertical_deg())
+    tan_v = np.tan(fov / 2.0)
+    tan_h = tan_v * w / h
+    depth = hi[1] - lo[1]
+    d = max((hi[0] - lo[0]) / (2 * fraction * tan_h), (hi[2] - lo[2]) / (2 * 0.85 * tan_v))
+    d += 0.5 * depth
+    shift = (0.5 - 0.5 * fraction) * 2 * d * tan_h
+    eye = np.array([c[0] + shift, lo[1] - d, c[2] + 0.15 * (hi[2] - lo[2])])
+    ps.look_at(eye, np.array([c[0] + shift, c[1], c[2]]))
+
+
+def _structure_points(viewer: Viewer, name: str) -> np.ndarray:
+    if name == MESH:
+        return viewer.mesh.V
+    if name == MESH_B:
+        return viewer.mesh.V + np.array([1.15 * np.ptp(viewer.mesh.V[:, 0]) + 1e-9, 0.0, 0.0])
+    if name == SURFACE and viewer.surf.mesh is not None:
+        return viewer.surf.mesh.V
+    for hook in viewer.extra.values():
+        pts = hook.points(viewer, name) if hasattr(hook, "points") else None
+        if pts is not None:
+            return pts
+    return viewer.mesh.V
 
 
 def install_extras(viewer: Viewer) -> None:

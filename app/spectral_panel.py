@@ -1,0 +1,133 @@
+"""Polyscope layer of the spectral panel (state in :mod:`app.spectral_state`)."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+import polyscope as ps
+import polyscope.imgui as psim
+import polyscope.implot as psimplot
+
+from .spectral_state import SpectralState
+
+if TYPE_CHECKING:
+    from .viewer import Viewer
+
+RECON = "reconstruction"
+EIGEN = "eigenfunction"
+RED = (1.0, 0.35, 0.35, 1.0)
+
+
+class Panel:
+    """Eigenmode browser and k slider; the reconstruction sits beside the original."""
+
+    def __init__(self) -> None:
+        self.state = SpectralState()
+        self._shown_k = -1
+        self._shown_mode = -1
+
+    def on_new_mesh(self, viewer: Viewer) -> None:
+        self.state.clear()
+        self._shown_k = self._shown_mode = -1
+        if ps.has_surface_mesh(RECON):
+            ps.remove_surface_mesh(RECON)
+
+    def show(self, viewer: Viewer, panel: str) -> None:
+        if ps.has_surface_mesh(RECON):
+            ps.get_surface_mesh(RECON).set_enabled(panel == "spectral")
+        if panel == "spectral" and self.state.basis is not None:
+            self.push_mode(viewer, force=True)
+
+    def _offset(self, viewer: Viewer) -> np.ndarray:
+        return np.array([1.15 * np.ptp(viewer.mesh.V[:, 0]) + 1e-9, 0.0, 0.0])
+
+    def push_mode(self, viewer: Viewer, force: bool = False) -> None:
+        st = self.state
+        if st.basis is None or (st.mode == self._shown_mode and not force):
+            return
+        self._shown_mode = st.mode
+        f, _ = st.eigenfunction()
+        r = float(np.abs(f).max()) or 1.0
+        ps.get_surface_mesh("mesh").add_scalar_quantity(
+            EIGEN, f, cmap="coolwarm", vminmax=(-r, r), enabled=True
+        )
+
+    def push_k(self, viewer: Viewer, force: bool = False) -> None:
+        st = self.state
+        if st.basis is None or (st.k == self._shown_k and not force):
+            return
+        self._shown_k = st.k
+        X = st.reconstruction + self._offset(viewer)
+        if not ps.has_surface_mesh(RECON):
+            ps.register_surface_mesh(RECON, X, viewer.mesh.F, smooth_shade=True)
+        else:
+            ps.get_surface_mesh(RECON).update_vertex_positions(X)
+        hi = float(np.percentile(st.vertex_error, 99)) or 1.0
+        ps.get_surface_mesh(RECON).add_scalar_quantity(
+            "error |x - x_k|", st.vertex_error, cmap="reds", vminmax=(0.0, hi), enabled=True
+        )
+
+    def points(self, viewer: Viewer, name: str) -> np.ndarray | None:
+        """World positions of a structure this panel registered (for camera framing)."""
+        if name == RECON and self.state.basis is not None:
+            return self.state.reconstruction + self._offset(viewer)
+        return None
+
+    def adopt(self, viewer: Viewer) -> None:
+        """Show a basis that just finished."""
+        if self.state.poll():
+            self.push_mode(viewer, force=True)
+            self.push_k(viewer, force=True)
+
+    def prepare_screenshot(self, viewer: Viewer, k: int) -> None:
+        """Compute synchronously (headless render) and show the reconstruction from k modes."""
+        st = self.state
+        st.k_request = max(k, 10)
+        st.k = k
+        st.start(viewer.mesh.V, viewer.mesh.F, background=False)
+        if st.error:
+            return
+        self.push_mode(viewer, force=True)
+        self.push_k(viewer, force=True)
+        viewer.show_panel()
+
+    def draw(self, viewer: Viewer) -> None:
+        if not psim.CollapsingHeader("Spectral", psim.ImGuiTreeNodeFlags_DefaultOpen):
+            return
+        st = self.state
+        self.adopt(viewer)
+        _, st.k_request = psim.InputInt("modes to compute", st.k_request)
+        st.k_request = int(np.clip(st.k_request, 2, max(len(viewer.mesh.V), 2)))
+        if st.busy:
+            psim.ProgressBar(st.progress, (-1, 0), st.message or "working")
+        elif psim.Button("compute eigenbasis"):
+            st.start(viewer.mesh.V, viewer.mesh.F)
+        if st.error:
+            psim.TextColored(RED, st.error)
+        if st.basis is None:
+            if not st.busy:
+                psim.TextUnformatted("-C u = lambda M u (cotangent stiffness, Voronoi mass)")
+            return
+        psim.TextUnformatted(st.message)
+        ch, mode = psim.SliderInt("eigenmode i", st.mode, 0, st.basis.k_max - 1)
+        if ch:
+            st.mode = mode
+            self.push_mode(viewer)
+        _, lam = st.eigenfunction()
+        psim.TextUnformatted(f"lambda_{st.mode} = {lam:.6g}  (frequency of -Laplacian, >= 0)")
+        ch, k = psim.SliderInt("k (reconstruct)", st.k, 1, st.basis.k_max)
+        if ch:
+            st.set_k(k)
+            self.push_k(viewer)
+        e = st.errors
+        psim.TextUnformatted(
+            f"k = {st.k}: mean error {e.mean[st.k]:.4g}, max {e.max[st.k]:.4g} "
+            f"({100 * e.relative_mean[st.k]:.3g}% of the diagonal)"
+        )
+        if psimplot.BeginPlot("mean error vs k (log scale)", (-1, 170)):
+            psimplot.SetupAxisScale(psimplot.ImAxis_Y1, psimplot.ImPlotScale_Log10)
+            ks = np.asarray(e.k, dtype=np.float64)[1:]
+            psimplot.PlotLine("mean |x - x_k|", ks, np.asarray(e.mean[1:], dtype=np.float64))
+            psimplot.PlotInfLines("current k", np.array([float(st.k)]))
+            psimplot.EndPlot()

@@ -1,0 +1,105 @@
+"""Spectral panel state: the eigenbasis (computed in a worker thread), the eigenmode browser and
+the k slider. No polyscope import.
+
+The basis is computed once per mesh (and cached on disk by ``meshlap_core.spectral``); the
+k slider then only calls :meth:`SpectralBasis.reconstruct`, which updates incrementally from
+the previous k.
+"""
+
+from __future__ import annotations
+
+import threading
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from meshlap_core.errors import MeshError
+from meshlap_core.spectral import SpectralBasis
+from meshlap_core.types import FloatArray, IntArray
+
+
+@dataclass
+class SpectralState:
+    """Basis, selected eigenmode ``mode`` and reconstruction order ``k``."""
+
+    k_request: int = 100
+    mode: int = 1
+    k: int = 10
+    progress: float = 0.0
+    message: str = ""
+    error: str = ""
+    basis: SpectralBasis | None = None
+    errors: Any = None  # ReconstructionErrors for every k of the basis
+    reconstruction: FloatArray = field(default_factory=lambda: np.zeros((0, 3)))
+    vertex_error: FloatArray = field(default_factory=lambda: np.zeros(0))
+    _thread: threading.Thread | None = None
+    _pending: SpectralBasis | None = None
+    _lock: threading.Lock = field(default_factory=threading.Lock)
+
+    @property
+    def busy(self) -> bool:
+        return self._thread is not None and self._thread.is_alive()
+
+    def clear(self) -> None:
+        """Forget the basis (a new mesh was loaded)."""
+        self.basis, self.errors, self._pending = None, None, None
+        self.reconstruction = np.zeros((0, 3))
+        self.vertex_error = np.zeros(0)
+        self.progress, self.message, self.error = 0.0, "", ""
+
+    def _progress(self, fraction: float, message: str) -> None:
+        self.progress, self.message = float(fraction), message
+
+    def _solve(self, V: FloatArray, F: IntArray, k: int) -> None:
+        try:
+            basis = SpectralBasis.compute(V, F, k, progress=self._progress)
+        except (MeshError, MemoryError, RuntimeError) as exc:
+            self.error = str(exc)
+            return
+        with self._lock:
+            self._pending = basis
+
+    def start(self, V: FloatArray, F: IntArray, background: bool = True) -> None:
+        """Compute ``k_request`` eigenpairs (at most n) in a worker thread (or right here)."""
+        if self.busy:
+            return
+        self.clear()
+        k = int(min(max(self.k_request, 2), len(V)))
+        self.message = f"computing {k} eigenpairs ..."
+        if background:
+            self._thread = threading.Thread(target=self._solve, args=(V, F, k), daemon=True)
+            self._thread.start()
+        else:
+            self._solve(V, F, k)
+            self.poll()
+
+    def poll(self) -> bool:
+        """Adopt a basis finished by the worker; True when a new one arrived (UI thread)."""
+        with self._lock:
+            basis, self._pending = self._pending, None
+        if basis is None:
+            return False
+        self.basis = basis
+        self.errors = basis.errors()
+        self.k = min(self.k, basis.k_max)
+        self.mode = min(max(self.mode, 0), basis.k_max - 1)
+        info = basis.info
+        how = "from the cache" if info.from_cache else f"in {sum(info.timings.values()):.2f} s"
+        self.message = f"{basis.k_max} eigenpairs {how}"
+        self.set_k(self.k)
+        return True
+
+    def eigenfunction(self) -> tuple[FloatArray, float]:
+        """The selected eigenfunction (a scalar field) and its frequency λ ≥ 0."""
+        if self.basis is None:
+            raise MeshError("no eigenbasis computed yet", "spectral")
+        return self.basis.eigenfunction(self.mode), float(self.basis.eigenvalues[self.mode])
+
+    def set_k(self, k: int) -> None:
+        """Rebuild the shape from the first ``k`` eigenvectors (incremental, O(n·|Δk|))."""
+        if self.basis is None:
+            return
+        self.k = int(np.clip(k, 1, self.basis.k_max))
+        self.reconstruction = self.basis.reconstruct(self.k)
+        self.vertex_error = np.linalg.norm(self.reconstruction - self.basis.V, axis=1)
