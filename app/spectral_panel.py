@@ -63,7 +63,7 @@ class Panel:
             ps.register_surface_mesh(RECON, X, viewer.mesh.F, smooth_shade=True)
         else:
             ps.get_surface_mesh(RECON).update_vertex_positions(X)
-        hi = float(np.percentile(st.vertex_error, 99)) or 1.0
+        hi = float(st.errors.max[st.k]) or 1.0  # precomputed for every k
         ps.get_surface_mesh(RECON).add_scalar_quantity(
             "error |x - x_k|", st.vertex_error, cmap="reds", vminmax=(0.0, hi), enabled=True
         )

@@ -34,7 +34,7 @@ class SpectralState:
     reconstruction: FloatArray = field(default_factory=lambda: np.zeros((0, 3)))
     vertex_error: FloatArray = field(default_factory=lambda: np.zeros(0))
     _thread: threading.Thread | None = None
-    _pending: SpectralBasis | None = None
+    _pending: tuple[SpectralBasis, Any] | None = None
     _lock: threading.Lock = field(default_factory=threading.Lock)
 
     @property
@@ -54,11 +54,13 @@ class SpectralState:
     def _solve(self, V: FloatArray, F: IntArray, k: int) -> None:
         try:
             basis = SpectralBasis.compute(V, F, k, progress=self._progress)
+            errors = basis.errors()  # every k at once (cumulative sums)
+            basis.reconstruct(max(1, k // 2))  # builds the slider's checkpoints off the UI thread
         except (MeshError, MemoryError, RuntimeError) as exc:
             self.error = str(exc)
             return
         with self._lock:
-            self._pending = basis
+            self._pending = (basis, errors)
 
     def start(self, V: FloatArray, F: IntArray, background: bool = True) -> None:
         """Compute ``k_request`` eigenpairs (at most n) in a worker thread (or right here)."""
@@ -77,15 +79,16 @@ class SpectralState:
     def poll(self) -> bool:
         """Adopt a basis finished by the worker; True when a new one arrived (UI thread)."""
         with self._lock:
-            basis, self._pending = self._pending, None
-        if basis is None:
+            pending, self._pending = self._pending, None
+        if pending is None:
             return False
+        basis, self.errors = pending
         self.basis = basis
-        self.errors = basis.errors()
         self.k = min(self.k, basis.k_max)
         self.mode = min(max(self.mode, 0), basis.k_max - 1)
         info = basis.info
-        how = "from the cache" if info.from_cache else f"in {sum(info.timings.values()):.2f} s"
+        total = info.timings.get("total", info.timings.get("eigensolve", 0.0))
+        how = "from the cache" if info.from_cache else f"in {total:.2f} s"
         self.message = f"{basis.k_max} eigenpairs {how}"
         self.set_k(self.k)
         return True

@@ -133,6 +133,7 @@ class CurvatureState:
     percentile: float = 2.0
     _key: tuple[Any, ...] = ()
     fields: dict[str, FloatArray] = field(default_factory=dict)
+    _summaries: dict[tuple[Any, ...], dict[str, Any]] = field(default_factory=dict)
 
     def update(self, mesh: MeshState) -> bool:
         """Recompute when the mesh, area or boundary rule changed. Returns whether it did."""
@@ -145,8 +146,29 @@ class CurvatureState:
 
     def color_range(self, name: str | None = None) -> tuple[float, float]:
         """Robust colour range of a field (symmetric around 0 for signed fields)."""
+        return self.summary(name)["range"]
+
+    def summary(self, name: str | None = None, bins: int = 60) -> dict[str, Any]:
+        """Range, min/max and histogram of a field, cached until the field or the clip
+        percentage changes (the panel reads it every frame)."""
         name = name or self.field_name
-        return robust_range(self.fields[name], FIELD_LABELS[name][1], self.percentile)
+        key = (self._key, name, self.percentile, bins)
+        cached = self._summaries.get(key)
+        if cached is None:
+            values = self.fields[name]
+            lo, hi = robust_range(values, FIELD_LABELS[name][1], self.percentile)
+            counts, edges = np.histogram(np.clip(values, lo, hi), bins=bins, range=(lo, hi))
+            cached = {
+                "range": (lo, hi),
+                "min": float(values.min()),
+                "max": float(values.max()),
+                "centers": 0.5 * (edges[1:] + edges[:-1]),
+                "counts": counts.astype(np.float64),
+                "width": float(edges[1] - edges[0]),
+            }
+            self._summaries = {k: v for k, v in self._summaries.items() if k[0] == self._key}
+            self._summaries[key] = cached
+        return cached
 
 
 @dataclass

@@ -57,6 +57,11 @@ def _init(backend: str) -> None:
                 "view",
             ) from exc
         raise MeshError(f"polyscope could not start its {backend} backend: {exc}", "view") from exc
+    if backend in ("openGL3_egl", "openGL_mock"):
+        # headless: render every requested frame (the default mode skips frames to hold 60 fps,
+        # so scripted frame_tick loops would silently skip the callback)
+        ps.set_max_fps(-1)
+        ps.set_frame_tick_limit_fps_mode("ignore_limits")
     ps.set_program_name("meshlap")
     ps.set_up_dir("z_up")
     ps.set_front_dir("neg_y_front")
@@ -381,17 +386,18 @@ class Viewer:
         if ch1 or ch2 or ch3 or ch4 or ch5 or ch6:
             self.push_curvature(force=ch2 or ch3)
             self.show_panel()
-        values = c.fields.get(c.field_name)
-        if values is None:
+        if c.field_name not in c.fields:
             return
-        lo, hi = c.color_range()
+        st = c.summary()
+        lo, hi = st["range"]
         psim.TextUnformatted(
-            f"min {values.min():.4g}  max {values.max():.4g}  colour range [{lo:.4g}, {hi:.4g}]"
+            f"min {st['min']:.4g}  max {st['max']:.4g}  colour range [{lo:.4g}, {hi:.4g}]"
         )
         psim.TextUnformatted(FIELD_LABELS[c.field_name][0])
-        if self._implot().BeginPlot("histogram", (-1, 160)):
-            self._implot().PlotHistogram("vertices", np.clip(values, lo, hi).astype(np.float64), 60)
-            self._implot().EndPlot()
+        ip = self._implot()
+        if ip.BeginPlot("histogram (clipped to the colour range)", (-1, 160)):
+            ip.PlotBars("vertices", st["centers"], st["counts"], st["width"])
+            ip.EndPlot()
 
     @staticmethod
     def _implot() -> Any:

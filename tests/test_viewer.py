@@ -17,6 +17,8 @@ def mock_backend(tmp_path_factory):
     os.chdir(tmp_path_factory.mktemp("polyscope"))
     ps.set_allow_headless_backends(True)
     ps.init("openGL_mock")
+    ps.set_max_fps(-1)
+    ps.set_frame_tick_limit_fps_mode("ignore_limits")  # every frame_tick runs the callback
     yield ps
     ps.remove_all_structures()
     os.chdir(old)
