@@ -15,6 +15,7 @@ if TYPE_CHECKING:
     from .viewer import Viewer
 
 SMOOTHED = "smoothed"
+INPUT = "smoothing input"
 RED = (1.0, 0.35, 0.35, 1.0)
 
 
@@ -25,19 +26,22 @@ class Panel:
         self.state = SmoothingState()
         self._registered = -1
         self._shown_iteration = -1
+        self._shift = np.zeros(3)
 
     def on_new_mesh(self, viewer: Viewer) -> None:
         self.state.smoother = None
         self.state.playing = False
-        if ps.has_surface_mesh(SMOOTHED):
-            ps.remove_surface_mesh(SMOOTHED)
+        for name in (SMOOTHED, INPUT):
+            if ps.has_surface_mesh(name):
+                ps.remove_surface_mesh(name)
         self._registered = -1
 
     def show(self, viewer: Viewer, panel: str) -> None:
         if panel == "smoothing" and self.state.smoother is None:
             self.rebuild(viewer)
-        if ps.has_surface_mesh(SMOOTHED):
-            ps.get_surface_mesh(SMOOTHED).set_enabled(panel == "smoothing")
+        for name in (SMOOTHED, INPUT):
+            if ps.has_surface_mesh(name):
+                ps.get_surface_mesh(name).set_enabled(panel == "smoothing")
         if ps.has_surface_mesh("mesh") and panel == "smoothing":
             ps.get_surface_mesh("mesh").set_enabled(False)
 
@@ -50,19 +54,27 @@ class Panel:
         st = self.state
         if st.smoother is None:
             return
+        from .viewer import side_offset
+
+        self._shift = side_offset(st.V_start)
         if self._registered != st.version:
-            if ps.has_surface_mesh(SMOOTHED):
-                ps.remove_surface_mesh(SMOOTHED)
-            sm = ps.register_surface_mesh(SMOOTHED, st.V, st.F, smooth_shade=True)
+            # the input (with its noise) stays put; the smoothed copy moves beside it
+            inp = ps.register_surface_mesh(INPUT, st.V_start, st.F, smooth_shade=True)
+            inp.set_color((0.85, 0.75, 0.6))
+            sm = ps.register_surface_mesh(SMOOTHED, st.V + self._shift, st.F, smooth_shade=True)
             sm.set_color((0.55, 0.7, 0.9))
             self._registered = st.version
         elif force or st.smoother.iteration != self._shown_iteration:
-            ps.get_surface_mesh(SMOOTHED).update_vertex_positions(st.V)
+            ps.get_surface_mesh(SMOOTHED).update_vertex_positions(st.V + self._shift)
         self._shown_iteration = st.smoother.iteration
 
     def points(self, viewer: Viewer, name: str) -> np.ndarray | None:
         """World positions of a structure this panel registered (for camera framing)."""
-        return self.state.V if name == SMOOTHED and self.state.smoother is not None else None
+        if self.state.smoother is None:
+            return None
+        if name == SMOOTHED:
+            return self.state.V + self._shift
+        return self.state.V_start if name == INPUT else None
 
     def prepare_screenshot(self, viewer: Viewer, iterations: int = 10) -> None:
         """Add a little noise, smooth a few steps and show the result (headless render)."""
@@ -119,6 +131,9 @@ class Panel:
             psim.TextColored(RED, fig["warning"])
         mu, g = st.amplification()
         if psimplot.BeginPlot("amplification g(mu) per step", (-1, 170)):
+            lo = min(-1.2, float(np.min(g)) - 0.1)
+            hi = max(1.2, float(np.max(g)) + 0.1)
+            psimplot.SetupAxisLimits(psimplot.ImAxis_Y1, lo, hi, psimplot.ImPlotCond_Always)
             psimplot.PlotLine(
                 "g", np.asarray(mu, dtype=np.float64), np.asarray(g, dtype=np.float64)
             )

@@ -31,6 +31,7 @@ class SmoothingState:
     error: str = ""
     smoother: Smoother | None = None
     V_original: FloatArray = field(default_factory=lambda: np.zeros((0, 3)))
+    V_start: FloatArray = field(default_factory=lambda: np.zeros((0, 3)))  # original + noise
     F: IntArray = field(default_factory=lambda: np.zeros((0, 3), dtype=np.int64))
     version: int = 0  # bumped when the stepper is rebuilt (connectivity may need re-upload)
 
@@ -45,7 +46,7 @@ class SmoothingState:
             self.error = str(exc)
             self.playing = False
             return False
-        self.V_original, self.F = np.asarray(V), np.asarray(F)
+        self.V_original, self.V_start, self.F = np.asarray(V), np.asarray(start), np.asarray(F)
         self.error = ""
         self.version += 1
         return True

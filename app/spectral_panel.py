@@ -40,7 +40,9 @@ class Panel:
             self.push_mode(viewer, force=True)
 
     def _offset(self, viewer: Viewer) -> np.ndarray:
-        return np.array([1.15 * np.ptp(viewer.mesh.V[:, 0]) + 1e-9, 0.0, 0.0])
+        from .viewer import side_offset
+
+        return side_offset(viewer.mesh.V)
 
     def push_mode(self, viewer: Viewer, force: bool = False) -> None:
         st = self.state

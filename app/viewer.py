@@ -63,10 +63,20 @@ def _init(backend: str) -> None:
         ps.set_max_fps(-1)
         ps.set_frame_tick_limit_fps_mode("ignore_limits")
     ps.set_program_name("meshlap")
-    ps.set_up_dir("z_up")
-    ps.set_front_dir("neg_y_front")
+    ps.set_up_dir("y_up")  # scans and the course meshes are y-up (polyscope's default)
+    ps.set_front_dir("neg_z_front")
     ps.set_ground_plane_mode("shadow_only")
     ps.set_open_imgui_window_for_user_callback(True)
+
+
+# parametric surfaces are written z-up; the viewer is y-up: display them rotated (x, y, z) ->
+# (x, z, -y) with a polyscope transform, so the data (and the numbers in the panel) are unchanged
+Z_TO_Y = np.array([[1.0, 0, 0, 0], [0, 0, 1, 0], [0, -1, 0, 0], [0, 0, 0, 1]])
+
+
+def side_offset(V: np.ndarray) -> np.ndarray:
+    """Offset of a copy shown beside a mesh: to its right as seen from the default camera."""
+    return np.array([-1.15 * float(np.ptp(V[:, 0])) - 1e-9, 0.0, 0.0])
 
 
 def remove_structure(name: str) -> None:
@@ -134,7 +144,7 @@ class Viewer:
         sm = ps.get_surface_mesh(MESH)
         self._add_field(sm, self.curv.field_name, enabled=True)
         if self.side_by_side:
-            shift = np.array([1.15 * np.ptp(self.mesh.V[:, 0]) + 1e-9, 0.0, 0.0])
+            shift = side_offset(self.mesh.V)
             if not ps.has_surface_mesh(MESH_B):
                 ps.register_surface_mesh(
                     MESH_B, self.mesh.V + shift, self.mesh.F, smooth_shade=True
@@ -213,11 +223,10 @@ class Viewer:
             return
         center = self.mesh.V[r.vertex]
         size = float(np.linalg.norm(r.polyline - center, axis=1).max()) or 1.0
-        normal = r.normal if np.linalg.norm(r.normal) > 0 else np.array([0.0, -1.0, 0.0])
-        # tilt a little inside the tangent plane: looking straight along the up axis (a flat
-        # mesh seen from above) is a degenerate camera frame
-        tilt = np.array([0.0, -1.0, 0.0]) - normal[1] * normal * -1.0
-        tilt -= np.dot(tilt, normal) * normal
+        normal = r.normal if np.linalg.norm(r.normal) > 0 else np.array([0.0, 0.0, 1.0])
+        # tilt a little towards the up axis inside the tangent plane: looking straight along
+        # the up axis (a flat mesh seen from above) is a degenerate camera frame
+        tilt = np.array([0.0, 1.0, 0.0]) - normal[1] * normal
         if np.linalg.norm(tilt) < 1e-6:
             tilt = np.array([1.0, 0.0, 0.0]) - normal[0] * normal
         tilt /= np.linalg.norm(tilt)
@@ -248,6 +257,7 @@ class Viewer:
         if self._surface_version != self.surf.version:
             self._surface_version = self.surf.version
             s = ps.register_surface_mesh(SURFACE, sm.V, sm.F, smooth_shade=True)
+            s.set_transform(Z_TO_Y)
             from meshlap_core.surfaces import curvature_fields as surface_curvature
 
             cf = surface_curvature(self.surf.name, sm.uv[:, 0], sm.uv[:, 1])
@@ -264,6 +274,7 @@ class Viewer:
         size = float(np.ptp(self.surf.mesh.V, axis=0).max()) if self.surf.mesh is not None else 1.0
         base, d1, d2 = self.surf.direction_vectors(scale=0.15 * size)
         pc = ps.register_point_cloud(SURFACE_POINT, base, radius=0.01)
+        pc.set_transform(Z_TO_Y)
         pc.set_color((0.9, 0.1, 0.1))
         pc.add_vector_quantity(
             "k1 direction", d1, vectortype="ambient", enabled=True, color=(0.85, 0.2, 0.1)
@@ -299,7 +310,8 @@ class Viewer:
                 self.panel = "onering"
                 return self.select_vertex(idx)
         if res.structure_name == SURFACE and self.surf.mesh is not None:
-            idx = self._vertex_of(data, res.position, self.surf.mesh.V, self.surf.mesh.F)
+            shown = self.surf.mesh.V @ Z_TO_Y[:3, :3].T  # picked positions are in world space
+            idx = self._vertex_of(data, res.position, shown, self.surf.mesh.F)
             if idx is not None and self.surf.pick_vertex(idx):
                 self.push_surface_point()
                 return True
@@ -567,7 +579,7 @@ def frame_scene_left(viewer: Viewer, fraction: float = 0.6) -> None:
     """Look at every enabled structure from the front so the scene fills the left
     ``fraction`` of the window (the panel sits on the right in screenshots)."""
     pts = []
-    for name in (MESH, MESH_B, SURFACE, "reconstruction", "smoothed"):
+    for name in (MESH, MESH_B, SURFACE, "reconstruction", "smoothed", "smoothing input"):
         if ps.has_surface_mesh(name) and ps.get_surface_mesh(name).is_enabled():
             pts.append(_structure_points(viewer, name))
     if not pts:
@@ -580,21 +592,23 @@ def frame_scene_left(viewer: Viewer, fraction: float = 0.6) -> None:
     fov = np.radians(ps.get_view_camera_parameters().get_fov_vertical_deg())
     tan_v = np.tan(fov / 2.0)
     tan_h = tan_v * w / h
-    depth = hi[1] - lo[1]
-    d = max((hi[0] - lo[0]) / (2 * fraction * tan_h), (hi[2] - lo[2]) / (2 * 0.85 * tan_v))
+    # y is up and the camera looks along +z from the front (scans face -z): seen from there,
+    # screen-right is -x, so aiming at c - shift puts the scene centre left of the window centre
+    depth = hi[2] - lo[2]
+    d = max((hi[0] - lo[0]) / (2 * fraction * tan_h), (hi[1] - lo[1]) / (2 * 0.85 * tan_v))
     d += 0.5 * depth
     shift = (0.5 - 0.5 * fraction) * 2 * d * tan_h
-    eye = np.array([c[0] + shift, lo[1] - d, c[2] + 0.15 * (hi[2] - lo[2])])
-    ps.look_at(eye, np.array([c[0] + shift, c[1], c[2]]))
+    eye = np.array([c[0] - shift, c[1] + 0.15 * (hi[1] - lo[1]), lo[2] - d])
+    ps.look_at(eye, np.array([c[0] - shift, c[1], c[2]]))
 
 
 def _structure_points(viewer: Viewer, name: str) -> np.ndarray:
     if name == MESH:
         return viewer.mesh.V
     if name == MESH_B:
-        return viewer.mesh.V + np.array([1.15 * np.ptp(viewer.mesh.V[:, 0]) + 1e-9, 0.0, 0.0])
+        return viewer.mesh.V + side_offset(viewer.mesh.V)
     if name == SURFACE and viewer.surf.mesh is not None:
-        return viewer.surf.mesh.V
+        return viewer.surf.mesh.V @ Z_TO_Y[:3, :3].T
     for hook in viewer.extra.values():
         pts = hook.points(viewer, name) if hasattr(hook, "points") else None
         if pts is not None:
