@@ -170,9 +170,9 @@ def test_picking_a_projected_vertex_selects_its_one_ring(tmp_path):
 
     mesh = MeshState()
     mesh.load(None)
-    # a vertex facing the default camera (which looks along +y from the front)
+    # a vertex near the middle, facing the default camera (which looks along +z from -z)
     N = vertex_normals(mesh.V, mesh.F)
-    target = int(np.argmin(N[:, 1] + 0.2 * np.abs(mesh.V[:, 2]) + 0.2 * np.abs(mesh.V[:, 0])))
+    target = int(np.argmin(N[:, 2] + 0.2 * np.abs(mesh.V[:, 1]) + 0.2 * np.abs(mesh.V[:, 0])))
     res = subprocess.run(
         [sys.executable, "-c", PICK_SCRIPT, str(target)],
         capture_output=True,
