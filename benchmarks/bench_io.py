@@ -70,16 +70,20 @@ def bench(path: Path, repeat: int) -> None:
     m = load_mesh(path)
     V, F = igl.read_triangle_mesh(src)
     same = np.array_equal(m.V, V) and np.array_equal(m.F, F)
-    print(f"{path.name}: {m.n_vertices:,} vertices, {m.n_faces:,} faces, "
-          f"{len(data) / 1e6:.1f} MB; arrays identical to libigl: {same}")
+    print(
+        f"{path.name}: {m.n_vertices:,} vertices, {m.n_faces:,} faces, "
+        f"{len(data) / 1e6:.1f} MB; arrays identical to libigl: {same}"
+    )
     if m.report.repairs:
         print(f"  repairs: {'; '.join(m.report.repairs)}")
     print(f"  igl.read_triangle_mesh {t_igl:8.3f} s")
     print(f"  parse                  {t_parse:8.3f} s   ratio {t_parse / t_igl:5.2f}")
     print(f"  validate               {t_val:8.3f} s")
     print(f"  load_mesh              {t_load:8.3f} s   ratio {t_load / t_igl:5.2f}")
-    print(f"  pipeline ours / igl    {t_pipe_ours:8.3f} s / {t_pipe_igl:.3f} s   "
-          f"ratio {t_pipe_ours / t_pipe_igl:5.2f}")
+    print(
+        f"  pipeline ours / igl    {t_pipe_ours:8.3f} s / {t_pipe_igl:.3f} s   "
+        f"ratio {t_pipe_ours / t_pipe_igl:5.2f}"
+    )
 
 
 def main() -> None:

@@ -146,8 +146,14 @@ def bench_explicit(name: str, V, F, laplacian: str, steps: int) -> dict:
 def bench_sweep(name: str, V, F, noisy=None) -> dict:
     t0 = time.perf_counter()
     rows = denoise_sweep(
-        V, F, V_noisy=noisy, noise_levels=(0.005, 0.02, 0.05), methods=("explicit", "implicit"),
-        lams=(0.1, 0.5, 1.0), iters=(10,), seed=0,
+        V,
+        F,
+        V_noisy=noisy,
+        noise_levels=(0.005, 0.02, 0.05),
+        methods=("explicit", "implicit"),
+        lams=(0.1, 0.5, 1.0),
+        iters=(10,),
+        seed=0,
     )
     el = time.perf_counter() - t0
     return {
@@ -170,8 +176,9 @@ def _load(folder: Path, name: str):
         return None
     t0 = time.perf_counter()
     mesh = load_mesh(path)
-    sys.stderr.write(f"bench: loaded {name} ({len(mesh.V)} vertices) in "
-                     f"{time.perf_counter() - t0:.2f} s\n")
+    sys.stderr.write(
+        f"bench: loaded {name} ({len(mesh.V)} vertices) in {time.perf_counter() - t0:.2f} s\n"
+    )
     return mesh
 
 
@@ -204,8 +211,10 @@ def main(argv: list[str] | None = None) -> int:
         print("no meshes found; nothing measured")
         return 1
 
-    head = (f"| {'benchmark':<42} | {'mesh':<14} | {'n':>7} | {'ours ms':>9} | {'naive ms':>9} "
-            f"| {'ratio':>7} | {'target':<15} | ok  | notes")
+    head = (
+        f"| {'benchmark':<42} | {'mesh':<14} | {'n':>7} | {'ours ms':>9} | {'naive ms':>9} "
+        f"| {'ratio':>7} | {'target':<15} | ok  | notes"
+    )
     print(head)
     print("|" + "|".join("-" * (len(c)) for c in head.split("|")[1:]))
     for r in results:

@@ -39,8 +39,14 @@ def write(path: Path, text: str | bytes) -> Path:
 def binary_ply(V, F, *, endian="<", coord="f4", index="i4", count="u1", extra=b"") -> bytes:
     """A binary PLY written by hand (variable-length face lists allowed)."""
     fmt = "binary_little_endian" if endian == "<" else "binary_big_endian"
-    names = {"f4": "float", "f8": "double", "i4": "int", "u4": "uint", "u1": "uchar",
-             "u2": "ushort"}
+    names = {
+        "f4": "float",
+        "f8": "double",
+        "i4": "int",
+        "u4": "uint",
+        "u1": "uchar",
+        "u2": "ushort",
+    }
     head = (
         f"ply\nformat {fmt} 1.0\ncomment hand-made\nelement vertex {len(V)}\n"
         f"property {names[coord]} x\nproperty {names[coord]} y\nproperty {names[coord]} z\n"
@@ -79,8 +85,10 @@ def ascii_stl(V, F) -> str:
 
 def same_triangles(A: np.ndarray, FA: np.ndarray, B: np.ndarray, FB: np.ndarray) -> bool:
     """Same set of triangles as point triples (vertex numbering may differ)."""
+
     def key(V, F):
         return sorted(tuple(map(tuple, V[f].round(6).tolist())) for f in F)
+
     return key(A, FA) == key(B, FB)
 
 
@@ -108,8 +116,11 @@ def test_obj_slash_forms_and_negative_indices(tmp_path):
     text = "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1/4 2/5 3/6\nv 0 1 0\nf -4/1/1 -2/2/2 -1//3\n"
     mesh = load_mesh(write(tmp_path / "neg.obj", text))
     assert np.array_equal(mesh.V, SQUARE_V) and np.array_equal(mesh.F, SQUARE_F)
-    plain = load_mesh(write(tmp_path / "neg_plain.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\n"
-                            "f 1 2 3\nv 0 1 0\nf -4 -2 -1\n"))
+    plain = load_mesh(
+        write(
+            tmp_path / "neg_plain.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\nv 0 1 0\nf -4 -2 -1\n"
+        )
+    )
     assert np.array_equal(plain.F, SQUARE_F)
 
 
@@ -126,8 +137,9 @@ def test_obj_fast_and_general_paths_agree(tmp_path):
 
 
 def test_obj_polygons_triangulated_and_reported(tmp_path):
-    text = ("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nv 2 1 0\nv 3 0.5 0\n"
-            "f 1 2 3 4\nf 2 5 7 6 3\n")
+    text = (
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nv 2 1 0\nv 3 0.5 0\nf 1 2 3 4\nf 2 5 7 6 3\n"
+    )
     mesh = load_mesh(write(tmp_path / "poly.obj", text))
     assert mesh.F.tolist() == [[0, 1, 2], [0, 2, 3], [1, 4, 6], [1, 6, 5], [1, 5, 2]]
     assert mesh.face_map.tolist() == [0, 0, 1, 1, 1]
@@ -232,40 +244,60 @@ def test_unreadable_file_simulated(tmp_path, monkeypatch):
 
 
 def test_off_comments_and_polygons(tmp_path):
-    text = ("OFF\n# a comment\n5 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n2 0.5 0\n"
-            "4 0 1 2 3\n3 1 4 2  255 0 0\n")
+    text = (
+        "OFF\n# a comment\n5 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n2 0.5 0\n"
+        "4 0 1 2 3\n3 1 4 2  255 0 0\n"
+    )
     mesh = load_mesh(write(tmp_path / "p.off", text))
     assert mesh.F.tolist() == [[0, 1, 2], [0, 2, 3], [1, 4, 2]]
     assert "triangulated 1 polygon" in mesh.report.repairs[0]
 
 
 def test_off_counts_on_header_line_and_coff(tmp_path):
-    mesh = load_mesh(write(tmp_path / "a.off", "OFF 4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n"
-                                               "3 0 1 2\n3 0 2 3\n"))
+    mesh = load_mesh(
+        write(tmp_path / "a.off", "OFF 4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n")
+    )
     assert np.array_equal(mesh.V, SQUARE_V) and np.array_equal(mesh.F, SQUARE_F)
-    mesh = load_mesh(write(tmp_path / "c.off", "COFF\n4 2 0\n0 0 0 255 0 0 255\n"
-                                               "1 0 0 0 255 0 255\n1 1 0 0 0 0 255\n"
-                                               "0 1 0 9 9 9 255\n3 0 1 2\n3 0 2 3\n"))
+    mesh = load_mesh(
+        write(
+            tmp_path / "c.off",
+            "COFF\n4 2 0\n0 0 0 255 0 0 255\n"
+            "1 0 0 0 255 0 255\n1 1 0 0 0 0 255\n"
+            "0 1 0 9 9 9 255\n3 0 1 2\n3 0 2 3\n",
+        )
+    )
     assert np.array_equal(mesh.V, SQUARE_V) and np.array_equal(mesh.F, SQUARE_F)
 
 
 @pytest.mark.parametrize(
     ("text", "needle"),
     [
-        ("OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n",
-         "truncated OFF file: the header declares 4 vertices and 2 faces, but the file has only "
-         "4 vertex lines and 1 face lines"),
-        ("OFF\n5 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n",
-         "declares 5 vertices and 2 faces, but the file has only 5 vertex lines and 1 face"),
-        ("OFF\n4 1 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n",
-         "OFF header counts do not match the data: it declares 4 vertices and 1 faces, but "
-         "1 more non-empty lines follow the last face"),
-        ("OFF\n4 2\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 7\n",
-         "face 1 has index 7 but the mesh has 4 vertices"),
-        ("OFF\n4 2\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n2 0 2\n",
-         "face 1 has 2 corners; a face needs at least 3"),
-        ("OFF\n4 2\n0 0 0\n1 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n",
-         "vertex 1 has 2 coordinates; it needs 3"),
+        (
+            "OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n",
+            "truncated OFF file: the header declares 4 vertices and 2 faces, but the file has only "
+            "4 vertex lines and 1 face lines",
+        ),
+        (
+            "OFF\n5 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n",
+            "declares 5 vertices and 2 faces, but the file has only 5 vertex lines and 1 face",
+        ),
+        (
+            "OFF\n4 1 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n",
+            "OFF header counts do not match the data: it declares 4 vertices and 1 faces, but "
+            "1 more non-empty lines follow the last face",
+        ),
+        (
+            "OFF\n4 2\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 7\n",
+            "face 1 has index 7 but the mesh has 4 vertices",
+        ),
+        (
+            "OFF\n4 2\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n2 0 2\n",
+            "face 1 has 2 corners; a face needs at least 3",
+        ),
+        (
+            "OFF\n4 2\n0 0 0\n1 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n",
+            "vertex 1 has 2 coordinates; it needs 3",
+        ),
         ("PLY\n4 2\n", "not an OFF file: the first line should be 'OFF', found 'PLY'"),
         ("OFF\n", "truncated OFF header"),
         ("OFF\nfour two\n", "OFF header counts should be integers"),
@@ -299,8 +331,9 @@ def test_binary_ply_hand_made(tmp_path, endian):
 def test_binary_ply_mixed_polygons_and_uint_indices(tmp_path):
     V = np.vstack([SQUARE_V, [[2, 0.5, 0]]])
     F = [[0, 1, 2, 3], [1, 4, 2]]
-    mesh = load_mesh(write(tmp_path / "q.ply", binary_ply(V, F, coord="f8", index="u4",
-                                                          count="u1")))
+    mesh = load_mesh(
+        write(tmp_path / "q.ply", binary_ply(V, F, coord="f8", index="u4", count="u1"))
+    )
     assert mesh.F.tolist() == [[0, 1, 2], [0, 2, 3], [1, 4, 2]]
     assert np.array_equal(mesh.V, V)
 
@@ -321,30 +354,44 @@ def test_ascii_ply_general_path_extra_element(tmp_path):
         load_vertex_scalars(path, "curv")
 
 
-PLY_HEAD = ("ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
-            "property float z\nelement face 2\nproperty list uchar int vertex_indices\n"
-            "end_header\n")
+PLY_HEAD = (
+    "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+    "property float z\nelement face 2\nproperty list uchar int vertex_indices\n"
+    "end_header\n"
+)
 PLY_BODY = "0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n"
 
 
 @pytest.mark.parametrize(
     ("data", "needle"),
     [
-        (PLY_HEAD + PLY_BODY[:-8], "truncated PLY file: the header declares 4 vertices and "
-                                   "2 faces, but the data ends after 1 of the 2 face records"),
-        (PLY_HEAD + PLY_BODY + "3 1 2 3\n", "PLY header counts do not match the data: after the "
-                                            "4 vertices and 2 faces it declares, 4 more values"),
+        (
+            PLY_HEAD + PLY_BODY[:-8],
+            "truncated PLY file: the header declares 4 vertices and "
+            "2 faces, but the data ends after 1 of the 2 face records",
+        ),
+        (
+            PLY_HEAD + PLY_BODY + "3 1 2 3\n",
+            "PLY header counts do not match the data: after the "
+            "4 vertices and 2 faces it declares, 4 more values",
+        ),
         (PLY_HEAD.replace("end_header\n", ""), "no 'end_header' line"),
         ("plx\n" + PLY_HEAD[4:] + PLY_BODY, "not a PLY file"),
         (PLY_HEAD.replace("ascii", "binary_middle_endian") + PLY_BODY, "unknown format"),
         (PLY_HEAD.replace("float z", "float w") + PLY_BODY, "vertex element has no 'z'"),
-        (PLY_HEAD.replace("element face 2", "element face 0") + PLY_BODY[:24],
-         "no faces (a point cloud is not a mesh)"),
+        (
+            PLY_HEAD.replace("element face 2", "element face 0") + PLY_BODY[:24],
+            "no faces (a point cloud is not a mesh)",
+        ),
         (PLY_HEAD.replace("float x", "quaternion x") + PLY_BODY, "bad property line"),
-        (PLY_HEAD + PLY_BODY.replace("3 0 2 3", "3 0 2 4"), "face 1 has index 4 but the mesh "
-                                                            "has 4 vertices"),
-        (PLY_HEAD + PLY_BODY.replace("1 1 0", "1 1 abc"), "cannot read 'abc' as a number "
-                                                          "(vertex record 2, property 'z')"),
+        (
+            PLY_HEAD + PLY_BODY.replace("3 0 2 3", "3 0 2 4"),
+            "face 1 has index 4 but the mesh has 4 vertices",
+        ),
+        (
+            PLY_HEAD + PLY_BODY.replace("1 1 0", "1 1 abc"),
+            "cannot read 'abc' as a number (vertex record 2, property 'z')",
+        ),
         (PLY_HEAD + PLY_BODY.replace("1 1 0", "1 1 nan"), "vertex 2 has a NaN"),
     ],
 )
@@ -359,13 +406,19 @@ def test_ascii_ply_bad_files(tmp_path, data, needle):
 def test_binary_ply_truncated_and_lying(tmp_path):
     V, F = primitives.icosphere(0)
     good = binary_ply(V, F)  # face records are 1 + 3*4 = 13 bytes: cutting 40 leaves 16 whole
-    with pytest.raises(MeshError, match=r"truncated PLY file: the header declares 12 vertices "
-                                        r"and 20 faces, but the data ends after 16 of the 20 face"):
+    with pytest.raises(
+        MeshError,
+        match=r"truncated PLY file: the header declares 12 vertices "
+        r"and 20 faces, but the data ends after 16 of the 20 face",
+    ):
         load_mesh(write(tmp_path / "t.ply", good[:-40]))
     with pytest.raises(MeshError, match=r"truncated PLY file.*ends inside the vertex element"):
         load_mesh(write(tmp_path / "t2.ply", good[: good.index(b"end_header") + 50]))
-    with pytest.raises(MeshError, match=r"after the 12 vertices and 20 faces it declares, "
-                                        r"7 more bytes follow"):
+    with pytest.raises(
+        MeshError,
+        match=r"after the 12 vertices and 20 faces it declares, "
+        r"7 more bytes follow",
+    ):
         load_mesh(write(tmp_path / "l.ply", binary_ply(V, F, extra=b"garbage")))
     ok = load_mesh(write(tmp_path / "nl.ply", binary_ply(V, F, extra=b"\n")))  # lenient
     assert np.array_equal(ok.F, F)
@@ -406,17 +459,25 @@ def test_ascii_stl(tmp_path):
 @pytest.mark.parametrize(
     ("data", "needle"),
     [
-        (lambda: binary_stl(*primitives.cube())[:-30],
-         "truncated or corrupt binary STL: the header declares 12 triangles (84 + 50·12 = 684 "
-         "bytes) but the file has 654 bytes"),
+        (
+            lambda: binary_stl(*primitives.cube())[:-30],
+            "truncated or corrupt binary STL: the header declares 12 triangles (84 + 50·12 = 684 "
+            "bytes) but the file has 654 bytes",
+        ),
         (lambda: b"\x01" * 40, "too short for binary STL (40 bytes"),
-        (lambda: ascii_stl(*primitives.cube()).rsplit("vertex", 1)[0],
-         "ASCII STL facet 11 has 2 vertices; STL facets are triangles (truncated file?)"),
+        (
+            lambda: ascii_stl(*primitives.cube()).rsplit("vertex", 1)[0],
+            "ASCII STL facet 11 has 2 vertices; STL facets are triangles (truncated file?)",
+        ),
         (lambda: "solid x\nendsolid x\n", "no 'facet'"),
-        (lambda: ascii_stl(SQUARE_V, SQUARE_F).replace("vertex 1.0 1.0 0.0", "vertex 1.0 1.0"),
-         "cannot read the coordinates of vertex line 2 of facet 0"),
-        (lambda: binary_stl(np.array([[0, 0, 0], [1, 0, 0], [np.nan, 1, 0]]), [[0, 1, 2]]),
-         "triangle 0 has a NaN or infinite coordinate at corner 2"),
+        (
+            lambda: ascii_stl(SQUARE_V, SQUARE_F).replace("vertex 1.0 1.0 0.0", "vertex 1.0 1.0"),
+            "cannot read the coordinates of vertex line 2 of facet 0",
+        ),
+        (
+            lambda: binary_stl(np.array([[0, 0, 0], [1, 0, 0], [np.nan, 1, 0]]), [[0, 1, 2]]),
+            "triangle 0 has a NaN or infinite coordinate at corner 2",
+        ),
         (lambda: binary_stl(SQUARE_V, np.zeros((0, 3), int)), "0 triangles"),
     ],
 )
@@ -434,8 +495,11 @@ def test_stl_bad_files(tmp_path, data, needle):
 @pytest.mark.parametrize("ext", [".obj", ".off", ".ply", ".OBJ"])
 @pytest.mark.parametrize("prim", ["torus", "bumpy", "grid"])
 def test_round_trip_exact(tmp_path, ext, prim):
-    V, F = {"torus": primitives.torus(9, 5), "bumpy": primitives.bumpy_sphere(2),
-            "grid": primitives.grid(5, 4)}[prim]
+    V, F = {
+        "torus": primitives.torus(9, 5),
+        "bumpy": primitives.bumpy_sphere(2),
+        "grid": primitives.grid(5, 4),
+    }[prim]
     path = tmp_path / f"m{ext}"
     save_mesh(path, V, F)
     mesh = load_mesh(path)
@@ -516,8 +580,7 @@ def test_save_refuses_to_overwrite_inputs(tmp_path, monkeypatch):
     with pytest.raises(MeshError, match="refusing to overwrite"):
         save_mesh(link, V, F, overwrite_inputs=[src])
     with pytest.raises(MeshError, match="refusing to overwrite"):
-        save_scalars(tmp_path / "in.csv", [1.0],
-                     overwrite_inputs=[tmp_path / "in.csv"])
+        save_scalars(tmp_path / "in.csv", [1.0], overwrite_inputs=[tmp_path / "in.csv"])
     assert src.read_bytes() == before
 
 

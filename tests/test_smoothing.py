@@ -284,8 +284,15 @@ def test_stepper_state_history_and_reset():
     assert s.iteration == 0 and len(s.history) == 1 and s.history[0]["iteration"] == 0
     s.run(4)
     assert s.iteration == 4 and [h["iteration"] for h in s.history] == [0, 1, 2, 3, 4]
-    keys = {"iteration", "time_ms", "step_rms", "step_max", "drift_rms", "volume",
-            "volume_change_pct"}
+    keys = {
+        "iteration",
+        "time_ms",
+        "step_rms",
+        "step_max",
+        "drift_rms",
+        "volume",
+        "volume_change_pct",
+    }
     assert keys <= set(s.history[-1])
     assert s.history[-1]["volume_change_pct"] < 0  # smoothing shrinks
     assert s.history[-1]["drift_rms"] > s.history[1]["drift_rms"] > 0
@@ -358,12 +365,25 @@ def test_unreferenced_vertices_stay_put():
 def test_denoise_sweep_rows_and_improvement():
     V, F = bumpy_sphere(3)
     rows = S.denoise_sweep(
-        V, F, noise_levels=(0.002, 0.01), methods=("explicit", "implicit", "taubin"),
-        lams=(0.1, 0.5), iters=(1, 5),
+        V,
+        F,
+        noise_levels=(0.002, 0.01),
+        methods=("explicit", "implicit", "taubin"),
+        lams=(0.1, 0.5),
+        iters=(1, 5),
     )
     assert len(rows) == 2 * 3 * 2 * 2
-    required = {"noise", "method", "laplacian", "lam", "iters", "rmse", "rmse_noisy",
-                "volume_change_pct", "dihedral_mae_deg"}
+    required = {
+        "noise",
+        "method",
+        "laplacian",
+        "lam",
+        "iters",
+        "rmse",
+        "rmse_noisy",
+        "volume_change_pct",
+        "dihedral_mae_deg",
+    }
     assert all(required <= set(r) for r in rows)
     assert all(r["stable"] and not r["diverged"] for r in rows)
     best = S.best_rows(rows, "rmse")
@@ -391,8 +411,13 @@ def test_denoise_sweep_with_a_given_noisy_mesh_and_open_volume():
 def test_denoise_sweep_flags_unstable_explicit_cotan():
     V, F = bumpy_sphere(2)
     rows = S.denoise_sweep(
-        V, F, noise_levels=(0.01,), methods=("explicit",), laplacians=("cotan",),
-        lams=(1.0,), iters=(50,),
+        V,
+        F,
+        noise_levels=(0.01,),
+        methods=("explicit",),
+        laplacians=("cotan",),
+        lams=(1.0,),
+        iters=(50,),
     )
     assert not rows[0]["stable"] and rows[0]["diverged"]
     assert np.isnan(rows[0]["rmse"])
@@ -419,8 +444,23 @@ def test_cli_smooth_json_and_out(cli, tmp_path, capsys):
     V, F = bumpy_sphere(2)
     src, out = tmp_path / "in.obj", tmp_path / "out.obj"
     _write_obj(src, V, F)
-    rc = cli(["smooth", str(src), "--method", "implicit", "--laplacian", "cotan", "--lam",
-              "0.01", "--iters", "3", "--out", str(out), "--json"])
+    rc = cli(
+        [
+            "smooth",
+            str(src),
+            "--method",
+            "implicit",
+            "--laplacian",
+            "cotan",
+            "--lam",
+            "0.01",
+            "--iters",
+            "3",
+            "--out",
+            str(out),
+            "--json",
+        ]
+    )
     assert rc == 0
     r = json.loads(capsys.readouterr().out)
     assert r["iters"] == 3 and len(r["iterations"]) == 4
@@ -452,13 +492,35 @@ def test_cli_denoise_eval_json_rows_and_csv(cli, tmp_path, capsys):
     V, F = bumpy_sphere(2)
     src, csv_path = tmp_path / "c.obj", tmp_path / "t.csv"
     _write_obj(src, V, F)
-    rc = cli(["denoise-eval", str(src), "--noise", "0.005,0.01", "--lam", "0.1,0.5",
-              "--iters", "2,4", "--csv", str(csv_path), "--json"])
+    rc = cli(
+        [
+            "denoise-eval",
+            str(src),
+            "--noise",
+            "0.005,0.01",
+            "--lam",
+            "0.1,0.5",
+            "--iters",
+            "2,4",
+            "--csv",
+            str(csv_path),
+            "--json",
+        ]
+    )
     assert rc == 0
     r = json.loads(capsys.readouterr().out)
     assert len(r["rows"]) == 2 * 2 * 2 * 2
-    keys = {"noise", "method", "laplacian", "lam", "iters", "rmse", "rmse_noisy",
-            "volume_change_pct", "dihedral_mae_deg"}
+    keys = {
+        "noise",
+        "method",
+        "laplacian",
+        "lam",
+        "iters",
+        "rmse",
+        "rmse_noisy",
+        "volume_change_pct",
+        "dihedral_mae_deg",
+    }
     assert all(keys <= set(row) for row in r["rows"])
     assert csv_path.read_text().count("\n") == 1 + len(r["rows"])
     noisy = tmp_path / "n.obj"
@@ -481,8 +543,9 @@ def test_fandisk_pair_smoothing_reduces_the_error(shared_mesh):
 
     clean, noisy = load_mesh(shared_mesh("fandisk.obj")), load_mesh(shared_mesh("fandisk_ns.obj"))
     assert np.array_equal(clean.F, noisy.F)
-    rows = S.denoise_sweep(clean.V, clean.F, V_noisy=noisy.V, methods=("explicit", "taubin"),
-                           lams=(0.5,), iters=(5,))
+    rows = S.denoise_sweep(
+        clean.V, clean.F, V_noisy=noisy.V, methods=("explicit", "taubin"), lams=(0.5,), iters=(5,)
+    )
     for r in rows:
         assert r["rmse"] < 0.7 * r["rmse_noisy"]
         assert r["dihedral_mae_deg"] < 0.5 * r["dihedral_mae_noisy_deg"]

@@ -38,8 +38,10 @@ def _random_uv(s: ParametricSurface, n: int, seed: int = 0) -> tuple[np.ndarray,
     """Random parameters well inside the domain (away from poles)."""
     rng = np.random.default_rng(seed)
     u0, u1, v0, v1 = s.domain
-    return (rng.uniform(u0 + 0.05 * (u1 - u0), u1 - 0.05 * (u1 - u0), n),
-            rng.uniform(v0 + 0.05 * (v1 - v0), v1 - 0.05 * (v1 - v0), n))
+    return (
+        rng.uniform(u0 + 0.05 * (u1 - u0), u1 - 0.05 * (u1 - u0), n),
+        rng.uniform(v0 + 0.05 * (v1 - v0), v1 - 0.05 * (v1 - v0), n),
+    )
 
 
 # ------------------------------------------------------------------------------------------
@@ -183,9 +185,12 @@ def test_extremes_of_normal_curvature_are_the_principal_curvatures(
     theta, kn = normal_curvature_curve(name, u, v, 2001)
     for sign, k, t_ext in ((-1, g.k1, g.theta_max), (1, g.k2, g.theta_min)):
         t0 = theta[np.argmin(sign * kn)]
-        res = minimize_scalar(lambda t, sg=sign: sg * normal_curvature(name, u, v, t),
-                              bounds=(t0 - 0.01, t0 + 0.01), method="bounded",
-                              options={"xatol": 1e-10})
+        res = minimize_scalar(
+            lambda t, sg=sign: sg * normal_curvature(name, u, v, t),
+            bounds=(t0 - 0.01, t0 + 0.01),
+            method="bounded",
+            options={"xatol": 1e-10},
+        )
         assert sign * res.fun == pytest.approx(k, abs=1e-9)
         assert normal_curvature(name, u, v, t_ext) == pytest.approx(k, abs=1e-12)
         assert 0 <= t_ext < np.pi
@@ -228,8 +233,11 @@ def test_numeric_derivatives_match_exact(name: str, method: str) -> None:
 def test_adding_a_surface_needs_only_p() -> None:
     # elliptic paraboloid z = (a u² + b v²)/2, at the origin k = a, b along the axes
     a, b = 3.0, 0.5
-    s = ParametricSurface("paraboloid", lambda u, v: np.stack(
-        np.broadcast_arrays(u, v, (a * u * u + b * v * v) / 2), axis=-1), (-1, 1, -1, 1))
+    s = ParametricSurface(
+        "paraboloid",
+        lambda u, v: np.stack(np.broadcast_arrays(u, v, (a * u * u + b * v * v) / 2), axis=-1),
+        (-1, 1, -1, 1),
+    )
     g = point_geometry(s, 0.0, 0.0)
     assert (g.k1, g.k2, g.K, g.H) == pytest.approx((a, b, a * b, (a + b) / 2), abs=1e-9)
     assert g.classification == "elliptic"
@@ -238,9 +246,13 @@ def test_adding_a_surface_needs_only_p() -> None:
 
 def test_non_analytic_p_falls_back_to_central_differences() -> None:
     # np.real drops the complex step, so "auto" must not use it
-    s = ParametricSurface("flat-z", lambda u, v: np.stack(
-        np.broadcast_arrays(np.real(u), np.real(v), np.real(u * u + v * v) / 2), axis=-1),
-        (-1, 1, -1, 1))
+    s = ParametricSurface(
+        "flat-z",
+        lambda u, v: np.stack(
+            np.broadcast_arrays(np.real(u), np.real(v), np.real(u * u + v * v) / 2), axis=-1
+        ),
+        (-1, 1, -1, 1),
+    )
     g = point_geometry(s, 0.0, 0.0)
     assert (g.k1, g.k2) == pytest.approx((1, 1), abs=1e-8)
     assert g.classification == "umbilic"
@@ -300,8 +312,9 @@ def test_closed_surfaces_mesh_watertight(name: str, chi: int) -> None:
     # welded: no two vertices at the same place, no degenerate face
     d = np.linalg.norm(m.V[:, None] - m.V[None], axis=2) + np.eye(len(m.V))
     assert d.min() > 1e-6
-    a = np.linalg.norm(np.cross(m.V[m.F[:, 1]] - m.V[m.F[:, 0]], m.V[m.F[:, 2]] - m.V[m.F[:, 0]]),
-                       axis=1)
+    a = np.linalg.norm(
+        np.cross(m.V[m.F[:, 1]] - m.V[m.F[:, 0]], m.V[m.F[:, 2]] - m.V[m.F[:, 0]]), axis=1
+    )
     assert a.min() > 1e-6
     assert len(boundary_loops(m.F)) == 0
 
@@ -328,8 +341,9 @@ def test_mesh_keeps_uv_and_follows_the_normal(name: str) -> None:
     assert np.min(np.sum(n_exact * n_mesh, axis=1)) > 0.8  # same orientation everywhere
 
 
-@pytest.mark.parametrize("name, loops", [("helicoid", 1), ("saddle", 1), ("cylinder", 2),
-                                         ("catenoid", 2)])
+@pytest.mark.parametrize(
+    "name, loops", [("helicoid", 1), ("saddle", 1), ("cylinder", 2), ("catenoid", 2)]
+)
 def test_open_surfaces_have_their_boundary(name: str, loops: int) -> None:
     m = mesh_surface(name, 8)
     assert len(boundary_loops(m.F)) == loops
@@ -435,8 +449,26 @@ def test_plot_is_written_atomically(tmp_path) -> None:
 def test_point_geometry_to_dict_is_json() -> None:
     d = point_geometry("torus", 0.2, 0.3).to_dict()
     back = json.loads(json.dumps(d))
-    for k in ("E", "F", "G", "e", "f", "g", "K", "H", "k1", "k2", "classification",
-              "dir1", "dir2", "dir1_uv", "dir2_uv", "theta_max", "theta_min", "n"):
+    for k in (
+        "E",
+        "F",
+        "G",
+        "e",
+        "f",
+        "g",
+        "K",
+        "H",
+        "k1",
+        "k2",
+        "classification",
+        "dir1",
+        "dir2",
+        "dir1_uv",
+        "dir2_uv",
+        "theta_max",
+        "theta_min",
+        "n",
+    ):
         assert k in back
     assert len(back["dir1"]) == 3 and len(back["dir1_uv"]) == 2
 
@@ -445,8 +477,10 @@ def test_core_import_stays_light() -> None:
     import subprocess
     import sys
 
-    code = ("import sys, meshlap_core.surfaces; "
-            "print(any(m.split('.')[0] in ('matplotlib', 'polyscope') for m in sys.modules))")
+    code = (
+        "import sys, meshlap_core.surfaces; "
+        "print(any(m.split('.')[0] in ('matplotlib', 'polyscope') for m in sys.modules))"
+    )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "False"
 
@@ -479,8 +513,9 @@ def test_cli_errors(capsys) -> None:
 
 def test_cli_plot_mesh_and_convergence(tmp_path, capsys) -> None:
     png, obj = tmp_path / "kn.png", tmp_path / "torus.obj"
-    code, out, _ = _cli(capsys, "torus", "--plot", str(png), "--mesh", str(obj), "--res", "12,8",
-                        "--json")
+    code, out, _ = _cli(
+        capsys, "torus", "--plot", str(png), "--mesh", str(obj), "--res", "12,8", "--json"
+    )
     assert code == 0
     d = json.loads(out)
     assert d["mesh"]["n_vertices"] == 96 and d["mesh"]["n_faces"] == 192
@@ -489,8 +524,9 @@ def test_cli_plot_mesh_and_convergence(tmp_path, capsys) -> None:
     m = mesh_surface("torus", (12, 8))
     np.testing.assert_allclose(back.V, m.V, atol=1e-12)
     np.testing.assert_array_equal(back.F, m.F)
-    code, out, err = _cli(capsys, "sphere", "--convergence", "--res", "1,2", "--mesher",
-                          "icosphere", "--json")
+    code, out, err = _cli(
+        capsys, "sphere", "--convergence", "--res", "1,2", "--mesher", "icosphere", "--json"
+    )
     assert code == 0
     d = json.loads(out)
     assert d["n_vertices"] == [42, 162]

@@ -114,8 +114,11 @@ def test_huge_coordinates_are_an_error_not_nans_later():
 
 def test_all_faces_degenerate_is_fatal():
     V = np.array([[0.0, 0, 0], [1, 0, 0], [2, 0, 0], [3, 0, 0]])  # collinear
-    with pytest.raises(MeshError, match=r"flat\.obj: all 3 faces are degenerate \(1 with a "
-                                        r"repeated vertex, 2 with zero area\)"):
+    with pytest.raises(
+        MeshError,
+        match=r"flat\.obj: all 3 faces are degenerate \(1 with a "
+        r"repeated vertex, 2 with zero area\)",
+    ):
         validate_mesh(V, [[0, 1, 2], [1, 2, 3], [0, 0, 1]], "flat.obj")
 
 
@@ -259,8 +262,7 @@ def test_bowtie_vertex():
 
 def test_two_closed_cones_pinched_at_a_vertex():
     # two tetrahedra sharing vertex 0: every edge has two faces, but vertex 0 has two fans
-    V = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [-1, 0, 0], [0, -1, 0],
-                  [0, 0, -1]])
+    V = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [-1, 0, 0], [0, -1, 0], [0, 0, -1]])
     tet = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
     F = np.vstack([tet, np.where(tet == 0, 0, tet + 3)])
     r = validate_mesh(V, F).report
