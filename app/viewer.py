@@ -10,6 +10,8 @@ updates where the connectivity is unchanged, never re-registration per frame).
 
 from __future__ import annotations
 
+import os
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -44,18 +46,27 @@ BOUNDARY_RULES = ("pi", "2pi", "zero")
 RED = (1.0, 0.35, 0.35, 1.0)
 
 
+NO_DISPLAY = (
+    "no display could be opened for the viewer window; render headless with "
+    "`meshlap view MESH --screenshot out.png`"
+)
+
+
 def _init(backend: str) -> None:
+    if (
+        backend == "auto"
+        and sys.platform.startswith("linux")
+        and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+    ):
+        # say so before polyscope tries: a failed init leaves a noisy atexit hook behind
+        raise MeshError(NO_DISPLAY, "view")
     if backend in ("openGL3_egl", "openGL_mock"):
         ps.set_allow_headless_backends(True)
     try:
         ps.init(backend)
     except RuntimeError as exc:
         if backend == "auto":
-            raise MeshError(
-                "no display could be opened for the viewer window; render headless with "
-                "`meshlap view MESH --screenshot out.png`",
-                "view",
-            ) from exc
+            raise MeshError(NO_DISPLAY, "view") from exc
         raise MeshError(f"polyscope could not start its {backend} backend: {exc}", "view") from exc
     if backend in ("openGL3_egl", "openGL_mock"):
         # headless: render every requested frame (the default mode skips frames to hold 60 fps,

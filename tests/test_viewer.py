@@ -184,3 +184,20 @@ def test_picking_a_projected_vertex_selects_its_one_ring(tmp_path):
     out = json.loads(res.stdout.strip().splitlines()[-1])
     assert out["front"] and out["hit"]
     assert out["vertex"] == target
+
+
+def test_no_display_is_one_clear_error(tmp_path):
+    env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
+    res = subprocess.run(
+        [sys.executable, "-m", "meshlap_core.cli", "view"],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        cwd=tmp_path,
+        env=env,
+    )
+    if sys.platform.startswith("linux"):
+        assert res.returncode == 2
+        lines = [ln for ln in res.stderr.splitlines() if not ln.startswith("[polyscope]")]
+        assert lines == [lines[0]] and lines[0].startswith("meshlap: error: view: no display")
+        assert "--screenshot" in lines[0]
