@@ -40,7 +40,14 @@ class SmoothingState:
         try:
             start = add_noise(V, F, self.noise_alpha, seed=self.seed) if self.noise_alpha else V
             self.smoother = Smoother(
-                start, F, self.method, self.laplacian, self.lam, reference=V, warn=False
+                start,
+                F,
+                self.method,
+                self.laplacian,
+                self.lam,
+                reference=V,
+                warn=False,
+                history_limit=1000,  # the panel reads only the last entry; playing never grows
             )
         except MeshError as exc:
             self.error = str(exc)

@@ -56,8 +56,9 @@ class SpectralState:
             basis = SpectralBasis.compute(V, F, k, progress=self._progress)
             errors = basis.errors()  # every k at once (cumulative sums)
             basis.reconstruct(max(1, k // 2))  # builds the slider's checkpoints off the UI thread
-        except (MeshError, MemoryError, RuntimeError) as exc:
-            self.error = str(exc)
+        except Exception as exc:  # a worker must report, never die silently
+            self.error = str(exc) if isinstance(exc, MeshError) else f"{type(exc).__name__}: {exc}"
+            self.message = ""
             return
         with self._lock:
             self._pending = (basis, errors)

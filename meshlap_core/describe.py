@@ -7,7 +7,6 @@ from typing import Any
 import numpy as np
 
 from . import topology
-from .errors import MeshError
 from .laplacian import face_areas
 from .types import FloatArray, IntArray, as_mesh
 
@@ -35,35 +34,28 @@ def mesh_info(
     V, F = as_mesh(V, F)
     n, m = len(V), len(F)
     lo, hi = V.min(axis=0), V.max(axis=0)
-    n_comp, _ = topology.connected_components(F, n)
-    E, count = topology.edge_face_counts(F)
+    summary = topology.surface_summary(F, n)
     info: dict[str, Any] = {
         "file": source,
         "n_vertices": n,
         "n_faces": m,
-        "n_edges": len(E),
+        "n_edges": summary["n_edges"],
         "bbox_min": lo.tolist(),
         "bbox_max": hi.tolist(),
         "bbox_diagonal": float(np.linalg.norm(hi - lo)),
         "surface_area": float(face_areas(V, F).sum()),
-        "n_components": n_comp,
-        "n_boundary_edges": int(np.sum(count == 1)),
-        "n_nonmanifold_edges": int(np.sum(count > 2)),
-        "euler_characteristic": topology.euler_characteristic(F),
+        "n_components": summary["n_components"],
+        "n_boundary_edges": summary["n_boundary_edges"],
+        "n_nonmanifold_edges": summary["n_nonmanifold_edges"],
+        "euler_characteristic": summary["euler_characteristic"],
+        "n_boundary_loops": summary["n_boundary_loops"],
+        "boundary_loop_lengths": summary["boundary_loop_lengths"],
     }
-    try:
-        loops = topology.boundary_loops(F)
-        info["n_boundary_loops"] = len(loops)
-        info["boundary_loop_lengths"] = [len(lp) for lp in loops]
-    except MeshError as exc:
-        info["n_boundary_loops"] = None
-        info["boundary_loop_lengths"] = None
-        info["boundary_note"] = exc.problem
-    try:
-        info["genus"] = topology.genus(F)
-    except MeshError as exc:
-        info["genus"] = None
-        info["genus_note"] = exc.problem
+    if "boundary_note" in summary:
+        info["boundary_note"] = summary["boundary_note"]
+    info["genus"] = summary["genus"]
+    if "genus_note" in summary:
+        info["genus_note"] = summary["genus_note"]
     info["closed"] = info["n_boundary_edges"] == 0
     if report is not None:
         info["n_nonmanifold_vertices"] = int(report.n_nonmanifold_vertices)
@@ -98,7 +90,7 @@ def format_info(info: dict[str, Any]) -> str:
         f"components        {info['n_components']}",
         f"boundary loops    {info['n_boundary_loops']}"
         + (
-            f" (lengths {info['boundary_loop_lengths']})"
+            f" (lengths {_short_list(info['boundary_loop_lengths'])})"
             if info.get("boundary_loop_lengths")
             else ""
         ),
@@ -124,3 +116,11 @@ def format_info(info: dict[str, Any]) -> str:
     for w in info.get("warnings", []):
         lines.append(f"warning           {w}")
     return "\n".join(lines)
+
+
+def _short_list(values: list[Any], shown: int = 10) -> str:
+    """``[3, 4, 5]``, or the first ``shown`` values and how many more (``--json`` has all)."""
+    if len(values) <= shown:
+        return str(list(values))
+    head = ", ".join(str(v) for v in values[:shown])
+    return f"[{head}, ... {len(values) - shown:,} more]"

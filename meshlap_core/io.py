@@ -91,6 +91,7 @@ def load_mesh(path: PathLike, *, repair: bool = True) -> Mesh:
     """
     p, src, data = _read_input(path)
     parsed = _parse(p.suffix.lower(), data, src)
+    del data  # the parsed arrays are copies: free the file's bytes before validating
     return validate_mesh(
         parsed.V,
         parsed.faces,
@@ -150,6 +151,16 @@ def _read_input(path: PathLike) -> tuple[Path, str, bytes]:
         what = f"unknown mesh format {p.suffix!r}" if ext else "the file name has no extension"
         raise MeshError(f"{what}; supported formats: {', '.join(MESH_FORMATS)}", src)
     try:
+        mode = p.stat().st_mode
+    except OSError as exc:
+        raise MeshError(f"cannot read the file: {exc.strerror or exc}", src) from None
+    if not stat.S_ISREG(mode):
+        # a FIFO would block forever, /dev/zero would never end
+        kind = ("a named pipe (FIFO)" if stat.S_ISFIFO(mode)
+                else "a device" if stat.S_ISCHR(mode) or stat.S_ISBLK(mode)
+                else "a socket" if stat.S_ISSOCK(mode) else "a special file")
+        raise MeshError(f"not a regular file ({kind}); meshlap reads mesh files only", src)
+    try:
         data = p.read_bytes()
     except PermissionError:
         raise MeshError("cannot read the file: permission denied", src) from None
@@ -176,6 +187,8 @@ def _parse(ext: str, data: bytes, src: str) -> _Parsed:
 
 
 _TEXT_BYTES = bytes(range(9, 14)) + bytes(range(32, 256))  # all but control characters
+# |index| at or above this cannot be a vertex index (and would overflow int64 arithmetic)
+_HUGE_INDEX = 2**53
 
 
 def _check_text(arr: np.ndarray, src: str, what: str, offset: int = 0) -> None:
@@ -301,6 +314,8 @@ def _parse_obj_fast(data: bytes, arr: np.ndarray, src: str) -> _Parsed | None:
     vals = _bulk_numbers(fbuf.tobytes(), np.int64)
     if vals is None or vals.size != int(sizes.sum()):
         return None
+    if vals.size and (vals.max() >= _HUGE_INDEX or vals.min() <= -_HUGE_INDEX):
+        return None  # numpy saturates huge integers; the general parser quotes them as written
     if b"-" in ftext and np.any(vals < 0):  # relative indices: -1 is the latest vertex
         nv_before = np.cumsum(is_v)[np.flatnonzero(is_f)]
         per_value = np.repeat(nv_before, sizes)
@@ -421,6 +436,12 @@ def _parse_obj_general(data: bytes, src: str) -> _Parsed:
                         "start at 1",
                         src,
                     )
+                if abs(i) >= _HUGE_INDEX:
+                    raise MeshError(
+                        f"line {ln}: face {len(sizes)} refers to vertex {head} (far beyond "
+                        "any vertex count)",
+                        src,
+                    )
                 if i < 0:
                     if nv_sofar + i < 0:
                         raise MeshError(
@@ -509,7 +530,8 @@ def _parse_off(data: bytes, src: str) -> _Parsed:
             vals = _bulk_numbers(body.tobytes(), np.float64)
             if vals is not None and vals.size == 3 * nv + 4 * nf:
                 fv = vals[3 * nv:].reshape(nf, 4)
-                if np.all(fv[:, 0] == 3) and np.all(np.mod(fv[:, 1:], 1) == 0):
+                if (np.all(fv[:, 0] == 3) and np.all(np.mod(fv[:, 1:], 1) == 0)
+                        and np.abs(fv[:, 1:]).max() < _HUGE_INDEX):
                     return _Parsed(V=vals[: 3 * nv].reshape(nv, 3),
                                    faces=fv[:, 1:].astype(np.int64))
     return _parse_off_general(data[body_start:], nv, nf, src)
@@ -561,6 +583,9 @@ def _parse_off_general(body: bytes, nv: int, nf: int, src: str) -> _Parsed:
             raise MeshError(f"face {k} has {c} corners; a face needs at least 3", src)
         if len(idx) < c:
             raise MeshError(f"face {k} declares {c} corners but lists {len(idx)}", src)
+        big = [i for i in idx if abs(i) >= _HUGE_INDEX]
+        if big:
+            raise MeshError(f"face {k} has index {big[0]} (far beyond any vertex count)", src)
         flat.extend(idx)
         sizes.append(c)
     vals = np.asarray(flat, dtype=np.int64)
@@ -608,6 +633,8 @@ def _ply_header(data: bytes, src: str) -> tuple[str, list[_PlyElement], int]:
         if not parts or parts[0] in ("ply", "comment", "obj_info"):
             continue
         if parts[0] == "format":
+            if fmt is not None:
+                raise MeshError(f"PLY header line {ln}: a second 'format' line", src)
             if len(parts) < 2 or parts[1] not in (
                 "ascii", "binary_little_endian", "binary_big_endian"
             ):
@@ -651,6 +678,8 @@ def _ply_mesh_parts(elements: list[_PlyElement], src: str) -> tuple[_PlyElement,
     for c in "xyz":
         if c not in names:
             raise MeshError(f"the PLY vertex element has no '{c}' property", src)
+        if any(p.name == c and p.count_dtype is not None for p in vert.props):
+            raise MeshError(f"the PLY vertex property '{c}' is a list, not a number", src)
     if face is None or face.count == 0:
         raise MeshError("the PLY file has no faces (a point cloud is not a mesh)", src)
     lists = [p for p in face.props if p.count_dtype is not None]
@@ -677,7 +706,7 @@ def _parse_ply(data: bytes, src: str) -> _Parsed:
     vv = values["vertex"]
     V = np.stack([np.asarray(vv[c], dtype=np.float64) for c in "xyz"], axis=1)
     props = {
-        p.name: np.asarray(vv[p.name], dtype=np.float64)
+        p.name: np.array(vv[p.name], dtype=np.float64)  # a copy, not a view of the file's bytes
         for p in vert.props
         if p.count_dtype is None
     }
@@ -702,6 +731,9 @@ def _ply_read_binary(data: bytes, pos: int, elements: list[_PlyElement], bo: str
     out: dict[str, dict[str, Any]] = {}
     total = len(data)
     for el in elements:
+        if not el.props:  # an element without properties has no data
+            out[el.name] = {}
+            continue
         if all(p.count_dtype is None for p in el.props):
             dt = np.dtype([(p.name, bo + p.dtype) for p in el.props])
             need = dt.itemsize * el.count
@@ -748,8 +780,12 @@ def _ply_binary_list_element(data: bytes, pos: int, el: _PlyElement, bo: str,
         if q + cdt.itemsize > total:
             raise MeshError(_truncated_msg(elements, el, total - pos, q + cdt.itemsize - pos), src)
         c = int(np.frombuffer(data, dtype=cdt, count=1, offset=q)[0])
+        if c < 0:
+            raise MeshError(f"{el.name} record 0 has a list of negative length {c}", src)
         lens.append(c)
         q += cdt.itemsize + c * np.dtype(p.dtype).itemsize
+        if q > total:
+            raise MeshError(_truncated_at(elements, el, 0), src)
     fields = []
     li = 0
     for p in el.props:
@@ -799,6 +835,9 @@ def _ply_binary_list_element(data: bytes, pos: int, el: _PlyElement, bo: str,
                 if pos + cdt.itemsize > total:
                     raise MeshError(_truncated_at(elements, el, r), src)
                 c = int(np.frombuffer(data, cdt, 1, pos)[0])
+                if c < 0:
+                    raise MeshError(f"{el.name} record {r} has a list of negative length {c}",
+                                    src)
                 pos += cdt.itemsize
                 if pos + c * idt.itemsize > total:
                     raise MeshError(_truncated_at(elements, el, r), src)
@@ -834,7 +873,7 @@ def _ply_read_ascii(data: bytes, pos: int, elements: list[_PlyElement],
         lists: dict[str, tuple[list[float], list[int]]] = {
             p.name: ([], []) for p in el.props if p.count_dtype is not None
         }
-        for r in range(el.count):
+        for r in range(el.count if el.props else 0):  # an element without properties has no data
             for p in el.props:
                 try:
                     if p.count_dtype is None:
@@ -842,6 +881,10 @@ def _ply_read_ascii(data: bytes, pos: int, elements: list[_PlyElement],
                         k += 1
                     else:
                         c = int(tokens[k])
+                        if c < 0:
+                            raise MeshError(
+                                f"{el.name} record {r} has a list of negative length {c}", src
+                            )
                         vals = [float(t) for t in tokens[k + 1: k + 1 + c]]
                         if len(vals) < c:
                             raise IndexError
@@ -864,6 +907,12 @@ def _ply_read_ascii(data: bytes, pos: int, elements: list[_PlyElement],
         for kk, (vs, cs) in lists.items():
             arr = np.asarray(vs, dtype=np.float64)
             if arr.size and np.all(np.mod(arr, 1) == 0):
+                if np.abs(arr).max() >= _HUGE_INDEX:
+                    raise MeshError(
+                        f"the {el.name} property {kk!r} has the value {np.abs(arr).max():.6g}, "
+                        "far beyond any vertex count",
+                        src,
+                    )
                 arr = arr.astype(np.int64)
             vals_out[kk] = (arr, np.asarray(cs, dtype=np.int64))
         out[el.name] = vals_out
@@ -894,7 +943,8 @@ def _ply_ascii_fast(body: np.ndarray, elements: list[_PlyElement]
         return None
     vv = vals[: k * nv].reshape(nv, k)
     ff = vals[k * nv:].reshape(nf, 4)
-    if not np.all(ff[:, 0] == 3) or not np.all(np.mod(ff[:, 1:], 1) == 0):
+    if (not np.all(ff[:, 0] == 3) or not np.all(np.mod(ff[:, 1:], 1) == 0)
+            or (nf and np.abs(ff[:, 1:]).max() >= _HUGE_INDEX)):
         return None
     return {
         "vertex": {p.name: vv[:, i] for i, p in enumerate(vert.props)},
@@ -1013,6 +1063,41 @@ def _check_output_path(path: PathLike, overwrite_inputs: Iterable[PathLike]) -> 
             raise MeshError(
                 "refusing to overwrite an input file; choose a different output path",
                 os.fspath(target),
+            )
+    return target
+
+
+def check_output_path(path: PathLike, overwrite_inputs: Iterable[PathLike] = (),
+                      suffixes: Iterable[str] | None = None) -> Path:
+    """Check an output path before any work is done (commands call it first, so that a
+    doomed run fails in a second and leaves nothing behind).
+
+    Parameters
+    ----------
+    path : str or PathLike
+    overwrite_inputs : iterable of path
+        Inputs the output must not replace.
+    suffixes : iterable of str, optional
+        Allowed extensions (lowercase, with the dot).
+
+    Returns
+    -------
+    path : Path
+
+    Raises
+    ------
+    MeshError
+        Empty path, a missing directory (named), a directory as target, an input as target,
+        or an extension not in ``suffixes``.
+    """
+    target = _check_output_path(path, overwrite_inputs)
+    if suffixes is not None:
+        allowed = tuple(suffixes)
+        if target.suffix.lower() not in allowed:
+            raise MeshError(
+                f"unsupported output type {target.suffix or '(none)'!r}; use "
+                f"{', '.join(allowed)}",
+                os.fspath(path),
             )
     return target
 

@@ -38,10 +38,14 @@ SGP 2012 (stiffness frozen, mass recomputed).
 
 from __future__ import annotations
 
+import contextlib
+import ctypes
 import math
+import os
+import sys
 import time
 import warnings
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import asdict, dataclass
 from typing import Any, Literal
 
@@ -190,8 +194,9 @@ def most_negative_eigenvalue(
     mu_min : float
         ``<= 0``.
     exact : bool
-        ``False`` when Lanczos did not converge and the Gershgorin bound
-        ``−max_i Σ_j |K_ij| / W_i`` (never above the true value) is returned instead.
+        ``False`` when Lanczos did not converge within its work budget (about ``3e8``
+        multiply-adds, a second or two) and the Gershgorin bound ``−max_i Σ_j |K_ij| / W_i``
+        (never above the true value) is returned instead.
 
     Notes
     -----
@@ -210,13 +215,33 @@ def most_negative_eigenvalue(
     if len(idx) <= 400:
         ev = np.linalg.eigvalsh(S.toarray())
         return -float(max(ev[-1], 0.0)), True
+    # bounded work: about 3e8 multiply-adds (a second or two whatever the mesh), then the
+    # Gershgorin bound; a clustered top of the spectrum (a perfectly regular grid) can otherwise
+    # keep ARPACK busy for minutes on a million vertices
+    budget = max(50, int(_EIGEN_WORK // (S.nnz + 20 * len(idx))))
+    calls = [0]
+
+    def matvec(x: FloatArray) -> FloatArray:
+        calls[0] += 1
+        if calls[0] > budget:
+            raise _OverBudget
+        return S @ x
+
+    op = sla.LinearOperator(S.shape, matvec=matvec, dtype=np.float64)
     try:
         ev = sla.eigsh(
-            S, k=1, which="LA", tol=tol, return_eigenvectors=False, maxiter=20 * len(idx)
+            op, k=1, which="LA", tol=tol, return_eigenvectors=False, maxiter=20 * len(idx)
         )
-    except sla.ArpackNoConvergence:
+    except (sla.ArpackNoConvergence, _OverBudget):
         return bound, False
     return -float(max(ev[0], 0.0)), True
+
+
+_EIGEN_WORK = 3e8  # multiply-adds most_negative_eigenvalue may spend before giving the bound
+
+
+class _OverBudget(Exception):
+    """The eigensolver used up its work budget."""
 
 
 def amplification_curve(
@@ -347,6 +372,8 @@ def _stability_from_mu(
             nu = taubin_mu(lam, k_pb)
         gain = _taubin_gain(lam, nu, mu_min)
         kpb = 1.0 / lam + 1.0 / nu
+        if not kpb > 0:  # 1/lam + 1/nu cancelled to 0 (k_pb far below 1/lam): use the known one
+            kpb = k_pb
         candidates = [1.0, abs(gain)]
         if 0 < kpb / 2 < k:  # the parabola's peak (the amplified pass band)
             candidates.append(abs(_taubin_gain(lam, nu, -kpb / 2)))
@@ -375,6 +402,8 @@ def _taubin_max_lam(k: float, kpb: float) -> float | None:
         nu = 1.0 / (kpb - 1.0 / lam)
         return _taubin_gain(lam, nu, -k) + 1.0
 
+    if not kpb > 0 or not math.isfinite(1.0 / kpb):
+        return None
     hi = (1.0 / kpb) * (1 - 1e-9)
     if h(hi) >= 0:
         return None
@@ -464,10 +493,59 @@ def _resolve_nu(method: str, lam: float, nu: float | None, k_pb: float) -> float
 # --------------------------------------------------------------------------- linear solver
 
 
+def _surely_positive_definite(A: sp.csr_matrix, margin: float = 1e-8) -> bool:
+    """True when the Jacobi-scaled ``D^-1/2 A D^-1/2`` is diagonally dominant by ``margin``.
+
+    Then all its eigenvalues are at least ``margin`` (Gershgorin) and a Cholesky factorization
+    cannot fail; ``False`` means "not proven" (the factorization may still succeed).
+    """
+    d = A.diagonal()
+    if len(d) == 0:
+        return True
+    if not np.all(d > 0):
+        return False
+    s = 1.0 / np.sqrt(d)
+    B = abs(A).tocsr()
+    off = np.asarray((sp.diags(s) @ B @ sp.diags(s)).sum(axis=1)).ravel() - 1.0
+    return bool(np.all(off <= 1.0 - margin))
+
+
+@contextlib.contextmanager
+def quiet_c_stdout() -> Iterator[None]:
+    """Silence what C libraries print on the process's standard output (file descriptor 1).
+
+    CHOLMOD (inside ``cholespy``) prints ``CHOLMOD warning: not positive definite`` with
+    ``printf`` before the Python exception is raised; on a ``--json`` command that line would
+    corrupt the output. Python's own ``sys.stdout`` is flushed first and is unaffected.
+    """
+    try:
+        sys.stdout.flush()
+        saved = os.dup(1)
+    except (OSError, ValueError):  # no real descriptor 1 (embedded interpreter)
+        yield
+        return
+    libc = None
+    with contextlib.suppress(OSError, AttributeError):
+        libc = ctypes.CDLL(None)
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(devnull, 1)
+        yield
+    finally:
+        if libc is not None:
+            with contextlib.suppress(Exception):
+                libc.fflush(None)  # drop C stdio's buffered copy of the message too
+        os.dup2(saved, 1)
+        os.close(saved)
+        os.close(devnull)
+
+
 class _SPDSolver:
     """Sparse Cholesky factorization of a symmetric positive definite matrix, reused per solve.
 
     Uses ``cholespy`` (CHOLMOD); falls back to SciPy's SuperLU when cholespy is unavailable.
+    A matrix that is not provably positive definite is factorized with the C standard output
+    silenced (:func:`quiet_c_stdout`), so CHOLMOD's complaint never reaches the user's output.
     """
 
     def __init__(self, A: sp.spmatrix) -> None:
@@ -482,18 +560,19 @@ class _SPDSolver:
             self._chol = None
             return
         self._lu = None
+        quiet = contextlib.nullcontext() if _surely_positive_definite(A) else quiet_c_stdout()
         try:
-            self._chol = CholeskySolverD(
-                self.n,
-                np.ascontiguousarray(A.indptr, dtype=np.int32),
-                np.ascontiguousarray(A.indices, dtype=np.int32),
-                np.ascontiguousarray(A.data, dtype=np.float64),
-                MatrixType.CSR,
-            )
-        except ValueError as exc:
+            with quiet:
+                self._chol = CholeskySolverD(
+                    self.n,
+                    np.ascontiguousarray(A.indptr, dtype=np.int32),
+                    np.ascontiguousarray(A.indices, dtype=np.int32),
+                    np.ascontiguousarray(A.data, dtype=np.float64),
+                    MatrixType.CSR,
+                )
+        except ValueError:
             raise MeshError(
-                f"the smoothing system is not positive definite ({exc}); the mesh may have "
-                "degenerate faces", "mesh"
+                "the implicit smoothing system is not numerically positive definite", "mesh"
             ) from None
 
     def solve(self, B: FloatArray) -> FloatArray:
@@ -546,6 +625,11 @@ class Smoother:
         Clean positions; the history then also records ``rmse`` against them.
     track_history : bool
         Record a metrics dict per iteration in :attr:`history` (cheap: O(n + m)).
+    history_limit : int, optional
+        Keep at most this many entries: the input's (``history[0]``) and the latest
+        ``history_limit − 1`` iterations (each entry carries its ``iteration``). An interactive
+        stepper that runs without end should set it (about 0.5 kB per entry); ``None`` (the
+        default) keeps every entry.
     warn : bool
         Emit a :class:`MeshWarning` when an explicit or Taubin ``λ`` is unstable on this mesh.
 
@@ -554,7 +638,8 @@ class Smoother:
     iteration : int
         Iterations done since construction or :meth:`reset`.
     history : list of dict
-        ``history[k]`` describes the mesh after ``k`` iterations (``history[0]`` the input):
+        ``history[k]`` describes the mesh after ``k`` iterations (``history[0]`` the input;
+        with ``history_limit`` only the latest iterations are kept, so use ``iteration``):
         ``iteration``, ``time_ms`` (the step alone), ``step_rms``/``step_max`` (displacement of
         this step), ``drift_rms`` (from the input), ``volume`` and ``volume_change_pct`` (both
         ``None`` on open meshes, see :attr:`volume_note`), and ``rmse`` with a reference.
@@ -595,9 +680,13 @@ class Smoother:
         area: str = "voronoi",
         reference: FloatArray | None = None,
         track_history: bool = True,
+        history_limit: int | None = None,
         warn: bool = True,
     ) -> None:
         self.V0, self.F = as_mesh(V, F)
+        if history_limit is not None and check_iters(history_limit, "history_limit") < 2:
+            raise MeshError(f"must be at least 2, got {history_limit}", "history_limit")
+        self.history_limit = history_limit
         self.n = len(self.V0)
         self.method = _check_choice(method, METHODS, "method")
         self.laplacian = _check_choice(laplacian, LAPLACIANS, "laplacian")
@@ -639,7 +728,7 @@ class Smoother:
         W, K = operator_parts(self.V0, self.F, self.laplacian, self.area)
         self._W0, self._K = W, K
         self.k_pb = self.pass_band * _diagonal_scale(W, K)
-        self.taubin_nu = _resolve_nu(self.method, self.lam, taubin_nu, self.k_pb)
+        self.taubin_nu = self._nu_for(self.lam)
         fixed = (
             boundary_vertex_mask(self.F, self.n) if self.fix_boundary
             else np.zeros(self.n, dtype=bool)
@@ -689,8 +778,9 @@ class Smoother:
         lam = check_lam(lam)
         if lam == self.lam:
             return
+        nu = self._nu_for(lam)
         self.lam = lam
-        self.taubin_nu = _resolve_nu(self.method, lam, self._nu_given, self.k_pb)
+        self.taubin_nu = nu
         self._stability = None
 
     def reset(self) -> None:
@@ -734,6 +824,8 @@ class Smoother:
         self.iteration += 1
         if self.track_history:
             self.history.append(self._metrics(new, old, elapsed))
+            if self.history_limit is not None and len(self.history) > self.history_limit:
+                del self.history[1]  # keep the input's entry and the latest ones
         return self.V
 
     def run(self, n: int) -> FloatArray:
@@ -746,6 +838,21 @@ class Smoother:
         return self.V
 
     # ---------------------------------------------------------------- internals
+
+    def _nu_for(self, lam: float) -> float | None:
+        """Taubin's ``ν`` for ``λ`` (``None`` for the other methods), with a useful message."""
+        try:
+            return _resolve_nu(self.method, lam, self._nu_given, self.k_pb)
+        except MeshError as exc:
+            if exc.source != "pass_band":
+                raise
+            raise MeshError(
+                f"Taubin's pass band k_PB = pass_band x mean(-L_ii) = {self.pass_band:g} x "
+                f"{self.k_pb / self.pass_band:.3g} = {self.k_pb:.3g} must be below 1/lam = "
+                f"{1.0 / lam:.3g}; use lam below {1.0 / self.k_pb:.3g} or a smaller pass band",
+                "pass_band",
+            ) from None
+
 
     def _warn_if_unstable(self) -> None:
         """Warn about an unstable explicit/Taubin λ; cheap (Gershgorin) unless near the limit."""
@@ -790,7 +897,17 @@ class Smoother:
         if self._solver is None or self._solver_key != key:
             Wf = self._W[free]
             A = (sp.diags(Wf) - self.lam * self._K_ff).tocsr()
-            self._solver = _SPDSolver(A)
+            try:
+                self._solver = _SPDSolver(A)
+            except MeshError:
+                stiff = float(np.max(-self._K_ff.diagonal() / Wf)) if len(free) else 0.0
+                raise MeshError(
+                    f"the implicit system W - lam K cannot be factorized: lam = {self.lam:g} "
+                    f"times the stiffest vertex's -L_ii = {stiff:.3g} is {self.lam * stiff:.3g}, "
+                    "beyond double precision (use a smaller lam, or rescale the mesh; the cotan "
+                    "lam is in units of length²)",
+                    "lam",
+                ) from None
             self._solver_key = key
             self.n_factorizations += 1
             self._rhs_fixed = (
@@ -939,8 +1056,10 @@ def denoise_sweep(
         ``noise``, ``method``, ``laplacian``, ``lam``, ``iters``, ``rmse``, ``rmse_noisy``,
         ``max_error``, ``volume_change_pct`` (vs the clean volume; ``None`` on open meshes),
         ``volume_change_noisy_pct``, ``dihedral_mae_deg``, ``dihedral_mae_noisy_deg``,
-        ``normal_dev_deg``, ``normal_dev_noisy_deg``, ``stable``, ``diverged``, ``seconds``
-        (smoothing time up to this checkpoint). Metrics of a diverged run are NaN.
+        ``normal_dev_deg``, ``normal_dev_noisy_deg``, ``stable``, ``diverged``, ``failed``
+        (``None``, or why this combination could not run, e.g. a Taubin pass band above
+        ``1/λ`` or an implicit system beyond double precision), ``seconds`` (smoothing time up
+        to this checkpoint). Metrics of a diverged or failed run are NaN.
     """
     V_clean, F = as_mesh(V_clean, F)
     for m in methods:
@@ -973,19 +1092,27 @@ def denoise_sweep(
         for lap in laplacians:
             for method in methods:
                 for lam in lam_list:
-                    with warnings.catch_warnings():
-                        warnings.simplefilter("ignore", MeshWarning)
-                        s = Smoother(
-                            Vn, F, method, lap, lam,  # type: ignore[arg-type]
-                            area=area, track_history=False, warn=False,
-                        )
-                    stable = _quick_stable(s)
+                    failed: str | None = None
+                    try:
+                        with warnings.catch_warnings():
+                            warnings.simplefilter("ignore", MeshWarning)
+                            s = Smoother(
+                                Vn, F, method, lap, lam,  # type: ignore[arg-type]
+                                area=area, track_history=False, warn=False,
+                            )
+                        stable = _quick_stable(s)
+                    except MeshError as exc:
+                        failed, stable = exc.problem, False
                     elapsed = 0.0
                     for k in iter_list:
-                        t0 = time.perf_counter()
-                        s.run(k - s.iteration)
-                        elapsed += time.perf_counter() - t0
-                        if s.diverged:
+                        if failed is None:
+                            t0 = time.perf_counter()
+                            try:
+                                s.run(k - s.iteration)
+                            except MeshError as exc:
+                                failed = exc.problem
+                            elapsed += time.perf_counter() - t0
+                        if failed is not None or s.diverged:
                             got: dict[str, Any] = {
                                 key: float("nan")
                                 for key in ("rmse", "max_error", "volume_change_pct",
@@ -1010,14 +1137,16 @@ def denoise_sweep(
                                 "normal_dev_deg": got["normal_dev_deg"],
                                 "normal_dev_noisy_deg": base["normal_dev_deg"],
                                 "stable": stable,
-                                "diverged": bool(s.diverged),
+                                "diverged": failed is None and bool(s.diverged),
+                                "failed": failed,
                                 "seconds": elapsed,
                             }
                         )
                     if progress is not None:
                         progress(
                             f"noise {level:g} {lap} {method} lam={lam:g}: "
-                            f"{s.iteration} iterations in {elapsed:.3f} s"
+                            + (f"failed: {failed}" if failed is not None else
+                               f"{s.iteration} iterations in {elapsed:.3f} s")
                         )
     return rows
 

@@ -854,6 +854,10 @@ class SurfaceMesh:
     res: tuple[int, int]
 
 
+# largest grid :func:`mesh_surface` builds (2^24 cells: 33.5 M triangles, about 1.3 GB of arrays)
+MAX_CELLS = 2**24
+
+
 def _parse_res(res: int | Sequence[int], name: str = "res") -> tuple[int, int]:
     try:
         if isinstance(res, int | np.integer):
@@ -864,6 +868,12 @@ def _parse_res(res: int | Sequence[int], name: str = "res") -> tuple[int, int]:
         raise MeshError(f"expected an int or a pair (nu, nv), got {res!r}", name) from None
     if nu < 1 or nv < 1:
         raise MeshError(f"needs at least 1 cell in each direction, got {nu} x {nv}", name)
+    if nu * nv > MAX_CELLS:
+        raise MeshError(
+            f"{nu} x {nv} cells is more than the {MAX_CELLS:,} meshlap meshes a surface with "
+            f"(about {2 * MAX_CELLS:,} triangles)",
+            name,
+        )
     return nu, nv
 
 
@@ -1178,6 +1188,11 @@ def convergence_study(
     if mesher == "icosphere" and surface.name != "sphere":
         raise MeshError(f"the icosphere mesher only meshes the sphere, not the {surface.name}",
                         "mesher")
+    for lev in levels:  # every level checked before the first (slow) one is meshed
+        if mesher == "grid":
+            _parse_res(lev)
+        elif not 0 <= lev <= 7:
+            raise MeshError(f"icosphere subdivision levels must be in 0..7, got {lev}", "res")
     meshes = []
     for lev in levels:
         if mesher == "grid":

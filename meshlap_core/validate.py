@@ -36,6 +36,16 @@ from .types import BoolArray, FloatArray, IntArray
 # lengths (l^4); with |x| <= 1e75 every edge is below ~3.5e75 and l^4 stays below ~1.5e302.
 MAX_COORDINATE = 1e75
 
+# A mesh whose bounding-box diagonal is below this (but not 0) is rejected: squared lengths
+# (l^2) and their products (l^4, Heron's formula) underflow into subnormal numbers and the
+# cotangent weights lose their accuracy (at 1e-80 the mean curvature is already 0.2 % off).
+MIN_EXTENT = 1e-60
+
+# A face whose smallest corner angle is below this (radians, about 0.006 degrees) is reported as
+# nearly degenerate (a needle or a cap): its cotangent weights exceed 1e4, so curvature and
+# cotan-Laplacian values near it are unreliable. None of the course meshes has one.
+SLIVER_ANGLE = 1e-4
+
 # A face is "zero-area" when |(b-a) x (c-a)| <= _DEGENERATE_REL * (l0^2 + l1^2 + l2^2), i.e. it is
 # collinear up to round-off. This is the same threshold laplacian.cotangents_intrinsic uses
 # (16 A^2 <= 1e-24 (sum l^2)^2), so the faces removed here are exactly those whose cotangent
@@ -206,8 +216,12 @@ def _sort_with_order(key: IntArray) -> tuple[IntArray, IntArray]:
         return np.zeros(0, dtype=np.int64), key
     top = int(key.max())
     if top < (2**62) // max(k, 1):
-        packed = np.sort(key * np.int64(k) + np.arange(k, dtype=np.int64))
-        return packed % k, packed // k
+        packed = key * np.int64(k)  # in place from here on: three arrays of k at the peak
+        packed += np.arange(k, dtype=np.int64)
+        packed.sort()
+        order = packed % k
+        packed //= k
+        return order, packed
     order = np.argsort(key)
     return order, key[order]
 
@@ -246,8 +260,12 @@ def topology_report(F: Any, n_vertices: int | None = None) -> MeshReport:
     src = F.ravel()
     dst = F[:, [1, 2, 0]].ravel()
     forward = src < dst  # direction of each half-edge relative to (lo, hi)
-    key = np.where(forward, src, dst) * np.int64(n) + np.where(forward, dst, src)
+    key = np.minimum(src, dst)
+    key *= np.int64(n)
+    key += np.maximum(src, dst)
+    del dst
     order, ks = _sort_with_order(key)
+    del key
     new = np.empty(len(ks), dtype=bool)
     new[0] = True
     np.not_equal(ks[1:], ks[:-1], out=new[1:])
@@ -260,30 +278,47 @@ def topology_report(F: Any, n_vertices: int | None = None) -> MeshReport:
     if rep.n_nonmanifold_edges:
         kb = ks[starts[bad]]
         rep.nonmanifold_edges = np.stack([kb // n, kb % n], axis=1)
+    del ks
 
     # orientation on two-face edges
     two = starts[counts == 2]
     rep.n_inconsistent_edges = int(np.count_nonzero(forward[order[two]] == forward[order[two + 1]]))
     rep.consistently_oriented = rep.n_inconsistent_edges == 0
+    del two, starts, counts, bad
 
     # wedges: join consecutive half-edges of the same undirected edge at both endpoints
     same = ~new[1:]  # pair (order[i], order[i+1]) on the same edge
-    ha, hb = order[:-1][same], order[1:][same]
-    corner = np.arange(3 * m, dtype=np.int64)
-    nxt = corner + 1
-    nxt[2::3] -= 3  # the corner at dst of half-edge h
-    # corner at the lower-index endpoint of half-edge h: h itself if forward, else its dst corner
-    c_lo = np.where(forward, corner, nxt)
-    c_hi = np.where(forward, nxt, corner)
-    rows = np.concatenate([c_lo[ha], c_hi[ha]])
-    cols = np.concatenate([c_lo[hb], c_hi[hb]])
+    del new
+    idx = np.int32 if 3 * m < 2**31 else np.int64  # corner ids: halve the memory when possible
+    ha, hb = order[:-1][same].astype(idx), order[1:][same].astype(idx)
+    del order, same
+
+    def ends(h: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        # the corners at the lower- and higher-index endpoints of half-edge h: h itself is the
+        # corner at its source, the next corner of the face (h + 1, wrapping) at its target
+        nxt = h + 1
+        nxt[h % 3 == 2] -= 3
+        fw = forward[h]
+        return np.where(fw, h, nxt), np.where(fw, nxt, h)
+
+    a_lo, a_hi = ends(ha)
+    del ha
+    b_lo, b_hi = ends(hb)
+    del hb
+    rows = np.concatenate([a_lo, a_hi])
+    del a_lo, a_hi
+    cols = np.concatenate([b_lo, b_hi])
+    del b_lo, b_hi
     G = sp.csr_matrix(
         (np.ones(len(rows), dtype=np.int8), (rows, cols)), shape=(3 * m, 3 * m)
     )
+    del rows, cols
     # weak components of the one-directional graph = components of the undirected one
     n_wedges, labels = connected_components(G, directed=True, connection="weak")
+    del G
     wedge_vertex = np.empty(n_wedges, dtype=np.int64)
     wedge_vertex[labels] = src
+    del labels
     wedges_per_vertex = np.bincount(wedge_vertex, minlength=n)
     nm_v = np.flatnonzero(wedges_per_vertex > 1)
     rep.n_nonmanifold_vertices = len(nm_v)
@@ -381,6 +416,13 @@ def _coerce_vertices(V: Any, label: str, vertex_map: IntArray) -> FloatArray:
             f"±{MAX_COORDINATE:.0e} overflow squared-length computations (rescale the mesh)",
             label,
         )
+    diag = float(np.sqrt(np.sum((arr.max(axis=0) - arr.min(axis=0)) ** 2)))
+    if 0.0 < diag < MIN_EXTENT:
+        raise MeshError(
+            f"the mesh is too small: its bounding-box diagonal is {diag:.3g}; below "
+            f"{MIN_EXTENT:.0e} squared-length computations underflow (rescale the mesh)",
+            label,
+        )
     return arr
 
 
@@ -447,6 +489,55 @@ def _fan_triangulate(flat: IntArray, sizes: IntArray) -> tuple[IntArray, IntArra
     return T, poly
 
 
+def _face_measures(
+    V: FloatArray, F: IntArray
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """Twice the area and the three squared edge lengths of every face (column arrays)."""
+    X, Y, Z = (np.ascontiguousarray(V[:, d]) for d in range(3))
+    i, j, k = F[:, 0], F[:, 1], F[:, 2]
+    ax, ay, az = X[i], Y[i], Z[i]
+    ux, uy, uz = X[j] - ax, Y[j] - ay, Z[j] - az  # b - a
+    vx, vy, vz = X[k] - ax, Y[k] - ay, Z[k] - az  # c - a
+    cx, cy, cz = uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx
+    dbl = np.sqrt(cx * cx + cy * cy + cz * cz)  # twice the area
+    wx, wy, wz = vx - ux, vy - uy, vz - uz  # c - b
+    a = wx * wx + wy * wy + wz * wz  # opposite corner 0
+    b = vx * vx + vy * vy + vz * vz  # opposite corner 1
+    c = ux * ux + uy * uy + uz * uz  # opposite corner 2
+    return dbl, a, b, c
+
+
+def _degenerate_from(F: IntArray, dbl: FloatArray, a: FloatArray, b: FloatArray,
+                     c: FloatArray) -> tuple[BoolArray, BoolArray]:
+    repeated = (F[:, 0] == F[:, 1]) | (F[:, 1] == F[:, 2]) | (F[:, 0] == F[:, 2])
+    zero = (dbl <= _DEGENERATE_REL * (a + b + c)) & ~repeated
+    return repeated, zero
+
+
+def _sliver_from(dbl: FloatArray, a: FloatArray, b: FloatArray, c: FloatArray,
+                 min_angle: float) -> BoolArray:
+    hi = np.maximum(np.maximum(a, b), c)
+    lo = np.minimum(np.minimum(a, b), c)
+    mid = a + b + c - hi - lo  # accurate: hi <= 4 mid by the triangle inequality
+    return dbl < np.sin(min_angle) * np.sqrt(hi * mid)
+
+
+def _face_flags(V: FloatArray, F: IntArray, chunk: int = 1 << 18
+                ) -> tuple[BoolArray, BoolArray, BoolArray]:
+    """Repeated-corner, zero-area and sliver masks, computed ``chunk`` faces at a time (the
+    per-face temporaries of :func:`_face_measures` stay a few MB whatever the mesh size)."""
+    m = len(F)
+    repeated = np.empty(m, dtype=bool)
+    zero = np.empty(m, dtype=bool)
+    sliver = np.empty(m, dtype=bool)
+    for s in range(0, m, chunk):
+        Fc = F[s: s + chunk]
+        measures = _face_measures(V, Fc)
+        repeated[s: s + chunk], zero[s: s + chunk] = _degenerate_from(Fc, *measures)
+        sliver[s: s + chunk] = _sliver_from(*measures, SLIVER_ANGLE)
+    return repeated, zero, sliver
+
+
 def degenerate_faces(V: FloatArray, F: IntArray) -> tuple[BoolArray, BoolArray]:
     """Faces with a repeated corner, and faces of zero area (collinear up to round-off).
 
@@ -463,18 +554,75 @@ def degenerate_faces(V: FloatArray, F: IntArray) -> tuple[BoolArray, BoolArray]:
         Distinct corners but ``|(b-a)×(c-a)| ≤ 0.5e-12 (l₀² + l₁² + l₂²)`` (the threshold
         below which the cotangent Laplacian zeroes a face's weights).
     """
-    repeated = (F[:, 0] == F[:, 1]) | (F[:, 1] == F[:, 2]) | (F[:, 0] == F[:, 2])
-    X, Y, Z = (np.ascontiguousarray(V[:, d]) for d in range(3))
-    i, j, k = F[:, 0], F[:, 1], F[:, 2]
-    ax, ay, az = X[i], Y[i], Z[i]
-    ux, uy, uz = X[j] - ax, Y[j] - ay, Z[j] - az  # b - a
-    vx, vy, vz = X[k] - ax, Y[k] - ay, Z[k] - az  # c - a
-    cx, cy, cz = uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx
-    dbl = np.sqrt(cx * cx + cy * cy + cz * cz)  # twice the area
-    wx, wy, wz = vx - ux, vy - uy, vz - uz  # c - b
-    l2 = ux * ux + uy * uy + uz * uz + vx * vx + vy * vy + vz * vz + wx * wx + wy * wy + wz * wz
-    zero = (dbl <= _DEGENERATE_REL * l2) & ~repeated
-    return repeated, zero
+    return _degenerate_from(F, *_face_measures(V, F))
+
+
+def sliver_faces(V: FloatArray, F: IntArray, min_angle: float = SLIVER_ANGLE) -> BoolArray:
+    """Nearly degenerate faces: smallest corner angle below ``min_angle`` (needles and caps).
+
+    Parameters
+    ----------
+    V : (n,3) float
+    F : (m,3) int
+    min_angle : float
+        In radians (default :data:`SLIVER_ANGLE` = 1e-4).
+
+    Returns
+    -------
+    sliver : (m,) bool
+        Zero-area faces (see :func:`degenerate_faces`) are slivers too.
+
+    Notes
+    -----
+    The smallest angle ``θ`` is opposite the shortest edge, and ``sin θ = 2A / (l_a l_b)`` with
+    ``l_a, l_b`` the two longer edges, so the test is ``2A < sin(min_angle) · l_a l_b`` (no
+    trigonometry per face). A needle (one short edge) has one such angle, a cap (one angle near
+    π) two; the cotangent of the angle, about ``1/θ``, is the weight the cotangent Laplacian puts
+    on the opposite edge.
+    """
+    if len(F) == 0:
+        return np.zeros(0, dtype=bool)
+    return _sliver_from(*_face_measures(V, F), min_angle)
+
+
+def duplicate_positions(V: FloatArray) -> BoolArray:
+    """Vertices at exactly the same position as an earlier vertex (cracks, unwelded seams).
+
+    Parameters
+    ----------
+    V : (n,3) float
+
+    Returns
+    -------
+    dup : (n,) bool
+        True for every vertex but the first at each repeated position.
+
+    Notes
+    -----
+    One 64-bit hash per vertex is sorted (``-0.0`` and ``0.0`` are the same position); only
+    equal hashes are compared coordinate by coordinate, so the cost is one sort of ``n`` keys.
+    """
+    n = len(V)
+    if n < 2:
+        return np.zeros(n, dtype=bool)
+    bits = np.ascontiguousarray(V + 0.0).view(np.uint64)
+    with np.errstate(over="ignore"):
+        h = (bits[:, 0] * np.uint64(0x9E3779B97F4A7C15)
+             ^ bits[:, 1] * np.uint64(0xC2B2AE3D27D4EB4F)
+             ^ bits[:, 2] * np.uint64(0x165667B19E3779F9))
+    order = np.argsort(h, kind="stable")
+    hs = h[order]
+    cand = np.flatnonzero(hs[1:] == hs[:-1])
+    dup = np.zeros(n, dtype=bool)
+    if len(cand) == 0:
+        return dup
+    # exact check of candidate groups (a hash collision of different positions is possible)
+    idx = np.unique(np.concatenate([order[cand], order[cand + 1]]))
+    _, first = np.unique(V[idx] + 0.0, axis=0, return_index=True)
+    keep = np.zeros(len(idx), dtype=bool)
+    keep[first] = True  # np.unique's first occurrence in idx order = lowest vertex index
+    dup[idx[~keep]] = True
+    return dup
 
 
 def duplicate_faces(F: IntArray, n: int) -> BoolArray:
@@ -611,7 +759,7 @@ def validate_mesh(
                 f"{_count(int((sizes[sizes > 3] - 2).sum()), 'triangle')} (fan triangulation)"
             )
 
-    repeated, zero = degenerate_faces(V, F)
+    repeated, zero, sliver = _face_flags(V, F)
     n_rep, n_zero = int(repeated.sum()), int(zero.sum())
     if n_rep + n_zero == len(F):
         raise MeshError(
@@ -628,9 +776,10 @@ def validate_mesh(
         what = f"{_count(n_rep + n_zero, 'degenerate face')} ({', '.join(parts)})"
         if repair:
             keep = ~(repeated | zero)
-            F, face_map = F[keep], face_map[keep]
+            F, face_map, sliver = F[keep], face_map[keep], sliver[keep]
             rep_list.append(f"removed {what}")
         else:
+            sliver &= ~(repeated | zero)  # reported as degenerate already
             warn_list.append(f"{what} (not removed: repair=False)")
 
     dup = duplicate_faces(F, n)
@@ -641,7 +790,7 @@ def validate_mesh(
             "(same three vertices as an earlier face, in any order)"
         )
         if repair:
-            F, face_map = F[~dup], face_map[~dup]
+            F, face_map, sliver = F[~dup], face_map[~dup], sliver[~dup]
             rep_list.append(f"removed {what}")
         else:
             warn_list.append(f"{what} (not removed: repair=False)")
@@ -667,6 +816,20 @@ def validate_mesh(
                 f"{_count(n_unused, 'unreferenced vertex', 'unreferenced vertices')} "
                 "(not removed: repair=False)"
             )
+
+    n_sliver = int(np.count_nonzero(sliver))
+    if n_sliver:
+        warn_list.append(
+            f"{_count(n_sliver, 'nearly degenerate face')} (a corner angle below "
+            f"{SLIVER_ANGLE:g} rad, {np.degrees(SLIVER_ANGLE):.2g}°: needle or cap triangles); "
+            "cotangent weights and curvature near them are unreliable"
+        )
+    n_same = int(np.count_nonzero(duplicate_positions(V)))
+    if n_same:
+        warn_list.append(
+            f"{_count(n_same, 'vertex has', 'vertices have')} the same position as another "
+            "vertex (not welded: the surface has a crack or seam there)"
+        )
 
     report = topology_report(F, len(V))
     report.n_input_vertices = n

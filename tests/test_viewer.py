@@ -3,6 +3,7 @@
 import os
 import subprocess
 import sys
+import tempfile
 
 import numpy as np
 import pytest
@@ -100,7 +101,10 @@ def test_export_writes_mesh_and_field(mock_backend, tmp_path):
 def _egl_available() -> bool:
     code = "import polyscope as ps; ps.set_allow_headless_backends(True); ps.init('openGL3_egl')"
     try:
-        res = subprocess.run([sys.executable, "-c", code], capture_output=True, timeout=120)
+        with tempfile.TemporaryDirectory() as tmp:  # polyscope writes .ini files into the cwd
+            res = subprocess.run(
+                [sys.executable, "-c", code], capture_output=True, timeout=120, cwd=tmp
+            )
     except subprocess.TimeoutExpired:
         return False
     return res.returncode == 0

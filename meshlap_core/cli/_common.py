@@ -72,3 +72,15 @@ def summary_stats(values: np.ndarray) -> dict[str, float]:
 def add_json_flag(p: argparse.ArgumentParser) -> None:
     """Add the common ``--json`` flag."""
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
+
+
+def print_report(source: Any, report: Any) -> None:
+    """The loader's repairs and warnings on stderr, one line each (``--json`` keeps them too).
+
+    ``meshlap: <file>: repaired: ...`` and ``meshlap: <file>: warning: ...``. Commands call it
+    once their work has succeeded, so that a failing run prints its error line alone.
+    """
+    for r in getattr(report, "repairs", []):
+        sys.stderr.write(f"meshlap: {source}: repaired: {r}\n")
+    for w in getattr(report, "warnings", []):
+        sys.stderr.write(f"meshlap: {source}: warning: {w}\n")

@@ -3,14 +3,15 @@
 from __future__ import annotations
 
 import argparse
-import sys
 from pathlib import Path
+
+import numpy as np
 
 from ..curvature import BOUNDARY_RULES, METHODS, curvature_field
 from ..errors import MeshError
-from ..io import load_mesh, save_mesh, save_scalars
+from ..io import check_output_path, load_mesh, save_mesh, save_scalars
 from ..laplacian import AREA_KINDS
-from ._common import add_json_flag, emit_json, summary_stats
+from ._common import add_json_flag, emit_json, print_report, summary_stats
 
 OUT_SUFFIXES = (".csv", ".npy", ".ply")
 
@@ -45,14 +46,14 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     out = Path(args.out) if args.out else None
-    if out is not None and out.suffix.lower() not in OUT_SUFFIXES:
-        raise MeshError(
-            f"unsupported output type {out.suffix!r}; use {', '.join(OUT_SUFFIXES)}", out
-        )
+    if out is not None:  # checked first: a doomed run fails at once and writes nothing
+        check_output_path(out, overwrite_inputs=(args.mesh,), suffixes=OUT_SUFFIXES)
     mesh = load_mesh(args.mesh)
-    for r in mesh.report.repairs:
-        print(f"meshlap: {args.mesh}: repaired: {r}", file=sys.stderr)
     values = curvature_field(mesh.V, mesh.F, args.method, args.area, args.boundary)
+    if not np.isfinite(values).all():  # never write or summarize a broken field
+        bad = int(np.count_nonzero(~np.isfinite(values)))
+        raise MeshError(f"the {args.method} curvature is not finite at {bad} vertices", args.mesh)
+    print_report(args.mesh, mesh.report)
     if out is not None:
         if out.suffix.lower() == ".ply":
             save_mesh(out, mesh.V, mesh.F, scalars=values, overwrite_inputs=(args.mesh,))
@@ -69,6 +70,7 @@ def run(args: argparse.Namespace) -> int:
                 "n_vertices": len(values),
                 **stats,
                 "repairs": mesh.report.repairs,
+                "warnings": mesh.report.warnings,
                 "out": str(out) if out else None,
             }
         )

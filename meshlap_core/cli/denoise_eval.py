@@ -20,12 +20,12 @@ from ..errors import MeshError
 from ..laplacian import AREA_KINDS
 from ..noise import NOISE_MODES
 from ..smoothing import LAPLACIANS, METHODS, best_rows, check_iters, check_lam, denoise_sweep
-from ._common import add_json_flag, emit_json, parse_list
+from ._common import add_json_flag, emit_json, parse_list, print_report
 
 COLUMNS = (
     "noise", "method", "laplacian", "lam", "iters", "rmse", "rmse_noisy", "max_error",
     "volume_change_pct", "volume_change_noisy_pct", "dihedral_mae_deg", "dihedral_mae_noisy_deg",
-    "normal_dev_deg", "normal_dev_noisy_deg", "stable", "diverged", "seconds",
+    "normal_dev_deg", "normal_dev_noisy_deg", "stable", "diverged", "seconds", "failed",
 )
 DEFAULT_NOISE = "0.005,0.02,0.05"
 
@@ -91,6 +91,9 @@ def run(args: argparse.Namespace) -> int:
         inputs = [Path(args.clean).resolve()] + ([Path(args.noisy).resolve()] if args.noisy else [])
         if Path(args.csv).resolve() in inputs:
             raise MeshError("refusing to overwrite an input mesh", args.csv)
+        from ..io import check_output_path
+
+        check_output_path(args.csv, overwrite_inputs=inputs, suffixes=(".csv",))
 
     clean = load_mesh(args.clean)
     Vn = None
@@ -138,8 +141,10 @@ def run(args: argparse.Namespace) -> int:
         },
         "seconds": seconds,
         "csv": args.csv,
+        "repairs": list(getattr(clean.report, "repairs", [])),
         "warnings": list(getattr(clean.report, "warnings", [])),
     }
+    print_report(args.clean, clean.report)
     if args.json:
         emit_json(result)
     else:
@@ -199,7 +204,10 @@ def format_table(r: dict[str, Any]) -> str:
         if prev is not None and row["noise"] != prev:
             lines.append("")
         prev = row["noise"]
-        note = "DIVERGED" if row["diverged"] else ("" if row["stable"] else "unstable lam")
+        note = (
+            f"FAILED: {row['failed']}" if row.get("failed")
+            else "DIVERGED" if row["diverged"] else ("" if row["stable"] else "unstable lam")
+        )
         lines.append(
             f"{row['noise']:>8.4g} {row['laplacian']:>9} {row['method']:>8} {row['lam']:>7.4g} "
             f"{row['iters']:>5d} {_num(row['rmse'], '.4g', 10)} "

@@ -7,7 +7,7 @@ import argparse
 from ..errors import MeshError
 from ..io import load_mesh
 from ..topology import one_ring
-from ._common import add_json_flag, emit_json
+from ._common import add_json_flag, emit_json, print_report
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -29,7 +29,9 @@ def run(args: argparse.Namespace) -> int:
             f"vertex {args.vertex} is out of range (the mesh has {n} vertices: 0..{n - 1})",
             "--vertex",
         )
-    ring = one_ring(mesh.F, n)
+    # a vertex's ring depends on its own faces only: on a 2 M-face mesh this is what keeps the
+    # command at the cost of loading the file
+    ring = one_ring(mesh.F[(mesh.F == args.vertex).any(axis=1)], n)
     if args.reverse:
         ring = ring.reversed()
     i = args.vertex
@@ -41,7 +43,10 @@ def run(args: argparse.Namespace) -> int:
         "valence": len(nbrs),
         "order": "clockwise" if args.reverse else "counter-clockwise",
         "ordered": bool(ring.regular[i]),
+        "repairs": list(mesh.report.repairs),
+        "warnings": list(mesh.report.warnings),
     }
+    print_report(args.mesh, mesh.report)  # vertex indices are those after the repairs
     if args.json:
         emit_json(result)
     else:

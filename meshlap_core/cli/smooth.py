@@ -85,6 +85,10 @@ def run(args: argparse.Namespace) -> int:
     pass_band = check_lam(_float_arg(args.pass_band, "--pass-band"), "--pass-band")
     if args.out is not None and Path(args.out).resolve() == Path(args.mesh).resolve():
         raise MeshError("refusing to overwrite the input mesh", args.out)
+    if args.out is not None:  # checked before the work: a doomed run fails at once
+        from ..io import WRITE_FORMATS, check_output_path
+
+        check_output_path(args.out, overwrite_inputs=[args.mesh], suffixes=WRITE_FORMATS)
 
     mesh = load_mesh(args.mesh)
     V, F = mesh.V, mesh.F
@@ -102,8 +106,6 @@ def run(args: argparse.Namespace) -> int:
             raise _cli_error(exc, args.mesh) from None
     setup_s = time.perf_counter() - t0
     msgs += [str(w.message) for w in caught]
-    for m in msgs:
-        sys.stderr.write(f"meshlap: warning: {m}\n")
 
     t1 = time.perf_counter()
     report_every = max(1, iters // 10)
@@ -164,6 +166,10 @@ def run(args: argparse.Namespace) -> int:
         "repairs": list(getattr(mesh.report, "repairs", [])),
         "warnings": msgs,
     }
+    for r in result["repairs"]:  # after the work succeeded: a failing run prints one line
+        sys.stderr.write(f"meshlap: {args.mesh}: repaired: {r}\n")
+    for m in msgs:
+        sys.stderr.write(f"meshlap: warning: {m}\n")
     if args.json:
         emit_json(result)
     else:

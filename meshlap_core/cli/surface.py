@@ -113,6 +113,15 @@ def _run_convergence(args: argparse.Namespace, surface: Any) -> int:
 
 
 def run(args: argparse.Namespace) -> int:
+    try:
+        return _run(args)
+    except MeshError as exc:  # name the flag the user typed, not the core's argument
+        flag = {"res": "--res", "u": "--u", "v": "--v", "params": "--param",
+                "mesher": "--mesher"}.get(exc.source or "")
+        raise (MeshError(exc.problem, flag) if flag else exc) from None
+
+
+def _run(args: argparse.Namespace) -> int:
     if args.list:
         return _run_list(args)
     surface = get_surface(args.name, **_params(args.param))
@@ -127,6 +136,16 @@ def run(args: argparse.Namespace) -> int:
     check_uv(surface, u, v, names=("--u", "--v"))
 
     plot = Path(args.plot) if args.plot else None
+    from ..io import WRITE_FORMATS, check_output_path
+
+    # both outputs checked before either is written: a failing run leaves no file behind
+    if plot is not None:
+        check_output_path(plot, suffixes=(".png",))
+    if args.mesh is not None:
+        check_output_path(args.mesh, suffixes=WRITE_FORMATS)
+        res = parse_list(args.res or "32", int, "--res")
+        if len(res) > 2:
+            raise MeshError(f"expected N or NU,NV, got {args.res!r}", "--res")
     if plot is not None:
         geo = plot_normal_curvature(surface, u, v, plot)
     else:
@@ -136,9 +155,6 @@ def run(args: argparse.Namespace) -> int:
     if args.mesh is not None:
         from ..io import save_mesh
 
-        res = parse_list(args.res or "32", int, "--res")
-        if len(res) > 2:
-            raise MeshError(f"expected N or NU,NV, got {args.res!r}", "--res")
         m = mesh_surface(surface, res[0] if len(res) == 1 else (res[0], res[1]))
         save_mesh(Path(args.mesh), m.V, m.F)
         mesh_info = {"path": str(args.mesh), "res": list(m.res), "n_vertices": len(m.V),

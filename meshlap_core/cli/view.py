@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 
+from ..errors import MeshError
+
 FIELDS = ("uniform", "cotan", "gaussian", "k1", "k2", "difference")
 PANELS = ("curvature", "onering", "spectral", "smoothing", "surfaces")
 
@@ -24,6 +26,20 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.k is not None and args.k < 1:
+        raise MeshError(f"must be at least 1, got {args.k}", "--k")
+    if args.screenshot is not None:
+        from ..io import check_output_path
+
+        # before the viewer starts: a missing folder, a directory, a non-PNG name or the input
+        # mesh itself as the target fail at once, and an existing PNG is replaced only by a
+        # complete new one (the viewer writes it atomically)
+        check_output_path(
+            args.screenshot,
+            overwrite_inputs=[args.mesh] if args.mesh else [],
+            suffixes=(".png",),
+        )
+    # a bad mesh fails in app.viewer.run before any window or EGL context is created
     from app.viewer import run as run_viewer  # the core CLI imports the GUI only here
 
     return run_viewer(
