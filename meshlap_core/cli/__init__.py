@@ -10,11 +10,13 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import sys
+import warnings
 from collections.abc import Sequence
 
 from .._version import __version__
-from ..errors import MeshError
+from ..errors import MeshError, MeshWarning
 
 # subcommand modules, in the order ``meshlap --help`` lists them
 COMMANDS: tuple[str, ...] = (
@@ -25,6 +27,8 @@ COMMANDS: tuple[str, ...] = (
     "surface",
     "smooth",
     "denoise_eval",
+    "report",
+    "spectral",
 )
 
 
@@ -48,26 +52,67 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of the ``meshlap`` console script; returns the exit code."""
+    """Entry point of the ``meshlap`` console script; returns the exit code.
+
+    Exit codes: 0 success; 2 bad input or arguments (one line ``meshlap: error: ...`` on
+    stderr, nothing else); 1 an internal error (one line too; set ``MESHLAP_DEBUG=1`` for the
+    traceback); 130 interrupted. Warnings raised while a command runs are printed after it
+    succeeds, one line ``meshlap: warning: ...`` each, and dropped when it fails.
+    """
     parser = build_parser()
     args = parser.parse_args(argv)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", MeshWarning)
+        try:
+            code = int(args.func(args) or 0)
+        except MeshError as exc:
+            return _fail(f"{exc}")
+        except MemoryError:
+            src = getattr(args, "mesh", None) or getattr(args, "clean", None)
+            return _fail(f"{src + ': ' if src else ''}out of memory (the input is too large "
+                         "for this machine)")
+        except BrokenPipeError:  # `meshlap ... | head`: the reader went away
+            _silence_stdout()
+            return 141
+        except OSError as exc:
+            name = getattr(exc, "filename", None)
+            what = exc.strerror or str(exc) or type(exc).__name__
+            return _fail(f"{name}: {what}" if name else what)
+        except KeyboardInterrupt:
+            sys.stderr.write("meshlap: interrupted\n")
+            return 130
+        except Exception as exc:  # a bug: still one line, unless debugging
+            if os.environ.get("MESHLAP_DEBUG"):
+                raise
+            msg = str(exc).splitlines()[0] if str(exc) else ""
+            what = f"{type(exc).__name__}: {msg}" if msg else type(exc).__name__
+            sys.stderr.write(
+                f"meshlap: error: internal error ({what}); please report it "
+                "(MESHLAP_DEBUG=1 shows the traceback)\n"
+            )
+            return 1
+    seen: set[str] = set()
+    for w in caught:
+        kind = "" if issubclass(w.category, MeshWarning) else f"{w.category.__name__}: "
+        line = f"meshlap: warning: {kind}{w.message}"
+        if line not in seen:
+            seen.add(line)
+            sys.stderr.write(line + "\n")
+    return code
+
+
+def _fail(message: str) -> int:
+    sys.stderr.write(f"meshlap: error: {' '.join(message.split())}\n")
+    return 2
+
+
+def _silence_stdout() -> None:
+    """Point stdout at /dev/null so the interpreter's final flush cannot fail again."""
     try:
-        return int(args.func(args) or 0)
-    except MeshError as exc:
-        sys.stderr.write(f"meshlap: error: {exc}\n")
-        return 2
-    except (OSError, MemoryError) as exc:
-        name = getattr(exc, "filename", None)
-        what = (
-            exc.strerror
-            if isinstance(exc, OSError) and exc.strerror
-            else str(exc) or type(exc).__name__
-        )
-        sys.stderr.write(f"meshlap: error: {name + ': ' if name else ''}{what}\n")
-        return 2
-    except KeyboardInterrupt:
-        sys.stderr.write("meshlap: interrupted\n")
-        return 130
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError, AttributeError):
+        pass
 
 
 if __name__ == "__main__":  # pragma: no cover
