@@ -1302,8 +1302,10 @@ def pencil_eigenpairs(
         elif k <= ncomp:
             lam, Y = np.zeros(k), np.asfortranarray(Z[:, :k] * d[:, None])
         else:
-            nw = (_default_workers(n, max(slice_size, first_slice)) if workers is None
-                  else max(1, int(workers)))
+            if workers is not None:
+                nw = max(1, int(workers))
+            else:  # (one slice below ~60 modes: no need to sample the machine's load)
+                nw = 1 if k < 60 else _default_workers(n, max(slice_size, first_slice))
             nb = 1 if blas_threads is None else max(1, int(blas_threads))
             info.messages.append(f"{nw} slice worker(s), {nb} BLAS thread(s)")
             rho = float(density) if density else float(m.sum() / (4 * np.pi))
