@@ -53,6 +53,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 
+from ._blas import blas_threads
 from .errors import MeshError, MeshWarning
 from .laplacian import AREA_KINDS, adjacency_matrix, cotan_stiffness, vertex_areas
 from .metrics import Reference, _signed_volume_unchecked, n_boundary_edges
@@ -213,7 +214,8 @@ def most_negative_eigenvalue(
     Ka = K[idx][:, idx]
     S = (sp.diags(s) @ (-Ka) @ sp.diags(s)).tocsr()
     if len(idx) <= 400:
-        ev = np.linalg.eigvalsh(S.toarray())
+        with blas_threads(1):  # threaded BLAS collapses on small dense work under load
+            ev = np.linalg.eigvalsh(S.toarray())
         return -float(max(ev[-1], 0.0)), True
     # bounded work: about 3e8 multiply-adds (a second or two whatever the mesh), then the
     # Gershgorin bound; a clustered top of the spectrum (a perfectly regular grid) can otherwise

@@ -75,6 +75,8 @@ from scipy.linalg import blas
 from scipy.sparse.csgraph import connected_components
 
 from . import laplacian as _lap
+from ._blas import blas_threads as _blas_threads
+from ._blas import thread_controller as _thread_controller
 from .errors import MeshError
 from .types import FloatArray, IntArray, as_mesh
 
@@ -1355,33 +1357,6 @@ def _max_residual(
     R = K @ Us - (m[:, None] * Us) * lam[None, idx]
     r = np.sqrt(np.sum(R * R / m[:, None], axis=0))
     return float(np.max(r / np.maximum(lam[idx], ref)))
-
-
-def _blas_threads(limit: int, controller: Any = None) -> Any:
-    """Context manager limiting BLAS threads (a no-op without ``threadpoolctl``).
-
-    Multi-threaded OpenBLAS on the tall-skinny products used here gains little on an idle
-    machine and collapses (5–20× slower, from spinning threads) when the cores are busy.
-    ``controller`` is a cached ``threadpoolctl.ThreadpoolController`` (0.02 ms per use instead
-    of 0.5 ms).
-    """
-    if controller is not None:
-        return controller.limit(limits=limit, user_api="blas")
-    try:
-        from threadpoolctl import threadpool_limits
-    except ImportError:  # pragma: no cover
-        import contextlib
-
-        return contextlib.nullcontext()
-    return threadpool_limits(limits=limit, user_api="blas")
-
-
-def _thread_controller() -> Any:
-    try:
-        from threadpoolctl import ThreadpoolController
-    except ImportError:  # pragma: no cover
-        return None
-    return ThreadpoolController()
 
 
 def _check_k(k: Any, n: int, name: str) -> int:
