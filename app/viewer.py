@@ -22,6 +22,7 @@ import polyscope.imgui as psim
 from meshlap_core.errors import MeshError
 from meshlap_core.io import atomic_write, save_mesh, save_scalars
 
+from . import smoothing_panel, spectral_panel
 from .camera import project_to_screen
 from .state import (
     FIELD_LABELS,
@@ -119,7 +120,11 @@ class Viewer:
         self.curv = curv or CurvatureState()
         self.ring = OneRingState()
         self.surf = SurfaceState()
-        self.extra: dict[str, Any] = {}  # spectral / smoothing panels register themselves here
+        # the spectral and smoothing panels live in their own modules; they get the same hooks
+        self.extra: dict[str, Any] = {
+            "spectral": spectral_panel.Panel(),
+            "smoothing": smoothing_panel.Panel(),
+        }
         self.panel = panel
         self.path_text = ""
         self.side_by_side = False
@@ -451,18 +456,10 @@ class Viewer:
         psim.TextUnformatted("order: " + " -> ".join(str(j) for j in r.neighbors[:40]))
 
     def panel_spectral(self) -> None:
-        hook = self.extra.get("spectral")
-        if hook is None:
-            psim.TextUnformatted("spectral panel unavailable")
-            return
-        hook.draw(self)
+        self.extra["spectral"].draw(self)
 
     def panel_smoothing(self) -> None:
-        hook = self.extra.get("smoothing")
-        if hook is None:
-            psim.TextUnformatted("smoothing panel unavailable")
-            return
-        hook.draw(self)
+        self.extra["smoothing"].draw(self)
 
     def panel_surfaces(self) -> None:
         if not psim.CollapsingHeader("Surfaces", psim.ImGuiTreeNodeFlags_DefaultOpen):
@@ -558,16 +555,15 @@ def run(
         )
     _init(backend or ("openGL3_egl" if shot else "auto"))
     viewer = Viewer(mesh, CurvatureState(field_name=field), panel=panel)
-    install_extras(viewer)
     viewer.sync_mesh()
     if shot is not None:
         ps.set_window_size(1600, 900)
         ps.set_build_default_gui_panels(False)  # the screenshot shows our panel only
     if panel == "onering":
         viewer.select_vertex(vertex if vertex is not None else 0)
-    if k is not None and "spectral" in viewer.extra:
+    if k is not None:
         viewer.extra["spectral"].prepare_screenshot(viewer, k)
-    if panel == "smoothing" and "smoothing" in viewer.extra:
+    if panel == "smoothing":
         viewer.extra["smoothing"].prepare_screenshot(viewer)
     ps.set_user_callback(viewer.callback)
     if shot is not None:
@@ -625,16 +621,6 @@ def _structure_points(viewer: Viewer, name: str) -> np.ndarray:
         if pts is not None:
             return pts
     return viewer.mesh.V
-
-
-def install_extras(viewer: Viewer) -> None:
-    """Attach the spectral and smoothing panels (separate modules, added when present)."""
-    for name, module in (("spectral", "app.spectral_panel"), ("smoothing", "app.smoothing_panel")):
-        try:
-            mod = __import__(module, fromlist=["Panel"])
-        except ModuleNotFoundError:
-            continue
-        viewer.extra[name] = mod.Panel()
 
 
 def _write_png(path: Path, rgba: np.ndarray) -> None:

@@ -27,7 +27,7 @@ from _util import print_table, shared_mesh
 
 from app.smoothing_state import SmoothingState
 from app.state import CurvatureState, MeshState
-from app.viewer import Viewer, _init, install_extras
+from app.viewer import Viewer, _init
 
 
 def main() -> None:
@@ -44,7 +44,6 @@ def main() -> None:
     print(f"mesh: {mesh.name}, {len(mesh.V)} vertices")
     _init("openGL3_egl")
     viewer = Viewer(mesh, CurvatureState(), panel="spectral")
-    install_extras(viewer)
     viewer.sync_mesh()
     ps.set_user_callback(viewer.callback)
     rows = []

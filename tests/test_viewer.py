@@ -27,12 +27,11 @@ def mock_backend(tmp_path_factory):
 
 def test_every_panel_runs_frames_on_mock(mock_backend, tmp_path):
     from app.state import CurvatureState, MeshState
-    from app.viewer import PANELS, Viewer, install_extras
+    from app.viewer import PANELS, Viewer
 
     mesh = MeshState()
     assert mesh.load(None)
     viewer = Viewer(mesh, CurvatureState())
-    install_extras(viewer)
     viewer.sync_mesh()
     ps.set_user_callback(viewer.callback)
     for panel in PANELS:
@@ -205,3 +204,13 @@ def test_no_display_is_one_clear_error(tmp_path):
         lines = [ln for ln in res.stderr.splitlines() if not ln.startswith("[polyscope]")]
         assert lines == [lines[0]] and lines[0].startswith("meshlap: error: view: no display")
         assert "--screenshot" in lines[0]
+
+
+def test_cli_choices_match_the_viewer():
+    """`meshlap view` lists its panels and fields without importing polyscope: keep in sync."""
+    from app.state import FIELD_LABELS
+    from app.viewer import PANELS
+    from meshlap_core.cli import view
+
+    assert view.PANELS == PANELS
+    assert view.FIELDS == tuple(FIELD_LABELS)

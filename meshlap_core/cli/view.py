@@ -6,6 +6,8 @@ import argparse
 
 from ..errors import MeshError
 
+# the viewer's names (app.viewer imports polyscope, so they are repeated here; a test keeps them
+# in sync)
 FIELDS = ("uniform", "cotan", "gaussian", "k1", "k2", "difference")
 PANELS = ("curvature", "onering", "spectral", "smoothing", "surfaces")
 
