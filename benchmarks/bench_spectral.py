@@ -186,6 +186,8 @@ def main() -> int:
                     help="BLAS threads for eigsh: 'both' (default: run it with one thread and "
                          "with OpenBLAS's default and keep the faster; on a busy 2-core machine "
                          "threaded OpenBLAS spins and slows ARPACK several-fold), '1', 'default'")
+    ap.add_argument("--case", action="append", metavar="MESH:K",
+                    help="only this comparison (repeatable), e.g. --case armadillo_igl:100")
     ap.add_argument("--json", help="write all results to this file")
     ap.add_argument("--memory-child", nargs=2, metavar=("MESH", "K"), help=argparse.SUPPRESS)
     args = ap.parse_args()
@@ -201,6 +203,14 @@ def main() -> int:
     cases = [("armadillo", (5, 15, 50, 100) if args.quick else (5, 15, 50, 100, 300))]
     if not args.quick:
         cases += [("armadillo_igl", (100,)), ("nefertiti", (100,))]
+    if args.case:
+        cases = []
+        for c in args.case:
+            name, _, kk = c.partition(":")
+            try:
+                cases.append((name, (int(kk),)))
+            except ValueError:
+                ap.error(f"--case wants MESH:K, got {c!r}")
     pencils: dict[str, Any] = {}
     for name, ks in cases:
         data = load(name)
@@ -224,7 +234,7 @@ def main() -> int:
               f"{r['orth_eigsh']:.1e} | {r['slices']} | {r['eigsh_blas']} |")
     sys.stdout.flush()
 
-    if args.quick:
+    if args.quick or args.case:
         return _finish(out, args)
 
     # k = 1000

@@ -71,7 +71,7 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
-from scipy.linalg import blas
+from scipy.linalg import blas, lapack
 from scipy.sparse.csgraph import connected_components
 
 from . import laplacian as _lap
@@ -104,6 +104,8 @@ _FIRST_SLICE = 128  # eigenpairs with the positive definite shift (cheaper Chole
 _ORTH_LEVEL = 1e-10  # orthogonality kept in the Lanczos basis
 _EDGE_TOL = 1e-4  # residual of the nearest Ritz value outside a slice's interval
 _CHOLESKY_MIN = 32  # use cholespy for the positive definite slice from this many eigenpairs
+_SPLIT = 0.4  # share of the interior (LDLᵀ) slice when two workers split <= _FIRST_SLICE pairs
+_ROW_THREADS = 1
 _SHIFT_REL = 1e-2  # σ₀ = −_SHIFT_REL · tr(K) / (n · tr(M))
 
 
@@ -291,6 +293,58 @@ def _ldl_inertia(
     return ldl, int(np.count_nonzero(piv < 0))
 
 
+class _QDLDL:
+    """``LDLᵀ`` of a symmetric matrix by QDLDL (AMD ordering, no pivoting), with its inertia.
+
+    QDLDL (the factorization of the OSQP solver) factors ``PAPᵀ = LDLᵀ`` with ``D`` diagonal
+    and no pivoting, so Sylvester's law of inertia gives ``#{λ(A) < 0} = #{D_ii < 0}``. It
+    computes its own AMD ordering, factors 2–4× faster than SuperLU's ``LU`` (which does the
+    work twice: ``L`` and ``U = DLᵀ``) and its solves release the GIL.
+    """
+
+    def __init__(self, solver: Any) -> None:
+        self.solver = solver
+
+    def solve(self, B: FloatArray) -> FloatArray:
+        if B.ndim == 1:
+            return np.asarray(self.solver.solve(np.ascontiguousarray(B)))
+        X = np.empty(B.shape, order="F")
+        for c in range(B.shape[1]):
+            X[:, c] = self.solver.solve(np.ascontiguousarray(B[:, c]))
+        return X
+
+
+def _qdldl_inertia(A: sp.csr_matrix, rng: np.random.Generator) -> tuple[_QDLDL, int]:
+    """QDLDL ``LDLᵀ`` of a symmetric matrix and the number of its negative eigenvalues; a
+    solve with a random right-hand side checks that no small pivot spoiled the factor.
+
+    Raises
+    ------
+    ImportError
+        ``qdldl`` is not installed (the caller falls back to SuperLU).
+    _Unstable
+        A zero, tiny or non-finite pivot.
+    """
+    import qdldl
+
+    n = A.shape[0]
+    try:
+        solver = qdldl.Solver(sp.triu(A, format="csc"), upper=True)
+        _, D, _ = solver.factors()
+    except (ValueError, RuntimeError) as exc:  # zero pivot
+        raise _Unstable(str(exc)) from None
+    D = np.asarray(D)
+    if not np.all(np.isfinite(D)) or np.any(D == 0):
+        raise _Unstable("zero pivot")
+    ldl = _QDLDL(solver)
+    b = rng.standard_normal(n)
+    x = ldl.solve(b)
+    scale = abs(A).sum(axis=1).max() * np.abs(x).max() + np.abs(b).max()
+    if not np.all(np.isfinite(x)) or np.abs(A @ x - b).max() > 1e-10 * scale:
+        raise _Unstable("inaccurate solve")
+    return ldl, int(np.count_nonzero(D < 0))
+
+
 class _ShiftInvert:
     """``Op(Y) = (A − σI)⁻¹ Y`` for the scaled pencil ``A = M^-½ K M^-½`` (symmetric, same
     eigenvalues ``λ`` as ``K u = λ M u`` with ``y = M^½ u``); ``Op`` has eigenvalues
@@ -334,8 +388,12 @@ class _ShiftInvert:
         if self._chol is None:
             for attempt in range(6):
                 s = sigma + (0.0 if attempt == 0 else (-1) ** attempt * 1e-3 * attempt * spacing)
+                S = (A - s * eye).tocsr()
                 try:
-                    self._lu, self.n_below = _ldl_inertia((A - s * eye).tocsr(), rng, ordering)
+                    try:
+                        self._lu, self.n_below = _qdldl_inertia(S, rng)
+                    except (ImportError, _Unstable):
+                        self._lu, self.n_below = _ldl_inertia(S, rng, ordering)
                     sigma = s
                     break
                 except _Unstable:
@@ -369,6 +427,83 @@ def _orthonormal_columns(X: FloatArray) -> FloatArray | None:
     return np.asfortranarray(Qx[:, :r]) if r else None
 
 
+def _gemm_update(C: FloatArray, A: FloatArray, B: FloatArray, alpha: float = -1.0) -> None:
+    """``C += alpha·A B`` in place (``C`` F-ordered ``n × b``): BLAS ``dgemm`` directly, as
+    numpy's matmul takes ~15× longer when the inner dimension is 1 and allocates a result."""
+    r = blas.dgemm(alpha, A, B, 1.0, C, overwrite_c=True)
+    if not np.shares_memory(r, C):  # pragma: no cover - C not F-contiguous
+        C[...] = r
+
+
+def _right_solve(W: FloatArray, R: FloatArray) -> None:
+    """``W ← W R⁻¹`` in place, ``R`` upper triangular (``W`` F-ordered)."""
+    r = blas.dtrsm(1.0, R, W, side=1, lower=0, overwrite_b=True)
+    if not np.shares_memory(r, W):  # pragma: no cover - W not F-contiguous
+        W[...] = r
+
+
+def _chol_qr(
+    W: FloatArray, passes: int, min_ratio: float, min_diag: float = 0.0
+) -> FloatArray | None:
+    """Cholesky QR in place: ``W ← W R⁻¹`` with ``R`` upper triangular, ``passes`` times (the
+    second pass restores orthogonality to round-off; Yamamoto et al. 2015, "Roundoff error
+    analysis of the CholeskyQR2 algorithm"); returns the accumulated ``R``. ``None`` (and
+    ``W`` untouched) when ``R`` is singular, has a diagonal entry ``<= min_diag`` or its
+    diagonal spreads more than ``1/min_ratio`` (too ill-conditioned for Cholesky QR: the
+    caller uses Householder QR)."""
+    b = W.shape[1]
+    Rtot = np.eye(b)
+    for p in range(passes):
+        R, info = lapack.dpotrf(W.T @ W, lower=0, clean=1)
+        dR = np.abs(np.diag(R))
+        if (info != 0 or not np.all(np.isfinite(dR)) or dR.min() <= min_ratio * dR.max()
+                or (p == 0 and dR.min() <= min_diag)):
+            if p:  # pragma: no cover - the first pass succeeded, so W is well conditioned
+                raise RuntimeError("Cholesky QR: second pass failed")
+            return None
+        _right_solve(W, R)
+        Rtot = R @ Rtot
+    return Rtot
+
+
+class _RowSplit:
+    """Tall-skinny products ``AᵀB`` and ``A C`` (``A``, ``B``: ``n × ·``) split by rows over
+    two threads: the caller's and one helper (numpy's matmul releases the GIL).
+
+    This is how one spectrum slice uses two idle cores: its products are memory bound and
+    each thread streams half of the rows. With ``helper=None`` the products run in the caller.
+    """
+
+    def __init__(self, helper: Any | None) -> None:
+        self.helper = helper
+
+    def tmm(self, A: FloatArray, B: FloatArray) -> FloatArray:
+        """``AᵀB``."""
+        n = A.shape[0]
+        if self.helper is None or n < 4096:
+            return A.T @ B
+        h = n // 2
+        fut = self.helper.submit(np.matmul, A[h:].T, B[h:])
+        G = A[:h].T @ B[:h]
+        G += fut.result()
+        return G
+
+    def mm(self, A: FloatArray, C: FloatArray, out: FloatArray) -> None:
+        """``out[...] = A C`` (``out`` F-ordered)."""
+        n = A.shape[0]
+        if self.helper is None or n < 4096:
+            np.matmul(A, C, out=out)
+            return
+        h = n // 2
+        top = np.empty((h, out.shape[1]), order="F")
+        bottom = np.empty((n - h, out.shape[1]), order="F")
+        fut = self.helper.submit(np.matmul, A[h:], C, out=bottom)
+        np.matmul(A[:h], C, out=top)
+        fut.result()
+        out[:h] = top
+        out[h:] = bottom
+
+
 class _BlockLanczos:
     """Block Lanczos for a symmetric operator, full (CGS2) reorthogonalization, deflation.
 
@@ -379,6 +514,8 @@ class _BlockLanczos:
     problem*, ch. 13).
     """
 
+    delayed = True  # DCGS2 (see :meth:`step`); False: classical Gram–Schmidt, 1–2 passes
+
     def __init__(
         self,
         op: Callable[[FloatArray, FloatArray], None],
@@ -387,8 +524,10 @@ class _BlockLanczos:
         X: FloatArray | None,
         rng: np.random.Generator,
         capacity: int,
+        rows: _RowSplit | None = None,
     ) -> None:
         self.op = op
+        self.rows = rows if rows is not None else _RowSplit(None)
         self.n = n
         self.b = block
         self.X = None if X is None or X.shape[1] == 0 else _orthonormal_columns(X)
@@ -405,6 +544,8 @@ class _BlockLanczos:
         self._measured = 1e-15  # largest orthogonality error measured so far
         self._last_measure = 0
         self.B_last = np.zeros((block, block))
+        self._work = (np.empty((n, 2 * block), order="F"), np.empty((n, 2 * block), order="F"),
+                      np.empty((n, block), order="F"))
         self.Q[:, :block] = self._random_orthonormal(block, 0, None)
 
     def _project(self, W: FloatArray, ncols: int) -> tuple[FloatArray, FloatArray]:
@@ -471,7 +612,78 @@ class _BlockLanczos:
         self.Q, self.T = Q, T
 
     def step(self) -> None:
-        """Apply the operator to the newest block and extend the basis by one block."""
+        """Apply the operator to the newest block and extend the basis by one block.
+
+        Delayed classical Gram–Schmidt (DCGS2; Świrydowicz, Langou, Ananthan, Yang & Thomas,
+        "Low synchronization Gram–Schmidt and GMRES algorithms", 2020, adapted to block
+        Lanczos): the newest block ``q̃`` was orthogonalized once when it was made. Its second
+        pass is done now, in the same two passes over the basis that orthogonalize
+        ``W = Op(q̃)``: one product ``Qᵀ[q̃ W]`` and one ``Q[c P']``, each with ``2b``
+        columns. These tall-skinny products are memory bound, so ``2b`` columns cost about as
+        much as ``b``: one pass per block instead of up to two. The correction of ``q̃`` to
+        ``q = (q̃ − Qc) S⁻¹`` is carried into ``Op(q)`` through the Lanczos relation
+        ``Op(Q) = Q T + q̃ R Eᵀ``, without applying the operator again.
+        """
+        if not self.delayed:
+            self._step_classical()
+            return
+        b, j0 = self.b, self.j
+        j1 = j0 + b
+        if j1 + b > self.max_dim:
+            self.exhausted = True
+        Qt = self.Q[:, j0:j1]  # q̃: orthogonalized once (exact for the first block)
+        W = np.empty((self.n, b), order="F")
+        self.op(Qt, W)
+        self.n_applied += b
+        size = float(np.linalg.norm(W, axis=0).max(initial=0.0))
+        if self.X is not None:  # deflated vectors: a pass now and one at the end
+            _gemm_update(W, self.X, self.X.T @ W)
+        if j0:
+            # (preallocated F-ordered operands: a fresh or C-ordered n × 2b array doubles the
+            # time of these products)
+            Qa, Y = self.Q[:, :j0], self._work[0]
+            Y[:, :b] = Qt
+            Y[:, b:] = W
+            C = self.rows.tmm(Qa, Y)
+            c, H1 = C[:, :b], C[:, b:]
+            Rp = self.T[j0:j1, j0 - b:j0].copy()  # q̃ Rp = last step's once-orthogonalized W
+            Rc = Rp @ c[j0 - b:j0]
+            cRc = c @ Rc
+            C[:, b:] -= cRc
+            D = self._work[1]
+            self.rows.mm(Qa, C, D)
+            q = self._work[2]
+            np.subtract(Qt, D[:, :b], out=q)
+            # q̃ − Qc = q S: S is within round-off of I (q̃ was orthogonal to ~1e-8 or better;
+            # the rank test in _finish_step sees to it), so one Cholesky QR pass is exact
+            S = _chol_qr(q, 1, 0.5)
+            if S is None:  # pragma: no cover - see the rank test in _finish_step
+                raise RuntimeError("Lanczos: lost orthogonality")
+            _gemm_update(W, Qt, Rc)
+            W -= D[:, b:]
+            _right_solve(W, S)
+            V = W
+            P = sla.solve_triangular(S, (H1 - self.T[:j0, :j0] @ c).T, trans="T",
+                                     check_finite=False).T  # (H1 holds H1 − cRc now)
+            # the previous block's relation Op(q_prev) = Q T + q̃ Rp, rewritten with q
+            self.T[:j0, j0 - b:j0] += c @ Rp
+            self.T[j0:j1, j0 - b:j0] = S @ Rp
+            self.T[:j0, j0:j1] = P
+            self.Q[:, j0:j1] = q
+        else:
+            q, V = Qt, W
+        g = q.T @ V
+        _gemm_update(V, q, g)
+        if self.X is not None:
+            # (what the projections against Q cancelled can leave ε·‖W‖/‖V‖ along X; the
+            # delayed pass of the next step covers Q only)
+            _gemm_update(V, self.X, self.X.T @ V)
+        self.T[j0:j1, j0:j1] = 0.5 * (g + g.T)
+        self.passes += 1
+        self._finish_step(V, size, j0, j1)
+
+    def _step_classical(self) -> None:
+        """:meth:`step` with classical Gram–Schmidt, a second pass when a bound asks for it."""
         b, j0 = self.b, self.j
         j1 = j0 + b
         if j1 + b > self.max_dim:
@@ -482,11 +694,18 @@ class _BlockLanczos:
         size = float(np.linalg.norm(W, axis=0).max(initial=0.0))
         W, H = self._project(W, j1)
         self.T[:j1, j0:j1] = H
+        self._finish_step(W, size, j0, j1)
+
+    def _finish_step(self, W: FloatArray, size: float, j0: int, j1: int) -> None:
+        """Normalize the orthogonalized block ``W`` (QR; breakdown: continue at random)."""
+        b = self.b
         if j1 + b > self.Q.shape[1]:
             self._grow()
         B = np.zeros((b, b))
         if self.exhausted:
             Qn = np.zeros((self.n, b))
+        elif (R := _chol_qr(W, 2, 1e-4, 1e-8 * size)) is not None:
+            Qn, B = W, R  # (well conditioned, no breakdown: Cholesky QR2 is 4× faster)
         else:
             Qn, R, piv = sla.qr(W, mode="economic", pivoting=True, check_finite=False)
             B[:, piv] = R
@@ -502,7 +721,8 @@ class _BlockLanczos:
         self.B_last = B
         self.j = j1
         if j1 + b - self._last_measure >= 16 * b:
-            self._measure(j1 + b)
+            # (the newest block is orthogonalized a second time only in the next step)
+            self._measure(j1 if self.delayed else j1 + b)
 
     def _measure(self, ncols: int) -> None:
         """Measure the orthogonality of the blocks added since the last measurement; the
@@ -530,7 +750,9 @@ class _BlockLanczos:
 
     def vectors(self, S: FloatArray) -> FloatArray:
         """Ritz vectors ``Q S`` (``n × S.shape[1]``, F-ordered)."""
-        return np.asfortranarray(self.Q[:, :self.j] @ S)
+        out = np.empty((self.n, S.shape[1]), order="F")
+        self.rows.mm(self.Q[:, :self.j], np.ascontiguousarray(S), out)
+        return out
 
 
 # --------------------------------------------------------------------------------------------
@@ -613,19 +835,48 @@ def _dense_eigenpairs(
     return lam, Y
 
 
-def _lowdin(Y: FloatArray) -> float:
+def _lowdin(Y: FloatArray, helper: Any | None = None) -> float:
     """Symmetric (Löwdin) orthonormalization of the columns of ``Y`` in place; returns the
-    departure ``max|YᵀY − I|`` before it."""
-    G = blas.dsyrk(1.0, Y, trans=True, lower=False)
-    G = np.triu(G) + np.triu(G, 1).T
-    err = float(np.abs(G - np.eye(len(G))).max(initial=0.0))
+    departure ``max|YᵀY − I|`` before it.
+
+    ``Y ← Y G^-½`` with ``G = YᵀY``. When ``G = I + E`` is that close to ``I`` (as slices
+    computed separately are: ``|E| ~ 1e-9``), ``G^-½ = I − E/2 + 3E²/8`` to ``O(‖E‖³)``;
+    otherwise from ``eigh(G)``. ``helper`` (an executor with one thread): the two
+    ``n × k`` products run on two cores, half of the rows each.
+    """
+    n, k = Y.shape
+    split = helper is not None and n >= 8192 and k >= 64
+    h = n // 2
+    if split:
+        fut = helper.submit(lambda: Y[h:].T @ Y[h:])
+        G = Y[:h].T @ Y[:h]
+        G += fut.result()
+        G = 0.5 * (G + G.T)
+    else:
+        G = blas.dsyrk(1.0, Y, trans=True, lower=False)
+        G = np.triu(G) + np.triu(G, 1).T
+    E = G - np.eye(k)
+    err = float(np.abs(E).max(initial=0.0))
     if err < 1e-11:  # e.g. a single slice: Q S is orthonormal already
         return err
-    w, E = np.linalg.eigh(G)
-    S = (E / np.sqrt(w)[None, :]) @ E.T
-    chunk = max(1, (1 << 24) // max(1, Y.shape[1]))
-    for r0 in range(0, Y.shape[0], chunk):
-        Y[r0:r0 + chunk] = Y[r0:r0 + chunk] @ S
+    if err * k <= 1e-4:  # ‖E‖₂ <= k·max|E|
+        S = np.eye(k) - 0.5 * E + 0.375 * (E @ E)
+    else:
+        w, V = np.linalg.eigh(G)
+        S = (V / np.sqrt(w)[None, :]) @ V.T
+    chunk = max(1, (1 << 24) // max(1, k))
+
+    def product(r0: int, r1: int) -> None:
+        for a in range(r0, r1, chunk):
+            b = min(a + chunk, r1)
+            Y[a:b] = Y[a:b] @ S
+
+    if split:
+        fut = helper.submit(product, h, n)
+        product(0, h)
+        fut.result()
+    else:
+        product(0, n)
     return err
 
 
@@ -700,6 +951,8 @@ class _SliceContext:
         self._done_count = 0
         self.cancel = threading.Event()
         self.error: BaseException | None = None
+        self.rows = _RowSplit(None)
+        self.inertia: dict[int, tuple[float, int]] = {}  # slice -> (shift, eigenvalues below)
 
     def report(self, index: int, n_conv: int, message: str) -> None:
         if self._progress is None:
@@ -736,9 +989,12 @@ def _run_slice(ctx: _SliceContext, spec: _SliceSpec, seed: int) -> _SliceResult:
         # the ordering the final inertia check reuses)
         cholesky=spec.expected >= _CHOLESKY_MIN,
     )
+    if not spec.spd:
+        ctx.inertia[spec.index] = (op.sigma, op.n_below)  # (planning of the next slices)
     parts = [x for x in (ctx.Zy, spec.X) if x is not None and x.shape[1]]
     X = np.asfortranarray(np.concatenate(parts, axis=1)) if parts else None
-    lz = _BlockLanczos(op, ctx.n, b, X, rng, capacity=int(3.2 * spec.expected) + 16 * b)
+    lz = _BlockLanczos(op, ctx.n, b, X, rng, capacity=int(3.2 * spec.expected) + 16 * b,
+                       rows=ctx.rows)
     next_check = max(2 * b, int(0.8 * spec.expected) // b * b)
     prev: tuple[int, float] | None = None
     while True:
@@ -907,13 +1163,22 @@ def _sliced_lanczos(
         sizes = [todo]
     elif spd_first and todo <= first_slice:
         # two workers: split, the Cholesky slice (cheaper solves) taking a little more
-        sizes = [todo - int(0.4 * todo), int(0.4 * todo)]
+        sizes = [todo - int(_SPLIT * todo), int(_SPLIT * todo)]
     else:
-        first = min(first_slice, todo) if spd_first else 0
-        rest = todo - first
-        n_int = max(1, -(-rest // slice_size))
-        per = -(-rest // n_int)
-        sizes = ([first] if spd_first else []) + [per] * n_int
+        if workers >= 2:
+            # equal slices, as many as a multiple of the workers (the last round keeps every
+            # thread busy), of the size nearest to slice_size
+            lo_n = max(workers, todo // slice_size // workers * workers)
+            cands = [c for c in (lo_n, lo_n + workers) if todo >= 32 * c] or [1]
+            n_sl = min(cands, key=lambda c: abs(np.log(todo / c / slice_size)))
+            per = -(-todo // n_sl)
+            sizes = [per] * n_sl
+        else:
+            first = min(first_slice, todo) if spd_first else 0
+            rest = todo - first
+            n_int = max(1, -(-rest // slice_size))
+            per = -(-rest // n_int)
+            sizes = ([first] if spd_first else []) + [per] * n_int
     sizes = [max(s_, 4) for s_ in sizes]
     n_total = len(sizes)
     lam_known_hi = float(found.lam.max(initial=0.0)) if known is not None else 0.0
@@ -927,9 +1192,24 @@ def _sliced_lanczos(
         near_all = len(near) == found.count
         known_X = np.asfortranarray(found.Y[:, near])
 
+    def plannable(i: int) -> bool:
+        """Slice ``i`` is planned from slice ``i − 1``: its inertia (known as soon as it is
+        factored) or, for the positive definite slice, its result. (So the plan does not
+        depend on which thread finishes first, and no thread waits for a long slice.)"""
+        if i < max(workers, 1) or (i - 1) in results:
+            return True
+        return not specs[i - 1].spd and (i - 1) in ctx.inertia
+
     def density_before(i: int) -> float:
-        """Eigenvalue density for planning slice ``i`` from slices ``<= i - workers``
-        (deterministic whatever order the threads finish in)."""
+        """Eigenvalue density for planning slice ``i``: between the last two inertia counts
+        at the shifts of slices ``< i`` (the first point is ``(0, base)``), else from the
+        finished slices ``<= i - workers``, else Weyl's."""
+        pts = [(0.0, base if known is None else n_null)] + [
+            ctx.inertia[j] for j in range(i) if j in ctx.inertia]
+        if len(pts) >= 2 and pts[-1][0] > pts[-2][0]:
+            (s0, n0), (s1, n1) = pts[-2], pts[-1]
+            if n1 - n0 >= 4:
+                return (n1 - n0) / (s1 - s0)
         j = i - max(workers, 1)
         while j >= 0:
             r = results.get(j)
@@ -982,15 +1262,15 @@ def _sliced_lanczos(
             checks.append((r.sigma, r.n_below))
 
     t_slices = time.perf_counter()
+    if _ROW_THREADS > 1 and workers == 1:
+        ctx.rows = _RowSplit(cf.ThreadPoolExecutor(max_workers=1))
     with (cf.ThreadPoolExecutor(max_workers=workers) if workers > 1 else _InlinePool()) as pool:
         running: dict[cf.Future[_SliceResult], int] = {}
         try:
             while True:
                 while len(running) < max(workers, 1):
                     i = len(specs)
-                    if i - workers >= 0 and (i - workers) not in results:
-                        break  # plan only from finished, deterministic information
-                    if not need_more(i):
+                    if not need_more(i) or not plannable(i):
                         break
                     specs.append(plan(i))
                     running[pool.submit(_run_slice, ctx, specs[-1], seed)] = i
@@ -1002,7 +1282,10 @@ def _sliced_lanczos(
                     specs.append(plan(len(specs)))
                     running[pool.submit(_run_slice, ctx, specs[-1], seed)] = len(specs) - 1
                     continue
-                done, _ = cf.wait(running, return_when=cf.FIRST_COMPLETED)
+                # (a short timeout while the next slice waits for an inertia count)
+                waiting = len(running) < max(workers, 1) and need_more(len(specs))
+                done, _ = cf.wait(running, timeout=0.01 if waiting else None,
+                                  return_when=cf.FIRST_COMPLETED)
                 for f in sorted(done, key=lambda f: running[f]):
                     del running[f]
                     absorb(f.result())
@@ -1292,6 +1575,7 @@ def pencil_eigenpairs(
         _report(progress, 1.0, "eigensolver: done")
     else:
         info.method = "shift-invert block Lanczos, spectrum slicing"
+        nw_used = 1
         kn = None
         if known is not None and len(known[0]):
             lam0 = np.asarray(known[0], dtype=np.float64)
@@ -1308,6 +1592,7 @@ def pencil_eigenpairs(
                 nw = max(1, int(workers))
             else:  # (one slice below ~60 modes: no need to sample the machine's load)
                 nw = 1 if k < 60 else _default_workers(n, max(slice_size, first_slice))
+            nw_used = nw
             nb = 1 if blas_threads is None else max(1, int(blas_threads))
             info.messages.append(f"{nw} slice worker(s), {nb} BLAS thread(s)")
             rho = float(density) if density else float(m.sum() / (4 * np.pi))
@@ -1319,7 +1604,13 @@ def pencil_eigenpairs(
                 )
         t1 = time.perf_counter()
         with _blas_threads(1):
-            info.orthogonality_error = _lowdin(Y)
+            if nw_used >= 2:
+                import concurrent.futures as cf
+
+                with cf.ThreadPoolExecutor(max_workers=1) as helper:
+                    info.orthogonality_error = _lowdin(Y, helper)
+            else:
+                info.orthogonality_error = _lowdin(Y)
         info.timings["orthonormalization"] = time.perf_counter() - t1
     info.min_raw_eigenvalue = float(lam.min(initial=0.0))
     neg = lam < 0
@@ -1344,7 +1635,7 @@ def pencil_eigenpairs(
 
 
 def _max_residual(
-    K: sp.csr_matrix, m: FloatArray, lam: FloatArray, U: FloatArray, sample: int = 64
+    K: sp.csr_matrix, m: FloatArray, lam: FloatArray, U: FloatArray, sample: int = 24
 ) -> float:
     """``max_i ||K u_i − λ_i M u_i||_{M⁻¹} / max(λ_i, λ_ref)`` over ``sample`` columns spread
     evenly (first and last included); ``||u_i||_M = 1``, ``λ_ref = tr(K)/(n·tr(M))``."""

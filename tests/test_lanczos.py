@@ -1,0 +1,226 @@
+"""Tests of the eigensolver's building blocks in meshlap_core.spectral.
+
+The pieces: block Lanczos with delayed classical Gram–Schmidt (DCGS2), Cholesky QR, the QDLDL
+``LDLᵀ`` with its inertia (and the SuperLU fallback), the row-split products for two cores,
+the Löwdin orthonormalization, and the slice plan for two workers. Each is checked against
+an independent reference: exact eigenvalues of a diagonal operator, dense LAPACK (``eigvalsh``,
+``qr``), Sylvester's law of inertia counted from dense eigenvalues.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures as cf
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from meshlap_core import spectral as S
+from meshlap_core.primitives import bumpy_sphere
+
+
+def _diag_lanczos(theta, *, delayed, X=None, steps, block=4, seed=0):
+    """Block Lanczos on the diagonal operator ``diag(theta)``."""
+    n = len(theta)
+
+    def op(Y, out):
+        out[...] = theta[:, None] * Y
+
+    rng = np.random.default_rng(seed)
+    lz = S._BlockLanczos(op, n, block, X, rng, capacity=steps * block + 2 * block)
+    lz.delayed = delayed
+    for _ in range(steps):
+        lz.step()
+    return lz
+
+
+# ------------------------------------------------------------------ block Lanczos, DCGS2
+
+
+def test_delayed_gram_schmidt_keeps_the_basis_orthonormal_and_the_lanczos_relation():
+    n, b, steps = 3000, 4, 40
+    theta = 1.0 / np.linspace(1.0, 50.0, n)  # shift-invert-like: a few large, many small
+    lz = _diag_lanczos(theta, delayed=True, steps=0)
+    start = lz.passes  # (the random first block is orthogonalized in full)
+    for _ in range(steps):
+        lz.step()
+    j = lz.j
+    Q = lz.Q[:, :j]
+    assert np.abs(Q.T @ Q - np.eye(j)).max() < 1e-12
+    # A Q_j = Q_j T_j + q̃ B Eᵀ: T's lower triangle (what the Ritz values use) is the
+    # projection QᵀAQ
+    T = np.tril(lz.T[:j, :j]) + np.tril(lz.T[:j, :j], -1).T
+    np.testing.assert_allclose(T, Q.T @ (theta[:, None] * Q), atol=1e-12)
+    assert lz.passes - start == steps  # one pass over the basis per block
+
+
+def test_delayed_and_classical_gram_schmidt_give_the_same_ritz_values():
+    n = 2000
+    rng = np.random.default_rng(3)
+    lam = np.sort(rng.uniform(0.5, 40.0, n))
+    theta = 1.0 / (lam + 0.1)
+    want = 12
+    exact = np.sort(theta)[::-1][:want]
+    vals = []
+    for delayed in (True, False):
+        lz = _diag_lanczos(theta, delayed=delayed, steps=30)
+        th, _, res = lz.ritz(want)
+        assert np.all(res / np.abs(th) < 1e-8)
+        vals.append(np.sort(th)[::-1])
+    np.testing.assert_allclose(vals[0], exact, rtol=1e-12)
+    np.testing.assert_allclose(vals[1], exact, rtol=1e-12)
+
+
+def test_invariant_subspace_breakdown_continues_with_orthonormal_random_blocks():
+    # three distinct eigenvalues: the Krylov space is exhausted after one block of 4
+    n = 500
+    theta = np.repeat([3.0, 2.0, 1.0], [100, 200, 200])
+    lz = _diag_lanczos(theta, delayed=True, steps=6)
+    Q = lz.Q[:, :lz.j]
+    assert np.abs(Q.T @ Q - np.eye(lz.j)).max() < 1e-12
+    th, _, _ = lz.ritz(lz.j)
+    # every Ritz value is one of the three eigenvalues (to round-off)
+    assert np.abs(th[:, None] - np.array([3.0, 2.0, 1.0])[None, :]).min(axis=1).max() < 1e-10
+
+
+def test_deflated_vectors_stay_out_of_the_basis():
+    n = 1000
+    theta = 1.0 / np.linspace(1.0, 20.0, n)
+    X = np.zeros((n, 2))
+    X[0, 0] = X[1, 1] = 1.0  # the two largest eigenvectors of diag(theta)
+    lz = _diag_lanczos(theta, delayed=True, X=X, steps=40)
+    Q = lz.Q[:, :lz.j]
+    assert np.abs(X.T @ Q).max() < 1e-13
+    th, _, res = lz.ritz(1)
+    assert res[0] < 1e-8
+    assert th[0] == pytest.approx(theta[2], rel=1e-12)  # the largest one not deflated
+
+
+# ------------------------------------------------------------------ small dense kernels
+
+
+def test_cholesky_qr_orthonormalizes_and_refuses_ill_conditioned_blocks():
+    rng = np.random.default_rng(1)
+    W = np.asfortranarray(rng.standard_normal((5000, 4)))
+    W0 = W.copy()
+    R = S._chol_qr(W, 2, 1e-4)
+    assert R is not None and np.allclose(R, np.triu(R))
+    np.testing.assert_allclose(W.T @ W, np.eye(4), atol=1e-14)
+    np.testing.assert_allclose(W @ R, W0, atol=1e-12)
+    # the same R as Householder QR (up to the signs of its rows)
+    _, Rh = np.linalg.qr(W0)
+    np.testing.assert_allclose(np.abs(R), np.abs(Rh), rtol=1e-10)
+    bad = np.asfortranarray(W0.copy())
+    bad[:, 3] = bad[:, 0] + 1e-9 * bad[:, 1]  # nearly dependent: Cholesky QR would be wrong
+    keep = bad.copy()
+    assert S._chol_qr(bad, 2, 1e-4) is None
+    np.testing.assert_array_equal(bad, keep)  # untouched when refused
+
+
+def test_gemm_update_and_right_solve_in_place():
+    rng = np.random.default_rng(2)
+    C = np.asfortranarray(rng.standard_normal((300, 4)))
+    A = np.asfortranarray(rng.standard_normal((300, 1)))  # inner dimension 1
+    B = rng.standard_normal((1, 4))
+    expect = C - A @ B
+    S._gemm_update(C, A, B)
+    np.testing.assert_allclose(C, expect, atol=1e-13)
+    R = np.triu(rng.standard_normal((4, 4))) + 4 * np.eye(4)
+    expect = C @ np.linalg.inv(R)
+    S._right_solve(C, R)
+    np.testing.assert_allclose(C, expect, atol=1e-12)
+
+
+def test_row_split_products_equal_the_plain_ones():
+    rng = np.random.default_rng(4)
+    A = np.asfortranarray(rng.standard_normal((10_001, 37)))
+    B = np.asfortranarray(rng.standard_normal((10_001, 8)))
+    Cm = rng.standard_normal((37, 8))
+    with cf.ThreadPoolExecutor(max_workers=1) as helper:
+        for rows in (S._RowSplit(None), S._RowSplit(helper)):
+            np.testing.assert_allclose(rows.tmm(A, B), A.T @ B, rtol=1e-12, atol=1e-10)
+            out = np.empty((10_001, 8), order="F")
+            rows.mm(A, Cm, out)
+            np.testing.assert_allclose(out, A @ Cm, rtol=1e-12, atol=1e-12)
+
+
+@pytest.mark.parametrize("perturbation", [1e-9, 1e-3])
+@pytest.mark.parametrize("threads", [1, 2])
+def test_lowdin_orthonormalizes_with_the_smallest_change(perturbation, threads):
+    # small perturbations take the series G^-1/2 = I − E/2 + 3E²/8, large ones eigh
+    rng = np.random.default_rng(5)
+    Q, _ = np.linalg.qr(rng.standard_normal((9000, 70)))
+    Y = np.asfortranarray(Q + perturbation * rng.standard_normal(Q.shape))
+    Y0 = Y.copy()
+    helper = cf.ThreadPoolExecutor(max_workers=1) if threads == 2 else None
+    try:
+        err = S._lowdin(Y, helper)
+    finally:
+        if helper is not None:
+            helper.shutdown()
+    assert err == pytest.approx(np.abs(Y0.T @ Y0 - np.eye(70)).max())
+    assert np.abs(Y.T @ Y - np.eye(70)).max() < 1e-13
+    # Löwdin is Y0 (Y0ᵀY0)^-1/2, the orthonormal matrix closest to Y0 (polar factor)
+    Uo, _, Vt = np.linalg.svd(Y0, full_matrices=False)
+    np.testing.assert_allclose(Y, Uo @ Vt, atol=1e-12)
+
+
+# ------------------------------------------------------------------ LDLᵀ and inertia
+
+
+def _indefinite(n=400, seed=6):
+    rng = np.random.default_rng(seed)
+    A = sp.random(n, n, density=0.01, random_state=seed)
+    A = (A + A.T + sp.diags(rng.uniform(-3.0, 5.0, n))).tocsr()
+    return A
+
+
+def test_qdldl_inertia_counts_the_negative_eigenvalues_and_solves():
+    A = _indefinite()
+    rng = np.random.default_rng(0)
+    ldl, neg = S._qdldl_inertia(A, rng)
+    assert neg == np.count_nonzero(np.linalg.eigvalsh(A.toarray()) < 0)
+    b = rng.standard_normal((A.shape[0], 3))
+    np.testing.assert_allclose(A @ ldl.solve(b), b, atol=1e-9)
+
+
+def test_shift_invert_falls_back_to_superlu_without_qdldl(monkeypatch):
+    A = _indefinite()
+    rng = np.random.default_rng(0)
+    op_q = S._ShiftInvert(A, 0.25, spd=False, rng=rng, spacing=1.0)
+
+    def unavailable(*args):
+        raise ImportError("no qdldl")
+
+    monkeypatch.setattr(S, "_qdldl_inertia", unavailable)
+    op_s = S._ShiftInvert(A, 0.25, spd=False, rng=rng, spacing=1.0)
+    assert isinstance(op_q._lu, S._QDLDL) and isinstance(op_s._lu, S._LDL)
+    assert op_q.n_below == op_s.n_below == np.count_nonzero(
+        np.linalg.eigvalsh(A.toarray()) < op_q.sigma)
+    Y = np.asfortranarray(rng.standard_normal((A.shape[0], 4)))
+    out_q, out_s = np.empty_like(Y), np.empty_like(Y)
+    op_q(Y, out_q)
+    op_s(Y, out_s)
+    np.testing.assert_allclose(out_q, out_s, rtol=1e-8, atol=1e-10)
+
+
+def test_a_shift_on_an_eigenvalue_is_moved_not_factored():
+    # A − σI exactly singular at σ = 2: QDLDL hits a zero pivot and the shift moves
+    A = sp.diags([1.0, 2.0, 3.0, 4.0]).tocsr()
+    op = S._ShiftInvert(A, 2.0, spd=False, rng=np.random.default_rng(0), spacing=1.0)
+    assert op.sigma != 2.0 and abs(op.sigma - 2.0) < 0.1
+    assert op.n_below == (1 if op.sigma > 2.0 else 0) + 1
+
+
+# ------------------------------------------------------------------ the slice plan
+
+
+def test_two_workers_get_an_even_number_of_equal_slices():
+    V, F = bumpy_sphere(3)  # (no exact multiplicities: no repair slice)
+    lam, _, info = S.laplacian_eigenpairs(V, F, 200, method="sparse", slice_size=40,
+                                          workers=2)
+    n_slices = len(info.krylov_dims)
+    assert n_slices >= 4 and n_slices % 2 == 0, info.messages
+    K, m = S.spectral_operators(V, F)
+    ref = np.linalg.eigvalsh(K.toarray() / np.sqrt(m)[:, None] / np.sqrt(m)[None, :])[:200]
+    np.testing.assert_allclose(lam, ref, rtol=1e-9, atol=1e-9 * ref.max())
