@@ -38,7 +38,7 @@ def _diag_lanczos(theta, *, delayed, X=None, steps, block=4, seed=0):
 
 
 def test_delayed_gram_schmidt_keeps_the_basis_orthonormal_and_the_lanczos_relation():
-    n, b, steps = 3000, 4, 40
+    n, steps = 3000, 40
     theta = 1.0 / np.linspace(1.0, 50.0, n)  # shift-invert-like: a few large, many small
     lz = _diag_lanczos(theta, delayed=True, steps=0)
     start = lz.passes  # (the random first block is orthogonalized in full)
@@ -73,7 +73,6 @@ def test_delayed_and_classical_gram_schmidt_give_the_same_ritz_values():
 
 def test_invariant_subspace_breakdown_continues_with_orthonormal_random_blocks():
     # three distinct eigenvalues: the Krylov space is exhausted after one block of 4
-    n = 500
     theta = np.repeat([3.0, 2.0, 1.0], [100, 200, 200])
     lz = _diag_lanczos(theta, delayed=True, steps=6)
     Q = lz.Q[:, :lz.j]
