@@ -104,7 +104,7 @@ _FIRST_SLICE = 128  # eigenpairs with the positive definite shift (cheaper Chole
 _ORTH_LEVEL = 1e-10  # orthogonality kept in the Lanczos basis
 _EDGE_TOL = 1e-4  # residual of the nearest Ritz value outside a slice's interval
 _CHOLESKY_MIN = 32  # use cholespy for the positive definite slice from this many eigenpairs
-_SPLIT = 0.4  # share of the interior (LDLᵀ) slice when two workers split <= _FIRST_SLICE pairs
+_SPLIT = 0.5  # share of the interior slice when two workers split <= _FIRST_SLICE pairs
 _ROW_THREADS = 1
 _SHIFT_REL = 1e-2  # σ₀ = −_SHIFT_REL · tr(K) / (n · tr(M))
 
@@ -903,6 +903,7 @@ class _SliceSpec:
     X: FloatArray | None = None  # extra vectors to deflate (known eigenvectors nearby)
     count: int | None = None  # if set: the `count` lowest eigenvalues >= lo (hi ignored)
     check_below: bool = True  # are there (undeflated) eigenvalues below lo to resolve?
+    check_top: bool = False  # the top slice: also factor in a gap below its top eigenvalue
 
 
 @dataclass
@@ -915,6 +916,7 @@ class _SliceResult:
     krylov_dim: int
     n_applied: int
     seconds: float
+    check: tuple[float, int] | None = None  # (shift, eigenvalues below it) near the top
 
 
 class _Cancelled(Exception):
@@ -952,6 +954,7 @@ class _SliceContext:
         self.cancel = threading.Event()
         self.error: BaseException | None = None
         self.rows = _RowSplit(None)
+        self.workers = 1
         self.inertia: dict[int, tuple[float, int]] = {}  # slice -> (shift, eigenvalues below)
 
     def report(self, index: int, n_conv: int, message: str) -> None:
@@ -985,9 +988,10 @@ def _run_slice(ctx: _SliceContext, spec: _SliceSpec, seed: int) -> _SliceResult:
     op = _ShiftInvert(
         ctx.A, spec.sigma, spd=spec.spd, rng=rng,
         spacing=max(width, ctx.scale) / max(spec.expected, 1), ordering=ctx.ordering,
-        # a few dozen solves do not repay CHOLMOD's slower factorization (and LDLᵀ computes
-        # the ordering the final inertia check reuses)
-        cholesky=spec.expected >= _CHOLESKY_MIN,
+        # CHOLMOD (cholespy) solves 4 right-hand sides 2× faster than QDLDL's one at a time,
+        # but factors 3× slower and holds the GIL meanwhile, stalling a concurrent slice:
+        # only for a long slice alone
+        cholesky=spec.expected >= _CHOLESKY_MIN and ctx.workers < 2,
     )
     if not spec.spd:
         ctx.inertia[spec.index] = (op.sigma, op.n_below)  # (planning of the next slices)
@@ -1043,13 +1047,27 @@ def _run_slice(ctx: _SliceContext, spec: _SliceSpec, seed: int) -> _SliceResult:
             step = int(min(step, max(b, -(-int(np.ceil(worst / rate)) // b) * b)))
         prev = (lz.j, worst)
         next_check = lz.j + step
+    sigma_used, n_below, j_used, n_applied = op.sigma, op.n_below, lz.j, lz.n_applied
     sel = np.flatnonzero(inside if lz.exhausted else inside & conv)
     sel = sel[np.argsort(lam[sel], kind="stable")]
     Y = lz.vectors(S[:, sel])
+    del lz, op
+    check = None
+    if spec.check_top and not ctx.cancel.is_set():
+        # The inertia check just above λ_k, done here in a gap between the two top
+        # eigenvalues of the top slice (everything below them is in this slice or a lower
+        # one): with two workers it overlaps the other slice instead of following both.
+        ls = lam[sel]
+        gaps = np.flatnonzero(np.diff(ls) > 1e-7 * np.maximum(np.abs(ls[1:]), ctx.scale))
+        if len(gaps):
+            t = int(gaps[-1])
+            chk = _ShiftInvert(ctx.A, 0.5 * (ls[t] + ls[t + 1]), spd=False, rng=rng,
+                               spacing=ls[t + 1] - ls[t], ordering=ctx.ordering)
+            check = (chk.sigma, chk.n_below)
     ctx.finished(spec.index, len(sel))
     return _SliceResult(
-        spec=spec, sigma=op.sigma, n_below=op.n_below, lam=lam[sel], Y=Y, krylov_dim=lz.j,
-        n_applied=lz.n_applied, seconds=time.perf_counter() - t0,
+        spec=spec, sigma=sigma_used, n_below=n_below, lam=lam[sel], Y=Y, krylov_dim=j_used,
+        n_applied=n_applied, seconds=time.perf_counter() - t0, check=check,
     )
 
 
@@ -1244,7 +1262,8 @@ def _sliced_lanczos(
         return _SliceSpec(i, sigma, lo, hi, spd, size,
                           known_X if (i == 0 and known is not None) else None, count,
                           check_below=lo > 0 and not (i == 0 and known_X is not None
-                                                      and near_all))
+                                                      and near_all),
+                          check_top=workers >= 2 and i == n_total - 1)
 
     def need_more(i: int) -> bool:
         return i < n_total
@@ -1260,8 +1279,12 @@ def _sliced_lanczos(
         info.n_factorizations += 1
         if not r.spec.spd:
             checks.append((r.sigma, r.n_below))
+        if r.check is not None:
+            checks.append(r.check)
+            info.n_factorizations += 1
 
     t_slices = time.perf_counter()
+    ctx.workers = workers
     if _ROW_THREADS > 1 and workers == 1:
         ctx.rows = _RowSplit(cf.ThreadPoolExecutor(max_workers=1))
     with (cf.ThreadPoolExecutor(max_workers=workers) if workers > 1 else _InlinePool()) as pool:
