@@ -22,23 +22,26 @@ The eigensolver (:func:`pencil_eigenpairs`, :func:`laplacian_eigenpairs`) is shi
 Lanczos with spectrum slicing, on the symmetric scaled pencil ``A = M^-½ K M^-½``:
 
 * ``[0, λ_k]`` is cut into consecutive intervals holding ~64 eigenvalues each (~128 for the
-  lowest), planned with Weyl's law ``N(λ) ≈ area·λ/4π`` and then with the density that finished
-  slices measured; slices run in two threads when two cores are idle.
-* The lowest interval uses a small negative shift ``σ₀`` scaled to the mesh and a Cholesky
-  factor of the positive definite ``A − σ₀I`` (``cholespy``); the others a shift in their middle
-  and an ``LDLᵀ`` factor (SuperLU, symmetric mode, no pivoting, one fill-reducing ordering
-  shared by all shifts). A singular matrix is never factored: a shift that lands on an
-  eigenvalue is moved.
-* Block Lanczos (block 4, Gram–Schmidt against the slice's own basis only, a second pass when
-  an error bound asks for it) runs until every Ritz value in the interval has a relative
+  lowest with one worker; equal slices, an even number of them, with two), planned with Weyl's
+  law ``N(λ) ≈ area·λ/4π`` and then with the density that the inertia counts at the shifts
+  measure (known as soon as a slice is factored); slices run in two threads when two cores
+  are idle.
+* Every interval gets a shift in its middle and an ``LDLᵀ`` factor without pivoting (QDLDL,
+  AMD ordering; SuperLU in symmetric mode as fallback). The lowest interval too: the null
+  space (one indicator per component) is deflated exactly, so nothing below 0 needs resolving,
+  and a middle shift converges it in ~30 % fewer steps than a shift below the spectrum. A
+  singular matrix is never factored: a shift that lands on an eigenvalue is moved.
+* Block Lanczos (block 4) with delayed classical Gram–Schmidt against the slice's own basis
+  (DCGS2: each block's second orthogonalization pass rides along with the next block's first,
+  one pass over the basis per block), until every Ritz value in the interval has a relative
   residual below 1e-8 and the nearest ones outside are resolved. Orthogonalizing only within
   a slice is what makes large ``k`` cheap: ``O(n·k·s)`` memory-bound vector work instead of the
   ``O(n·k²)`` of a single Lanczos run (ARPACK's restarts), for slices of ``s`` eigenvalues.
-* Sylvester's law of inertia checks the result: the signs of ``D`` at every interior shift,
-  and at one more shift in a gap just above ``λ_k``, count the eigenvalues below it, which
-  must equal the number found; a deficit is searched for again with the found vectors
-  deflated. Slices are finally orthonormalized together (Löwdin: one ``O(n·k²)`` product at
-  BLAS-3 speed).
+* Sylvester's law of inertia checks the result: the signs of ``D`` at every shift, and at one
+  more shift in a gap just above ``λ_k`` (factored by the top slice as soon as it is done),
+  count the eigenvalues below it, which must equal the number found; a deficit is searched
+  for again with the found vectors deflated. Slices are finally orthonormalized together
+  (Löwdin: ``O(n·k²)`` products at BLAS-3 speed, on two cores when two workers ran).
 
 Small meshes (or ``k`` close to ``n``) use a dense solver.
 
@@ -100,13 +103,11 @@ _DENSE_HARD_MAX_N = 8000
 _BLOCK = 4  # block size (handles eigenvalue multiplicities up to 4 without relying on round-off)
 _TOL = 1e-8  # relative residual of the shift-inverted Ritz pairs: ||Op y − θ y|| <= tol |θ|
 _SLICE = 64  # eigenpairs per slice with an interior shift (LDLᵀ solves)
-_FIRST_SLICE = 128  # eigenpairs with the positive definite shift (cheaper Cholesky solves)
+_FIRST_SLICE = 128  # eigenpairs in the lowest slice (one worker; one-sided: no neighbour below)
 _ORTH_LEVEL = 1e-10  # orthogonality kept in the Lanczos basis
+_LAMBDA_TOL = 1e-6  # relative residual ||K u − λ M u||_{M⁻¹} / λ of every pair
 _EDGE_TOL = 1e-4  # residual of the nearest Ritz value outside a slice's interval
-_CHOLESKY_MIN = 32  # use cholespy for the positive definite slice from this many eigenpairs
-_SPLIT = 0.5  # share of the interior slice when two workers split <= _FIRST_SLICE pairs
-_ROW_THREADS = 1
-_SHIFT_REL = 1e-2  # σ₀ = −_SHIFT_REL · tr(K) / (n · tr(M))
+_SPLIT = 0.42  # share of the interior slice when two workers split <= _FIRST_SLICE pairs
 
 
 # --------------------------------------------------------------------------------------------
@@ -350,10 +351,10 @@ class _ShiftInvert:
     eigenvalues ``λ`` as ``K u = λ M u`` with ``y = M^½ u``); ``Op`` has eigenvalues
     ``θ = 1/(λ − σ)``.
 
-    ``spd=True`` (``σ`` below the spectrum): Cholesky with ``cholespy`` (falls back to LDLᵀ if
-    CHOLMOD finds the matrix numerically indefinite). Otherwise ``LDLᵀ`` with inertia:
+    ``LDLᵀ`` without pivoting (QDLDL, else SuperLU in symmetric mode) with its inertia:
     ``n_below`` is the number of eigenvalues ``λ < σ``. A shift that lands (numerically) on an
-    eigenvalue is moved by a small fraction of ``spacing``.
+    eigenvalue (zero or tiny pivot, inaccurate solve) is moved by a small fraction of
+    ``spacing``: a singular matrix is never used.
     """
 
     def __init__(
@@ -361,57 +362,32 @@ class _ShiftInvert:
         A: sp.csr_matrix,
         sigma: float,
         *,
-        spd: bool,
         rng: np.random.Generator,
         spacing: float,
         ordering: _Ordering | None = None,
-        cholesky: bool = True,
     ) -> None:
-        self.n_below = 0
-        self._chol: Any = None
-        self._lu: Any = None
         n = A.shape[0]
         eye = sp.identity(n, format="csr")
         if ordering is None:
             ordering = _Ordering(n)
-        if spd and cholesky:
+        for attempt in range(6):
+            s = sigma + (0.0 if attempt == 0 else (-1) ** attempt * 1e-3 * attempt * spacing)
+            S = (A - s * eye).tocsr()
             try:
-                import cholespy
-
-                S = (A - sigma * eye).tocoo()
-                self._chol = cholespy.CholeskySolverD(
-                    n, S.row.astype(np.int32), S.col.astype(np.int32), S.data,
-                    cholespy.MatrixType.COO,
-                )
-            except (ImportError, ValueError, RuntimeError):
-                self._chol = None
-        if self._chol is None:
-            for attempt in range(6):
-                s = sigma + (0.0 if attempt == 0 else (-1) ** attempt * 1e-3 * attempt * spacing)
-                S = (A - s * eye).tocsr()
                 try:
-                    try:
-                        self._lu, self.n_below = _qdldl_inertia(S, rng)
-                    except (ImportError, _Unstable):
-                        self._lu, self.n_below = _ldl_inertia(S, rng, ordering)
-                    sigma = s
-                    break
-                except _Unstable:
-                    continue
-            else:
-                raise RuntimeError(f"could not factor A - sigma I near sigma = {sigma:.6g}")
-            if spd and self.n_below:
-                raise RuntimeError("a shift below the spectrum has eigenvalues below it")
+                    self._lu, self.n_below = _qdldl_inertia(S, rng)
+                except (ImportError, _Unstable):
+                    self._lu, self.n_below = _ldl_inertia(S, rng, ordering)
+                sigma = s
+                break
+            except _Unstable:
+                continue
+        else:
+            raise RuntimeError(f"could not factor A - sigma I near sigma = {sigma:.6g}")
         self.sigma = float(sigma)
 
     def __call__(self, Y: FloatArray, out: FloatArray) -> None:
-        if self._chol is not None:
-            B = np.ascontiguousarray(Y)
-            X = np.empty_like(B)
-            self._chol.solve(B, X)
-            out[...] = X
-        else:
-            out[...] = self._lu.solve(Y)
+        out[...] = self._lu.solve(Y)
 
 
 # --------------------------------------------------------------------------------------------
@@ -466,44 +442,6 @@ def _chol_qr(
     return Rtot
 
 
-class _RowSplit:
-    """Tall-skinny products ``AᵀB`` and ``A C`` (``A``, ``B``: ``n × ·``) split by rows over
-    two threads: the caller's and one helper (numpy's matmul releases the GIL).
-
-    This is how one spectrum slice uses two idle cores: its products are memory bound and
-    each thread streams half of the rows. With ``helper=None`` the products run in the caller.
-    """
-
-    def __init__(self, helper: Any | None) -> None:
-        self.helper = helper
-
-    def tmm(self, A: FloatArray, B: FloatArray) -> FloatArray:
-        """``AᵀB``."""
-        n = A.shape[0]
-        if self.helper is None or n < 4096:
-            return A.T @ B
-        h = n // 2
-        fut = self.helper.submit(np.matmul, A[h:].T, B[h:])
-        G = A[:h].T @ B[:h]
-        G += fut.result()
-        return G
-
-    def mm(self, A: FloatArray, C: FloatArray, out: FloatArray) -> None:
-        """``out[...] = A C`` (``out`` F-ordered)."""
-        n = A.shape[0]
-        if self.helper is None or n < 4096:
-            np.matmul(A, C, out=out)
-            return
-        h = n // 2
-        top = np.empty((h, out.shape[1]), order="F")
-        bottom = np.empty((n - h, out.shape[1]), order="F")
-        fut = self.helper.submit(np.matmul, A[h:], C, out=bottom)
-        np.matmul(A[:h], C, out=top)
-        fut.result()
-        out[:h] = top
-        out[h:] = bottom
-
-
 class _BlockLanczos:
     """Block Lanczos for a symmetric operator, full (CGS2) reorthogonalization, deflation.
 
@@ -524,10 +462,8 @@ class _BlockLanczos:
         X: FloatArray | None,
         rng: np.random.Generator,
         capacity: int,
-        rows: _RowSplit | None = None,
     ) -> None:
         self.op = op
-        self.rows = rows if rows is not None else _RowSplit(None)
         self.n = n
         self.b = block
         self.X = None if X is None or X.shape[1] == 0 else _orthonormal_columns(X)
@@ -644,14 +580,14 @@ class _BlockLanczos:
             Qa, Y = self.Q[:, :j0], self._work[0]
             Y[:, :b] = Qt
             Y[:, b:] = W
-            C = self.rows.tmm(Qa, Y)
+            C = Qa.T @ Y
             c, H1 = C[:, :b], C[:, b:]
             Rp = self.T[j0:j1, j0 - b:j0].copy()  # q̃ Rp = last step's once-orthogonalized W
             Rc = Rp @ c[j0 - b:j0]
             cRc = c @ Rc
             C[:, b:] -= cRc
             D = self._work[1]
-            self.rows.mm(Qa, C, D)
+            np.matmul(Qa, C, out=D)
             q = self._work[2]
             np.subtract(Qt, D[:, :b], out=q)
             # q̃ − Qc = q S: S is within round-off of I (q̃ was orthogonal to ~1e-8 or better;
@@ -737,21 +673,23 @@ class _BlockLanczos:
         self.delta = self._measured
         self._last_measure = ncols
 
-    def ritz(self, want: int) -> tuple[FloatArray, FloatArray, FloatArray]:
-        """The ``want`` Ritz values of largest ``|θ|``, their ``T``-eigenvectors, residuals."""
+    def ritz(self, want: int) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+        """The ``want`` Ritz values of largest ``|θ|``, their ``T``-eigenvectors, residuals
+        ``||Op y − θ y||`` and the coefficients ``C`` (``b × want``) of those residuals on the
+        next block: ``Op y − θ y = q̃ C``."""
         j = self.j
         th, S = sla.eigh(self.T[:j, :j], lower=True, check_finite=False)
         order = np.argsort(-np.abs(th), kind="stable")[:want]
         th, S = th[order], S[:, order]
-        res = np.linalg.norm(self.B_last @ S[j - self.b:j, :], axis=0)
+        C = self.B_last @ S[j - self.b:j, :]
         if self.exhausted:
-            res[:] = 0.0
-        return th, S, res
+            C[:] = 0.0
+        return th, S, np.linalg.norm(C, axis=0), C
 
     def vectors(self, S: FloatArray) -> FloatArray:
         """Ritz vectors ``Q S`` (``n × S.shape[1]``, F-ordered)."""
         out = np.empty((self.n, S.shape[1]), order="F")
-        self.rows.mm(self.Q[:, :self.j], np.ascontiguousarray(S), out)
+        np.matmul(self.Q[:, :self.j], np.ascontiguousarray(S), out=out)
         return out
 
 
@@ -898,7 +836,6 @@ class _SliceSpec:
     sigma: float
     lo: float
     hi: float
-    spd: bool
     expected: int
     X: FloatArray | None = None  # extra vectors to deflate (known eigenvectors nearby)
     count: int | None = None  # if set: the `count` lowest eigenvalues >= lo (hi ignored)
@@ -910,7 +847,7 @@ class _SliceSpec:
 class _SliceResult:
     spec: _SliceSpec
     sigma: float
-    n_below: int  # eigenvalues below sigma (inertia); 0 for the positive definite shift
+    n_below: int  # eigenvalues below sigma (inertia)
     lam: FloatArray
     Y: FloatArray
     krylov_dim: int
@@ -953,8 +890,6 @@ class _SliceContext:
         self._done_count = 0
         self.cancel = threading.Event()
         self.error: BaseException | None = None
-        self.rows = _RowSplit(None)
-        self.workers = 1
         self.inertia: dict[int, tuple[float, int]] = {}  # slice -> (shift, eigenvalues below)
 
     def report(self, index: int, n_conv: int, message: str) -> None:
@@ -986,19 +921,13 @@ def _run_slice(ctx: _SliceContext, spec: _SliceSpec, seed: int) -> _SliceResult:
     b = ctx.block
     width = spec.hi - max(spec.lo, 0.0)
     op = _ShiftInvert(
-        ctx.A, spec.sigma, spd=spec.spd, rng=rng,
+        ctx.A, spec.sigma, rng=rng,
         spacing=max(width, ctx.scale) / max(spec.expected, 1), ordering=ctx.ordering,
-        # CHOLMOD (cholespy) solves 4 right-hand sides 2× faster than QDLDL's one at a time,
-        # but factors 3× slower and holds the GIL meanwhile, stalling a concurrent slice:
-        # only for a long slice alone
-        cholesky=spec.expected >= _CHOLESKY_MIN and ctx.workers < 2,
     )
-    if not spec.spd:
-        ctx.inertia[spec.index] = (op.sigma, op.n_below)  # (planning of the next slices)
+    ctx.inertia[spec.index] = (op.sigma, op.n_below)  # (planning of the next slices)
     parts = [x for x in (ctx.Zy, spec.X) if x is not None and x.shape[1]]
     X = np.asfortranarray(np.concatenate(parts, axis=1)) if parts else None
-    lz = _BlockLanczos(op, ctx.n, b, X, rng, capacity=int(3.2 * spec.expected) + 16 * b,
-                       rows=ctx.rows)
+    lz = _BlockLanczos(op, ctx.n, b, X, rng, capacity=int(3.2 * spec.expected) + 16 * b)
     next_check = max(2 * b, int(0.8 * spec.expected) // b * b)
     prev: tuple[int, float] | None = None
     while True:
@@ -1007,10 +936,24 @@ def _run_slice(ctx: _SliceContext, spec: _SliceSpec, seed: int) -> _SliceResult:
         lz.step()
         if lz.j < next_check and not lz.exhausted:
             continue
-        th, S, res = lz.ritz(lz.j)
+        th, S, res, C = lz.ritz(lz.j)
         with np.errstate(divide="ignore"):
             lam = op.sigma + 1.0 / th
-        rel = res / np.maximum(np.abs(th), 1e-300)
+        # Two residuals. Of the shift-inverted pair, relative to |θ|. And in the pencil: with
+        # μ = σ + 1/θ, (A − μ)y = −(A − σ)(Op y − θy)/θ = −(A − σ)q̃ C/θ, exactly and cheaply
+        # (one sparse product with the next block). The first alone lets eigenvalues far
+        # from the shift (λ ≪ σ in the lowest slice) keep λ-relative residuals up to
+        # tol·λ_max/λ (1e-3 on meshes of slivers); the second asks for _LAMBDA_TOL relative
+        # to λ. (It is an estimate from the Lanczos relation, so it keeps falling as Lanczos
+        # converges: no round-off floor can stall it.)
+        Qn = lz.Q[:, lz.j:lz.j + b]
+        Z = ctx.A @ Qn - op.sigma * Qn
+        G = Z.T @ Z
+        rlam = np.sqrt(np.maximum(np.einsum("ij,ij->j", C, G @ C), 0.0)) / np.maximum(
+            np.abs(th), 1e-300)
+        rel = np.maximum(res / np.maximum(np.abs(th), 1e-300) / ctx.tol,
+                         rlam / np.maximum(_LAMBDA_TOL * np.abs(lam), 1e-300)
+                         ) * ctx.tol  # (in units of tol)
         conv = rel <= ctx.tol
         if spec.count is None:
             hi = spec.hi
@@ -1023,7 +966,7 @@ def _run_slice(ctx: _SliceContext, spec: _SliceSpec, seed: int) -> _SliceResult:
         # outside, so nothing inside is still undiscovered)
         worst = float(np.log10(np.maximum(rel[inside], 1e-300) / ctx.tol).max(initial=-1.0))
         for side in ("above", "below"):
-            if side == "below" and (spec.spd or not spec.check_below):
+            if side == "below" and not spec.check_below:
                 continue
             out = np.flatnonzero(lam >= hi if side == "above" else lam < spec.lo)
             if len(out) == 0 or not np.isfinite(hi):
@@ -1061,7 +1004,7 @@ def _run_slice(ctx: _SliceContext, spec: _SliceSpec, seed: int) -> _SliceResult:
         gaps = np.flatnonzero(np.diff(ls) > 1e-7 * np.maximum(np.abs(ls[1:]), ctx.scale))
         if len(gaps):
             t = int(gaps[-1])
-            chk = _ShiftInvert(ctx.A, 0.5 * (ls[t] + ls[t + 1]), spd=False, rng=rng,
+            chk = _ShiftInvert(ctx.A, 0.5 * (ls[t] + ls[t + 1]), rng=rng,
                                spacing=ls[t + 1] - ls[t], ordering=ctx.ordering)
             check = (chk.sigma, chk.n_below)
     ctx.finished(spec.index, len(sel))
@@ -1144,10 +1087,10 @@ def _sliced_lanczos(
 
     The range ``[0, λ_k]`` is cut into consecutive intervals ``[b_{i-1}, b_i)`` holding about
     ``slice_size`` eigenvalues each (widths from Weyl's law ``N(λ) ≈ area·λ/4π`` at first, then
-    from the density measured by finished slices); each interval is one task for a pool of
-    ``workers`` threads (BLAS and the sparse solves release the GIL). The lowest interval uses
-    the positive definite shift, the others the shift at their middle. Afterwards the inertia
-    of every shift, and of one extra shift in a gap just above ``λ_k``, is compared with the
+    from the inertia counts at the shifts); each interval is one task for a pool of
+    ``workers`` threads (BLAS and the sparse solves release the GIL), with its shift in its
+    middle. Afterwards the inertia of every shift, and of one extra shift in a gap just above
+    ``λ_k``, is compared with the
     number of eigenvalues found below it; a deficit is searched for again with the known
     eigenvectors deflated.
     """
@@ -1173,14 +1116,14 @@ def _sliced_lanczos(
     specs: list[_SliceSpec] = []
 
     # ---- planning --------------------------------------------------------------------------
-    # The lowest slice uses the positive definite shift, whose Cholesky solves cost a third
-    # of an indefinite LDLᵀ solve: it takes a larger share (first_slice eigenpairs).
+    # The lowest slice has no eigenvalues below it to resolve (the null space is deflated):
+    # with one worker it takes a larger share (first_slice eigenpairs).
     todo = target - base
-    spd_first = known is None
-    if spd_first and (todo <= first_slice and not (workers >= 2 and todo >= 60)):
+    first_big = known is None
+    if first_big and (todo <= first_slice and not (workers >= 2 and todo >= 60)):
         sizes = [todo]
-    elif spd_first and todo <= first_slice:
-        # two workers: split, the Cholesky slice (cheaper solves) taking a little more
+    elif first_big and todo <= first_slice:
+        # two workers: split, the lowest slice (one-sided) taking a little more
         sizes = [todo - int(_SPLIT * todo), int(_SPLIT * todo)]
     else:
         if workers >= 2:
@@ -1192,11 +1135,11 @@ def _sliced_lanczos(
             per = -(-todo // n_sl)
             sizes = [per] * n_sl
         else:
-            first = min(first_slice, todo) if spd_first else 0
+            first = min(first_slice, todo) if first_big else 0
             rest = todo - first
             n_int = max(1, -(-rest // slice_size))
             per = -(-rest // n_int)
-            sizes = ([first] if spd_first else []) + [per] * n_int
+            sizes = ([first] if first_big else []) + [per] * n_int
     sizes = [max(s_, 4) for s_ in sizes]
     n_total = len(sizes)
     lam_known_hi = float(found.lam.max(initial=0.0)) if known is not None else 0.0
@@ -1211,12 +1154,12 @@ def _sliced_lanczos(
         known_X = np.asfortranarray(found.Y[:, near])
 
     def plannable(i: int) -> bool:
-        """Slice ``i`` is planned from slice ``i − 1``: its inertia (known as soon as it is
-        factored) or, for the positive definite slice, its result. (So the plan does not
-        depend on which thread finishes first, and no thread waits for a long slice.)"""
+        """Slice ``i`` is planned from the inertia of slice ``i − 1``, known as soon as it is
+        factored (so the plan does not depend on which thread finishes first, and no thread
+        waits for a long slice to end)."""
         if i < max(workers, 1) or (i - 1) in results:
             return True
-        return not specs[i - 1].spd and (i - 1) in ctx.inertia
+        return (i - 1) in ctx.inertia
 
     def density_before(i: int) -> float:
         """Eigenvalue density for planning slice ``i``: between the last two inertia counts
@@ -1233,15 +1176,15 @@ def _sliced_lanczos(
             r = results.get(j)
             if r is not None:
                 lo = max(r.spec.lo, 0.0)
-                cnt = len(r.lam) + (base if r.spec.spd and known is None else 0)
+                cnt = len(r.lam) + (base if r.spec.index == 0 and known is None else 0)
                 if cnt >= 4 and r.spec.hi > lo:
                     return cnt / (r.spec.hi - lo)
             j -= 1
         return weyl_density
 
     def plan(i: int) -> _SliceSpec:
-        # (the positive definite slice starts just below 0: round-off can put a zero mode
-        # that the component indicators do not cover a hair below 0)
+        # (the lowest slice starts just below 0: round-off can put a zero mode that the
+        # component indicators do not cover a hair below 0)
         lo = specs[-1].hi if specs else (lam_known_hi if known is not None else -1e-6 * scale)
         rho = density_before(i)
         start = max(lo, 0.0)
@@ -1255,11 +1198,7 @@ def _sliced_lanczos(
             count = max(target - have, 1)
             size = count
         hi = start + size * (1.0 if count is not None or i < n_total - 1 else 1.05) / rho
-        if known is None and i == 0:
-            sigma, spd = -_SHIFT_REL * scale, True
-        else:
-            sigma, spd = 0.5 * (start + hi), False
-        return _SliceSpec(i, sigma, lo, hi, spd, size,
+        return _SliceSpec(i, 0.5 * (start + hi), lo, hi, size,
                           known_X if (i == 0 and known is not None) else None, count,
                           check_below=lo > 0 and not (i == 0 and known_X is not None
                                                       and near_all),
@@ -1277,16 +1216,12 @@ def _sliced_lanczos(
         info.krylov_dims.append(r.krylov_dim)
         info.n_operator_applications += r.n_applied
         info.n_factorizations += 1
-        if not r.spec.spd:
-            checks.append((r.sigma, r.n_below))
+        checks.append((r.sigma, r.n_below))
         if r.check is not None:
             checks.append(r.check)
             info.n_factorizations += 1
 
     t_slices = time.perf_counter()
-    ctx.workers = workers
-    if _ROW_THREADS > 1 and workers == 1:
-        ctx.rows = _RowSplit(cf.ThreadPoolExecutor(max_workers=1))
     with (cf.ThreadPoolExecutor(max_workers=workers) if workers > 1 else _InlinePool()) as pool:
         running: dict[cf.Future[_SliceResult], int] = {}
         try:
@@ -1342,7 +1277,7 @@ def _sliced_lanczos(
                     break
             if tau is None:
                 tau = lam_sorted[-1] * (1 + 1e-6) + 1e-6 * scale
-            op = _ShiftInvert(ctx.A, tau, spd=False, rng=rng, ordering=ctx.ordering,
+            op = _ShiftInvert(ctx.A, tau, rng=rng, ordering=ctx.ordering,
                               spacing=1e-3 * max(lam_sorted[-1] - lam_sorted[k - 1], scale))
             info.n_factorizations += 1
             checks.append((op.sigma, op.n_below))
@@ -1373,9 +1308,8 @@ def _sliced_lanczos(
                               & (found.lam <= hi + 0.25 * (hi - lo)))
         near = near[near >= n_null]  # the null space is deflated in every slice already
         below = bool(np.any(found.lam[:found.count] < lo - 0.25 * (hi - lo)))
-        spec = _SliceSpec(repair_index, 0.5 * (lo + hi), lo, hi, False,
-                          max(missing, 4), np.asfortranarray(found.Y[:, near]),
-                          check_below=below and lo > 0)
+        spec = _SliceSpec(repair_index, 0.5 * (lo + hi), lo, hi, max(missing, 4),
+                          np.asfortranarray(found.Y[:, near]), check_below=below and lo > 0)
         repair_index += 1
         r = _run_slice(ctx, spec, seed)
         absorb(r)
@@ -1531,7 +1465,7 @@ def pencil_eigenpairs(
         block Lanczos.
     tol, block, slice_size, first_slice
         Tuning of the sparse solver: relative residual of the shift-inverted Ritz pairs, block
-        size, eigenpairs per interior slice and in the lowest (positive definite) slice.
+        size, eigenpairs per interior slice and in the lowest slice (one worker).
     workers : int, optional
         Slices solved concurrently in threads; default 2 when two cores are idle (sampled from
         ``/proc/stat``), else 1 (also when memory would be tight). The Gram–Schmidt products
@@ -1555,11 +1489,11 @@ def pencil_eigenpairs(
     Notes
     -----
     One eigenvalue 0 per connected component of the sparsity graph, with the normalized
-    indicator as eigenvector (deflated exactly). The sparse solver never factors a singular
-    matrix: the lowest slice uses the shift ``σ₀ = −10⁻² tr(K)/(n tr(M))``, proportional to the
-    mesh's frequency scale (so total areas from 10⁻² to 10⁶ behave alike), and interior shifts
-    are moved off eigenvalues. Sylvester inertia counts at every interior shift, plus one in a
-    gap just above ``λ_k``, prove that no eigenvalue was skipped.
+    indicator as eigenvector (deflated exactly), so no shift is ever needed at or below 0. The
+    shifts are placed from Weyl's law scaled by the mesh's area (so total areas from 10⁻² to
+    10⁶ behave alike) and moved off eigenvalues: a singular matrix is never factored.
+    Sylvester inertia counts at every shift, plus one in a gap just above ``λ_k``, prove that
+    no eigenvalue was skipped.
     """
     t0 = time.perf_counter()
     K = sp.csr_matrix(K, dtype=np.float64)
