@@ -105,6 +105,7 @@ _TOL = 1e-8  # relative residual of the shift-inverted Ritz pairs: ||Op y − θ
 _SLICE = 64  # eigenpairs per slice with an interior shift (LDLᵀ solves)
 _FIRST_SLICE = 128  # eigenpairs in the lowest slice (one worker; one-sided: no neighbour below)
 _ORTH_LEVEL = 1e-10  # orthogonality kept in the Lanczos basis
+_CHECK_EVERY = 8  # convergence checks at least every j/_CHECK_EVERY Lanczos vectors
 _LAMBDA_TOL = 1e-6  # relative residual ||K u − λ M u||_{M⁻¹} / λ of every pair
 _EDGE_TOL = 1e-4  # residual of the nearest Ritz value outside a slice's interval
 _SPLIT = 0.42  # share of the interior slice when two workers split <= _FIRST_SLICE pairs
@@ -984,7 +985,7 @@ def _run_slice(ctx: _SliceContext, spec: _SliceSpec, seed: int) -> _SliceResult:
             break  # (the last case is a safeguard; the inertia check catches what is missing)
         # next check: where the convergence rate seen so far says it will be done (residuals
         # fall geometrically with the Krylov dimension), at least one block, at most j/8
-        step = max(b, (lz.j // 8) // b * b)
+        step = max(b, (lz.j // _CHECK_EVERY) // b * b)
         if prev is not None and prev[1] > worst:
             rate = (prev[1] - worst) / (lz.j - prev[0])  # decades per basis vector
             step = int(min(step, max(b, -(-int(np.ceil(worst / rate)) // b) * b)))
