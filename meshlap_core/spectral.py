@@ -1036,20 +1036,25 @@ class _InlinePool:
 
 
 def _idle_cores(window: float = 0.05) -> float:
-    """Idle CPU cores right now: ``/proc/stat`` sampled over ``window`` seconds (Linux), else
-    the number of cores minus the 1-minute load average."""
+    """CPU cores not used by other processes right now: ``/proc/stat`` sampled over ``window``
+    seconds (Linux), with this process's own CPU time counted as idle (threaded BLAS spins its
+    threads for a while after a call: that is not load); else the number of cores minus the
+    1-minute load average."""
     cpus = os.cpu_count() or 1
 
-    def sample() -> tuple[int, int]:
+    def sample() -> tuple[float, float, float]:
         with open("/proc/stat") as f:
-            vals = [int(x) for x in f.readline().split()[1:]]
-        return vals[3] + (vals[4] if len(vals) > 4 else 0), sum(vals)  # idle + iowait, total
+            vals = [int(x) for x in f.readline().split()[1:8]]
+        # idle + iowait, total (user..softirq; guest time is inside user), own CPU seconds
+        return vals[3] + vals[4], sum(vals), time.process_time()
 
     try:
-        i0, t0 = sample()
+        hz = os.sysconf("SC_CLK_TCK")
+        i0, t0, p0 = sample()
         time.sleep(window)
-        i1, t1 = sample()
-        return cpus * (i1 - i0) / max(t1 - t0, 1)
+        i1, t1, p1 = sample()
+        free = (i1 - i0) + (p1 - p0) * hz
+        return float(min(cpus, cpus * free / max(t1 - t0, 1)))
     except (OSError, ValueError, IndexError):
         try:
             return cpus - os.getloadavg()[0]
