@@ -1,6 +1,7 @@
 """Benchmark: meshlap's Laplace–Beltrami eigensolver against the eigsh call a user would write.
 
-    python benchmarks/bench_spectral.py [--repeat 2] [--quick] [--baseline-1000] [--json FILE]
+    python benchmarks/bench_spectral.py [--repeat 2] [--quick] [--case MESH:K] [--baseline-1000]
+                                        [--json FILE]
 
 Both solvers get the same pencil ``K = −C`` (cotangent stiffness, positive semidefinite) and
 ``M`` (Voronoi lumped mass), built once by :func:`meshlap_core.spectral.spectral_operators`:
