@@ -284,15 +284,27 @@ def _ldl_inertia(
                 and np.array_equal(lu.perm_c, np.arange(n))):
             raise _Unstable("SuperLU pivoted")
         ldl = _LDL(lu, perm)
-    piv = lu.U.diagonal()
+    return ldl, _checked_inertia(A, ldl, lu.U.diagonal(), rng)
+
+
+def _checked_inertia(A: sp.csr_matrix, ldl: Any, piv: FloatArray, rng: np.random.Generator) -> int:
+    """The number of negative pivots of an ``LDLᵀ`` of ``A`` (its negative eigenvalues, by
+    Sylvester's law of inertia), after checking the factor: no zero or non-finite pivot, and a
+    solve with a random right-hand side accurate to ``1e-10`` (a tiny pivot spoils it).
+
+    Raises
+    ------
+    _Unstable
+    """
+    piv = np.asarray(piv)
     if not np.all(np.isfinite(piv)) or np.any(piv == 0):
         raise _Unstable("zero pivot")
-    b = rng.standard_normal(n)
+    b = rng.standard_normal(A.shape[0])
     x = ldl.solve(b)
     scale = abs(A).sum(axis=1).max() * np.abs(x).max() + np.abs(b).max()
     if not np.all(np.isfinite(x)) or np.abs(A @ x - b).max() > 1e-10 * scale:
         raise _Unstable("inaccurate solve")
-    return ldl, int(np.count_nonzero(piv < 0))
+    return int(np.count_nonzero(piv < 0))
 
 
 class _QDLDL:
@@ -329,22 +341,13 @@ def _qdldl_inertia(A: sp.csr_matrix, rng: np.random.Generator) -> tuple[_QDLDL, 
     """
     import qdldl
 
-    n = A.shape[0]
     try:
         solver = qdldl.Solver(sp.triu(A, format="csc"), upper=True)
         _, D, _ = solver.factors()
     except (ValueError, RuntimeError) as exc:  # zero pivot
         raise _Unstable(str(exc)) from None
-    D = np.asarray(D)
-    if not np.all(np.isfinite(D)) or np.any(D == 0):
-        raise _Unstable("zero pivot")
     ldl = _QDLDL(solver)
-    b = rng.standard_normal(n)
-    x = ldl.solve(b)
-    scale = abs(A).sum(axis=1).max() * np.abs(x).max() + np.abs(b).max()
-    if not np.all(np.isfinite(x)) or np.abs(A @ x - b).max() > 1e-10 * scale:
-        raise _Unstable("inaccurate solve")
-    return ldl, int(np.count_nonzero(D < 0))
+    return ldl, _checked_inertia(A, ldl, D, rng)
 
 
 class _ShiftInvert:
