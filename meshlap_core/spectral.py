@@ -316,8 +316,9 @@ class _QDLDL:
     work twice: ``L`` and ``U = DLᵀ``) and its solves release the GIL.
     """
 
-    def __init__(self, solver: Any) -> None:
+    def __init__(self, solver: Any, pattern: tuple[IntArray, IntArray]) -> None:
         self.solver = solver
+        self.pattern = pattern  # (indptr, indices) of the factored upper triangle
 
     def solve(self, B: FloatArray) -> FloatArray:
         if B.ndim == 1:
@@ -328,9 +329,15 @@ class _QDLDL:
         return X
 
 
-def _qdldl_inertia(A: sp.csr_matrix, rng: np.random.Generator) -> tuple[_QDLDL, int]:
+def _qdldl_inertia(
+    A: sp.csr_matrix, rng: np.random.Generator, reuse: _QDLDL | None = None
+) -> tuple[_QDLDL, int]:
     """QDLDL ``LDLᵀ`` of a symmetric matrix and the number of its negative eigenvalues; a
     solve with a random right-hand side checks that no small pivot spoiled the factor.
+
+    ``reuse``: a factorization no longer needed of a matrix with the same pattern (another
+    shift): refactored in place, skipping the AMD ordering and symbolic analysis (0.04 s
+    instead of 0.1 s at 40k vertices).
 
     Raises
     ------
@@ -341,12 +348,19 @@ def _qdldl_inertia(A: sp.csr_matrix, rng: np.random.Generator) -> tuple[_QDLDL, 
     """
     import qdldl
 
+    U = sp.triu(A, format="csc")
+    pattern = (U.indptr, U.indices)
     try:
-        solver = qdldl.Solver(sp.triu(A, format="csc"), upper=True)
+        if (reuse is not None and np.array_equal(reuse.pattern[0], U.indptr)
+                and np.array_equal(reuse.pattern[1], U.indices)):
+            solver = reuse.solver
+            solver.update(U, upper=True)
+        else:
+            solver = qdldl.Solver(U, upper=True)
         _, D, _ = solver.factors()
     except (ValueError, RuntimeError) as exc:  # zero pivot
         raise _Unstable(str(exc)) from None
-    ldl = _QDLDL(solver)
+    ldl = _QDLDL(solver, pattern)
     return ldl, _checked_inertia(A, ldl, D, rng)
 
 
@@ -369,6 +383,7 @@ class _ShiftInvert:
         rng: np.random.Generator,
         spacing: float,
         ordering: _Ordering | None = None,
+        reuse: Any | None = None,
     ) -> None:
         n = A.shape[0]
         eye = sp.identity(n, format="csr")
@@ -379,7 +394,8 @@ class _ShiftInvert:
             S = (A - s * eye).tocsr()
             try:
                 try:
-                    self._lu, self.n_below = _qdldl_inertia(S, rng)
+                    r, reuse = (reuse if isinstance(reuse, _QDLDL) else None), None
+                    self._lu, self.n_below = _qdldl_inertia(S, rng, r)
                 except (ImportError, _Unstable):
                     self._lu, self.n_below = _ldl_inertia(S, rng, ordering)
                 sigma = s
@@ -894,6 +910,7 @@ class _SliceContext:
         self._done_count = 0
         self.cancel = threading.Event()
         self.error: BaseException | None = None
+        self.local = threading.local()  # per worker thread: a spare factorization to reuse
         self.inertia: dict[int, tuple[float, int]] = {}  # slice -> (shift, eigenvalues below)
 
     def report(self, index: int, n_conv: int, message: str) -> None:
@@ -924,10 +941,14 @@ def _run_slice(ctx: _SliceContext, spec: _SliceSpec, seed: int) -> _SliceResult:
     rng = np.random.default_rng([seed, spec.index])
     b = ctx.block
     width = spec.hi - max(spec.lo, 0.0)
+    # (the factorization of this thread's previous slice, done with, is refactored in place)
+    spare, ctx.local.spare = getattr(ctx.local, "spare", None), None
     op = _ShiftInvert(
         ctx.A, spec.sigma, rng=rng,
         spacing=max(width, ctx.scale) / max(spec.expected, 1), ordering=ctx.ordering,
+        reuse=spare,
     )
+    del spare
     ctx.inertia[spec.index] = (op.sigma, op.n_below)  # (planning of the next slices)
     parts = [x for x in (ctx.Zy, spec.X) if x is not None and x.shape[1]]
     X = np.asfortranarray(np.concatenate(parts, axis=1)) if parts else None
@@ -998,6 +1019,7 @@ def _run_slice(ctx: _SliceContext, spec: _SliceSpec, seed: int) -> _SliceResult:
     sel = np.flatnonzero(inside if lz.exhausted else inside & conv)
     sel = sel[np.argsort(lam[sel], kind="stable")]
     Y = lz.vectors(S[:, sel])
+    spare = op._lu
     del lz, op
     check = None
     if spec.check_top and not ctx.cancel.is_set():
@@ -1009,8 +1031,10 @@ def _run_slice(ctx: _SliceContext, spec: _SliceSpec, seed: int) -> _SliceResult:
         if len(gaps):
             t = int(gaps[-1])
             chk = _ShiftInvert(ctx.A, 0.5 * (ls[t] + ls[t + 1]), rng=rng,
-                               spacing=ls[t + 1] - ls[t], ordering=ctx.ordering)
+                               spacing=ls[t + 1] - ls[t], ordering=ctx.ordering, reuse=spare)
             check = (chk.sigma, chk.n_below)
+            spare = chk._lu
+    ctx.local.spare = spare
     ctx.finished(spec.index, len(sel))
     return _SliceResult(
         spec=spec, sigma=sigma_used, n_below=n_below, lam=lam[sel], Y=Y, krylov_dim=j_used,
@@ -1286,7 +1310,8 @@ def _sliced_lanczos(
                     break
             if tau is None:
                 tau = lam_sorted[-1] * (1 + 1e-6) + 1e-6 * scale
-            op = _ShiftInvert(ctx.A, tau, rng=rng, ordering=ctx.ordering,
+            spare, ctx.local.spare = getattr(ctx.local, "spare", None), None
+            op = _ShiftInvert(ctx.A, tau, rng=rng, ordering=ctx.ordering, reuse=spare,
                               spacing=1e-3 * max(lam_sorted[-1] - lam_sorted[k - 1], scale))
             info.n_factorizations += 1
             checks.append((op.sigma, op.n_below))

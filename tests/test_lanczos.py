@@ -210,3 +210,25 @@ def test_two_workers_get_an_even_number_of_equal_slices():
     K, m = S.spectral_operators(V, F)
     ref = np.linalg.eigvalsh(K.toarray() / np.sqrt(m)[:, None] / np.sqrt(m)[None, :])[:200]
     np.testing.assert_allclose(lam, ref, rtol=1e-9, atol=1e-9 * ref.max())
+
+
+def test_qdldl_refactors_a_spare_factorization_of_the_same_pattern():
+    A = _indefinite()
+    eye = sp.identity(A.shape[0], format="csr")
+    rng = np.random.default_rng(0)
+    first, _ = S._qdldl_inertia((A - 0.5 * eye).tocsr(), rng)
+    again, neg = S._qdldl_inertia((A - 1.5 * eye).tocsr(), rng, reuse=first)
+    assert again.solver is first.solver  # refactored in place
+    assert neg == np.count_nonzero(np.linalg.eigvalsh(A.toarray()) < 1.5)
+    b = rng.standard_normal(A.shape[0])
+    np.testing.assert_allclose((A - 1.5 * eye) @ again.solve(b), b, atol=1e-9)
+    # another pattern (one off-diagonal pair fewer): a fresh factorization
+    B = A.tolil()
+    i, j = B.nonzero()
+    off = np.flatnonzero(i != j)[0]
+    B[i[off], j[off]] = B[j[off], i[off]] = 0.0
+    B = B.tocsr()
+    B.eliminate_zeros()
+    other, neg_b = S._qdldl_inertia(B, rng, reuse=again)
+    assert other.solver is not again.solver
+    assert neg_b == np.count_nonzero(np.linalg.eigvalsh(B.toarray()) < 0)
