@@ -583,15 +583,8 @@ class _BlockLanczos:
         if not self.delayed:
             self._step_classical()
             return
-        b, j0 = self.b, self.j
-        j1 = j0 + b
-        if j1 + b > self.max_dim:
-            self.exhausted = True
+        b, j0, j1, W, size = self._apply_newest()
         Qt = self.Q[:, j0:j1]  # q̃: orthogonalized once (exact for the first block)
-        W = np.empty((self.n, b), order="F")
-        self.op(Qt, W)
-        self.n_applied += b
-        size = float(np.linalg.norm(W, axis=0).max(initial=0.0))
         if self.X is not None:  # deflated vectors: a pass now and one at the end
             _gemm_update(W, self.X, self.X.T @ W)
         if j0:
@@ -638,8 +631,9 @@ class _BlockLanczos:
         self.passes += 1
         self._finish_step(V, size, j0, j1)
 
-    def _step_classical(self) -> None:
-        """:meth:`step` with classical Gram–Schmidt, a second pass when a bound asks for it."""
+    def _apply_newest(self) -> tuple[int, int, int, FloatArray, float]:
+        """``W = Op(newest block)``; returns ``(b, j0, j1, W, max column norm of W)`` with the
+        newest block in ``Q[:, j0:j1]``."""
         b, j0 = self.b, self.j
         j1 = j0 + b
         if j1 + b > self.max_dim:
@@ -647,7 +641,11 @@ class _BlockLanczos:
         W = np.empty((self.n, b), order="F")
         self.op(self.Q[:, j0:j1], W)
         self.n_applied += b
-        size = float(np.linalg.norm(W, axis=0).max(initial=0.0))
+        return b, j0, j1, W, float(np.linalg.norm(W, axis=0).max(initial=0.0))
+
+    def _step_classical(self) -> None:
+        """:meth:`step` with classical Gram–Schmidt, a second pass when a bound asks for it."""
+        _, j0, j1, W, size = self._apply_newest()
         W, H = self._project(W, j1)
         self.T[:j1, j0:j1] = H
         self._finish_step(W, size, j0, j1)
@@ -676,9 +674,10 @@ class _BlockLanczos:
         self.T[j1:j1 + b, j0:j1] = B
         self.B_last = B
         self.j = j1
-        if j1 + b - self._last_measure >= 16 * b:
-            # (the newest block is orthogonalized a second time only in the next step)
-            self._measure(j1 if self.delayed else j1 + b)
+        if not self.delayed and j1 + b - self._last_measure >= 16 * b:
+            # (recalibrates the bound that decides classical second passes; DCGS2 always
+            # makes its one delayed pass and needs no bound)
+            self._measure(j1 + b)
 
     def _measure(self, ncols: int) -> None:
         """Measure the orthogonality of the blocks added since the last measurement; the
@@ -974,12 +973,12 @@ def _run_slice(ctx: _SliceContext, spec: _SliceSpec, seed: int) -> _SliceResult:
         Qn = lz.Q[:, lz.j:lz.j + b]
         Z = ctx.A @ Qn - op.sigma * Qn
         G = Z.T @ Z
-        rlam = np.sqrt(np.maximum(np.einsum("ij,ij->j", C, G @ C), 0.0)) / np.maximum(
-            np.abs(th), 1e-300)
-        rel = np.maximum(res / np.maximum(np.abs(th), 1e-300) / ctx.tol,
-                         rlam / np.maximum(_LAMBDA_TOL * np.abs(lam), 1e-300)
-                         ) * ctx.tol  # (in units of tol)
-        conv = rel <= ctx.tol
+        ath = np.maximum(np.abs(th), 1e-300)
+        rlam = np.sqrt(np.maximum(np.einsum("ij,ij->j", C, G @ C), 0.0)) / ath
+        # each pair's residual over its tolerance (converged at <= 1)
+        ratio = np.maximum(res / ath / ctx.tol,
+                           rlam / np.maximum(_LAMBDA_TOL * np.abs(lam), 1e-300))
+        conv = ratio <= 1.0
         if spec.count is None:
             hi = spec.hi
         else:  # the `count` lowest Ritz values >= lo
@@ -989,7 +988,7 @@ def _run_slice(ctx: _SliceContext, spec: _SliceSpec, seed: int) -> _SliceResult:
         # decades still missing: every inside Ritz pair to `tol`, and the nearest Ritz value
         # outside on each bounded side to `_EDGE_TOL` (resolved well enough to be sure it is
         # outside, so nothing inside is still undiscovered)
-        worst = float(np.log10(np.maximum(rel[inside], 1e-300) / ctx.tol).max(initial=-1.0))
+        worst = float(np.log10(np.maximum(ratio[inside], 1e-300)).max(initial=-1.0))
         for side in ("above", "below"):
             if side == "below" and not spec.check_below:
                 continue
@@ -998,7 +997,7 @@ def _run_slice(ctx: _SliceContext, spec: _SliceSpec, seed: int) -> _SliceResult:
                 worst = max(worst, 3.0)  # not even approximated yet
                 continue
             nearest = out[np.argmin(np.abs(lam[out] - op.sigma))]
-            worst = max(worst, float(np.log10(max(rel[nearest], 1e-300) / _EDGE_TOL)))
+            worst = max(worst, float(np.log10(max(ratio[nearest] * ctx.tol, 1e-300) / _EDGE_TOL)))
         n_in = int(np.count_nonzero(inside & conv))
         ctx.report(
             spec.index, n_in,
@@ -1566,7 +1565,7 @@ def pencil_eigenpairs(
         _report(progress, 1.0, "eigensolver: done")
     else:
         info.method = "shift-invert block Lanczos, spectrum slicing"
-        nw_used = 1
+        nw = 1  # slice workers (also the cores the final orthonormalization may use)
         kn = None
         if known is not None and len(known[0]):
             lam0 = np.asarray(known[0], dtype=np.float64)
@@ -1583,7 +1582,6 @@ def pencil_eigenpairs(
                 nw = max(1, int(workers))
             else:  # (one slice below ~60 modes: no need to sample the machine's load)
                 nw = 1 if k < 60 else _default_workers(n, max(slice_size, first_slice))
-            nw_used = nw
             nb = 1 if blas_threads is None else max(1, int(blas_threads))
             info.messages.append(f"{nw} slice worker(s), {nb} BLAS thread(s)")
             rho = float(density) if density else float(m.sum() / (4 * np.pi))
@@ -1595,7 +1593,7 @@ def pencil_eigenpairs(
                 )
         t1 = time.perf_counter()
         with _blas_threads(1):
-            if nw_used >= 2:
+            if nw >= 2:
                 import concurrent.futures as cf
 
                 with cf.ThreadPoolExecutor(max_workers=1) as helper:
