@@ -9,7 +9,9 @@ import polyscope as ps
 import polyscope.imgui as psim
 import polyscope.implot as psimplot
 
-from .smoothing_state import LAPLACIANS, METHODS, SmoothingState
+from meshlap_core.options import LAPLACIAN_KINDS as LAPLACIANS
+
+from .smoothing_state import METHODS, SmoothingState
 
 if TYPE_CHECKING:
     from .viewer import Viewer

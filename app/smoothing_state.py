@@ -15,7 +15,6 @@ from meshlap_core.smoothing import Smoother, amplification_curve
 from meshlap_core.types import FloatArray, IntArray
 
 METHODS = ("explicit", "implicit", "taubin")
-LAPLACIANS = ("uniform", "cotan")
 
 
 @dataclass

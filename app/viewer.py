@@ -21,6 +21,8 @@ import polyscope.imgui as psim
 
 from meshlap_core.errors import MeshError
 from meshlap_core.io import atomic_write, save_mesh, save_scalars
+from meshlap_core.options import AREA_KINDS as AREAS
+from meshlap_core.options import BOUNDARY_RULES
 
 from . import smoothing_panel, spectral_panel
 from .camera import project_to_screen
@@ -42,8 +44,7 @@ SURFACE = "surface"
 SURFACE_POINT = "surface point"
 
 PANELS = ("curvature", "onering", "spectral", "smoothing", "surfaces")
-AREAS = ("barycentric", "voronoi")
-BOUNDARY_RULES = ("pi", "2pi", "zero")
+
 RED = (1.0, 0.35, 0.35, 1.0)
 
 

@@ -92,7 +92,7 @@ def compare(name: str, K: sp.csr_matrix, m: np.ndarray, k: int, repeat: int) -> 
     settings = BASELINE_SETTINGS
     for r in range(repeat):
         runs = [("ours", None)] + [("base", st) for st in settings]
-        for who, st in (runs if r % 2 == 0 else runs[::-1]):
+        for who, st in runs if r % 2 == 0 else runs[::-1]:
             t = time.perf_counter()
             if who == "ours":
                 res_o = ours(K, m, k)
@@ -103,18 +103,27 @@ def compare(name: str, K: sp.csr_matrix, m: np.ndarray, k: int, repeat: int) -> 
                 res_b = baseline(K, m, k)
                 dt = time.perf_counter() - t
                 t_b.setdefault(str(st), []).append(dt)
-            log(f"  {name} k={k} {who}{'' if st is None else ' (BLAS ' + str(st) + ')'}: "
-                f"{dt:.2f} s")
+            log(
+                f"  {name} k={k} {who}{'' if st is None else ' (BLAS ' + str(st) + ')'}: {dt:.2f} s"
+            )
     assert res_o is not None and res_b is not None
     lam, U, info = res_o
     best = min(t_b, key=lambda st: min(t_b[st]))
     return {
-        "mesh": name, "n": len(m), "k": k, "ours_s": min(t_o), "eigsh_s": min(t_b[best]),
-        "eigsh_blas": best, "ratio": min(t_b[best]) / min(t_o),
+        "mesh": name,
+        "n": len(m),
+        "k": k,
+        "ours_s": min(t_o),
+        "eigsh_s": min(t_b[best]),
+        "eigsh_blas": best,
+        "ratio": min(t_b[best]) / min(t_o),
         "rel_eig_diff": rel_diff(lam, res_b[0]),
-        "orth_ours": orth_error(U, m), "orth_eigsh": orth_error(res_b[1], m),
-        "residual": info.max_residual, "slices": len(info.shifts),
-        "times_ours": t_o, "times_eigsh": t_b,
+        "orth_ours": orth_error(U, m),
+        "orth_eigsh": orth_error(res_b[1], m),
+        "residual": info.max_residual,
+        "slices": len(info.shifts),
+        "times_ours": t_o,
+        "times_eigsh": t_b,
     }
 
 
@@ -132,9 +141,20 @@ def memory_child(name: str, k: int) -> None:
     _lam, U, info = pencil_eigenpairs(K, m, k)
     dt = time.perf_counter() - t
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-    print(json.dumps({"n": len(m), "k": k, "seconds": dt, "peak_rss_mib": peak / 1024,
-                      "rss_before_solve_mib": base / 1024, "orth": orth_error(U, m),
-                      "residual": info.max_residual, "slices": len(info.shifts)}))
+    print(
+        json.dumps(
+            {
+                "n": len(m),
+                "k": k,
+                "seconds": dt,
+                "peak_rss_mib": peak / 1024,
+                "rss_before_solve_mib": base / 1024,
+                "orth": orth_error(U, m),
+                "residual": info.max_residual,
+                "slices": len(info.shifts),
+            }
+        )
+    )
 
 
 def reconstruct_speed(V: np.ndarray, F: np.ndarray, kmax: int) -> dict[str, Any]:
@@ -168,12 +188,18 @@ def reconstruct_speed(V: np.ndarray, F: np.ndarray, kmax: int) -> dict[str, Any]
     errs = basis.errors()
     t_err = time.perf_counter() - t
     return {
-        "n": len(V), "k_max": kmax, "basis_s": t_basis,
-        "plain_ms_max": 1e3 * max(plain), "plain_ms_median": 1e3 * float(np.median(plain)),
-        "jump_ms_max": 1e3 * max(rand), "jump_ms_median": 1e3 * float(np.median(rand)),
-        "step_ms_max": 1e3 * max(step), "step_ms_median": 1e3 * float(np.median(step)),
+        "n": len(V),
+        "k_max": kmax,
+        "basis_s": t_basis,
+        "plain_ms_max": 1e3 * max(plain),
+        "plain_ms_median": 1e3 * float(np.median(plain)),
+        "jump_ms_max": 1e3 * max(rand),
+        "jump_ms_median": 1e3 * float(np.median(rand)),
+        "step_ms_max": 1e3 * max(step),
+        "step_ms_median": 1e3 * float(np.median(step)),
         "incremental_vs_direct": float(np.abs(full - ref).max()),
-        "all_k_errors_s": t_err, "l2_error_k1_kmax": [float(errs.l2[1]), float(errs.l2[-1])],
+        "all_k_errors_s": t_err,
+        "l2_error_k1_kmax": [float(errs.l2[1]), float(errs.l2[-1])],
     }
 
 
@@ -181,14 +207,23 @@ def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=2, help="interleaved runs per case (best kept)")
     ap.add_argument("--quick", action="store_true", help="armadillo k <= 100 only")
-    ap.add_argument("--baseline-1000", action="store_true",
-                    help="also run eigsh for k = 1000 (takes minutes)")
-    ap.add_argument("--baseline-threads", default="both", choices=("both", "1", "default"),
-                    help="BLAS threads for eigsh: 'both' (default: run it with one thread and "
-                         "with OpenBLAS's default and keep the faster; on a busy 2-core machine "
-                         "threaded OpenBLAS spins and slows ARPACK several-fold), '1', 'default'")
-    ap.add_argument("--case", action="append", metavar="MESH:K",
-                    help="only this comparison (repeatable), e.g. --case armadillo_igl:100")
+    ap.add_argument(
+        "--baseline-1000", action="store_true", help="also run eigsh for k = 1000 (takes minutes)"
+    )
+    ap.add_argument(
+        "--baseline-threads",
+        default="both",
+        choices=("both", "1", "default"),
+        help="BLAS threads for eigsh: 'both' (default: run it with one thread and "
+        "with OpenBLAS's default and keep the faster; on a busy 2-core machine "
+        "threaded OpenBLAS spins and slows ARPACK several-fold), '1', 'default'",
+    )
+    ap.add_argument(
+        "--case",
+        action="append",
+        metavar="MESH:K",
+        help="only this comparison (repeatable), e.g. --case armadillo_igl:100",
+    )
     ap.add_argument("--json", help="write all results to this file")
     ap.add_argument("--memory-child", nargs=2, metavar=("MESH", "K"), help=argparse.SUPPRESS)
     args = ap.parse_args()
@@ -196,8 +231,9 @@ def main() -> int:
         memory_child(args.memory_child[0], int(args.memory_child[1]))
         return 0
     out: dict[str, Any] = {"cpus": os.cpu_count(), "loadavg_start": os.getloadavg()[0]}
-    BASELINE_SETTINGS[:] = (["1", "default"] if args.baseline_threads == "both"
-                            else [args.baseline_threads])
+    BASELINE_SETTINGS[:] = (
+        ["1", "default"] if args.baseline_threads == "both" else [args.baseline_threads]
+    )
     out["baseline_blas_threads"] = args.baseline_threads
 
     rows = []
@@ -224,15 +260,21 @@ def main() -> int:
             rows.append(compare(name, K, m, k, args.repeat))
     out["comparisons"] = rows
     print("\n## Eigensolver: meshlap vs `eigsh(K, k, M=M, sigma=-1e-8, which='LM')`\n")
-    print(f"(best of {args.repeat} interleaved runs each; eigsh run with BLAS threads "
-          f"{' and '.join(BASELINE_SETTINGS)}, the faster kept, in the last column)\n")
-    print("| mesh | n | k | meshlap [s] | eigsh [s] | speed-up | max rel. Δλ | "
-          "max\\|UᵀMU−I\\| meshlap | eigsh | slices | eigsh BLAS |")
+    print(
+        f"(best of {args.repeat} interleaved runs each; eigsh run with BLAS threads "
+        f"{' and '.join(BASELINE_SETTINGS)}, the faster kept, in the last column)\n"
+    )
+    print(
+        "| mesh | n | k | meshlap [s] | eigsh [s] | speed-up | max rel. Δλ | "
+        "max\\|UᵀMU−I\\| meshlap | eigsh | slices | eigsh BLAS |"
+    )
     print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|")
     for r in rows:
-        print(f"| {r['mesh']} | {r['n']:,} | {r['k']} | {r['ours_s']:.2f} | {r['eigsh_s']:.2f} | "
-              f"{r['ratio']:.1f}× | {r['rel_eig_diff']:.1e} | {r['orth_ours']:.1e} | "
-              f"{r['orth_eigsh']:.1e} | {r['slices']} | {r['eigsh_blas']} |")
+        print(
+            f"| {r['mesh']} | {r['n']:,} | {r['k']} | {r['ours_s']:.2f} | {r['eigsh_s']:.2f} | "
+            f"{r['ratio']:.1f}× | {r['rel_eig_diff']:.1e} | {r['orth_ours']:.1e} | "
+            f"{r['orth_eigsh']:.1e} | {r['slices']} | {r['eigsh_blas']} |"
+        )
     sys.stdout.flush()
 
     if args.quick or args.case:
@@ -244,8 +286,14 @@ def main() -> int:
         t = time.perf_counter()
         lam, U, info = ours(K, m, 1000)
         dt = time.perf_counter() - t
-        row: dict[str, Any] = {"n": len(m), "k": 1000, "ours_s": dt, "orth": orth_error(U, m),
-                               "residual": info.max_residual, "slices": len(info.shifts)}
+        row: dict[str, Any] = {
+            "n": len(m),
+            "k": 1000,
+            "ours_s": dt,
+            "orth": orth_error(U, m),
+            "residual": info.max_residual,
+            "slices": len(info.shifts),
+        }
         log(f"  armadillo k=1000 ours: {dt:.1f} s")
         if args.baseline_1000:
             BASELINE_THREADS[0] = 1
@@ -255,10 +303,15 @@ def main() -> int:
             row["rel_eig_diff"] = rel_diff(lam, lb)
         out["k1000"] = row
         print("\n## k = 1000 on armadillo (target: under a minute)\n")
-        extra = (f", eigsh {row['eigsh_s']:.1f} s, max rel. Δλ {row['rel_eig_diff']:.1e}"
-                 if "eigsh_s" in row else "")
-        print(f"meshlap: {dt:.1f} s ({row['slices']} slices), max|UᵀMU−I| = {row['orth']:.1e}, "
-              f"max relative residual {row['residual']:.1e}{extra}")
+        extra = (
+            f", eigsh {row['eigsh_s']:.1f} s, max rel. Δλ {row['rel_eig_diff']:.1e}"
+            if "eigsh_s" in row
+            else ""
+        )
+        print(
+            f"meshlap: {dt:.1f} s ({row['slices']} slices), max|UᵀMU−I| = {row['orth']:.1e}, "
+            f"max relative residual {row['residual']:.1e}{extra}"
+        )
 
     # dragon: non-manifold, 7 components, tiny area
     data = load("dragon")
@@ -268,8 +321,12 @@ def main() -> int:
         lam, U, info = ours(K, m, 100)
         dt = time.perf_counter() - t
         drow: dict[str, Any] = {
-            "n": len(m), "area": float(m.sum()), "components": info.n_components,
-            "zero_eigenvalues": int(np.sum(lam == 0)), "ours_s": dt, "orth": orth_error(U, m),
+            "n": len(m),
+            "area": float(m.sum()),
+            "components": info.n_components,
+            "zero_eigenvalues": int(np.sum(lam == 0)),
+            "ours_s": dt,
+            "orth": orth_error(U, m),
             "residual": info.max_residual,
         }
         log(f"  dragon k=100 ours: {dt:.2f} s")
@@ -285,23 +342,29 @@ def main() -> int:
             drow["eigsh_error"] = f"{type(exc).__name__}: {exc}"
         out["dragon"] = drow
         print("\n## dragon (cleaned by load_mesh: non-manifold edges, 7 components)\n")
-        print(f"{drow['n']:,} vertices, total area {drow['area']:.3g}: meshlap k=100 in "
-              f"{dt:.2f} s, {drow['zero_eigenvalues']} zero eigenvalues for "
-              f"{drow['components']} components, max|UᵀMU−I| = {drow['orth']:.1e}, "
-              f"max relative residual {drow['residual']:.1e}.")
+        print(
+            f"{drow['n']:,} vertices, total area {drow['area']:.3g}: meshlap k=100 in "
+            f"{dt:.2f} s, {drow['zero_eigenvalues']} zero eigenvalues for "
+            f"{drow['components']} components, max|UᵀMU−I| = {drow['orth']:.1e}, "
+            f"max relative residual {drow['residual']:.1e}."
+        )
         if "eigsh_error" in drow:
             print(f"eigsh with sigma=-1e-8 failed: {drow['eigsh_error']}")
         else:
-            print(f"eigsh with sigma=-1e-8: {drow['eigsh_s']:.2f} s, max rel. Δλ "
-                  f"{drow['eigsh_rel_eig_diff']:.1e}, max|UᵀMU−I| {drow['eigsh_orth']:.1e}, "
-                  f"smallest eigenvalue {drow['eigsh_min_eig']:.2e}")
+            print(
+                f"eigsh with sigma=-1e-8: {drow['eigsh_s']:.2f} s, max rel. Δλ "
+                f"{drow['eigsh_rel_eig_diff']:.1e}, max|UᵀMU−I| {drow['eigsh_orth']:.1e}, "
+                f"smallest eigenvalue {drow['eigsh_min_eig']:.2e}"
+            )
 
     # memory on the 173k-vertex mesh, in a child process
     if (MESH_DIR / "armadillo_loop.obj").is_file():
         log("  armadillo_loop k=300 (child process)...")
         proc = subprocess.run(
             [sys.executable, __file__, "--memory-child", "armadillo_loop", "300"],
-            capture_output=True, text=True, check=False,
+            capture_output=True,
+            text=True,
+            check=False,
         )
         try:
             mem = json.loads(proc.stdout.strip().splitlines()[-1])
@@ -312,10 +375,12 @@ def main() -> int:
         if "error" in mem:
             print(f"child failed: {mem['error']}")
         else:
-            print(f"{mem['n']:,} vertices: {mem['seconds']:.1f} s, peak RSS "
-                  f"{mem['peak_rss_mib']:.0f} MiB (process; "
-                  f"{mem['rss_before_solve_mib']:.0f}"
-                  f" MiB before the solve), max|UᵀMU−I| = {mem['orth']:.1e}")
+            print(
+                f"{mem['n']:,} vertices: {mem['seconds']:.1f} s, peak RSS "
+                f"{mem['peak_rss_mib']:.0f} MiB (process; "
+                f"{mem['rss_before_solve_mib']:.0f}"
+                f" MiB before the solve), max|UᵀMU−I| = {mem['orth']:.1e}"
+            )
     else:
         log("skip armadillo_loop: ../shared/meshes/armadillo_loop.obj not present")
 
@@ -324,19 +389,23 @@ def main() -> int:
         rec = reconstruct_speed(*pencils["nefertiti"], 300)
         out["reconstruct"] = rec
         print("\n## reconstruct(k) for the k slider, nefertiti, k_max = 300 (target: < 16 ms)\n")
-        print(f"plain U_k(U_kᵀMX): median {rec['plain_ms_median']:.1f} ms, max "
-              f"{rec['plain_ms_max']:.1f} ms; SpectralBasis.reconstruct random jumps: median "
-              f"{rec['jump_ms_median']:.2f} ms, max {rec['jump_ms_max']:.2f} ms; steps of ±1: "
-              f"median {rec['step_ms_median']:.2f} ms, max {rec['step_ms_max']:.2f} ms "
-              f"(incremental vs direct: {rec['incremental_vs_direct']:.1e}). Errors for all "
-              f"300 k in one pass: {rec['all_k_errors_s']:.2f} s.")
+        print(
+            f"plain U_k(U_kᵀMX): median {rec['plain_ms_median']:.1f} ms, max "
+            f"{rec['plain_ms_max']:.1f} ms; SpectralBasis.reconstruct random jumps: median "
+            f"{rec['jump_ms_median']:.2f} ms, max {rec['jump_ms_max']:.2f} ms; steps of ±1: "
+            f"median {rec['step_ms_median']:.2f} ms, max {rec['step_ms_max']:.2f} ms "
+            f"(incremental vs direct: {rec['incremental_vs_direct']:.1e}). Errors for all "
+            f"300 k in one pass: {rec['all_k_errors_s']:.2f} s."
+        )
     return _finish(out, args)
 
 
 def _finish(out: dict[str, Any], args: argparse.Namespace) -> int:
     out["loadavg_end"] = os.getloadavg()[0]
-    print(f"\n(load average at start {out['loadavg_start']:.1f}, at end {out['loadavg_end']:.1f}; "
-          f"{out['cpus']} CPUs)")
+    print(
+        f"\n(load average at start {out['loadavg_start']:.1f}, at end {out['loadavg_end']:.1f}; "
+        f"{out['cpus']} CPUs)"
+    )
     if args.json:
         Path(args.json).write_text(json.dumps(out, indent=1))
     return 0

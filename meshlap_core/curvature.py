@@ -21,24 +21,20 @@ Meyer, Desbrun, Schröder & Barr, "Discrete differential-geometry operators for 
 
 from __future__ import annotations
 
-from typing import Literal
-
 import igl
 import numpy as np
 
 from .errors import MeshError
 from .laplacian import (
-    AreaKind,
     _check_area,
     cotan_stiffness,
     uniform_laplacian,
     vertex_areas,
 )
+from .options import BOUNDARY_RULES, DEFAULT_AREA, DEFAULT_BOUNDARY, AreaKind, BoundaryRule
 from .topology import boundary_vertex_mask
 from .types import FloatArray, IntArray, as_mesh
 
-BoundaryRule = Literal["pi", "2pi", "zero"]
-BOUNDARY_RULES: tuple[str, ...] = ("pi", "2pi", "zero")
 METHODS: tuple[str, ...] = ("uniform", "cotan", "gaussian", "k1", "k2")
 
 
@@ -151,7 +147,7 @@ def _cotan_H(V: FloatArray, F: IntArray, area: FloatArray, N: FloatArray) -> Flo
     return -0.5 * np.sum(Lx * N, axis=1)
 
 
-def mean_curvature_cotan(V: FloatArray, F: IntArray, area: AreaKind = "barycentric") -> FloatArray:
+def mean_curvature_cotan(V: FloatArray, F: IntArray, area: AreaKind = DEFAULT_AREA) -> FloatArray:
     """Mean curvature from the Laplace–Beltrami operator, ``H = −½ (M⁻¹C x · n)``.
 
     ``C`` is the cotangent stiffness (negative semidefinite), ``M`` the lumped ``area``
@@ -167,7 +163,9 @@ def mean_curvature_cotan(V: FloatArray, F: IntArray, area: AreaKind = "barycentr
     return _cotan_H(V, F, vertex_areas(V, F, area), vertex_normals(V, F))
 
 
-def angle_deficit(V: FloatArray, F: IntArray, boundary: BoundaryRule = "pi") -> FloatArray:
+def angle_deficit(
+    V: FloatArray, F: IntArray, boundary: BoundaryRule = DEFAULT_BOUNDARY
+) -> FloatArray:
     """Integrated Gaussian curvature: the angle deficit at every vertex.
 
     Interior vertices: ``2π − Σθ``. Boundary vertices: ``π − Σθ`` (``"pi"``, the default, the
@@ -183,7 +181,10 @@ def angle_deficit(V: FloatArray, F: IntArray, boundary: BoundaryRule = "pi") -> 
 
 
 def gaussian_curvature(
-    V: FloatArray, F: IntArray, area: AreaKind = "barycentric", boundary: BoundaryRule = "pi"
+    V: FloatArray,
+    F: IntArray,
+    area: AreaKind = DEFAULT_AREA,
+    boundary: BoundaryRule = DEFAULT_BOUNDARY,
 ) -> FloatArray:
     """Angle-deficit Gaussian curvature ``K = (2π − Σθ) / A_i`` (see :func:`angle_deficit`).
 
@@ -215,7 +216,10 @@ def principal_from_HK(H: FloatArray, K: FloatArray) -> tuple[FloatArray, FloatAr
 
 
 def principal_curvatures(
-    V: FloatArray, F: IntArray, area: AreaKind = "barycentric", boundary: BoundaryRule = "pi"
+    V: FloatArray,
+    F: IntArray,
+    area: AreaKind = DEFAULT_AREA,
+    boundary: BoundaryRule = DEFAULT_BOUNDARY,
 ) -> tuple[FloatArray, FloatArray]:
     """Principal curvatures from the cotangent ``H`` and the angle-deficit ``K`` (same area).
 
@@ -263,7 +267,10 @@ def principal_curvature_quadric(
 
 
 def curvature_fields(
-    V: FloatArray, F: IntArray, area: AreaKind = "barycentric", boundary: BoundaryRule = "pi"
+    V: FloatArray,
+    F: IntArray,
+    area: AreaKind = DEFAULT_AREA,
+    boundary: BoundaryRule = DEFAULT_BOUNDARY,
 ) -> dict[str, FloatArray]:
     """Every per-vertex curvature field at once, sharing normals, areas and operators.
 
@@ -300,8 +307,8 @@ def curvature_field(
     V: FloatArray,
     F: IntArray,
     method: str,
-    area: AreaKind = "barycentric",
-    boundary: BoundaryRule = "pi",
+    area: AreaKind = DEFAULT_AREA,
+    boundary: BoundaryRule = DEFAULT_BOUNDARY,
 ) -> FloatArray:
     """One named field of :func:`curvature_fields` (``method`` in uniform, cotan, gaussian, k1,
     k2, difference)."""

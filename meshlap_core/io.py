@@ -127,8 +127,9 @@ def load_vertex_scalars(path: PathLike, name: str = "quality") -> FloatArray:
     """
     p, src, data = _read_input(path)
     if p.suffix.lower() != ".ply":
-        raise MeshError(f"per-vertex scalars can only be read from .ply files, not {p.suffix!r}",
-                        src)
+        raise MeshError(
+            f"per-vertex scalars can only be read from .ply files, not {p.suffix!r}", src
+        )
     parsed = _parse_ply(data, src)
     if name not in parsed.vertex_props:
         have = ", ".join(sorted(parsed.vertex_props)) or "none"
@@ -156,9 +157,15 @@ def _read_input(path: PathLike) -> tuple[Path, str, bytes]:
         raise MeshError(f"cannot read the file: {exc.strerror or exc}", src) from None
     if not stat.S_ISREG(mode):
         # a FIFO would block forever, /dev/zero would never end
-        kind = ("a named pipe (FIFO)" if stat.S_ISFIFO(mode)
-                else "a device" if stat.S_ISCHR(mode) or stat.S_ISBLK(mode)
-                else "a socket" if stat.S_ISSOCK(mode) else "a special file")
+        kind = (
+            "a named pipe (FIFO)"
+            if stat.S_ISFIFO(mode)
+            else "a device"
+            if stat.S_ISCHR(mode) or stat.S_ISBLK(mode)
+            else "a socket"
+            if stat.S_ISSOCK(mode)
+            else "a special file"
+        )
         raise MeshError(f"not a regular file ({kind}); meshlap reads mesh files only", src)
     try:
         data = p.read_bytes()
@@ -167,8 +174,9 @@ def _read_input(path: PathLike) -> tuple[Path, str, bytes]:
     except OSError as exc:
         raise MeshError(f"cannot read the file: {exc.strerror or exc}", src) from None
     if not data or data.isspace():
-        raise MeshError("the file is empty" if not data else "the file contains only whitespace",
-                        src)
+        raise MeshError(
+            "the file is empty" if not data else "the file contains only whitespace", src
+        )
     return p, src, data
 
 
@@ -238,14 +246,15 @@ def _bulk_numbers(text: bytes, dtype: type) -> np.ndarray | None:
             return None
 
 
-def _select_lines(data: bytes, arr: np.ndarray, starts: IntArray, ends: IntArray,
-                  mask: np.ndarray) -> bytes:
+def _select_lines(
+    data: bytes, arr: np.ndarray, starts: IntArray, ends: IntArray, mask: np.ndarray
+) -> bytes:
     """Concatenate the selected lines (each keeps its ``\\n``)."""
     idx = np.flatnonzero(mask)
     if len(idx) == 0:
         return b""
     if idx[-1] - idx[0] + 1 == len(idx):  # one contiguous block (the usual case)
-        return data[starts[idx[0]]: ends[idx[-1]]] + b"\n"
+        return data[starts[idx[0]] : ends[idx[-1]]] + b"\n"
     lens = np.diff(np.concatenate([starts, [len(arr)]]))
     out = arr[np.repeat(mask, lens)].tobytes()
     return out if out.endswith(b"\n") else out + b"\n"
@@ -356,8 +365,9 @@ def _blank_after_slash(buf: np.ndarray) -> None:
     buf[(slash - slash[last_ws] > 0) & ~ws] = 32
 
 
-def _check_obj_faces(vals: IntArray, sizes: IntArray, nv: int, face_lines: IntArray,
-                     src: str) -> None:
+def _check_obj_faces(
+    vals: IntArray, sizes: IntArray, nv: int, face_lines: IntArray, src: str
+) -> None:
     """File-level checks with line numbers: corners per face, 1-based indices in range."""
     small = np.flatnonzero(sizes < 3)
     if len(small):
@@ -372,11 +382,12 @@ def _check_obj_faces(vals: IntArray, sizes: IntArray, nv: int, face_lines: IntAr
         pos = int(np.flatnonzero(bad)[0])
         k = int(np.searchsorted(np.cumsum(sizes), pos, side="right"))
         v = int(vals[pos])
-        why = ("OBJ indices start at 1" if v == 0
-               else f"the file has {nv:,} {'vertex' if nv == 1 else 'vertices'}")
-        raise MeshError(
-            f"line {int(face_lines[k])}: face {k} refers to vertex {v} but {why}", src
+        why = (
+            "OBJ indices start at 1"
+            if v == 0
+            else f"the file has {nv:,} {'vertex' if nv == 1 else 'vertices'}"
         )
+        raise MeshError(f"line {int(face_lines[k])}: face {k} refers to vertex {v} but {why}", src)
 
 
 def _parse_obj_general(data: bytes, src: str) -> _Parsed:
@@ -426,8 +437,7 @@ def _parse_obj_general(data: bytes, src: str) -> _Parsed:
                     i = int(head)
                 except ValueError:
                     raise MeshError(
-                        f"line {ln}: cannot read {tok!r} as a vertex index "
-                        f"(face {len(sizes)})",
+                        f"line {ln}: cannot read {tok!r} as a vertex index (face {len(sizes)})",
                         src,
                     ) from None
                 if i == 0:
@@ -468,8 +478,9 @@ def _parse_obj_general(data: bytes, src: str) -> _Parsed:
     idx = vals - 1
     faces: Any = idx.reshape(-1, 3) if np.all(size_arr == 3) else Polygons(idx, size_arr)
     warns = _ignored_warnings(n_ignored)
-    return _Parsed(V=np.asarray(coords, dtype=np.float64).reshape(-1, 3), faces=faces,
-                   warnings=warns)
+    return _Parsed(
+        V=np.asarray(coords, dtype=np.float64).reshape(-1, 3), faces=faces, warnings=warns
+    )
 
 
 # --------------------------------------------------------------------------------------------
@@ -486,7 +497,7 @@ def _parse_off(data: bytes, src: str) -> _Parsed:
     tokens: list[str] = []
     keyword = None
     while li < len(starts):
-        parts = _strip_comment(data[starts[li]: ends[li]].decode("latin-1")).split()
+        parts = _strip_comment(data[starts[li] : ends[li]].decode("latin-1")).split()
         li += 1
         if not parts:
             continue
@@ -529,11 +540,15 @@ def _parse_off(data: bytes, src: str) -> _Parsed:
         if len(ntok) == nv + nf and np.all(ntok[:nv] == 3) and np.all(ntok[nv:] == 4):
             vals = _bulk_numbers(body.tobytes(), np.float64)
             if vals is not None and vals.size == 3 * nv + 4 * nf:
-                fv = vals[3 * nv:].reshape(nf, 4)
-                if (np.all(fv[:, 0] == 3) and np.all(np.mod(fv[:, 1:], 1) == 0)
-                        and np.abs(fv[:, 1:]).max() < _HUGE_INDEX):
-                    return _Parsed(V=vals[: 3 * nv].reshape(nv, 3),
-                                   faces=fv[:, 1:].astype(np.int64))
+                fv = vals[3 * nv :].reshape(nf, 4)
+                if (
+                    np.all(fv[:, 0] == 3)
+                    and np.all(np.mod(fv[:, 1:], 1) == 0)
+                    and np.abs(fv[:, 1:]).max() < _HUGE_INDEX
+                ):
+                    return _Parsed(
+                        V=vals[: 3 * nv].reshape(nv, 3), faces=fv[:, 1:].astype(np.int64)
+                    )
     return _parse_off_general(data[body_start:], nv, nf, src)
 
 
@@ -574,7 +589,7 @@ def _parse_off_general(body: bytes, nv: int, nf: int, src: str) -> _Parsed:
         parts = lines[nv + k]
         try:
             c = int(parts[0])
-            idx = [int(t) for t in parts[1: 1 + c]]
+            idx = [int(t) for t in parts[1 : 1 + c]]
         except ValueError:
             raise MeshError(
                 f"cannot read face {k} ({' '.join(parts)[:60]!r}) as integers", src
@@ -598,10 +613,22 @@ def _parse_off_general(body: bytes, nv: int, nf: int, src: str) -> _Parsed:
 # PLY
 
 _PLY_TYPES = {
-    "char": "i1", "int8": "i1", "uchar": "u1", "uint8": "u1",
-    "short": "i2", "int16": "i2", "ushort": "u2", "uint16": "u2",
-    "int": "i4", "int32": "i4", "uint": "u4", "uint32": "u4",
-    "float": "f4", "float32": "f4", "double": "f8", "float64": "f8",
+    "char": "i1",
+    "int8": "i1",
+    "uchar": "u1",
+    "uint8": "u1",
+    "short": "i2",
+    "int16": "i2",
+    "ushort": "u2",
+    "uint16": "u2",
+    "int": "i4",
+    "int32": "i4",
+    "uint": "u4",
+    "uint32": "u4",
+    "float": "f4",
+    "float32": "f4",
+    "double": "f8",
+    "float64": "f8",
 }
 
 
@@ -636,7 +663,9 @@ def _ply_header(data: bytes, src: str) -> tuple[str, list[_PlyElement], int]:
             if fmt is not None:
                 raise MeshError(f"PLY header line {ln}: a second 'format' line", src)
             if len(parts) < 2 or parts[1] not in (
-                "ascii", "binary_little_endian", "binary_big_endian"
+                "ascii",
+                "binary_little_endian",
+                "binary_big_endian",
             ):
                 raise MeshError(f"PLY header line {ln}: unknown format {line.strip()!r}", src)
             fmt = parts[1]
@@ -644,8 +673,9 @@ def _ply_header(data: bytes, src: str) -> tuple[str, list[_PlyElement], int]:
             try:
                 elements.append(_PlyElement(parts[1], int(parts[2])))
             except (IndexError, ValueError):
-                raise MeshError(f"PLY header line {ln}: bad element line {line.strip()!r}",
-                                src) from None
+                raise MeshError(
+                    f"PLY header line {ln}: bad element line {line.strip()!r}", src
+                ) from None
             if elements[-1].count < 0:
                 raise MeshError(f"PLY header line {ln}: negative element count", src)
         elif parts[0] == "property":
@@ -659,8 +689,9 @@ def _ply_header(data: bytes, src: str) -> tuple[str, list[_PlyElement], int]:
                 else:
                     elements[-1].props.append(_PlyProp(parts[2], _PLY_TYPES[parts[1]]))
             except (IndexError, KeyError):
-                raise MeshError(f"PLY header line {ln}: bad property line {line.strip()!r}",
-                                src) from None
+                raise MeshError(
+                    f"PLY header line {ln}: bad property line {line.strip()!r}", src
+                ) from None
         else:
             raise MeshError(f"PLY header line {ln}: unknown keyword {parts[0]!r}", src)
     if fmt is None:
@@ -724,8 +755,9 @@ def _describe_counts(elements: list[_PlyElement]) -> str:
     return " and ".join(f"{e.count:,} {names.get(e.name, e.name + ' records')}" for e in elements)
 
 
-def _ply_read_binary(data: bytes, pos: int, elements: list[_PlyElement], bo: str,
-                     src: str) -> dict[str, dict[str, Any]]:
+def _ply_read_binary(
+    data: bytes, pos: int, elements: list[_PlyElement], bo: str, src: str
+) -> dict[str, dict[str, Any]]:
     """Binary PLY body: fixed-size elements via one structured ``frombuffer``; list elements
     assume the first record's list lengths for all records (checked), else a record loop."""
     out: dict[str, dict[str, Any]] = {}
@@ -762,13 +794,15 @@ def _truncated_msg(elements: list[_PlyElement], el: _PlyElement, have: int, need
     )
 
 
-def _ply_binary_list_element(data: bytes, pos: int, el: _PlyElement, bo: str,
-                             elements: list[_PlyElement], src: str
-                             ) -> tuple[dict[str, Any], int]:
+def _ply_binary_list_element(
+    data: bytes, pos: int, el: _PlyElement, bo: str, elements: list[_PlyElement], src: str
+) -> tuple[dict[str, Any], int]:
     total = len(data)
     if el.count == 0:
-        return {p.name: (np.zeros(0), np.zeros(0, np.int64)) if p.count_dtype else np.zeros(0)
-                for p in el.props}, pos
+        return {
+            p.name: (np.zeros(0), np.zeros(0, np.int64)) if p.count_dtype else np.zeros(0)
+            for p in el.props
+        }, pos
     # read the first record to learn its list lengths
     lens = []
     q = pos
@@ -812,8 +846,10 @@ def _ply_binary_list_element(data: bytes, pos: int, el: _PlyElement, bo: str,
                 if p.count_dtype is None:
                     out[p.name] = rec[p.name]
                 else:
-                    out[p.name] = (rec[p.name].reshape(-1),
-                                   np.full(el.count, lens[li], dtype=np.int64))
+                    out[p.name] = (
+                        rec[p.name].reshape(-1),
+                        np.full(el.count, lens[li], dtype=np.int64),
+                    )
                     li += 1
             return out, pos + need
     # variable list lengths: one record at a time
@@ -836,8 +872,7 @@ def _ply_binary_list_element(data: bytes, pos: int, el: _PlyElement, bo: str,
                     raise MeshError(_truncated_at(elements, el, r), src)
                 c = int(np.frombuffer(data, cdt, 1, pos)[0])
                 if c < 0:
-                    raise MeshError(f"{el.name} record {r} has a list of negative length {c}",
-                                    src)
+                    raise MeshError(f"{el.name} record {r} has a list of negative length {c}", src)
                 pos += cdt.itemsize
                 if pos + c * idt.itemsize > total:
                     raise MeshError(_truncated_at(elements, el, r), src)
@@ -857,8 +892,9 @@ def _truncated_at(elements: list[_PlyElement], el: _PlyElement, r: int) -> str:
     )
 
 
-def _ply_read_ascii(data: bytes, pos: int, elements: list[_PlyElement],
-                    src: str) -> dict[str, dict[str, Any]]:
+def _ply_read_ascii(
+    data: bytes, pos: int, elements: list[_PlyElement], src: str
+) -> dict[str, dict[str, Any]]:
     body = np.frombuffer(data, dtype=np.uint8)[pos:]
     _check_text(body, src, "PLY", pos)
     fast = _ply_ascii_fast(body, elements)
@@ -885,7 +921,7 @@ def _ply_read_ascii(data: bytes, pos: int, elements: list[_PlyElement],
                             raise MeshError(
                                 f"{el.name} record {r} has a list of negative length {c}", src
                             )
-                        vals = [float(t) for t in tokens[k + 1: k + 1 + c]]
+                        vals = [float(t) for t in tokens[k + 1 : k + 1 + c]]
                         if len(vals) < c:
                             raise IndexError
                         lists[p.name][0].extend(vals)
@@ -925,8 +961,9 @@ def _ply_read_ascii(data: bytes, pos: int, elements: list[_PlyElement],
     return out
 
 
-def _ply_ascii_fast(body: np.ndarray, elements: list[_PlyElement]
-                    ) -> dict[str, dict[str, Any]] | None:
+def _ply_ascii_fast(
+    body: np.ndarray, elements: list[_PlyElement]
+) -> dict[str, dict[str, Any]] | None:
     """Exactly ``vertex`` (scalars) then ``face`` (one list, all triangles), one record per line."""
     if [e.name for e in elements] != ["vertex", "face"]:
         return None
@@ -942,14 +979,18 @@ def _ply_ascii_fast(body: np.ndarray, elements: list[_PlyElement]
     if vals is None or vals.size != k * nv + 4 * nf:
         return None
     vv = vals[: k * nv].reshape(nv, k)
-    ff = vals[k * nv:].reshape(nf, 4)
-    if (not np.all(ff[:, 0] == 3) or not np.all(np.mod(ff[:, 1:], 1) == 0)
-            or (nf and np.abs(ff[:, 1:]).max() >= _HUGE_INDEX)):
+    ff = vals[k * nv :].reshape(nf, 4)
+    if (
+        not np.all(ff[:, 0] == 3)
+        or not np.all(np.mod(ff[:, 1:], 1) == 0)
+        or (nf and np.abs(ff[:, 1:]).max() >= _HUGE_INDEX)
+    ):
         return None
     return {
         "vertex": {p.name: vv[:, i] for i, p in enumerate(vert.props)},
-        "face": {face.props[0].name: (ff[:, 1:].astype(np.int64).ravel(),
-                                      np.full(nf, 3, dtype=np.int64))},
+        "face": {
+            face.props[0].name: (ff[:, 1:].astype(np.int64).ravel(), np.full(nf, 3, dtype=np.int64))
+        },
     }
 
 
@@ -1067,8 +1108,9 @@ def _check_output_path(path: PathLike, overwrite_inputs: Iterable[PathLike]) -> 
     return target
 
 
-def check_output_path(path: PathLike, overwrite_inputs: Iterable[PathLike] = (),
-                      suffixes: Iterable[str] | None = None) -> Path:
+def check_output_path(
+    path: PathLike, overwrite_inputs: Iterable[PathLike] = (), suffixes: Iterable[str] | None = None
+) -> Path:
     """Check an output path before any work is done (commands call it first, so that a
     doomed run fails in a second and leaves nothing behind).
 
@@ -1095,8 +1137,7 @@ def check_output_path(path: PathLike, overwrite_inputs: Iterable[PathLike] = (),
         allowed = tuple(suffixes)
         if target.suffix.lower() not in allowed:
             raise MeshError(
-                f"unsupported output type {target.suffix or '(none)'!r}; use "
-                f"{', '.join(allowed)}",
+                f"unsupported output type {target.suffix or '(none)'!r}; use {', '.join(allowed)}",
                 os.fspath(path),
             )
     return target
@@ -1147,19 +1188,21 @@ def atomic_write(
     parent = target.parent if str(target.parent) else Path(".")
     tmp = parent / f".{target.name}.{secrets.token_hex(6)}.tmp"
     try:
-        fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0),
-                     0o666)
+        fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0), 0o666)
     except PermissionError:
-        raise MeshError("cannot write in this directory: permission denied",
-                        os.fspath(parent)) from None
+        raise MeshError(
+            "cannot write in this directory: permission denied", os.fspath(parent)
+        ) from None
     except OSError as exc:
-        raise MeshError(f"cannot create a file here: {exc.strerror or exc}",
-                        os.fspath(parent)) from None
+        raise MeshError(
+            f"cannot create a file here: {exc.strerror or exc}", os.fspath(parent)
+        ) from None
     if target.exists():  # keep the permissions of the file being replaced
         with contextlib.suppress(OSError):
             os.chmod(tmp, stat.S_IMODE(target.stat().st_mode))
-    f: IO[Any] = (os.fdopen(fd, "wb") if mode == "wb"
-                  else os.fdopen(fd, "w", encoding=encoding, newline="\n"))
+    f: IO[Any] = (
+        os.fdopen(fd, "wb") if mode == "wb" else os.fdopen(fd, "w", encoding=encoding, newline="\n")
+    )
     try:
         yield f
         f.flush()
@@ -1219,7 +1262,8 @@ def save_mesh(
     if ext not in WRITE_FORMATS:
         raise MeshError(
             f"cannot write {ext!r} files; use one of {', '.join(WRITE_FORMATS)}"
-            if ext else f"the output has no extension; use one of {', '.join(WRITE_FORMATS)}",
+            if ext
+            else f"the output has no extension; use one of {', '.join(WRITE_FORMATS)}",
             os.fspath(path),
         )
     V, F = as_mesh(V, F)
@@ -1245,8 +1289,9 @@ def save_mesh(
             np.savetxt(f, F, fmt="3 %d %d %d")
 
 
-def _write_ply(f: IO[bytes], V: FloatArray, F: IntArray, q: FloatArray | None,
-               binary: bool) -> None:
+def _write_ply(
+    f: IO[bytes], V: FloatArray, F: IntArray, q: FloatArray | None, binary: bool
+) -> None:
     props = ["x", "y", "z"] + (["quality"] if q is not None else [])
     head = [
         "ply",

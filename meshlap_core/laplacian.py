@@ -16,21 +16,17 @@ Meyer, Desbrun, Schröder & Barr, "Discrete differential-geometry operators for 
 
 from __future__ import annotations
 
-from typing import Literal
-
 import igl
 import numpy as np
 import scipy.sparse as sp
 
 from .errors import MeshError
+from .options import AREA_KINDS, DEFAULT_AREA, DEGENERATE_REL, MASS_AREA, AreaKind
 from .types import FloatArray, IntArray, as_faces, as_mesh
 
-AreaKind = Literal["barycentric", "voronoi"]
-AREA_KINDS: tuple[str, ...] = ("barycentric", "voronoi")
-
-# A face whose squared double area is below this fraction of (sum of squared edge lengths)^2
-# is treated as degenerate: its cotangent weights are set to zero instead of +-inf.
-_DEGENERATE_REL = 1e-24
+# A face with 16 A² ≤ (2·DEGENERATE_REL)² (Σ l²)² is degenerate (see options.DEGENERATE_REL):
+# its cotangent weights are set to zero instead of ±inf.
+_DEGENERATE_REL16 = (2.0 * DEGENERATE_REL) ** 2
 
 
 def _check_area(area: str) -> None:
@@ -100,7 +96,7 @@ def cotangents_intrinsic(l2: FloatArray) -> FloatArray:
     a, b, c = l2[:, 0], l2[:, 1], l2[:, 2]
     area16 = 2.0 * (a * b + b * c + c * a) - (a * a + b * b + c * c)  # = 16 A^2
     scale = (a + b + c) ** 2
-    ok = area16 > _DEGENERATE_REL * scale
+    ok = area16 > _DEGENERATE_REL16 * scale
     four_area = np.where(ok, np.sqrt(np.where(ok, area16, 1.0)), 1.0)  # 4A
     num = np.stack([b + c - a, c + a - b, a + b - c], axis=1)
     return np.where(ok[:, None], num / four_area[:, None], 0.0)
@@ -163,7 +159,7 @@ def cotan_stiffness(V: FloatArray, F: IntArray) -> sp.csr_matrix:
     return C
 
 
-def vertex_areas(V: FloatArray, F: IntArray, area: AreaKind = "barycentric") -> FloatArray:
+def vertex_areas(V: FloatArray, F: IntArray, area: AreaKind = DEFAULT_AREA) -> FloatArray:
     """Lumped per-vertex areas (the diagonal of the mass matrix).
 
     ``barycentric``: ``A_i = ⅓ Σ`` areas of the faces around ``i``. ``voronoi``: the mixed
@@ -198,7 +194,7 @@ def vertex_areas(V: FloatArray, F: IntArray, area: AreaKind = "barycentric") -> 
     return a
 
 
-def mass_matrix(V: FloatArray, F: IntArray, area: AreaKind = "voronoi") -> sp.csr_matrix:
+def mass_matrix(V: FloatArray, F: IntArray, area: AreaKind = MASS_AREA) -> sp.csr_matrix:
     """Lumped (diagonal) mass matrix ``M = diag(vertex_areas(V, F, area))``.
 
     Parameters
@@ -260,7 +256,7 @@ def uniform_laplacian(F: IntArray, n: int) -> sp.csr_matrix:
     return (sp.diags(inv) @ A - sp.diags((deg > 0).astype(np.float64))).tocsr()
 
 
-def laplace_beltrami(V: FloatArray, F: IntArray, area: AreaKind = "barycentric") -> sp.csr_matrix:
+def laplace_beltrami(V: FloatArray, F: IntArray, area: AreaKind = DEFAULT_AREA) -> sp.csr_matrix:
     """Pointwise Laplace–Beltrami operator ``Δ = M⁻¹ C`` (negative semidefinite).
 
     Applied to the coordinates it gives ``Δx = −2 H n``. Rows of vertices with zero area

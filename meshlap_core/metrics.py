@@ -331,9 +331,7 @@ def _dihedral_unchecked(V: FloatArray, F: IntArray, adj: EdgeFaces) -> FloatArra
     return np.pi - phi
 
 
-def dihedral_histogram(
-    theta: FloatArray, bins: int = 36
-) -> tuple[np.ndarray, FloatArray]:
+def dihedral_histogram(theta: FloatArray, bins: int = 36) -> tuple[np.ndarray, FloatArray]:
     """Histogram of dihedral angles in degrees over ``[0, 360]``.
 
     Parameters

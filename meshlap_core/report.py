@@ -420,8 +420,10 @@ class _Ctx:
             V, F, apath = _load_asset(file)
             if alpha is not None:
                 V = noise.add_noise(V, F, alpha, mode="isotropic", seed=_NOISE_SEED)
-                label = (f"assets/{file} + seeded Gaussian noise σ = {alpha:g} × bbox diagonal "
-                         f"(stand-in for {name}, {len(V):,} vertices)")
+                label = (
+                    f"assets/{file} + seeded Gaussian noise σ = {alpha:g} × bbox diagonal "
+                    f"(stand-in for {name}, {len(V):,} vertices)"
+                )
                 apath = None
             else:
                 label = f"assets/{file} (stand-in for {name}, {len(V):,} vertices)"
@@ -451,8 +453,9 @@ class _Ctx:
         with atomic_write(path, "w", overwrite_inputs=self.inputs) as f:
             f.write(buf.getvalue())
         self.tables.append(path)
-        return _Table(name, caption, list(columns), [list(r) for r in rows], self.rel(path),
-                      max_rows)
+        return _Table(
+            name, caption, list(columns), [list(r) for r in rows], self.rel(path), max_rows
+        )
 
     def save_fig(self, fig: Any, name: str, caption: str, kind: str = "plot") -> _Fig:
         path = self.fig_dir / f"{name}.png"
@@ -478,11 +481,16 @@ class _Ctx:
     ) -> _Fig | None:
         """A viewer screenshot of a mesh (saved to a temporary OBJ unless ``use_file``), or
         ``None`` when screenshots are unavailable (the reason is kept)."""
-        if self.screenshots and self.max_screenshots is not None \
-                and self.shots_ok >= self.max_screenshots:
+        if (
+            self.screenshots
+            and self.max_screenshots is not None
+            and self.shots_ok >= self.max_screenshots
+        ):
             self.screenshots = False
-            self.screenshot_reason = (f"the limit of {self.max_screenshots} viewer screenshots "
-                                      "was reached (--max-screenshots)")
+            self.screenshot_reason = (
+                f"the limit of {self.max_screenshots} viewer screenshots "
+                "was reached (--max-screenshots)"
+            )
         if not self.screenshots:
             return None
         out = self.fig_dir / f"{name}.png"
@@ -504,7 +512,11 @@ class _Ctx:
             cmd += ["--vertex", str(vertex)]
         try:
             proc = subprocess.run(
-                cmd, cwd=self.tmp, capture_output=True, text=True, timeout=180,
+                cmd,
+                cwd=self.tmp,
+                capture_output=True,
+                text=True,
+                timeout=180,
                 env={**os.environ, "PYTHONWARNINGS": "ignore"},
             )
             ok = proc.returncode == 0 and out.is_file()
@@ -546,8 +558,7 @@ class _Ctx:
         """A screenshot; if unavailable, a matplotlib rendering of the same mesh and field."""
         if label is None and mesh is not None and V is None:
             label = mesh.name
-        fig = self.shot(name, caption, mesh=mesh, V=V, F=F, field=field,
-                        label=label)
+        fig = self.shot(name, caption, mesh=mesh, V=V, F=F, field=field, label=label)
         if fig is not None:
             return fig
         if mesh is not None and V is None:
@@ -561,8 +572,7 @@ class _Ctx:
         if sm is not None:
             cax = f.add_axes((0.86, 0.15, 0.03, 0.7))
             f.colorbar(sm, cax=cax)
-        return self.save_fig(f, name, caption + " (matplotlib rendering: no screenshot)",
-                             "render")
+        return self.save_fig(f, name, caption + " (matplotlib rendering: no screenshot)", "render")
 
 
 def _last_line(text: str) -> str:
@@ -606,15 +616,18 @@ def _autocrop(path: Path, margin: int = 12) -> bool:
         panel = (0, r1, c0, w)
     scene = diff.copy()
     if panel is not None:
-        scene[panel[0]:panel[1], panel[2]:panel[3]] = False
+        scene[panel[0] : panel[1], panel[2] : panel[3]] = False
     sb = _bbox(scene)
     pieces = []
     if sb is not None:
         r0, r1, c0, c1 = sb
-        pieces.append(img[max(r0 - margin, 0):min(r1 + margin, h),
-                          max(c0 - margin, 0):min(c1 + margin, w)])
+        pieces.append(
+            img[
+                max(r0 - margin, 0) : min(r1 + margin, h), max(c0 - margin, 0) : min(c1 + margin, w)
+            ]
+        )
     if panel is not None:
-        pieces.append(img[panel[0]:panel[1], panel[2]:panel[3]])
+        pieces.append(img[panel[0] : panel[1], panel[2] : panel[3]])
     if not pieces:
         return False
     H = max(p.shape[0] for p in pieces)
@@ -625,7 +638,7 @@ def _autocrop(path: Path, margin: int = 12) -> bool:
     x = 0
     for p in pieces:
         y = (H - p.shape[0]) // 2 if p is pieces[0] and len(pieces) > 1 else 0
-        out[y:y + p.shape[0], x:x + p.shape[1]] = p
+        out[y : y + p.shape[0], x : x + p.shape[1]] = p
         x += p.shape[1] + gap
     with atomic_write(path, "wb") as fh:
         mpimg.imsave(fh, np.clip(out, 0, 1), format="png")
@@ -714,14 +727,17 @@ def _draw_mesh(
                 r = float(np.percentile(np.abs(finite), 98)) if finite.size else 1.0
                 lo, hi = -(r or 1.0), (r or 1.0)
             else:
-                lo, hi = (np.percentile(finite, [1, 99]) if finite.size else (0.0, 1.0))
+                lo, hi = np.percentile(finite, [1, 99]) if finite.size else (0.0, 1.0)
                 lo, hi = float(lo), float(hi)
                 if hi <= lo:
                     hi = lo + 1.0
         else:
             lo, hi = vmin, vmax
-        norm = (mpl.colors.LogNorm(max(lo, 1e-300), hi, clip=True) if log
-                else mpl.colors.Normalize(lo, hi))
+        norm = (
+            mpl.colors.LogNorm(max(lo, 1e-300), hi, clip=True)
+            if log
+            else mpl.colors.Normalize(lo, hi)
+        )
         cm = mpl.colormaps[cmap]
         base = cm(norm(np.nan_to_num(np.maximum(fv, lo) if log else fv)))
         sm = mpl.cm.ScalarMappable(norm=norm, cmap=cm)
@@ -730,7 +746,8 @@ def _draw_mesh(
     idx = np.flatnonzero(keep)
     order = idx[np.argsort(T[idx, :, 2].mean(axis=1))]
     pc = PolyCollection(
-        T[order][:, :, :2], facecolors=col[order],
+        T[order][:, :, :2],
+        facecolors=col[order],
         edgecolors=(0.1, 0.1, 0.1, 0.6) if edges else col[order],
         linewidths=0.6 if edges else 0.25,
     )
@@ -744,8 +761,15 @@ def _draw_mesh(
     return sm
 
 
-def _map_row(items: Sequence[tuple[str, FloatArray]], V: FloatArray, F: IntArray, vmax: float,
-             label: str, vmin: float = 0.0, log: bool = False) -> Any:
+def _map_row(
+    items: Sequence[tuple[str, FloatArray]],
+    V: FloatArray,
+    F: IntArray,
+    vmax: float,
+    label: str,
+    vmin: float = 0.0,
+    log: bool = False,
+) -> Any:
     """One row of meshes coloured by per-vertex values on a shared vmin..vmax scale."""
     n = len(items)
     fig = _new_figure(3.4 * n + 0.9, 3.9)
@@ -753,8 +777,9 @@ def _map_row(items: Sequence[tuple[str, FloatArray]], V: FloatArray, F: IntArray
     sm = None
     for i, (title, vals) in enumerate(items):
         ax = fig.add_axes((0.005 + i * w, 0.0, w, 0.86))
-        sm = _draw_mesh(ax, V, F, vals, cmap="magma", symmetric=False, vmin=vmin, vmax=vmax,
-                        log=log)
+        sm = _draw_mesh(
+            ax, V, F, vals, cmap="magma", symmetric=False, vmin=vmin, vmax=vmax, log=log
+        )
         ax.set_title(title, fontsize=8)
     cax = fig.add_axes((0.005 + n * w + 0.01, 0.12, 0.012, 0.66))
     fig.colorbar(sm, cax=cax, label=label)
@@ -791,9 +816,16 @@ def _section_onering(ctx: _Ctx, sec: _Section) -> None:
         pairs = list(zip(nb, nb[1:] + ([nb[0]] if not ring.boundary[v] else []), strict=False))
         ok = all((v, a, b) in faces for a, b in pairs)
         all_ok &= ok
-        rows.append([v, int(ring.valence[v]), "boundary" if ring.boundary[v] else "interior",
-                     " → ".join(map(str, nb)), " → ".join(map(str, ring.reversed()[v].tolist())),
-                     ok])
+        rows.append(
+            [
+                v,
+                int(ring.valence[v]),
+                "boundary" if ring.boundary[v] else "interior",
+                " → ".join(map(str, nb)),
+                " → ".join(map(str, ring.reversed()[v].tolist())),
+                ok,
+            ]
+        )
     ctx.progress.step("one-rings ordered")
     sec.p(
         f"Mesh: {mesh.label}. `topology.one_ring` orders the neighbours of every vertex at once. "
@@ -807,11 +839,14 @@ def _section_onering(ctx: _Ctx, sec: _Section) -> None:
         f"is a face (v, a, b) of the mesh; valences range from {int(ring.valence.min())} to "
         f"{int(ring.valence.max())} (a triangulated cube has corners of different valence)."
     )
-    sec.add(ctx.table(
-        "onering_cube", f"Ordered one-rings of every vertex of {mesh.name} (0-based indices).",
-        ["vertex", "valence", "kind", "neighbours_ccw", "neighbours_cw", "ccw_pairs_are_faces"],
-        rows,
-    ))
+    sec.add(
+        ctx.table(
+            "onering_cube",
+            f"Ordered one-rings of every vertex of {mesh.name} (0-based indices).",
+            ["vertex", "valence", "kind", "neighbours_ccw", "neighbours_cw", "ccw_pairs_are_faces"],
+            rows,
+        )
+    )
     v0 = 0
     nb = ring[v0]
     N = curvature.vertex_normals(V, F)
@@ -821,27 +856,58 @@ def _section_onering(ctx: _Ctx, sec: _Section) -> None:
     _draw_mesh(ax, V, F, None, cam=cam, edges=True)
     P = V @ cam.T
     ax.plot(*P[v0, :2], "o", color="crimson", ms=12, zorder=5)
-    ax.annotate(f"v{v0}", P[v0, :2], xytext=(9, -16), textcoords="offset points",
-                color="crimson", fontsize=12, weight="bold")
+    ax.annotate(
+        f"v{v0}",
+        P[v0, :2],
+        xytext=(9, -16),
+        textcoords="offset points",
+        color="crimson",
+        fontsize=12,
+        weight="bold",
+    )
     ring_pts = P[nb, :2]
     cyc = np.vstack([ring_pts, ring_pts[:1]]) if not ring.boundary[v0] else ring_pts
     for a, b in itertools.pairwise(cyc):
-        ax.annotate("", b, a, arrowprops={"arrowstyle": "-|>", "color": "tab:blue", "lw": 2.2,
-                                          "mutation_scale": 18}, zorder=6)
+        ax.annotate(
+            "",
+            b,
+            a,
+            arrowprops={"arrowstyle": "-|>", "color": "tab:blue", "lw": 2.2, "mutation_scale": 18},
+            zorder=6,
+        )
     for i, (w, pt) in enumerate(zip(nb.tolist(), ring_pts, strict=True)):
         ax.plot(*pt, "o", color="tab:blue", ms=9, zorder=7)
-        ax.annotate(f"{i}: v{w}", pt, xytext=(7, 7), textcoords="offset points",
-                    fontsize=12, color="navy", weight="bold", zorder=8)
-    fig.suptitle(f"{mesh.name}: one-ring of vertex {v0}, seen from outside along its normal\n"
-                 "neighbours numbered 0, 1, 2, … in counter-clockwise order", fontsize=11)
-    f1 = ctx.save_fig(fig, "onering_cube",
-                      f"The one-ring of vertex {v0} seen from outside: position i in the "
-                      "order is labelled 'i: v<index>' (0-based, as in the viewer) and the "
-                      "arrows follow the order, counter-clockwise.")
+        ax.annotate(
+            f"{i}: v{w}",
+            pt,
+            xytext=(7, 7),
+            textcoords="offset points",
+            fontsize=12,
+            color="navy",
+            weight="bold",
+            zorder=8,
+        )
+    fig.suptitle(
+        f"{mesh.name}: one-ring of vertex {v0}, seen from outside along its normal\n"
+        "neighbours numbered 0, 1, 2, … in counter-clockwise order",
+        fontsize=11,
+    )
+    f1 = ctx.save_fig(
+        fig,
+        "onering_cube",
+        f"The one-ring of vertex {v0} seen from outside: position i in the "
+        "order is labelled 'i: v<index>' (0-based, as in the viewer) and the "
+        "arrows follow the order, counter-clockwise.",
+    )
     ctx.progress.step("figure drawn")
-    f2 = ctx.shot("onering_cube_viewer", f"The viewer's one-ring panel on vertex {v0} "
-                  "(numbers are the order).", mesh=mesh, panel="onering", vertex=v0,
-                  use_file=True)
+    f2 = ctx.shot(
+        "onering_cube_viewer",
+        f"The viewer's one-ring panel on vertex {v0} (numbers are the order).",
+        mesh=mesh,
+        panel="onering",
+        vertex=v0,
+        use_file=True,
+    )
     ctx.progress.step("screenshot")
     sec.figs([f1, f2])
     if f2 is None:
@@ -878,16 +944,27 @@ def _section_uniform(ctx: _Ctx, sec: _Section) -> None:
             rows.append([name, label, "all", len(m.V), *_stats_row(f[key])])
             rows.append([name, label, "interior", int((~bnd).sum()), *_stats_row(f[key][~bnd])])
         s, target = _gauss_bonnet(m.V, m.F)
-        gb_rows.append([name, topology.euler_characteristic(m.F, len(m.V)), s, target,
-                        abs(s - target)])
+        gb_rows.append(
+            [name, topology.euler_characteristic(m.F, len(m.V)), s, target, abs(s - target)]
+        )
         sec.p(f"Mesh `{name}`: {m.label}.")
     ctx.progress.step("curvature computed")
-    sec.add(ctx.table("uniform_ranges", "Value ranges (all vertices, then interior only).",
-                      ["mesh", "field", "vertices", "n", *STAT_COLUMNS],
-                      [[r[0], r[1], r[2], r[3], *r[4:]] for r in rows]))
-    sec.add(ctx.table("gauss_bonnet", "Gauss–Bonnet check: Σ K_i A_i against 2πχ.",
-                      ["mesh", "euler_characteristic", "sum_K_A", "two_pi_chi", "abs_difference"],
-                      gb_rows))
+    sec.add(
+        ctx.table(
+            "uniform_ranges",
+            "Value ranges (all vertices, then interior only).",
+            ["mesh", "field", "vertices", "n", *STAT_COLUMNS],
+            [[r[0], r[1], r[2], r[3], *r[4:]] for r in rows],
+        )
+    )
+    sec.add(
+        ctx.table(
+            "gauss_bonnet",
+            "Gauss–Bonnet check: Σ K_i A_i against 2πχ.",
+            ["mesh", "euler_characteristic", "sum_K_A", "two_pi_chi", "abs_difference"],
+            gb_rows,
+        )
+    )
     pl = ctx.mesh("plane")
     fpl = fields["plane"]
     bnd = topology.boundary_vertex_mask(pl.F, len(pl.V))
@@ -899,8 +976,10 @@ def _section_uniform(ctx: _Ctx, sec: _Section) -> None:
         f"over boundary vertices = {_num(np.abs(fpl['gaussian'][bnd]).max() if bnd.any() else 0)}"
         " (a flat boundary vertex has Σθ = π except at the corners of the patch, where the "
         "π rule leaves the turning angle of the boundary as K·A). Gauss–Bonnet: "
-        + "; ".join(f"{r[0]}: Σ K_i A_i = {_num(r[2], 6)} vs 2πχ = {_num(r[3], 6)}"
-                    for r in gb_rows) + "."
+        + "; ".join(
+            f"{r[0]}: Σ K_i A_i = {_num(r[2], 6)} vs 2πχ = {_num(r[3], 6)}" for r in gb_rows
+        )
+        + "."
     )
     fig = _new_figure(10.0, 6.4)
     for i, name in enumerate(names):
@@ -915,10 +994,17 @@ def _section_uniform(ctx: _Ctx, sec: _Section) -> None:
             ax.set_ylabel("vertices")
             ax.tick_params(labelsize=8)
     fig.tight_layout()
-    sec.figs([ctx.save_fig(fig, "uniform_histograms",
-                           "Histograms of uniform H and angle-deficit K (values clipped to the "
-                           "1st–99th percentile so that a few boundary values do not hide the "
-                           "rest; the table has the full ranges).")])
+    sec.figs(
+        [
+            ctx.save_fig(
+                fig,
+                "uniform_histograms",
+                "Histograms of uniform H and angle-deficit K (values clipped to the "
+                "1st–99th percentile so that a few boundary values do not hide the "
+                "rest; the table has the full ranges).",
+            )
+        ]
+    )
     ctx.progress.step("histograms")
     shots = [("lilium_s", "uniform"), ("lilium_s", "gaussian"), ("plane", "gaussian")]
     if not ctx.quick:  # H uniform is exactly 0 on the flat plane: a one-colour map
@@ -926,11 +1012,15 @@ def _section_uniform(ctx: _Ctx, sec: _Section) -> None:
     figs = []
     for name, fld in shots:
         m = ctx.mesh(name)
-        figs.append(ctx.shot_or_render(
-            f"uniform_{name}_{fld}",
-            f"{name}: {'H uniform' if fld == 'uniform' else 'K angle deficit'} (viewer colour "
-            "map, range clipped at 2 % each end; the panel shows min/max and a histogram)",
-            m, field=fld))
+        figs.append(
+            ctx.shot_or_render(
+                f"uniform_{name}_{fld}",
+                f"{name}: {'H uniform' if fld == 'uniform' else 'K angle deficit'} (viewer colour "
+                "map, range clipped at 2 % each end; the panel shows min/max and a histogram)",
+                m,
+                field=fld,
+            )
+        )
         ctx.progress.step(f"map {name} {fld}")
     sec.figs(figs)
 
@@ -950,29 +1040,83 @@ def _section_helicoid(ctx: _Ctx, sec: _Section) -> None:
         "The closed forms below are the textbook ones for c = 1: E = 1, F = 0, G = 1 + u², "
         "e = g = 0, f = −1/√(1+u²), K = −1/(1+u²)², κ = ±1/(1+u²), κₙ(θ) = −sin 2θ at u = 0."
     )
-    exact = {"E": 1.0, "F": 0.0, "G": 1.0, "e": 0.0, "f": -1.0, "g": 0.0, "K": -1.0, "H": 0.0,
-             "k1": 1.0, "k2": -1.0}
+    exact = {
+        "E": 1.0,
+        "F": 0.0,
+        "G": 1.0,
+        "e": 0.0,
+        "f": -1.0,
+        "g": 0.0,
+        "K": -1.0,
+        "H": 0.0,
+        "k1": 1.0,
+        "k2": -1.0,
+    }
     rows = [[k, getattr(geo, k), exact[k], abs(getattr(geo, k) - exact[k])] for k in exact]
-    rows += [["theta_max (deg)", math.degrees(geo.theta_max), 135.0,
-              abs(math.degrees(geo.theta_max) - 135.0)],
-             ["theta_min (deg)", math.degrees(geo.theta_min), 45.0,
-              abs(math.degrees(geo.theta_min) - 45.0)]]
-    sec.add(ctx.table("helicoid_origin",
-                      "First and second fundamental forms and curvatures of the helicoid at the "
-                      "origin (do Carmo's sign), computed against the closed forms.",
-                      ["quantity", "computed", "closed_form", "abs_difference"], rows))
+    rows += [
+        [
+            "theta_max (deg)",
+            math.degrees(geo.theta_max),
+            135.0,
+            abs(math.degrees(geo.theta_max) - 135.0),
+        ],
+        [
+            "theta_min (deg)",
+            math.degrees(geo.theta_min),
+            45.0,
+            abs(math.degrees(geo.theta_min) - 45.0),
+        ],
+    ]
+    sec.add(
+        ctx.table(
+            "helicoid_origin",
+            "First and second fundamental forms and curvatures of the helicoid at the "
+            "origin (do Carmo's sign), computed against the closed forms.",
+            ["quantity", "computed", "closed_form", "abs_difference"],
+            rows,
+        )
+    )
     theta, kn = surfaces.normal_curvature_curve("helicoid", 0.0, 0.0, 721)
     dev = float(np.abs(kn + np.sin(2 * theta)).max())
     pts = []
     for u, v in ((0.0, 0.0), (0.5, 1.0), (1.0, 2.0)):
         g = surfaces.point_geometry("helicoid", u, v)
         k_exact = 1.0 / (1.0 + u * u)
-        pts.append([u, v, g.k1, g.k2, k_exact, -k_exact, g.K, -1.0 / (1 + u * u) ** 2, g.H,
-                    -g.H, g.classification])
-    sec.add(ctx.table("helicoid_principal",
-                      "Principal curvatures along the helicoid (κ₁ ≥ κ₂; H_core = −H_surfaces).",
-                      ["u", "v", "k1", "k2", "k1_exact", "k2_exact", "K", "K_exact",
-                       "H_surfaces", "H_core_sign", "classification"], pts))
+        pts.append(
+            [
+                u,
+                v,
+                g.k1,
+                g.k2,
+                k_exact,
+                -k_exact,
+                g.K,
+                -1.0 / (1 + u * u) ** 2,
+                g.H,
+                -g.H,
+                g.classification,
+            ]
+        )
+    sec.add(
+        ctx.table(
+            "helicoid_principal",
+            "Principal curvatures along the helicoid (κ₁ ≥ κ₂; H_core = −H_surfaces).",
+            [
+                "u",
+                "v",
+                "k1",
+                "k2",
+                "k1_exact",
+                "k2_exact",
+                "K",
+                "K_exact",
+                "H_surfaces",
+                "H_core_sign",
+                "classification",
+            ],
+            pts,
+        )
+    )
     sec.p(
         f"Measured: at the origin the point is {geo.classification} with κ₁ = {_num(geo.k1)} "
         f"at θ = {math.degrees(geo.theta_max):.1f}° and κ₂ = {_num(geo.k2)} at "
@@ -982,25 +1126,36 @@ def _section_helicoid(ctx: _Ctx, sec: _Section) -> None:
     path = ctx.fig_dir / "helicoid_kn.png"
     surfaces.plot_normal_curvature("helicoid", 0.0, 0.0, path)
     ctx.figures.append(path)
-    f1 = _Fig(ctx.rel(path), "Normal curvature κₙ(θ) of the helicoid at the origin, with κ₁, "
-              "κ₂ and their directions (do Carmo's sign).")
+    f1 = _Fig(
+        ctx.rel(path),
+        "Normal curvature κₙ(θ) of the helicoid at the origin, with κ₁, "
+        "κ₂ and their directions (do Carmo's sign).",
+    )
     ctx.progress.step("helicoid at the origin")
-    f2 = ctx.shot("helicoid_viewer", "The viewer's surfaces panel: the helicoid and the point "
-                  "(u, v) = (0, 0) with I, II, K, H (do Carmo's sign) and κₙ(θ).",
-                  panel="surfaces")
+    f2 = ctx.shot(
+        "helicoid_viewer",
+        "The viewer's surfaces panel: the helicoid and the point "
+        "(u, v) = (0, 0) with I, II, K, H (do Carmo's sign) and κₙ(θ).",
+        panel="surfaces",
+    )
     ctx.progress.step("screenshot")
     sec.figs([f1, f2])
     if f2 is None:
         sec.note(f"No viewer screenshot of the surfaces panel: {ctx.screenshot_reason}.")
 
     if ctx.quick:
-        plan = [("helicoid", "grid", (8, 16, 32)), ("sphere", "icosphere", (1, 2, 3, 4)),
-                ("torus", "grid", (8, 16, 32))]
+        plan = [
+            ("helicoid", "grid", (8, 16, 32)),
+            ("sphere", "icosphere", (1, 2, 3, 4)),
+            ("torus", "grid", (8, 16, 32)),
+        ]
     else:
-        plan = [("helicoid", "grid", (8, 16, 32, 64, 128)),
-                ("sphere", "icosphere", (1, 2, 3, 4, 5)),
-                ("sphere", "grid", (8, 16, 32, 64, 128)),
-                ("torus", "grid", (8, 16, 32, 64, 128))]
+        plan = [
+            ("helicoid", "grid", (8, 16, 32, 64, 128)),
+            ("sphere", "icosphere", (1, 2, 3, 4, 5)),
+            ("sphere", "grid", (8, 16, 32, 64, 128)),
+            ("torus", "grid", (8, 16, 32, 64, 128)),
+        ]
     studies = []
     for surf, mesher, res in plan:
         studies.append(surfaces.convergence_study(surf, res, mesher))
@@ -1009,9 +1164,20 @@ def _section_helicoid(ctx: _Ctx, sec: _Section) -> None:
     for st in studies:
         for est, d in st.errors.items():
             for i, r in enumerate(st.resolutions):
-                rows.append([st.surface, st.mesher, r, st.n_vertices[i], st.h[i], est,
-                             d["max"][i], d["order_max"][i - 1] if i else None, d["mean"][i],
-                             d["order_mean"][i - 1] if i else None])
+                rows.append(
+                    [
+                        st.surface,
+                        st.mesher,
+                        r,
+                        st.n_vertices[i],
+                        st.h[i],
+                        est,
+                        d["max"][i],
+                        d["order_max"][i - 1] if i else None,
+                        d["mean"][i],
+                        d["order_mean"][i - 1] if i else None,
+                    ]
+                )
     sec.p(
         "Convergence: meshes of the parameter rectangle (`grid`) or subdivided icospheres, "
         "errors |discrete − exact| over interior vertices, with the exact H taken in the core's "
@@ -1022,17 +1188,58 @@ def _section_helicoid(ctx: _Ctx, sec: _Section) -> None:
     summary = []
     for st in studies:
         for est, d in st.errors.items():
-            summary.append([st.surface, st.mesher, est, f"{st.resolutions[0]}…{st.resolutions[-1]}",
-                            d["max"][0], d["max"][-1], d["order_max"][-1], d["mean"][-1],
-                            d["order_mean"][-1]])
-    sec.add(ctx.table("convergence_summary", "Coarsest and finest level of each study, with "
-                      "the observed order between the two finest levels.",
-                      ["surface", "mesher", "estimator", "levels", "max_error_coarsest",
-                       "max_error_finest", "order_max_finest", "mean_error_finest",
-                       "order_mean_finest"], summary))
-    sec.add(ctx.table("convergence", "Every level of every study.",
-                      ["surface", "mesher", "res", "vertices", "h", "estimator", "max_error",
-                       "order_max", "mean_error", "order_mean"], rows, max_rows=0))
+            summary.append(
+                [
+                    st.surface,
+                    st.mesher,
+                    est,
+                    f"{st.resolutions[0]}…{st.resolutions[-1]}",
+                    d["max"][0],
+                    d["max"][-1],
+                    d["order_max"][-1],
+                    d["mean"][-1],
+                    d["order_mean"][-1],
+                ]
+            )
+    sec.add(
+        ctx.table(
+            "convergence_summary",
+            "Coarsest and finest level of each study, with "
+            "the observed order between the two finest levels.",
+            [
+                "surface",
+                "mesher",
+                "estimator",
+                "levels",
+                "max_error_coarsest",
+                "max_error_finest",
+                "order_max_finest",
+                "mean_error_finest",
+                "order_mean_finest",
+            ],
+            summary,
+        )
+    )
+    sec.add(
+        ctx.table(
+            "convergence",
+            "Every level of every study.",
+            [
+                "surface",
+                "mesher",
+                "res",
+                "vertices",
+                "h",
+                "estimator",
+                "max_error",
+                "order_max",
+                "mean_error",
+                "order_mean",
+            ],
+            rows,
+            max_rows=0,
+        )
+    )
     finals = []
     for st in studies:
         for est, d in st.errors.items():
@@ -1044,8 +1251,8 @@ def _section_helicoid(ctx: _Ctx, sec: _Section) -> None:
         "Read off the table (finest pair of levels): converging with order > 1.5: "
         + (", ".join(f"{s} {m}: {e} (order {o:.2f})" for s, m, e, _, o in conv) or "none")
         + ". Stalling (|order| < 0.3): "
-        + (", ".join(f"{s} {m}: {e} (max error {_num(x)})" for s, m, e, x, _ in stall)
-           or "none") + "."
+        + (", ".join(f"{s} {m}: {e} (max error {_num(x)})" for s, m, e, x, _ in stall) or "none")
+        + "."
     )
     from matplotlib.ticker import NullFormatter
 
@@ -1063,8 +1270,16 @@ def _section_helicoid(ctx: _Ctx, sec: _Section) -> None:
             ax.set_ylabel("max |discrete − exact|")
             ax.legend(fontsize=7)
     fig.tight_layout()
-    sec.figs([ctx.save_fig(fig, "convergence", "Max error of each estimator against h "
-                           "(log-log). A slope of 2 is second-order convergence.")])
+    sec.figs(
+        [
+            ctx.save_fig(
+                fig,
+                "convergence",
+                "Max error of each estimator against h "
+                "(log-log). A slope of 2 is second-order convergence.",
+            )
+        ]
+    )
 
 
 # --------------------------------------------------------------------------------------------
@@ -1086,19 +1301,31 @@ def _section_cotan(ctx: _Ctx, sec: _Section) -> None:
         f = curvature.curvature_fields(m.V, m.F)
         fields[name] = f
         bnd = topology.boundary_vertex_mask(m.F, len(m.V))
-        for key, label in (("uniform", "H uniform"), ("cotan", "H cotan"),
-                           ("difference", "H uniform − H cotan")):
+        for key, label in (
+            ("uniform", "H uniform"),
+            ("cotan", "H cotan"),
+            ("difference", "H uniform − H cotan"),
+        ):
             rows.append([name, label, "all", *_stats_row(f[key])])
             rows.append([name, label, "interior", *_stats_row(f[key][~bnd])])
     ctx.progress.step("fields")
-    sec.add(ctx.table("cotan_uniform_ranges", "Value ranges of both estimators and of their "
-                      "difference.", ["mesh", "field", "vertices", *STAT_COLUMNS], rows))
+    sec.add(
+        ctx.table(
+            "cotan_uniform_ranges",
+            "Value ranges of both estimators and of their difference.",
+            ["mesh", "field", "vertices", *STAT_COLUMNS],
+            rows,
+        )
+    )
     m = ctx.mesh("lilium_s")
     f = fields["lilium_s"]
     bnd = topology.boundary_vertex_mask(m.F, len(m.V))
     inner = ~bnd
-    r = float(np.corrcoef(f["uniform"][inner], f["cotan"][inner])[0, 1]) if inner.sum() > 2 \
+    r = (
+        float(np.corrcoef(f["uniform"][inner], f["cotan"][inner])[0, 1])
+        if inner.sum() > 2
         else float("nan")
+    )
     # scaling: a curvature scales like 1/length; the uniform H scales like length
     s = 2.0
     f2 = curvature.curvature_fields(m.V * s, m.F)
@@ -1108,11 +1335,16 @@ def _section_cotan(ctx: _Ctx, sec: _Section) -> None:
         b = float(np.median(np.abs(f2[key][inner])))
         expect = 1.0 / s if key != "gaussian" else 1.0 / s**2
         scale_rows.append([label, a, b, b / a if a else float("nan"), expect])
-    sec.add(ctx.table("cotan_scaling", f"Median |value| over interior vertices of lilium_s "
-                      f"before and after scaling the mesh by {s:g} (a curvature must scale by "
-                      "1/s, K by 1/s²).",
-                      ["estimator", "median_abs_s1", "median_abs_s2", "ratio",
-                       "expected_for_a_curvature"], scale_rows))
+    sec.add(
+        ctx.table(
+            "cotan_scaling",
+            f"Median |value| over interior vertices of lilium_s "
+            f"before and after scaling the mesh by {s:g} (a curvature must scale by "
+            "1/s, K by 1/s²).",
+            ["estimator", "median_abs_s1", "median_abs_s2", "ratio", "expected_for_a_curvature"],
+            scale_rows,
+        )
+    )
     cot_ratio, uni_ratio = scale_rows[0][3], scale_rows[1][3]
     sec.p(
         f"Measured on lilium_s (interior vertices): the two estimators are correlated "
@@ -1124,15 +1356,17 @@ def _section_cotan(ctx: _Ctx, sec: _Section) -> None:
         "times the true H), a shape indicator rather than a curvature estimate."
     )
     fig = _new_figure(13.0, 3.8)
-    for j, (key, c) in enumerate((("uniform", "tab:blue"), ("cotan", "tab:red"),
-                                  ("difference", "tab:purple"))):
+    for j, (key, c) in enumerate(
+        (("uniform", "tab:blue"), ("cotan", "tab:red"), ("difference", "tab:purple"))
+    ):
         ax = fig.add_subplot(1, 4, j + 1)
         v = f[key][inner]
         lo, hi = np.percentile(v, [1, 99])
         ax.hist(np.clip(v, lo, hi), bins=60, color=c)
         ax.set_yscale("log")
-        ax.set_title(f"lilium_s interior: {'H ' + key if key != 'difference' else 'H_u − H_c'}",
-                     fontsize=9)
+        ax.set_title(
+            f"lilium_s interior: {'H ' + key if key != 'difference' else 'H_u − H_c'}", fontsize=9
+        )
         ax.tick_params(labelsize=7)
     ax = fig.add_subplot(1, 4, 4)
     lim = np.percentile(np.abs(f["cotan"][inner]), 99)
@@ -1145,21 +1379,36 @@ def _section_cotan(ctx: _Ctx, sec: _Section) -> None:
     ax.grid(alpha=0.3)
     fig.tight_layout()
     agree = float(np.mean(np.sign(f["uniform"][inner]) == np.sign(f["cotan"][inner])))
-    sec.figs([ctx.save_fig(fig, "cotan_histograms", "Histograms over the interior vertices "
-                           "(log counts, values clipped to p01..p99; note the different x "
-                           "scales) and uniform against cotangent H per vertex: the sign agrees "
-                           f"at {100 * agree:.0f} % of the interior vertices.")])
+    sec.figs(
+        [
+            ctx.save_fig(
+                fig,
+                "cotan_histograms",
+                "Histograms over the interior vertices "
+                "(log counts, values clipped to p01..p99; note the different x "
+                "scales) and uniform against cotangent H per vertex: the sign agrees "
+                f"at {100 * agree:.0f} % of the interior vertices.",
+            )
+        ]
+    )
     ctx.progress.step("histograms")
     figs = []
-    for fld, label in (("uniform", "H uniform"), ("cotan", "H cotan"),
-                       ("difference", "H uniform − H cotan")):
-        figs.append(ctx.shot_or_render(f"cotan_lilium_{fld}", f"lilium_s: {label}", m,
-                                       field=fld))
+    for fld, label in (
+        ("uniform", "H uniform"),
+        ("cotan", "H cotan"),
+        ("difference", "H uniform − H cotan"),
+    ):
+        figs.append(ctx.shot_or_render(f"cotan_lilium_{fld}", f"lilium_s: {label}", m, field=fld))
         ctx.progress.step(f"map {fld}")
     sec.figs(figs)
     ratio = scale_rows[0][1] / scale_rows[1][1] if scale_rows[1][1] else float("inf")
-    dom = ("dominated by −H_cotan" if ratio > 5 else "dominated by H_uniform" if ratio < 0.2
-           else "a mix of both")
+    dom = (
+        "dominated by −H_cotan"
+        if ratio > 5
+        else "dominated by H_uniform"
+        if ratio < 0.2
+        else "a mix of both"
+    )
     sec.p(
         "Each map has its own colour range (symmetric about 0, clipped at 2 % each end), so "
         "the patterns can be compared side by side although the magnitudes differ: median "
@@ -1221,8 +1470,18 @@ def _section_spectral(ctx: _Ctx, sec: _Section) -> None:
         t0 = time.perf_counter()
         b = spectral.SpectralBasis.compute(V, F, k, cache=False)
         sec_k = time.perf_counter() - t0
-        solves.append([m.name, n, k, b.info.method, sec_k, b.info.timings.get("eigensolve"),
-                       b.info.max_residual, float(b.eigenvalues[-1])])
+        solves.append(
+            [
+                m.name,
+                n,
+                k,
+                b.info.method,
+                sec_k,
+                b.info.timings.get("eigensolve"),
+                b.info.max_residual,
+                float(b.eigenvalues[-1]),
+            ]
+        )
         basis = b
     assert basis is not None
     if not ctx.quick:
@@ -1234,9 +1493,18 @@ def _section_spectral(ctx: _Ctx, sec: _Section) -> None:
                 ctx.progress.step(f"eigen-solve armadillo_igl k={k}")
                 t0 = time.perf_counter()
                 b2 = spectral.SpectralBasis.compute(mb.V, mb.F, k, cache=False)
-                solves.append(["armadillo_igl", len(mb.V), k, b2.info.method,
-                               time.perf_counter() - t0, b2.info.timings.get("eigensolve"),
-                               b2.info.max_residual, float(b2.eigenvalues[-1])])
+                solves.append(
+                    [
+                        "armadillo_igl",
+                        len(mb.V),
+                        k,
+                        b2.info.method,
+                        time.perf_counter() - t0,
+                        b2.info.timings.get("eigensolve"),
+                        b2.info.max_residual,
+                        float(b2.eigenvalues[-1]),
+                    ]
+                )
                 del b2
     err = basis.errors(k_max=kmax)
     diag = err.diagonal
@@ -1247,34 +1515,71 @@ def _section_spectral(ctx: _Ctx, sec: _Section) -> None:
     ctx.progress.step("errors for every k")
     rows = []
     for k in ks:
-        rows.append([k, float(basis.eigenvalues[k - 1]), err.mean[k] / diag, err.max[k] / diag,
-                     err.rms[k] / diag, float(nomass[sample.index(k)]),
-                     float(wrong[sample.index(k)])])
-    sec.add(ctx.table("spectral_errors",
-                      "Reconstruction error per k, relative to the bounding-box diagonal "
-                      f"({_num(diag)}). The last two columns are the wrong-inner-product bug "
-                      "in its two forms (see below).",
-                      ["k", "lambda_k", "mean_error", "max_error", "rms_error",
-                       "rms_error_no_mass", "rms_error_unit_vectors"], rows))
+        rows.append(
+            [
+                k,
+                float(basis.eigenvalues[k - 1]),
+                err.mean[k] / diag,
+                err.max[k] / diag,
+                err.rms[k] / diag,
+                float(nomass[sample.index(k)]),
+                float(wrong[sample.index(k)]),
+            ]
+        )
+    sec.add(
+        ctx.table(
+            "spectral_errors",
+            "Reconstruction error per k, relative to the bounding-box diagonal "
+            f"({_num(diag)}). The last two columns are the wrong-inner-product bug "
+            "in its two forms (see below).",
+            [
+                "k",
+                "lambda_k",
+                "mean_error",
+                "max_error",
+                "rms_error",
+                "rms_error_no_mass",
+                "rms_error_unit_vectors",
+            ],
+            rows,
+        )
+    )
     course_fast, course_slow = COURSE_EIGEN_SECONDS
     solve_rows = [[*r, course_fast / r[4], course_slow / r[4]] for r in solves]
-    sec.add(ctx.table("spectral_timings",
-                      "Eigen-solve wall-clock times (from scratch, this machine, shared with "
-                      "other jobs), and how many times faster than the course report's 388 s "
-                      "and 5,771 s.",
-                      ["mesh", "vertices", "k", "method", "seconds", "eigensolve_seconds",
-                       "max_residual", "lambda_max", "speedup_vs_388s", "speedup_vs_5771s"],
-                      solve_rows))
+    sec.add(
+        ctx.table(
+            "spectral_timings",
+            "Eigen-solve wall-clock times (from scratch, this machine, shared with "
+            "other jobs), and how many times faster than the course report's 388 s "
+            "and 5,771 s.",
+            [
+                "mesh",
+                "vertices",
+                "k",
+                "method",
+                "seconds",
+                "eigensolve_seconds",
+                "max_residual",
+                "lambda_max",
+                "speedup_vs_388s",
+                "speedup_vs_5771s",
+            ],
+            solve_rows,
+        )
+    )
     k5, k100 = ks[0], (100 if 100 in ks else kmax)
     e5, e100 = err.rms[k5] / diag, err.rms[k100] / diag
     w5, w100 = wrong[sample.index(k5)], wrong[sample.index(k100)]
     n5, n100 = nomass[sample.index(k5)], nomass[sample.index(k100)]
     n_change = 100.0 * abs(n100 - n5) / n5 if n5 else float("nan")
     # the area-weighted L2 error of an M-orthogonal projection can only decrease with k
-    mono = bool(np.all(np.diff(err.l2[1:kmax + 1]) <= 1e-9 * diag))
-    mono_txt = (f"its area-weighted L² error never increases with k (checked for every k up "
-                f"to {kmax}, as an M-orthogonal projection must)" if mono else
-                "its area-weighted L² error is NOT monotone in k (unexpected: check the solver)")
+    mono = bool(np.all(np.diff(err.l2[1 : kmax + 1]) <= 1e-9 * diag))
+    mono_txt = (
+        f"its area-weighted L² error never increases with k (checked for every k up "
+        f"to {kmax}, as an M-orthogonal projection must)"
+        if mono
+        else "its area-weighted L² error is NOT monotone in k (unexpected: check the solver)"
+    )
     wrong_min_k = sample[int(np.argmin(wrong))]
     slow = max(solves, key=lambda r: r[4])
     sec.p(
@@ -1298,8 +1603,11 @@ def _section_spectral(ctx: _Ctx, sec: _Section) -> None:
         f"(a) With the solver's M-orthonormal vectors and no M, the error is {_num(n5)} "
         f"diagonals at k = {k5} and {_num(n100)} at k = {k100}: it changes by only "
         f"{n_change:.1f} %"
-        + (" — the course's symptom of an error that barely moves from k = 5 to 100"
-           if n_change < 25 else "")
+        + (
+            " — the course's symptom of an error that barely moves from k = 5 to 100"
+            if n_change < 25
+            else ""
+        )
         + " (the reconstruction is scaled by about 1/(vertex area) and lands far from the "
         f"mesh). (b) With each eigenvector scaled to unit length (what a general eigensolver "
         f"for M⁻¹C returns), the error goes from {_num(w5)} to {_num(w100)} "
@@ -1313,10 +1621,17 @@ def _section_spectral(ctx: _Ctx, sec: _Section) -> None:
     ax = fig.add_subplot(1, 2, 1)
     kk = np.arange(1, kmax + 1)
     ax.loglog(kk, err.rms[1:] / diag, "-", color="tab:green", label="(c) with M (ours)")
-    ax.loglog(sample, wrong, "o--", ms=3, color="tab:red",
-              label="(b) no M, unit-length eigenvectors")
-    ax.loglog(sample, nomass, "s--", ms=3, color="tab:purple",
-              label="(a) no M, M-orthonormal eigenvectors")
+    ax.loglog(
+        sample, wrong, "o--", ms=3, color="tab:red", label="(b) no M, unit-length eigenvectors"
+    )
+    ax.loglog(
+        sample,
+        nomass,
+        "s--",
+        ms=3,
+        color="tab:purple",
+        label="(a) no M, M-orthonormal eigenvectors",
+    )
     ax.loglog(kk, err.max[1:] / diag, ":", color="tab:green", alpha=0.7, label="max error, M")
     for k in ks:
         ax.axvline(k, color="0.85", lw=0.8, zorder=0)
@@ -1326,17 +1641,23 @@ def _section_spectral(ctx: _Ctx, sec: _Section) -> None:
     ax.legend(fontsize=7)
     ax.grid(alpha=0.3, which="both")
     ax = fig.add_subplot(1, 2, 2)
-    ax.semilogy(np.arange(1, kmax + 1), np.maximum(basis.eigenvalues[:kmax], 1e-12), ".",
-                ms=2)
+    ax.semilogy(np.arange(1, kmax + 1), np.maximum(basis.eigenvalues[:kmax], 1e-12), ".", ms=2)
     ax.set_xlabel("index i")
     ax.set_ylabel("λ_i (frequency of −Δ)")
     ax.set_title("spectrum", fontsize=10)
     ax.grid(alpha=0.3)
     fig.tight_layout()
-    sec.figs([ctx.save_fig(fig, "spectral_error_vs_k",
-                           "Left: RMS reconstruction error with the M inner product (solid; "
-                           "dotted: max error) and with the two forms of the Euclidean-inner-"
-                           "product bug (dashed). Right: the eigenvalues.")])
+    sec.figs(
+        [
+            ctx.save_fig(
+                fig,
+                "spectral_error_vs_k",
+                "Left: RMS reconstruction error with the M inner product (solid; "
+                "dotted: max error) and with the two forms of the Euclidean-inner-"
+                "product bug (dashed). Right: the eigenvalues.",
+            )
+        ]
+    )
     fig = _new_figure(10.0, 3.6)
     ax = fig.add_subplot(1, 1, 1)
     errs = {k: basis.vertex_error(k) / diag for k in ks}
@@ -1351,27 +1672,63 @@ def _section_spectral(ctx: _Ctx, sec: _Section) -> None:
     ax.set_title("per-vertex reconstruction error", fontsize=10)
     fig.tight_layout()
     meds = "; ".join(f"k = {k}: {_num(float(np.median(errs[k])))}" for k in ks)
-    sec.figs([ctx.save_fig(fig, "spectral_error_histograms",
-                           "Histograms of the per-vertex error |x − x̂| / diagonal (log scale). "
-                           f"Median per k: {meds}.")])
+    sec.figs(
+        [
+            ctx.save_fig(
+                fig,
+                "spectral_error_histograms",
+                "Histograms of the per-vertex error |x − x̂| / diagonal (log scale). "
+                f"Median per k: {meds}.",
+            )
+        ]
+    )
     ctx.progress.step("plots")
     shot_ks = [ks[0], ks[-1]] if ctx.quick else [k for k in ks if k in (5, 15, 50, 100, 500)]
-    figs = [] if ctx.quick else [ctx.shot_or_render(
-        "spectral_original", f"{m.name}: original, coloured by cotangent H", m)]
+    figs = (
+        []
+        if ctx.quick
+        else [
+            ctx.shot_or_render(
+                "spectral_original", f"{m.name}: original, coloured by cotangent H", m
+            )
+        ]
+    )
     for k in shot_ks:
         R = basis.reconstruct(k)
-        figs.append(ctx.shot_or_render(
-            f"spectral_k{k}", f"reconstruction from k = {k} eigenvectors (coloured by its "
-            "cotangent H)", V=R, F=F, label=f"{m.name}_k{k}"))
+        figs.append(
+            ctx.shot_or_render(
+                f"spectral_k{k}",
+                f"reconstruction from k = {k} eigenvectors (coloured by its cotangent H)",
+                V=R,
+                F=F,
+                label=f"{m.name}_k{k}",
+            )
+        )
         ctx.progress.step(f"picture k={k}")
     sec.figs(figs)
     vmax = float(np.percentile(errs[shot_ks[0]], 99))
     vmin = max(float(np.percentile(errs[shot_ks[-1]], 1)), vmax * 1e-4)
-    fig = _map_row([(f"k = {k}", errs[k]) for k in shot_ks], V, F, vmax, "error / diagonal",
-                   vmin=vmin, log=True)
-    sec.figs([ctx.save_fig(fig, "spectral_error_maps", "Per-vertex error |x − x̂| / diagonal "
-                           f"drawn on the original {m.name} (one logarithmic colour scale for "
-                           "all k).", "render")])
+    fig = _map_row(
+        [(f"k = {k}", errs[k]) for k in shot_ks],
+        V,
+        F,
+        vmax,
+        "error / diagonal",
+        vmin=vmin,
+        log=True,
+    )
+    sec.figs(
+        [
+            ctx.save_fig(
+                fig,
+                "spectral_error_maps",
+                "Per-vertex error |x − x̂| / diagonal "
+                f"drawn on the original {m.name} (one logarithmic colour scale for "
+                "all k).",
+                "render",
+            )
+        ]
+    )
 
 
 # --------------------------------------------------------------------------------------------
@@ -1385,8 +1742,11 @@ def _lam_grid(ctx: _Ctx, lap: str, method: str, limit: float) -> list[float]:
     ends above the limit (1.1× and 2×) on purpose."""
     if method == "explicit":
         if lap == "uniform":
-            return [0.5, 1.0, round(1.1 * limit, 3), round(2.0 * limit, 3)] if ctx.quick else \
-                [0.25, 0.5, 1.0, round(1.1 * limit, 3), round(2.0 * limit, 3)]
+            return (
+                [0.5, 1.0, round(1.1 * limit, 3), round(2.0 * limit, 3)]
+                if ctx.quick
+                else [0.25, 0.5, 1.0, round(1.1 * limit, 3), round(2.0 * limit, 3)]
+            )
         fr = (0.5, 0.9, 1.1, 2.0) if ctx.quick else (0.25, 0.5, 0.9, 1.1, 2.0)
         return [f * limit for f in fr]
     if lap == "uniform":
@@ -1425,8 +1785,9 @@ def _section_smoothing(ctx: _Ctx, sec: _Section) -> None:
             for method in ("explicit", "implicit"):
                 for lam in _lam_grid(ctx, lap, method, limit):
                     gain = float(smoothing.amplification_curve(method, lam, [mu_min])[0])
-                    radius = float(np.abs(smoothing.amplification_curve(method, lam,
-                                                                        mu_grid)).max())
+                    radius = float(
+                        np.abs(smoothing.amplification_curve(method, lam, mu_grid)).max()
+                    )
                     stable = abs(gain) <= 1.0 + 1e-12
                     with warnings.catch_warnings():
                         warnings.simplefilter("ignore", MeshWarning)
@@ -1435,27 +1796,67 @@ def _section_smoothing(ctx: _Ctx, sec: _Section) -> None:
                     s.run(iters)
                     dt = time.perf_counter() - t0
                     last = s.history[-1]
-                    rows.append([
-                        name, lap, method, lam, lam / limit, mu_min, limit, gain, radius,
-                        stable, s.iteration,
-                        s.diverged, last["drift_rms"], last["volume_change_pct"],
-                        1e3 * dt / max(s.iteration, 1),
-                    ])
+                    rows.append(
+                        [
+                            name,
+                            lap,
+                            method,
+                            lam,
+                            lam / limit,
+                            mu_min,
+                            limit,
+                            gain,
+                            radius,
+                            stable,
+                            s.iteration,
+                            s.diverged,
+                            last["drift_rms"],
+                            last["volume_change_pct"],
+                            1e3 * dt / max(s.iteration, 1),
+                        ]
+                    )
                     hist[(name, lap, method, lam)] = s.history
                     if not s.diverged:
-                        shots.append((name, lap, method, f"{method} {lap} λ = {_num(lam)}",
-                                      lam / limit, stable, s.V.copy()))
+                        shots.append(
+                            (
+                                name,
+                                lap,
+                                method,
+                                f"{method} {lap} λ = {_num(lam)}",
+                                lam / limit,
+                                stable,
+                                s.V.copy(),
+                            )
+                        )
                 ctx.progress.step(f"{name} {lap} {method}")
-    sec.add(ctx.table(
-        "smoothing_stability",
-        "Stability numbers and the state after the iterations. μ_min is the most negative "
-        "eigenvalue of L (`smoothing.most_negative_eigenvalue`); high_freq_gain = g(μ_min) "
-        "(`smoothing.amplification_curve`), the factor applied to the highest frequency each "
-        "step; spectral_radius = max |g| over [μ_min, 0]; stable = |g(μ_min)| ≤ 1; "
-        "lam_over_limit = λ / (2/|μ_min|); volume change is undefined (—) on an open mesh.",
-        ["mesh", "laplacian", "method", "lam", "lam_over_limit", "mu_min", "explicit_lam_limit",
-         "high_freq_gain", "spectral_radius", "stable", "iterations", "diverged", "drift_rms",
-         "volume_change_pct", "ms_per_step"], rows))
+    sec.add(
+        ctx.table(
+            "smoothing_stability",
+            "Stability numbers and the state after the iterations. μ_min is the most negative "
+            "eigenvalue of L (`smoothing.most_negative_eigenvalue`); high_freq_gain = g(μ_min) "
+            "(`smoothing.amplification_curve`), the factor applied to the highest frequency each "
+            "step; spectral_radius = max |g| over [μ_min, 0]; stable = |g(μ_min)| ≤ 1; "
+            "lam_over_limit = λ / (2/|μ_min|); volume change is undefined (—) on an open mesh.",
+            [
+                "mesh",
+                "laplacian",
+                "method",
+                "lam",
+                "lam_over_limit",
+                "mu_min",
+                "explicit_lam_limit",
+                "high_freq_gain",
+                "spectral_radius",
+                "stable",
+                "iterations",
+                "diverged",
+                "drift_rms",
+                "volume_change_pct",
+                "ms_per_step",
+            ],
+            rows,
+        )
+    )
     unstable = [r for r in rows if not r[9]]
     div = [r for r in unstable if r[11]]
     div_stable = [r for r in rows if r[9] and r[11]]
@@ -1465,13 +1866,23 @@ def _section_smoothing(ctx: _Ctx, sec: _Section) -> None:
         f"Measured: {len(unstable)} of {len(rows)} runs are predicted unstable "
         f"(|g(μ_min)| > 1), all explicit with λ above 2/|μ_min|; {len(div)} of them blew up "
         f"within {iters} iterations (the stepper stops at the first runaway step: "
-        + (", ".join(f"{r[0]} {r[1]} λ = {_num(r[3])} after {r[10]} steps" for r in div[:4])
-           or "none") + ("" if len(div) <= 4 else ", …") + "); "
-        + (f"{len(div_stable)} predicted-stable runs diverged. " if div_stable else
-           "no predicted-stable run diverged. ")
-        + (f"No implicit run diverged, up to λ = {impl_max:.3g}× the explicit limit "
-           "(g = 1/(1 − λμ) lies in (0, 1] for every λ). " if impl_ok else
-           "Some implicit run diverged (unexpected); see the table. ")
+        + (
+            ", ".join(f"{r[0]} {r[1]} λ = {_num(r[3])} after {r[10]} steps" for r in div[:4])
+            or "none"
+        )
+        + ("" if len(div) <= 4 else ", …")
+        + "); "
+        + (
+            f"{len(div_stable)} predicted-stable runs diverged. "
+            if div_stable
+            else "no predicted-stable run diverged. "
+        )
+        + (
+            f"No implicit run diverged, up to λ = {impl_max:.3g}× the explicit limit "
+            "(g = 1/(1 − λμ) lies in (0, 1] for every λ). "
+            if impl_ok
+            else "Some implicit run diverged (unexpected); see the table. "
+        )
         + "Explicit limits 2/|μ_min|: "
         + "; ".join(f"{nm} {lap}: {_num(lim)}" for (nm, lap), lim in limits.items())
         + ". The uniform limit is at least 1 on any mesh (μ_min ≥ −2); the cotangent one has "
@@ -1482,8 +1893,10 @@ def _section_smoothing(ctx: _Ctx, sec: _Section) -> None:
     hist_figs = []
     for name in ("plane_ns", "fandisk_ns"):
         closed = ctx.mesh(name).F is not None and metrics.is_closed(ctx.mesh(name).F)
-        panels = [("drift_rms", "RMS displacement from the input", True),
-                  ("step_rms", "RMS displacement of each step", True)]
+        panels = [
+            ("drift_rms", "RMS displacement from the input", True),
+            ("step_rms", "RMS displacement of each step", True),
+        ]
         if closed:
             panels.append(("volume_change_pct", "volume change %", False))
         fig = _new_figure(4.3 * len(panels), 6.4)
@@ -1496,15 +1909,24 @@ def _section_smoothing(ctx: _Ctx, sec: _Section) -> None:
                     lams = sorted(k[3] for k in runs if k[2] == method)
                     for q, lam in enumerate(lams):
                         h = runs[(name, lap, method, lam)]
-                        pts = [(e["iteration"], e[key]) for e in h
-                               if e[key] is not None and (not logy or e[key] > 0)]
+                        pts = [
+                            (e["iteration"], e[key])
+                            for e in h
+                            if e[key] is not None and (not logy or e[key] > 0)
+                        ]
                         if not pts:
                             continue
                         it, y = zip(*pts, strict=True)
                         colour = mpl.colormaps[cmap](0.35 + 0.6 * q / max(len(lams) - 1, 1))
                         rel = lam / limits[(name, lap)]
-                        ax.plot(it, y, style, color=colour, lw=1.3,
-                                label=f"{method[:4]} λ={_num(lam, 2)} ({rel:.2g}× limit)")
+                        ax.plot(
+                            it,
+                            y,
+                            style,
+                            color=colour,
+                            lw=1.3,
+                            label=f"{method[:4]} λ={_num(lam, 2)} ({rel:.2g}× limit)",
+                        )
                         if rel <= 1.0 or method == "implicit":
                             finite_stable.extend(y)
                 if not logy and finite_stable:
@@ -1520,22 +1942,38 @@ def _section_smoothing(ctx: _Ctx, sec: _Section) -> None:
                 if j == 0:
                     ax.legend(fontsize=5.5, ncol=1)
         fig.tight_layout()
-        hist_figs.append(ctx.save_fig(
-            fig, f"smoothing_history_{name}",
-            f"{name}: per iteration, displacement from the input and of each step (it grows "
-            "where a run is unstable)" + (", and volume change (y range set by the stable runs)"
-                                         if closed else "; volume is undefined on an open mesh")
-            + ". Dashed reds: explicit, solid blues: implicit, darker = larger λ."))
+        hist_figs.append(
+            ctx.save_fig(
+                fig,
+                f"smoothing_history_{name}",
+                f"{name}: per iteration, displacement from the input and of each step (it grows "
+                "where a run is unstable)"
+                + (
+                    ", and volume change (y range set by the stable runs)"
+                    if closed
+                    else "; volume is undefined on an open mesh"
+                )
+                + ". Dashed reds: explicit, solid blues: implicit, darker = larger λ.",
+            )
+        )
     sec.figs(hist_figs)
     mu_min = mus[("fandisk_ns", "uniform")]
     mu = np.linspace(mu_min, 0.0, 400)
     fig = _new_figure(6.5, 3.8)
     ax = fig.add_subplot(1, 1, 1)
-    for method, lam, style in (("explicit", 0.5, "--"), ("explicit", 1.0, "--"),
-                               ("explicit", round(1.1 * 2 / abs(mu_min), 3), "--"),
-                               ("implicit", 1.0, "-"), ("implicit", 10.0, "-")):
-        ax.plot(-mu, smoothing.amplification_curve(method, lam, mu), style,
-                label=f"{method} λ = {lam:g}")
+    for method, lam, style in (
+        ("explicit", 0.5, "--"),
+        ("explicit", 1.0, "--"),
+        ("explicit", round(1.1 * 2 / abs(mu_min), 3), "--"),
+        ("implicit", 1.0, "-"),
+        ("implicit", 10.0, "-"),
+    ):
+        ax.plot(
+            -mu,
+            smoothing.amplification_curve(method, lam, mu),
+            style,
+            label=f"{method} λ = {lam:g}",
+        )
     ax.axhline(1, color="0.5", lw=0.7)
     ax.axhline(-1, color="0.5", lw=0.7)
     ax.set_xlabel("frequency −μ of the uniform Laplacian")
@@ -1544,9 +1982,17 @@ def _section_smoothing(ctx: _Ctx, sec: _Section) -> None:
     ax.legend(fontsize=7)
     ax.grid(alpha=0.3)
     fig.tight_layout()
-    sec.figs([ctx.save_fig(fig, "smoothing_gain", "Gain per step against frequency: outside "
-                           "the band [−1, 1] a mode grows; explicit λ above 2/|μ_min| leaves it "
-                           "at the highest frequencies.")])
+    sec.figs(
+        [
+            ctx.save_fig(
+                fig,
+                "smoothing_gain",
+                "Gain per step against frequency: outside "
+                "the band [−1, 1] a mode grows; explicit λ above 2/|μ_min| leaves it "
+                "at the highest frequencies.",
+            )
+        ]
+    )
     ctx.progress.step("plots")
     # pictures: per mesh and Laplacian, one explicit and one implicit run
     # (quick: fandisk_ns with the uniform Laplacian only)
@@ -1557,18 +2003,26 @@ def _section_smoothing(ctx: _Ctx, sec: _Section) -> None:
             figs.append(ctx.shot_or_render(f"smoothing_{name}_input", f"{name}: input", mesh))
         for lap in ("uniform", "cotan") if not ctx.quick else ("uniform",):
             for meth in ("explicit", "implicit"):
-                c = sorted((s for s in shots if s[0] == name and s[1] == lap and s[2] == meth
-                            and s[5]), key=lambda s: s[4])
+                c = sorted(
+                    (s for s in shots if s[0] == name and s[1] == lap and s[2] == meth and s[5]),
+                    key=lambda s: s[4],
+                )
                 if not c:
                     continue
                 # explicit: the largest stable λ; implicit: the middle of the grid (the largest
                 # flattens and shrinks the mesh beyond recognition)
                 _n, _l, _m, label, ratio, _st, Vs = c[-1] if meth == "explicit" else c[len(c) // 2]
                 key = re.sub(r"[^a-z0-9]+", "_", f"{name}_{meth}_{lap}").strip("_")
-                figs.append(ctx.shot_or_render(
-                    f"smoothing_{key}", f"{name} after {iters} iterations: {label} "
-                    f"({ratio:.3g}× the explicit limit; coloured by cotangent H)", V=Vs,
-                    F=mesh.F, label=f"{name}_{meth}_{lap}_{iters}"))
+                figs.append(
+                    ctx.shot_or_render(
+                        f"smoothing_{key}",
+                        f"{name} after {iters} iterations: {label} "
+                        f"({ratio:.3g}× the explicit limit; coloured by cotangent H)",
+                        V=Vs,
+                        F=mesh.F,
+                        label=f"{name}_{meth}_{lap}_{iters}",
+                    )
+                )
                 ctx.progress.step(f"picture {name} {lap} {meth}")
     sec.figs(figs)
 
@@ -1581,13 +2035,17 @@ def _section_smoothing(ctx: _Ctx, sec: _Section) -> None:
 def _denoise_grid(ctx: _Ctx, lap: str, method: str, limit: float) -> list[float]:
     q = ctx.quick
     if lap == "uniform":
-        fr = {"explicit": (0.1, 0.5, 0.9) if q else (0.1, 0.3, 0.5, 0.9),
-              "implicit": (0.1, 0.3, 1.0) if q else (0.1, 0.3, 1.0, 3.0, 10.0),
-              "taubin": (0.3, 0.6) if q else (0.3, 0.5, 0.7, 0.9)}[method]
+        fr = {
+            "explicit": (0.1, 0.5, 0.9) if q else (0.1, 0.3, 0.5, 0.9),
+            "implicit": (0.1, 0.3, 1.0) if q else (0.1, 0.3, 1.0, 3.0, 10.0),
+            "taubin": (0.3, 0.6) if q else (0.3, 0.5, 0.7, 0.9),
+        }[method]
         return list(fr)
-    fr = {"explicit": (0.3, 0.9) if q else (0.1, 0.3, 0.5, 0.9),
-          "implicit": (1.0, 10.0) if q else (0.3, 1.0, 3.0, 10.0, 100.0),
-          "taubin": (0.5,) if q else (0.3, 0.5, 0.7)}[method]
+    fr = {
+        "explicit": (0.3, 0.9) if q else (0.1, 0.3, 0.5, 0.9),
+        "implicit": (1.0, 10.0) if q else (0.3, 1.0, 3.0, 10.0, 100.0),
+        "taubin": (0.5,) if q else (0.3, 0.5, 0.7),
+    }[method]
     return [f * limit for f in fr]
 
 
@@ -1600,8 +2058,9 @@ def _section_denoising(ctx: _Ctx, sec: _Section) -> None:
     noisy = ctx.mesh("fandisk_ns")
     V0, F = clean.V, clean.F
     if noisy.V.shape != V0.shape or not np.array_equal(noisy.F, F):
-        raise MeshError("fandisk_ns must have the same faces and vertex order as fandisk",
-                        noisy.label)
+        raise MeshError(
+            "fandisk_ns must have the same faces and vertex order as fandisk", noisy.label
+        )
     alphas = (0.002, 0.005) if ctx.quick else (0.001, 0.002, 0.005, 0.01)
     iters = (1, 5, 10, 20) if ctx.quick else (1, 2, 5, 10, 20, 50, 100)
     methods = ("explicit", "implicit") if ctx.quick else ("explicit", "implicit", "taubin")
@@ -1625,20 +2084,46 @@ def _section_denoising(ctx: _Ctx, sec: _Section) -> None:
             limit = 2.0 / abs(mu_min)
             for method in methods:
                 got = smoothing.denoise_sweep(
-                    V0, F, V_noisy=Vn, methods=(method,), laplacians=(lap,),
-                    lams=_denoise_grid(ctx, lap, method, limit), iters=iters,
+                    V0,
+                    F,
+                    V_noisy=Vn,
+                    methods=(method,),
+                    laplacians=(lap,),
+                    lams=_denoise_grid(ctx, lap, method, limit),
+                    iters=iters,
                 )
                 for r in got:
                     r["case"] = label
                     r["lam_over_limit"] = r["lam"] / limit
                 rows.extend(got)
             ctx.progress.step(f"sweep {label} {lap}")
-    cols = ["case", "noise", "method", "laplacian", "lam", "lam_over_limit", "iters", "rmse",
-            "rmse_noisy", "max_error", "volume_change_pct", "volume_change_noisy_pct",
-            "dihedral_mae_deg", "dihedral_mae_noisy_deg", "normal_dev_deg", "stable",
-            "diverged", "seconds"]
-    sweep_tab = ctx.table("denoise_sweep", "Every run of the sweep.", cols,
-                          [[r[c] for c in cols] for r in rows], max_rows=0)
+    cols = [
+        "case",
+        "noise",
+        "method",
+        "laplacian",
+        "lam",
+        "lam_over_limit",
+        "iters",
+        "rmse",
+        "rmse_noisy",
+        "max_error",
+        "volume_change_pct",
+        "volume_change_noisy_pct",
+        "dihedral_mae_deg",
+        "dihedral_mae_noisy_deg",
+        "normal_dev_deg",
+        "stable",
+        "diverged",
+        "seconds",
+    ]
+    sweep_tab = ctx.table(
+        "denoise_sweep",
+        "Every run of the sweep.",
+        cols,
+        [[r[c] for c in cols] for r in rows],
+        max_rows=0,
+    )
     by_case = {label: [r for r in rows if r["case"] == label] for label, _ in cases}
     level = {label: rs[0]["noise"] for label, rs in by_case.items()}
 
@@ -1650,26 +2135,53 @@ def _section_denoising(ctx: _Ctx, sec: _Section) -> None:
         # settings that improve the positions (RMSE below the noisy one) qualify
         improving = [r for r in rs if math.isfinite(r["rmse"]) and r["rmse"] < r["rmse_noisy"]]
         bd = smoothing.best_rows(improving or rs, "dihedral_mae_deg")[0]
-        vol_ok = [r for r in rs if r["volume_change_pct"] is not None
-                  and math.isfinite(r["volume_change_pct"]) and abs(r["volume_change_pct"]) <= 1]
+        vol_ok = [
+            r
+            for r in rs
+            if r["volume_change_pct"] is not None
+            and math.isfinite(r["volume_change_pct"])
+            and abs(r["volume_change_pct"]) <= 1
+        ]
         bv = smoothing.best_rows(vol_ok, "rmse")[0] if vol_ok else None
-        rec_rows.append([
-            label, level[label], b["rmse_noisy"], _config(b), b["rmse"],
-            100 * (1 - b["rmse"] / b["rmse_noisy"]), b["volume_change_pct"], _config(bd),
-            bd["dihedral_mae_deg"], b["dihedral_mae_noisy_deg"],
-            _config(bv) if bv else None, bv["rmse"] if bv else None,
-            bv["volume_change_pct"] if bv else None,
-        ])
+        rec_rows.append(
+            [
+                label,
+                level[label],
+                b["rmse_noisy"],
+                _config(b),
+                b["rmse"],
+                100 * (1 - b["rmse"] / b["rmse_noisy"]),
+                b["volume_change_pct"],
+                _config(bd),
+                bd["dihedral_mae_deg"],
+                b["dihedral_mae_noisy_deg"],
+                _config(bv) if bv else None,
+                bv["rmse"] if bv else None,
+                bv["volume_change_pct"] if bv else None,
+            ]
+        )
     rec_tab = ctx.table(
         "denoise_recommendation",
         "Recommendation per noise level, read off the sweep: the setting with the lowest RMSE, "
         "the one with the lowest dihedral-angle error among those that lower the RMSE, and the "
         "lowest RMSE among settings that change the volume by at most 1 %.",
-        ["case", "noise_level", "rmse_noisy", "best_rmse_setting", "best_rmse",
-         "rmse_reduction_pct", "best_rmse_volume_change_pct", "best_dihedral_setting",
-         "best_dihedral_mae_deg", "noisy_dihedral_mae_deg", "best_rmse_volume_1pct_setting",
-         "best_rmse_volume_1pct", "best_rmse_volume_1pct_change_pct"],
-        rec_rows)
+        [
+            "case",
+            "noise_level",
+            "rmse_noisy",
+            "best_rmse_setting",
+            "best_rmse",
+            "rmse_reduction_pct",
+            "best_rmse_volume_change_pct",
+            "best_dihedral_setting",
+            "best_dihedral_mae_deg",
+            "noisy_dihedral_mae_deg",
+            "best_rmse_volume_1pct_setting",
+            "best_rmse_volume_1pct",
+            "best_rmse_volume_1pct_change_pct",
+        ],
+        rec_rows,
+    )
     per_method = []
     combos = [(lap, m) for lap in ("uniform", "cotan") for m in methods]
     wins: dict[tuple[str, str], int] = dict.fromkeys(combos, 0)
@@ -1680,34 +2192,67 @@ def _section_denoising(ctx: _Ctx, sec: _Section) -> None:
             b = smoothing.best_rows(sub, "rmse")
             if b:
                 best_by[(lap, m)] = b[0]
-                per_method.append([label, level[label], lap, m, b[0]["lam"],
-                                   b[0]["lam_over_limit"], b[0]["iters"], b[0]["rmse"],
-                                   b[0]["rmse_noisy"], b[0]["volume_change_pct"],
-                                   b[0]["dihedral_mae_deg"],
-                                   sum(1 for r in sub if r["diverged"]), len(sub)])
+                per_method.append(
+                    [
+                        label,
+                        level[label],
+                        lap,
+                        m,
+                        b[0]["lam"],
+                        b[0]["lam_over_limit"],
+                        b[0]["iters"],
+                        b[0]["rmse"],
+                        b[0]["rmse_noisy"],
+                        b[0]["volume_change_pct"],
+                        b[0]["dihedral_mae_deg"],
+                        sum(1 for r in sub if r["diverged"]),
+                        len(sub),
+                    ]
+                )
         if best_by:
             wins[min(best_by, key=lambda c: best_by[c]["rmse"])] += 1
     pm_tab = ctx.table(
         "denoise_best_per_method",
         "The best setting (lowest RMSE) of each Laplacian and method at each noise level.",
-        ["case", "noise_level", "laplacian", "method", "lam", "lam_over_limit", "iters", "rmse",
-         "rmse_noisy", "volume_change_pct", "dihedral_mae_deg", "diverged_runs", "runs"],
-        per_method)
+        [
+            "case",
+            "noise_level",
+            "laplacian",
+            "method",
+            "lam",
+            "lam_over_limit",
+            "iters",
+            "rmse",
+            "rmse_noisy",
+            "volume_change_pct",
+            "dihedral_mae_deg",
+            "diverged_runs",
+            "runs",
+        ],
+        per_method,
+    )
     ctx.progress.step("tables")
 
     # sentences generated from the numbers
     n_cases = len(by_case)
     ranking = sorted(wins.items(), key=lambda kv: -kv[1])
     top, top_wins = ranking[0]
-    sec.p("**Recommendation (computed from the table, not written by hand).** " + (
-        f"The lowest RMSE is reached by {top[1]} smoothing with the {top[0]} Laplacian at "
-        f"{top_wins} of {n_cases} noise levels"
-        + (", ".join(f"; {c[1]} {c[0]} at {w}" for c, w in ranking[1:] if w) or "")
-        + ". Per level: "
-        + "; ".join(f"{r[0]} (noise {_num(r[1])}): {r[3]} lowers the RMSE from {_num(r[2])} "
-                    f"to {_num(r[4])} ({r[5]:.0f} % less) with a volume change of "
-                    f"{_pct(r[6]) if r[6] is not None else 'undefined'}"
-                    for r in rec_rows) + "."))
+    sec.p(
+        "**Recommendation (computed from the table, not written by hand).** "
+        + (
+            f"The lowest RMSE is reached by {top[1]} smoothing with the {top[0]} Laplacian at "
+            f"{top_wins} of {n_cases} noise levels"
+            + (", ".join(f"; {c[1]} {c[0]} at {w}" for c, w in ranking[1:] if w) or "")
+            + ". Per level: "
+            + "; ".join(
+                f"{r[0]} (noise {_num(r[1])}): {r[3]} lowers the RMSE from {_num(r[2])} "
+                f"to {_num(r[4])} ({r[5]:.0f} % less) with a volume change of "
+                f"{_pct(r[6]) if r[6] is not None else 'undefined'}"
+                for r in rec_rows
+            )
+            + "."
+        )
+    )
     vol_same = sum(1 for r in rec_rows if r[10] == r[3])
     differ = [r for r in rec_rows if r[7] != r[3]]
     sec.p(
@@ -1729,8 +2274,10 @@ def _section_denoising(ctx: _Ctx, sec: _Section) -> None:
     xs = [level[lab] for lab in synth]
     ax.loglog(xs, [by_case[lab][0]["rmse_noisy"] for lab in synth], "k-o", label="noisy input")
     for lap, m in combos:
-        ys = [next((r[7] for r in per_method if r[0] == lab and r[2] == lap and r[3] == m),
-                   np.nan) for lab in synth]
+        ys = [
+            next((r[7] for r in per_method if r[0] == lab and r[2] == lap and r[3] == m), np.nan)
+            for lab in synth
+        ]
         ax.loglog(xs, ys, "o-" if lap == "uniform" else "s--", ms=4, label=f"{m} {lap}")
     nl = level[noisy.name]
     ax.plot([nl], [by_case[noisy.name][0]["rmse_noisy"]], "k*", ms=12, label=f"{noisy.name}")
@@ -1742,15 +2289,22 @@ def _section_denoising(ctx: _Ctx, sec: _Section) -> None:
     ax = fig.add_subplot(1, 2, 2)
     rs = by_case[noisy.name]
     for lap, m in combos:
-        bpm = next((r for r in per_method if r[0] == noisy.name and r[2] == lap and r[3] == m),
-                   None)
+        bpm = next(
+            (r for r in per_method if r[0] == noisy.name and r[2] == lap and r[3] == m), None
+        )
         if bpm is None:
             continue
-        sub = sorted((r for r in rs if r["laplacian"] == lap and r["method"] == m
-                      and r["lam"] == bpm[4]), key=lambda r: r["iters"])
-        ax.plot([r["iters"] for r in sub], [r["volume_change_pct"] for r in sub],
-                "o-" if lap == "uniform" else "s--", ms=4,
-                label=f"{m} {lap} λ = {_num(bpm[4], 2)}")
+        sub = sorted(
+            (r for r in rs if r["laplacian"] == lap and r["method"] == m and r["lam"] == bpm[4]),
+            key=lambda r: r["iters"],
+        )
+        ax.plot(
+            [r["iters"] for r in sub],
+            [r["volume_change_pct"] for r in sub],
+            "o-" if lap == "uniform" else "s--",
+            ms=4,
+            label=f"{m} {lap} λ = {_num(bpm[4], 2)}",
+        )
     ax.axhline(0, color="0.5", lw=0.7)
     ax.set_xscale("log")
     ax.set_xlabel("iterations")
@@ -1759,22 +2313,39 @@ def _section_denoising(ctx: _Ctx, sec: _Section) -> None:
     ax.legend(fontsize=7)
     ax.grid(alpha=0.3)
     fig.tight_layout()
-    sec.figs([ctx.save_fig(fig, "denoise_rmse_volume",
-                           "Left: the best RMSE each method reaches, against the noise level "
-                           "(the star is the given noisy mesh). Right: volume change against "
-                           "iterations at the λ that gave each method its best RMSE.")])
+    sec.figs(
+        [
+            ctx.save_fig(
+                fig,
+                "denoise_rmse_volume",
+                "Left: the best RMSE each method reaches, against the noise level "
+                "(the star is the given noisy mesh). Right: volume change against "
+                "iterations at the λ that gave each method its best RMSE.",
+            )
+        ]
+    )
 
     # dihedral histograms and error maps on the given noisy mesh
-    best_n = {c: next(r for r in rs if r["laplacian"] == c[0] and r["method"] == c[1]
-                      and r["lam"] == bp[4] and r["iters"] == bp[6])
-              for c in combos for bp in per_method
-              if bp[0] == noisy.name and (bp[2], bp[3]) == c}
+    best_n = {
+        c: next(
+            r
+            for r in rs
+            if r["laplacian"] == c[0]
+            and r["method"] == c[1]
+            and r["lam"] == bp[4]
+            and r["iters"] == bp[6]
+        )
+        for c in combos
+        for bp in per_method
+        if bp[0] == noisy.name and (bp[2], bp[3]) == c
+    }
     sm_V: dict[tuple[str, str], FloatArray] = {}
     for c, r in best_n.items():
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", MeshWarning)
-            sm_V[c] = smoothing.smooth(noisy.V, F, r["method"], r["laplacian"], r["lam"],
-                                       r["iters"], warn=False)
+            sm_V[c] = smoothing.smooth(
+                noisy.V, F, r["method"], r["laplacian"], r["lam"], r["iters"], warn=False
+            )
     adj = metrics.edge_faces(F)
     th_clean = np.degrees(metrics.dihedral_angles(V0, F, adj))
     th_noisy = np.degrees(metrics.dihedral_angles(noisy.V, F, adj))
@@ -1784,25 +2355,42 @@ def _section_denoising(ctx: _Ctx, sec: _Section) -> None:
     hi_d = 5.0 * math.ceil(float(both.max()) / 5.0)
     bins = np.linspace(lo_d, hi_d, max(int((hi_d - lo_d) / 2.5), 10) + 1)
     fig = _new_figure(11.0, 4.0)
-    for j, (title, items) in enumerate((
-        ("input", [("clean", V0), ("noisy", noisy.V)]),
-        ("best setting of each method", [(f"{c[1]} {c[0]}", v) for c, v in sm_V.items()]
-         + [("clean", V0)]),
-    )):
+    for j, (title, items) in enumerate(
+        (
+            ("input", [("clean", V0), ("noisy", noisy.V)]),
+            (
+                "best setting of each method",
+                [(f"{c[1]} {c[0]}", v) for c, v in sm_V.items()] + [("clean", V0)],
+            ),
+        )
+    ):
         ax = fig.add_subplot(1, 2, j + 1)
         for lab, Vx in items:
             th = np.degrees(metrics.dihedral_angles(Vx, F, adj))
-            ax.hist(th[np.isfinite(th)], bins=bins, histtype="step", lw=1.4, label=lab,
-                    color="k" if lab == "clean" else None)
+            ax.hist(
+                th[np.isfinite(th)],
+                bins=bins,
+                histtype="step",
+                lw=1.4,
+                label=lab,
+                color="k" if lab == "clean" else None,
+            )
         ax.set_yscale("log")
         ax.set_xlabel("dihedral angle (degrees; 180 = flat)")
         ax.set_ylabel("edges")
         ax.set_title(f"{noisy.name}: {title}", fontsize=10)
         ax.legend(fontsize=7)
     fig.tight_layout()
-    sec.figs([ctx.save_fig(fig, "denoise_dihedral",
-                           "Dihedral-angle histograms (log counts) of the clean, the noisy and "
-                           "the denoised meshes (each method at its lowest-RMSE setting).")])
+    sec.figs(
+        [
+            ctx.save_fig(
+                fig,
+                "denoise_dihedral",
+                "Dihedral-angle histograms (log counts) of the clean, the noisy and "
+                "the denoised meshes (each method at its lowest-RMSE setting).",
+            )
+        ]
+    )
     sharp = np.abs(th_clean - 180.0) > 30.0
     sharp_v = np.zeros(len(V0), dtype=bool)
     sharp_v[adj.edges[sharp].ravel()] = True
@@ -1819,39 +2407,67 @@ def _section_denoising(ctx: _Ctx, sec: _Section) -> None:
             f"angle is more than 30° from flat ({int(sharp_v.sum())} vertices on them). Mean "
             f"|dihedral − clean| on those edges / on the other edges: noisy "
             f"{_num(edge_err(noisy.V, sharp))}° / {_num(edge_err(noisy.V, ~sharp))}°; "
-            + "; ".join(f"{c[1]} {c[0]} {_num(edge_err(v, sharp))}° / "
-                        f"{_num(edge_err(v, ~sharp))}°" for c, v in sm_V.items())
+            + "; ".join(
+                f"{c[1]} {c[0]} {_num(edge_err(v, sharp))}° / {_num(edge_err(v, ~sharp))}°"
+                for c, v in sm_V.items()
+            )
             + ". Mean position error at vertices on sharp edges / elsewhere: "
             + "; ".join(
                 f"{c[1]} {c[0]} {_num(float(np.linalg.norm(v - V0, axis=1)[sharp_v].mean()))}"
                 f" / {_num(float(np.linalg.norm(v - V0, axis=1)[~sharp_v].mean()))}"
-                for c, v in sm_V.items()) + "."
+                for c, v in sm_V.items()
+            )
+            + "."
         )
     else:
-        sec.p(f"The clean {clean.name} has no sharp edge (every dihedral angle is within 30° "
-              "of flat), so feature preservation cannot be judged on it.")
+        sec.p(
+            f"The clean {clean.name} has no sharp edge (every dihedral angle is within 30° "
+            "of flat), so feature preservation cannot be judged on it."
+        )
     show = [("noisy input", noisy.V)] + [
         (f"{c[1]} {c[0]} ({_config(best_n[c]).split(' ', 2)[2]})", sm_V[c])
-        for c in sorted(sm_V, key=lambda c: best_n[c]["rmse"])[:3]]
+        for c in sorted(sm_V, key=lambda c: best_n[c]["rmse"])[:3]
+    ]
     errs = [np.linalg.norm(Vx - V0, axis=1) for _, Vx in show]
     vmax = float(np.percentile(errs[0], 99))
-    fig = _map_row([(f"{title}\nRMSE {_num(float(np.sqrt(np.mean(e**2))))}", e)
-                    for (title, _Vx), e in zip(show, errs, strict=True)], V0, F, vmax,
-                   "|x − x_clean|")
-    sec.figs([ctx.save_fig(fig, "denoise_error_maps",
-                           f"Per-vertex error against the clean mesh, drawn on the clean "
-                           f"{clean.name} (same colour scale): the noisy input and the three "
-                           "methods with the lowest RMSE, each at its best setting.",
-                           "render")])
+    fig = _map_row(
+        [
+            (f"{title}\nRMSE {_num(float(np.sqrt(np.mean(e**2))))}", e)
+            for (title, _Vx), e in zip(show, errs, strict=True)
+        ],
+        V0,
+        F,
+        vmax,
+        "|x − x_clean|",
+    )
+    sec.figs(
+        [
+            ctx.save_fig(
+                fig,
+                "denoise_error_maps",
+                f"Per-vertex error against the clean mesh, drawn on the clean "
+                f"{clean.name} (same colour scale): the noisy input and the three "
+                "methods with the lowest RMSE, each at its best setting.",
+                "render",
+            )
+        ]
+    )
     ctx.progress.step("plots")
     best_c = min(best_n, key=lambda c: best_n[c]["rmse"])
-    sec.figs([
-        None if ctx.quick else ctx.shot_or_render("denoise_noisy", f"{noisy.name} (input)",
-                                                  noisy),
-        ctx.shot_or_render("denoise_best", f"{noisy.name} denoised with the lowest-RMSE "
-                           f"setting: {_config(best_n[best_c])}", V=sm_V[best_c], F=F,
-                           label=f"{noisy.name}_denoised"),
-    ])
+    sec.figs(
+        [
+            None
+            if ctx.quick
+            else ctx.shot_or_render("denoise_noisy", f"{noisy.name} (input)", noisy),
+            ctx.shot_or_render(
+                "denoise_best",
+                f"{noisy.name} denoised with the lowest-RMSE setting: {_config(best_n[best_c])}",
+                V=sm_V[best_c],
+                F=F,
+                label=f"{noisy.name}_denoised",
+            ),
+        ]
+    )
     ctx.progress.step("pictures")
 
 
@@ -1917,17 +2533,25 @@ def _html_inline(text: str) -> str:
 
 def _html_table(t: _Table) -> list[str]:
     rows = t.rows if t.max_rows is None else t.rows[: t.max_rows]
-    out = [f'<p><em>{_html_inline(t.caption)}</em> (<a href="{html.escape(t.csv)}">CSV</a>, '
-           f"{len(t.rows)} rows)</p>"]
+    out = [
+        f'<p><em>{_html_inline(t.caption)}</em> (<a href="{html.escape(t.csv)}">CSV</a>, '
+        f"{len(t.rows)} rows)</p>"
+    ]
     if rows:
         out.append("<table>")
-        out.append("<thead><tr>" + "".join(f"<th>{html.escape(c)}</th>" for c in t.columns)
-                   + "</tr></thead>")
+        out.append(
+            "<thead><tr>"
+            + "".join(f"<th>{html.escape(c)}</th>" for c in t.columns)
+            + "</tr></thead>"
+        )
         out.append("<tbody>")
         for r in rows:
             cells = "".join(
-                f'<td class="s">{html.escape(_fmt(x))}</td>' if isinstance(x, str)
-                else f"<td>{html.escape(_fmt(x))}</td>" for x in r)
+                f'<td class="s">{html.escape(_fmt(x))}</td>'
+                if isinstance(x, str)
+                else f"<td>{html.escape(_fmt(x))}</td>"
+                for x in r
+            )
             out.append(f"<tr>{cells}</tr>")
         out.append("</tbody></table>")
         if len(rows) < len(t.rows):
@@ -1935,18 +2559,26 @@ def _html_table(t: _Table) -> list[str]:
     return out
 
 
-def _render_html(title: str, head_html: list[str], sections: list[_Section],
-                 timing: _Table) -> str:
-    out = ["<!DOCTYPE html>", '<html lang="en">', "<head>", '<meta charset="utf-8" />',
-           f"<title>{html.escape(title)}</title>", f"<style>{_CSS}</style>", "</head>", "<body>"]
+def _render_html(title: str, head_html: list[str], sections: list[_Section], timing: _Table) -> str:
+    out = [
+        "<!DOCTYPE html>",
+        '<html lang="en">',
+        "<head>",
+        '<meta charset="utf-8" />',
+        f"<title>{html.escape(title)}</title>",
+        f"<style>{_CSS}</style>",
+        "</head>",
+        "<body>",
+    ]
     out += head_html
     for s in sections:
         out.append(f'<section id="{s.key}">')
         out.append(f"<h2>{s.number}. {html.escape(s.title)}</h2>")
         out.append(f"<p><em>Section time: {s.seconds:.1f} s.</em></p>")
         if s.error:
-            out.append(f'<p class="err"><strong>This section failed:</strong> '
-                       f"{html.escape(s.error)}</p>")
+            out.append(
+                f'<p class="err"><strong>This section failed:</strong> {html.escape(s.error)}</p>'
+            )
         for b in s.blocks:
             if isinstance(b, _Para):
                 cls = ' class="note"' if b.kind == "note" else ""
@@ -1958,7 +2590,8 @@ def _render_html(title: str, head_html: list[str], sections: list[_Section],
                     out.append(
                         f'<figure><a href="{html.escape(f.path)}"><img src="{html.escape(f.path)}"'
                         f' alt="{html.escape(f.caption)}" /></a>'
-                        f"<figcaption>{_html_inline(f.caption)}</figcaption></figure>")
+                        f"<figcaption>{_html_inline(f.caption)}</figcaption></figure>"
+                    )
                 out.append("</div>")
             elif isinstance(b, _Table):
                 out += _html_table(b)
@@ -1999,8 +2632,10 @@ def parse_sections(text: str | Sequence[str] | None) -> list[str]:
     for t in items:
         key = SECTIONS[int(t) - 1] if t.isdigit() and 1 <= int(t) <= len(SECTIONS) else t
         if key not in SECTIONS:
-            raise MeshError(f"unknown section {t!r}; choose from 1-{len(SECTIONS)} or "
-                            f"{', '.join(SECTIONS)}", "--sections")
+            raise MeshError(
+                f"unknown section {t!r}; choose from 1-{len(SECTIONS)} or {', '.join(SECTIONS)}",
+                "--sections",
+            )
         if key not in out:
             out.append(key)
     return sorted(out, key=SECTIONS.index)
@@ -2014,15 +2649,23 @@ def _mesh_note(ctx: _Ctx) -> str:
         return "No mesh files were needed by the selected sections."
     if not subs:
         return f"All meshes come from {where}."
-    why = (f"{where} does not exist" if ctx.meshes_dir is None or not ctx.meshes_dir.is_dir()
-           else f"{where} has no " + ", ".join(f"{k}.obj" for k in subs))
-    head = ("**The course meshes were not found, so this report uses the bundled assets "
-            "instead** " if not real else "**Some course meshes were not found; bundled assets "
-            "stand in for them** ")
-    return (head + f"({why}). The numbers below are therefore NOT those of the course meshes: "
-            + "; ".join(f"{k} → {m.label}" for k, m in subs.items())
-            + ". Run with `--meshes DIR` (a folder with the course's .obj files) for the real "
-            "study.")
+    why = (
+        f"{where} does not exist"
+        if ctx.meshes_dir is None or not ctx.meshes_dir.is_dir()
+        else f"{where} has no " + ", ".join(f"{k}.obj" for k in subs)
+    )
+    head = (
+        "**The course meshes were not found, so this report uses the bundled assets instead** "
+        if not real
+        else "**Some course meshes were not found; bundled assets stand in for them** "
+    )
+    return (
+        head
+        + f"({why}). The numbers below are therefore NOT those of the course meshes: "
+        + "; ".join(f"{k} → {m.label}" for k, m in subs.items())
+        + ". Run with `--meshes DIR` (a folder with the course's .obj files) for the real "
+        "study."
+    )
 
 
 def build_report(
@@ -2090,15 +2733,28 @@ def build_report(
     try:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
-        raise MeshError(f"cannot create the output directory: {exc.strerror or exc}",
-                        os.fspath(out)) from None
+        raise MeshError(
+            f"cannot create the output directory: {exc.strerror or exc}", os.fspath(out)
+        ) from None
     progress = Progress(progress_stream, len(keys))
-    cmd = list(viewer_cmd) if viewer_cmd is not None else [
-        sys.executable, "-m", "meshlap_core.cli", "view"]
+    cmd = (
+        list(viewer_cmd)
+        if viewer_cmd is not None
+        else [sys.executable, "-m", "meshlap_core.cli", "view"]
+    )
     built: list[_Section] = []
     with tempfile.TemporaryDirectory(prefix="meshlap-report-") as tmp:
-        ctx = _Ctx(out, mdir if mdir.is_dir() else None, explicit, quick, screenshots, cmd,
-                   progress, Path(tmp), max_screenshots)
+        ctx = _Ctx(
+            out,
+            mdir if mdir.is_dir() else None,
+            explicit,
+            quick,
+            screenshots,
+            cmd,
+            progress,
+            Path(tmp),
+            max_screenshots,
+        )
         ctx.meshes_wanted = mdir
         for i, key in enumerate(keys, start=1):
             func, steps_q, steps_f = _SECTION_FUNCS[key]
@@ -2113,25 +2769,38 @@ def build_report(
                 sec.error = f"{type(exc).__name__}: {exc}"
                 status = "FAILED"
             sec.seconds = time.perf_counter() - t0
-            fallback = any(isinstance(b, _FigRow) and any(f.kind == "render" and
-                                                          f.caption.endswith("no screenshot)")
-                                                          for f in b.figs) for b in sec.blocks)
+            fallback = any(
+                isinstance(b, _FigRow)
+                and any(f.kind == "render" and f.caption.endswith("no screenshot)") for f in b.figs)
+                for b in sec.blocks
+            )
             noted = any(isinstance(b, _Para) and b.kind == "note" for b in sec.blocks)
             if fallback and not noted:
-                sec.note("Pictures whose caption says 'matplotlib rendering' are not viewer "
-                         f"screenshots: {ctx.screenshot_reason}.")
+                sec.note(
+                    "Pictures whose caption says 'matplotlib rendering' are not viewer "
+                    f"screenshots: {ctx.screenshot_reason}."
+                )
             progress.end(sec.seconds, status)
             built.append(sec)
         total = time.perf_counter() - t_start
         note = _mesh_note(ctx)
         timing = ctx.table(
-            "section_timings", "Wall-clock seconds per section on this machine.",
+            "section_timings",
+            "Wall-clock seconds per section on this machine.",
             ["section", "title", "seconds", "figures", "tables", "status"],
-            [[f"{s.number}. {s.key}", s.title, s.seconds,
-              sum(len(b.figs) for b in s.blocks if isinstance(b, _FigRow)),
-              sum(1 for b in s.blocks if isinstance(b, _Table)),
-              "failed" if s.error else "ok"] for s in built]
-            + [["total", "", total, len(ctx.figures), len(ctx.tables) + 1, ""]])
+            [
+                [
+                    f"{s.number}. {s.key}",
+                    s.title,
+                    s.seconds,
+                    sum(len(b.figs) for b in s.blocks if isinstance(b, _FigRow)),
+                    sum(1 for b in s.blocks if isinstance(b, _Table)),
+                    "failed" if s.error else "ok",
+                ]
+                for s in built
+            ]
+            + [["total", "", total, len(ctx.figures), len(ctx.tables) + 1, ""]],
+        )
         head_md, head_html = _head(ctx, built, keys, total, note)
         md_path, html_path = out / "report.md", out / "report.html"
         with atomic_write(md_path, "w", overwrite_inputs=ctx.inputs) as f:
@@ -2139,9 +2808,15 @@ def build_report(
         with atomic_write(html_path, "w", overwrite_inputs=ctx.inputs) as f:
             f.write(_render_html("meshlap report", head_html, built, timing))
     return ReportResult(
-        out_dir=out, markdown=md_path, html=html_path, figures=list(ctx.figures),
-        tables=list(ctx.tables), section_seconds={s.key: s.seconds for s in built},
-        total_seconds=total, mesh_note=note, screenshots_ok=ctx.shots_ok,
+        out_dir=out,
+        markdown=md_path,
+        html=html_path,
+        figures=list(ctx.figures),
+        tables=list(ctx.tables),
+        section_seconds={s.key: s.seconds for s in built},
+        total_seconds=total,
+        mesh_note=note,
+        screenshots_ok=ctx.shots_ok,
         screenshot_failures=list(ctx.shot_failures),
         errors={s.key: s.error for s in built if s.error},
     )
@@ -2156,18 +2831,25 @@ def _machine() -> str:
         igl_v = version("libigl")
     except Exception:
         igl_v = "?"
-    return (f"{platform.system()} {platform.machine()}, {os.cpu_count()} CPUs, Python "
-            f"{platform.python_version()}, numpy {np.__version__}, scipy {scipy.__version__}, "
-            f"libigl {igl_v}")
+    return (
+        f"{platform.system()} {platform.machine()}, {os.cpu_count()} CPUs, Python "
+        f"{platform.python_version()}, numpy {np.__version__}, scipy {scipy.__version__}, "
+        f"libigl {igl_v}"
+    )
 
 
-def _head(ctx: _Ctx, built: list[_Section], keys: list[str], total: float,
-          note: str) -> tuple[list[str], list[str]]:
+def _head(
+    ctx: _Ctx, built: list[_Section], keys: list[str], total: float, note: str
+) -> tuple[list[str], list[str]]:
     mode = "quick" if ctx.quick else "full"
-    cmd = "meshlap report" + (f" --meshes {ctx.meshes_dir}" if ctx.meshes_explicit else "") \
-        + f" --out {ctx.out}" + (" --quick" if ctx.quick else "") \
+    cmd = (
+        "meshlap report"
+        + (f" --meshes {ctx.meshes_dir}" if ctx.meshes_explicit else "")
+        + f" --out {ctx.out}"
+        + (" --quick" if ctx.quick else "")
         + ("" if len(keys) == len(SECTIONS) else f" --sections {','.join(keys)}")
-    shots = (f"{ctx.shots_ok} viewer screenshots" if ctx.shots_ok else "no viewer screenshots")
+    )
+    shots = f"{ctx.shots_ok} viewer screenshots" if ctx.shots_ok else "no viewer screenshots"
     if ctx.shot_failures:
         shots += f" (screenshots stopped: {ctx.shot_failures[0]})"
     elif not ctx.screenshots and ctx.screenshot_reason:
@@ -2191,11 +2873,18 @@ def _head(ctx: _Ctx, built: list[_Section], keys: list[str], total: float,
         "",
     ]
     if failed:
-        lines += ["> **Failed sections:** " + "; ".join(f"{s.number}. {s.key}: {s.error}"
-                                                       for s in failed), ""]
-    lines += ["Contents: " + " · ".join(f"[{s.number}. {s.title}](#{s.number}-"
-                                        f"{_slug(s.title)}) ({s.seconds:.1f} s)"
-                                        for s in built)]
+        lines += [
+            "> **Failed sections:** "
+            + "; ".join(f"{s.number}. {s.key}: {s.error}" for s in failed),
+            "",
+        ]
+    lines += [
+        "Contents: "
+        + " · ".join(
+            f"[{s.number}. {s.title}](#{s.number}-{_slug(s.title)}) ({s.seconds:.1f} s)"
+            for s in built
+        )
+    ]
     h = [
         "<h1>meshlap report</h1>",
         f'<p class="note">{_html_inline(note)}</p>',
@@ -2204,12 +2893,21 @@ def _head(ctx: _Ctx, built: list[_Section], keys: list[str], total: float,
         f"<p>{_html_inline(lines[8])}</p>",
     ]
     if failed:
-        h.append('<p class="err">' + html.escape(
-            "Failed sections: " + "; ".join(f"{s.number}. {s.key}: {s.error}" for s in failed))
-            + "</p>")
-    h.append("<p>Contents: " + " · ".join(
-        f'<a href="#{s.key}">{s.number}. {html.escape(s.title)}</a> ({s.seconds:.1f} s)'
-        for s in built) + "</p>")
+        h.append(
+            '<p class="err">'
+            + html.escape(
+                "Failed sections: " + "; ".join(f"{s.number}. {s.key}: {s.error}" for s in failed)
+            )
+            + "</p>"
+        )
+    h.append(
+        "<p>Contents: "
+        + " · ".join(
+            f'<a href="#{s.key}">{s.number}. {html.escape(s.title)}</a> ({s.seconds:.1f} s)'
+            for s in built
+        )
+        + "</p>"
+    )
     return lines, h
 
 

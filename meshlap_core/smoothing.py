@@ -53,19 +53,19 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 
-from ._blas import blas_threads
+from .linalg.blas import blas_threads
 from .errors import MeshError, MeshWarning
-from .laplacian import AREA_KINDS, adjacency_matrix, cotan_stiffness, vertex_areas
+from .laplacian import adjacency_matrix, cotan_stiffness, vertex_areas
 from .metrics import Reference, _signed_volume_unchecked, n_boundary_edges
 from .noise import NOISE_MODES, add_noise, bbox_diagonal
+from .options import AREA_KINDS, LAPLACIAN_KINDS, MASS_AREA, AreaKind, LaplacianKind
 from .topology import boundary_vertex_mask
 from .types import FloatArray, IntArray, as_mesh, as_vertices
 
 Method = Literal["explicit", "implicit", "taubin"]
-LaplacianKind = Literal["uniform", "cotan"]
 MassMode = Literal["frozen", "recompute"]
 METHODS: tuple[str, ...] = ("explicit", "implicit", "taubin")
-LAPLACIANS: tuple[str, ...] = ("uniform", "cotan")
+LAPLACIANS = LAPLACIAN_KINDS  # the name this module's callers use
 MASS_MODES: tuple[str, ...] = ("frozen", "recompute")
 
 DEFAULT_PASS_BAND = 0.1  # Taubin's k_PB, in the units of the Laplacian's eigenvalues
@@ -132,7 +132,7 @@ def taubin_mu(lam: float, k_pb: float = DEFAULT_PASS_BAND) -> float:
 
 
 def operator_parts(
-    V: FloatArray, F: IntArray, laplacian: LaplacianKind = "uniform", area: str = "voronoi"
+    V: FloatArray, F: IntArray, laplacian: LaplacianKind = "uniform", area: AreaKind = MASS_AREA
 ) -> tuple[FloatArray, sp.csr_matrix]:
     """The mass ``W`` and stiffness ``K`` of a Laplacian ``L = W⁻¹K`` (negative semidefinite).
 
@@ -341,7 +341,8 @@ class Stability:
         if self.stable:
             return None
         limit = (
-            "" if self.max_stable_lam is None
+            ""
+            if self.max_stable_lam is None
             else f" (largest stable lam {self.max_stable_lam:.4g})"
         )
         return (
@@ -356,7 +357,12 @@ def _taubin_gain(lam: float, nu: float, mu: float) -> float:
 
 
 def _stability_from_mu(
-    method: str, laplacian: str, lam: float, nu: float | None, mu_min: float, exact: bool,
+    method: str,
+    laplacian: str,
+    lam: float,
+    nu: float | None,
+    mu_min: float,
+    exact: bool,
     k_pb: float,
 ) -> Stability:
     k = -mu_min
@@ -430,7 +436,7 @@ def stability(
     *,
     taubin_nu: float | None = None,
     pass_band: float = DEFAULT_PASS_BAND,
-    area: str = "voronoi",
+    area: AreaKind = MASS_AREA,
 ) -> Stability:
     """Stability figures of ``method`` with step ``lam`` on the mesh ``(V, F)``.
 
@@ -679,7 +685,7 @@ class Smoother:
         fix_boundary: bool = False,
         preserve_volume: bool = False,
         mass: MassMode = "frozen",
-        area: str = "voronoi",
+        area: AreaKind = MASS_AREA,
         reference: FloatArray | None = None,
         track_history: bool = True,
         history_limit: int | None = None,
@@ -732,7 +738,8 @@ class Smoother:
         self.k_pb = self.pass_band * _diagonal_scale(W, K)
         self.taubin_nu = self._nu_for(self.lam)
         fixed = (
-            boundary_vertex_mask(self.F, self.n) if self.fix_boundary
+            boundary_vertex_mask(self.F, self.n)
+            if self.fix_boundary
             else np.zeros(self.n, dtype=bool)
         )
         self.pinned = fixed | ~(W > 0)  # fixed boundary, plus vertices with no faces / zero area
@@ -768,7 +775,13 @@ class Smoother:
         if self._stability is None:
             mu_min, exact = most_negative_eigenvalue(self._W0, self._K)
             self._stability = _stability_from_mu(
-                self.method, self.laplacian, self.lam, self.taubin_nu, mu_min, exact, self.k_pb,
+                self.method,
+                self.laplacian,
+                self.lam,
+                self.taubin_nu,
+                mu_min,
+                exact,
+                self.k_pb,
             )
         return self._stability
 
@@ -855,7 +868,6 @@ class Smoother:
                 "pass_band",
             ) from None
 
-
     def _warn_if_unstable(self) -> None:
         """Warn about an unstable explicit/Taubin λ; cheap (Gershgorin) unless near the limit."""
         active = self._W0 > 0
@@ -912,9 +924,7 @@ class Smoother:
                 ) from None
             self._solver_key = key
             self.n_factorizations += 1
-            self._rhs_fixed = (
-                self.lam * (self._K_fp @ x[self._fixed]) if len(self._fixed) else None
-            )
+            self._rhs_fixed = self.lam * (self._K_fp @ x[self._fixed]) if len(self._fixed) else None
         if len(self._fixed) == 0:  # nothing pinned: no gathers or scatters
             return self._solver.solve(self._W[:, None] * x)
         rhs = self._W[free][:, None] * x[free]
@@ -1003,7 +1013,8 @@ def smooth(
     if s.diverged:
         raise MeshError(
             f"{method} smoothing diverged after {s.iteration} iterations; "
-            f"the largest stable lam is {s.stability.max_stable_lam}", "lam"
+            f"the largest stable lam is {s.stability.max_stable_lam}",
+            "lam",
         )
     return s.V.copy()
 
@@ -1023,7 +1034,7 @@ def denoise_sweep(
     iters: Sequence[int] = (10,),
     seed: int = 0,
     noise_mode: str = "isotropic",
-    area: str = "voronoi",
+    area: AreaKind = MASS_AREA,
     progress: Callable[[str], None] | None = None,
 ) -> list[dict[str, Any]]:
     """Denoising table: noise levels × Laplacians × methods × λ × iteration counts.
@@ -1099,8 +1110,14 @@ def denoise_sweep(
                         with warnings.catch_warnings():
                             warnings.simplefilter("ignore", MeshWarning)
                             s = Smoother(
-                                Vn, F, method, lap, lam,  # type: ignore[arg-type]
-                                area=area, track_history=False, warn=False,
+                                Vn,
+                                F,
+                                method,
+                                lap,
+                                lam,  # type: ignore[arg-type]
+                                area=area,
+                                track_history=False,
+                                warn=False,
                             )
                         stable = _quick_stable(s)
                     except MeshError as exc:
@@ -1117,8 +1134,13 @@ def denoise_sweep(
                         if failed is not None or s.diverged:
                             got: dict[str, Any] = {
                                 key: float("nan")
-                                for key in ("rmse", "max_error", "volume_change_pct",
-                                            "dihedral_mae_deg", "normal_dev_deg")
+                                for key in (
+                                    "rmse",
+                                    "max_error",
+                                    "volume_change_pct",
+                                    "dihedral_mae_deg",
+                                    "normal_dev_deg",
+                                )
                             }
                         else:
                             got = ref.compare(s.V)
@@ -1147,8 +1169,11 @@ def denoise_sweep(
                     if progress is not None:
                         progress(
                             f"noise {level:g} {lap} {method} lam={lam:g}: "
-                            + (f"failed: {failed}" if failed is not None else
-                               f"{s.iteration} iterations in {elapsed:.3f} s")
+                            + (
+                                f"failed: {failed}"
+                                if failed is not None
+                                else f"{s.iteration} iterations in {elapsed:.3f} s"
+                            )
                         )
     return rows
 

@@ -78,15 +78,13 @@ from scipy.linalg import blas, lapack
 from scipy.sparse.csgraph import connected_components
 
 from . import laplacian as _lap
-from ._blas import blas_threads as _blas_threads
-from ._blas import thread_controller as _thread_controller
+from .linalg.blas import blas_threads as _blas_threads
+from .linalg.blas import thread_controller as _thread_controller
 from .errors import MeshError
+from .options import AREA_KINDS, LAPLACIAN_KINDS, MASS_AREA, AreaKind, LaplacianKind
 from .types import FloatArray, IntArray, as_mesh
 
-LaplacianKind = Literal["cotan", "uniform"]
-MassKind = Literal["voronoi", "barycentric"]
-LAPLACIAN_KINDS: tuple[str, ...] = ("cotan", "uniform")
-MASS_KINDS: tuple[str, ...] = ("voronoi", "barycentric")
+MASS_KINDS = AREA_KINDS  # the lumped mass of the pencil is a vertex area
 
 ProgressCallback = Callable[[float, str], None]
 """``progress(fraction, message)``: ``fraction`` in ``[0, 1]``; raise from it to cancel."""
@@ -136,7 +134,7 @@ def spectral_operators(
     V: FloatArray,
     F: IntArray,
     laplacian: LaplacianKind = "cotan",
-    mass: MassKind = "voronoi",
+    mass: AreaKind = MASS_AREA,
 ) -> tuple[sp.csr_matrix, FloatArray]:
     """The pencil ``(K, m)`` of the eigenproblem ``K u = λ diag(m) u``.
 
@@ -280,8 +278,7 @@ def _ldl_inertia(
     if lu is None:
         assert perm is not None
         lu = factor(perm, "NATURAL")
-        if not (np.array_equal(lu.perm_r, lu.perm_c)
-                and np.array_equal(lu.perm_c, np.arange(n))):
+        if not (np.array_equal(lu.perm_r, lu.perm_c) and np.array_equal(lu.perm_c, np.arange(n))):
             raise _Unstable("SuperLU pivoted")
         ldl = _LDL(lu, perm)
     return ldl, _checked_inertia(A, ldl, lu.U.diagonal(), rng)
@@ -351,8 +348,11 @@ def _qdldl_inertia(
     U = sp.triu(A, format="csc")
     pattern = (U.indptr, U.indices)
     try:
-        if (reuse is not None and np.array_equal(reuse.pattern[0], U.indptr)
-                and np.array_equal(reuse.pattern[1], U.indices)):
+        if (
+            reuse is not None
+            and np.array_equal(reuse.pattern[0], U.indptr)
+            and np.array_equal(reuse.pattern[1], U.indices)
+        ):
             solver = reuse.solver
             solver.update(U, upper=True)
         else:
@@ -452,8 +452,12 @@ def _chol_qr(
     for p in range(passes):
         R, info = lapack.dpotrf(W.T @ W, lower=0, clean=1)
         dR = np.abs(np.diag(R))
-        if (info != 0 or not np.all(np.isfinite(dR)) or dR.min() <= min_ratio * dR.max()
-                or (p == 0 and dR.min() <= min_diag)):
+        if (
+            info != 0
+            or not np.all(np.isfinite(dR))
+            or dR.min() <= min_ratio * dR.max()
+            or (p == 0 and dR.min() <= min_diag)
+        ):
             if p:  # pragma: no cover - the first pass succeeded, so W is well conditioned
                 raise RuntimeError("Cholesky QR: second pass failed")
             return None
@@ -500,8 +504,11 @@ class _BlockLanczos:
         self._measured = 1e-15  # largest orthogonality error measured so far
         self._last_measure = 0
         self.B_last = np.zeros((block, block))
-        self._work = (np.empty((n, 2 * block), order="F"), np.empty((n, 2 * block), order="F"),
-                      np.empty((n, block), order="F"))
+        self._work = (
+            np.empty((n, 2 * block), order="F"),
+            np.empty((n, 2 * block), order="F"),
+            np.empty((n, block), order="F"),
+        )
         self.Q[:, :block] = self._random_orthonormal(block, 0, None)
 
     def _project(self, W: FloatArray, ncols: int) -> tuple[FloatArray, FloatArray]:
@@ -546,9 +553,7 @@ class _BlockLanczos:
         self.delta = max(self.delta, est)
         return W, H
 
-    def _random_orthonormal(
-        self, count: int, ncols: int, extra: FloatArray | None
-    ) -> FloatArray:
+    def _random_orthonormal(self, count: int, ncols: int, extra: FloatArray | None) -> FloatArray:
         """``count`` random orthonormal columns orthogonal to ``X``, ``Q[:, :ncols]``, ``extra``."""
         W = np.asfortranarray(self.rng.standard_normal((self.n, count)))
         for _ in range(2):
@@ -595,8 +600,8 @@ class _BlockLanczos:
             Y[:, b:] = W
             C = Qa.T @ Y
             c, H1 = C[:, :b], C[:, b:]
-            Rp = self.T[j0:j1, j0 - b:j0].copy()  # q̃ Rp = last step's once-orthogonalized W
-            Rc = Rp @ c[j0 - b:j0]
+            Rp = self.T[j0:j1, j0 - b : j0].copy()  # q̃ Rp = last step's once-orthogonalized W
+            Rc = Rp @ c[j0 - b : j0]
             cRc = c @ Rc
             C[:, b:] -= cRc
             D = self._work[1]
@@ -612,11 +617,12 @@ class _BlockLanczos:
             W -= D[:, b:]
             _right_solve(W, S)
             V = W
-            P = sla.solve_triangular(S, (H1 - self.T[:j0, :j0] @ c).T, trans="T",
-                                     check_finite=False).T  # (H1 holds H1 − cRc now)
+            P = sla.solve_triangular(
+                S, (H1 - self.T[:j0, :j0] @ c).T, trans="T", check_finite=False
+            ).T  # (H1 holds H1 − cRc now)
             # the previous block's relation Op(q_prev) = Q T + q̃ Rp, rewritten with q
-            self.T[:j0, j0 - b:j0] += c @ Rp
-            self.T[j0:j1, j0 - b:j0] = S @ Rp
+            self.T[:j0, j0 - b : j0] += c @ Rp
+            self.T[j0:j1, j0 - b : j0] = S @ Rp
             self.T[:j0, j0:j1] = P
             self.Q[:, j0:j1] = q
         else:
@@ -670,8 +676,8 @@ class _BlockLanczos:
             if rank < b:  # (partial) breakdown: an invariant subspace was found
                 B[rank:, :] = 0.0
                 Qn[:, rank:] = self._random_orthonormal(b - rank, j1, Qn[:, :rank])
-        self.Q[:, j1:j1 + b] = Qn
-        self.T[j1:j1 + b, j0:j1] = B
+        self.Q[:, j1 : j1 + b] = Qn
+        self.T[j1 : j1 + b, j0:j1] = B
         self.B_last = B
         self.j = j1
         if not self.delayed and j1 + b - self._last_measure >= 16 * b:
@@ -700,7 +706,7 @@ class _BlockLanczos:
         th, S = sla.eigh(self.T[:j, :j], lower=True, check_finite=False)
         order = np.argsort(-np.abs(th), kind="stable")[:want]
         th, S = th[order], S[:, order]
-        C = self.B_last @ S[j - self.b:j, :]
+        C = self.B_last @ S[j - self.b : j, :]
         if self.exhausted:
             C[:] = 0.0
         return th, S, np.linalg.norm(C, axis=0), C
@@ -708,7 +714,7 @@ class _BlockLanczos:
     def vectors(self, S: FloatArray) -> FloatArray:
         """Ritz vectors ``Q S`` (``n × S.shape[1]``, F-ordered)."""
         out = np.empty((self.n, S.shape[1]), order="F")
-        np.matmul(self.Q[:, :self.j], np.ascontiguousarray(S), out=out)
+        np.matmul(self.Q[:, : self.j], np.ascontiguousarray(S), out=out)
         return out
 
 
@@ -752,9 +758,9 @@ class _Found:
         need = self.count + len(lam)
         if need > self.Y.shape[1]:
             Y2 = np.empty((self.n, max(need, int(self.Y.shape[1] * 1.5))), order="F")
-            Y2[:, :self.count] = self.Y[:, :self.count]
+            Y2[:, : self.count] = self.Y[:, : self.count]
             self.Y = Y2
-        self.Y[:, self.count:need] = Y
+        self.Y[:, self.count : need] = Y
         self.lam = np.concatenate([self.lam, lam])
         self.count = need
 
@@ -943,8 +949,11 @@ def _run_slice(ctx: _SliceContext, spec: _SliceSpec, seed: int) -> _SliceResult:
     # (the factorization of this thread's previous slice, done with, is refactored in place)
     spare, ctx.local.spare = getattr(ctx.local, "spare", None), None
     op = _ShiftInvert(
-        ctx.A, spec.sigma, rng=rng,
-        spacing=max(width, ctx.scale) / max(spec.expected, 1), ordering=ctx.ordering,
+        ctx.A,
+        spec.sigma,
+        rng=rng,
+        spacing=max(width, ctx.scale) / max(spec.expected, 1),
+        ordering=ctx.ordering,
         reuse=spare,
     )
     del spare
@@ -970,14 +979,15 @@ def _run_slice(ctx: _SliceContext, spec: _SliceSpec, seed: int) -> _SliceResult:
         # tol·λ_max/λ (1e-3 on meshes of slivers); the second asks for _LAMBDA_TOL relative
         # to λ. (It is an estimate from the Lanczos relation, so it keeps falling as Lanczos
         # converges: no round-off floor can stall it.)
-        Qn = lz.Q[:, lz.j:lz.j + b]
+        Qn = lz.Q[:, lz.j : lz.j + b]
         Z = ctx.A @ Qn - op.sigma * Qn
         G = Z.T @ Z
         ath = np.maximum(np.abs(th), 1e-300)
         rlam = np.sqrt(np.maximum(np.einsum("ij,ij->j", C, G @ C), 0.0)) / ath
         # each pair's residual over its tolerance (converged at <= 1)
-        ratio = np.maximum(res / ath / ctx.tol,
-                           rlam / np.maximum(_LAMBDA_TOL * np.abs(lam), 1e-300))
+        ratio = np.maximum(
+            res / ath / ctx.tol, rlam / np.maximum(_LAMBDA_TOL * np.abs(lam), 1e-300)
+        )
         conv = ratio <= 1.0
         if spec.count is None:
             hi = spec.hi
@@ -1000,7 +1010,8 @@ def _run_slice(ctx: _SliceContext, spec: _SliceSpec, seed: int) -> _SliceResult:
             worst = max(worst, float(np.log10(max(ratio[nearest] * ctx.tol, 1e-300) / _EDGE_TOL)))
         n_in = int(np.count_nonzero(inside & conv))
         ctx.report(
-            spec.index, n_in,
+            spec.index,
+            n_in,
             f"eigensolver: slice {spec.index} (shift {op.sigma:.4g}): {n_in} eigenpairs, "
             f"Krylov dimension {lz.j}",
         )
@@ -1029,15 +1040,28 @@ def _run_slice(ctx: _SliceContext, spec: _SliceSpec, seed: int) -> _SliceResult:
         gaps = np.flatnonzero(np.diff(ls) > 1e-7 * np.maximum(np.abs(ls[1:]), ctx.scale))
         if len(gaps):
             t = int(gaps[-1])
-            chk = _ShiftInvert(ctx.A, 0.5 * (ls[t] + ls[t + 1]), rng=rng,
-                               spacing=ls[t + 1] - ls[t], ordering=ctx.ordering, reuse=spare)
+            chk = _ShiftInvert(
+                ctx.A,
+                0.5 * (ls[t] + ls[t + 1]),
+                rng=rng,
+                spacing=ls[t + 1] - ls[t],
+                ordering=ctx.ordering,
+                reuse=spare,
+            )
             check = (chk.sigma, chk.n_below)
             spare = chk._lu
     ctx.local.spare = spare
     ctx.finished(spec.index, len(sel))
     return _SliceResult(
-        spec=spec, sigma=sigma_used, n_below=n_below, lam=lam[sel], Y=Y, krylov_dim=j_used,
-        n_applied=n_applied, seconds=time.perf_counter() - t0, check=check,
+        spec=spec,
+        sigma=sigma_used,
+        n_below=n_below,
+        lam=lam[sel],
+        Y=Y,
+        krylov_dim=j_used,
+        n_applied=n_applied,
+        seconds=time.perf_counter() - t0,
+        check=check,
     )
 
 
@@ -1139,8 +1163,9 @@ def _sliced_lanczos(
         found.add(known[0], known[1])
         n_null = 0
     base = found.count
-    ctx = _SliceContext(K, m, Zy, tol=tol, block=block, target=target, base_count=base,
-                        progress=progress)
+    ctx = _SliceContext(
+        K, m, Zy, tol=tol, block=block, target=target, base_count=base, progress=progress
+    )
     scale = ctx.scale
     seed = 20240611
     checks: list[tuple[float, int]] = []  # (shift, eigenvalues below it) from inertia
@@ -1198,7 +1223,8 @@ def _sliced_lanczos(
         at the shifts of slices ``< i`` (the first point is ``(0, base)``), else from the
         finished slices ``<= i - workers``, else Weyl's."""
         pts = [(0.0, base if known is None else n_null)] + [
-            ctx.inertia[j] for j in range(i) if j in ctx.inertia]
+            ctx.inertia[j] for j in range(i) if j in ctx.inertia
+        ]
         if len(pts) >= 2 and pts[-1][0] > pts[-2][0]:
             (s0, n0), (s1, n1) = pts[-2], pts[-1]
             if n1 - n0 >= 4:
@@ -1230,11 +1256,17 @@ def _sliced_lanczos(
             count = max(target - have, 1)
             size = count
         hi = start + size * (1.0 if count is not None or i < n_total - 1 else 1.05) / rho
-        return _SliceSpec(i, 0.5 * (start + hi), lo, hi, size,
-                          known_X if (i == 0 and known is not None) else None, count,
-                          check_below=lo > 0 and not (i == 0 and known_X is not None
-                                                      and near_all),
-                          check_top=workers >= 2 and i == n_total - 1)
+        return _SliceSpec(
+            i,
+            0.5 * (start + hi),
+            lo,
+            hi,
+            size,
+            known_X if (i == 0 and known is not None) else None,
+            count,
+            check_below=lo > 0 and not (i == 0 and known_X is not None and near_all),
+            check_top=workers >= 2 and i == n_total - 1,
+        )
 
     def need_more(i: int) -> bool:
         return i < n_total
@@ -1254,7 +1286,7 @@ def _sliced_lanczos(
             info.n_factorizations += 1
 
     t_slices = time.perf_counter()
-    with (cf.ThreadPoolExecutor(max_workers=workers) if workers > 1 else _InlinePool()) as pool:
+    with cf.ThreadPoolExecutor(max_workers=workers) if workers > 1 else _InlinePool() as pool:
         running: dict[cf.Future[_SliceResult], int] = {}
         try:
             while True:
@@ -1274,8 +1306,9 @@ def _sliced_lanczos(
                     continue
                 # (a short timeout while the next slice waits for an inertia count)
                 waiting = len(running) < max(workers, 1) and need_more(len(specs))
-                done, _ = cf.wait(running, timeout=0.01 if waiting else None,
-                                  return_when=cf.FIRST_COMPLETED)
+                done, _ = cf.wait(
+                    running, timeout=0.01 if waiting else None, return_when=cf.FIRST_COMPLETED
+                )
                 for f in sorted(done, key=lambda f: running[f]):
                     del running[f]
                     absorb(f.result())
@@ -1310,8 +1343,14 @@ def _sliced_lanczos(
             if tau is None:
                 tau = lam_sorted[-1] * (1 + 1e-6) + 1e-6 * scale
             spare, ctx.local.spare = getattr(ctx.local, "spare", None), None
-            op = _ShiftInvert(ctx.A, tau, rng=rng, ordering=ctx.ordering, reuse=spare,
-                              spacing=1e-3 * max(lam_sorted[-1] - lam_sorted[k - 1], scale))
+            op = _ShiftInvert(
+                ctx.A,
+                tau,
+                rng=rng,
+                ordering=ctx.ordering,
+                reuse=spare,
+                spacing=1e-3 * max(lam_sorted[-1] - lam_sorted[k - 1], scale),
+            )
             info.n_factorizations += 1
             checks.append((op.sigma, op.n_below))
             del op
@@ -1322,8 +1361,7 @@ def _sliced_lanczos(
             have = found.below(s)
             if have > nu:
                 raise RuntimeError(
-                    f"eigensolver: {have} eigenvalues found below {s:.6g} but inertia counts "
-                    f"{nu}"
+                    f"eigensolver: {have} eigenvalues found below {s:.6g} but inertia counts {nu}"
                 )
             if have < nu:
                 bad = (prev, s, nu - have)
@@ -1337,12 +1375,20 @@ def _sliced_lanczos(
             f"inertia check: {missing} eigenvalue(s) in [{lo:.6g}, {hi:.6g}) were missed; "
             "searching again with the found ones deflated"
         )
-        near = np.flatnonzero((found.lam >= lo - 0.25 * (hi - lo))
-                              & (found.lam <= hi + 0.25 * (hi - lo)))
+        near = np.flatnonzero(
+            (found.lam >= lo - 0.25 * (hi - lo)) & (found.lam <= hi + 0.25 * (hi - lo))
+        )
         near = near[near >= n_null]  # the null space is deflated in every slice already
-        below = bool(np.any(found.lam[:found.count] < lo - 0.25 * (hi - lo)))
-        spec = _SliceSpec(repair_index, 0.5 * (lo + hi), lo, hi, max(missing, 4),
-                          np.asfortranarray(found.Y[:, near]), check_below=below and lo > 0)
+        below = bool(np.any(found.lam[: found.count] < lo - 0.25 * (hi - lo)))
+        spec = _SliceSpec(
+            repair_index,
+            0.5 * (lo + hi),
+            lo,
+            hi,
+            max(missing, 4),
+            np.asfortranarray(found.Y[:, near]),
+            check_below=below and lo > 0,
+        )
         repair_index += 1
         r = _run_slice(ctx, spec, seed)
         absorb(r)
@@ -1383,7 +1429,8 @@ def _dedupe(found: _Found, old_count: int, scale: float) -> None:
         tol = 1e-6 * max(abs(lam[i]), scale)
         a, b = np.searchsorted(kept_sorted, [lam[i] - tol, lam[i] + tol + 1e-300])
         cl = [int(kept_idx[t]) for t in range(a, b)] + [
-            j for j in extra if abs(lam[j] - lam[i]) <= tol]
+            j for j in extra if abs(lam[j] - lam[i]) <= tol
+        ]
         if cl:
             Yc = found.Y[:, cl]
             w = found.Y[:, i].copy()
@@ -1398,7 +1445,7 @@ def _dedupe(found: _Found, old_count: int, scale: float) -> None:
     keep += sorted(extra)
     if len(keep) < found.count:
         ka = np.asarray(keep, dtype=np.int64)
-        found.Y[:, :len(ka)] = found.Y[:, ka]
+        found.Y[:, : len(ka)] = found.Y[:, ka]
         found.lam = lam[ka]
         found.count = len(ka)
 
@@ -1409,7 +1456,7 @@ def laplacian_eigenpairs(
     k: int,
     *,
     laplacian: LaplacianKind = "cotan",
-    mass: MassKind = "voronoi",
+    mass: AreaKind = MASS_AREA,
     progress: ProgressCallback | None = None,
     known: tuple[FloatArray, FloatArray] | None = None,
     method: Literal["auto", "dense", "sparse"] = "auto",
@@ -1452,10 +1499,14 @@ def laplacian_eigenpairs(
     if "density" not in tuning:
         # Weyl's law N(λ) ≈ area·λ/4π; for the graph Laplacian of a near-equilateral mesh the
         # same count gives λ ≈ 4π√3·N/n
-        tuning["density"] = (m.sum() / (4 * np.pi) if opts["laplacian"] == "cotan"
-                             else len(m) / (4 * np.pi * np.sqrt(3.0)))
-    lam, U, info = pencil_eigenpairs(K, m, k, progress=progress, known=known, method=method,
-                                     **tuning)
+        tuning["density"] = (
+            m.sum() / (4 * np.pi)
+            if opts["laplacian"] == "cotan"
+            else len(m) / (4 * np.pi * np.sqrt(3.0))
+        )
+    lam, U, info = pencil_eigenpairs(
+        K, m, k, progress=progress, known=known, method=method, **tuning
+    )
     info.timings["operators"] = t_ops
     info.timings["total"] = time.perf_counter() - t_start
     return lam, U, info
@@ -1587,8 +1638,18 @@ def pencil_eigenpairs(
             rho = float(density) if density else float(m.sum() / (4 * np.pi))
             with _blas_threads(nb):
                 lam, Y = _sliced_lanczos(
-                    K, m, k, Z, info, known=kn, progress=progress, tol=tol, block=block,
-                    slice_size=slice_size, first_slice=first_slice, workers=nw,
+                    K,
+                    m,
+                    k,
+                    Z,
+                    info,
+                    known=kn,
+                    progress=progress,
+                    tol=tol,
+                    block=block,
+                    slice_size=slice_size,
+                    first_slice=first_slice,
+                    workers=nw,
                     weyl_density=rho,
                 )
         t1 = time.perf_counter()
@@ -1602,7 +1663,8 @@ def pencil_eigenpairs(
                 before = _lowdin(Y)
         if before > 1e-11:
             info.messages.append(
-                f"slices orthonormalized together (Lowdin; max|U^T M U - I| was {before:.1e})")
+                f"slices orthonormalized together (Lowdin; max|U^T M U - I| was {before:.1e})"
+            )
         info.timings["orthonormalization"] = time.perf_counter() - t1
     info.min_raw_eigenvalue = float(lam.min(initial=0.0))
     neg = lam < 0
@@ -1649,8 +1711,9 @@ def _orthogonality(U: FloatArray, m: FloatArray) -> float:
     kk = U.shape[1]
     if kk == 0:
         return 0.0
-    idx = np.unique(np.r_[0, kk // 3, (2 * kk) // 3, kk - 1,
-                          np.random.default_rng(kk).integers(0, kk, 4)])
+    idx = np.unique(
+        np.r_[0, kk // 3, (2 * kk) // 3, kk - 1, np.random.default_rng(kk).integers(0, kk, 4)]
+    )
     G = U[:, idx].T @ (m[:, None] * U)
     E = np.zeros_like(G)
     E[np.arange(len(idx)), idx] = 1.0
@@ -1753,7 +1816,11 @@ def _validate_arrays(
 
 
 def _read_cache(
-    path: Path, key: str, options: dict[str, str], K: sp.csr_matrix, m: FloatArray,
+    path: Path,
+    key: str,
+    options: dict[str, str],
+    K: sp.csr_matrix,
+    m: FloatArray,
     messages: list[str],
 ) -> tuple[FloatArray, FloatArray, float] | None:
     """The validated cached basis, or ``None`` (missing, or unusable: reason in ``messages``)."""
@@ -1880,7 +1947,7 @@ class SpectralBasis:
         k: int,
         *,
         laplacian: LaplacianKind = "cotan",
-        mass: MassKind = "voronoi",
+        mass: AreaKind = MASS_AREA,
         cache: bool = True,
         cache_dir: str | os.PathLike | None = None,
         progress: ProgressCallback | None = None,
@@ -1913,13 +1980,19 @@ class SpectralBasis:
         path = None
         msgs: list[str] = []
         if cache:
-            path = _cache_file(Path(cache_dir) if cache_dir else default_cache_dir(),
-                               mesh_key(V, F, opts))
+            path = _cache_file(
+                Path(cache_dir) if cache_dir else default_cache_dir(), mesh_key(V, F, opts)
+            )
             known = _read_cache(path, mesh_key(V, F, opts), opts, K, m, msgs)
             if known is not None and len(known[0]) >= k:
                 info = SolveInfo(
-                    method="cache", n_vertices=len(V), k=k, from_cache=True,
-                    cache_path=str(path), messages=msgs, n_components=_components(K)[0],
+                    method="cache",
+                    n_vertices=len(V),
+                    k=k,
+                    from_cache=True,
+                    cache_path=str(path),
+                    messages=msgs,
+                    n_components=_components(K)[0],
                     orthogonality_error=known[2],
                 )
                 info.timings["eigensolve"] = 0.0
@@ -1929,7 +2002,12 @@ class SpectralBasis:
                 basis._cache_path = path
                 return basis
         lam, U, info = laplacian_eigenpairs(
-            V, F, k, laplacian=laplacian, mass=mass, progress=progress,
+            V,
+            F,
+            k,
+            laplacian=laplacian,
+            mass=mass,
+            progress=progress,
             known=None if known is None else known[:2],
         )
         info.messages[:0] = msgs
@@ -1974,7 +2052,7 @@ class SpectralBasis:
         F: IntArray,
         *,
         laplacian: LaplacianKind = "cotan",
-        mass: MassKind = "voronoi",
+        mass: AreaKind = MASS_AREA,
     ) -> SpectralBasis:
         """Load a basis written by :meth:`save` for the mesh ``(V, F)``; every check of the
         cache applies (a file for another mesh or options raises :class:`MeshError`)."""
@@ -1988,8 +2066,14 @@ class SpectralBasis:
             raise
         except Exception as exc:
             raise MeshError(f"not a usable spectral basis: {exc}", os.fspath(path)) from None
-        info = SolveInfo(method="file", n_vertices=len(V), k=len(lam), cache_path=os.fspath(path),
-                         n_components=_components(K)[0], orthogonality_error=orth)
+        info = SolveInfo(
+            method="file",
+            n_vertices=len(V),
+            k=len(lam),
+            cache_path=os.fspath(path),
+            n_components=_components(K)[0],
+            orthogonality_error=orth,
+        )
         return cls(V, F, lam, U, m, opts, info)
 
     # ---- basic accessors -----------------------------------------------------------------
@@ -2054,14 +2138,26 @@ class SpectralBasis:
             msgs: list[str] = []
             got = None
             if self._cache_path is not None:
-                got = _read_cache(self._cache_path, mesh_key(self.V, self.F, self.options),
-                                  self.options, K, m, msgs)
+                got = _read_cache(
+                    self._cache_path,
+                    mesh_key(self.V, self.F, self.options),
+                    self.options,
+                    K,
+                    m,
+                    msgs,
+                )
             if got is not None and len(got[0]) >= k:
                 lam, U = got[0][:k], got[1][:, :k]
-                info = SolveInfo(method="cache", n_vertices=self.n_vertices, k=k,
-                                 from_cache=True, cache_path=str(self._cache_path),
-                                 messages=msgs, n_components=self.info.n_components,
-                                 orthogonality_error=got[2])
+                info = SolveInfo(
+                    method="cache",
+                    n_vertices=self.n_vertices,
+                    k=k,
+                    from_cache=True,
+                    cache_path=str(self._cache_path),
+                    messages=msgs,
+                    n_components=self.info.n_components,
+                    orthogonality_error=got[2],
+                )
                 write = False
             else:
                 with self._lock:
@@ -2069,8 +2165,13 @@ class SpectralBasis:
                 if got is not None and len(got[0]) > len(known[0]):
                     known = (got[0], got[1])
                 lam, U, info = laplacian_eigenpairs(
-                    self.V, self.F, k, laplacian=lap, mass=mass,  # type: ignore[arg-type]
-                    progress=progress, known=known,
+                    self.V,
+                    self.F,
+                    k,
+                    laplacian=lap,
+                    mass=mass,  # type: ignore[arg-type]
+                    progress=progress,
+                    known=known,
                 )
                 info.messages[:0] = msgs
                 write = True
@@ -2180,8 +2281,15 @@ class SpectralBasis:
         )
 
     def _error_pass(
-        self, Xa: FloatArray, U: FloatArray, c: FloatArray, chunk: int,
-        sums: FloatArray, sq: FloatArray, wsq: FloatArray, mx: FloatArray,
+        self,
+        Xa: FloatArray,
+        U: FloatArray,
+        c: FloatArray,
+        chunk: int,
+        sums: FloatArray,
+        sq: FloatArray,
+        wsq: FloatArray,
+        mx: FloatArray,
     ) -> None:
         n, kmax = len(Xa), len(c)
         for r0 in range(0, n, chunk):
@@ -2205,14 +2313,20 @@ def compute_basis(
     k: int,
     *,
     laplacian: LaplacianKind = "cotan",
-    mass: MassKind = "voronoi",
+    mass: AreaKind = MASS_AREA,
     cache: bool = True,
     cache_dir: str | os.PathLike | None = None,
     progress: ProgressCallback | None = None,
 ) -> SpectralBasis:
     """One-shot wrapper of :meth:`SpectralBasis.compute`."""
     return SpectralBasis.compute(
-        V, F, k, laplacian=laplacian, mass=mass, cache=cache, cache_dir=cache_dir,
+        V,
+        F,
+        k,
+        laplacian=laplacian,
+        mass=mass,
+        cache=cache,
+        cache_dir=cache_dir,
         progress=progress,
     )
 
@@ -2223,7 +2337,7 @@ def reconstruct(
     k: int,
     *,
     laplacian: LaplacianKind = "cotan",
-    mass: MassKind = "voronoi",
+    mass: AreaKind = MASS_AREA,
     cache: bool = False,
 ) -> FloatArray:
     """Spectral reconstruction of the vertices from their ``k`` lowest modes, ``(n,3)``."""

@@ -127,12 +127,14 @@ class ParametricSurface:
     def __post_init__(self) -> None:
         u0, u1, v0, v1 = (float(x) for x in self.domain)
         if not all(math.isfinite(x) for x in (u0, u1, v0, v1)) or not (u0 < u1 and v0 < v1):
-            raise MeshError(f"domain must be finite with u0 < u1 and v0 < v1, got {self.domain}",
-                            self.name)
+            raise MeshError(
+                f"domain must be finite with u0 < u1 and v0 < v1, got {self.domain}", self.name
+            )
         bad = [e for e in self.poles if e not in EDGES]
         if bad:
-            raise MeshError(f"unknown pole edge(s) {bad}; choose among {', '.join(EDGES)}",
-                            self.name)
+            raise MeshError(
+                f"unknown pole edge(s) {bad}; choose among {', '.join(EDGES)}", self.name
+            )
         object.__setattr__(self, "domain", (u0, u1, v0, v1))
 
     def __call__(self, u: Any, v: Any) -> FloatArray:
@@ -175,8 +177,13 @@ def helicoid(c: float = 1.0) -> ParametricSurface:
         )
 
     return ParametricSurface(
-        "helicoid", p, (0.0, 1.0, 0.0, 2 * np.pi), derivatives=d, default_uv=(0.0, 0.0),
-        description="minimal surface (u cos v, u sin v, c v); hyperbolic, H = 0", params={"c": c},
+        "helicoid",
+        p,
+        (0.0, 1.0, 0.0, 2 * np.pi),
+        derivatives=d,
+        default_uv=(0.0, 0.0),
+        description="minimal surface (u cos v, u sin v, c v); hyperbolic, H = 0",
+        params={"c": c},
     )
 
 
@@ -203,8 +210,13 @@ def sphere(r: float = 1.0) -> ParametricSurface:
         )
 
     return ParametricSurface(
-        "sphere", p, (0.0, np.pi, 0.0, 2 * np.pi), closed_v=True, poles=("u0", "u1"),
-        derivatives=d, default_uv=(np.pi / 3, np.pi / 4),
+        "sphere",
+        p,
+        (0.0, np.pi, 0.0, 2 * np.pi),
+        closed_v=True,
+        poles=("u0", "u1"),
+        derivatives=d,
+        default_uv=(np.pi / 3, np.pi / 4),
         description="sphere of radius r (polar angle u, azimuth v); umbilic, K = 1/r²",
         params={"r": r},
     )
@@ -238,9 +250,15 @@ def torus(R: float = 3.0, r: float = 1.0) -> ParametricSurface:
         )
 
     return ParametricSurface(
-        "torus", p, (0.0, 2 * np.pi, 0.0, 2 * np.pi), closed_u=True, closed_v=True,
-        derivatives=d, default_uv=(0.0, 0.0),
-        description="ring torus, radii R > r; K > 0 outside, < 0 inside", params={"R": R, "r": r},
+        "torus",
+        p,
+        (0.0, 2 * np.pi, 0.0, 2 * np.pi),
+        closed_u=True,
+        closed_v=True,
+        derivatives=d,
+        default_uv=(0.0, 0.0),
+        description="ring torus, radii R > r; K > 0 outside, < 0 inside",
+        params={"R": R, "r": r},
     )
 
 
@@ -256,8 +274,13 @@ def catenoid(c: float = 1.0) -> ParametricSurface:
         return _xyz(w * np.cos(u), w * np.sin(u), v)
 
     return ParametricSurface(
-        "catenoid", p, (0.0, 2 * np.pi, -1.0, 1.0), closed_u=True, default_uv=(0.0, 0.0),
-        description="minimal surface of revolution c cosh(z/c); hyperbolic, H = 0", params={"c": c},
+        "catenoid",
+        p,
+        (0.0, 2 * np.pi, -1.0, 1.0),
+        closed_u=True,
+        default_uv=(0.0, 0.0),
+        description="minimal surface of revolution c cosh(z/c); hyperbolic, H = 0",
+        params={"c": c},
     )
 
 
@@ -282,8 +305,13 @@ def saddle(a: float = 1.0) -> ParametricSurface:
         )
 
     return ParametricSurface(
-        "saddle", p, (-1.0, 1.0, -1.0, 1.0), derivatives=d, default_uv=(0.0, 0.0),
-        description="hyperbolic paraboloid z = a(u² − v²); hyperbolic everywhere", params={"a": a},
+        "saddle",
+        p,
+        (-1.0, 1.0, -1.0, 1.0),
+        derivatives=d,
+        default_uv=(0.0, 0.0),
+        description="hyperbolic paraboloid z = a(u² − v²); hyperbolic everywhere",
+        params={"a": a},
     )
 
 
@@ -308,7 +336,11 @@ def monkey_saddle(a: float = 1.0) -> ParametricSurface:
         )
 
     return ParametricSurface(
-        "monkey_saddle", p, (-1.0, 1.0, -1.0, 1.0), derivatives=d, default_uv=(0.0, 0.0),
+        "monkey_saddle",
+        p,
+        (-1.0, 1.0, -1.0, 1.0),
+        derivatives=d,
+        default_uv=(0.0, 0.0),
         description="z = a(u³ − 3uv²); planar point at the origin, hyperbolic elsewhere",
         params={"a": a},
     )
@@ -336,8 +368,13 @@ def cylinder(r: float = 1.0, height: float = 2.0) -> ParametricSurface:
         )
 
     return ParametricSurface(
-        "cylinder", p, (0.0, 2 * np.pi, 0.0, height), closed_u=True, derivatives=d,
-        default_uv=(0.0, height / 2), description="circular cylinder of radius r; parabolic, K = 0",
+        "cylinder",
+        p,
+        (0.0, 2 * np.pi, 0.0, height),
+        closed_u=True,
+        derivatives=d,
+        default_uv=(0.0, height / 2),
+        description="circular cylinder of radius r; parabolic, K = 0",
         params={"r": r, "height": height},
     )
 
@@ -376,8 +413,9 @@ def get_surface(name: str | ParametricSurface, **params: float) -> ParametricSur
         return name
     key = str(name).strip().lower().replace("-", "_")
     if key not in SURFACES:
-        raise MeshError(f"unknown surface {name!r}; known surfaces: {', '.join(SURFACES)}",
-                        "surface")
+        raise MeshError(
+            f"unknown surface {name!r}; known surfaces: {', '.join(SURFACES)}", "surface"
+        )
     factory = SURFACES[key]
     known = list(inspect.signature(factory).parameters)
     bad = [k for k in params if k not in known]
@@ -412,9 +450,7 @@ def check_uv(
         bad = ~np.isfinite(arr) | (arr < lo - slack) | (arr > hi + slack)
         if bad.any():
             val = arr.ravel()[int(np.flatnonzero(bad.ravel())[0])]
-            raise MeshError(
-                f"{val:g} is outside the {surface.name}'s domain [{lo:g}, {hi:g}]", nm
-            )
+            raise MeshError(f"{val:g} is outside the {surface.name}'s domain [{lo:g}, {hi:g}]", nm)
         out.append(np.clip(arr, lo, hi))
     return out[0], out[1]
 
@@ -452,8 +488,15 @@ def _supports_complex(surface: ParametricSurface) -> bool:
     return bool(np.iscomplexobj(P))
 
 
-def _stencil(fun: Callable[[np.ndarray, np.ndarray], np.ndarray], u: np.ndarray, v: np.ndarray,
-             axis: int, offsets: np.ndarray, weights: np.ndarray, step: float) -> np.ndarray:
+def _stencil(
+    fun: Callable[[np.ndarray, np.ndarray], np.ndarray],
+    u: np.ndarray,
+    v: np.ndarray,
+    axis: int,
+    offsets: np.ndarray,
+    weights: np.ndarray,
+    step: float,
+) -> np.ndarray:
     """``Σ_k w_k fun(x + o_k step) `` along ``axis`` (0 = u, 1 = v), all offsets in one call."""
     o = offsets.reshape((-1,) + (1,) * u.ndim) * step
     uu = u[None] + (o if axis == 0 else 0.0)
@@ -490,8 +533,9 @@ def surface_derivatives(
     """
     surface = get_surface(surface)
     if method not in DERIVATIVE_METHODS:
-        raise MeshError(f"unknown method {method!r}; choose one of {', '.join(DERIVATIVE_METHODS)}",
-                        "method")
+        raise MeshError(
+            f"unknown method {method!r}; choose one of {', '.join(DERIVATIVE_METHODS)}", "method"
+        )
     u, v = np.broadcast_arrays(np.asarray(u, dtype=np.float64), np.asarray(v, dtype=np.float64))
     P = np.real(_evaluate(surface, u, v)).astype(np.float64)
     if method == "exact" and surface.derivatives is None:
@@ -627,8 +671,20 @@ def curvature_fields(
     w1, w2 = W[..., :, 0], W[..., :, 1]
     nan = np.where(singular, np.nan, 1.0)
     return CurvatureFields(
-        n=n, E=E, F=F, G=G, e=e, f=f, g=g, K=K, H=H, k1=k1 * nan, k2=k2 * nan,
-        w1=w1 * nan[..., None], w2=w2 * nan[..., None], singular=singular,
+        n=n,
+        E=E,
+        F=F,
+        G=G,
+        e=e,
+        f=f,
+        g=g,
+        K=K,
+        H=H,
+        k1=k1 * nan,
+        k2=k2 * nan,
+        w1=w1 * nan[..., None],
+        w2=w2 * nan[..., None],
+        singular=singular,
     )
 
 
@@ -811,11 +867,33 @@ def point_geometry(
         angles.append(t)
     k1, k2 = float(cf.k1), float(cf.k2)
     return PointGeometry(
-        surface=surface.name, u=uf, v=vf, p=D.p, p_u=D.p_u, p_v=D.p_v, p_uu=D.p_uu, p_uv=D.p_uv,
-        p_vv=D.p_vv, n=np.asarray(cf.n), E=float(cf.E), F=float(cf.F), G=float(cf.G),
-        e=float(cf.e), f=float(cf.f), g=float(cf.g), K=float(cf.K), H=float(cf.H), k1=k1, k2=k2,
-        dir1_uv=dirs_uv[0], dir2_uv=dirs_uv[1], dir1=dirs_3d[0], dir2=dirs_3d[1],
-        theta_max=angles[0], theta_min=angles[1], classification=classify(k1, k2, tol),
+        surface=surface.name,
+        u=uf,
+        v=vf,
+        p=D.p,
+        p_u=D.p_u,
+        p_v=D.p_v,
+        p_uu=D.p_uu,
+        p_uv=D.p_uv,
+        p_vv=D.p_vv,
+        n=np.asarray(cf.n),
+        E=float(cf.E),
+        F=float(cf.F),
+        G=float(cf.G),
+        e=float(cf.e),
+        f=float(cf.f),
+        g=float(cf.g),
+        K=float(cf.K),
+        H=float(cf.H),
+        k1=k1,
+        k2=k2,
+        dir1_uv=dirs_uv[0],
+        dir2_uv=dirs_uv[1],
+        dir1=dirs_3d[0],
+        dir2=dirs_3d[1],
+        theta_max=angles[0],
+        theta_min=angles[1],
+        classification=classify(k1, k2, tol),
     )
 
 
@@ -899,8 +977,9 @@ def mesh_surface(surface: ParametricSurface | str, res: int | Sequence[int] = 32
     nu, nv = _parse_res(res)
     for closed, cnt, nm in ((surface.closed_u, nu, "u"), (surface.closed_v, nv, "v")):
         if closed and cnt < 3:
-            raise MeshError(f"the {surface.name} is closed in {nm}: needs at least 3 cells there",
-                            "res")
+            raise MeshError(
+                f"the {surface.name} is closed in {nm}: needs at least 3 cells there", "res"
+            )
     u0, u1, v0, v1 = surface.domain
     # closed directions: the last sample would repeat the first, the seam wraps instead
     us = np.linspace(u0, u1, nu + 1)[:nu] if surface.closed_u else np.linspace(u0, u1, nu + 1)
@@ -927,8 +1006,13 @@ def mesh_surface(surface: ParametricSurface | str, res: int | Sequence[int] = 32
     collapsed = np.bincount(idx.ravel(), minlength=Nu * Nv) > 1
     pole = collapsed[used]
     return SurfaceMesh(
-        V=np.ascontiguousarray(V, dtype=np.float64), F=np.ascontiguousarray(F), uv=uv,
-        pole=pole, boundary=boundary_vertex_mask(F, len(V)), surface=surface.name, res=(nu, nv),
+        V=np.ascontiguousarray(V, dtype=np.float64),
+        F=np.ascontiguousarray(F),
+        uv=uv,
+        pole=pole,
+        boundary=boundary_vertex_mask(F, len(V)),
+        surface=surface.name,
+        res=(nu, nv),
     )
 
 
@@ -1058,8 +1142,9 @@ class _Level:
     pole: BoolArray
 
 
-def _study(surface: str, mesher: str, levels: Sequence[int], exclude_poles: bool,
-           meshes: Sequence[_Level]) -> ConvergenceStudy:
+def _study(
+    surface: str, mesher: str, levels: Sequence[int], exclude_poles: bool, meshes: Sequence[_Level]
+) -> ConvergenceStudy:
     keys = ("max", "mean", "worst_uv", "worst_is_pole")
     errs: dict[str, dict[str, list[Any]]] = {e: {k: [] for k in keys} for e in ESTIMATORS}
     n_v, n_c, hs = [], [], []
@@ -1116,8 +1201,12 @@ def exact_curvature_at(
         u0, u1, v0, v1 = surface.domain
         eps_u, eps_v = 1e-6 * (u1 - u0), 1e-6 * (v1 - v0)
         tol = 1e-9 * (u1 - u0 + v1 - v0)
-        for edge, col, inside in (("u0", 0, u0 + eps_u), ("u1", 0, u1 - eps_u),
-                                  ("v0", 1, v0 + eps_v), ("v1", 1, v1 - eps_v)):
+        for edge, col, inside in (
+            ("u0", 0, u0 + eps_u),
+            ("u1", 0, u1 - eps_u),
+            ("v0", 1, v0 + eps_v),
+            ("v1", 1, v1 - eps_v),
+        ):
             if edge in surface.poles:
                 at = pole & (np.abs(uv[:, col] - surface.domain[EDGES.index(edge)]) <= tol)
                 uv[at, col] = inside
@@ -1186,8 +1275,9 @@ def convergence_study(
     if not levels:
         raise MeshError("needs at least one resolution", "res")
     if mesher == "icosphere" and surface.name != "sphere":
-        raise MeshError(f"the icosphere mesher only meshes the sphere, not the {surface.name}",
-                        "mesher")
+        raise MeshError(
+            f"the icosphere mesher only meshes the sphere, not the {surface.name}", "mesher"
+        )
     for lev in levels:  # every level checked before the first (slow) one is meshed
         if mesher == "grid":
             _parse_res(lev)
@@ -1206,8 +1296,17 @@ def convergence_study(
             r = float(surface.params.get("r", 1.0))
             V, F = icosphere(lev, r)
             n = len(V)
-            meshes.append(_Level(V, F, np.ones(n, bool), np.full(n, 1.0 / r),
-                                 np.full(n, 1.0 / r**2), None, np.zeros(n, bool)))
+            meshes.append(
+                _Level(
+                    V,
+                    F,
+                    np.ones(n, bool),
+                    np.full(n, 1.0 / r),
+                    np.full(n, 1.0 / r**2),
+                    None,
+                    np.zeros(n, bool),
+                )
+            )
         if progress is not None:
             progress(f"{surface.name}: {mesher} level {lev}, {len(meshes[-1].V)} vertices")
     return _study(surface.name, mesher, levels, exclude_poles, meshes)
@@ -1267,10 +1366,20 @@ def plot_normal_curvature(
         for t in (geo.theta_min, geo.theta_min + np.pi):
             ax.axvline(t, color="tab:blue", lw=0.8, ls=":")
             ax.plot([t], [geo.k2], "o", color="tab:blue", zorder=3)
-        ax.plot([], [], "o:", color="tab:red",
-                label=rf"max at $\theta_1 = {_num(geo.theta_max)}$, $\theta_1 + \pi$")
-        ax.plot([], [], "o:", color="tab:blue",
-                label=rf"min at $\theta_2 = {_num(geo.theta_min)}$, $\theta_2 + \pi$")
+        ax.plot(
+            [],
+            [],
+            "o:",
+            color="tab:red",
+            label=rf"max at $\theta_1 = {_num(geo.theta_max)}$, $\theta_1 + \pi$",
+        )
+        ax.plot(
+            [],
+            [],
+            "o:",
+            color="tab:blue",
+            label=rf"min at $\theta_2 = {_num(geo.theta_min)}$, $\theta_2 + \pi$",
+        )
     ticks = np.arange(0, 2 * np.pi + 1e-9, np.pi / 4)
     labels = ["0", "π/4", "π/2", "3π/4", "π", "5π/4", "3π/2", "7π/4", "2π"]
     ax.set_xticks(ticks, labels)
@@ -1288,12 +1397,14 @@ def plot_normal_curvature(
     ax.grid(alpha=0.3)
     ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize=8, framealpha=0.9)
     fig.text(
-        0.72, 0.12,
+        0.72,
+        0.12,
         "$\\kappa_n(\\theta) = \\frac{e c^2 + 2 f cs + g s^2}{E c^2 + 2 F cs + G s^2}$\n"
         "$c = \\cos\\theta,\\ s = \\sin\\theta$\n\n"
         f"E = {_num(geo.E)}, F = {_num(geo.F)}, G = {_num(geo.G)}\n"
         f"e = {_num(geo.e)}, f = {_num(geo.f)}, g = {_num(geo.g)}",
-        fontsize=8, va="bottom",
+        fontsize=8,
+        va="bottom",
     )
     with atomic_write(path, "wb") as fh:
         fig.savefig(fh, format="png")

@@ -249,8 +249,10 @@ def surface_summary(F: IntArray, n: int | None = None) -> dict[str, Any]:
         out["boundary_loop_lengths"] = []
     else:
         verts, inv = np.unique(np.concatenate([a, b]), return_inverse=True)
-        G = sp.coo_matrix((np.ones(len(a), dtype=np.int8), (inv[: len(a)], inv[len(a):])),
-                          shape=(len(verts), len(verts))).tocsr()
+        G = sp.coo_matrix(
+            (np.ones(len(a), dtype=np.int8), (inv[: len(a)], inv[len(a) :])),
+            shape=(len(verts), len(verts)),
+        ).tocsr()
         n_loops, labels = _cc(G, directed=True, connection="weak")
         has_out = np.zeros(len(verts), dtype=bool)
         has_out[inv[: len(a)]] = True  # a loop's length counts the vertices it leaves

@@ -30,27 +30,8 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
 from .errors import MeshError
+from .options import DEGENERATE_REL, MAX_COORDINATE, MIN_EXTENT, SLIVER_ANGLE
 from .types import BoolArray, FloatArray, IntArray
-
-# |coordinate| above this is rejected: the cotangent code forms products of squared edge
-# lengths (l^4); with |x| <= 1e75 every edge is below ~3.5e75 and l^4 stays below ~1.5e302.
-MAX_COORDINATE = 1e75
-
-# A mesh whose bounding-box diagonal is below this (but not 0) is rejected: squared lengths
-# (l^2) and their products (l^4, Heron's formula) underflow into subnormal numbers and the
-# cotangent weights lose their accuracy (at 1e-80 the mean curvature is already 0.2 % off).
-MIN_EXTENT = 1e-60
-
-# A face whose smallest corner angle is below this (radians, about 0.006 degrees) is reported as
-# nearly degenerate (a needle or a cap): its cotangent weights exceed 1e4, so curvature and
-# cotan-Laplacian values near it are unreliable. None of the course meshes has one.
-SLIVER_ANGLE = 1e-4
-
-# A face is "zero-area" when |(b-a) x (c-a)| <= _DEGENERATE_REL * (l0^2 + l1^2 + l2^2), i.e. it is
-# collinear up to round-off. This is the same threshold laplacian.cotangents_intrinsic uses
-# (16 A^2 <= 1e-24 (sum l^2)^2), so the faces removed here are exactly those whose cotangent
-# weights would be zeroed there.
-_DEGENERATE_REL = 0.5e-12
 
 
 def _count(n: int, singular: str, plural: str | None = None) -> str:
@@ -309,9 +290,7 @@ def topology_report(F: Any, n_vertices: int | None = None) -> MeshReport:
     del a_lo, a_hi
     cols = np.concatenate([b_lo, b_hi])
     del b_lo, b_hi
-    G = sp.csr_matrix(
-        (np.ones(len(rows), dtype=np.int8), (rows, cols)), shape=(3 * m, 3 * m)
-    )
+    G = sp.csr_matrix((np.ones(len(rows), dtype=np.int8), (rows, cols)), shape=(3 * m, 3 * m))
     del rows, cols
     # weak components of the one-directional graph = components of the undirected one
     n_wedges, labels = connected_components(G, directed=True, connection="weak")
@@ -434,9 +413,7 @@ def _coerce_faces(F: Any, label: str) -> tuple[IntArray, IntArray | None]:
         if int(sizes.sum()) != len(flat):
             raise MeshError("polygon sizes do not add up to the number of indices", label)
         return flat, sizes
-    if isinstance(F, np.ndarray) or (
-        isinstance(F, Sequence) and len(F) and not _is_ragged(F)
-    ):
+    if isinstance(F, np.ndarray) or (isinstance(F, Sequence) and len(F) and not _is_ragged(F)):
         raw = np.asarray(F)
         if raw.size == 0:
             return np.zeros((0, 3), dtype=np.int64), None
@@ -507,23 +484,26 @@ def _face_measures(
     return dbl, a, b, c
 
 
-def _degenerate_from(F: IntArray, dbl: FloatArray, a: FloatArray, b: FloatArray,
-                     c: FloatArray) -> tuple[BoolArray, BoolArray]:
+def _degenerate_from(
+    F: IntArray, dbl: FloatArray, a: FloatArray, b: FloatArray, c: FloatArray
+) -> tuple[BoolArray, BoolArray]:
     repeated = (F[:, 0] == F[:, 1]) | (F[:, 1] == F[:, 2]) | (F[:, 0] == F[:, 2])
-    zero = (dbl <= _DEGENERATE_REL * (a + b + c)) & ~repeated
+    zero = (dbl <= DEGENERATE_REL * (a + b + c)) & ~repeated
     return repeated, zero
 
 
-def _sliver_from(dbl: FloatArray, a: FloatArray, b: FloatArray, c: FloatArray,
-                 min_angle: float) -> BoolArray:
+def _sliver_from(
+    dbl: FloatArray, a: FloatArray, b: FloatArray, c: FloatArray, min_angle: float
+) -> BoolArray:
     hi = np.maximum(np.maximum(a, b), c)
     lo = np.minimum(np.minimum(a, b), c)
     mid = a + b + c - hi - lo  # accurate: hi <= 4 mid by the triangle inequality
     return dbl < np.sin(min_angle) * np.sqrt(hi * mid)
 
 
-def _face_flags(V: FloatArray, F: IntArray, chunk: int = 1 << 18
-                ) -> tuple[BoolArray, BoolArray, BoolArray]:
+def _face_flags(
+    V: FloatArray, F: IntArray, chunk: int = 1 << 18
+) -> tuple[BoolArray, BoolArray, BoolArray]:
     """Repeated-corner, zero-area and sliver masks, computed ``chunk`` faces at a time (the
     per-face temporaries of :func:`_face_measures` stay a few MB whatever the mesh size)."""
     m = len(F)
@@ -531,10 +511,10 @@ def _face_flags(V: FloatArray, F: IntArray, chunk: int = 1 << 18
     zero = np.empty(m, dtype=bool)
     sliver = np.empty(m, dtype=bool)
     for s in range(0, m, chunk):
-        Fc = F[s: s + chunk]
+        Fc = F[s : s + chunk]
         measures = _face_measures(V, Fc)
-        repeated[s: s + chunk], zero[s: s + chunk] = _degenerate_from(Fc, *measures)
-        sliver[s: s + chunk] = _sliver_from(*measures, SLIVER_ANGLE)
+        repeated[s : s + chunk], zero[s : s + chunk] = _degenerate_from(Fc, *measures)
+        sliver[s : s + chunk] = _sliver_from(*measures, SLIVER_ANGLE)
     return repeated, zero, sliver
 
 
@@ -607,9 +587,11 @@ def duplicate_positions(V: FloatArray) -> BoolArray:
         return np.zeros(n, dtype=bool)
     bits = np.ascontiguousarray(V + 0.0).view(np.uint64)
     with np.errstate(over="ignore"):
-        h = (bits[:, 0] * np.uint64(0x9E3779B97F4A7C15)
-             ^ bits[:, 1] * np.uint64(0xC2B2AE3D27D4EB4F)
-             ^ bits[:, 2] * np.uint64(0x165667B19E3779F9))
+        h = (
+            bits[:, 0] * np.uint64(0x9E3779B97F4A7C15)
+            ^ bits[:, 1] * np.uint64(0xC2B2AE3D27D4EB4F)
+            ^ bits[:, 2] * np.uint64(0x165667B19E3779F9)
+        )
     order = np.argsort(h, kind="stable")
     hs = h[order]
     cand = np.flatnonzero(hs[1:] == hs[:-1])

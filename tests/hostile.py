@@ -67,8 +67,15 @@ def off_text(V, F) -> str:
     return "\n".join(lines) + "\n"
 
 
-def ply_binary(V, F, *, byte_order: str = "<", n_vertices_header: int | None = None,
-               n_faces_header: int | None = None, index_type: str = "int") -> bytes:
+def ply_binary(
+    V,
+    F,
+    *,
+    byte_order: str = "<",
+    n_vertices_header: int | None = None,
+    n_faces_header: int | None = None,
+    index_type: str = "int",
+) -> bytes:
     """Binary PLY with ``double`` coordinates and a ``uchar``-counted index list."""
     V = np.asarray(V, dtype=float)
     F = np.asarray(F, dtype=np.int64)
@@ -92,9 +99,15 @@ def ply_ascii(V, F, *, n_faces_header: int | None = None) -> str:
     V = np.asarray(V, dtype=float)
     nf = len(F) if n_faces_header is None else n_faces_header
     head = [
-        "ply", "format ascii 1.0", f"element vertex {len(V)}", "property float x",
-        "property float y", "property float z", f"element face {nf}",
-        "property list uchar int vertex_indices", "end_header",
+        "ply",
+        "format ascii 1.0",
+        f"element vertex {len(V)}",
+        "property float x",
+        "property float y",
+        "property float z",
+        f"element face {nf}",
+        "property list uchar int vertex_indices",
+        "end_header",
     ]
     lines = head + [f"{x!r} {y!r} {z!r}" for x, y, z in V.tolist()]
     lines += [f"{len(f)} " + " ".join(str(int(i)) for i in f) for f in F]
@@ -104,8 +117,7 @@ def ply_ascii(V, F, *, n_faces_header: int | None = None) -> str:
 def stl_binary(V, F, n_header: int | None = None) -> bytes:
     V = np.asarray(V, dtype=float)
     F = np.asarray(F, dtype=np.int64)
-    rec = np.zeros(len(F), dtype=[("normal", "<f4", (3,)), ("v", "<f4", (3, 3)),
-                                  ("attr", "<u2")])
+    rec = np.zeros(len(F), dtype=[("normal", "<f4", (3,)), ("v", "<f4", (3, 3)), ("attr", "<u2")])
     with np.errstate(over="ignore"):  # huge coordinates overflow float32 on purpose
         rec["v"] = V[F]
     n = len(F) if n_header is None else n_header
@@ -146,8 +158,11 @@ def _random_bytes(n: int, seed: int) -> bytes:
 def _quads() -> str:
     """A 3 x 3 vertex grid as 4 quads (fan-triangulated into 8 triangles)."""
     V, _ = primitives.grid(3, 3)
-    quads = [[i * 3 + j, (i + 1) * 3 + j, (i + 1) * 3 + j + 1, i * 3 + j + 1]
-             for i in range(2) for j in range(2)]
+    quads = [
+        [i * 3 + j, (i + 1) * 3 + j, (i + 1) * 3 + j + 1, i * 3 + j + 1]
+        for i in range(2)
+        for j in range(2)
+    ]
     return obj_text(V, quads)
 
 
@@ -281,149 +296,397 @@ CORPUS: list[Hostile] = [
     # ---- files that are not meshes at all
     Hostile("empty.obj", _text("empty.obj", lambda: ""), "error", ("empty",)),
     Hostile("blank.off", _text("blank.off", lambda: "  \n\n\t\n"), "error", ("whitespace",)),
-    Hostile("comments.obj", _text("comments.obj", lambda: "# nothing\n# here\n"), "error",
-            ("no vertices",)),
-    Hostile("comments.off", _text("comments.off", lambda: "# OFF\n# 3 1 0\n"), "error",
-            ("not an off file",)),
-    Hostile("comments.ply", _text(
-        "comments.ply", lambda: "ply\nformat ascii 1.0\ncomment nothing\nend_header\n"),
-        "error", ("no vertices",)),
-    Hostile("garbage.obj", _text("garbage.obj", lambda: _random_bytes(4096, 1)), "error",
-            ("binary data",)),
-    Hostile("garbage.off", _text("garbage.off", lambda: _random_bytes(4096, 2)), "error",
-            ("not an off file", "binary data")),
-    Hostile("garbage.ply", _text("garbage.ply", lambda: _random_bytes(4096, 3)), "error",
-            ("not a ply file",)),
-    Hostile("garbage.stl", _text("garbage.stl", lambda: _random_bytes(4096, 4)), "error",
-            ("corrupt",)),
-    Hostile("utf16.obj", _text("utf16.obj", lambda: obj_text(*tetra()).encode("utf-16")),
-            "error", ("binary data",)),
-    Hostile("gzipped.obj", _text("gzipped.obj", lambda: gzip.compress(obj_text(*tetra()).encode(),
-                                                                       mtime=0)),
-            "error", ("binary data",)),
-    Hostile("points.obj", _text("points.obj", lambda: "v 0 0 0\nv 1 0 0\nv 0 1 0\n"), "error",
-            ("no faces",)),
-    Hostile("wrong_ext.xyz", _text("wrong_ext.xyz", lambda: obj_text(*tetra())), "error",
-            ("unknown mesh format",)),
+    Hostile(
+        "comments.obj",
+        _text("comments.obj", lambda: "# nothing\n# here\n"),
+        "error",
+        ("no vertices",),
+    ),
+    Hostile(
+        "comments.off",
+        _text("comments.off", lambda: "# OFF\n# 3 1 0\n"),
+        "error",
+        ("not an off file",),
+    ),
+    Hostile(
+        "comments.ply",
+        _text("comments.ply", lambda: "ply\nformat ascii 1.0\ncomment nothing\nend_header\n"),
+        "error",
+        ("no vertices",),
+    ),
+    Hostile(
+        "garbage.obj",
+        _text("garbage.obj", lambda: _random_bytes(4096, 1)),
+        "error",
+        ("binary data",),
+    ),
+    Hostile(
+        "garbage.off",
+        _text("garbage.off", lambda: _random_bytes(4096, 2)),
+        "error",
+        ("not an off file", "binary data"),
+    ),
+    Hostile(
+        "garbage.ply",
+        _text("garbage.ply", lambda: _random_bytes(4096, 3)),
+        "error",
+        ("not a ply file",),
+    ),
+    Hostile(
+        "garbage.stl", _text("garbage.stl", lambda: _random_bytes(4096, 4)), "error", ("corrupt",)
+    ),
+    Hostile(
+        "utf16.obj",
+        _text("utf16.obj", lambda: obj_text(*tetra()).encode("utf-16")),
+        "error",
+        ("binary data",),
+    ),
+    Hostile(
+        "gzipped.obj",
+        _text("gzipped.obj", lambda: gzip.compress(obj_text(*tetra()).encode(), mtime=0)),
+        "error",
+        ("binary data",),
+    ),
+    Hostile(
+        "points.obj",
+        _text("points.obj", lambda: "v 0 0 0\nv 1 0 0\nv 0 1 0\n"),
+        "error",
+        ("no faces",),
+    ),
+    Hostile(
+        "wrong_ext.xyz",
+        _text("wrong_ext.xyz", lambda: obj_text(*tetra())),
+        "error",
+        ("unknown mesh format",),
+    ),
     Hostile("meshdir.obj", _directory, "error", ("directory",)),
     # ---- truncated and lying headers
-    Hostile("truncated.off", _text("truncated.off", lambda: off_text(*tetra())[:40]), "error",
-            ("truncated",)),
-    Hostile("lying.off", _text("lying.off", lambda: off_text(*tetra()).replace("4 4 0", "3 1 0")),
-            "error", ("do not match",)),
-    Hostile("huge_counts.off", _text("huge_counts.off", _huge_count_off), "error",
-            ("truncated",)),
-    Hostile("truncated.ply", _text("truncated.ply", lambda: _cube_ply_binary()[:300]), "error",
-            ("truncated",)),
-    Hostile("lying_vertices.ply", _text(
-        "lying_vertices.ply", lambda: ply_binary(*primitives.cube(), n_vertices_header=2**31 - 1)),
-        "error", ("truncated",)),
-    Hostile("lying_faces.ply", _text(
-        "lying_faces.ply", lambda: ply_binary(*primitives.cube(), n_faces_header=2**31 - 1)),
-        "error", ("truncated",)),
-    Hostile("lying_ascii.ply", _text(
-        "lying_ascii.ply", lambda: ply_ascii(*primitives.cube(), n_faces_header=2)),
-        "error", ("do not match",)),
-    Hostile("no_end_header.ply", _text(
-        "no_end_header.ply", lambda: ply_ascii(*tetra()).replace("end_header", "end_heade")),
-        "error", ("end_header",)),
-    Hostile("ascii_says_binary.ply", _text(
+    Hostile(
+        "truncated.off",
+        _text("truncated.off", lambda: off_text(*tetra())[:40]),
+        "error",
+        ("truncated",),
+    ),
+    Hostile(
+        "lying.off",
+        _text("lying.off", lambda: off_text(*tetra()).replace("4 4 0", "3 1 0")),
+        "error",
+        ("do not match",),
+    ),
+    Hostile("huge_counts.off", _text("huge_counts.off", _huge_count_off), "error", ("truncated",)),
+    Hostile(
+        "truncated.ply",
+        _text("truncated.ply", lambda: _cube_ply_binary()[:300]),
+        "error",
+        ("truncated",),
+    ),
+    Hostile(
+        "lying_vertices.ply",
+        _text(
+            "lying_vertices.ply",
+            lambda: ply_binary(*primitives.cube(), n_vertices_header=2**31 - 1),
+        ),
+        "error",
+        ("truncated",),
+    ),
+    Hostile(
+        "lying_faces.ply",
+        _text("lying_faces.ply", lambda: ply_binary(*primitives.cube(), n_faces_header=2**31 - 1)),
+        "error",
+        ("truncated",),
+    ),
+    Hostile(
+        "lying_ascii.ply",
+        _text("lying_ascii.ply", lambda: ply_ascii(*primitives.cube(), n_faces_header=2)),
+        "error",
+        ("do not match",),
+    ),
+    Hostile(
+        "no_end_header.ply",
+        _text("no_end_header.ply", lambda: ply_ascii(*tetra()).replace("end_header", "end_heade")),
+        "error",
+        ("end_header",),
+    ),
+    Hostile(
         "ascii_says_binary.ply",
-        lambda: _cube_ply_binary().replace(b"binary_little_endian", b"ascii")),
-        "error", ("binary data",)),
-    Hostile("float_index.ply", _text(
-        "float_index.ply", lambda: ply_binary(*tetra(), index_type="float")),
-        "error", ("integers",)),
-    Hostile("truncated.stl", _text(
-        "truncated.stl", lambda: stl_binary(*primitives.cube())[:-30]), "error", ("truncated",)),
-    Hostile("lying.stl", _text(
-        "lying.stl", lambda: stl_binary(*primitives.cube(), n_header=2**32 - 1)), "error",
-        ("corrupt",)),
+        _text(
+            "ascii_says_binary.ply",
+            lambda: _cube_ply_binary().replace(b"binary_little_endian", b"ascii"),
+        ),
+        "error",
+        ("binary data",),
+    ),
+    Hostile(
+        "float_index.ply",
+        _text("float_index.ply", lambda: ply_binary(*tetra(), index_type="float")),
+        "error",
+        ("integers",),
+    ),
+    Hostile(
+        "truncated.stl",
+        _text("truncated.stl", lambda: stl_binary(*primitives.cube())[:-30]),
+        "error",
+        ("truncated",),
+    ),
+    Hostile(
+        "lying.stl",
+        _text("lying.stl", lambda: stl_binary(*primitives.cube(), n_header=2**32 - 1)),
+        "error",
+        ("corrupt",),
+    ),
     # ---- bad numbers
-    Hostile("nan.obj", _text("nan.obj", lambda: obj_text(*tetra()).replace("v 0.0 0.0 1.0",
-                                                                            "v 0 nan 1")),
-            "error", ("nan",)),
-    Hostile("inf.off", _text("inf.off", lambda: off_text(*tetra()).replace("1.0 0.0 0.0",
-                                                                          "1.0 inf 0.0")),
-            "error", ("infinite",)),
-    Hostile("huge.ply", _text("huge.ply", lambda: ply_binary(tetra()[0] * 1e300, tetra()[1])),
-            "error", ("overflow",)),
-    Hostile("huge.stl", _text("huge.stl", lambda: stl_binary(tetra()[0] * 1e39, tetra()[1])),
-            "error", ("infinite",)),  # 1e39 overflows float32 to inf
+    Hostile(
+        "nan.obj",
+        _text("nan.obj", lambda: obj_text(*tetra()).replace("v 0.0 0.0 1.0", "v 0 nan 1")),
+        "error",
+        ("nan",),
+    ),
+    Hostile(
+        "inf.off",
+        _text("inf.off", lambda: off_text(*tetra()).replace("1.0 0.0 0.0", "1.0 inf 0.0")),
+        "error",
+        ("infinite",),
+    ),
+    Hostile(
+        "huge.ply",
+        _text("huge.ply", lambda: ply_binary(tetra()[0] * 1e300, tetra()[1])),
+        "error",
+        ("overflow",),
+    ),
+    Hostile(
+        "huge.stl",
+        _text("huge.stl", lambda: stl_binary(tetra()[0] * 1e39, tetra()[1])),
+        "error",
+        ("infinite",),
+    ),  # 1e39 overflows float32 to inf
     # ---- bad indices
-    Hostile("index_oob.obj", _text("index_oob.obj", lambda: obj_text(*tetra()) + "f 1 2 9\n"),
-            "error", ("vertex 9",)),
-    Hostile("index_oob.off", _text(
-        "index_oob.off", lambda: off_text(tetra()[0], [[0, 1, 2], [0, 1, 7]])), "error",
-        ("index 7",)),
-    Hostile("index_negative.off", _text(
-        "index_negative.off", lambda: off_text(tetra()[0], [[0, 1, 2], [0, 1, -1]])), "error",
-        ("index -1",)),
-    Hostile("index_oob.ply", _text(
-        "index_oob.ply", lambda: ply_binary(tetra()[0], [[0, 1, 2], [0, 1, 4]])), "error",
-        ("index 4",)),
-    Hostile("zero_index.obj", _text(
-        "zero_index.obj", lambda: obj_text(*tetra(), one_based=False)), "error",
-        ("start at 1",)),
-    Hostile("negative_oob.obj", _text(
-        "negative_oob.obj", lambda: "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -9\n"), "error",
-        ("relative index",)),
-    Hostile("face1.obj", _text("face1.obj", lambda: obj_text(*tetra()) + "f 1\n"), "error",
-            ("at least 3",)),
-    Hostile("face2.off", _text("face2.off", lambda: off_text(tetra()[0], [[0, 1, 2], [0, 1]])),
-            "error", ("at least 3",)),
-    Hostile("face2.ply", _text("face2.ply", lambda: ply_ascii(tetra()[0], [[0, 1, 2], [0, 1]])),
-            "error", ("at least 3",)),
-    Hostile("all_degenerate.obj", _text(
+    Hostile(
+        "index_oob.obj",
+        _text("index_oob.obj", lambda: obj_text(*tetra()) + "f 1 2 9\n"),
+        "error",
+        ("vertex 9",),
+    ),
+    Hostile(
+        "index_oob.off",
+        _text("index_oob.off", lambda: off_text(tetra()[0], [[0, 1, 2], [0, 1, 7]])),
+        "error",
+        ("index 7",),
+    ),
+    Hostile(
+        "index_negative.off",
+        _text("index_negative.off", lambda: off_text(tetra()[0], [[0, 1, 2], [0, 1, -1]])),
+        "error",
+        ("index -1",),
+    ),
+    Hostile(
+        "index_oob.ply",
+        _text("index_oob.ply", lambda: ply_binary(tetra()[0], [[0, 1, 2], [0, 1, 4]])),
+        "error",
+        ("index 4",),
+    ),
+    Hostile(
+        "zero_index.obj",
+        _text("zero_index.obj", lambda: obj_text(*tetra(), one_based=False)),
+        "error",
+        ("start at 1",),
+    ),
+    Hostile(
+        "negative_oob.obj",
+        _text("negative_oob.obj", lambda: "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -9\n"),
+        "error",
+        ("relative index",),
+    ),
+    Hostile(
+        "face1.obj",
+        _text("face1.obj", lambda: obj_text(*tetra()) + "f 1\n"),
+        "error",
+        ("at least 3",),
+    ),
+    Hostile(
+        "face2.off",
+        _text("face2.off", lambda: off_text(tetra()[0], [[0, 1, 2], [0, 1]])),
+        "error",
+        ("at least 3",),
+    ),
+    Hostile(
+        "face2.ply",
+        _text("face2.ply", lambda: ply_ascii(tetra()[0], [[0, 1, 2], [0, 1]])),
+        "error",
+        ("at least 3",),
+    ),
+    Hostile(
         "all_degenerate.obj",
-        lambda: obj_text([[0, 0, 0], [1, 0, 0], [2, 0, 0], [3, 0, 0]], [[0, 1, 2], [1, 2, 3]])),
-        "error", ("degenerate",)),
-    Hostile("all_repeated.off", _text(
-        "all_repeated.off", lambda: off_text(tetra()[0], [[0, 0, 1], [2, 3, 3]])), "error",
-        ("degenerate",)),
+        _text(
+            "all_degenerate.obj",
+            lambda: obj_text([[0, 0, 0], [1, 0, 0], [2, 0, 0], [3, 0, 0]], [[0, 1, 2], [1, 2, 3]]),
+        ),
+        "error",
+        ("degenerate",),
+    ),
+    Hostile(
+        "all_repeated.off",
+        _text("all_repeated.off", lambda: off_text(tetra()[0], [[0, 0, 1], [2, 3, 3]])),
+        "error",
+        ("degenerate",),
+    ),
     # ---- files that load (repaired and/or with warnings)
-    Hostile("single_triangle.obj", _text("single_triangle.obj", lambda: obj_text(TRI_V, TRI_F)),
-            "ok", n_vertices=3, n_faces=1),
-    Hostile("quads.obj", _text("quads.obj", _quads), "ok", n_vertices=9, n_faces=8,
-            repairs=("triangulated",)),
-    Hostile("pentagon.off", _text("pentagon.off", _pentagon_off), "ok", n_vertices=5,
-            n_faces=3, repairs=("triangulated",)),
-    Hostile("collinear.obj", _text("collinear.obj", _with_collinear), "ok", n_vertices=9,
-            n_faces=8, repairs=("degenerate",)),
-    Hostile("duplicate_faces.obj", _text("duplicate_faces.obj", _with_duplicate_faces), "ok",
-            n_vertices=8, n_faces=12, repairs=("duplicate face",), closed=True),
-    Hostile("duplicate_vertices.obj", _text("duplicate_vertices.obj", _duplicate_vertices),
-            "ok", n_vertices=6, n_faces=2, warnings=("same position",)),
-    Hostile("nonmanifold_edge.obj", _text("nonmanifold_edge.obj", _nonmanifold_edge), "ok",
-            n_vertices=5, n_faces=3, warnings=("non-manifold edge",), manifold=False),
-    Hostile("bowtie.obj", _text("bowtie.obj", _bowtie), "ok", n_vertices=5, n_faces=2,
-            warnings=("non-manifold vert",)),
-    Hostile("inconsistent.obj", _text("inconsistent.obj", _inconsistent), "ok", n_vertices=16,
-            n_faces=18, warnings=("not consistently oriented",), manifold=False),
-    Hostile("components.obj", _text("components.obj", _components), "ok", n_vertices=49,
-            n_faces=85),
-    Hostile("isolated.obj", _text("isolated.obj", _isolated), "ok", n_vertices=8, n_faces=12,
-            repairs=("3 unreferenced",), closed=True),
-    Hostile("relative.obj", _text("relative.obj", _relative_indices), "ok", n_vertices=4,
-            n_faces=4, closed=True),
-    Hostile("crlf_bom.obj", _text("crlf_bom.obj", _crlf_bom), "ok", n_vertices=4, n_faces=4,
-            closed=True),
-    Hostile("bigendian.ply", _text("bigendian.ply",
-                                   lambda: ply_binary(*primitives.cube(), byte_order=">")),
-            "ok", n_vertices=8, n_faces=12, closed=True),
-    Hostile("cube.stl", _text("cube.stl", lambda: stl_binary(*primitives.cube())), "ok",
-            n_vertices=8, n_faces=12, repairs=("welded",), closed=True),
+    Hostile(
+        "single_triangle.obj",
+        _text("single_triangle.obj", lambda: obj_text(TRI_V, TRI_F)),
+        "ok",
+        n_vertices=3,
+        n_faces=1,
+    ),
+    Hostile(
+        "quads.obj",
+        _text("quads.obj", _quads),
+        "ok",
+        n_vertices=9,
+        n_faces=8,
+        repairs=("triangulated",),
+    ),
+    Hostile(
+        "pentagon.off",
+        _text("pentagon.off", _pentagon_off),
+        "ok",
+        n_vertices=5,
+        n_faces=3,
+        repairs=("triangulated",),
+    ),
+    Hostile(
+        "collinear.obj",
+        _text("collinear.obj", _with_collinear),
+        "ok",
+        n_vertices=9,
+        n_faces=8,
+        repairs=("degenerate",),
+    ),
+    Hostile(
+        "duplicate_faces.obj",
+        _text("duplicate_faces.obj", _with_duplicate_faces),
+        "ok",
+        n_vertices=8,
+        n_faces=12,
+        repairs=("duplicate face",),
+        closed=True,
+    ),
+    Hostile(
+        "duplicate_vertices.obj",
+        _text("duplicate_vertices.obj", _duplicate_vertices),
+        "ok",
+        n_vertices=6,
+        n_faces=2,
+        warnings=("same position",),
+    ),
+    Hostile(
+        "nonmanifold_edge.obj",
+        _text("nonmanifold_edge.obj", _nonmanifold_edge),
+        "ok",
+        n_vertices=5,
+        n_faces=3,
+        warnings=("non-manifold edge",),
+        manifold=False,
+    ),
+    Hostile(
+        "bowtie.obj",
+        _text("bowtie.obj", _bowtie),
+        "ok",
+        n_vertices=5,
+        n_faces=2,
+        warnings=("non-manifold vert",),
+    ),
+    Hostile(
+        "inconsistent.obj",
+        _text("inconsistent.obj", _inconsistent),
+        "ok",
+        n_vertices=16,
+        n_faces=18,
+        warnings=("not consistently oriented",),
+        manifold=False,
+    ),
+    Hostile(
+        "components.obj", _text("components.obj", _components), "ok", n_vertices=49, n_faces=85
+    ),
+    Hostile(
+        "isolated.obj",
+        _text("isolated.obj", _isolated),
+        "ok",
+        n_vertices=8,
+        n_faces=12,
+        repairs=("3 unreferenced",),
+        closed=True,
+    ),
+    Hostile(
+        "relative.obj",
+        _text("relative.obj", _relative_indices),
+        "ok",
+        n_vertices=4,
+        n_faces=4,
+        closed=True,
+    ),
+    Hostile(
+        "crlf_bom.obj", _text("crlf_bom.obj", _crlf_bom), "ok", n_vertices=4, n_faces=4, closed=True
+    ),
+    Hostile(
+        "bigendian.ply",
+        _text("bigendian.ply", lambda: ply_binary(*primitives.cube(), byte_order=">")),
+        "ok",
+        n_vertices=8,
+        n_faces=12,
+        closed=True,
+    ),
+    Hostile(
+        "cube.stl",
+        _text("cube.stl", lambda: stl_binary(*primitives.cube())),
+        "ok",
+        n_vertices=8,
+        n_faces=12,
+        repairs=("welded",),
+        closed=True,
+    ),
     # ---- numerically degenerate but valid geometry
-    Hostile("needles.obj", _text("needles.obj", _needles), "ok", n_vertices=25, n_faces=32,
-            warnings=("nearly degenerate",)),
-    Hostile("cap.obj", _text("cap.obj", _caps), "ok", n_vertices=5, n_faces=6,
-            warnings=("nearly degenerate",), closed=True),
-    Hostile("near_zero_area.obj", _text("near_zero_area.obj", _near_zero_area), "ok",
-            n_vertices=72, n_faces=144, warnings=("nearly degenerate",), closed=True),
-    Hostile("tiny_scale.obj", _text("tiny_scale.obj", _scaled(1e-60)), "ok", n_vertices=42,
-            n_faces=80, closed=True),
-    Hostile("large_scale.obj", _text("large_scale.obj", _scaled(1e60)), "ok", n_vertices=42,
-            n_faces=80, closed=True),
+    Hostile(
+        "needles.obj",
+        _text("needles.obj", _needles),
+        "ok",
+        n_vertices=25,
+        n_faces=32,
+        warnings=("nearly degenerate",),
+    ),
+    Hostile(
+        "cap.obj",
+        _text("cap.obj", _caps),
+        "ok",
+        n_vertices=5,
+        n_faces=6,
+        warnings=("nearly degenerate",),
+        closed=True,
+    ),
+    Hostile(
+        "near_zero_area.obj",
+        _text("near_zero_area.obj", _near_zero_area),
+        "ok",
+        n_vertices=72,
+        n_faces=144,
+        warnings=("nearly degenerate",),
+        closed=True,
+    ),
+    Hostile(
+        "tiny_scale.obj",
+        _text("tiny_scale.obj", _scaled(1e-60)),
+        "ok",
+        n_vertices=42,
+        n_faces=80,
+        closed=True,
+    ),
+    Hostile(
+        "large_scale.obj",
+        _text("large_scale.obj", _scaled(1e60)),
+        "ok",
+        n_vertices=42,
+        n_faces=80,
+        closed=True,
+    ),
 ]
 
 BY_NAME: dict[str, Hostile] = {h.name: h for h in CORPUS}

@@ -75,7 +75,7 @@ def test_invariant_subspace_breakdown_continues_with_orthonormal_random_blocks()
     # three distinct eigenvalues: the Krylov space is exhausted after one block of 4
     theta = np.repeat([3.0, 2.0, 1.0], [100, 200, 200])
     lz = _diag_lanczos(theta, delayed=True, steps=6)
-    Q = lz.Q[:, :lz.j]
+    Q = lz.Q[:, : lz.j]
     assert np.abs(Q.T @ Q - np.eye(lz.j)).max() < 1e-12
     th, _, _, _ = lz.ritz(lz.j)
     # every Ritz value is one of the three eigenvalues (to round-off)
@@ -88,7 +88,7 @@ def test_deflated_vectors_stay_out_of_the_basis():
     X = np.zeros((n, 2))
     X[0, 0] = X[1, 1] = 1.0  # the two largest eigenvectors of diag(theta)
     lz = _diag_lanczos(theta, delayed=True, X=X, steps=40)
-    Q = lz.Q[:, :lz.j]
+    Q = lz.Q[:, : lz.j]
     assert np.abs(X.T @ Q).max() < 1e-13
     th, _, res, _ = lz.ritz(1)
     assert res[0] < 1e-8
@@ -181,8 +181,11 @@ def test_shift_invert_falls_back_to_superlu_without_qdldl(monkeypatch):
     monkeypatch.setattr(S, "_qdldl_inertia", unavailable)
     op_s = S._ShiftInvert(A, 0.25, rng=rng, spacing=1.0)
     assert isinstance(op_q._lu, S._QDLDL) and isinstance(op_s._lu, S._LDL)
-    assert op_q.n_below == op_s.n_below == np.count_nonzero(
-        np.linalg.eigvalsh(A.toarray()) < op_q.sigma)
+    assert (
+        op_q.n_below
+        == op_s.n_below
+        == np.count_nonzero(np.linalg.eigvalsh(A.toarray()) < op_q.sigma)
+    )
     Y = np.asfortranarray(rng.standard_normal((A.shape[0], 4)))
     out_q, out_s = np.empty_like(Y), np.empty_like(Y)
     op_q(Y, out_q)
@@ -203,8 +206,7 @@ def test_a_shift_on_an_eigenvalue_is_moved_not_factored():
 
 def test_two_workers_get_an_even_number_of_equal_slices():
     V, F = bumpy_sphere(3)  # (no exact multiplicities: no repair slice)
-    lam, _, info = S.laplacian_eigenpairs(V, F, 200, method="sparse", slice_size=40,
-                                          workers=2)
+    lam, _, info = S.laplacian_eigenpairs(V, F, 200, method="sparse", slice_size=40, workers=2)
     n_slices = len(info.krylov_dims)
     assert n_slices >= 4 and n_slices % 2 == 0, info.messages
     K, m = S.spectral_operators(V, F)

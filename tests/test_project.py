@@ -39,11 +39,12 @@ def test_core_never_imports_polyscope():
     assert res.returncode == 0, res.stderr
 
 
-def test_ruff_clean():
+@pytest.mark.parametrize("args", [["check"], ["format", "--check"]], ids=["check", "format"])
+def test_ruff_clean(args):
     ruff = shutil.which("ruff") or str(Path(sys.executable).parent / "ruff")
     if not Path(ruff).exists():
         pytest.skip("ruff is not installed (it comes with the [test] extra)")
-    res = subprocess.run([ruff, "check", str(ROOT)], capture_output=True, text=True, timeout=120)
+    res = subprocess.run([ruff, *args, str(ROOT)], capture_output=True, text=True, timeout=120)
     assert res.returncode == 0, res.stdout + res.stderr
 
 

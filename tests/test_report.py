@@ -22,44 +22,170 @@ PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 
 # the columns every table must have (written here, independently of the module)
 EXPECTED_COLUMNS = {
-    "onering_cube": ["vertex", "valence", "kind", "neighbours_ccw", "neighbours_cw",
-                     "ccw_pairs_are_faces"],
-    "uniform_ranges": ["mesh", "field", "vertices", "n", "min", "max", "mean", "median", "p01",
-                       "p99"],
+    "onering_cube": [
+        "vertex",
+        "valence",
+        "kind",
+        "neighbours_ccw",
+        "neighbours_cw",
+        "ccw_pairs_are_faces",
+    ],
+    "uniform_ranges": [
+        "mesh",
+        "field",
+        "vertices",
+        "n",
+        "min",
+        "max",
+        "mean",
+        "median",
+        "p01",
+        "p99",
+    ],
     "gauss_bonnet": ["mesh", "euler_characteristic", "sum_K_A", "two_pi_chi", "abs_difference"],
     "helicoid_origin": ["quantity", "computed", "closed_form", "abs_difference"],
-    "helicoid_principal": ["u", "v", "k1", "k2", "k1_exact", "k2_exact", "K", "K_exact",
-                           "H_surfaces", "H_core_sign", "classification"],
-    "convergence": ["surface", "mesher", "res", "vertices", "h", "estimator", "max_error",
-                    "order_max", "mean_error", "order_mean"],
-    "convergence_summary": ["surface", "mesher", "estimator", "levels", "max_error_coarsest",
-                            "max_error_finest", "order_max_finest", "mean_error_finest",
-                            "order_mean_finest"],
-    "cotan_uniform_ranges": ["mesh", "field", "vertices", "min", "max", "mean", "median", "p01",
-                             "p99"],
-    "cotan_scaling": ["estimator", "median_abs_s1", "median_abs_s2", "ratio",
-                      "expected_for_a_curvature"],
-    "spectral_errors": ["k", "lambda_k", "mean_error", "max_error", "rms_error",
-                        "rms_error_no_mass", "rms_error_unit_vectors"],
-    "spectral_timings": ["mesh", "vertices", "k", "method", "seconds", "eigensolve_seconds",
-                         "max_residual", "lambda_max", "speedup_vs_388s", "speedup_vs_5771s"],
-    "smoothing_stability": ["mesh", "laplacian", "method", "lam", "lam_over_limit", "mu_min",
-                            "explicit_lam_limit", "high_freq_gain", "spectral_radius", "stable",
-                            "iterations", "diverged", "drift_rms", "volume_change_pct",
-                            "ms_per_step"],
-    "denoise_sweep": ["case", "noise", "method", "laplacian", "lam", "lam_over_limit", "iters",
-                      "rmse", "rmse_noisy", "max_error", "volume_change_pct",
-                      "volume_change_noisy_pct", "dihedral_mae_deg", "dihedral_mae_noisy_deg",
-                      "normal_dev_deg", "stable", "diverged", "seconds"],
-    "denoise_recommendation": ["case", "noise_level", "rmse_noisy", "best_rmse_setting",
-                               "best_rmse", "rmse_reduction_pct", "best_rmse_volume_change_pct",
-                               "best_dihedral_setting", "best_dihedral_mae_deg",
-                               "noisy_dihedral_mae_deg", "best_rmse_volume_1pct_setting",
-                               "best_rmse_volume_1pct", "best_rmse_volume_1pct_change_pct"],
-    "denoise_best_per_method": ["case", "noise_level", "laplacian", "method", "lam",
-                                "lam_over_limit", "iters", "rmse", "rmse_noisy",
-                                "volume_change_pct", "dihedral_mae_deg", "diverged_runs",
-                                "runs"],
+    "helicoid_principal": [
+        "u",
+        "v",
+        "k1",
+        "k2",
+        "k1_exact",
+        "k2_exact",
+        "K",
+        "K_exact",
+        "H_surfaces",
+        "H_core_sign",
+        "classification",
+    ],
+    "convergence": [
+        "surface",
+        "mesher",
+        "res",
+        "vertices",
+        "h",
+        "estimator",
+        "max_error",
+        "order_max",
+        "mean_error",
+        "order_mean",
+    ],
+    "convergence_summary": [
+        "surface",
+        "mesher",
+        "estimator",
+        "levels",
+        "max_error_coarsest",
+        "max_error_finest",
+        "order_max_finest",
+        "mean_error_finest",
+        "order_mean_finest",
+    ],
+    "cotan_uniform_ranges": [
+        "mesh",
+        "field",
+        "vertices",
+        "min",
+        "max",
+        "mean",
+        "median",
+        "p01",
+        "p99",
+    ],
+    "cotan_scaling": [
+        "estimator",
+        "median_abs_s1",
+        "median_abs_s2",
+        "ratio",
+        "expected_for_a_curvature",
+    ],
+    "spectral_errors": [
+        "k",
+        "lambda_k",
+        "mean_error",
+        "max_error",
+        "rms_error",
+        "rms_error_no_mass",
+        "rms_error_unit_vectors",
+    ],
+    "spectral_timings": [
+        "mesh",
+        "vertices",
+        "k",
+        "method",
+        "seconds",
+        "eigensolve_seconds",
+        "max_residual",
+        "lambda_max",
+        "speedup_vs_388s",
+        "speedup_vs_5771s",
+    ],
+    "smoothing_stability": [
+        "mesh",
+        "laplacian",
+        "method",
+        "lam",
+        "lam_over_limit",
+        "mu_min",
+        "explicit_lam_limit",
+        "high_freq_gain",
+        "spectral_radius",
+        "stable",
+        "iterations",
+        "diverged",
+        "drift_rms",
+        "volume_change_pct",
+        "ms_per_step",
+    ],
+    "denoise_sweep": [
+        "case",
+        "noise",
+        "method",
+        "laplacian",
+        "lam",
+        "lam_over_limit",
+        "iters",
+        "rmse",
+        "rmse_noisy",
+        "max_error",
+        "volume_change_pct",
+        "volume_change_noisy_pct",
+        "dihedral_mae_deg",
+        "dihedral_mae_noisy_deg",
+        "normal_dev_deg",
+        "stable",
+        "diverged",
+        "seconds",
+    ],
+    "denoise_recommendation": [
+        "case",
+        "noise_level",
+        "rmse_noisy",
+        "best_rmse_setting",
+        "best_rmse",
+        "rmse_reduction_pct",
+        "best_rmse_volume_change_pct",
+        "best_dihedral_setting",
+        "best_dihedral_mae_deg",
+        "noisy_dihedral_mae_deg",
+        "best_rmse_volume_1pct_setting",
+        "best_rmse_volume_1pct",
+        "best_rmse_volume_1pct_change_pct",
+    ],
+    "denoise_best_per_method": [
+        "case",
+        "noise_level",
+        "laplacian",
+        "method",
+        "lam",
+        "lam_over_limit",
+        "iters",
+        "rmse",
+        "rmse_noisy",
+        "volume_change_pct",
+        "dihedral_mae_deg",
+        "diverged_runs",
+        "runs",
+    ],
     "section_timings": ["section", "title", "seconds", "figures", "tables", "status"],
 }
 
@@ -122,8 +248,9 @@ def test_every_referenced_figure_exists_and_is_a_valid_png(quick):
     # nothing written that the report does not show
     written = {p.relative_to(quick.out_dir).as_posix() for p in quick.figures}
     assert written == md_figs
-    assert {p.name for p in (quick.out_dir / "figures").iterdir()} == {Path(r).name
-                                                                       for r in md_figs}
+    assert {p.name for p in (quick.out_dir / "figures").iterdir()} == {
+        Path(r).name for r in md_figs
+    }
 
 
 def test_screenshots_are_real_unless_egl_is_missing(quick):
@@ -157,8 +284,23 @@ def test_every_table_has_the_expected_columns(quick):
         assert all(len(r) == len(cols) for r in rows), name
 
 
-VOID_TAGS = frozenset({"area", "base", "br", "col", "embed", "hr", "img", "input", "link", "meta",
-                       "source", "track", "wbr"})
+VOID_TAGS = frozenset(
+    {
+        "area",
+        "base",
+        "br",
+        "col",
+        "embed",
+        "hr",
+        "img",
+        "input",
+        "link",
+        "meta",
+        "source",
+        "track",
+        "wbr",
+    }
+)
 
 
 class _Checker(HTMLParser):
@@ -187,8 +329,10 @@ class _Checker(HTMLParser):
         if tag in self.VOID:
             return
         if not self.stack or self.stack[-1] != tag:
-            self.problems.append(f"</{tag}> closes <{self.stack[-1] if self.stack else None}>"
-                                 f" at line {self.getpos()[0]}")
+            self.problems.append(
+                f"</{tag}> closes <{self.stack[-1] if self.stack else None}>"
+                f" at line {self.getpos()[0]}"
+            )
             return
         self.stack.pop()
 
@@ -230,8 +374,10 @@ def test_tables_agree_with_the_mathematics(quick):
     # convergence under refinement (analytic references): second order with the Voronoi area
     # on the icospheres, a stall near 15 % with the barycentric one; H uniform never converges
     # on the sphere (it is O(h^2), so its error tends to |H| = 1)
-    conv = {(r["surface"], r["mesher"], r["estimator"]): r
-            for r in read_table(quick, "convergence_summary")}
+    conv = {
+        (r["surface"], r["mesher"], r["estimator"]): r
+        for r in read_table(quick, "convergence_summary")
+    }
     ico = {e: r for (s_, m_, e), r in conv.items() if (s_, m_) == ("sphere", "icosphere")}
     assert float(ico["K deficit voronoi"]["order_max_finest"]) > 1.5
     assert 0.1 < float(ico["H cotan barycentric"]["max_error_finest"]) < 0.2
@@ -276,8 +422,11 @@ def test_spectral_and_smoothing_tables_show_the_expected_behaviour(quick):
     # the uniform Laplacian's spectrum lies in [-2, 0]
     assert all(-2 - 1e-9 <= float(r["mu_min"]) < 0 for r in rows if r["laplacian"] == "uniform")
     # twice the explicit limit multiplies the top mode by -3 per step: it must blow up
-    twice = [r for r in rows if r["method"] == "explicit"
-             and float(r["lam_over_limit"]) == pytest.approx(2.0, rel=1e-2)]
+    twice = [
+        r
+        for r in rows
+        if r["method"] == "explicit" and float(r["lam_over_limit"]) == pytest.approx(2.0, rel=1e-2)
+    ]
     assert twice and all(r["diverged"] == "true" for r in twice)
 
 
@@ -323,8 +472,20 @@ def test_failed_screenshots_fall_back_to_renderings_with_a_note(tmp_path):
 def test_cli_report_json_and_progress(tmp_path, capsys):
     empty = tmp_path / "none"
     empty.mkdir()
-    code = main(["report", "--meshes", str(empty), "--out", str(tmp_path / "o"), "--quick",
-                 "--sections", "onering", "--no-screenshots", "--json"])
+    code = main(
+        [
+            "report",
+            "--meshes",
+            str(empty),
+            "--out",
+            str(tmp_path / "o"),
+            "--quick",
+            "--sections",
+            "onering",
+            "--no-screenshots",
+            "--json",
+        ]
+    )
     cap = capsys.readouterr()
     assert code == 0
     obj = json.loads(cap.out)

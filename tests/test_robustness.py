@@ -74,8 +74,17 @@ MESH_COMMANDS: dict[str, tuple[Argv, tuple[str, ...]]] = {
         ("k.npy",),
     ),
     "curvature-k1-voronoi": (
-        lambda m, out: ["curvature", m, "--method", "k1", "--area", "voronoi", "--json",
-                        "--out", out / "k1.csv"],
+        lambda m, out: [
+            "curvature",
+            m,
+            "--method",
+            "k1",
+            "--area",
+            "voronoi",
+            "--json",
+            "--out",
+            out / "k1.csv",
+        ],
         ("k1.csv",),
     ),
     "onering": (lambda m, out: ["onering", m, "--vertex", 0, "--json"], ()),
@@ -84,8 +93,21 @@ MESH_COMMANDS: dict[str, tuple[Argv, tuple[str, ...]]] = {
         ("s.ply",),
     ),
     "smooth-implicit-cotan": (  # the cotan lam has units of length²: scale it to the mesh
-        lambda m, out: ["smooth", m, "--method", "implicit", "--laplacian", "cotan",
-                        "--lam", _lam_for(m), "--iters", 2, "--json", "--out", out / "si.obj"],
+        lambda m, out: [
+            "smooth",
+            m,
+            "--method",
+            "implicit",
+            "--laplacian",
+            "cotan",
+            "--lam",
+            _lam_for(m),
+            "--iters",
+            2,
+            "--json",
+            "--out",
+            out / "si.obj",
+        ],
         ("si.obj",),
     ),
     "smooth-taubin": (
@@ -93,9 +115,23 @@ MESH_COMMANDS: dict[str, tuple[Argv, tuple[str, ...]]] = {
         (),
     ),
     "denoise-eval": (
-        lambda m, out: ["denoise-eval", m, "--methods", "explicit,implicit",
-                        "--laplacian", "uniform,cotan", "--lam", "0.5", "--iters", 2,
-                        "--noise", "0.01", "--json", "--csv", out / "t.csv"],
+        lambda m, out: [
+            "denoise-eval",
+            m,
+            "--methods",
+            "explicit,implicit",
+            "--laplacian",
+            "uniform,cotan",
+            "--lam",
+            "0.5",
+            "--iters",
+            2,
+            "--noise",
+            "0.01",
+            "--json",
+            "--csv",
+            out / "t.csv",
+        ],
         ("t.csv",),
     ),
 }
@@ -200,8 +236,9 @@ def test_curvature_is_finite_and_satisfies_gauss_bonnet(capsys, loaded, case):
     assert K.shape == (case.n_vertices,) and np.isfinite(K).all()
     m = load_mesh(mesh)
     for method in ("uniform", "cotan", "k1", "k2"):  # the other fields are finite too
-        code, stdout, _ = run_cli(capsys, "curvature", mesh, "--method", method, "--json",
-                                  "--area", "voronoi")
+        code, stdout, _ = run_cli(
+            capsys, "curvature", mesh, "--method", method, "--json", "--area", "voronoi"
+        )
         assert code == 0
         assert all(json.loads(stdout)[k] is not None for k in ("min", "max", "mean", "median"))
     if m.report.n_nonmanifold_vertices or m.report.n_nonmanifold_edges:
@@ -287,8 +324,10 @@ def torus_obj(tmp_path):
         (["smooth", "{mesh}", "--iters", "-1"], ("--iters",)),
         (["smooth", "{mesh}", "--iters", "2.5"], ("--iters",)),
         (["smooth", "{mesh}", "--method", "taubin", "--taubin-mu", "nan"], ("--taubin-mu",)),
-        (["smooth", "{mesh}", "--method", "taubin", "--lam", "0.5", "--taubin-mu", "0.1"],
-         ("--taubin-mu",)),
+        (
+            ["smooth", "{mesh}", "--method", "taubin", "--lam", "0.5", "--taubin-mu", "0.1"],
+            ("--taubin-mu",),
+        ),
         (["smooth", "{mesh}", "--pass-band", "-1"], ("--pass-band",)),
         (["denoise-eval", "{mesh}", "--lam", "0.5,nan"], ("--lam",)),
         (["denoise-eval", "{mesh}", "--lam", "0.5,-1"], ("--lam",)),
@@ -308,8 +347,19 @@ def torus_obj(tmp_path):
         (["surface", "helicoid", "--convergence", "--res", "8,0"], ("--res",)),
         (["info", "{mesh}", "--bogus"], ("--bogus",)),
         (["view", "{mesh}", "--k", "0", "--screenshot", "{tmp}/x.png"], ("--k",)),
-        (["view", "{mesh}", "--panel", "onering", "--vertex", "72", "--screenshot",
-          "{tmp}/x.png"], ("--vertex",)),
+        (
+            [
+                "view",
+                "{mesh}",
+                "--panel",
+                "onering",
+                "--vertex",
+                "72",
+                "--screenshot",
+                "{tmp}/x.png",
+            ],
+            ("--vertex",),
+        ),
     ],
 )
 def test_bad_arguments_one_error_line(capsys, tmp_path, torus_obj, argv, names):
@@ -332,8 +382,7 @@ def test_denoise_eval_mismatched_meshes(capsys, tmp_path, torus_obj):
     csv = tmp_path / "t.csv"
     csv.write_bytes(SENTINEL)
     for noisy in (other, flipped):
-        code, out, err = run_cli(capsys, "denoise-eval", torus_obj, "--noisy", noisy,
-                                 "--csv", csv)
+        code, out, err = run_cli(capsys, "denoise-eval", torus_obj, "--noisy", noisy, "--csv", csv)
         line = assert_one_error_line(code, out, err, str(noisy))
         assert "same faces and vertex order" in line
     assert csv.read_bytes() == SENTINEL
@@ -353,8 +402,18 @@ def test_denoise_eval_noisy_file_that_does_not_load(capsys, tmp_path, torus_obj)
     [
         ["curvature", "{mesh}", "--out", "{missing}/k.npy"],
         ["smooth", "{mesh}", "--out", "{missing}/s.obj"],
-        ["denoise-eval", "{mesh}", "--iters", "1", "--lam", "0.5", "--noise", "0.01",
-         "--csv", "{missing}/t.csv"],
+        [
+            "denoise-eval",
+            "{mesh}",
+            "--iters",
+            "1",
+            "--lam",
+            "0.5",
+            "--noise",
+            "0.01",
+            "--csv",
+            "{missing}/t.csv",
+        ],
         ["surface", "helicoid", "--mesh", "{missing}/h.obj"],
         ["surface", "helicoid", "--plot", "{missing}/p.png"],
         ["view", "{mesh}", "--screenshot", "{missing}/shot.png"],
@@ -398,8 +457,19 @@ def test_output_onto_an_input_a_directory_or_a_wrong_type(capsys, tmp_path, argv
 def test_smooth_divergence_keeps_the_existing_output(capsys, tmp_path, torus_obj):
     out = tmp_path / "s.obj"
     out.write_bytes(SENTINEL)
-    code, stdout, err = run_cli(capsys, "smooth", torus_obj, "--laplacian", "cotan",
-                                "--lam", "100", "--iters", "200", "--out", out)
+    code, stdout, err = run_cli(
+        capsys,
+        "smooth",
+        torus_obj,
+        "--laplacian",
+        "cotan",
+        "--lam",
+        "100",
+        "--iters",
+        "200",
+        "--out",
+        out,
+    )
     line = assert_one_error_line(code, stdout, err, "--lam")
     assert "diverged" in line and "nothing written" in line
     assert out.read_bytes() == SENTINEL
@@ -420,8 +490,10 @@ def test_existing_outputs_replaced_only_by_complete_ones(capsys, tmp_path, torus
 
 
 def test_missing_file_and_no_extension(capsys, tmp_path):
-    for path, words in ((tmp_path / "nope.obj", "no such file"),
-                        (tmp_path / "README", "no extension")):
+    for path, words in (
+        (tmp_path / "nope.obj", "no such file"),
+        (tmp_path / "README", "no extension"),
+    ):
         if path.suffix == "":
             path.write_text("v 0 0 0\n")
         code, out, err = run_cli(capsys, "info", path)
@@ -566,8 +638,13 @@ def test_core_operators_on_degenerate_input_are_finite_or_refused(tmp_path):
     import subprocess
     import sys
 
-    res = subprocess.run([sys.executable, "-c", DEGENERATE_SCRIPT], capture_output=True,
-                         text=True, timeout=300, cwd=tmp_path)
+    res = subprocess.run(
+        [sys.executable, "-c", DEGENERATE_SCRIPT],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        cwd=tmp_path,
+    )
     last = res.stderr.strip().splitlines()[-1:] or ["(nothing)"]
     assert res.returncode == 0, f"crashed ({res.returncode}) at {last[0]}"
     results = [json.loads(line) for line in res.stdout.splitlines()]
@@ -577,9 +654,11 @@ def test_core_operators_on_degenerate_input_are_finite_or_refused(tmp_path):
     refused = {(name, f) for name, f, r in results if r.startswith("MeshError")}
     # the quadric fit refuses unreferenced vertices (libigl misbehaves on them); the implicit
     # cotan system of a needle is beyond double precision and says so
-    assert refused <= {("unreferenced_last", "quadric_fit"),
-                       ("unreferenced_first", "quadric_fit"),
-                       ("needle", "smooth_implicit_cotan")}, refused
+    assert refused <= {
+        ("unreferenced_last", "quadric_fit"),
+        ("unreferenced_first", "quadric_fit"),
+        ("needle", "smooth_implicit_cotan"),
+    }, refused
     assert ("unreferenced_last", "quadric_fit") in refused
 
 
@@ -601,7 +680,10 @@ def test_sliver_warnings_name_the_count(capsys, tmp_path, name):
     code, out, err = run_cli(capsys, "info", mesh, "--json")
     warnings = json.loads(out)["warnings"]
     assert any(w.startswith(f"{n_thin:,} nearly degenerate face") for w in warnings)
-    for argv in (["curvature", mesh], ["onering", mesh, "--vertex", 0],
-                 ["smooth", mesh, "--iters", 1]):
+    for argv in (
+        ["curvature", mesh],
+        ["onering", mesh, "--vertex", 0],
+        ["smooth", mesh, "--iters", 1],
+    ):
         code, out, err = run_cli(capsys, *argv)
         assert code == 0 and "nearly degenerate" in err, (argv, err)

@@ -24,7 +24,10 @@ def meshlap(*argv, cwd: Path, env: dict | None = None) -> subprocess.CompletedPr
     """``python -m meshlap_core.cli ARGV`` in ``cwd`` (a TimeoutExpired fails the test)."""
     return subprocess.run(
         [sys.executable, "-m", "meshlap_core.cli", *map(str, argv)],
-        capture_output=True, text=True, timeout=TIMEOUT, cwd=cwd,
+        capture_output=True,
+        text=True,
+        timeout=TIMEOUT,
+        cwd=cwd,
         env={**os.environ, "MESHLAP_CACHE_DIR": str(cwd / "cache"), **(env or {})},
         stdin=subprocess.DEVNULL,
     )

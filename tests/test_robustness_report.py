@@ -8,8 +8,9 @@ import pytest
 
 from meshlap_core.cli import COMMANDS, main
 
-pytestmark = pytest.mark.skipif("report" not in COMMANDS,
-                                reason="the report command is not registered yet")
+pytestmark = pytest.mark.skipif(
+    "report" not in COMMANDS, reason="the report command is not registered yet"
+)
 
 
 @pytest.fixture(autouse=True)
@@ -46,8 +47,19 @@ def test_report_corrupt_course_mesh_fails_its_section_only(capsys, tmp_path):
     meshes.mkdir()
     (meshes / "cube.obj").write_bytes(hostile.build("garbage.obj", tmp_path).read_bytes())
     out = tmp_path / "report"
-    code = main(["report", "--meshes", str(meshes), "--out", str(out), "--sections", "onering",
-                 "--quick", "--no-screenshots"])
+    code = main(
+        [
+            "report",
+            "--meshes",
+            str(meshes),
+            "--out",
+            str(out),
+            "--sections",
+            "onering",
+            "--quick",
+            "--no-screenshots",
+        ]
+    )
     _, err = capsys.readouterr()
     assert code != 0 and "Traceback" not in err
     errors = [line for line in err.splitlines() if line.startswith("meshlap: error: ")]

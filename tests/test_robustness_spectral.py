@@ -20,8 +20,9 @@ from meshlap_core.cli import COMMANDS, main
 from meshlap_core.io import load_mesh
 from meshlap_core.laplacian import cotan_stiffness, vertex_areas
 
-pytestmark = pytest.mark.skipif("spectral" not in COMMANDS,
-                                reason="the spectral command is not registered yet")
+pytestmark = pytest.mark.skipif(
+    "spectral" not in COMMANDS, reason="the spectral command is not registered yet"
+)
 
 
 @pytest.fixture(autouse=True)
@@ -97,6 +98,7 @@ def test_spectral_outputs_are_checked_first_and_kept_on_failure(capsys, tmp_path
         code, _, err = run_cli(capsys, "spectral", good, "--k", 3, "--out", target)
         assert code == 2 and err.count("\n") == 1 and err.startswith("meshlap: error: ")
     assert not (tmp_path / "missing").exists() and not (tmp_path / "b.txt").exists()
-    code, _, err = run_cli(capsys, "spectral", good, "--k", 3, "--save-reconstruction",
-                                out)  # an existing file, not a folder
+    code, _, err = run_cli(
+        capsys, "spectral", good, "--k", 3, "--save-reconstruction", out
+    )  # an existing file, not a folder
     assert code == 2 and err.count("\n") == 1 and out.read_bytes() == b"previous basis"

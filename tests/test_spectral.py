@@ -39,15 +39,22 @@ def _dense_reference(V, F, k, **kw):
     """Generalized eigenvalues of (K, M) straight from LAPACK (no code of ours but the pencil)."""
     K, m = S.spectral_operators(V, F, **kw)
     with threadpool_limits(1):  # threaded LAPACK crawls on a loaded 2-core machine
-        return scipy.linalg.eigh(K.toarray(), np.diag(m), eigvals_only=True,
-                                 subset_by_index=(0, k - 1))
+        return scipy.linalg.eigh(
+            K.toarray(), np.diag(m), eigvals_only=True, subset_by_index=(0, k - 1)
+        )
 
 
 def _eigsh_reference(V, F, k):
     """scipy's ARPACK shift-invert on the same pencil (shift scaled to the mesh)."""
     K, m = S.spectral_operators(V, F)
-    lam = spla.eigsh(K, k, M=sp.diags(m).tocsc(), sigma=-1e-3 * K.diagonal().mean() / m.mean(),
-                     which="LM", return_eigenvectors=False)
+    lam = spla.eigsh(
+        K,
+        k,
+        M=sp.diags(m).tocsc(),
+        sigma=-1e-3 * K.diagonal().mean() / m.mean(),
+        which="LM",
+        return_eigenvectors=False,
+    )
     return np.sort(lam)
 
 
@@ -145,8 +152,7 @@ def test_open_mesh_neumann_eigenvalues_of_the_unit_square():
     V, F = grid(45, 45)  # unit square, open: natural (Neumann) boundary conditions
     lam = S.laplacian_eigenpairs(V, F, 6, method="sparse")[0]
     pi2 = np.pi**2
-    np.testing.assert_allclose(lam, [0, pi2, pi2, 2 * pi2, 4 * pi2, 4 * pi2], rtol=1e-2,
-                               atol=1e-12)
+    np.testing.assert_allclose(lam, [0, pi2, pi2, 2 * pi2, 4 * pi2, 4 * pi2], rtol=1e-2, atol=1e-12)
 
 
 def test_scale_covariance_tiny_and_huge_meshes():
@@ -182,8 +188,9 @@ def test_uniform_laplacian_is_the_graph_laplacian():
     K, m = S.spectral_operators(V, F, laplacian="uniform")
     np.testing.assert_array_equal(m, 1.0)
     A = K.toarray()
-    np.testing.assert_allclose(np.diag(A), [len(set(F[np.any(F == i, 1)].ravel())) - 1
-                                            for i in range(len(V))])
+    np.testing.assert_allclose(
+        np.diag(A), [len(set(F[np.any(F == i, 1)].ravel())) - 1 for i in range(len(V))]
+    )
     with threadpool_limits(1):
         ref = np.linalg.eigvalsh(A)[:25]
     np.testing.assert_allclose(lam, ref, rtol=1e-9, atol=1e-12)
@@ -221,8 +228,7 @@ def test_incremental_reconstruction_equals_the_direct_product():
     m = basis.mass
     for k in [5, 6, 120, 0, 37, 36, 99, 1, 64, 120, 3]:
         Uk = basis.vectors[:, :k]
-        np.testing.assert_allclose(basis.reconstruct(k), Uk @ (Uk.T @ (m[:, None] * V)),
-                                   atol=1e-12)
+        np.testing.assert_allclose(basis.reconstruct(k), Uk @ (Uk.T @ (m[:, None] * V)), atol=1e-12)
     out = basis.reconstruct(10)
     out[:] = 0.0  # the caller owns the returned array
     assert np.abs(basis.reconstruct(10)).max() > 0.5
@@ -280,7 +286,7 @@ def test_unit_sphere_eigenvalues_cluster_at_l_l_plus_1():
     lam = S.laplacian_eigenpairs(V, F, 16, method="sparse")[0]
     assert lam[0] == 0.0
     for deg, rtol in ((1, 0.005), (2, 0.005), (3, 0.01)):
-        block = lam[deg * deg:(deg + 1) ** 2]  # multiplicity 2l + 1
+        block = lam[deg * deg : (deg + 1) ** 2]  # multiplicity 2l + 1
         np.testing.assert_allclose(block, deg * (deg + 1), rtol=rtol)
     # and the clusters are separated: 3, 5, 7 values, not more
     assert lam[4] - lam[3] > 3.0 and lam[9] - lam[8] > 5.0
@@ -426,9 +432,21 @@ def sphere_obj(tmp_path):
 
 
 def test_cli_json(sphere_obj, tmp_path, capsys):
-    code = main(["spectral", str(sphere_obj), "--k", "60", "--reconstruct", "5,15,60",
-                 "--save-reconstruction", str(tmp_path / "rec"), "--out",
-                 str(tmp_path / "basis.npz"), "--json"])
+    code = main(
+        [
+            "spectral",
+            str(sphere_obj),
+            "--k",
+            "60",
+            "--reconstruct",
+            "5,15,60",
+            "--save-reconstruction",
+            str(tmp_path / "rec"),
+            "--out",
+            str(tmp_path / "basis.npz"),
+            "--json",
+        ]
+    )
     assert code == 0
     r = json.loads(capsys.readouterr().out)
     assert r["n_vertices"] == 642 and r["k"] == 60 and len(r["eigenvalues"]) == 60
@@ -454,8 +472,10 @@ def test_cli_errors_and_no_cache(sphere_obj, tmp_path, capsys):
     assert main(["spectral", str(sphere_obj), "--k", "10", "--reconstruct", "20"]) == 2
     assert "--reconstruct" in capsys.readouterr().err
     assert main(["spectral", str(sphere_obj), "--k", "10", "--out", str(sphere_obj)]) == 2
-    assert main(["spectral", str(sphere_obj), "--k", "12", "--no-cache",
-                 "--laplacian", "uniform"]) == 0
+    assert (
+        main(["spectral", str(sphere_obj), "--k", "12", "--no-cache", "--laplacian", "uniform"])
+        == 0
+    )
     out = capsys.readouterr().out
     assert "uniform" in out and "reconstruction error" in out
     assert not (tmp_path / "cache").exists()

@@ -69,8 +69,10 @@ def main(argv: Sequence[str] | None = None) -> int:
             return _fail(f"{exc}")
         except MemoryError:
             src = getattr(args, "mesh", None) or getattr(args, "clean", None)
-            return _fail(f"{src + ': ' if src else ''}out of memory (the input is too large "
-                         "for this machine)")
+            return _fail(
+                f"{src + ': ' if src else ''}out of memory (the input is too large "
+                "for this machine)"
+            )
         except BrokenPipeError:  # `meshlap ... | head`: the reader went away
             _silence_stdout()
             return 141

@@ -7,10 +7,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..curvature import BOUNDARY_RULES, METHODS, curvature_field
+from ..curvature import METHODS, curvature_field
 from ..errors import MeshError
 from ..io import check_output_path, load_mesh, save_mesh, save_scalars
-from ..laplacian import AREA_KINDS
+from ..options import AREA_KINDS, BOUNDARY_RULES
 from ._common import add_json_flag, emit_json, print_report, summary_stats
 
 OUT_SUFFIXES = (".csv", ".npy", ".ply")

@@ -17,15 +17,30 @@ from typing import Any
 import numpy as np
 
 from ..errors import MeshError
-from ..laplacian import AREA_KINDS
 from ..noise import NOISE_MODES
+from ..options import AREA_KINDS
 from ..smoothing import LAPLACIANS, METHODS, best_rows, check_iters, check_lam, denoise_sweep
 from ._common import add_json_flag, emit_json, parse_list, print_report
 
 COLUMNS = (
-    "noise", "method", "laplacian", "lam", "iters", "rmse", "rmse_noisy", "max_error",
-    "volume_change_pct", "volume_change_noisy_pct", "dihedral_mae_deg", "dihedral_mae_noisy_deg",
-    "normal_dev_deg", "normal_dev_noisy_deg", "stable", "diverged", "seconds", "failed",
+    "noise",
+    "method",
+    "laplacian",
+    "lam",
+    "iters",
+    "rmse",
+    "rmse_noisy",
+    "max_error",
+    "volume_change_pct",
+    "volume_change_noisy_pct",
+    "dihedral_mae_deg",
+    "dihedral_mae_noisy_deg",
+    "normal_dev_deg",
+    "normal_dev_noisy_deg",
+    "stable",
+    "diverged",
+    "seconds",
+    "failed",
 )
 DEFAULT_NOISE = "0.005,0.02,0.05"
 
@@ -116,9 +131,18 @@ def run(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     try:
         rows = denoise_sweep(
-            clean.V, clean.F, V_noisy=Vn, noise_levels=noise, methods=methods,
-            laplacians=laplacians, lams=lams, iters=iters, seed=seed,
-            noise_mode=args.noise_mode, area=args.area, progress=progress,
+            clean.V,
+            clean.F,
+            V_noisy=Vn,
+            noise_levels=noise,
+            methods=methods,
+            laplacians=laplacians,
+            lams=lams,
+            iters=iters,
+            seed=seed,
+            noise_mode=args.noise_mode,
+            area=args.area,
+            progress=progress,
         )
     except MeshError as exc:
         raise exc.with_source(args.clean) from None
@@ -159,8 +183,18 @@ def _volume_note(rows: list[dict[str, Any]]) -> str | None:
 
 
 def _brief(r: dict[str, Any]) -> dict[str, Any]:
-    keys = ("noise", "method", "laplacian", "lam", "iters", "rmse", "rmse_noisy",
-            "dihedral_mae_deg", "dihedral_mae_noisy_deg", "volume_change_pct")
+    keys = (
+        "noise",
+        "method",
+        "laplacian",
+        "lam",
+        "iters",
+        "rmse",
+        "rmse_noisy",
+        "dihedral_mae_deg",
+        "dihedral_mae_noisy_deg",
+        "volume_change_pct",
+    )
     return {k: r[k] for k in keys}
 
 
@@ -205,8 +239,11 @@ def format_table(r: dict[str, Any]) -> str:
             lines.append("")
         prev = row["noise"]
         note = (
-            f"FAILED: {row['failed']}" if row.get("failed")
-            else "DIVERGED" if row["diverged"] else ("" if row["stable"] else "unstable lam")
+            f"FAILED: {row['failed']}"
+            if row.get("failed")
+            else "DIVERGED"
+            if row["diverged"]
+            else ("" if row["stable"] else "unstable lam")
         )
         lines.append(
             f"{row['noise']:>8.4g} {row['laplacian']:>9} {row['method']:>8} {row['lam']:>7.4g} "

@@ -28,19 +28,42 @@ def register(sub: argparse._SubParsersAction) -> None:
             "assets and the report says so."
         ),
     )
-    p.add_argument("--meshes", metavar="DIR", default=None,
-                   help="folder with the course meshes (default: ../shared/meshes)")
-    p.add_argument("--out", metavar="DIR", default=DEFAULT_OUT,
-                   help=f"output folder (default: ./{DEFAULT_OUT})")
-    p.add_argument("--quick", action="store_true",
-                   help="smaller sweeps and fewer pictures (under 2 minutes on 2 cores)")
-    p.add_argument("--sections", metavar="LIST", default=None,
-                   help="only these sections: numbers 1-7 or names (onering, uniform, "
-                        "helicoid, cotan, spectral, smoothing, denoising)")
-    p.add_argument("--no-screenshots", action="store_true",
-                   help="draw meshes with matplotlib instead of the viewer's EGL screenshots")
-    p.add_argument("--max-screenshots", metavar="N", type=int, default=None,
-                   help="take at most N viewer screenshots, draw the rest with matplotlib")
+    p.add_argument(
+        "--meshes",
+        metavar="DIR",
+        default=None,
+        help="folder with the course meshes (default: ../shared/meshes)",
+    )
+    p.add_argument(
+        "--out",
+        metavar="DIR",
+        default=DEFAULT_OUT,
+        help=f"output folder (default: ./{DEFAULT_OUT})",
+    )
+    p.add_argument(
+        "--quick",
+        action="store_true",
+        help="smaller sweeps and fewer pictures (under 2 minutes on 2 cores)",
+    )
+    p.add_argument(
+        "--sections",
+        metavar="LIST",
+        default=None,
+        help="only these sections: numbers 1-7 or names (onering, uniform, "
+        "helicoid, cotan, spectral, smoothing, denoising)",
+    )
+    p.add_argument(
+        "--no-screenshots",
+        action="store_true",
+        help="draw meshes with matplotlib instead of the viewer's EGL screenshots",
+    )
+    p.add_argument(
+        "--max-screenshots",
+        metavar="N",
+        type=int,
+        default=None,
+        help="take at most N viewer screenshots, draw the rest with matplotlib",
+    )
     add_json_flag(p)
     p.set_defaults(func=run)
 
@@ -64,8 +87,10 @@ def run(args: argparse.Namespace) -> int:
         print(f"wrote {result.html}")
         print(f"wrote {len(result.figures)} figures in {result.out_dir / 'figures'}")
         print(f"wrote {len(result.tables)} tables in {result.out_dir / 'tables'}")
-        print(f"total {result.total_seconds:.1f} s: " + ", ".join(
-            f"{k} {v:.1f} s" for k, v in result.section_seconds.items()))
+        print(
+            f"total {result.total_seconds:.1f} s: "
+            + ", ".join(f"{k} {v:.1f} s" for k, v in result.section_seconds.items())
+        )
         if result.screenshot_failures:
             print(f"screenshots failed: {result.screenshot_failures[0]}")
     for key, err in result.errors.items():

@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import MeshError, MeshWarning
-from ..laplacian import AREA_KINDS
+from ..options import AREA_KINDS
 from ..smoothing import LAPLACIANS, MASS_MODES, METHODS, Smoother, check_iters, check_lam
 from ._common import add_json_flag, emit_json, summary_stats
 
@@ -39,16 +39,20 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--taubin-mu", default=None, help="Taubin's negative factor (default from --pass-band)"
     )
     p.add_argument(
-        "--pass-band", default="0.1",
+        "--pass-band",
+        default="0.1",
         help="Taubin pass band relative to mean(-L_ii); equals k_PB for uniform (default 0.1)",
     )
     p.add_argument("--fix-boundary", action="store_true", help="keep boundary vertices fixed")
     p.add_argument(
-        "--preserve-volume", action="store_true",
+        "--preserve-volume",
+        action="store_true",
         help="rescale to keep the enclosed volume (closed meshes)",
     )
     p.add_argument(
-        "--mass", choices=MASS_MODES, default="frozen",
+        "--mass",
+        choices=MASS_MODES,
+        default="frozen",
         help="cotan mass matrix frozen (factorize once) or recomputed each step (default frozen)",
     )
     p.add_argument(
@@ -98,9 +102,17 @@ def run(args: argparse.Namespace) -> int:
         warnings.simplefilter("always", MeshWarning)
         try:
             s = Smoother(
-                V, F, args.method, args.laplacian, lam,
-                taubin_nu=nu, pass_band=pass_band, fix_boundary=args.fix_boundary,
-                preserve_volume=args.preserve_volume, mass=args.mass, area=args.area,
+                V,
+                F,
+                args.method,
+                args.laplacian,
+                lam,
+                taubin_nu=nu,
+                pass_band=pass_band,
+                fix_boundary=args.fix_boundary,
+                preserve_volume=args.preserve_volume,
+                mass=args.mass,
+                area=args.area,
             )
         except MeshError as exc:
             raise _cli_error(exc, args.mesh) from None
@@ -180,8 +192,11 @@ def run(args: argparse.Namespace) -> int:
 def _cli_error(exc: MeshError, mesh: str) -> MeshError:
     """Map core argument names to the CLI flags users typed."""
     flags = {
-        "lam": "--lam", "taubin_nu": "--taubin-mu", "pass_band": "--pass-band",
-        "preserve_volume": "--preserve-volume", "mesh": str(mesh),
+        "lam": "--lam",
+        "taubin_nu": "--taubin-mu",
+        "pass_band": "--pass-band",
+        "preserve_volume": "--preserve-volume",
+        "mesh": str(mesh),
     }
     if exc.source in flags:
         return MeshError(exc.problem, flags[exc.source])

@@ -14,7 +14,8 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import MeshError
-from ..spectral import LAPLACIAN_KINDS, MASS_KINDS, SpectralBasis
+from ..options import AREA_KINDS, LAPLACIAN_KINDS
+from ..spectral import SpectralBasis
 from ._common import add_json_flag, emit_json, parse_list
 
 _DEFAULT_RECONSTRUCT = (5, 15, 50, 100, 300, 1000)
@@ -32,19 +33,37 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("mesh", help="mesh file (OBJ, OFF, PLY, STL)")
     p.add_argument("--k", required=True, help="number of eigenmodes (1 <= K <= vertices)")
-    p.add_argument("--mass", choices=MASS_KINDS, default="voronoi",
-                   help="lumped mass for the cotan Laplacian (default voronoi)")
-    p.add_argument("--laplacian", choices=LAPLACIAN_KINDS, default="cotan",
-                   help="cotan (default) or uniform (graph Laplacian D - A, identity mass)")
-    p.add_argument("--reconstruct", default=None,
-                   help="comma-separated mode counts to reconstruct with, each <= K "
-                        "(default: 5,15,50,100,300,1000 up to K, and K)")
-    p.add_argument("--save-reconstruction", metavar="DIR", default=None,
-                   help="write each reconstruction as DIR/<mesh>_k<k>.obj")
+    p.add_argument(
+        "--mass",
+        choices=AREA_KINDS,
+        default="voronoi",
+        help="lumped mass for the cotan Laplacian (default voronoi)",
+    )
+    p.add_argument(
+        "--laplacian",
+        choices=LAPLACIAN_KINDS,
+        default="cotan",
+        help="cotan (default) or uniform (graph Laplacian D - A, identity mass)",
+    )
+    p.add_argument(
+        "--reconstruct",
+        default=None,
+        help="comma-separated mode counts to reconstruct with, each <= K "
+        "(default: 5,15,50,100,300,1000 up to K, and K)",
+    )
+    p.add_argument(
+        "--save-reconstruction",
+        metavar="DIR",
+        default=None,
+        help="write each reconstruction as DIR/<mesh>_k<k>.obj",
+    )
     p.add_argument("--out", default=None, help="also save the basis as this .npz file")
-    p.add_argument("--no-cache", action="store_true",
-                   help="neither read nor write the user cache "
-                        "($MESHLAP_CACHE_DIR, $XDG_CACHE_HOME/meshlap or ~/.cache/meshlap)")
+    p.add_argument(
+        "--no-cache",
+        action="store_true",
+        help="neither read nor write the user cache "
+        "($MESHLAP_CACHE_DIR, $XDG_CACHE_HOME/meshlap or ~/.cache/meshlap)",
+    )
     add_json_flag(p)
     p.set_defaults(func=run)
 
@@ -85,8 +104,9 @@ def run(args: argparse.Namespace) -> int:
         recon = parse_list(args.reconstruct, int, "--reconstruct")
         bad = [r for r in recon if r < 1 or r > k]
         if bad:
-            raise MeshError(f"each value must be between 1 and --k = {k}; got {bad[0]}",
-                            "--reconstruct")
+            raise MeshError(
+                f"each value must be between 1 and --k = {k}; got {bad[0]}", "--reconstruct"
+            )
     if args.out is not None:  # checked before the work: a doomed run fails at once
         check_output_path(args.out, overwrite_inputs=[args.mesh], suffixes=(".npz",))
     out_dir = None
@@ -110,7 +130,12 @@ def run(args: argparse.Namespace) -> int:
 
     try:
         basis = SpectralBasis.compute(
-            V, F, k, laplacian=args.laplacian, mass=args.mass, cache=not args.no_cache,
+            V,
+            F,
+            k,
+            laplacian=args.laplacian,
+            mass=args.mass,
+            cache=not args.no_cache,
             progress=_Progress(),
         )
     except MeshError as exc:
@@ -191,8 +216,7 @@ def format_spectral(r: dict[str, Any]) -> str:
         f"max|U^T M U - I| = {_fmt(r['orthogonality_error'])}, "
         f"max relative residual {_fmt(r['max_residual'])}",
         "",
-        "reconstruction error |x - x_k| (bbox diagonal "
-        f"{r['bbox_diagonal']:.4g}):",
+        f"reconstruction error |x - x_k| (bbox diagonal {r['bbox_diagonal']:.4g}):",
         f"{'k':>6} {'mean':>11} {'max':>11} {'rms':>11} {'mean/diag':>10}",
     ]
     for row in r["reconstruction"]:

@@ -38,24 +38,45 @@ def register(sub: argparse._SubParsersAction) -> None:
         "its normal-curvature plot, a mesh of it, or the convergence of the discrete curvature "
         "estimators on its meshes.",
     )
-    p.add_argument("name", nargs="?", default="helicoid",
-                   help=f"surface: {', '.join(SURFACES)} (default helicoid)")
+    p.add_argument(
+        "name",
+        nargs="?",
+        default="helicoid",
+        help=f"surface: {', '.join(SURFACES)} (default helicoid)",
+    )
     p.add_argument("--u", type=float, help="parameter u (default: the surface's default point)")
     p.add_argument("--v", type=float, help="parameter v (default: the surface's default point)")
-    p.add_argument("--param", action="append", default=[], metavar="KEY=VALUE",
-                   help="shape parameter, e.g. --param R=2 --param r=0.5 (repeatable)")
+    p.add_argument(
+        "--param",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="shape parameter, e.g. --param R=2 --param r=0.5 (repeatable)",
+    )
     p.add_argument("--plot", metavar="PNG", help="save a plot of the normal curvature κn(θ)")
     p.add_argument("--mesh", metavar="OUT", help="write a triangle mesh of the surface")
-    p.add_argument("--res", help="--mesh: cells per direction N or NU,NV (default 32); "
-                   f"--convergence: list of levels (default {DEFAULT_RES['grid']}, "
-                   f"icosphere {DEFAULT_RES['icosphere']})")
-    p.add_argument("--convergence", action="store_true",
-                   help="table of discrete-vs-exact curvature errors and observed orders")
-    p.add_argument("--mesher", choices=("grid", "icosphere"), default="grid",
-                   help="--convergence meshes: the (u,v) grid (default) or icospheres "
-                   "(sphere only)")
-    p.add_argument("--exclude-poles", action="store_true",
-                   help="--convergence: leave the pole vertices of a grid mesh out")
+    p.add_argument(
+        "--res",
+        help="--mesh: cells per direction N or NU,NV (default 32); "
+        f"--convergence: list of levels (default {DEFAULT_RES['grid']}, "
+        f"icosphere {DEFAULT_RES['icosphere']})",
+    )
+    p.add_argument(
+        "--convergence",
+        action="store_true",
+        help="table of discrete-vs-exact curvature errors and observed orders",
+    )
+    p.add_argument(
+        "--mesher",
+        choices=("grid", "icosphere"),
+        default="grid",
+        help="--convergence meshes: the (u,v) grid (default) or icospheres (sphere only)",
+    )
+    p.add_argument(
+        "--exclude-poles",
+        action="store_true",
+        help="--convergence: leave the pole vertices of a grid mesh out",
+    )
     p.add_argument("--list", action="store_true", help="list the surfaces and exit")
     add_json_flag(p)
     p.set_defaults(func=run)
@@ -82,10 +103,18 @@ def _run_list(args: argparse.Namespace) -> int:
     rows = []
     for name in SURFACES:
         s = get_surface(name)
-        rows.append({"name": name, "domain": list(s.domain), "closed_u": s.closed_u,
-                     "closed_v": s.closed_v, "poles": list(s.poles), "params": dict(s.params),
-                     "exact_derivatives": s.derivatives is not None,
-                     "description": s.description})
+        rows.append(
+            {
+                "name": name,
+                "domain": list(s.domain),
+                "closed_u": s.closed_u,
+                "closed_v": s.closed_v,
+                "poles": list(s.poles),
+                "params": dict(s.params),
+                "exact_derivatives": s.derivatives is not None,
+                "description": s.description,
+            }
+        )
     if args.json:
         emit_json({"surfaces": rows})
     else:
@@ -96,13 +125,20 @@ def _run_list(args: argparse.Namespace) -> int:
 
 
 def _run_convergence(args: argparse.Namespace, surface: Any) -> int:
-    for flag, val in (("--mesh", args.mesh), ("--plot", args.plot), ("--u", args.u),
-                      ("--v", args.v)):
+    for flag, val in (
+        ("--mesh", args.mesh),
+        ("--plot", args.plot),
+        ("--u", args.u),
+        ("--v", args.v),
+    ):
         if val is not None:
             raise MeshError("cannot be combined with --convergence", flag)
     levels = parse_list(args.res or DEFAULT_RES[args.mesher], int, "--res")
     study = convergence_study(
-        surface, levels, mesher=args.mesher, exclude_poles=args.exclude_poles,
+        surface,
+        levels,
+        mesher=args.mesher,
+        exclude_poles=args.exclude_poles,
         progress=lambda line: print(f"meshlap: {line}", file=sys.stderr, flush=True),
     )
     if args.json:
@@ -116,8 +152,13 @@ def run(args: argparse.Namespace) -> int:
     try:
         return _run(args)
     except MeshError as exc:  # name the flag the user typed, not the core's argument
-        flag = {"res": "--res", "u": "--u", "v": "--v", "params": "--param",
-                "mesher": "--mesher"}.get(exc.source or "")
+        flag = {
+            "res": "--res",
+            "u": "--u",
+            "v": "--v",
+            "params": "--param",
+            "mesher": "--mesher",
+        }.get(exc.source or "")
         raise (MeshError(exc.problem, flag) if flag else exc) from None
 
 
@@ -157,13 +198,24 @@ def _run(args: argparse.Namespace) -> int:
 
         m = mesh_surface(surface, res[0] if len(res) == 1 else (res[0], res[1]))
         save_mesh(Path(args.mesh), m.V, m.F)
-        mesh_info = {"path": str(args.mesh), "res": list(m.res), "n_vertices": len(m.V),
-                     "n_faces": len(m.F), "n_boundary_vertices": int(m.boundary.sum()),
-                     "n_pole_vertices": int(m.pole.sum())}
+        mesh_info = {
+            "path": str(args.mesh),
+            "res": list(m.res),
+            "n_vertices": len(m.V),
+            "n_faces": len(m.F),
+            "n_boundary_vertices": int(m.boundary.sum()),
+            "n_pole_vertices": int(m.pole.sum()),
+        }
 
     if args.json:
-        emit_json({**geo.to_dict(), "params": dict(surface.params),
-                   "plot": str(plot) if plot else None, "mesh": mesh_info})
+        emit_json(
+            {
+                **geo.to_dict(),
+                "params": dict(surface.params),
+                "plot": str(plot) if plot else None,
+                "mesh": mesh_info,
+            }
+        )
         return 0
     params = ", ".join(f"{k}={x:g}" for k, x in surface.params.items())
     print(f"{geo.surface} [{params}] at (u, v) = ({geo.u:.6g}, {geo.v:.6g})")
@@ -174,14 +226,19 @@ def _run(args: argparse.Namespace) -> int:
     print(f"  first form   E = {geo.E:.6g}   F = {geo.F:.6g}   G = {geo.G:.6g}")
     print(f"  second form  e = {geo.e:.6g}   f = {geo.f:.6g}   g = {geo.g:.6g}")
     print(f"  K = {geo.K:.6g}   H = {geo.H:.6g}   ({geo.classification})")
-    for k, t, d_uv, d3, what in ((geo.k1, geo.theta_max, geo.dir1_uv, geo.dir1, "max"),
-                                 (geo.k2, geo.theta_min, geo.dir2_uv, geo.dir2, "min")):
+    for k, t, d_uv, d3, what in (
+        (geo.k1, geo.theta_max, geo.dir1_uv, geo.dir1, "max"),
+        (geo.k2, geo.theta_min, geo.dir2_uv, geo.dir2, "min"),
+    ):
         name = "k1" if what == "max" else "k2"
-        print(f"  {name} = {k:.6g}: κn is {what} at θ = {t:.6g} (and θ + π); "
-              f"direction (u,v) {_vec(d_uv)}, 3-D {_vec(d3)}")
+        print(
+            f"  {name} = {k:.6g}: κn is {what} at θ = {t:.6g} (and θ + π); "
+            f"direction (u,v) {_vec(d_uv)}, 3-D {_vec(d3)}"
+        )
     if plot is not None:
         print(f"wrote {plot}")
     if mesh_info is not None:
-        print(f"wrote {args.mesh}: {mesh_info['n_vertices']} vertices, "
-              f"{mesh_info['n_faces']} faces")
+        print(
+            f"wrote {args.mesh}: {mesh_info['n_vertices']} vertices, {mesh_info['n_faces']} faces"
+        )
     return 0
