@@ -53,9 +53,9 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 
-from .linalg.blas import blas_threads
 from .errors import MeshError, MeshWarning
 from .laplacian import adjacency_matrix, cotan_stiffness, vertex_areas
+from .linalg.blas import blas_threads
 from .metrics import Reference, _signed_volume_unchecked, n_boundary_edges
 from .noise import NOISE_MODES, add_noise, bbox_diagonal
 from .options import AREA_KINDS, LAPLACIAN_KINDS, MASS_AREA, AreaKind, LaplacianKind

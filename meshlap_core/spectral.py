@@ -78,9 +78,9 @@ from scipy.linalg import blas, lapack
 from scipy.sparse.csgraph import connected_components
 
 from . import laplacian as _lap
+from .errors import MeshError
 from .linalg.blas import blas_threads as _blas_threads
 from .linalg.blas import thread_controller as _thread_controller
-from .errors import MeshError
 from .options import AREA_KINDS, LAPLACIAN_KINDS, MASS_AREA, AreaKind, LaplacianKind
 from .types import FloatArray, IntArray, as_mesh
 
