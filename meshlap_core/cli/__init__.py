@@ -23,6 +23,7 @@ COMMANDS: tuple[str, ...] = (
     "info",
     "curvature",
     "onering",
+    "inspect",
     "view",
     "surface",
     "smooth",
