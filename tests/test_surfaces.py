@@ -21,12 +21,12 @@ from meshlap_core.io import load_mesh
 from meshlap_core.surfaces import (
     ParametricSurface,
     convergence_study,
-    curvature_fields,
     get_surface,
     mesh_surface,
     normal_curvature,
     normal_curvature_curve,
     point_geometry,
+    surface_curvature_fields,
     surface_derivatives,
 )
 from meshlap_core.topology import boundary_loops, edge_face_counts, euler_characteristic
@@ -108,7 +108,7 @@ def test_torus_sign_of_K_inside_and_outside() -> None:
     assert top.K == pytest.approx(0, abs=1e-12)
     assert top.classification == "parabolic"
     u, v = _random_uv(s, 200)
-    cf = curvature_fields(s, u, v)
+    cf = surface_curvature_fields(s, u, v)
     np.testing.assert_allclose(cf.K, np.cos(v) / (r * (R + r * np.cos(v))), atol=1e-12)
     # the normal points outwards, away from the tube's core circle
     core = np.stack([R * np.cos(u), R * np.sin(u), np.zeros_like(u)], axis=1)
@@ -143,7 +143,7 @@ def test_catenoid_numeric_derivatives_give_the_minimal_surface() -> None:
     s = get_surface("catenoid", c=c)
     assert s.derivatives is None  # exercises the numeric path
     u, v = _random_uv(s, 100)
-    cf = curvature_fields(s, u, v)
+    cf = surface_curvature_fields(s, u, v)
     np.testing.assert_allclose(cf.H, 0, atol=1e-9)
     np.testing.assert_allclose(cf.K, -1 / (c**2 * np.cosh(v / c) ** 4), atol=1e-9)
 
@@ -336,7 +336,7 @@ def test_mesh_keeps_uv_and_follows_the_normal(name: str) -> None:
     m = mesh_surface(s, 10)
     np.testing.assert_allclose(m.V, s(m.uv[:, 0], m.uv[:, 1]), atol=1e-14)
     ok = ~m.pole
-    n_exact = curvature_fields(s, m.uv[ok, 0], m.uv[ok, 1]).n
+    n_exact = surface_curvature_fields(s, m.uv[ok, 0], m.uv[ok, 1]).n
     n_mesh = vertex_normals(m.V, m.F)[ok]
     assert np.min(np.sum(n_exact * n_mesh, axis=1)) > 0.8  # same orientation everywhere
 
