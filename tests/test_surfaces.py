@@ -532,3 +532,119 @@ def test_cli_plot_mesh_and_convergence(tmp_path, capsys) -> None:
     assert d["n_vertices"] == [42, 162]
     assert set(d["errors"]) == set(surfaces.ESTIMATORS)
     assert "vertices" in err  # progress on stderr, not stdout
+
+
+# ------------------------------------------------------------------------------------------
+# singular points (issue 14, item 5)
+# ------------------------------------------------------------------------------------------
+
+
+def _expected_singular(name: str, u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Where each catalogue surface (default parameters) degenerates, worked out by hand:
+    only the sphere's two poles (|p_u × p_v| = r² sin u)."""
+    if name == "sphere":
+        return (u == 0.0) | (u == np.pi)
+    return np.zeros(np.broadcast(u, v).shape, dtype=bool)
+
+
+@pytest.mark.parametrize("name", list(surfaces.SURFACES))
+def test_singular_points_of_every_catalogue_surface(name: str) -> None:
+    s = get_surface(name)
+    u0, u1, v0, v1 = s.domain
+    # a grid that includes every edge and corner of the domain (the poles among them)
+    U, V = np.meshgrid(np.linspace(u0, u1, 13), np.linspace(v0, v1, 11), indexing="ij")
+    np.testing.assert_array_equal(surfaces.is_singular(s, U, V), _expected_singular(name, U, V))
+    cf = surface_curvature_fields(s, U, V)
+    np.testing.assert_array_equal(cf.singular, _expected_singular(name, U, V))
+    assert np.isnan(cf.K[cf.singular]).all() and np.isfinite(cf.K[~cf.singular]).all()
+
+
+@pytest.mark.parametrize("r", [1e-6, 1.0, 1e6])
+@pytest.mark.parametrize("u", [0.0, np.pi])
+def test_both_sphere_poles_are_singular_at_every_scale(r: float, u: float) -> None:
+    s = get_surface("sphere", r=r)
+    assert bool(surfaces.is_singular(s, u, 0.0))
+    with pytest.raises(MeshError, match=r"singular.*pole"):
+        point_geometry(s, u, 0.0)
+    with pytest.raises(MeshError, match="singular"):
+        normal_curvature(s, u, 0.0, 0.3)
+    # 1e-6 away from the pole the sphere is regular and umbilic, K = 1/r²
+    inside = 1e-6 if u == 0 else np.pi - 1e-6
+    g = point_geometry(s, inside, 0.0)
+    assert g.K == pytest.approx(1 / r**2, rel=1e-6)
+    assert g.classification == "umbilic"
+
+
+def test_south_pole_cli_is_refused_like_the_north_pole(capsys) -> None:
+    for u in ("0", "3.141592653589793"):
+        code, out, err = _cli(capsys, "sphere", "--u", u, "--v", "0")
+        assert code == 2 and out == ""
+        assert err.count("\n") == 1 and err.startswith("meshlap: error: --u/--v: ")
+        assert "singular" in err
+
+
+def test_singular_test_is_against_the_surface_scale() -> None:
+    # the mean of |p_u x p_v| over the domain is the area over the parameter area: 2r²/π
+    for r in (1e-6, 1.0, 1e6):
+        assert surfaces.surface_scale(get_surface("sphere", r=r)) == pytest.approx(
+            2 * r * r / np.pi, rel=1e-3
+        )
+    assert surfaces.surface_scale("cylinder") == pytest.approx(1.0)  # |p_u x p_v| = r = 1
+
+
+@pytest.mark.parametrize("scale", [1e-8, 1.0, 1e8])
+def test_an_undeclared_apex_is_found_by_the_scale_test(scale: float) -> None:
+    # a cone (u cos v, u sin v, u) declares no pole: |p_u x p_v| = √2 u vanishes at u = 0
+    cone = ParametricSurface(
+        "cone",
+        lambda u, v: scale * np.stack(np.broadcast_arrays(u * np.cos(v), u * np.sin(v), u), -1),
+        (0.0, 1.0, 0.0, 2 * np.pi),
+    )
+    v = np.linspace(0, 2 * np.pi, 7)
+    assert surfaces.is_singular(cone, 0.0, v).all()
+    assert not surfaces.is_singular(cone, 1e-6, v).any()
+    assert not surfaces.is_singular(cone, 0.5, v).any()
+    with pytest.raises(MeshError, match="area scale"):
+        point_geometry(cone, 0.0, 1.0)
+    # K = 0 (developable); n = (−cos v, −sin v, 1)/√2 points into the cone, so the circle
+    # around the axis bends towards n: κ₁ = +1/(√2 u · scale), κ₂ = 0 along the rulings
+    g = point_geometry(cone, 0.5, 1.0)
+    assert g.K == pytest.approx(0, abs=1e-6 / scale**2)
+    assert g.k1 == pytest.approx(1 / (np.sqrt(2) * 0.5 * scale), rel=1e-6)
+    assert g.k2 == pytest.approx(0, abs=1e-6 / scale)
+
+
+@pytest.mark.parametrize("name", list(surfaces.SURFACES))
+def test_regular_points_stay_regular(name: str) -> None:
+    s = get_surface(name)
+    u, v = _random_uv(s, 500, seed=3)
+    assert not surfaces.is_singular(s, u, v).any()
+    u0, u1, v0, v1 = s.domain
+    # within 1e-6 of the domain width of every edge, poles included
+    eps_u, eps_v = 1e-6 * (u1 - u0), 1e-6 * (v1 - v0)
+    near = np.array([u0 + eps_u, u1 - eps_u])
+    assert not surfaces.is_singular(s, near[:, None], v[None, :20]).any()
+    assert not surfaces.is_singular(s, u[:20, None], np.array([v0 + eps_v, v1 - eps_v])).any()
+
+
+def test_flat_helicoid_is_a_disc_with_a_pole() -> None:
+    s = get_surface("helicoid", c=0.0)
+    assert s.poles == ("u0",) and s.closed_v
+    assert surfaces.is_singular(s, 0.0, np.linspace(0, 6, 5)).all()
+    g = point_geometry(s)  # the default point moves off the pole
+    assert (g.u, g.K, g.H) == pytest.approx((0.5, 0.0, 0.0), abs=1e-12)
+    assert g.classification == "planar"
+    m = mesh_surface(s, 8)
+    assert m.pole.sum() == 1 and not m.boundary[m.pole].any()  # the centre: an interior fan
+    assert euler_characteristic(m.F) == 1 and len(boundary_loops(m.F)) == 1
+    _, count = edge_face_counts(m.F)
+    assert count.max() == 2
+
+
+@pytest.mark.parametrize(
+    "name, param", [("helicoid", "c"), ("saddle", "a"), ("monkey_saddle", "a")]
+)
+@pytest.mark.parametrize("value", [np.nan, np.inf, -np.inf])
+def test_shape_parameters_must_be_finite(name: str, param: str, value: float) -> None:
+    with pytest.raises(MeshError, match=rf"^{param}: must be a finite number"):
+        get_surface(name, **{param: value})

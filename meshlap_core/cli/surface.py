@@ -156,6 +156,7 @@ def run(args: argparse.Namespace) -> int:
             "res": "--res",
             "u": "--u",
             "v": "--v",
+            "u, v": "--u/--v",
             "params": "--param",
             "mesher": "--mesher",
         }.get(exc.source or "")

@@ -3,8 +3,9 @@
 Modules: :mod:`.catalogue` (:class:`ParametricSurface`, the shipped surfaces, :func:`get_surface`),
 :mod:`.derivatives` (exact / complex-step / central derivatives), :mod:`.geometry` (fundamental
 forms, curvature fields, normal curvature, classification, :func:`point_geometry`),
-:mod:`.meshing` (:func:`mesh_surface`), :mod:`.convergence` (:func:`convergence_study`) and
-:mod:`.plot` (the ``κₙ(θ)`` figure). Everything public is re-exported here.
+:mod:`.meshing` (:func:`mesh_surface`), :mod:`.convergence` (:func:`convergence_study`),
+:mod:`.plot` (the ``κₙ(θ)`` figure) and :mod:`.singular` (singular points: declared poles and
+``|p_u × p_v|`` negligible against the surface's area scale). Everything public is re-exported here.
 
 A :class:`ParametricSurface` is a map ``p`` on a parameter rectangle ``[u0,u1] × [v0,v1]``.
 At any ``(u, v)`` this module computes the partial derivatives, the unit normal
@@ -73,6 +74,7 @@ from .geometry import (
 )
 from .meshing import MAX_CELLS, SurfaceMesh, mesh_surface
 from .plot import plot_normal_curvature
+from .singular import SINGULAR_REL, is_singular, surface_scale
 
 curvature_fields = surface_curvature_fields
 """Former name of :func:`surface_curvature_fields`, kept for ``app/viewer.py``; not to be
@@ -84,6 +86,7 @@ __all__ = [
     "EDGES",
     "ESTIMATORS",
     "MAX_CELLS",
+    "SINGULAR_REL",
     "SURFACES",
     "ConvergenceStudy",
     "CurvatureFields",
@@ -103,6 +106,7 @@ __all__ = [
     "exact_curvature_at",
     "get_surface",
     "helicoid",
+    "is_singular",
     "mesh_surface",
     "monkey_saddle",
     "normal_curvature",
@@ -113,5 +117,6 @@ __all__ = [
     "sphere",
     "surface_curvature_fields",
     "surface_derivatives",
+    "surface_scale",
     "torus",
 ]

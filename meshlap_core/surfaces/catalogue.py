@@ -117,8 +117,12 @@ def helicoid(c: float = 1.0) -> ParametricSurface:
     A minimal surface (``H = 0``) with ``K = −c²/(c² + u²)²``. For ``c = 1``: ``E = 1, F = 0,
     G = 1 + u², e = g = 0, f = −1/√(1+u²)``, ``κ = ±1/(1+u²)``, and at the origin
     ``κₙ(θ) = −sin 2θ``.
+
+    ``c = 0`` degenerates to the flat unit disc in polar coordinates: closed in ``v``, with a
+    pole at its centre ``u = 0`` (declared, so meshes collapse it and the point is singular);
+    its default point is then ``(0.5, 0)``.
     """
-    c = float(c)
+    c = _finite(c, "c")
 
     def p(u: np.ndarray, v: np.ndarray) -> np.ndarray:
         return _xyz(u * np.cos(v), u * np.sin(v), c * v)
@@ -137,8 +141,10 @@ def helicoid(c: float = 1.0) -> ParametricSurface:
         "helicoid",
         p,
         (0.0, 1.0, 0.0, 2 * np.pi),
+        closed_v=c == 0,
+        poles=("u0",) if c == 0 else (),
         derivatives=d,
-        default_uv=(0.0, 0.0),
+        default_uv=(0.0, 0.0) if c != 0 else (0.5, 0.0),
         description="minimal surface (u cos v, u sin v, c v); hyperbolic, H = 0",
         params={"c": c},
     )
@@ -248,7 +254,7 @@ def saddle(a: float = 1.0) -> ParametricSurface:
 
     At the origin ``κ₁ = 2a, κ₂ = −2a`` along the axes, ``K = −4a²``.
     """
-    a = float(a)
+    a = _finite(a, "a")
 
     def p(u: np.ndarray, v: np.ndarray) -> np.ndarray:
         return _xyz(u, v, a * (u * u - v * v))
@@ -279,7 +285,7 @@ def monkey_saddle(a: float = 1.0) -> ParametricSurface:
 
     The origin is a planar point (``II = 0``); everywhere else the surface is hyperbolic.
     """
-    a = float(a)
+    a = _finite(a, "a")
 
     def p(u: np.ndarray, v: np.ndarray) -> np.ndarray:
         return _xyz(u, v, a * (u**3 - 3 * u * v * v))
@@ -336,6 +342,13 @@ def cylinder(r: float = 1.0, height: float = 2.0) -> ParametricSurface:
         description="circular cylinder of radius r; parabolic, K = 0",
         params={"r": r, "height": height},
     )
+
+
+def _finite(x: float, name: str) -> float:
+    x = float(x)
+    if not math.isfinite(x):
+        raise MeshError(f"must be a finite number, got {x}", name)
+    return x
 
 
 def _positive(x: float, name: str) -> float:

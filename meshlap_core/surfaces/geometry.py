@@ -14,11 +14,9 @@ from ..errors import MeshError
 from ..types import BoolArray, FloatArray
 from .catalogue import ParametricSurface, check_uv, get_surface
 from .derivatives import DerivativeMethod, surface_derivatives
+from .singular import singular_description, singular_mask
 
 CLASSIFICATIONS: tuple[str, ...] = ("elliptic", "hyperbolic", "parabolic", "planar", "umbilic")
-
-# A point is singular when |p_u x p_v| <= _SINGULAR_REL * |p_u| |p_v| (or p_u or p_v vanishes).
-_SINGULAR_REL = 1e-10
 
 
 def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -28,7 +26,9 @@ def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 @dataclass(frozen=True)
 class CurvatureFields:
     """Fundamental forms and curvatures at a batch of points (every field has shape ``S``
-    unless noted). ``singular`` marks points where ``p_u × p_v = 0`` (all values NaN there)."""
+    unless noted). ``singular`` marks the singular points of the parameterization (a declared
+    pole, or ``p_u × p_v`` negligible against the surface's area scale: see
+    :mod:`meshlap_core.surfaces.singular`); every curvature value is NaN there."""
 
     n: FloatArray  # S + (3,)
     E: FloatArray
@@ -73,8 +73,7 @@ def surface_curvature_fields(
     D = surface_derivatives(surface, u, v, method)
     N = np.cross(D.p_u, D.p_v)
     nn = np.linalg.norm(N, axis=-1)
-    ref = np.linalg.norm(D.p_u, axis=-1) * np.linalg.norm(D.p_v, axis=-1)
-    singular = (nn <= _SINGULAR_REL * ref) | (ref == 0)
+    singular = singular_mask(surface, u, v, N)
     n = np.divide(N, nn[..., None], out=np.full_like(N, np.nan), where=~singular[..., None])
     E, F, G = _dot(D.p_u, D.p_u), _dot(D.p_u, D.p_v), _dot(D.p_v, D.p_v)
     e, f, g = _dot(D.p_uu, n), _dot(D.p_uv, n), _dot(D.p_vv, n)
@@ -245,9 +244,11 @@ class PointGeometry:
 
 def _require_regular(surface: ParametricSurface, cf: CurvatureFields, u: float, v: float) -> None:
     if bool(np.any(cf.singular)):
+        D = surface_derivatives(surface, u, v)
+        why = singular_description(surface, u, v, np.cross(D.p_u, D.p_v))
         raise MeshError(
-            f"the parameterization of the {surface.name} is singular at (u, v) = ({u:g}, {v:g}) "
-            "(p_u × p_v = 0, e.g. a pole): the normal and the forms are undefined there",
+            f"the parameterization of the {surface.name} is singular at (u, v) = ({float(u)!r}, "
+            f"{float(v)!r}) ({why}): the normal, the forms and the curvatures are undefined there",
             "u, v",
         )
 
