@@ -648,3 +648,87 @@ def test_flat_helicoid_is_a_disc_with_a_pole() -> None:
 def test_shape_parameters_must_be_finite(name: str, param: str, value: float) -> None:
     with pytest.raises(MeshError, match=rf"^{param}: must be a finite number"):
         get_surface(name, **{param: value})
+
+
+# ------------------------------------------------------------------------------------------
+# bounded work (issue 14, items 6 and 7)
+# ------------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("res", [4096, (1, 16777216), (2048, 2049), (10**9, 10**9)])
+def test_mesh_memory_is_refused_before_any_allocation(res) -> None:
+    import tracemalloc
+
+    tracemalloc.start()
+    try:
+        with pytest.raises(MeshError, match=r"^res: .* GiB of memory .* GiB limit"):
+            mesh_surface("helicoid", res)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 2**20  # nothing of the mesh's size (≥ 2 GiB) was allocated
+
+
+def test_memory_estimate_and_limit() -> None:
+    assert surfaces.estimate_mesh_bytes(4096, 4096) == surfaces.MESH_BYTES_PER_CELL * 4096**2
+    assert surfaces.MAX_CELLS * surfaces.MESH_BYTES_PER_CELL <= surfaces.MAX_MESH_BYTES
+    assert surfaces.MAX_MESH_BYTES == 2 * 1024**3
+    # the largest square grid under the limit is accepted (checked, not built)
+    side = int(np.sqrt(surfaces.MAX_CELLS))
+    assert surfaces.check_mesh_res("helicoid", (side, side)) == (side, side)
+    with pytest.raises(MeshError, match="at least 3 cells"):
+        surfaces.check_mesh_res("torus", (2, 8))
+    with pytest.raises(MeshError, match=r"^--res: "):
+        surfaces.check_mesh_res("torus", 10**6, name="--res")
+
+
+@pytest.mark.parametrize("res", ["4096", "1,16777216", "3000,3000"])
+def test_cli_refuses_a_mesh_above_the_memory_limit(tmp_path, capsys, res: str) -> None:
+    out = tmp_path / "h.obj"
+    code, stdout, err = _cli(capsys, "helicoid", "--mesh", str(out), "--res", res)
+    assert code == 2 and stdout == ""
+    assert err.count("\n") == 1 and err.startswith("meshlap: error: --res: ")
+    assert "GiB" in err and "limit" in err
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(
+    "name, levels, exclude_poles, match",
+    [
+        ("helicoid", (8, 1), False, "level 1: the mesh has no interior vertex"),
+        ("saddle", (16, 8, 1), False, "level 1"),
+        ("torus", (8, 2), False, "closed in u"),
+        ("helicoid", (8, 2000), False, "GiB"),
+        ("helicoid", (8, 1000, 1000, 1100), False, "levels together"),
+        ("sphere", (8, 0), False, "at least 1 cell"),
+    ],
+)
+def test_every_convergence_level_is_checked_before_any_meshing(
+    name: str, levels: tuple[int, ...], exclude_poles: bool, match: str
+) -> None:
+    lines: list[str] = []
+    with pytest.raises(MeshError, match=match):
+        convergence_study(name, levels, exclude_poles=exclude_poles, progress=lines.append)
+    assert lines == []  # no level was meshed
+
+
+@pytest.mark.parametrize("name", list(surfaces.SURFACES))
+@pytest.mark.parametrize("exclude_poles", [False, True])
+def test_small_levels_fail_only_before_meshing(name: str, exclude_poles: bool) -> None:
+    """The up-front check (from a mesh of at most 3 x 3 cells) agrees with the study itself:
+    a level either passes it and is studied, or fails before anything is meshed."""
+    for n in range(1, 6):
+        lines: list[str] = []
+        try:
+            st = convergence_study(name, (n,), exclude_poles=exclude_poles, progress=lines.append)
+        except MeshError:
+            assert lines == []
+            assert n < 3  # three cells per direction always leave an interior vertex
+        else:
+            assert len(lines) == 1 and st.n_compared[0] >= 1
+
+
+def test_cli_convergence_refuses_a_bad_level_with_one_line(capsys) -> None:
+    code, out, err = _cli(capsys, "helicoid", "--convergence", "--res", "8,1")
+    assert code == 2 and out == ""
+    assert err.count("\n") == 1 and "--res" in err and "level 1" in err

@@ -72,7 +72,16 @@ from .geometry import (
     point_geometry,
     surface_curvature_fields,
 )
-from .meshing import MAX_CELLS, SurfaceMesh, mesh_surface
+from .meshing import (
+    MAX_CELLS,
+    MAX_MESH_BYTES,
+    MESH_BYTES_PER_CELL,
+    STUDY_BYTES_PER_CELL,
+    SurfaceMesh,
+    check_mesh_res,
+    estimate_mesh_bytes,
+    mesh_surface,
+)
 from .plot import plot_normal_curvature
 from .singular import SINGULAR_REL, is_singular, surface_scale
 
@@ -86,7 +95,10 @@ __all__ = [
     "EDGES",
     "ESTIMATORS",
     "MAX_CELLS",
+    "MAX_MESH_BYTES",
+    "MESH_BYTES_PER_CELL",
     "SINGULAR_REL",
+    "STUDY_BYTES_PER_CELL",
     "SURFACES",
     "ConvergenceStudy",
     "CurvatureFields",
@@ -98,11 +110,13 @@ __all__ = [
     "SurfaceMap",
     "SurfaceMesh",
     "catenoid",
+    "check_mesh_res",
     "check_uv",
     "classify",
     "convergence_study",
     "curvature_fields",
     "cylinder",
+    "estimate_mesh_bytes",
     "exact_curvature_at",
     "get_surface",
     "helicoid",

@@ -19,7 +19,13 @@ from ..topology import edges
 from ..types import BoolArray, FloatArray, IntArray
 from .catalogue import EDGES, ParametricSurface, get_surface
 from .geometry import surface_curvature_fields
-from .meshing import _parse_res, mesh_surface
+from .meshing import (
+    MAX_MESH_BYTES,
+    STUDY_BYTES_PER_CELL,
+    STUDY_KEPT_BYTES_PER_CELL,
+    check_mesh_res,
+    mesh_surface,
+)
 
 ESTIMATORS: tuple[str, ...] = (
     "H uniform",
@@ -267,7 +273,7 @@ def convergence_study(
       only on minimal surfaces (helicoid, catenoid), where the answer is 0.
     """
     surface = get_surface(surface)
-    levels = _check_levels(surface, mesher, resolutions)
+    levels = _check_levels(surface, mesher, resolutions, exclude_poles)
     meshes = []
     for lev in levels:
         meshes.append(_make_level(surface, mesher, lev, exclude_poles))
@@ -276,8 +282,12 @@ def convergence_study(
     return _study(surface.name, mesher, levels, exclude_poles, meshes)
 
 
-def _check_levels(surface: ParametricSurface, mesher: str, resolutions: Sequence[int]) -> list[int]:
-    """The levels as ints, every one checked before the first (slow) one is meshed."""
+def _check_levels(
+    surface: ParametricSurface, mesher: str, resolutions: Sequence[int], exclude_poles: bool
+) -> list[int]:
+    """The levels as ints, every one checked before the first (slow) one is meshed: its
+    resolution, its memory (the levels kept plus the largest one's estimators, against
+    :data:`~meshlap_core.surfaces.meshing.MAX_MESH_BYTES`) and that it has a vertex to compare."""
     if mesher not in ("grid", "icosphere"):
         raise MeshError(f"unknown mesher {mesher!r}; choose grid or icosphere", "mesher")
     try:
@@ -290,12 +300,38 @@ def _check_levels(surface: ParametricSurface, mesher: str, resolutions: Sequence
         raise MeshError(
             f"the icosphere mesher only meshes the sphere, not the {surface.name}", "mesher"
         )
+    if mesher == "icosphere":
+        for lev in levels:
+            if not 0 <= lev <= 7:
+                raise MeshError(f"icosphere subdivision levels must be in 0..7, got {lev}", "res")
+        return levels
+    cells = []
     for lev in levels:
-        if mesher == "grid":
-            _parse_res(lev)
-        elif not 0 <= lev <= 7:
-            raise MeshError(f"icosphere subdivision levels must be in 0..7, got {lev}", "res")
+        nu, nv = check_mesh_res(surface, lev, "res", STUDY_BYTES_PER_CELL)
+        _check_has_interior(surface, lev, nu, nv, exclude_poles)
+        cells.append(nu * nv)
+    need = STUDY_KEPT_BYTES_PER_CELL * sum(cells) + STUDY_BYTES_PER_CELL * max(cells)
+    if need > MAX_MESH_BYTES:
+        raise MeshError(
+            f"the {len(levels)} levels together would need about {need / 1024**3:.2f} GiB of "
+            f"memory, more than the {MAX_MESH_BYTES / 1024**3:.2f} GiB limit: use fewer or "
+            "smaller levels",
+            "res",
+        )
     return levels
+
+
+def _check_has_interior(
+    surface: ParametricSurface, lev: int, nu: int, nv: int, exclude_poles: bool
+) -> None:
+    """Refuse a grid level without an interior vertex to compare, from a mesh of at most 3 × 3
+    cells: whether a vertex is interior (and not a pole) depends only on whether each
+    direction has 1, 2 or at least 3 cells, on its closedness and on the poles."""
+    m = mesh_surface(surface, (min(nu, 3), min(nv, 3)))
+    if not np.any(~m.boundary & ~(m.pole if exclude_poles else False)):
+        raise MeshError(
+            f"level {lev}: the mesh has no interior vertex to compare; use a finer res", "res"
+        )
 
 
 def _make_level(surface: ParametricSurface, mesher: str, lev: int, exclude_poles: bool) -> _Level:

@@ -6,6 +6,7 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -48,8 +49,31 @@ class SurfaceMesh:
     res: tuple[int, int]
 
 
-# largest grid :func:`mesh_surface` builds (2^24 cells: 33.5 M triangles, about 1.3 GB of arrays)
-MAX_CELLS = 2**24
+MAX_MESH_BYTES = 2 * 1024**3
+"""Largest estimated peak memory (2 GiB) of one mesh generation; larger ``res`` is refused before
+anything is allocated (:func:`check_mesh_res`)."""
+MESH_BYTES_PER_CELL = 512
+"""Estimated peak bytes per grid cell of :func:`mesh_surface` (and of writing the mesh): measured
+456–510 bytes (peak RSS) at 512² and 1024² cells on the helicoid and the sphere; the output alone
+(``V, F, uv, pole, boundary``) is 90 bytes per cell, the edge table of the boundary mask most of
+the rest."""
+STUDY_BYTES_PER_CELL = 1536
+"""Estimated peak bytes per cell of one :func:`~meshlap_core.surfaces.convergence_study` level
+(the five discrete estimators): measured 1170–1440 bytes at 256² and 512² cells."""
+STUDY_KEPT_BYTES_PER_CELL = 128
+"""Bytes per cell a finished study level keeps (mesh, exact values) until the table is built."""
+MAX_CELLS = MAX_MESH_BYTES // MESH_BYTES_PER_CELL
+"""Largest grid :func:`mesh_surface` builds: 4,194,304 cells (2048 x 2048), 8.4 M triangles."""
+
+
+def _gib(n_bytes: float) -> str:
+    return f"{n_bytes / 1024**3:.2f} GiB"
+
+
+def estimate_mesh_bytes(nu: int, nv: int, bytes_per_cell: int = MESH_BYTES_PER_CELL) -> int:
+    """Estimated peak memory in bytes of meshing ``nu × nv`` cells (``bytes_per_cell · nu · nv``,
+    see :data:`MESH_BYTES_PER_CELL`). Pure arithmetic: nothing is allocated."""
+    return int(bytes_per_cell) * int(nu) * int(nv)
 
 
 def _parse_res(res: int | Sequence[int], name: str = "res") -> tuple[int, int]:
@@ -62,12 +86,51 @@ def _parse_res(res: int | Sequence[int], name: str = "res") -> tuple[int, int]:
         raise MeshError(f"expected an int or a pair (nu, nv), got {res!r}", name) from None
     if nu < 1 or nv < 1:
         raise MeshError(f"needs at least 1 cell in each direction, got {nu} x {nv}", name)
-    if nu * nv > MAX_CELLS:
+    return nu, nv
+
+
+def check_mesh_res(
+    surface: ParametricSurface | str,
+    res: int | Sequence[int],
+    name: str = "res",
+    bytes_per_cell: int = MESH_BYTES_PER_CELL,
+) -> tuple[int, int]:
+    """Check a mesh resolution before anything is allocated and return ``(nu, nv)``.
+
+    Parameters
+    ----------
+    surface : ParametricSurface or str
+    res : int or (nu, nv)
+        Cells per direction.
+    name : str
+        The argument named in errors.
+    bytes_per_cell : int
+        The memory model (:data:`MESH_BYTES_PER_CELL`, or :data:`STUDY_BYTES_PER_CELL` for a
+        convergence level).
+
+    Raises
+    ------
+    MeshError
+        Naming ``name``: not one or two integers, fewer than 1 cell, an estimated peak memory
+        ``bytes_per_cell · nu · nv`` above :data:`MAX_MESH_BYTES` (the message gives the
+        estimate), or fewer than 3 cells around a closed direction.
+    """
+    surface = get_surface(surface)
+    nu, nv = _parse_res(res, name)
+    need = estimate_mesh_bytes(nu, nv, bytes_per_cell)
+    if need > MAX_MESH_BYTES:
+        most = MAX_MESH_BYTES // bytes_per_cell
         raise MeshError(
-            f"{nu} x {nv} cells is more than the {MAX_CELLS:,} meshlap meshes a surface with "
-            f"(about {2 * MAX_CELLS:,} triangles)",
+            f"{nu} x {nv} cells would need about {_gib(need)} of memory (estimated at "
+            f"{bytes_per_cell} bytes per cell), more than the {_gib(MAX_MESH_BYTES)} limit: "
+            f"use at most {most:,} cells (e.g. {math.isqrt(most)} x {math.isqrt(most)})",
             name,
         )
+    for closed, cnt, nm in ((surface.closed_u, nu, "u"), (surface.closed_v, nv, "v")):
+        if closed and cnt < 3:
+            raise MeshError(
+                f"the {surface.name} is closed in {nm}: needs at least 3 cells there", name
+            )
     return nu, nv
 
 
@@ -87,15 +150,11 @@ def mesh_surface(surface: ParametricSurface | str, res: int | Sequence[int] = 32
     Raises
     ------
     MeshError
-        On a bad ``res``, or fewer than 3 cells around a closed direction.
+        On a bad ``res`` (see :func:`check_mesh_res`: checked before anything is allocated,
+        including the memory estimate against :data:`MAX_MESH_BYTES`).
     """
     surface = get_surface(surface)
-    nu, nv = _parse_res(res)
-    for closed, cnt, nm in ((surface.closed_u, nu, "u"), (surface.closed_v, nv, "v")):
-        if closed and cnt < 3:
-            raise MeshError(
-                f"the {surface.name} is closed in {nm}: needs at least 3 cells there", "res"
-            )
+    nu, nv = check_mesh_res(surface, res)
     u0, u1, v0, v1 = surface.domain
     # closed directions: the last sample would repeat the first, the seam wraps instead
     us = np.linspace(u0, u1, nu + 1)[:nu] if surface.closed_u else np.linspace(u0, u1, nu + 1)
