@@ -732,3 +732,13 @@ def test_cli_convergence_refuses_a_bad_level_with_one_line(capsys) -> None:
     code, out, err = _cli(capsys, "helicoid", "--convergence", "--res", "8,1")
     assert code == 2 and out == ""
     assert err.count("\n") == 1 and "--res" in err and "level 1" in err
+
+
+def test_public_aliases() -> None:
+    # meshlap_core.surface (the public API) and the viewer's former name stay importable
+    assert surfaces.surface("torus", R=2.0).params == {"R": 2.0, "r": 1.0}
+    assert surfaces.curvature_fields is surface_curvature_fields
+    # the parametric torus and the triangle mesh of primitives: the same points
+    s = surfaces.torus(R=2.0, r=0.5)
+    V, _ = primitives.torus(8, 6, R=2.0, r=0.5)
+    np.testing.assert_allclose(mesh_surface(s, (8, 6)).V, V, atol=1e-14)

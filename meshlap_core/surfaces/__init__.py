@@ -85,6 +85,9 @@ from .meshing import (
 from .plot import plot_normal_curvature
 from .singular import SINGULAR_REL, is_singular, surface_scale
 
+surface = get_surface
+"""``surface(name, **params)``: the catalogue surface by name, the name
+``meshlap_core.surface`` (the public API) resolves to; same as :func:`get_surface`."""
 curvature_fields = surface_curvature_fields
 """Former name of :func:`surface_curvature_fields`, kept for ``app/viewer.py``; not to be
 confused with :func:`meshlap_core.curvature.curvature_fields` (discrete, on a mesh)."""
@@ -129,6 +132,7 @@ __all__ = [
     "point_geometry",
     "saddle",
     "sphere",
+    "surface",
     "surface_curvature_fields",
     "surface_derivatives",
     "surface_scale",

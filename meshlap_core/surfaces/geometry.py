@@ -272,7 +272,8 @@ def point_geometry(
     ------
     MeshError
         ``(u, v)`` outside the domain (naming ``u`` or ``v``) or a singular point of the
-        parameterization (a pole).
+        parameterization (a declared pole, or ``|p_u × p_v|`` negligible against the surface's
+        area scale: :func:`~meshlap_core.surfaces.singular.is_singular`), naming ``u, v``.
 
     Examples
     --------
