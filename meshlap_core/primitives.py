@@ -54,8 +54,13 @@ def grid(nx: int = 10, ny: int = 10, size: float = 1.0) -> tuple[FloatArray, Int
 def torus(
     n_major: int = 32, n_minor: int = 16, R: float = 3.0, r: float = 1.0
 ) -> tuple[FloatArray, IntArray]:
-    """Torus around the z axis, ``p(u,v) = ((R + r cos v) cos u, (R + r cos v) sin u, r sin v)``,
-    sampled on a regular ``n_major × n_minor`` grid with welded seams (genus 1, χ = 0).
+    """Triangle mesh ``(V, F)`` of the torus around the z axis,
+    ``p(u,v) = ((R + r cos v) cos u, (R + r cos v) sin u, r sin v)``, sampled on a regular
+    ``n_major × n_minor`` grid with welded seams (genus 1, χ = 0).
+
+    The *parametric* torus (exact geometry at any ``(u, v)``) is
+    :func:`meshlap_core.surfaces.torus`; ``mesh_surface(surfaces.torus(R, r), (n_major, n_minor))``
+    gives this same mesh.
     """
     if n_major < 3 or n_minor < 3:
         raise MeshError("a torus needs at least 3 x 3 samples", "torus")

@@ -687,6 +687,28 @@ CORPUS: list[Hostile] = [
         n_faces=80,
         closed=True,
     ),
+    # round 2: surfaces
+    Hostile(
+        "surface_sphere_poles.obj",
+        _text(
+            "surface_sphere_poles.obj",
+            lambda: obj_text(*_surface_mesh("sphere", (12, 10))),
+        ),
+        "ok",
+        n_vertices=112,
+        n_faces=220,
+        closed=True,
+    ),
+    Hostile(
+        "surface_disc_pole.obj",
+        _text(
+            "surface_disc_pole.obj",
+            lambda: obj_text(*_surface_mesh("helicoid", 8, c=0.0)),
+        ),
+        "ok",
+        n_vertices=65,
+        n_faces=120,
+    ),
 ]
 
 BY_NAME: dict[str, Hostile] = {h.name: h for h in CORPUS}
@@ -707,3 +729,12 @@ def build(name: str, folder: Path) -> Path:
         if h.name == name:
             return h.build(folder)
     raise KeyError(name)
+
+
+# round 2: surfaces (called lazily by the CORPUS entries above)
+def _surface_mesh(name: str, res, **params: float) -> tuple[np.ndarray, np.ndarray]:
+    """A grid mesh of a parametric surface, its pole edges collapsed to fans."""
+    from meshlap_core.surfaces import get_surface, mesh_surface
+
+    m = mesh_surface(get_surface(name, **params), res)
+    return m.V, m.F

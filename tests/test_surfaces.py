@@ -21,12 +21,12 @@ from meshlap_core.io import load_mesh
 from meshlap_core.surfaces import (
     ParametricSurface,
     convergence_study,
-    curvature_fields,
     get_surface,
     mesh_surface,
     normal_curvature,
     normal_curvature_curve,
     point_geometry,
+    surface_curvature_fields,
     surface_derivatives,
 )
 from meshlap_core.topology import boundary_loops, edge_face_counts, euler_characteristic
@@ -108,7 +108,7 @@ def test_torus_sign_of_K_inside_and_outside() -> None:
     assert top.K == pytest.approx(0, abs=1e-12)
     assert top.classification == "parabolic"
     u, v = _random_uv(s, 200)
-    cf = curvature_fields(s, u, v)
+    cf = surface_curvature_fields(s, u, v)
     np.testing.assert_allclose(cf.K, np.cos(v) / (r * (R + r * np.cos(v))), atol=1e-12)
     # the normal points outwards, away from the tube's core circle
     core = np.stack([R * np.cos(u), R * np.sin(u), np.zeros_like(u)], axis=1)
@@ -143,7 +143,7 @@ def test_catenoid_numeric_derivatives_give_the_minimal_surface() -> None:
     s = get_surface("catenoid", c=c)
     assert s.derivatives is None  # exercises the numeric path
     u, v = _random_uv(s, 100)
-    cf = curvature_fields(s, u, v)
+    cf = surface_curvature_fields(s, u, v)
     np.testing.assert_allclose(cf.H, 0, atol=1e-9)
     np.testing.assert_allclose(cf.K, -1 / (c**2 * np.cosh(v / c) ** 4), atol=1e-9)
 
@@ -336,7 +336,7 @@ def test_mesh_keeps_uv_and_follows_the_normal(name: str) -> None:
     m = mesh_surface(s, 10)
     np.testing.assert_allclose(m.V, s(m.uv[:, 0], m.uv[:, 1]), atol=1e-14)
     ok = ~m.pole
-    n_exact = curvature_fields(s, m.uv[ok, 0], m.uv[ok, 1]).n
+    n_exact = surface_curvature_fields(s, m.uv[ok, 0], m.uv[ok, 1]).n
     n_mesh = vertex_normals(m.V, m.F)[ok]
     assert np.min(np.sum(n_exact * n_mesh, axis=1)) > 0.8  # same orientation everywhere
 
@@ -532,3 +532,213 @@ def test_cli_plot_mesh_and_convergence(tmp_path, capsys) -> None:
     assert d["n_vertices"] == [42, 162]
     assert set(d["errors"]) == set(surfaces.ESTIMATORS)
     assert "vertices" in err  # progress on stderr, not stdout
+
+
+# ------------------------------------------------------------------------------------------
+# singular points (issue 14, item 5)
+# ------------------------------------------------------------------------------------------
+
+
+def _expected_singular(name: str, u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Where each catalogue surface (default parameters) degenerates, worked out by hand:
+    only the sphere's two poles (|p_u × p_v| = r² sin u)."""
+    if name == "sphere":
+        return (u == 0.0) | (u == np.pi)
+    return np.zeros(np.broadcast(u, v).shape, dtype=bool)
+
+
+@pytest.mark.parametrize("name", list(surfaces.SURFACES))
+def test_singular_points_of_every_catalogue_surface(name: str) -> None:
+    s = get_surface(name)
+    u0, u1, v0, v1 = s.domain
+    # a grid that includes every edge and corner of the domain (the poles among them)
+    U, V = np.meshgrid(np.linspace(u0, u1, 13), np.linspace(v0, v1, 11), indexing="ij")
+    np.testing.assert_array_equal(surfaces.is_singular(s, U, V), _expected_singular(name, U, V))
+    cf = surface_curvature_fields(s, U, V)
+    np.testing.assert_array_equal(cf.singular, _expected_singular(name, U, V))
+    assert np.isnan(cf.K[cf.singular]).all() and np.isfinite(cf.K[~cf.singular]).all()
+
+
+@pytest.mark.parametrize("r", [1e-6, 1.0, 1e6])
+@pytest.mark.parametrize("u", [0.0, np.pi])
+def test_both_sphere_poles_are_singular_at_every_scale(r: float, u: float) -> None:
+    s = get_surface("sphere", r=r)
+    assert bool(surfaces.is_singular(s, u, 0.0))
+    with pytest.raises(MeshError, match=r"singular.*pole"):
+        point_geometry(s, u, 0.0)
+    with pytest.raises(MeshError, match="singular"):
+        normal_curvature(s, u, 0.0, 0.3)
+    # 1e-6 away from the pole the sphere is regular and umbilic, K = 1/r²
+    inside = 1e-6 if u == 0 else np.pi - 1e-6
+    g = point_geometry(s, inside, 0.0)
+    assert g.K == pytest.approx(1 / r**2, rel=1e-6)
+    assert g.classification == "umbilic"
+
+
+def test_south_pole_cli_is_refused_like_the_north_pole(capsys) -> None:
+    for u in ("0", "3.141592653589793"):
+        code, out, err = _cli(capsys, "sphere", "--u", u, "--v", "0")
+        assert code == 2 and out == ""
+        assert err.count("\n") == 1 and err.startswith("meshlap: error: --u/--v: ")
+        assert "singular" in err
+
+
+def test_singular_test_is_against_the_surface_scale() -> None:
+    # the mean of |p_u x p_v| over the domain is the area over the parameter area: 2r²/π
+    for r in (1e-6, 1.0, 1e6):
+        assert surfaces.surface_scale(get_surface("sphere", r=r)) == pytest.approx(
+            2 * r * r / np.pi, rel=1e-3
+        )
+    assert surfaces.surface_scale("cylinder") == pytest.approx(1.0)  # |p_u x p_v| = r = 1
+
+
+@pytest.mark.parametrize("scale", [1e-8, 1.0, 1e8])
+def test_an_undeclared_apex_is_found_by_the_scale_test(scale: float) -> None:
+    # a cone (u cos v, u sin v, u) declares no pole: |p_u x p_v| = √2 u vanishes at u = 0
+    cone = ParametricSurface(
+        "cone",
+        lambda u, v: scale * np.stack(np.broadcast_arrays(u * np.cos(v), u * np.sin(v), u), -1),
+        (0.0, 1.0, 0.0, 2 * np.pi),
+    )
+    v = np.linspace(0, 2 * np.pi, 7)
+    assert surfaces.is_singular(cone, 0.0, v).all()
+    assert not surfaces.is_singular(cone, 1e-6, v).any()
+    assert not surfaces.is_singular(cone, 0.5, v).any()
+    with pytest.raises(MeshError, match="area scale"):
+        point_geometry(cone, 0.0, 1.0)
+    # K = 0 (developable); n = (−cos v, −sin v, 1)/√2 points into the cone, so the circle
+    # around the axis bends towards n: κ₁ = +1/(√2 u · scale), κ₂ = 0 along the rulings
+    g = point_geometry(cone, 0.5, 1.0)
+    assert g.K == pytest.approx(0, abs=1e-6 / scale**2)
+    assert g.k1 == pytest.approx(1 / (np.sqrt(2) * 0.5 * scale), rel=1e-6)
+    assert g.k2 == pytest.approx(0, abs=1e-6 / scale)
+
+
+@pytest.mark.parametrize("name", list(surfaces.SURFACES))
+def test_regular_points_stay_regular(name: str) -> None:
+    s = get_surface(name)
+    u, v = _random_uv(s, 500, seed=3)
+    assert not surfaces.is_singular(s, u, v).any()
+    u0, u1, v0, v1 = s.domain
+    # within 1e-6 of the domain width of every edge, poles included
+    eps_u, eps_v = 1e-6 * (u1 - u0), 1e-6 * (v1 - v0)
+    near = np.array([u0 + eps_u, u1 - eps_u])
+    assert not surfaces.is_singular(s, near[:, None], v[None, :20]).any()
+    assert not surfaces.is_singular(s, u[:20, None], np.array([v0 + eps_v, v1 - eps_v])).any()
+
+
+def test_flat_helicoid_is_a_disc_with_a_pole() -> None:
+    s = get_surface("helicoid", c=0.0)
+    assert s.poles == ("u0",) and s.closed_v
+    assert surfaces.is_singular(s, 0.0, np.linspace(0, 6, 5)).all()
+    g = point_geometry(s)  # the default point moves off the pole
+    assert (g.u, g.K, g.H) == pytest.approx((0.5, 0.0, 0.0), abs=1e-12)
+    assert g.classification == "planar"
+    m = mesh_surface(s, 8)
+    assert m.pole.sum() == 1 and not m.boundary[m.pole].any()  # the centre: an interior fan
+    assert euler_characteristic(m.F) == 1 and len(boundary_loops(m.F)) == 1
+    _, count = edge_face_counts(m.F)
+    assert count.max() == 2
+
+
+@pytest.mark.parametrize(
+    "name, param", [("helicoid", "c"), ("saddle", "a"), ("monkey_saddle", "a")]
+)
+@pytest.mark.parametrize("value", [np.nan, np.inf, -np.inf])
+def test_shape_parameters_must_be_finite(name: str, param: str, value: float) -> None:
+    with pytest.raises(MeshError, match=rf"^{param}: must be a finite number"):
+        get_surface(name, **{param: value})
+
+
+# ------------------------------------------------------------------------------------------
+# bounded work (issue 14, items 6 and 7)
+# ------------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("res", [4096, (1, 16777216), (2048, 2049), (10**9, 10**9)])
+def test_mesh_memory_is_refused_before_any_allocation(res) -> None:
+    import tracemalloc
+
+    tracemalloc.start()
+    try:
+        with pytest.raises(MeshError, match=r"^res: .* GiB of memory .* GiB limit"):
+            mesh_surface("helicoid", res)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 2**20  # nothing of the mesh's size (≥ 2 GiB) was allocated
+
+
+def test_memory_estimate_and_limit() -> None:
+    assert surfaces.estimate_mesh_bytes(4096, 4096) == surfaces.MESH_BYTES_PER_CELL * 4096**2
+    assert surfaces.MAX_CELLS * surfaces.MESH_BYTES_PER_CELL <= surfaces.MAX_MESH_BYTES
+    assert surfaces.MAX_MESH_BYTES == 2 * 1024**3
+    # the largest square grid under the limit is accepted (checked, not built)
+    side = int(np.sqrt(surfaces.MAX_CELLS))
+    assert surfaces.check_mesh_res("helicoid", (side, side)) == (side, side)
+    with pytest.raises(MeshError, match="at least 3 cells"):
+        surfaces.check_mesh_res("torus", (2, 8))
+    with pytest.raises(MeshError, match=r"^--res: "):
+        surfaces.check_mesh_res("torus", 10**6, name="--res")
+
+
+@pytest.mark.parametrize("res", ["4096", "1,16777216", "3000,3000"])
+def test_cli_refuses_a_mesh_above_the_memory_limit(tmp_path, capsys, res: str) -> None:
+    out = tmp_path / "h.obj"
+    code, stdout, err = _cli(capsys, "helicoid", "--mesh", str(out), "--res", res)
+    assert code == 2 and stdout == ""
+    assert err.count("\n") == 1 and err.startswith("meshlap: error: --res: ")
+    assert "GiB" in err and "limit" in err
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(
+    "name, levels, exclude_poles, match",
+    [
+        ("helicoid", (8, 1), False, "level 1: the mesh has no interior vertex"),
+        ("saddle", (16, 8, 1), False, "level 1"),
+        ("torus", (8, 2), False, "closed in u"),
+        ("helicoid", (8, 2000), False, "GiB"),
+        ("helicoid", (8, 1000, 1000, 1100), False, "levels together"),
+        ("sphere", (8, 0), False, "at least 1 cell"),
+    ],
+)
+def test_every_convergence_level_is_checked_before_any_meshing(
+    name: str, levels: tuple[int, ...], exclude_poles: bool, match: str
+) -> None:
+    lines: list[str] = []
+    with pytest.raises(MeshError, match=match):
+        convergence_study(name, levels, exclude_poles=exclude_poles, progress=lines.append)
+    assert lines == []  # no level was meshed
+
+
+@pytest.mark.parametrize("name", list(surfaces.SURFACES))
+@pytest.mark.parametrize("exclude_poles", [False, True])
+def test_small_levels_fail_only_before_meshing(name: str, exclude_poles: bool) -> None:
+    """The up-front check (from a mesh of at most 3 x 3 cells) agrees with the study itself:
+    a level either passes it and is studied, or fails before anything is meshed."""
+    for n in range(1, 6):
+        lines: list[str] = []
+        try:
+            st = convergence_study(name, (n,), exclude_poles=exclude_poles, progress=lines.append)
+        except MeshError:
+            assert lines == []
+            assert n < 3  # three cells per direction always leave an interior vertex
+        else:
+            assert len(lines) == 1 and st.n_compared[0] >= 1
+
+
+def test_cli_convergence_refuses_a_bad_level_with_one_line(capsys) -> None:
+    code, out, err = _cli(capsys, "helicoid", "--convergence", "--res", "8,1")
+    assert code == 2 and out == ""
+    assert err.count("\n") == 1 and "--res" in err and "level 1" in err
+
+
+def test_public_aliases() -> None:
+    # meshlap_core.surface (the public API) and the viewer's former name stay importable
+    assert surfaces.surface("torus", R=2.0).params == {"R": 2.0, "r": 1.0}
+    assert surfaces.curvature_fields is surface_curvature_fields
+    # the parametric torus and the triangle mesh of primitives: the same points
+    s = surfaces.torus(R=2.0, r=0.5)
+    V, _ = primitives.torus(8, 6, R=2.0, r=0.5)
+    np.testing.assert_allclose(mesh_surface(s, (8, 6)).V, V, atol=1e-14)

@@ -18,8 +18,12 @@ import numpy as np
 from ..errors import MeshError
 from ..surfaces import (
     SURFACES,
+    ParametricSurface,
+    PointGeometry,
+    check_mesh_res,
     check_uv,
     convergence_study,
+    estimate_mesh_bytes,
     get_surface,
     mesh_surface,
     plot_normal_curvature,
@@ -28,6 +32,7 @@ from ..surfaces import (
 from ._common import add_json_flag, emit_json, parse_list
 
 DEFAULT_RES = {"grid": "8,16,32,64,128", "icosphere": "1,2,3,4,5"}
+PROGRESS_BYTES = 256 * 1024**2  # --mesh: a line on stderr before meshes estimated above this
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -156,6 +161,7 @@ def run(args: argparse.Namespace) -> int:
             "res": "--res",
             "u": "--u",
             "v": "--v",
+            "u, v": "--u/--v",
             "params": "--param",
             "mesher": "--mesher",
         }.get(exc.source or "")
@@ -187,25 +193,13 @@ def _run(args: argparse.Namespace) -> int:
         res = parse_list(args.res or "32", int, "--res")
         if len(res) > 2:
             raise MeshError(f"expected N or NU,NV, got {args.res!r}", "--res")
+        nu, nv = check_mesh_res(surface, res[0] if len(res) == 1 else (res[0], res[1]), "--res")
     if plot is not None:
         geo = plot_normal_curvature(surface, u, v, plot)
     else:
         geo = point_geometry(surface, u, v)
 
-    mesh_info = None
-    if args.mesh is not None:
-        from ..io import save_mesh
-
-        m = mesh_surface(surface, res[0] if len(res) == 1 else (res[0], res[1]))
-        save_mesh(Path(args.mesh), m.V, m.F)
-        mesh_info = {
-            "path": str(args.mesh),
-            "res": list(m.res),
-            "n_vertices": len(m.V),
-            "n_faces": len(m.F),
-            "n_boundary_vertices": int(m.boundary.sum()),
-            "n_pole_vertices": int(m.pole.sum()),
-        }
+    mesh_info = None if args.mesh is None else _write_mesh(surface, args.mesh, nu, nv)
 
     if args.json:
         emit_json(
@@ -217,6 +211,43 @@ def _run(args: argparse.Namespace) -> int:
             }
         )
         return 0
+    _print_point(geo, surface)
+    if plot is not None:
+        print(f"wrote {plot}")
+    if mesh_info is not None:
+        print(
+            f"wrote {args.mesh}: {mesh_info['n_vertices']} vertices, {mesh_info['n_faces']} faces"
+        )
+    return 0
+
+
+def _write_mesh(surface: ParametricSurface, path: str, nu: int, nv: int) -> dict[str, Any]:
+    """Mesh ``nu × nv`` cells (already checked), write them, return the JSON summary; a line on
+    stderr first when the estimated peak memory is large."""
+    from ..io import save_mesh
+
+    need = estimate_mesh_bytes(nu, nv)
+    if need >= PROGRESS_BYTES:
+        print(
+            f"meshlap: meshing the {surface.name}: {nu} x {nv} cells, estimated peak memory "
+            f"{need / 1024**3:.2f} GiB",
+            file=sys.stderr,
+            flush=True,
+        )
+    m = mesh_surface(surface, (nu, nv))
+    save_mesh(Path(path), m.V, m.F)
+    return {
+        "path": str(path),
+        "res": list(m.res),
+        "n_vertices": len(m.V),
+        "n_faces": len(m.F),
+        "n_boundary_vertices": int(m.boundary.sum()),
+        "n_pole_vertices": int(m.pole.sum()),
+    }
+
+
+def _print_point(geo: PointGeometry, surface: ParametricSurface) -> None:
+    """The text report of one point."""
     params = ", ".join(f"{k}={x:g}" for k, x in surface.params.items())
     print(f"{geo.surface} [{params}] at (u, v) = ({geo.u:.6g}, {geo.v:.6g})")
     print(f"  p    = {_vec(geo.p)}")
@@ -235,10 +266,3 @@ def _run(args: argparse.Namespace) -> int:
             f"  {name} = {k:.6g}: κn is {what} at θ = {t:.6g} (and θ + π); "
             f"direction (u,v) {_vec(d_uv)}, 3-D {_vec(d3)}"
         )
-    if plot is not None:
-        print(f"wrote {plot}")
-    if mesh_info is not None:
-        print(
-            f"wrote {args.mesh}: {mesh_info['n_vertices']} vertices, {mesh_info['n_faces']} faces"
-        )
-    return 0

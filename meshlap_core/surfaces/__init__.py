@@ -1,0 +1,140 @@
+"""Parametric surfaces ``p(u, v)``: exact differential geometry and the bridge to the meshes.
+
+Modules: :mod:`.catalogue` (:class:`ParametricSurface`, the shipped surfaces, :func:`get_surface`),
+:mod:`.derivatives` (exact / complex-step / central derivatives), :mod:`.geometry` (fundamental
+forms, curvature fields, normal curvature, classification, :func:`point_geometry`),
+:mod:`.meshing` (:func:`mesh_surface`), :mod:`.convergence` (:func:`convergence_study`),
+:mod:`.plot` (the ``κₙ(θ)`` figure) and :mod:`.singular` (singular points: declared poles and
+``|p_u × p_v|`` negligible against the surface's area scale). Everything public is re-exported here.
+
+A :class:`ParametricSurface` is a map ``p`` on a parameter rectangle ``[u0,u1] × [v0,v1]``.
+At any ``(u, v)`` this module computes the partial derivatives, the unit normal
+``n = (p_u × p_v) / |p_u × p_v|`` (always this orientation), the first fundamental form
+``I = [[E, F], [F, G]]``, the second fundamental form ``II = [[e, f], [f, g]]`` with
+``e = p_uu · n, f = p_uv · n, g = p_vv · n``, the Gaussian curvature
+``K = (eg − f²)/(EG − F²)``, the mean curvature ``H = (eG − 2fF + gE) / (2(EG − F²))``, the
+principal curvatures ``κ₁ ≥ κ₂`` and directions, the normal curvature
+``κₙ(θ) = II(w, w) / I(w, w)`` for ``w = (cos θ, sin θ)`` and the point classification.
+It also triangulates the parameter rectangle (:func:`mesh_surface`) and measures how the
+discrete estimators of :mod:`meshlap_core.curvature` converge to the exact values
+(:func:`convergence_study`).
+
+Sign conventions. ``II`` is measured against ``n = p_u × p_v / |…|``: ``κₙ < 0`` where the
+surface bends away from ``n``. Every shipped closed surface has ``n`` pointing outwards, so the
+unit sphere has ``κ₁ = κ₂ = H = −1`` here (the textbook sign of do Carmo). The discrete core uses
+``Δx = −2 H n`` (negative semidefinite Laplacian), whose ``H`` is **minus** this one for the
+same normal (``+1`` on the unit sphere). :func:`convergence_study` therefore compares the core's
+``H`` with ``−H``; ``K`` does not depend on the sign.
+
+Derivatives. A surface may carry its exact derivatives; otherwise (and in the tests, to check
+them) they are computed numerically: first derivatives by the complex step
+``p_u ≈ Im p(u + ih, v) / h`` (exact to rounding, needs ``p`` written with numpy functions that
+accept complex input and are analytic: no ``abs``, ``maximum``, ``real``), second derivatives by
+a 6th-order central difference of the complex-step first derivatives. A ``p`` that does not
+return complex values for complex input falls back to 6th-order central differences.
+
+References
+----------
+M. do Carmo, *Differential Geometry of Curves and Surfaces*, 1976, ch. 3.
+Squire & Trapp, "Using complex variables to estimate derivatives of real functions", SIAM
+Review 40, 1998 (the complex step).
+Meyer, Desbrun, Schröder & Barr, "Discrete differential-geometry operators for triangulated
+2-manifolds", 2003 (the estimators being tested).
+Xu, "Convergence of the discrete Laplace–Beltrami operator", 2004; Hildebrandt, Polthier &
+Wardetzky, "On the convergence of metric and geometric properties of polyhedral surfaces", 2006.
+"""
+
+from .catalogue import (
+    EDGES,
+    SURFACES,
+    DerivativeMap,
+    ParametricSurface,
+    SurfaceMap,
+    catenoid,
+    check_uv,
+    cylinder,
+    get_surface,
+    helicoid,
+    monkey_saddle,
+    saddle,
+    sphere,
+    torus,
+)
+from .convergence import ESTIMATORS, ConvergenceStudy, convergence_study, exact_curvature_at
+from .derivatives import DERIVATIVE_METHODS, DerivativeMethod, Derivatives, surface_derivatives
+from .geometry import (
+    CLASSIFICATIONS,
+    CurvatureFields,
+    PointGeometry,
+    classify,
+    normal_curvature,
+    normal_curvature_curve,
+    point_geometry,
+    surface_curvature_fields,
+)
+from .meshing import (
+    MAX_CELLS,
+    MAX_MESH_BYTES,
+    MESH_BYTES_PER_CELL,
+    STUDY_BYTES_PER_CELL,
+    SurfaceMesh,
+    check_mesh_res,
+    estimate_mesh_bytes,
+    mesh_surface,
+)
+from .plot import plot_normal_curvature
+from .singular import SINGULAR_REL, is_singular, surface_scale
+
+surface = get_surface
+"""``surface(name, **params)``: the catalogue surface by name, the name
+``meshlap_core.surface`` (the public API) resolves to; same as :func:`get_surface`."""
+curvature_fields = surface_curvature_fields
+"""Former name of :func:`surface_curvature_fields`, kept for ``app/viewer.py``; not to be
+confused with :func:`meshlap_core.curvature.curvature_fields` (discrete, on a mesh)."""
+
+__all__ = [
+    "CLASSIFICATIONS",
+    "DERIVATIVE_METHODS",
+    "EDGES",
+    "ESTIMATORS",
+    "MAX_CELLS",
+    "MAX_MESH_BYTES",
+    "MESH_BYTES_PER_CELL",
+    "SINGULAR_REL",
+    "STUDY_BYTES_PER_CELL",
+    "SURFACES",
+    "ConvergenceStudy",
+    "CurvatureFields",
+    "DerivativeMap",
+    "DerivativeMethod",
+    "Derivatives",
+    "ParametricSurface",
+    "PointGeometry",
+    "SurfaceMap",
+    "SurfaceMesh",
+    "catenoid",
+    "check_mesh_res",
+    "check_uv",
+    "classify",
+    "convergence_study",
+    "curvature_fields",
+    "cylinder",
+    "estimate_mesh_bytes",
+    "exact_curvature_at",
+    "get_surface",
+    "helicoid",
+    "is_singular",
+    "mesh_surface",
+    "monkey_saddle",
+    "normal_curvature",
+    "normal_curvature_curve",
+    "plot_normal_curvature",
+    "point_geometry",
+    "saddle",
+    "sphere",
+    "surface",
+    "surface_curvature_fields",
+    "surface_derivatives",
+    "surface_scale",
+    "torus",
+]

@@ -1,0 +1,331 @@
+"""Fundamental forms, curvature fields, normal curvature, point classification and the
+geometry of one point of a parametric surface (do Carmo, ch. 3; signs in the package notes).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..errors import MeshError
+from ..types import BoolArray, FloatArray
+from .catalogue import ParametricSurface, check_uv, get_surface
+from .derivatives import DerivativeMethod, surface_derivatives
+from .singular import singular_description, singular_mask
+
+CLASSIFICATIONS: tuple[str, ...] = ("elliptic", "hyperbolic", "parabolic", "planar", "umbilic")
+
+
+def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return np.einsum("...i,...i->...", a, b)
+
+
+@dataclass(frozen=True)
+class CurvatureFields:
+    """Fundamental forms and curvatures at a batch of points (every field has shape ``S``
+    unless noted). ``singular`` marks the singular points of the parameterization (a declared
+    pole, or ``p_u × p_v`` negligible against the surface's area scale: see
+    :mod:`meshlap_core.surfaces.singular`); every curvature value is NaN there."""
+
+    n: FloatArray  # S + (3,)
+    E: FloatArray
+    F: FloatArray
+    G: FloatArray
+    e: FloatArray
+    f: FloatArray
+    g: FloatArray
+    K: FloatArray
+    H: FloatArray
+    k1: FloatArray
+    k2: FloatArray
+    w1: FloatArray  # S + (2,): parameter direction of k1, unit in the metric (w·I·w = 1)
+    w2: FloatArray  # S + (2,)
+    singular: BoolArray
+
+
+def surface_curvature_fields(
+    surface: ParametricSurface | str, u: Any, v: Any, method: DerivativeMethod = "auto"
+) -> CurvatureFields:
+    """Vectorized fundamental forms and curvatures at ``(u, v)`` (no domain check).
+
+    Parameters
+    ----------
+    surface : ParametricSurface or str
+    u, v : array_like, broadcastable to a shape ``S``
+    method : see :func:`surface_derivatives`
+
+    Returns
+    -------
+    CurvatureFields
+
+    Notes
+    -----
+    ``K = (eg − f²)/(EG − F²)`` and ``H = (eG − 2fF + gE)/(2(EG − F²))`` as in do Carmo. The
+    principal curvatures are the eigenvalues of the shape operator ``I⁻¹II``, computed stably
+    as those of the symmetric ``L⁻¹ II L⁻ᵀ`` (``I = LLᵀ``, Cholesky), so that ``κ₁ − κ₂`` is
+    accurate to rounding even at umbilics; the principal parameter directions are
+    ``w = L⁻ᵀ y`` for its unit eigenvectors ``y`` (so ``wᵀ I w = 1``).
+    """
+    surface = get_surface(surface)
+    D = surface_derivatives(surface, u, v, method)
+    N = np.cross(D.p_u, D.p_v)
+    nn = np.linalg.norm(N, axis=-1)
+    singular = singular_mask(surface, u, v, N)
+    n = np.divide(N, nn[..., None], out=np.full_like(N, np.nan), where=~singular[..., None])
+    E, F, G = _dot(D.p_u, D.p_u), _dot(D.p_u, D.p_v), _dot(D.p_v, D.p_v)
+    e, f, g = _dot(D.p_uu, n), _dot(D.p_uv, n), _dot(D.p_vv, n)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        det = np.where(singular, np.nan, E * G - F * F)
+        K = (e * g - f * f) / det
+        H = (e * G - 2 * f * F + g * E) / (2 * det)
+        l11 = np.sqrt(E)
+        l21 = F / l11
+        l22 = np.sqrt(det / E)
+        # M = L^{-1} = [[m11, 0], [m21, m22]]
+        m11, m21, m22 = 1 / l11, -l21 / (l11 * l22), 1 / l22
+        a = m11 * m11 * e
+        b = m11 * (m21 * e + m22 * f)
+        c = m21 * m21 * e + 2 * m21 * m22 * f + m22 * m22 * g
+    S = np.stack([np.stack([a, b], -1), np.stack([b, c], -1)], -2)
+    S = np.where(singular[..., None, None], 0.0, S)
+    lam, Y = np.linalg.eigh(S)  # ascending
+    k2, k1 = lam[..., 0], lam[..., 1]
+    # at umbilics every direction is principal: report u (k1) and its metric-orthogonal (k2)
+    umb = np.abs(k1 - k2) <= 1e-12 * np.maximum(1.0, np.maximum(np.abs(k1), np.abs(k2)))
+    Y = np.where(umb[..., None, None], np.eye(2), Y[..., ::-1])  # columns: y1 (k1), y2 (k2)
+    Mt = np.zeros(S.shape)  # L^{-T} = M^T = [[m11, m21], [0, m22]]
+    Mt[..., 0, 0], Mt[..., 0, 1], Mt[..., 1, 1] = m11, m21, m22
+    W = Mt @ Y
+    w1, w2 = W[..., :, 0], W[..., :, 1]
+    nan = np.where(singular, np.nan, 1.0)
+    return CurvatureFields(
+        n=n,
+        E=E,
+        F=F,
+        G=G,
+        e=e,
+        f=f,
+        g=g,
+        K=K,
+        H=H,
+        k1=k1 * nan,
+        k2=k2 * nan,
+        w1=w1 * nan[..., None],
+        w2=w2 * nan[..., None],
+        singular=singular,
+    )
+
+
+def normal_curvature(
+    surface: ParametricSurface | str,
+    u: float,
+    v: float,
+    theta: Any,
+    method: DerivativeMethod = "auto",
+) -> FloatArray:
+    """Normal curvature ``κₙ(θ) = (e c² + 2f cs + g s²) / (E c² + 2F cs + G s²)`` at ``(u, v)``,
+    ``c = cos θ``, ``s = sin θ``, θ the angle of the direction in the ``(u, v)`` plane.
+
+    Returns
+    -------
+    kn : float array of the shape of ``theta``
+    """
+    surface = get_surface(surface)
+    uu, vv = check_uv(surface, u, v)
+    cf = surface_curvature_fields(surface, uu, vv, method)
+    _require_regular(surface, cf, float(uu), float(vv))
+    th = np.asarray(theta, dtype=np.float64)
+    c, s = np.cos(th), np.sin(th)
+    second = cf.e * c * c + 2 * cf.f * c * s + cf.g * s * s
+    first = cf.E * c * c + 2 * cf.F * c * s + cf.G * s * s
+    return second / first
+
+
+def normal_curvature_curve(
+    surface: ParametricSurface | str, u: float, v: float, n: int = 361
+) -> tuple[FloatArray, FloatArray]:
+    """``κₙ(θ)`` sampled at ``n`` equally spaced angles ``θ ∈ [0, 2π]`` (both ends, so that a
+    plot closes; the default 361 is a 1° step).
+
+    Returns
+    -------
+    theta : (n,) float
+    kn : (n,) float
+    """
+    if int(n) < 2:
+        raise MeshError(f"needs at least 2 samples, got {n}", "n")
+    theta = np.linspace(0.0, 2 * np.pi, int(n))
+    return theta, normal_curvature(surface, u, v, theta)
+
+
+def classify(k1: float, k2: float, tol: float = 1e-8) -> str:
+    """Classify a point from its principal curvatures ``κ₁ ≥ κ₂``.
+
+    ``planar``: both ≈ 0; ``umbilic``: ``κ₁ ≈ κ₂ ≠ 0`` (a spherical point); ``parabolic``: one
+    ≈ 0; ``elliptic``: same sign (``K > 0``); ``hyperbolic``: opposite signs (``K < 0``).
+    "≈ 0" means ``|κ| ≤ tol`` and "≈" means ``|κ₁ − κ₂| ≤ tol·max(1, |κ₁|, |κ₂|)`` (curvatures in
+    units of 1/length of ``p``).
+    """
+    a1, a2 = abs(k1) <= tol, abs(k2) <= tol
+    if a1 and a2:
+        return "planar"
+    if abs(k1 - k2) <= tol * max(1.0, abs(k1), abs(k2)):
+        return "umbilic"
+    if a1 or a2:
+        return "parabolic"
+    return "elliptic" if k1 * k2 > 0 else "hyperbolic"
+
+
+@dataclass(frozen=True)
+class PointGeometry:
+    """Everything at one point ``(u, v)`` of a surface (see the module notes for the signs).
+
+    Attributes
+    ----------
+    surface : str
+    u, v : float
+    p, p_u, p_v, p_uu, p_uv, p_vv : (3,) float
+    n : (3,) float
+        ``(p_u × p_v) / |p_u × p_v|``.
+    E, F, G, e, f, g : float
+        First and second fundamental forms.
+    K, H, k1, k2 : float
+        Gaussian, mean and principal curvatures (``k1 ≥ k2``, ``H = (k1 + k2)/2``).
+    dir1_uv, dir2_uv : (2,) float
+        Principal directions in the parameter plane, unit Euclidean vectors ``(cos θ, sin θ)``.
+    dir1, dir2 : (3,) float
+        The same as unit 3-D tangent vectors ``(p_u cos θ + p_v sin θ) / |…|``.
+    theta_max, theta_min : float
+        Angles in ``[0, π)`` where ``κₙ`` is largest (``= k1``) and smallest (``= k2``); the
+        extremes repeat at ``+π``. At an umbilic ``κₙ`` is constant and ``theta_max = 0``.
+    classification : str
+        One of ``elliptic, hyperbolic, parabolic, planar, umbilic`` (see :func:`classify`).
+    """
+
+    surface: str
+    u: float
+    v: float
+    p: FloatArray
+    p_u: FloatArray
+    p_v: FloatArray
+    p_uu: FloatArray
+    p_uv: FloatArray
+    p_vv: FloatArray
+    n: FloatArray
+    E: float
+    F: float
+    G: float
+    e: float
+    f: float
+    g: float
+    K: float
+    H: float
+    k1: float
+    k2: float
+    dir1_uv: FloatArray
+    dir2_uv: FloatArray
+    dir1: FloatArray
+    dir2: FloatArray
+    theta_max: float
+    theta_min: float
+    classification: str
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON-ready dict (lists for vectors); keys are the attribute names."""
+        out: dict[str, Any] = {}
+        for k in self.__dataclass_fields__:
+            x = getattr(self, k)
+            out[k] = x.tolist() if isinstance(x, np.ndarray) else x
+        return out
+
+
+def _require_regular(surface: ParametricSurface, cf: CurvatureFields, u: float, v: float) -> None:
+    if bool(np.any(cf.singular)):
+        D = surface_derivatives(surface, u, v)
+        why = singular_description(surface, u, v, np.cross(D.p_u, D.p_v))
+        raise MeshError(
+            f"the parameterization of the {surface.name} is singular at (u, v) = ({float(u)!r}, "
+            f"{float(v)!r}) ({why}): the normal, the forms and the curvatures are undefined there",
+            "u, v",
+        )
+
+
+def _direction_angle(w: np.ndarray) -> float:
+    """Angle in ``[0, π)`` of the line spanned by the parameter vector ``w``."""
+    t = math.atan2(float(w[1]), float(w[0])) % np.pi
+    return 0.0 if t >= np.pi - 1e-15 else t
+
+
+def point_geometry(
+    surface: ParametricSurface | str,
+    u: float | None = None,
+    v: float | None = None,
+    method: DerivativeMethod = "auto",
+    tol: float = 1e-8,
+) -> PointGeometry:
+    """Everything about the surface at one point ``(u, v)`` (default: ``surface.default_uv``).
+
+    Raises
+    ------
+    MeshError
+        ``(u, v)`` outside the domain (naming ``u`` or ``v``) or a singular point of the
+        parameterization (a declared pole, or ``|p_u × p_v|`` negligible against the surface's
+        area scale: :func:`~meshlap_core.surfaces.singular.is_singular`), naming ``u, v``.
+
+    Examples
+    --------
+    >>> g = point_geometry("helicoid", 0.0, 0.0)
+    >>> round(g.f, 12), round(g.K, 12), g.classification
+    (-1.0, -1.0, 'hyperbolic')
+    """
+    surface = get_surface(surface)
+    u = surface.default_uv[0] if u is None else u
+    v = surface.default_uv[1] if v is None else v
+    uu, vv = check_uv(surface, u, v)
+    if uu.ndim or vv.ndim:
+        raise MeshError("expected a single number", "u" if uu.ndim else "v")
+    uf, vf = float(uu), float(vv)
+    D = surface_derivatives(surface, uf, vf, method)
+    cf = surface_curvature_fields(surface, uf, vf, method)
+    _require_regular(surface, cf, uf, vf)
+    dirs_uv, dirs_3d, angles = [], [], []
+    for w in (cf.w1, cf.w2):
+        t = _direction_angle(w)
+        d_uv = np.array([math.cos(t), math.sin(t)])
+        d3 = d_uv[0] * D.p_u + d_uv[1] * D.p_v
+        dirs_uv.append(d_uv)
+        dirs_3d.append(d3 / np.linalg.norm(d3))
+        angles.append(t)
+    k1, k2 = float(cf.k1), float(cf.k2)
+    return PointGeometry(
+        surface=surface.name,
+        u=uf,
+        v=vf,
+        p=D.p,
+        p_u=D.p_u,
+        p_v=D.p_v,
+        p_uu=D.p_uu,
+        p_uv=D.p_uv,
+        p_vv=D.p_vv,
+        n=np.asarray(cf.n),
+        E=float(cf.E),
+        F=float(cf.F),
+        G=float(cf.G),
+        e=float(cf.e),
+        f=float(cf.f),
+        g=float(cf.g),
+        K=float(cf.K),
+        H=float(cf.H),
+        k1=k1,
+        k2=k2,
+        dir1_uv=dirs_uv[0],
+        dir2_uv=dirs_uv[1],
+        dir1=dirs_3d[0],
+        dir2=dirs_3d[1],
+        theta_max=angles[0],
+        theta_min=angles[1],
+        classification=classify(k1, k2, tol),
+    )
