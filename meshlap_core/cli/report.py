@@ -1,7 +1,7 @@
 """``meshlap report [--meshes DIR] [--out DIR] [--quick]``: regenerate the whole study.
 
 Writes ``report.md``, ``report.html``, ``figures/*.png`` and ``tables/*.csv`` into ``--out``
-(see :mod:`meshlap_core.report`). A progress bar and the time of each section go to stderr;
+(see :mod:`meshlap_core.study`). A progress bar and the time of each section go to stderr;
 stdout gets the list of files (or one JSON object with ``--json``). Sign convention of every
 Laplacian used: negative semidefinite, ``Δx = −2Hn``.
 """
@@ -69,7 +69,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..report import build_report
+    from ..study import build_report
 
     result = build_report(
         args.out,
