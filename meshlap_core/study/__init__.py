@@ -24,16 +24,18 @@ the non-negative frequencies of ``−Δ``. :mod:`meshlap_core.surfaces` measures
 fundamental form against ``n = p_u × p_v`` with do Carmo's sign (``e = p_uu · n``), so its ``H``
 is the **negative** of the core's for the same normal; section 3 says so where both appear.
 
-This package is headless: it never imports polyscope nor the viewer. Mesh pictures come from the
-viewer run in a subprocess (``python -m meshlap_core.cli view MESH --screenshot OUT.png``, EGL);
-when that fails (no EGL, no display libraries) the report still builds, says why, and draws the
-mesh with matplotlib instead. Plots use matplotlib's Agg canvas (imported lazily). Every file is
-written atomically (:func:`meshlap_core.io.atomic_write`).
+This package is headless: it never imports polyscope nor the viewer. Mesh pictures come from a
+screenshot function the caller passes (:class:`~meshlap_core.study.shots.Screenshot`; the
+``meshlap report`` command passes the viewer's, rendering with polyscope's EGL backend in its own
+process); without one, or when it fails (no EGL, no display libraries), the report still builds,
+says why, and draws the mesh with matplotlib instead. Plots use matplotlib's Agg canvas
+(imported lazily). Every file is written atomically (:func:`meshlap_core.io.atomic_write`).
 
 Modules: :mod:`.document` (blocks, result, number formatting), :mod:`.render_md`,
-:mod:`.render_html`, :mod:`.figures` (matplotlib rasterizer, autocrop), :mod:`.context` (meshes,
-files, screenshots, progress bar), :mod:`.sections` (one module per section), :mod:`.build`
-(:func:`build_report`, :func:`parse_sections`).
+:mod:`.render_html`, :mod:`.figures` (matplotlib rasterizer, autocrop), :mod:`.shots` (the
+screenshot interface), :mod:`.context` (meshes, files, screenshots, progress bar),
+:mod:`.sections` (one module per section), :mod:`.build` (:func:`build_report`,
+:func:`parse_sections`).
 """
 
 from __future__ import annotations
@@ -42,6 +44,7 @@ from .build import build_report, parse_sections
 from .context import ASSETS_DIR, PACKAGE_ROOT, Progress, default_meshes_dir
 from .document import ReportResult
 from .sections import COURSE_EIGEN_SECONDS, SECTION_TITLES, SECTIONS
+from .shots import MeshSource, Screenshot
 
 __all__ = [
     "ASSETS_DIR",
@@ -49,8 +52,10 @@ __all__ = [
     "PACKAGE_ROOT",
     "SECTIONS",
     "SECTION_TITLES",
+    "MeshSource",
     "Progress",
     "ReportResult",
+    "Screenshot",
     "build_report",
     "default_meshes_dir",
     "parse_sections",

@@ -7,8 +7,6 @@ import html
 import os
 import platform
 import re
-import sys
-import tempfile
 import time
 from collections.abc import Sequence
 from pathlib import Path
@@ -24,6 +22,7 @@ from .document import FigRow, Para, ReportResult, Section, Table
 from .render_html import html_inline, render_html
 from .render_md import render_md
 from .sections import SECTION_RUNNERS, SECTION_TITLES, SECTIONS
+from .shots import Screenshot
 
 
 def parse_sections(text: str | Sequence[str] | None) -> list[str]:
@@ -83,7 +82,7 @@ def build_report(
     sections: Sequence[str] | str | None = None,
     screenshots: bool = True,
     progress_stream: IO[str] | None = None,
-    viewer_cmd: Sequence[str] | None = None,
+    screenshot: Screenshot | None = None,
     max_screenshots: int | None = None,
 ) -> ReportResult:
     """Run the study and write ``report.md``, ``report.html``, ``figures/*.png`` and
@@ -105,17 +104,18 @@ def build_report(
     sections : list of str or str, optional
         Subset of :data:`SECTIONS` (names or numbers 1–7); default all.
     screenshots : bool
-        Take viewer screenshots (a subprocess with polyscope's EGL backend). When ``False`` or
+        Take viewer screenshots with ``screenshot``. When ``False``, without ``screenshot``, or
         when the first screenshot fails, meshes are drawn with matplotlib and the report says
         why.
     progress_stream : text stream, optional
         Where the progress bar goes (the CLI passes stderr); ``None``: silent.
-    viewer_cmd : list of str, optional
-        The command that takes screenshots (default
-        ``[sys.executable, "-m", "meshlap_core.cli", "view"]``).
+    screenshot : Screenshot, optional
+        The function that renders a viewer frame (:class:`~meshlap_core.study.shots.Screenshot`;
+        the ``meshlap report`` command passes :class:`meshlap_core.cli.report.ViewerScreenshots`).
+        The study never imports the viewer itself.
     max_screenshots : int, optional
-        Take at most this many viewer screenshots (each is a subprocess of a few seconds); the
-        later pictures are drawn with matplotlib and the report says so. Default: no limit.
+        Take at most this many viewer screenshots; the later pictures are drawn with
+        matplotlib and the report says so. Default: no limit.
 
     Returns
     -------
@@ -138,28 +138,19 @@ def build_report(
         raise MeshError("is not a directory", os.fspath(mdir))
     out = _output_dir(out_dir)
     progress = Progress(progress_stream, len(keys))
-    cmd = (
-        list(viewer_cmd)
-        if viewer_cmd is not None
-        else [sys.executable, "-m", "meshlap_core.cli", "view"]
+    take = screenshot if screenshots else None
+    ctx = Context(
+        out, mdir if mdir.is_dir() else None, explicit, quick, take, progress, max_screenshots
     )
-    with tempfile.TemporaryDirectory(prefix="meshlap-report-") as tmp:
-        ctx = Context(
-            out,
-            mdir if mdir.is_dir() else None,
-            explicit,
-            quick,
-            screenshots,
-            cmd,
-            progress,
-            Path(tmp),
-            max_screenshots,
+    if screenshots and screenshot is None:
+        ctx.screenshot_reason = (
+            "no screenshot function was given (`meshlap report` passes the viewer's)"
         )
-        ctx.meshes_wanted = mdir
-        built = [_run_section(ctx, key, i) for i, key in enumerate(keys, start=1)]
-        total = time.perf_counter() - t_start
-        note = _mesh_note(ctx)
-        md_path, html_path = _write_pages(ctx, built, keys, total, note)
+    ctx.meshes_wanted = mdir
+    built = [_run_section(ctx, key, i) for i, key in enumerate(keys, start=1)]
+    total = time.perf_counter() - t_start
+    note = _mesh_note(ctx)
+    md_path, html_path = _write_pages(ctx, built, keys, total, note)
     return ReportResult(
         out_dir=out,
         markdown=md_path,

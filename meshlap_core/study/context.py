@@ -6,8 +6,6 @@ from __future__ import annotations
 
 import csv
 import io
-import os
-import subprocess
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -15,10 +13,11 @@ from pathlib import Path
 from typing import IO, Any
 
 from .. import curvature, noise
-from ..io import atomic_write, load_mesh, save_mesh
+from ..io import atomic_write, load_mesh
 from ..types import FloatArray, IntArray
 from .document import Fig, Table, csv_cell
 from .figures import autocrop, draw_mesh, new_figure
+from .shots import MeshSource, Screenshot, failure_reason
 
 PACKAGE_ROOT = Path(__file__).resolve().parents[2]
 ASSETS_DIR = PACKAGE_ROOT / "assets"
@@ -133,10 +132,8 @@ class Context:
         meshes_dir: Path | None,
         meshes_explicit: bool,
         quick: bool,
-        screenshots: bool,
-        viewer_cmd: Sequence[str],
+        screenshot: Screenshot | None,
         progress: Progress,
-        tmp: Path,
         max_screenshots: int | None = None,
     ) -> None:
         self.out = out_dir
@@ -149,11 +146,10 @@ class Context:
         self.meshes_explicit = meshes_explicit
         self.meshes_wanted: Path | None = meshes_dir
         self.quick = quick
-        self.screenshots = screenshots
-        self.screenshot_reason = "" if screenshots else "screenshots were turned off"
-        self.viewer_cmd = list(viewer_cmd)
+        self.screenshot = screenshot
+        self.screenshots = screenshot is not None
+        self.screenshot_reason = "" if self.screenshots else "screenshots were turned off"
         self.progress = progress
-        self.tmp = tmp
         self.figures: list[Path] = []
         self.tables: list[Path] = []
         self.shots_ok = 0
@@ -241,8 +237,8 @@ class Context:
         use_file: bool = False,
         label: str | None = None,
     ) -> Fig | None:
-        """A viewer screenshot of a mesh (saved to a temporary OBJ unless ``use_file``), or
-        ``None`` when screenshots are unavailable (the reason is kept)."""
+        """A viewer screenshot of a mesh (its file if ``use_file``, else its arrays named
+        ``label``), or ``None`` when screenshots are unavailable (the reason is kept)."""
         if (
             self.screenshots
             and self.max_screenshots is not None
@@ -256,42 +252,17 @@ class Context:
         if not self.screenshots:
             return None
         out = self.fig_dir / f"{name}.png"
-        args: list[str] = []
+        source: MeshSource = None
         if mesh is not None and V is None:
             V, F = mesh.V, mesh.F
         if use_file and mesh is not None and mesh.path is not None:
-            args.append(str(mesh.path))
+            source = mesh.path
         elif V is not None and F is not None:
-            sub = self.tmp / f"shot{self.shots_ok + len(self.shot_failures)}_{name}"
-            sub.mkdir(parents=True, exist_ok=True)
-            tmp_obj = sub / f"{label or name}.obj"
-            save_mesh(tmp_obj, V, F)
-            args.append(str(tmp_obj))
-        cmd = [*self.viewer_cmd, *args, "--screenshot", str(out), "--panel", panel]
-        if panel == "curvature":
-            cmd += ["--field", field]
+            source = (V, F, label or name)
+        options: dict[str, Any] = {"field": field} if panel == "curvature" else {}
         if vertex is not None:
-            cmd += ["--vertex", str(vertex)]
-        try:
-            proc = subprocess.run(
-                cmd,
-                cwd=self.tmp,
-                capture_output=True,
-                text=True,
-                timeout=180,
-                env={**os.environ, "PYTHONWARNINGS": "ignore"},
-            )
-            ok = proc.returncode == 0 and out.is_file()
-            why = _last_line(proc.stderr) or f"exit code {proc.returncode}"
-        except (OSError, subprocess.TimeoutExpired) as exc:
-            ok, why = False, f"{type(exc).__name__}: {exc}"
-        if ok:
-            try:
-                ok = autocrop(out)
-            except Exception as exc:  # a broken PNG counts as a failed screenshot
-                ok, why = False, f"unreadable PNG ({exc})"
-            if not ok:
-                why = why if "PNG" in why else "the screenshot is blank"
+            options["vertex"] = vertex
+        ok, why = self._take(source, panel, options, out)
         if not ok:
             self.shot_failures.append(f"{name}: {why}")
             out.unlink(missing_ok=True)
@@ -302,6 +273,27 @@ class Context:
         self.shots_ok += 1
         self.figures.append(out)
         return Fig(self.rel(out), caption, "screenshot")
+
+    def _take(
+        self, source: MeshSource, panel: str, options: dict[str, Any], out: Path
+    ) -> tuple[bool, str]:
+        """Call the screenshot function and autocrop its PNG: ``(ok, reason if not ok)``."""
+        take = self.screenshot
+        if take is None:
+            return False, self.screenshot_reason
+        try:
+            ok = bool(take(source, panel, options, out.resolve())) and out.is_file()
+            why = "the viewer wrote no screenshot"
+        except Exception as exc:  # whatever the viewer raises is the reason, given once
+            ok, why = False, failure_reason(exc)
+        if ok:
+            try:
+                ok = autocrop(out)
+            except Exception as exc:  # a broken PNG counts as a failed screenshot
+                ok, why = False, f"unreadable PNG ({exc})"
+            if not ok:
+                why = why if "PNG" in why else "the screenshot is blank"
+        return ok, why
 
     def shot_or_render(
         self,
@@ -335,10 +327,3 @@ class Context:
             cax = f.add_axes((0.86, 0.15, 0.03, 0.7))
             f.colorbar(sm, cax=cax)
         return self.save_fig(f, name, caption + " (matplotlib rendering: no screenshot)", "render")
-
-
-def _last_line(text: str) -> str:
-    """The last line of a subprocess's stderr that is not polyscope's chatter (≤ 300 chars)."""
-    lines = [ln.strip() for ln in (text or "").splitlines() if ln.strip()]
-    lines = [ln for ln in lines if not ln.startswith("[polyscope]")] or lines
-    return lines[-1][:300] if lines else ""
