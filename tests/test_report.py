@@ -1,13 +1,13 @@
 """``meshlap report``: a quick report on the bundled assets builds, its figures are valid PNGs, its
 tables have the expected columns and the numbers in them obey the mathematics; the HTML is
-well-formed; a failing screenshot subprocess degrades to matplotlib renderings with a note."""
+well-formed; a failing screenshot function degrades to matplotlib renderings with a note, and the
+screenshot function gets the mesh, panel and options the report asks for."""
 
 from __future__ import annotations
 
 import csv
 import json
 import re
-import sys
 from html.parser import HTMLParser
 from pathlib import Path
 
@@ -15,8 +15,9 @@ import numpy as np
 import pytest
 
 from meshlap_core.cli import main
+from meshlap_core.cli.report import ViewerScreenshots
 from meshlap_core.errors import MeshError
-from meshlap_core.report import SECTIONS, build_report, parse_sections
+from meshlap_core.study import SECTIONS, build_report, parse_sections
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 
@@ -190,7 +191,7 @@ EXPECTED_COLUMNS = {
 }
 
 
-SHOTS = 4  # real viewer screenshots in the module's report (each is a subprocess of ~3 s)
+SHOTS = 4  # real viewer screenshots in the module's report (~2 s each)
 
 
 @pytest.fixture(scope="module")
@@ -200,7 +201,8 @@ def quick(tmp_path_factory):
     the test short; both paths are then exercised)."""
     empty = tmp_path_factory.mktemp("no_meshes")
     out = tmp_path_factory.mktemp("report")
-    return build_report(out, empty, quick=True, max_screenshots=SHOTS)
+    with ViewerScreenshots() as screenshot:
+        return build_report(out, empty, quick=True, max_screenshots=SHOTS, screenshot=screenshot)
 
 
 def read_table(result, name: str) -> list[dict[str, str]]:
@@ -455,8 +457,11 @@ def test_denoising_recommendation_is_read_off_the_sweep(quick):
 def test_failed_screenshots_fall_back_to_renderings_with_a_note(tmp_path):
     empty = tmp_path / "none"
     empty.mkdir()
-    fail = [sys.executable, "-c", "import sys; sys.exit('no EGL display on this test machine')"]
-    res = build_report(tmp_path / "out", empty, quick=True, sections="1,4", viewer_cmd=fail)
+
+    def fail(mesh, panel, options, out_png):
+        raise RuntimeError("no EGL display on this test machine")
+
+    res = build_report(tmp_path / "out", empty, quick=True, sections="1,4", screenshot=fail)
     assert res.errors == {}
     assert res.screenshots_ok == 0
     assert res.screenshot_failures and "no EGL display" in res.screenshot_failures[0]
@@ -467,6 +472,42 @@ def test_failed_screenshots_fall_back_to_renderings_with_a_note(tmp_path):
         check_png(res.out_dir / rel)
     # only one attempt: later pictures do not retry a broken viewer
     assert len(res.screenshot_failures) == 1
+
+
+def test_screenshot_function_gets_the_mesh_panel_and_options(tmp_path):
+    """The study asks its screenshot function for the one-ring panel on the cube file with
+    vertex 0, and for curvature maps of arrays named after the mesh; a written PNG is
+    autocropped and shown as a screenshot, and a function returning False stops the rest."""
+    import matplotlib.image as mpimg
+
+    empty = tmp_path / "none"
+    empty.mkdir()
+    calls = []
+
+    def fake(mesh, panel, options, out_png):
+        calls.append((mesh, panel, dict(options), out_png))
+        img = np.ones((120, 200, 4))
+        img[30:90, 20:110, :3] = np.linspace(0, 0.8, 90)[None, :, None]  # a "mesh" on white
+        img[0:40, 150:200, :3] = 0.2  # a "panel" at the top right
+        mpimg.imsave(out_png, img)
+        return len(calls) < 3
+
+    res = build_report(tmp_path / "out", empty, quick=True, sections="1,4", screenshot=fake)
+    assert res.errors == {} and res.screenshots_ok == 2
+    (m0, p0, o0, out0), (m1, p1, o1, _) = calls[:2]
+    assert isinstance(m0, Path) and m0.name == "cube.obj" and p0 == "onering"
+    assert o0 == {"vertex": 0} and out0.is_absolute() and out0.name == "onering_cube_viewer.png"
+    V, F, name = m1
+    assert V.shape[1] == 3 and F.shape[1] == 3 and V.dtype == np.float64 and name == "lilium_s"
+    assert p1 == "curvature" and o1 == {"field": "uniform"}
+    # autocrop: the mesh (90 + 2 * 12 margin wide) and the panel (50) side by side, gap 12
+    shot = mpimg.imread(out0)
+    assert shot.shape[1] == 90 + 2 * 12 + 12 + 50
+    md = res.markdown.read_text(encoding="utf-8")
+    assert len(calls) == 3 and res.screenshot_failures == [
+        "cotan_lilium_cotan: the viewer wrote no screenshot"
+    ]
+    assert "the viewer wrote no screenshot" in md
 
 
 def test_cli_report_json_and_progress(tmp_path, capsys):
