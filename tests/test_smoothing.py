@@ -560,3 +560,35 @@ def test_explicit_with_mass_recompute_uses_the_current_areas():
         X = X + lam * (C @ X) / lap.vertex_areas(X, F, "voronoi")[:, None]
     got = S.smooth(V, F, "explicit", "cotan", lam, 3, mass="recompute")
     np.testing.assert_allclose(got, X, atol=1e-12)
+
+
+# ----------------------------------------------------------------------------- linalg.spd
+
+
+def test_spd_solver_matches_a_direct_solve_and_is_reused():
+    from meshlap_core.linalg.spd import SPDSolver, surely_positive_definite
+
+    V, F = bumpy_sphere(2)
+    W, K = S.operator_parts(V, F, "cotan")
+    A = (sp.diags(W) - 0.01 * K).tocsr()  # W − λK: symmetric positive definite
+    assert surely_positive_definite(A)
+    solver = SPDSolver(A)
+    for B in (V, V[:, 0], 2.0 * V + 1.0):
+        np.testing.assert_allclose(solver.solve(B), sla.spsolve(A.tocsc(), B), atol=1e-12)
+
+
+def test_spd_solver_refuses_an_indefinite_matrix_without_printing(capfd):
+    from meshlap_core.linalg.spd import SPDSolver, surely_positive_definite
+
+    A = sp.csr_matrix(np.array([[1.0, 2.0], [2.0, 1.0]]))  # eigenvalues 3 and −1
+    assert not surely_positive_definite(A)
+    with pytest.raises(np.linalg.LinAlgError, match="positive definite"):
+        SPDSolver(A)
+    out, _ = capfd.readouterr()
+    assert out == ""  # CHOLMOD's printf never reaches standard output
+
+
+def test_implicit_system_beyond_double_precision_is_refused_naming_lam():
+    V, F = icosphere(1)
+    with pytest.raises(MeshError, match=r"^lam: the implicit system .* cannot be factorized"):
+        S.smooth(V, F, "implicit", "cotan", 1e200, 1)

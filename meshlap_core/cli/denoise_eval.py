@@ -83,7 +83,7 @@ def _names(text: str, allowed: tuple[str, ...], flag: str) -> list[str]:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..io import load_mesh  # written by the io agent; imported here so --help never needs it
+    from ..io import load_mesh  # imported here so --help never loads the mesh readers
 
     methods = _names(args.methods, METHODS, "--methods")
     laplacians = _names(args.laplacian, LAPLACIANS, "--laplacian")

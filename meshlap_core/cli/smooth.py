@@ -81,7 +81,7 @@ def _int_arg(text: str, name: str) -> int:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..io import load_mesh  # written by the io agent; imported here so --help never needs it
+    from ..io import load_mesh  # imported here so --help never loads the mesh readers
 
     lam = check_lam(_float_arg(args.lam, "--lam"), "--lam")
     iters = _int_arg(args.iters, "--iters")
