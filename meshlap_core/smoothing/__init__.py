@@ -55,6 +55,7 @@ from .params import (
     DEFAULT_PASS_BAND,
     LAPLACIANS,
     MASS_MODES,
+    MAX_ITERS,
     METHODS,
     MassMode,
     Method,
@@ -69,13 +70,15 @@ from .stability import (
     operator_parts,
     stability,
 )
-from .stepper import Smoother, smooth
+from .stepper import DivergenceError, Smoother, smooth
 
 __all__ = [
     "DEFAULT_PASS_BAND",
     "LAPLACIANS",
     "MASS_MODES",
+    "MAX_ITERS",
     "METHODS",
+    "DivergenceError",
     "MassMode",
     "Method",
     "Smoother",

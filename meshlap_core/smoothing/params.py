@@ -23,6 +23,12 @@ MASS_MODES: tuple[str, ...] = ("frozen", "recompute")
 
 DEFAULT_PASS_BAND = 0.1  # Taubin's k_PB, in the units of the Laplacian's eigenvalues
 
+MAX_ITERS = 10_000_000
+"""The most iterations one call may ask for (``smooth --iters``, ``denoise-eval --iters``,
+:func:`smooth`, :meth:`Smoother.run`): 10⁷ steps take minutes on a 42-vertex icosphere and
+about six hours on a 43k-vertex mesh (2 ms per explicit step); more is refused rather than left
+running. An interactive stepper calls :meth:`Smoother.step` without this bound."""
+
 
 # --------------------------------------------------------------------------- argument checks
 
@@ -38,16 +44,32 @@ def check_lam(lam: Any, name: str = "lam") -> float:
     return value
 
 
-def check_iters(iters: Any, name: str = "iters") -> int:
-    """Return ``iters`` as an int; MeshError naming ``name`` unless it is an integer >= 0."""
+def check_iters(iters: Any, name: str = "iters", maximum: int | None = MAX_ITERS) -> int:
+    """Return ``iters`` as an int; MeshError naming ``name`` unless it is an integer >= 0 and,
+    when ``maximum`` is given, at most ``maximum`` (default :data:`MAX_ITERS`)."""
     if isinstance(iters, bool) or not isinstance(iters, int | np.integer):
         if isinstance(iters, float) and iters.is_integer():
             iters = int(iters)
         else:
             raise MeshError(f"must be an integer >= 0, got {iters!r}", name)
     if iters < 0:
-        raise MeshError(f"must be an integer >= 0, got {iters!r}", name)
+        raise MeshError(f"must be an integer >= 0, got {_show_int(iters)}", name)
+    if maximum is not None and iters > maximum:
+        shown = _show_int(iters)
+        raise MeshError(
+            f"must be at most {maximum} (the limit of one run: 10^7 steps take hours on a mesh of "
+            f"10^4 vertices), got {shown}; run a longer smoothing in several parts",
+            name,
+        )
     return int(iters)
+
+
+def _show_int(value: int) -> str:
+    """``value`` in full, or its number of digits when it is longer than 40 digits (``str`` of
+    an int over 4300 digits raises)."""
+    if abs(value) < 10**40:
+        return str(int(value))
+    return f"a number of about {int(math.log10(abs(value))) + 1} digits"
 
 
 def _check_choice(value: str, choices: tuple[str, ...], name: str) -> str:

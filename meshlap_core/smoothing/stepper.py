@@ -47,6 +47,11 @@ from .stability import (
 )
 
 
+class DivergenceError(MeshError):
+    """Explicit or Taubin smoothing blew up (``λ`` above the stable limit); a :class:`MeshError`
+    whose message gives the iteration and the largest stable ``λ``."""
+
+
 class Smoother:
     """Laplacian smoothing stepper: build once, then ``step()`` (cheap) as often as needed.
 
@@ -90,6 +95,12 @@ class Smoother:
         ``history_limit − 1`` iterations (each entry carries its ``iteration``). An interactive
         stepper that runs without end should set it (about 0.5 kB per entry); ``None`` (the
         default) keeps every entry.
+    history_samples : int, optional
+        Keep at most this many entries (``>= 4``) spread over the whole run: the input's, every
+        :attr:`history_stride`-th iteration and always the latest one; when the list is full the
+        stride doubles and every other sample is dropped, so a run of any length keeps between
+        ``history_samples / 2`` and ``history_samples`` entries. Cannot be combined with
+        ``history_limit``.
     warn : bool
         Emit a :class:`MeshWarning` when an explicit or Taubin ``λ`` is unstable on this mesh.
 
@@ -103,10 +114,23 @@ class Smoother:
         ``iteration``, ``time_ms`` (the step alone), ``step_rms``/``step_max`` (displacement of
         this step), ``drift_rms`` (from the input), ``volume`` and ``volume_change_pct`` (both
         ``None`` on open meshes, see :attr:`volume_note`), and ``rmse`` with a reference.
+    history_stride : int
+        With ``history_samples``: the spacing of the kept iterations (1 until the list first
+        fills up, then a power of 2).
     diverged : bool
-        ``True`` once a step blew up (a non-finite coordinate, or one farther than 1000 bounding-box
-        diagonals from the input's bounding box: no smoothing moves a vertex that far); that step
-        is discarded and later steps do nothing.
+        ``True`` once a step blew up: a non-finite coordinate, or an RMS displacement from the
+        input above :attr:`divergence_limit`. That step is discarded and later steps do nothing
+        until :meth:`reset` or :meth:`set_lam`; :meth:`divergence_message` says what happened
+        and gives the largest stable ``λ``.
+    divergence_limit : float
+        Explicit: the input's bounding-box diagonal (a convergent explicit flow contracts the
+        mesh towards a weighted centroid inside its bounding box and never moves it that far).
+        Taubin and implicit: 1000 diagonals. Taubin amplifies its pass band on purpose (spectral
+        radius slightly above 1, e.g. 1.0007 per step), so a long stable Taubin run inflates
+        slowly (2.5× its size after 5,000 steps on a sphere) and only a blow-up counts; an
+        implicit step cannot diverge, so only a numerical failure trips it.
+    diagonal : float
+        The input's bounding-box diagonal (the unit of :attr:`divergence_limit`).
     closed : bool
     volume_note : str or None
         Why the volume is undefined (open mesh), else ``None``.
@@ -141,12 +165,11 @@ class Smoother:
         reference: FloatArray | None = None,
         track_history: bool = True,
         history_limit: int | None = None,
+        history_samples: int | None = None,
         warn: bool = True,
     ) -> None:
         self.V0, self.F = as_mesh(V, F)
-        if history_limit is not None and check_iters(history_limit, "history_limit") < 2:
-            raise MeshError(f"must be at least 2, got {history_limit}", "history_limit")
-        self.history_limit = history_limit
+        self._init_history(history_limit, history_samples)
         self.n = len(self.V0)
         self.method = _check_choice(method, METHODS, "method")
         self.laplacian = _check_choice(laplacian, LAPLACIANS, "laplacian")
@@ -168,6 +191,18 @@ class Smoother:
         if warn and self.method != "implicit":
             self._warn_if_unstable()
         self.reset()
+
+    def _init_history(self, limit: int | None, samples: int | None) -> None:
+        """Check and store ``history_limit`` / ``history_samples``."""
+        if limit is not None and check_iters(limit, "history_limit", None) < 2:
+            raise MeshError(f"must be at least 2, got {limit}", "history_limit")
+        if samples is not None and check_iters(samples, "history_samples", None) < 4:
+            raise MeshError(f"must be at least 4, got {samples}", "history_samples")
+        if limit is not None and samples is not None:
+            raise MeshError("give history_limit or history_samples, not both", "history_samples")
+        self.history_limit = limit
+        self.history_samples = None if samples is None else int(samples)
+        self.history_stride = 1
 
     def _init_volume(self, preserve_volume: bool) -> None:
         """Closedness, the input's enclosed volume and the volume-preservation check."""
@@ -194,8 +229,8 @@ class Smoother:
     def _init_operator(self, fix_boundary: bool) -> None:
         """``W``, ``K``, Taubin's factors, the pinned vertices, the free/fixed blocks of ``K``."""
         self.fix_boundary = fix_boundary
-        scale = float(np.abs(self.V0).max(initial=0.0))
-        self._blowup = scale + 1e3 * max(bbox_diagonal(self.V0), 1e-300)
+        self.diagonal = bbox_diagonal(self.V0)
+        self.divergence_limit = self.diagonal * (1.0 if self.method == "explicit" else 1e3)
         W, K = operator_parts(self.V0, self.F, self.laplacian, self.area)
         self._W0, self._K = W, K
         self.k_pb = self.pass_band * _diagonal_scale(W, K)
@@ -247,15 +282,37 @@ class Smoother:
     def set_lam(self, lam: float) -> None:
         """Change ``λ`` (and Taubin's ``ν`` if it was derived from it) without losing the state.
 
-        The implicit system is refactorized on the next step; nothing else is recomputed.
+        The current positions, the iteration count and the history are kept; the next step
+        starts from the current positions with the new ``λ``. The implicit system is
+        refactorized on the next step; nothing else is recomputed. A diverged smoother resumes
+        from its last good positions (the discarded step is not replayed). A bad ``λ`` raises
+        :class:`MeshError` and changes nothing.
         """
         lam = check_lam(lam)
         if lam == self.lam:
+            self.diverged = False
             return
         nu = self._nu_for(lam)
         self.lam = lam
         self.taubin_nu = nu
         self._stability = None
+        self.diverged = False
+
+    def divergence_message(self) -> str | None:
+        """Why stepping stopped (``None`` unless :attr:`diverged`), with the largest stable ``λ``.
+
+        Computing the largest stable ``λ`` may need an eigensolve (see :attr:`stability`).
+        """
+        if not self.diverged:
+            return None
+        limit = self.stability.max_stable_lam
+        return (
+            f"{self.method} smoothing diverged at iteration {self.iteration + 1}: the vertices "
+            f"moved farther (RMS) than {self._limit_words()} or became "
+            "non-finite (largest stable lam for this mesh: "
+            + ("none found" if limit is None else f"{limit:.4g}")
+            + f", lam is {self.lam:g})"
+        )
 
     def reset(self) -> None:
         """Back to the input positions: iteration 0, history with the input's entry only.
@@ -266,6 +323,7 @@ class Smoother:
         self._W = self._W0
         self.iteration = 0
         self.diverged = False
+        self.history_stride = 1
         self.history: list[dict[str, Any]] = []
         if self.track_history:
             self.history.append(self._metrics(self._V, None, 0.0))
@@ -290,20 +348,23 @@ class Smoother:
         if self.preserve_volume:
             new = self._rescale_volume(new)
         elapsed = time.perf_counter() - t0
-        if not np.abs(new).max(initial=0.0) <= self._blowup:  # also catches NaN
+        d0 = new - self.V0
+        drift = math.sqrt(float(np.einsum("ij,ij->", d0, d0)) / max(self.n, 1))
+        if not drift <= self.divergence_limit:  # also catches NaN and inf
             self.diverged = True
             return self.V
         old = self._V
         self._V = new
         self.iteration += 1
         if self.track_history:
-            self.history.append(self._metrics(new, old, elapsed))
-            if self.history_limit is not None and len(self.history) > self.history_limit:
-                del self.history[1]  # keep the input's entry and the latest ones
+            self._record(self._metrics(new, old, elapsed, drift))
         return self.V
 
     def run(self, n: int) -> FloatArray:
-        """Do ``n`` iterations (stops early if the iteration diverges); return the positions."""
+        """Do ``n`` iterations (stops early if the iteration diverges); return the positions.
+
+        ``n`` is at most :data:`~meshlap_core.smoothing.params.MAX_ITERS` per call.
+        """
         n = check_iters(n, "n")
         for _ in range(n):
             self.step()
@@ -312,6 +373,12 @@ class Smoother:
         return self.V
 
     # ---------------------------------------------------------------- internals
+
+    def _limit_words(self) -> str:
+        """:attr:`divergence_limit` in words."""
+        if self.method == "explicit":
+            return f"the bounding-box diagonal {self.diagonal:.4g}"
+        return f"1000 bounding-box diagonals ({self.divergence_limit:.4g})"
 
     def _nu_for(self, lam: float) -> float | None:
         """Taubin's ``ν`` for ``λ`` (``None`` for the other methods), with a useful message."""
@@ -411,7 +478,25 @@ class Smoother:
         out[free] = c + s * (x[free] - c)
         return out
 
-    def _metrics(self, x: FloatArray, old: FloatArray | None, elapsed: float) -> dict[str, Any]:
+    def _record(self, entry: dict[str, Any]) -> None:
+        """Append a history entry, keeping the list within ``history_limit``/``history_samples``."""
+        h = self.history
+        if self.history_samples is not None:
+            if len(h) > 1 and h[-1]["iteration"] % self.history_stride:
+                h.pop()  # the previous latest entry is off the sampling grid
+            h.append(entry)
+            if len(h) > self.history_samples:
+                self.history_stride *= 2
+                kept = [e for e in h[:-1] if e["iteration"] % self.history_stride == 0]
+                h[:] = [*kept, h[-1]]
+            return
+        h.append(entry)
+        if self.history_limit is not None and len(h) > self.history_limit:
+            del h[1]  # keep the input's entry and the latest ones
+
+    def _metrics(
+        self, x: FloatArray, old: FloatArray | None, elapsed: float, drift: float = 0.0
+    ) -> dict[str, Any]:
         entry: dict[str, Any] = {"iteration": self.iteration, "time_ms": 1e3 * elapsed}
         if old is None:
             entry["step_rms"] = entry["step_max"] = 0.0
@@ -420,8 +505,7 @@ class Smoother:
             d2 = np.einsum("ij,ij->i", d, d)
             entry["step_rms"] = float(np.sqrt(d2.mean())) if d2.size else 0.0
             entry["step_max"] = float(np.sqrt(d2.max())) if d2.size else 0.0
-        d0 = x - self.V0
-        entry["drift_rms"] = float(np.sqrt(np.einsum("ij,ij->", d0, d0) / max(self.n, 1)))
+        entry["drift_rms"] = drift  # RMS of x − V0, measured by step()
         if self.closed and self.volume0 is not None:
             vol = _signed_volume_unchecked(x, self.F, self._FT)
             entry["volume"] = vol
@@ -470,15 +554,15 @@ def smooth(
     Raises
     ------
     MeshError
-        On bad arguments, or if explicit smoothing diverged (non-finite coordinates).
+        On bad arguments (``iters`` above :data:`~meshlap_core.smoothing.params.MAX_ITERS`
+        too).
+    DivergenceError
+        If explicit or Taubin smoothing diverged (see :attr:`Smoother.diverged`).
     """
     iters = check_iters(iters)
     s = Smoother(V, F, method, laplacian, lam, track_history=False, **options)
     s.run(iters)
-    if s.diverged:
-        raise MeshError(
-            f"{method} smoothing diverged after {s.iteration} iterations; "
-            f"the largest stable lam is {s.stability.max_stable_lam}",
-            "lam",
-        )
+    message = s.divergence_message()
+    if message is not None:
+        raise DivergenceError(message, "lam")
     return s.V.copy()
