@@ -590,7 +590,10 @@ def test_spd_solver_refuses_an_indefinite_matrix_without_printing(capfd):
 
 def test_implicit_system_beyond_double_precision_is_refused_naming_lam():
     V, F = icosphere(1)
-    with pytest.raises(MeshError, match=r"^lam: the implicit system .* cannot be factorized"):
+    with (
+        pytest.raises(MeshError, match=r"^lam: the implicit system .* cannot be factorized"),
+        pytest.warns(MeshWarning, match="ill-conditioned"),
+    ):
         S.smooth(V, F, "implicit", "cotan", 1e200, 1)
 
 
@@ -826,3 +829,28 @@ def test_cli_smooth_divergence_names_the_stable_lam(cli, tmp_path, capsys):
     assert err.count("\n") == 1
     assert err.startswith("meshlap: error: --lam: explicit smoothing diverged at iteration")
     assert "largest stable lam for this mesh: 1." in err and "nothing written" in err
+
+
+def test_an_ill_conditioned_implicit_lam_is_announced():
+    V, F = icosphere(2)
+    V = V + np.array([5.0, 0.0, 0.0])
+    W, _ = S.operator_parts(V, F, "uniform")
+    centroid = (W[:, None] * V).sum(axis=0) / W.sum()  # an exact implicit step conserves it
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", MeshWarning)
+        X = S.smooth(V, F, "implicit", "uniform", 1e4, 1)  # 1e4 x max(-L_ii) = 1e4: fine
+    np.testing.assert_allclose((W[:, None] * X).sum(axis=0) / W.sum(), centroid, atol=1e-10 * 5)
+    lam = 10 * S.ILL_CONDITIONED  # max(-L_ii) = 1 for the uniform Laplacian
+    with pytest.warns(MeshWarning, match=r"ill-conditioned.*1e\+11 > 1e\+10"):
+        S.Smoother(V, F, "implicit", "uniform", lam)
+
+
+def test_cli_smooth_announces_an_ill_conditioned_implicit_lam(cli, tmp_path, capsys):
+    V, F = icosphere(1)
+    src = tmp_path / "s.obj"
+    _write_obj(src, V, F)
+    argv = ["smooth", str(src), "--method", "implicit", "--lam", "1e12", "--json"]
+    assert cli(argv) == 0
+    out, err = capsys.readouterr()
+    assert any("ill-conditioned" in w for w in json.loads(out)["warnings"])
+    assert "meshlap: warning: implicit smoothing with lam=1e+12 is ill-conditioned" in err

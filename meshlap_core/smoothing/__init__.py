@@ -70,10 +70,11 @@ from .stability import (
     operator_parts,
     stability,
 )
-from .stepper import DivergenceError, Smoother, smooth
+from .stepper import ILL_CONDITIONED, DivergenceError, Smoother, smooth
 
 __all__ = [
     "DEFAULT_PASS_BAND",
+    "ILL_CONDITIONED",
     "LAPLACIANS",
     "MASS_MODES",
     "MAX_ITERS",
