@@ -560,3 +560,297 @@ def test_explicit_with_mass_recompute_uses_the_current_areas():
         X = X + lam * (C @ X) / lap.vertex_areas(X, F, "voronoi")[:, None]
     got = S.smooth(V, F, "explicit", "cotan", lam, 3, mass="recompute")
     np.testing.assert_allclose(got, X, atol=1e-12)
+
+
+# ----------------------------------------------------------------------------- linalg.spd
+
+
+def test_spd_solver_matches_a_direct_solve_and_is_reused():
+    from meshlap_core.linalg.spd import SPDSolver, surely_positive_definite
+
+    V, F = bumpy_sphere(2)
+    W, K = S.operator_parts(V, F, "cotan")
+    A = (sp.diags(W) - 0.01 * K).tocsr()  # W − λK: symmetric positive definite
+    assert surely_positive_definite(A)
+    solver = SPDSolver(A)
+    for B in (V, V[:, 0], 2.0 * V + 1.0):
+        np.testing.assert_allclose(solver.solve(B), sla.spsolve(A.tocsc(), B), atol=1e-12)
+
+
+def test_spd_solver_refuses_an_indefinite_matrix_without_printing(capfd):
+    from meshlap_core.linalg.spd import SPDSolver, surely_positive_definite
+
+    A = sp.csr_matrix(np.array([[1.0, 2.0], [2.0, 1.0]]))  # eigenvalues 3 and −1
+    assert not surely_positive_definite(A)
+    with pytest.raises(np.linalg.LinAlgError, match="positive definite"):
+        SPDSolver(A)
+    out, _ = capfd.readouterr()
+    assert out == ""  # CHOLMOD's printf never reaches standard output
+
+
+def test_implicit_system_beyond_double_precision_is_refused_naming_lam():
+    V, F = icosphere(1)
+    with (
+        pytest.raises(MeshError, match=r"^lam: the implicit system .* cannot be factorized"),
+        pytest.warns(MeshWarning, match="ill-conditioned"),
+    ):
+        S.smooth(V, F, "implicit", "cotan", 1e200, 1)
+
+
+# ----------------------------------------------------------------------------- bounded work
+
+
+def test_iteration_counts_beyond_the_limit_are_refused():
+    V, F = icosphere(1)
+    assert S.check_iters(S.MAX_ITERS) == S.MAX_ITERS
+    with pytest.raises(MeshError, match=r"^iters: must be at most 10000000"):
+        S.smooth(V, F, "explicit", "uniform", 0.5, S.MAX_ITERS + 1)
+    s = S.Smoother(V, F, "implicit", "uniform", 1.0)
+    with pytest.raises(MeshError, match=r"^n: must be at most"):
+        s.run(10**20)  # beyond int64 too
+    assert s.iteration == 0
+    with pytest.raises(MeshError, match=r"^iters: .*about 5000 digits"):
+        S.check_iters(10**4999)
+    with pytest.raises(MeshError, match="iters"):
+        S.denoise_sweep(V, F, noise_levels=(0.01,), iters=(2, S.MAX_ITERS + 1))
+
+
+def _entries_without_time(history):
+    return [{k: v for k, v in h.items() if k != "time_ms"} for h in history]
+
+
+def test_history_samples_keeps_a_decimated_history_with_the_first_and_last_step():
+    V, F = icosphere(2)
+    full = S.Smoother(V, F, "explicit", "uniform", 0.5)
+    full.run(1001)
+    s = S.Smoother(V, F, "explicit", "uniform", 0.5, history_samples=40)
+    for k in range(1, 1002):
+        s.step()
+        assert len(s.history) <= 40
+        assert s.history[0]["iteration"] == 0 and s.history[-1]["iteration"] == k
+    its = [h["iteration"] for h in s.history]
+    assert s.history_stride == 32 and len(s.history) >= 20  # never fewer than half
+    assert all(i % s.history_stride == 0 for i in its[:-1])
+    assert its[:-1] == list(range(0, 1001, s.history_stride))
+    # every kept entry is exactly the one a full history would hold for that iteration
+    want = _entries_without_time(full.history[i] for i in its)
+    assert _entries_without_time(s.history) == want
+    s.reset()
+    assert s.history_stride == 1 and [h["iteration"] for h in s.history] == [0]
+
+
+def test_history_options_are_checked():
+    V, F = icosphere(1)
+    with pytest.raises(MeshError, match="history_samples"):
+        S.Smoother(V, F, history_samples=3)
+    with pytest.raises(MeshError, match=r"history_samples.*not both"):
+        S.Smoother(V, F, history_limit=10, history_samples=10)
+
+
+def test_divergence_stops_at_the_first_step_farther_than_the_bounding_box_diagonal():
+    V, F = icosphere(2)
+    V = add_noise(V, F, 0.01, seed=1)
+    lam = 1.5 * S.stability(V, F, "explicit", "uniform", 1e-6).max_stable_lam
+    s = S.Smoother(V, F, "explicit", "uniform", lam, warn=False)
+    s.run(500)
+    assert s.diverged
+    # the same iteration by hand: x ← x + λ D⁻¹(A − D) x
+    W, K = S.operator_parts(V, F, "uniform")
+    diag = float(np.linalg.norm(V.max(axis=0) - V.min(axis=0)))
+    x, k = V.copy(), 0
+    while True:
+        nxt = x + lam * (K @ x) / W[:, None]
+        if np.sqrt(np.mean(np.sum((nxt - V) ** 2, axis=1))) > diag:
+            break
+        x, k = nxt, k + 1
+    assert s.iteration == k and s.divergence_limit == pytest.approx(diag)
+    for method in ("taubin", "implicit"):  # these only stop on a blow-up (see the docstring)
+        other = S.Smoother(V, F, method, "uniform", 0.5, warn=False)
+        assert other.divergence_limit == pytest.approx(1000 * diag)
+    np.testing.assert_allclose(s.V, x, rtol=1e-9, atol=1e-9 * diag)
+    msg = s.divergence_message()
+    limit = s.stability.max_stable_lam
+    assert f"diverged at iteration {k + 1}" in msg and f"{limit:.4g}" in msg
+    before = s.V.copy()
+    s.step()  # a diverged smoother does nothing
+    assert s.iteration == k and np.array_equal(s.V, before)
+    with pytest.raises(S.DivergenceError, match=r"^lam: explicit smoothing diverged") as exc:
+        S.smooth(V, F, "explicit", "uniform", lam, 500, warn=False)
+    assert isinstance(exc.value, MeshError)
+    assert S.Smoother(V, F, "explicit", "uniform", 0.5).divergence_message() is None
+
+
+@pytest.mark.parametrize("laplacian", S.LAPLACIANS)
+def test_stable_runs_never_trip_the_divergence_check(laplacian):
+    V, F = icosphere(2)
+    for method in S.METHODS:
+        lam = LAM[laplacian] if method != "implicit" else 1e4  # implicit: collapse to a point
+        s = S.Smoother(V, F, method, laplacian, lam, warn=False)
+        s.run(300)
+        assert not s.diverged
+
+
+def test_set_lam_keeps_the_current_mesh_and_only_refactorizes():
+    V, F = bumpy_sphere(2)
+    W, K = S.operator_parts(V, F, "cotan")  # frozen mass: the operator of the input
+    s = S.Smoother(V, F, "implicit", "cotan", 0.01)
+    s.run(3)
+    here = s.V.copy()
+    s.set_lam(0.05)
+    assert np.array_equal(s.V, here) and s.iteration == 3 and len(s.history) == 4
+    assert s.n_factorizations == 1  # refactorized lazily, on the next step
+    s.step()
+    want = sla.spsolve((sp.diags(W) - 0.05 * K).tocsc(), W[:, None] * here)
+    np.testing.assert_allclose(s.V, want, atol=1e-12)
+    assert s.n_factorizations == 2 and s.iteration == 4
+    assert [h["iteration"] for h in s.history] == [0, 1, 2, 3, 4]
+    s.set_lam(0.05)  # unchanged λ: no refactorization
+    s.step()
+    assert s.n_factorizations == 2
+    # explicit: the next step is x + λ' W⁻¹K x from the current positions
+    e = S.Smoother(V, F, "explicit", "cotan", 1e-4)
+    e.run(2)
+    here = e.V.copy()
+    e.set_lam(2e-4)
+    np.testing.assert_allclose(e.step(), here + 2e-4 * (K @ here) / W[:, None], atol=1e-12)
+    assert e.n_factorizations == 0 and e.stability.lam == 2e-4
+
+
+def test_set_lam_refuses_a_bad_lam_without_changing_anything():
+    V, F = icosphere(1)
+    s = S.Smoother(V, F, "taubin", "uniform", 0.5, taubin_nu=-0.6)
+    s.run(2)
+    here = s.V.copy()
+    for bad in (0.0, float("nan"), 0.7):  # 0.7: the given ν = −0.6 is no longer below −λ
+        with pytest.raises(MeshError):
+            s.set_lam(bad)
+        assert s.lam == 0.5 and s.taubin_nu == -0.6 and np.array_equal(s.V, here)
+
+
+def test_set_lam_resumes_a_diverged_smoother_from_its_last_good_positions():
+    V, F = icosphere(2)
+    V = add_noise(V, F, 0.01, seed=1)
+    limit = S.stability(V, F, "explicit", "uniform", 1e-6).max_stable_lam
+    s = S.Smoother(V, F, "explicit", "uniform", 1.5 * limit, warn=False)
+    s.run(500)
+    assert s.diverged
+    k, good = s.iteration, s.V.copy()
+    s.set_lam(0.5 * limit)
+    assert not s.diverged and s.divergence_message() is None
+    s.run(10)
+    assert not s.diverged and s.iteration == k + 10
+    W, K = S.operator_parts(V, F, "uniform")
+    x = good
+    for _ in range(10):
+        x = x + 0.5 * limit * (K @ x) / W[:, None]
+    np.testing.assert_allclose(s.V, x, atol=1e-12)
+
+
+class _Stream:
+    """A text stream that says whether it is a terminal."""
+
+    def __init__(self, tty):
+        self.tty, self.text = tty, ""
+
+    def isatty(self):
+        return self.tty
+
+    def write(self, s):
+        self.text += s
+
+    def flush(self):
+        pass
+
+
+def _run_progress(tty, seconds_per_step, steps=100):
+    from meshlap_core.cli.smooth import Progress
+
+    now = [0.0]
+    stream = _Stream(tty)
+    p = Progress(stream, steps, clock=lambda: now[0])
+    for k in range(1, steps + 1):
+        now[0] += seconds_per_step
+        p.update(k)
+    p.close()
+    return stream.text
+
+
+def test_progress_is_silent_on_short_runs_and_reports_long_ones():
+    assert _run_progress(tty=False, seconds_per_step=0.05) == ""  # 5 s in all: nothing
+    lines = _run_progress(tty=False, seconds_per_step=1.0).splitlines()  # 100 s
+    assert [ln.split()[1] for ln in lines] == ["10/100", "40/100", "70/100", "100/100"]
+    assert all(ln.startswith("smooth: ") for ln in lines)
+    assert "about 90 s left" in lines[0]  # 10 of 100 steps in 10 s
+    text = _run_progress(tty=True, seconds_per_step=0.1)  # a terminal: redrawn in place
+    assert "\n" not in text and text.count("\r") >= 10
+    assert text.endswith("\r\x1b[K")  # erased at the end
+    assert _run_progress(tty=True, seconds_per_step=0.001) == ""  # under a second
+
+
+def test_cli_smooth_refuses_iteration_counts_beyond_the_limit(cli, tmp_path, capsys):
+    V, F = icosphere(1)
+    src = tmp_path / "s.obj"
+    _write_obj(src, V, F)
+    for text in ("99999999999999999999", str(S.MAX_ITERS + 1), "9" * 5000):
+        assert cli(["smooth", str(src), "--iters", text]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and err.startswith("meshlap: error: --iters: must be at most")
+    assert cli(["denoise-eval", str(src), "--iters", "5,99999999999999999999"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--iters: must be at most" in err
+
+
+def test_cli_smooth_long_run_keeps_a_decimated_history(cli, tmp_path, capsys):
+    V, F = icosphere(1)
+    src = tmp_path / "s.obj"
+    _write_obj(src, V, F)
+    assert cli(["smooth", str(src), "--iters", "60", "--json"]) == 0
+    out, err = capsys.readouterr()
+    r = json.loads(out)
+    assert err == ""  # a short run prints no progress
+    assert r["iterations_stride"] == 1 and r["iterations_note"] is None
+    assert [h["iteration"] for h in r["iterations"]] == list(range(61))
+    assert cli(["smooth", str(src), "--iters", "4001", "--json"]) == 0
+    r = json.loads(capsys.readouterr().out)
+    its = [h["iteration"] for h in r["iterations"]]
+    assert len(its) <= 2000 and its[0] == 0 and its[-1] == 4001 and r["iters"] == 4001
+    assert r["iterations_stride"] == 4 and its[:-1] == list(range(0, 4001, 4))
+    assert "decimated" in r["iterations_note"]
+    assert cli(["smooth", str(src), "--iters", "4001"]) == 0
+    assert "history decimated" in capsys.readouterr().out
+
+
+def test_cli_smooth_divergence_names_the_stable_lam(cli, tmp_path, capsys):
+    V, F = icosphere(2)
+    src = tmp_path / "s.obj"
+    _write_obj(src, add_noise(V, F, 0.01, seed=1), F)
+    assert cli(["smooth", str(src), "--lam", "2.5", "--iters", "500"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1
+    assert err.startswith("meshlap: error: --lam: explicit smoothing diverged at iteration")
+    assert "largest stable lam for this mesh: 1." in err and "nothing written" in err
+
+
+def test_an_ill_conditioned_implicit_lam_is_announced():
+    V, F = icosphere(2)
+    V = V + np.array([5.0, 0.0, 0.0])
+    W, _ = S.operator_parts(V, F, "uniform")
+    centroid = (W[:, None] * V).sum(axis=0) / W.sum()  # an exact implicit step conserves it
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", MeshWarning)
+        X = S.smooth(V, F, "implicit", "uniform", 1e4, 1)  # 1e4 x max(-L_ii) = 1e4: fine
+    np.testing.assert_allclose((W[:, None] * X).sum(axis=0) / W.sum(), centroid, atol=1e-10 * 5)
+    lam = 10 * S.ILL_CONDITIONED  # max(-L_ii) = 1 for the uniform Laplacian
+    with pytest.warns(MeshWarning, match=r"ill-conditioned.*1e\+11 > 1e\+10"):
+        S.Smoother(V, F, "implicit", "uniform", lam)
+
+
+def test_cli_smooth_announces_an_ill_conditioned_implicit_lam(cli, tmp_path, capsys):
+    V, F = icosphere(1)
+    src = tmp_path / "s.obj"
+    _write_obj(src, V, F)
+    argv = ["smooth", str(src), "--method", "implicit", "--lam", "1e12", "--json"]
+    assert cli(argv) == 0
+    out, err = capsys.readouterr()
+    assert any("ill-conditioned" in w for w in json.loads(out)["warnings"])
+    assert "meshlap: warning: implicit smoothing with lam=1e+12 is ill-conditioned" in err

@@ -19,7 +19,15 @@ import numpy as np
 from ..errors import MeshError
 from ..noise import NOISE_MODES
 from ..options import AREA_KINDS
-from ..smoothing import LAPLACIANS, METHODS, best_rows, check_iters, check_lam, denoise_sweep
+from ..smoothing import (
+    LAPLACIANS,
+    MAX_ITERS,
+    METHODS,
+    best_rows,
+    check_iters,
+    check_lam,
+    denoise_sweep,
+)
 from ._common import add_json_flag, emit_json, parse_list, print_report
 
 COLUMNS = (
@@ -64,7 +72,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--methods", default="explicit,implicit", help="from explicit,implicit,taubin")
     p.add_argument("--laplacian", default="uniform", help="uniform and/or cotan (default uniform)")
     p.add_argument("--lam", default="0.1,0.5,1.0", help="step sizes (default 0.1,0.5,1.0)")
-    p.add_argument("--iters", default="10", help="iteration counts (default 10)")
+    p.add_argument(
+        "--iters", default="10", help=f"iteration counts, each 0 to {MAX_ITERS} (default 10)"
+    )
     p.add_argument("--seed", default="0", help="noise seed (default 0)")
     p.add_argument("--area", choices=AREA_KINDS, default="voronoi", help="cotan lumped area")
     p.add_argument("--csv", default=None, help="also write the table as CSV here")
@@ -82,13 +92,8 @@ def _names(text: str, allowed: tuple[str, ...], flag: str) -> list[str]:
     return list(dict.fromkeys(values))
 
 
-def run(args: argparse.Namespace) -> int:
-    from ..io import load_mesh  # written by the io agent; imported here so --help never needs it
-
-    methods = _names(args.methods, METHODS, "--methods")
-    laplacians = _names(args.laplacian, LAPLACIANS, "--laplacian")
-    lams = [check_lam(v, "--lam") for v in parse_list(args.lam, float, "--lam")]
-    iters = [check_iters(v, "--iters") for v in parse_list(args.iters, int, "--iters")]
+def _seed_and_noise(args: argparse.Namespace) -> tuple[int, list[float]]:
+    """``--seed`` and the ``--noise`` levels (none with ``--noisy``), checked."""
     try:
         seed = int(args.seed)
     except ValueError:
@@ -102,13 +107,29 @@ def run(args: argparse.Namespace) -> int:
     for a in noise:
         if a < 0:
             raise MeshError(f"noise levels must be >= 0, got {a:g}", "--noise")
-    if args.csv is not None:
-        inputs = [Path(args.clean).resolve()] + ([Path(args.noisy).resolve()] if args.noisy else [])
-        if Path(args.csv).resolve() in inputs:
-            raise MeshError("refusing to overwrite an input mesh", args.csv)
-        from ..io import check_output_path
+    return seed, noise
 
-        check_output_path(args.csv, overwrite_inputs=inputs, suffixes=(".csv",))
+
+def _check_csv(args: argparse.Namespace) -> None:
+    """Refuse a ``--csv`` path that is an input or cannot be written, before any work."""
+    inputs = [Path(args.clean).resolve()] + ([Path(args.noisy).resolve()] if args.noisy else [])
+    if Path(args.csv).resolve() in inputs:
+        raise MeshError("refusing to overwrite an input mesh", args.csv)
+    from ..io import check_output_path
+
+    check_output_path(args.csv, overwrite_inputs=inputs, suffixes=(".csv",))
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..io import load_mesh  # imported here so --help never loads the mesh readers
+
+    methods = _names(args.methods, METHODS, "--methods")
+    laplacians = _names(args.laplacian, LAPLACIANS, "--laplacian")
+    lams = [check_lam(v, "--lam") for v in parse_list(args.lam, float, "--lam")]
+    iters = [check_iters(v, "--iters") for v in parse_list(args.iters, int, "--iters")]
+    seed, noise = _seed_and_noise(args)
+    if args.csv is not None:
+        _check_csv(args)
 
     clean = load_mesh(args.clean)
     Vn = None

@@ -2,6 +2,10 @@
 
 Sign convention: the Laplacian is negative semidefinite (``L = D⁻¹A − I`` or ``M⁻¹C``), so an
 explicit step is ``x′ = x + λLx`` with ``λ > 0``.
+
+Bounded work: ``--iters`` above :data:`~meshlap_core.smoothing.MAX_ITERS` (10⁷) is refused; the
+per-iteration history keeps at most :data:`HISTORY_SAMPLES` entries (decimated, always with the
+input and the last step; the JSON says the stride); a long run shows its progress on stderr.
 """
 
 from __future__ import annotations
@@ -10,13 +14,25 @@ import argparse
 import sys
 import time
 import warnings
+from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import Any, TextIO
 
 from ..errors import MeshError, MeshWarning
 from ..options import AREA_KINDS
-from ..smoothing import LAPLACIANS, MASS_MODES, METHODS, Smoother, check_iters, check_lam
+from ..smoothing import (
+    LAPLACIANS,
+    MASS_MODES,
+    MAX_ITERS,
+    METHODS,
+    Smoother,
+    check_iters,
+    check_lam,
+)
 from ._common import add_json_flag, emit_json, summary_stats
+
+HISTORY_SAMPLES = 2000
+"""At most this many per-iteration entries in the output (about 1 MB of JSON)."""
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -34,7 +50,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--method", choices=METHODS, default="explicit", help="default: explicit")
     p.add_argument("--laplacian", choices=LAPLACIANS, default="uniform", help="default: uniform")
     p.add_argument("--lam", default="0.5", help="step lambda > 0 (default 0.5)")
-    p.add_argument("--iters", default="10", help="number of iterations >= 0 (default 10)")
+    p.add_argument(
+        "--iters",
+        default="10",
+        help=f"number of iterations, 0 to {MAX_ITERS} (default 10)",
+    )
     p.add_argument(
         "--taubin-mu", default=None, help="Taubin's negative factor (default from --pass-band)"
     )
@@ -73,6 +93,9 @@ def _float_arg(text: str | None, name: str) -> float | None:
 
 
 def _int_arg(text: str, name: str) -> int:
+    digits = text.strip()
+    if len(digits) > 40 and digits.isascii() and digits.isdigit():  # int() refuses > 4300 digits
+        raise MeshError(f"must be at most {MAX_ITERS}, got a number of {len(digits)} digits", name)
     try:
         value = int(text)
     except ValueError:
@@ -81,7 +104,7 @@ def _int_arg(text: str, name: str) -> int:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..io import load_mesh  # written by the io agent; imported here so --help never needs it
+    from ..io import load_mesh  # imported here so --help never loads the mesh readers
 
     lam = check_lam(_float_arg(args.lam, "--lam"), "--lam")
     iters = _int_arg(args.iters, "--iters")
@@ -98,46 +121,19 @@ def run(args: argparse.Namespace) -> int:
     V, F = mesh.V, mesh.F
     msgs: list[str] = list(getattr(mesh.report, "warnings", []))
     t0 = time.perf_counter()
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always", MeshWarning)
-        try:
-            s = Smoother(
-                V,
-                F,
-                args.method,
-                args.laplacian,
-                lam,
-                taubin_nu=nu,
-                pass_band=pass_band,
-                fix_boundary=args.fix_boundary,
-                preserve_volume=args.preserve_volume,
-                mass=args.mass,
-                area=args.area,
-            )
-        except MeshError as exc:
-            raise _cli_error(exc, args.mesh) from None
+    s, caught = _make_smoother(args, V, F, lam, nu, pass_band)
     setup_s = time.perf_counter() - t0
-    msgs += [str(w.message) for w in caught]
+    msgs += caught
 
     t1 = time.perf_counter()
-    report_every = max(1, iters // 10)
-    for k in range(iters):
-        s.step()
-        if s.diverged:
-            break
-        if iters >= 50 and (k + 1) % report_every == 0:
-            sys.stderr.write(f"smooth: {k + 1}/{iters} iterations\n")
+    _iterate(s, iters)
     run_s = time.perf_counter() - t1
     t2 = time.perf_counter()
     stab = s.stability
     stab_s = time.perf_counter() - t2
 
     if s.diverged:
-        raise MeshError(
-            f"{args.method} smoothing diverged at iteration {s.iteration + 1} "
-            f"(largest stable lam for this mesh: {_fmt(stab.max_stable_lam)}); nothing written",
-            "--lam",
-        )
+        raise MeshError(f"{s.divergence_message()}; nothing written", "--lam")
     out_path = None
     if args.out is not None:
         from ..io import save_mesh
@@ -174,6 +170,8 @@ def run(args: argparse.Namespace) -> int:
             "step_ms": summary_stats(step_ms) if step_ms else None,
         },
         "iterations": s.history,
+        "iterations_stride": s.history_stride,
+        "iterations_note": _history_note(s),
         "out": out_path,
         "repairs": list(getattr(mesh.report, "repairs", [])),
         "warnings": msgs,
@@ -187,6 +185,113 @@ def run(args: argparse.Namespace) -> int:
     else:
         print(format_smooth(result))
     return 0
+
+
+def _make_smoother(
+    args: argparse.Namespace, V: Any, F: Any, lam: float, nu: float | None, pass_band: float
+) -> tuple[Smoother, list[str]]:
+    """The stepper of the command's options and the warnings its construction gave."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", MeshWarning)
+        try:
+            s = Smoother(
+                V,
+                F,
+                args.method,
+                args.laplacian,
+                lam,
+                taubin_nu=nu,
+                pass_band=pass_band,
+                fix_boundary=args.fix_boundary,
+                preserve_volume=args.preserve_volume,
+                mass=args.mass,
+                area=args.area,
+                history_samples=HISTORY_SAMPLES,
+            )
+        except MeshError as exc:
+            raise _cli_error(exc, args.mesh) from None
+    return s, [str(w.message) for w in caught]
+
+
+def _iterate(s: Smoother, iters: int) -> None:
+    """Step ``iters`` times (progress on stderr for long runs), stopping if the run diverges."""
+    progress = Progress(sys.stderr, iters)
+    for k in range(iters):
+        s.step()
+        if s.diverged:
+            break
+        progress.update(k + 1)
+    progress.close()
+
+
+def _history_note(s: Smoother) -> str | None:
+    if s.history_stride == 1:
+        return None
+    return (
+        f"decimated: {len(s.history)} of {s.iteration + 1} entries kept (the input, every "
+        f"{s.history_stride}th iteration and the last one; at most {HISTORY_SAMPLES}); "
+        "timings.step_ms summarises the kept entries"
+    )
+
+
+class Progress:
+    """Progress of a long loop on stderr, never in the way of a short run's output.
+
+    On a terminal: one line redrawn in place (``\\r``) at most every ``redraw_s`` seconds once
+    ``start_s`` seconds have passed, erased by :meth:`close`. Otherwise (a pipe, a log, a test
+    capturing stderr): nothing for the first ``long_s`` seconds, then one full line every
+    ``every_s`` seconds; a run shorter than ``long_s`` prints nothing.
+
+    Parameters
+    ----------
+    stream : text stream
+    total : int
+        Iterations planned.
+    clock : callable, optional
+        Seconds (``time.monotonic`` by default; tests pass a fake clock).
+    """
+
+    def __init__(
+        self,
+        stream: TextIO,
+        total: int,
+        *,
+        clock: Callable[[], float] = time.monotonic,
+        start_s: float = 1.0,
+        redraw_s: float = 0.5,
+        long_s: float = 10.0,
+        every_s: float = 30.0,
+    ) -> None:
+        self.stream, self.total, self.clock = stream, total, clock
+        try:
+            self.tty = bool(stream.isatty())
+        except (AttributeError, ValueError):
+            self.tty = False
+        self.t0 = clock()
+        self.next_s = start_s if self.tty else long_s
+        self.gap_s = redraw_s if self.tty else every_s
+        self.drawn = False
+
+    def update(self, done: int) -> None:
+        """Record that ``done`` of ``total`` iterations are finished (one clock read: ~50 ns)."""
+        now = self.clock() - self.t0
+        if now < self.next_s:
+            return
+        self.next_s = now + self.gap_s
+        left = now * (self.total - done) / done if done else float("nan")
+        text = (
+            f"smooth: {done}/{self.total} iterations ({100.0 * done / self.total:.1f} %), "
+            f"{now:.0f} s elapsed, about {left:.0f} s left"
+        )
+        self.stream.write(f"\r{text}\x1b[K" if self.tty else text + "\n")
+        self.stream.flush()
+        self.drawn = True
+
+    def close(self) -> None:
+        """Erase the terminal line (a later error or report starts on a clean line)."""
+        if self.tty and self.drawn:
+            self.stream.write("\r\x1b[K")
+            self.stream.flush()
 
 
 def _cli_error(exc: MeshError, mesh: str) -> MeshError:
@@ -243,6 +348,8 @@ def format_smooth(r: dict[str, Any]) -> str:
     hist = r["iterations"]
     if len(hist) > 1:
         lines.append("")
+        if r["iterations_note"]:
+            lines.append(f"history {r['iterations_note']}")
         lines.append(f"{'iter':>6} {'step RMS':>11} {'drift RMS':>11} {'volume %':>10} {'ms':>8}")
         stride = max(1, (len(hist) - 1) // 20)
         shown = list(range(stride, len(hist), stride))
