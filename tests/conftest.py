@@ -28,3 +28,10 @@ def shared_mesh() -> Callable[[str], Path]:
         return path
 
     return get
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    config.addinivalue_line(
+        "markers",
+        "window: drives `meshlap view` in a real X window (Xvfb + xdotool; skipped without them)",
+    )
