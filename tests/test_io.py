@@ -606,7 +606,7 @@ def test_atomic_write_failure_in_writer_keeps_old_mesh(tmp_path, monkeypatch):
     def broken(*args, **kwargs):
         raise OSError(28, "No space left on device")
 
-    monkeypatch.setattr("meshlap_core.io._write_ply", broken)
+    monkeypatch.setattr("meshlap_core.io.write._write_ply", broken)
     with pytest.raises(OSError, match="No space left"):
         save_mesh(target, V * 2, F)
     assert target.read_bytes() == before

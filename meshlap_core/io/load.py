@@ -1,0 +1,150 @@
+"""Loading: the file read, the format chosen by extension, the result validated."""
+
+from __future__ import annotations
+
+import os
+import stat
+from pathlib import Path
+
+from ..errors import MeshError
+from ..types import FloatArray
+from ..validate import Mesh, validate_mesh
+from ._scan import Parsed
+from .atomic import PathLike
+from .obj import _parse_obj
+from .off import _parse_off
+from .ply import _parse_ply
+from .stl import _parse_stl
+
+MESH_FORMATS: tuple[str, ...] = (".obj", ".off", ".ply", ".stl")
+
+
+def load_mesh(path: PathLike, *, repair: bool = True) -> Mesh:
+    """Load an OBJ, OFF, PLY (ASCII / binary) or STL (ASCII / binary) triangle mesh.
+
+    The format is chosen by the extension (case-insensitive). The result is validated (and,
+    with ``repair=True``, repaired) by :func:`meshlap_core.validate.validate_mesh`.
+
+    Parameters
+    ----------
+    path : str or PathLike
+    repair : bool
+        Remove degenerate / duplicate faces and unreferenced vertices (always reported).
+
+    Returns
+    -------
+    mesh : Mesh
+        ``mesh.V (n,3) float64``, ``mesh.F (m,3) int64``, ``mesh.report`` (repairs, warnings,
+        manifoldness), ``mesh.vertex_map`` (index of each vertex in the file).
+
+    Raises
+    ------
+    MeshError
+        Missing / unreadable / empty file, a directory, an unknown extension, or any problem
+        with the contents (the message names the file).
+
+    Examples
+    --------
+    >>> mesh = load_mesh("bunny.obj")            # doctest: +SKIP
+    >>> mesh.V.shape, mesh.report.repairs        # doctest: +SKIP
+    ((3485, 3), [])
+    """
+    p, src, data = _read_input(path)
+    parsed = _parse(p.suffix.lower(), data, src)
+    del data  # the parsed arrays are copies: free the file's bytes before validating
+    return validate_mesh(
+        parsed.V,
+        parsed.faces,
+        src,
+        repair=repair,
+        vertex_map=parsed.vertex_map,
+        repairs=parsed.repairs,
+        warnings=parsed.warnings,
+    )
+
+
+def load_vertex_scalars(path: PathLike, name: str = "quality") -> FloatArray:
+    """Read one per-vertex scalar property (default ``quality``) from a PLY file.
+
+    The values are in the file's vertex order (use ``mesh.vertex_map`` to follow a repaired
+    mesh): ``load_vertex_scalars(p)[mesh.vertex_map]``.
+
+    Parameters
+    ----------
+    path : str or PathLike
+        A ``.ply`` file.
+    name : str
+        The vertex property.
+
+    Returns
+    -------
+    values : (n,) float64
+
+    Raises
+    ------
+    MeshError
+        Not a PLY file, or the vertex element has no such property.
+    """
+    p, src, data = _read_input(path)
+    if p.suffix.lower() != ".ply":
+        raise MeshError(
+            f"per-vertex scalars can only be read from .ply files, not {p.suffix!r}", src
+        )
+    parsed = _parse_ply(data, src)
+    if name not in parsed.vertex_props:
+        have = ", ".join(sorted(parsed.vertex_props)) or "none"
+        raise MeshError(f"the vertex element has no property {name!r} (properties: {have})", src)
+    return parsed.vertex_props[name]
+
+
+def _read_input(path: PathLike) -> tuple[Path, str, bytes]:
+    try:
+        src = os.fspath(path)
+    except TypeError:
+        raise MeshError(f"expected a file path, got {type(path).__name__}", "path") from None
+    p = Path(src)
+    if not p.exists():
+        raise MeshError("no such file", src)
+    if p.is_dir():
+        raise MeshError("is a directory, not a mesh file", src)
+    ext = p.suffix.lower()
+    if ext not in MESH_FORMATS:
+        what = f"unknown mesh format {p.suffix!r}" if ext else "the file name has no extension"
+        raise MeshError(f"{what}; supported formats: {', '.join(MESH_FORMATS)}", src)
+    try:
+        mode = p.stat().st_mode
+    except OSError as exc:
+        raise MeshError(f"cannot read the file: {exc.strerror or exc}", src) from None
+    if not stat.S_ISREG(mode):
+        # a FIFO would block forever, /dev/zero would never end
+        kind = (
+            "a named pipe (FIFO)"
+            if stat.S_ISFIFO(mode)
+            else "a device"
+            if stat.S_ISCHR(mode) or stat.S_ISBLK(mode)
+            else "a socket"
+            if stat.S_ISSOCK(mode)
+            else "a special file"
+        )
+        raise MeshError(f"not a regular file ({kind}); meshlap reads mesh files only", src)
+    try:
+        data = p.read_bytes()
+    except PermissionError:
+        raise MeshError("cannot read the file: permission denied", src) from None
+    except OSError as exc:
+        raise MeshError(f"cannot read the file: {exc.strerror or exc}", src) from None
+    if not data or data.isspace():
+        raise MeshError(
+            "the file is empty" if not data else "the file contains only whitespace", src
+        )
+    return p, src, data
+
+
+def _parse(ext: str, data: bytes, src: str) -> Parsed:
+    if ext == ".obj":
+        return _parse_obj(data, src)
+    if ext == ".off":
+        return _parse_off(data, src)
+    if ext == ".ply":
+        return _parse_ply(data, src)
+    return _parse_stl(data, src)
