@@ -1,12 +1,28 @@
-"""The shared scanner: what every text format's parser agrees on.
+"""The shared scanner: one tokenizer contract for every text format (OBJ, OFF, PLY, STL).
 
-Byte-level helpers over a file's bytes held as a ``uint8`` array (line tables, tokens per
-line, bulk number parsing, binary-garbage detection) and :class:`Parsed`, what a format
-parser hands to :func:`meshlap_core.validate.validate_mesh`.
+The contract, followed by the bulk (numpy) and the per-line parsers alike:
+
+* **lines** end at ``\\n``, ``\\r\\n`` or ``\\r``, nothing else (not U+0085, U+2028,
+  U+2029, VT or FF, which :meth:`str.splitlines` would also split on);
+* **tokens** are separated by ASCII whitespace (space, tab, VT, FF); a non-ASCII space is part
+  of a token;
+* **numbers** are ASCII decimal literals with an optional exponent (``-1``, ``.5``,
+  ``2.5e-3``), plus ``nan``/``inf``/``infinity`` (any case), which the validator then refuses;
+  **integers** are ASCII digits with an optional sign. Anything else in a numeric field
+  (``1_0``, ``0x10``, non-ASCII or full-width digits, ``3f2``) is an error naming the line,
+  although Python's ``float``/``int`` would accept some of it.
+
+:func:`bulk_numbers` (numpy's ``fromstring``) only answers for text made of the characters of
+such literals, and callers check that it yields one value per token, so a bulk parse either
+agrees with :func:`to_float`/:func:`to_int` value for value or declines (None) and the caller
+falls back to its per-line path. Also here: byte-level helpers over a file's bytes held as a
+``uint8`` array (line tables, tokens per line, binary-garbage detection) and :class:`Parsed`,
+what a format parser hands to :func:`meshlap_core.validate.validate_mesh`.
 """
 
 from __future__ import annotations
 
+import re
 import warnings
 from dataclasses import dataclass, field
 from typing import Any
@@ -32,6 +48,47 @@ class Parsed:
 TEXT_BYTES = bytes(range(9, 14)) + bytes(range(32, 256))  # all but control characters
 # |index| at or above this cannot be a vertex index (and would overflow int64 arithmetic)
 HUGE_INDEX = 2**53
+
+WHITESPACE = b" \t\v\f\r\n"  # exactly what ``bytes.split()`` splits on
+DIGITS = b"0123456789"
+INT_CHARS = DIGITS + b"+-"
+FLOAT_CHARS = INT_CHARS + b".eE"
+_LINE_BREAK = re.compile(rb"\r\n|\r|\n")
+_FLOAT = re.compile(
+    rb"[+-]?(?:(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?|(?i:nan|inf|infinity))"
+)
+_INT = re.compile(rb"[+-]?[0-9]+")
+
+
+def split_lines(data: bytes) -> list[bytes]:
+    """The lines of ``data``, split at ``\\n``, ``\\r\\n`` and ``\\r`` only."""
+    return _LINE_BREAK.split(data) if b"\r" in data else data.split(b"\n")
+
+
+def has_bare_cr(data: bytes) -> bool:
+    """Whether a ``\\r`` not followed by ``\\n`` ends a line (the bulk paths, which split at
+    ``\\n``, then leave the file to the per-line parsers)."""
+    n_cr = data.count(b"\r")
+    return bool(n_cr) and n_cr != data.count(b"\r\n")
+
+
+def to_float(tok: bytes) -> float:
+    """One number token under the contract; ``ValueError`` for anything else."""
+    if _FLOAT.fullmatch(tok) is None:
+        raise ValueError(tok)
+    return float(tok)
+
+
+def to_int(tok: bytes) -> int:
+    """One integer token under the contract (ASCII digits, optional sign); else ``ValueError``."""
+    if _INT.fullmatch(tok) is None:
+        raise ValueError(tok)
+    return int(tok)
+
+
+def shown(text: bytes, n: int = 60) -> str:
+    """``text`` (stripped, at most ``n`` characters) for an error message."""
+    return text.strip().decode("utf-8", errors="replace")[:n]
 
 
 def check_text(arr: np.ndarray, src: str, what: str, offset: int = 0) -> None:
@@ -72,7 +129,16 @@ def tokens_per_line(buf: np.ndarray) -> IntArray:
 
 
 def bulk_numbers(text: bytes, dtype: type) -> np.ndarray | None:
-    """All whitespace-separated numbers of ``text``, or None if one does not parse."""
+    """All whitespace-separated numbers of ``text``, or None if one does not parse.
+
+    None also when ``text`` holds a character that no literal of the contract has (letters
+    other than ``e``/``E``, ``_``, non-ASCII bytes; for an integer ``dtype`` also ``.``, ``e``):
+    numpy would read ``nan`` or hexadecimal forms the contract leaves to the per-line parsers.
+    The caller still checks that the count equals the number of tokens (``"1-2"`` is one token).
+    """
+    allowed = INT_CHARS if np.dtype(dtype).kind in "iu" else FLOAT_CHARS
+    if text.translate(None, allowed + WHITESPACE):
+        return None
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         try:
@@ -95,6 +161,6 @@ def select_lines(
     return out if out.endswith(b"\n") else out + b"\n"
 
 
-def strip_comment(line: str) -> str:
-    i = line.find("#")
+def strip_comment(line: bytes) -> bytes:
+    i = line.find(b"#")
     return line if i < 0 else line[:i]

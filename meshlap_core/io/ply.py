@@ -10,7 +10,17 @@ import numpy as np
 
 from ..errors import MeshError
 from ..validate import Polygons
-from ._scan import HUGE_INDEX, Parsed, bulk_numbers, check_text, tokens_per_line
+from ._scan import (
+    HUGE_INDEX,
+    Parsed,
+    bulk_numbers,
+    check_text,
+    shown,
+    split_lines,
+    to_float,
+    to_int,
+    tokens_per_line,
+)
 
 _PLY_TYPES = {
     "char": "i1",
@@ -52,11 +62,11 @@ def _ply_header(data: bytes, src: str) -> tuple[str, list[_PlyElement], int]:
     m = re.search(rb"end_header[ \t]*\r?\n", data)
     if m is None:
         raise MeshError("the PLY header has no 'end_header' line (truncated or not PLY)", src)
-    header = data[: m.start()].decode("latin-1")
     fmt = None
     elements: list[_PlyElement] = []
-    for ln, line in enumerate(header.splitlines(), 1):
-        parts = line.split()
+    for ln, raw in enumerate(split_lines(data[: m.start()]), 1):
+        line = raw.decode("latin-1")
+        parts = [t.decode("latin-1") for t in raw.split()]
         if not parts or parts[0] in ("ply", "comment", "obj_info"):
             continue
         if parts[0] == "format":
@@ -71,32 +81,62 @@ def _ply_header(data: bytes, src: str) -> tuple[str, list[_PlyElement], int]:
             fmt = parts[1]
         elif parts[0] == "element":
             try:
-                elements.append(_PlyElement(parts[1], int(parts[2])))
+                elements.append(_PlyElement(parts[1], to_int(parts[2].encode("latin-1"))))
             except (IndexError, ValueError):
                 raise MeshError(
                     f"PLY header line {ln}: bad element line {line.strip()!r}", src
                 ) from None
-            if elements[-1].count < 0:
-                raise MeshError(f"PLY header line {ln}: negative element count", src)
+            _check_element(elements, len(data) - m.end(), ln, src)
         elif parts[0] == "property":
             if not elements:
                 raise MeshError(f"PLY header line {ln}: property before any element", src)
             try:
                 if parts[1] == "list":
-                    elements[-1].props.append(
-                        _PlyProp(parts[4], _PLY_TYPES[parts[3]], _PLY_TYPES[parts[2]])
-                    )
+                    prop = _PlyProp(parts[4], _PLY_TYPES[parts[3]], _PLY_TYPES[parts[2]])
                 else:
-                    elements[-1].props.append(_PlyProp(parts[2], _PLY_TYPES[parts[1]]))
+                    prop = _PlyProp(parts[2], _PLY_TYPES[parts[1]])
             except (IndexError, KeyError):
                 raise MeshError(
                     f"PLY header line {ln}: bad property line {line.strip()!r}", src
                 ) from None
+            _check_property(elements[-1], prop, ln, src)
+            elements[-1].props.append(prop)
         else:
             raise MeshError(f"PLY header line {ln}: unknown keyword {parts[0]!r}", src)
     if fmt is None:
         raise MeshError("the PLY header has no 'format' line", src)
     return fmt, elements, m.end()
+
+
+def _check_element(elements: list[_PlyElement], body_bytes: int, ln: int, src: str) -> None:
+    """The element just declared: a new name, a count the body could hold."""
+    el = elements[-1]
+    if el.count < 0:
+        raise MeshError(f"PLY header line {ln}: negative element count", src)
+    if any(e.name == el.name for e in elements[:-1]):
+        raise MeshError(f"PLY header line {ln}: a second {el.name!r} element", src)
+    if el.count > body_bytes:  # every record takes at least one byte
+        raise MeshError(
+            f"truncated PLY file (or a wrong count): header line {ln} declares {el.count:,} "
+            f"{el.name} records but only {body_bytes:,} bytes follow the header",
+            src,
+        )
+
+
+def _check_property(el: _PlyElement, prop: _PlyProp, ln: int, src: str) -> None:
+    """A property about to be added to ``el``: a new name, an integer list count type."""
+    if any(p.name == prop.name for p in el.props):
+        raise MeshError(
+            f"PLY header line {ln}: the {el.name} element declares the property "
+            f"{prop.name!r} twice",
+            src,
+        )
+    if prop.count_dtype is not None and prop.count_dtype[0] == "f":
+        raise MeshError(
+            f"PLY header line {ln}: the list property {prop.name!r} has a floating-point "
+            "count type; a list count must be an integer type (uchar, ushort, uint, ...)",
+            src,
+        )
 
 
 def _ply_mesh_parts(elements: list[_PlyElement], src: str) -> tuple[_PlyElement, _PlyElement]:
@@ -167,12 +207,13 @@ def _ply_read_binary(
             out[el.name] = {}
             continue
         if all(p.count_dtype is None for p in el.props):
-            dt = np.dtype([(p.name, bo + p.dtype) for p in el.props])
+            # positional field names: a property's name never meets numpy's field namespace
+            dt = np.dtype([(f"p{i}", bo + p.dtype) for i, p in enumerate(el.props)])
             need = dt.itemsize * el.count
             if pos + need > total:
                 raise MeshError(_truncated_msg(elements, el, total - pos, need), src)
             rec = np.frombuffer(data, dtype=dt, count=el.count, offset=pos)
-            out[el.name] = {p.name: rec[p.name] for p in el.props}
+            out[el.name] = {p.name: rec[f"p{i}"] for i, p in enumerate(el.props)}
             pos += need
             continue
         vals, pos = _ply_binary_list_element(data, pos, el, bo, elements, src)
@@ -220,14 +261,14 @@ def _ply_binary_list_element(
         q += cdt.itemsize + c * np.dtype(p.dtype).itemsize
         if q > total:
             raise MeshError(_truncated_at(elements, el, 0), src)
-    fields = []
+    fields = []  # positional names: n<i> holds the count of list property i, p<i> its values
     li = 0
-    for p in el.props:
+    for i, p in enumerate(el.props):
         if p.count_dtype is None:
-            fields.append((p.name, bo + p.dtype))
+            fields.append((f"p{i}", bo + p.dtype))
         else:
-            fields.append((f"__n_{p.name}", bo + p.count_dtype))
-            fields.append((p.name, bo + p.dtype, (lens[li],)))
+            fields.append((f"n{i}", bo + p.count_dtype))
+            fields.append((f"p{i}", bo + p.dtype, (lens[li],)))
             li += 1
     dt = np.dtype(fields)
     need = dt.itemsize * el.count
@@ -235,19 +276,19 @@ def _ply_binary_list_element(
         rec = np.frombuffer(data, dtype=dt, count=el.count, offset=pos)
         li = 0
         uniform = True
-        for p in el.props:
+        for i, p in enumerate(el.props):
             if p.count_dtype is not None:
-                uniform &= bool(np.all(rec[f"__n_{p.name}"] == lens[li]))
+                uniform &= bool(np.all(rec[f"n{i}"] == lens[li]))
                 li += 1
         if uniform:
             out: dict[str, Any] = {}
             li = 0
-            for p in el.props:
+            for i, p in enumerate(el.props):
                 if p.count_dtype is None:
-                    out[p.name] = rec[p.name]
+                    out[p.name] = rec[f"p{i}"]
                 else:
                     out[p.name] = (
-                        rec[p.name].reshape(-1),
+                        rec[f"p{i}"].reshape(-1),
                         np.full(el.count, lens[li], dtype=np.int64),
                     )
                     li += 1
@@ -320,15 +361,15 @@ def _ply_read_ascii(
             for p in el.props:
                 try:
                     if p.count_dtype is None:
-                        scal[p.name].append(float(tokens[k]))
+                        scal[p.name].append(to_float(tokens[k]))
                         k += 1
                     else:
-                        c = int(tokens[k])
+                        c = to_int(tokens[k])
                         if c < 0:
                             raise MeshError(
                                 f"{el.name} record {r} has a list of negative length {c}", src
                             )
-                        vals = [float(t) for t in tokens[k + 1 : k + 1 + c]]
+                        vals = [to_float(t) for t in tokens[k + 1 : k + 1 + c]]
                         if len(vals) < c:
                             raise IndexError
                         lists[p.name][0].extend(vals)
@@ -342,7 +383,7 @@ def _ply_read_ascii(
                     ) from None
                 except ValueError:
                     raise MeshError(
-                        f"cannot read {tokens[k].decode('latin-1')[:30]!r} as a number "
+                        f"cannot read {shown(tokens[k], 30)!r} as a number "
                         f"({el.name} record {r}, property {p.name!r})",
                         src,
                     ) from None

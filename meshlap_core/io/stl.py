@@ -8,7 +8,16 @@ import numpy as np
 
 from ..errors import MeshError
 from ..types import FloatArray
-from ._scan import TEXT_BYTES, Parsed, bulk_numbers, check_text, tokens_per_line
+from ._scan import (
+    TEXT_BYTES,
+    Parsed,
+    bulk_numbers,
+    check_text,
+    has_bare_cr,
+    shown,
+    to_float,
+    tokens_per_line,
+)
 
 _STL_DTYPE = np.dtype([("normal", "<f4", (3,)), ("v", "<f4", (3, 3)), ("attr", "<u2")])
 
@@ -60,6 +69,8 @@ def _stl_ascii_corners(data: bytes, src: str) -> FloatArray:
     arr = np.frombuffer(data, dtype=np.uint8)
     check_text(arr, src, "STL")
     lower = data.lower()
+    if has_bare_cr(lower):  # a bare CR ends a line too
+        lower = lower.replace(b"\r\n", b"\n").replace(b"\r", b"\n")
     facets = [m.start() for m in re.finditer(rb"(?m)^[ \t]*facet\b", lower)]
     verts = list(re.finditer(rb"(?m)^[ \t]*vertex\b([^\n]*)", lower))
     if not facets:
@@ -80,11 +91,19 @@ def _stl_ascii_corners(data: bytes, src: str) -> FloatArray:
     text = b"\n".join(m.group(1) for m in verts) + b"\n"
     ntok = tokens_per_line(np.frombuffer(text, dtype=np.uint8))
     vals = bulk_numbers(text, np.float64) if np.all(ntok == 3) else None
-    if vals is None or vals.size != 3 * len(verts):
-        bad_v = int(np.flatnonzero(ntok != 3)[0]) if np.any(ntok != 3) else 0
-        raise MeshError(
-            f"ASCII STL: cannot read the coordinates of vertex line {bad_v} of facet "
-            f"{bad_v // 3} ({verts[bad_v].group(1).strip()[:40].decode('latin-1')!r})",
-            src,
-        )
-    return vals.reshape(-1, 3)
+    if vals is not None and vals.size == 3 * len(verts):
+        return vals.reshape(-1, 3)
+    out = np.empty((len(verts), 3))  # per line: nan/inf, or the first line that is no number
+    for i, m in enumerate(verts):
+        parts = m.group(1).split()
+        try:
+            if len(parts) != 3:
+                raise ValueError
+            out[i] = [to_float(t) for t in parts]
+        except ValueError:
+            raise MeshError(
+                f"ASCII STL: cannot read the coordinates of vertex line {i} of facet "
+                f"{i // 3} ({shown(m.group(1), 40)!r})",
+                src,
+            ) from None
+    return out
