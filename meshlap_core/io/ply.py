@@ -350,63 +350,70 @@ def _ply_read_ascii(
         return fast
     tokens = body.tobytes().split()
     k = 0
-    nt = len(tokens)
     out: dict[str, dict[str, Any]] = {}
     for el in elements:
-        scal: dict[str, list[float]] = {p.name: [] for p in el.props if p.count_dtype is None}
-        lists: dict[str, tuple[list[float], list[int]]] = {
-            p.name: ([], []) for p in el.props if p.count_dtype is not None
-        }
-        for r in range(el.count if el.props else 0):  # an element without properties has no data
-            for p in el.props:
-                try:
-                    if p.count_dtype is None:
-                        scal[p.name].append(to_float(tokens[k]))
-                        k += 1
-                    else:
-                        c = to_int(tokens[k])
-                        if c < 0:
-                            raise MeshError(
-                                f"{el.name} record {r} has a list of negative length {c}", src
-                            )
-                        vals = [to_float(t) for t in tokens[k + 1 : k + 1 + c]]
-                        if len(vals) < c:
-                            raise IndexError
-                        lists[p.name][0].extend(vals)
-                        lists[p.name][1].append(c)
-                        k += 1 + c
-                except IndexError:
-                    raise MeshError(
-                        f"truncated PLY file: the header declares {_describe_counts(elements)}, "
-                        f"but the data ends after {r:,} of the {el.count:,} {el.name} records",
-                        src,
-                    ) from None
-                except ValueError:
-                    raise MeshError(
-                        f"cannot read {shown(tokens[k], 30)!r} as a number "
-                        f"({el.name} record {r}, property {p.name!r})",
-                        src,
-                    ) from None
-        vals_out: dict[str, Any] = {kk: np.asarray(v, dtype=np.float64) for kk, v in scal.items()}
-        for kk, (vs, cs) in lists.items():
-            arr = np.asarray(vs, dtype=np.float64)
-            if arr.size and np.all(np.mod(arr, 1) == 0):
-                if np.abs(arr).max() >= HUGE_INDEX:
-                    raise MeshError(
-                        f"the {el.name} property {kk!r} has the value {np.abs(arr).max():.6g}, "
-                        "far beyond any vertex count",
-                        src,
-                    )
-                arr = arr.astype(np.int64)
-            vals_out[kk] = (arr, np.asarray(cs, dtype=np.int64))
-        out[el.name] = vals_out
-    if k < nt:
+        out[el.name], k = _ply_ascii_element(tokens, k, el, elements, src)
+    if k < len(tokens):
         raise MeshError(
             f"PLY header counts do not match the data: after the {_describe_counts(elements)} "
-            f"it declares, {nt - k:,} more values follow",
+            f"it declares, {len(tokens) - k:,} more values follow",
             src,
         )
     return out
+
+
+def _ply_ascii_element(
+    tokens: list[bytes], k: int, el: _PlyElement, elements: list[_PlyElement], src: str
+) -> tuple[dict[str, Any], int]:
+    """The records of ``el`` from ``tokens[k:]``; returns its values and the next token."""
+    scal: dict[str, list[float]] = {p.name: [] for p in el.props if p.count_dtype is None}
+    lists: dict[str, tuple[list[float], list[int]]] = {
+        p.name: ([], []) for p in el.props if p.count_dtype is not None
+    }
+    for r in range(el.count if el.props else 0):  # an element without properties has no data
+        for p in el.props:
+            if k >= len(tokens):
+                raise MeshError(_truncated_at(elements, el, r), src)
+            where = f"({el.name} record {r}, property {p.name!r})"
+            if p.count_dtype is None:
+                scal[p.name].append(_ascii_number(tokens[k], to_float, "a number", where, src))
+                k += 1
+                continue
+            c = _ascii_number(tokens[k], to_int, "an integer list count", where, src)
+            if c < 0:
+                raise MeshError(f"{el.name} record {r} has a list of negative length {c}", src)
+            items = tokens[k + 1 : k + 1 + c]
+            if len(items) < c:
+                raise MeshError(
+                    f"{_truncated_at(elements, el, r)} ({el.name} record {r} declares a list "
+                    f"of {c:,} values, {len(items):,} follow)",
+                    src,
+                )
+            lists[p.name][0].extend(
+                _ascii_number(t, to_float, "a number", where, src) for t in items
+            )
+            lists[p.name][1].append(c)
+            k += 1 + c
+    vals_out: dict[str, Any] = {kk: np.asarray(v, dtype=np.float64) for kk, v in scal.items()}
+    for kk, (vs, cs) in lists.items():
+        arr = np.asarray(vs, dtype=np.float64)
+        if arr.size and np.all(np.mod(arr, 1) == 0):
+            if np.abs(arr).max() >= HUGE_INDEX:
+                raise MeshError(
+                    f"the {el.name} property {kk!r} has the value {np.abs(arr).max():.6g}, "
+                    "far beyond any vertex count",
+                    src,
+                )
+            arr = arr.astype(np.int64)
+        vals_out[kk] = (arr, np.asarray(cs, dtype=np.int64))
+    return vals_out, k
+
+
+def _ascii_number(tok: bytes, conv: Any, what: str, where: str, src: str) -> Any:
+    try:
+        return conv(tok)
+    except ValueError:
+        raise MeshError(f"cannot read {shown(tok, 30)!r} as {what} {where}", src) from None
 
 
 def _ply_ascii_fast(
