@@ -249,3 +249,17 @@ def test_off_and_ply_comment_with_unicode_separator(tmp_path):
     )
     mesh = load_mesh(write(tmp_path / "c.ply", ply))
     assert mesh.F.tolist() == [[0, 1, 2]]
+
+
+def test_off_and_ply_bare_cr_line_ends(tmp_path):
+    off = "OFF\r3 1 0\r0 0 0\r1 0 0\r0 1 0\r3 0 1 2\r"
+    assert load_mesh(write(tmp_path / "cr.off", off)).F.tolist() == [[0, 1, 2]]
+    ply = (
+        "ply\rformat ascii 1.0\relement vertex 3\rproperty float x\rproperty float y\r"
+        "property float z\relement face 1\rproperty list uchar int vertex_indices\rend_header\r"
+        "0 0 0\r1 0 0\r0 1 0\r3 0 1 2\r"
+    )
+    mesh = load_mesh(write(tmp_path / "cr.ply", ply))
+    assert mesh.F.tolist() == [[0, 1, 2]] and np.array_equal(
+        mesh.V, [[0, 0, 0], [1, 0, 0], [0, 1, 0]]
+    )

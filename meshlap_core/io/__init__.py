@@ -11,6 +11,12 @@ one record per line, any binary PLY/STL) is parsed in bulk with numpy, without a
 over lines; everything else (slashes, negative indices, comments inside data, polygons in OFF,
 extra properties) takes a slower per-line path that gives the same result.
 
+One tokenizer contract for every format (:mod:`._scan`): lines end at ``\\n``, ``\\r\\n`` or
+``\\r`` only; numbers are ASCII decimal/exponent literals (``nan``/``inf`` reach the validator,
+which refuses them); anything else in a numeric field is an error naming the line. Headers
+are checked against bodies, never guessed; reads are bounded in size and time
+(:func:`~meshlap_core.io.load.read_bounded`).
+
 Writing: :func:`save_mesh` (``.obj``, ``.off``, ``.ply``; PLY can carry a per-vertex
 ``quality`` scalar), :func:`save_scalars` (``.csv``, ``.npy``, ``.ply``) and the
 :func:`atomic_write` context manager they use: temp file in the target's directory, fsync,

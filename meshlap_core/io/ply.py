@@ -57,9 +57,9 @@ class _PlyElement:
 
 
 def _ply_header(data: bytes, src: str) -> tuple[str, list[_PlyElement], int]:
-    if not (data.startswith(b"ply\n") or data.startswith(b"ply\r\n")):
+    if not (data.startswith(b"ply\n") or data.startswith(b"ply\r")):
         raise MeshError("not a PLY file: it does not start with 'ply'", src)
-    m = re.search(rb"end_header[ \t]*\r?\n", data)
+    m = re.search(rb"end_header[ \t]*(?:\r\n|\r|\n)", data)  # the contract's line ends
     if m is None:
         raise MeshError("the PLY header has no 'end_header' line (truncated or not PLY)", src)
     fmt = None
