@@ -28,7 +28,8 @@ import igl
 import numpy as np
 
 from meshlap_core import laplacian
-from meshlap_core.io import _parse, load_mesh
+from meshlap_core.io import load_mesh
+from meshlap_core.io.load import _parse
 from meshlap_core.validate import validate_mesh
 
 SHARED = Path(__file__).resolve().parents[1].parent / "shared" / "meshes"

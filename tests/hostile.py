@@ -124,6 +124,132 @@ def stl_binary(V, F, n_header: int | None = None) -> bytes:
     return b"meshlap hostile corpus".ljust(80, b" ") + struct.pack("<I", n) + rec.tobytes()
 
 
+def ply_with(
+    fmt: str, vertex_props: list[str], face_props: list[str], body: bytes, *, nv: int, nf: int
+) -> bytes:
+    """A PLY file with the header written property by property (``"float x"``,
+    ``"list uchar int vertex_indices"``) and ``body`` as given (round 2: io)."""
+    head = [f"ply\nformat {fmt} 1.0\nelement vertex {nv}"]
+    head += [f"property {p}" for p in vertex_props]
+    head += [f"element face {nf}"] + [f"property {p}" for p in face_props] + ["end_header\n"]
+    return "\n".join(head).encode("ascii") + body
+
+
+TETRA_BIN = (  # the tetrahedron below as float32 vertices and uchar/int32 triangle records
+    np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], dtype="<f4").tobytes(),
+    b"".join(struct.pack("<Biii", 3, *f) for f in [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]]),
+)
+XYZ = ["float x", "float y", "float z"]
+INDICES = "list uchar int vertex_indices"
+
+
+# ------------------------------------------------------------------------------ round 2: io
+
+
+def _tetra_obj_lines() -> list[str]:
+    return obj_text(*tetra()).splitlines()
+
+
+def _dup_prop_ascii() -> bytes:
+    body = b"0 0 0 7\n1 0 0 7\n0 1 0 7\n0 0 1 7\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n"
+    return ply_with("ascii", [*XYZ, "float x"], [INDICES], body, nv=4, nf=4)
+
+
+def _dup_prop_binary() -> bytes:
+    V = np.frombuffer(TETRA_BIN[0], dtype="<f4").reshape(4, 3)
+    body = np.column_stack([V, V[:, :1]]).astype("<f4").tobytes() + TETRA_BIN[1]
+    return ply_with("binary_little_endian", [*XYZ, "float x"], [INDICES], body, nv=4, nf=4)
+
+
+def _internal_names_ply() -> bytes:
+    """Property names a parser might use for itself (list counts, positional fields)."""
+    V = np.frombuffer(TETRA_BIN[0], dtype="<f4").reshape(4, 3)
+    rec = np.zeros(4, dtype=[("p", "<f4", (3,)), ("a", "u1"), ("b", "u1")])
+    rec["p"] = V
+    faces = b"".join(chunk + b"\x05" for chunk in _face_records())
+    return ply_with(
+        "binary_little_endian",
+        [*XYZ, "uchar p0", "uchar n0"],
+        [INDICES, "uchar __n_vertex_indices"],
+        rec.tobytes() + faces,
+        nv=4,
+        nf=4,
+    )
+
+
+def _face_records() -> list[bytes]:
+    return [TETRA_BIN[1][i : i + 13] for i in range(0, len(TETRA_BIN[1]), 13)]
+
+
+def _float_count_nan() -> bytes:
+    faces = b"".join(struct.pack("<fiii", float("nan"), 0, 1, 2) for _ in range(4))
+    return ply_with(
+        "binary_little_endian",
+        XYZ,
+        ["list float int vertex_indices"],
+        TETRA_BIN[0] + faces,
+        nv=4,
+        nf=4,
+    )
+
+
+def _float_count_inf_ascii() -> bytes:
+    body = b"0 0 0\n1 0 0\n0 1 0\n0 0 1\ninf 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n"
+    return ply_with("ascii", XYZ, ["list float int vertex_indices"], body, nv=4, nf=4)
+
+
+def _ascii_tetra_ply(first_face: str) -> bytes:
+    body = f"0 0 0\n1 0 0\n0 1 0\n0 0 1\n{first_face}\n3 0 1 3\n3 0 3 2\n3 1 2 3\n"
+    return ply_with("ascii", XYZ, [INDICES], body.encode(), nv=4, nf=4)
+
+
+def _off_counts(nv: int, nf: int, extra_vertex: bool) -> str:
+    """Tetrahedron OFF whose header counts disagree with its body."""
+    V, F = tetra()
+    lines = ["OFF", f"{nv} {nf} 0"] + [f"{x!r} {y!r} {z!r}" for x, y, z in V.tolist()]
+    if extra_vertex:
+        lines.append("0.25 0.25 0.25")
+    lines += ["3 " + " ".join(str(int(i)) for i in f) for f in F]
+    return "\n".join(lines) + "\n"
+
+
+def _obj_token(old: str, new: str) -> Callable[[], str]:
+    return lambda: "\n".join(_tetra_obj_lines()).replace(old, new, 1) + "\n"
+
+
+def _unicode_comments_obj() -> str:
+    lines = _tetra_obj_lines()
+    out = []
+    for i, line in enumerate(lines):
+        sep = "\u2028\u2029\u0085"[i % 3]
+        out += [line, f"# note{sep}f 1 2 3{sep}v 9 9 9"]
+    return "\n".join(out) + "\n"
+
+
+def _continued_last_face() -> str:
+    lines = _tetra_obj_lines()
+    last = lines[-1].split()
+    return "\n".join([*lines[:-1], " ".join(last[:3]) + " \\", last[3] + " \\"])
+
+
+def _slash_faces() -> str:
+    V, F = primitives.cube()
+    lines = [f"v {x!r} {y!r} {z!r}" for x, y, z in V.tolist()] + ["vt 0 0", "vn 0 0 1"]
+    lines += [f"f {a + 1}/1/1 {b + 1}/1/1 {c + 1}//1" for a, b, c in F.tolist()]
+    return "\n".join(lines) + "\n"
+
+
+def _unicode_comments_off() -> str:
+    return off_text(*tetra()).replace("OFF\n", "OFF\n# caf\u00e9\u0085 3 0 1 2\n", 1)
+
+
+def _stream(folder: Path) -> Path:
+    """A file that reports size 0 but streams (procfs); 'no such file' where there is none."""
+    path = folder / "stream.obj"
+    path.symlink_to("/proc/self/pagemap")
+    return path
+
+
 def _write(folder: Path, name: str, data: str | bytes) -> Path:
     path = folder / name
     if isinstance(data, str):
@@ -709,6 +835,134 @@ CORPUS: list[Hostile] = [
         n_vertices=65,
         n_faces=120,
     ),
+    # round 2: io
+    Hostile(
+        "dup_prop_ascii.ply", _text("dup_prop_ascii.ply", _dup_prop_ascii), "error", ("twice",)
+    ),
+    Hostile(
+        "dup_prop_binary.ply", _text("dup_prop_binary.ply", _dup_prop_binary), "error", ("twice",)
+    ),
+    Hostile(
+        "internal_names.ply",
+        _text("internal_names.ply", _internal_names_ply),
+        "ok",
+        n_vertices=4,
+        n_faces=4,
+        closed=True,
+    ),
+    Hostile(
+        "float_count_nan.ply",
+        _text("float_count_nan.ply", _float_count_nan),
+        "error",
+        ("count type",),
+    ),
+    Hostile(
+        "float_count_inf.ply",
+        _text("float_count_inf.ply", _float_count_inf_ascii),
+        "error",
+        ("count type",),
+    ),
+    Hostile(
+        "inf_count.ply",
+        _text("inf_count.ply", lambda: _ascii_tetra_ply("inf 0 2 1")),
+        "error",
+        ("integer list count",),
+    ),
+    Hostile(
+        "negative_count.ply",
+        _text("negative_count.ply", lambda: _ascii_tetra_ply("-3 0 2 1")),
+        "error",
+        ("negative length",),
+    ),
+    Hostile(
+        "huge_list_count.ply",
+        _text("huge_list_count.ply", lambda: _ascii_tetra_ply("99999999999999999999 0 2 1")),
+        "error",
+        ("declares a list of 99,999,999,999,999,999,999 values",),
+    ),
+    Hostile(
+        "off_face_as_vertex.off",
+        _text("off_face_as_vertex.off", lambda: _off_counts(5, 3, False)),
+        "error",
+        ("declares 5 vertices and 3 faces, but the body has 4 vertex lines and 4 face",),
+    ),
+    Hostile(
+        "off_vertex_as_face.off",
+        _text("off_vertex_as_face.off", lambda: _off_counts(4, 5, True)),
+        "error",
+        ("declares 4 vertices and 5 faces, but the body has 5 vertex lines and 4 face",),
+    ),
+    Hostile(
+        "underscore_digits.obj",
+        _text("underscore_digits.obj", _obj_token("v 1.0", "v 1_0")),
+        "error",
+        ("line 2: cannot read 'v 1_0",),
+    ),
+    Hostile(
+        "fullwidth_digits.obj",
+        _text("fullwidth_digits.obj", _obj_token("v 1.0", "v \uff11.0")),
+        "error",
+        ("line 2: cannot read",),
+    ),
+    Hostile(
+        "arabic_digits.off",
+        _text("arabic_digits.off", lambda: off_text(*tetra()).replace("\n1.0", "\n\u0661.0", 1)),
+        "error",
+        ("cannot read vertex 1",),
+    ),
+    Hostile(
+        "glued_face.obj",
+        _text("glued_face.obj", _obj_token("f 1 3 2", "f 1 3f2")),
+        "error",
+        ("cannot read '3f2'",),
+    ),
+    Hostile(
+        "glued_vertex.obj",
+        _text("glued_vertex.obj", _obj_token("v 1.0 0.0 0.0", "v 1.0v2.0 0.0")),
+        "error",
+        ("line 2: a vertex needs 3 coordinates, found 2",),
+    ),
+    Hostile(
+        "unicode_separators.obj",
+        _text("unicode_separators.obj", _unicode_comments_obj),
+        "ok",
+        n_vertices=4,
+        n_faces=4,
+        closed=True,
+    ),
+    Hostile(
+        "unicode_separators.off",
+        _text("unicode_separators.off", _unicode_comments_off),
+        "ok",
+        n_vertices=4,
+        n_faces=4,
+        closed=True,
+    ),
+    Hostile(
+        "bare_cr.obj",
+        _text("bare_cr.obj", lambda: obj_text(*tetra()).replace("\n", "\r")),
+        "ok",
+        n_vertices=4,
+        n_faces=4,
+        closed=True,
+    ),
+    Hostile(
+        "continued_last_face.obj",
+        _text("continued_last_face.obj", _continued_last_face),
+        "ok",
+        n_vertices=4,
+        n_faces=4,
+        closed=True,
+    ),
+    Hostile(
+        "slash_faces.obj",
+        _text("slash_faces.obj", _slash_faces),
+        "ok",
+        n_vertices=8,
+        n_faces=12,
+        closed=True,
+    ),
+    Hostile("stream.obj", _stream, "error", ("streams more than", "no such file")),
 ]
 
 BY_NAME: dict[str, Hostile] = {h.name: h for h in CORPUS}

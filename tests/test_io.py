@@ -231,10 +231,14 @@ def test_obj_interleaved_blocks_and_no_final_newline(tmp_path):
 def test_unreadable_file_simulated(tmp_path, monkeypatch):
     path = write(tmp_path / "locked.obj", SQUARE_OBJ)
 
-    def deny(self):
-        raise PermissionError(13, "Permission denied", str(self))
+    real_open = os.open
 
-    monkeypatch.setattr(Path, "read_bytes", deny)
+    def deny(p, flags, *args):  # the reader opens the file with os.open (non-blocking)
+        if os.fspath(p) == str(path):
+            raise PermissionError(13, "Permission denied", str(p))
+        return real_open(p, flags, *args)
+
+    monkeypatch.setattr(os, "open", deny)
     with pytest.raises(MeshError) as info:
         load_mesh(path)
     assert str(info.value) == f"{path}: cannot read the file: permission denied"
@@ -606,7 +610,7 @@ def test_atomic_write_failure_in_writer_keeps_old_mesh(tmp_path, monkeypatch):
     def broken(*args, **kwargs):
         raise OSError(28, "No space left on device")
 
-    monkeypatch.setattr("meshlap_core.io._write_ply", broken)
+    monkeypatch.setattr("meshlap_core.io.write._write_ply", broken)
     with pytest.raises(OSError, match="No space left"):
         save_mesh(target, V * 2, F)
     assert target.read_bytes() == before

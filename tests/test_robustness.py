@@ -505,10 +505,16 @@ def test_unreadable_file(capsys, tmp_path, monkeypatch):
     mesh = tmp_path / "locked.obj"
     save_mesh(mesh, *primitives.cube())
 
-    def denied(self):
-        raise PermissionError(13, "Permission denied", str(self))
+    import os  # the loader opens the mesh with os.open (non-blocking, bounded reads)
 
-    monkeypatch.setattr(Path, "read_bytes", denied)
+    real_open = os.open
+
+    def denied(p, flags, *args):
+        if os.fspath(p) == str(mesh):
+            raise PermissionError(13, "Permission denied", str(p))
+        return real_open(p, flags, *args)
+
+    monkeypatch.setattr(os, "open", denied)
     code, out, err = run_cli(capsys, "curvature", mesh)
     assert "permission denied" in assert_one_error_line(code, out, err, str(mesh))
 

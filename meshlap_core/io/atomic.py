@@ -1,0 +1,157 @@
+"""Output paths checked before any work, and files written atomically (temp file, fsync,
+``os.replace``): used by every writer of meshes, scalars, reports and caches."""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import secrets
+import stat
+from collections.abc import Iterable, Iterator
+from pathlib import Path
+from typing import IO, Any
+
+from ..errors import MeshError
+
+PathLike = str | os.PathLike
+
+
+def _resolved(path: PathLike) -> Path:
+    return Path(os.path.abspath(os.fspath(path))).resolve(strict=False)
+
+
+def _check_output_path(path: PathLike, overwrite_inputs: Iterable[PathLike]) -> Path:
+    target = Path(os.fspath(path))
+    if not os.fspath(path):
+        raise MeshError("the output path is empty", "path")
+    parent = target.parent if str(target.parent) else Path(".")
+    if not parent.is_dir():
+        raise MeshError("the output directory does not exist", os.fspath(parent))
+    if target.is_dir():
+        raise MeshError("the output path is a directory", os.fspath(target))
+    res = _resolved(target)
+    for inp in overwrite_inputs:
+        same = _resolved(inp) == res
+        if not same and target.exists() and Path(os.fspath(inp)).exists():
+            with contextlib.suppress(OSError):
+                same = os.path.samefile(target, inp)
+        if same:
+            raise MeshError(
+                "refusing to overwrite an input file; choose a different output path",
+                os.fspath(target),
+            )
+    return target
+
+
+def check_output_path(
+    path: PathLike, overwrite_inputs: Iterable[PathLike] = (), suffixes: Iterable[str] | None = None
+) -> Path:
+    """Check an output path before any work is done (commands call it first, so that a
+    doomed run fails in a second and leaves nothing behind).
+
+    Parameters
+    ----------
+    path : str or PathLike
+    overwrite_inputs : iterable of path
+        Inputs the output must not replace.
+    suffixes : iterable of str, optional
+        Allowed extensions (lowercase, with the dot).
+
+    Returns
+    -------
+    path : Path
+
+    Raises
+    ------
+    MeshError
+        Empty path, a missing directory (named), a directory as target, an input as target,
+        or an extension not in ``suffixes``.
+    """
+    target = _check_output_path(path, overwrite_inputs)
+    if suffixes is not None:
+        allowed = tuple(suffixes)
+        if target.suffix.lower() not in allowed:
+            raise MeshError(
+                f"unsupported output type {target.suffix or '(none)'!r}; use {', '.join(allowed)}",
+                os.fspath(path),
+            )
+    return target
+
+
+@contextlib.contextmanager
+def atomic_write(
+    path: PathLike,
+    mode: str = "w",
+    *,
+    overwrite_inputs: Iterable[PathLike] = (),
+    encoding: str = "utf-8",
+) -> Iterator[IO[Any]]:
+    """Write a file atomically: the target appears complete or not at all.
+
+    A temporary file is created in the target's directory, written through the yielded file
+    object, flushed, fsync'ed and renamed over the target with ``os.replace``. If the ``with``
+    body raises, the temporary file is removed and an existing target is left untouched.
+
+    Parameters
+    ----------
+    path : str or PathLike
+        The file to (re)place.
+    mode : {"w", "wb"}
+        Text (UTF-8, ``\\n`` newlines) or binary.
+    overwrite_inputs : iterable of path
+        Paths that must not be written (e.g. the command's input mesh); compared after
+        resolving symlinks.
+
+    Yields
+    ------
+    f : file object
+
+    Raises
+    ------
+    MeshError
+        The directory does not exist (named), the target is a directory or one of
+        ``overwrite_inputs``, or the directory is not writable.
+
+    Examples
+    --------
+    >>> with atomic_write(tmp / "values.txt") as f:   # doctest: +SKIP
+    ...     f.write("1.0\\n")
+    """
+    if mode not in ("w", "wb"):
+        raise MeshError(f"mode must be 'w' or 'wb', got {mode!r}", "mode")
+    target = _check_output_path(path, overwrite_inputs)
+    parent = target.parent if str(target.parent) else Path(".")
+    tmp = parent / f".{target.name}.{secrets.token_hex(6)}.tmp"
+    try:
+        fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0), 0o666)
+    except PermissionError:
+        raise MeshError(
+            "cannot write in this directory: permission denied", os.fspath(parent)
+        ) from None
+    except OSError as exc:
+        raise MeshError(
+            f"cannot create a file here: {exc.strerror or exc}", os.fspath(parent)
+        ) from None
+    if target.exists():  # keep the permissions of the file being replaced
+        with contextlib.suppress(OSError):
+            os.chmod(tmp, stat.S_IMODE(target.stat().st_mode))
+    f: IO[Any] = (
+        os.fdopen(fd, "wb") if mode == "wb" else os.fdopen(fd, "w", encoding=encoding, newline="\n")
+    )
+    try:
+        yield f
+        f.flush()
+        os.fsync(f.fileno())
+        f.close()
+        os.replace(tmp, target)
+    except BaseException:
+        f.close()
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        raise
+    with contextlib.suppress(OSError):  # make the rename itself durable (best effort)
+        dfd = os.open(parent, os.O_RDONLY)
+        try:
+            os.fsync(dfd)
+        finally:
+            os.close(dfd)

@@ -1,0 +1,166 @@
+"""Writers: meshes (``.obj``, ``.off``, ``.ply``) and per-vertex scalars (``.csv``,
+``.npy``, ``.ply``), all through :func:`~meshlap_core.io.atomic.atomic_write`."""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Iterable
+from pathlib import Path
+from typing import IO, Any
+
+import numpy as np
+
+from ..errors import MeshError
+from ..types import FloatArray, IntArray, as_mesh
+from .atomic import PathLike, atomic_write
+
+WRITE_FORMATS: tuple[str, ...] = (".obj", ".off", ".ply")
+SCALAR_FORMATS: tuple[str, ...] = (".csv", ".npy", ".ply")
+
+
+def save_mesh(
+    path: PathLike,
+    V: Any,
+    F: Any,
+    *,
+    scalars: Any = None,
+    overwrite_inputs: Iterable[PathLike] = (),
+    binary: bool = True,
+) -> None:
+    """Write a triangle mesh as ``.obj``, ``.off`` or ``.ply`` (by extension), atomically.
+
+    Parameters
+    ----------
+    path : str or PathLike
+    V : (n,3) float
+    F : (m,3) int
+        0-based (written 1-based in OBJ).
+    scalars : (n,) float, optional
+        Per-vertex values, stored as the PLY vertex property ``quality`` (``double``); only
+        ``.ply`` can carry them.
+    overwrite_inputs : iterable of path
+        Paths that must not be overwritten (the CLI passes its input file).
+    binary : bool
+        PLY only: ``binary_little_endian`` (default) or ``ascii``.
+
+    Raises
+    ------
+    MeshError
+        Unknown extension, scalars of the wrong length or on a non-PLY file, a missing output
+        directory (named), or writing onto an input.
+
+    Notes
+    -----
+    Coordinates are written with 17 significant digits in the text formats (and as doubles in
+    binary PLY), so a write/read round trip gives back exactly the same ``V`` and ``F``.
+    """
+    ext = Path(os.fspath(path)).suffix.lower()
+    if ext not in WRITE_FORMATS:
+        raise MeshError(
+            f"cannot write {ext!r} files; use one of {', '.join(WRITE_FORMATS)}"
+            if ext
+            else f"the output has no extension; use one of {', '.join(WRITE_FORMATS)}",
+            os.fspath(path),
+        )
+    V, F = as_mesh(V, F)
+    q = None
+    if scalars is not None:
+        if ext != ".ply":
+            raise MeshError("only .ply files can carry per-vertex scalars", os.fspath(path))
+        q = np.asarray(scalars, dtype=np.float64).ravel()
+        if len(q) != len(V):
+            raise MeshError(f"has {len(q):,} values for {len(V):,} vertices", "scalars")
+    if ext == ".ply":
+        with atomic_write(path, "wb", overwrite_inputs=overwrite_inputs) as f:
+            _write_ply(f, V, F, q, binary)
+        return
+    with atomic_write(path, "wb", overwrite_inputs=overwrite_inputs) as f:
+        if ext == ".obj":
+            f.write(f"# written by meshlap: {len(V)} vertices, {len(F)} faces\n".encode())
+            np.savetxt(f, V, fmt="v %.17g %.17g %.17g")
+            np.savetxt(f, F + 1, fmt="f %d %d %d")
+        else:
+            f.write(f"OFF\n{len(V)} {len(F)} 0\n".encode())
+            np.savetxt(f, V, fmt="%.17g %.17g %.17g")
+            np.savetxt(f, F, fmt="3 %d %d %d")
+
+
+def _write_ply(
+    f: IO[bytes], V: FloatArray, F: IntArray, q: FloatArray | None, binary: bool
+) -> None:
+    props = ["x", "y", "z"] + (["quality"] if q is not None else [])
+    head = [
+        "ply",
+        f"format {'binary_little_endian' if binary else 'ascii'} 1.0",
+        "comment written by meshlap",
+        f"element vertex {len(V)}",
+        *(f"property double {p}" for p in props),
+        f"element face {len(F)}",
+        "property list uchar int vertex_indices",
+        "end_header",
+    ]
+    f.write(("\n".join(head) + "\n").encode("ascii"))
+    cols = V if q is None else np.column_stack([V, q])
+    if binary:
+        f.write(np.ascontiguousarray(cols, dtype="<f8").tobytes())
+        if len(F) and F.max() > np.iinfo(np.int32).max:
+            raise MeshError("too many vertices for a PLY int32 index", "F")
+        rec = np.empty(len(F), dtype=[("n", "u1"), ("i", "<i4", (3,))])
+        rec["n"] = 3
+        rec["i"] = F
+        f.write(rec.tobytes())
+    else:
+        np.savetxt(f, cols, fmt=" ".join(["%.17g"] * cols.shape[1]))
+        np.savetxt(f, F, fmt="3 %d %d %d")
+
+
+def save_scalars(
+    path: PathLike,
+    values: Any,
+    *,
+    V: Any = None,
+    F: Any = None,
+    overwrite_inputs: Iterable[PathLike] = (),
+) -> None:
+    """Write per-vertex (or per-face) scalars as ``.csv``, ``.npy`` or ``.ply``, atomically.
+
+    Parameters
+    ----------
+    path : str or PathLike
+        ``.csv``: a header line ``value`` then one value per line (17 significant digits);
+        ``.npy``: a 1-D float64 array; ``.ply``: the mesh with a ``quality`` vertex property
+        (needs ``V`` and ``F``).
+    values : (n,) float
+    V : (n,3) float, optional
+    F : (m,3) int, optional
+        Required for ``.ply``.
+    overwrite_inputs : iterable of path
+        Paths that must not be overwritten.
+
+    Raises
+    ------
+    MeshError
+        Unknown extension, values not 1-D, ``.ply`` without ``V``/``F``, or the output
+        problems of :func:`atomic_write`.
+    """
+    ext = Path(os.fspath(path)).suffix.lower()
+    if ext not in SCALAR_FORMATS:
+        raise MeshError(
+            f"cannot write scalars to {ext or 'a file without extension'!r}; use one of "
+            f"{', '.join(SCALAR_FORMATS)}",
+            os.fspath(path),
+        )
+    vals = np.asarray(values, dtype=np.float64)
+    if vals.ndim != 1:
+        raise MeshError(f"should be a 1-D array; shape is {vals.shape}", "values")
+    if ext == ".ply":
+        if V is None or F is None:
+            raise MeshError("writing scalars to .ply needs the mesh (V and F)", os.fspath(path))
+        save_mesh(path, V, F, scalars=vals, overwrite_inputs=overwrite_inputs)
+        return
+    with atomic_write(path, "wb", overwrite_inputs=overwrite_inputs) as f:
+        if ext == ".npy":
+            np.save(f, vals, allow_pickle=False)
+        else:
+            f.write(b"value\n")
+            np.savetxt(f, vals, fmt="%.17g")
