@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from .errors import MeshError
-from .topology import edge_face_counts
+from .topology import EdgeTable
 from .types import FloatArray, IntArray, as_faces, as_mesh, as_vertices
 
 
@@ -79,8 +79,7 @@ def max_error(V: FloatArray, V_ref: FloatArray) -> float:
 
 def n_boundary_edges(F: IntArray) -> int:
     """Number of undirected edges used by exactly one face."""
-    _, count = edge_face_counts(as_faces(F))
-    return int(np.count_nonzero(count == 1))
+    return int(np.count_nonzero(EdgeTable.from_faces(F).counts == 1))
 
 
 def is_closed(F: IntArray) -> bool:
@@ -265,27 +264,16 @@ def edge_faces(F: IntArray) -> EdgeFaces:
     -------
     EdgeFaces
     """
-    F = as_faces(F)
-    m = len(F)
-    if m == 0:
-        z = np.zeros((0, 2), dtype=np.int64)
-        return EdgeFaces(z, z.copy(), np.zeros(0, dtype=bool))
-    src = np.concatenate([F[:, 0], F[:, 1], F[:, 2]])
-    dst = np.concatenate([F[:, 1], F[:, 2], F[:, 0]])
-    face = np.tile(np.arange(m, dtype=np.int64), 3)
-    lo, hi = np.minimum(src, dst), np.maximum(src, dst)
-    order = np.lexsort((hi, lo))
-    lo_s, hi_s = lo[order], hi[order]
-    new_group = np.ones(len(order), dtype=bool)
-    new_group[1:] = (lo_s[1:] != lo_s[:-1]) | (hi_s[1:] != hi_s[:-1])
-    starts = np.flatnonzero(new_group)
-    counts = np.diff(np.append(starts, len(order)))
-    first = starts[counts == 2]
-    h1, h2 = order[first], order[first + 1]
+    t = EdgeTable.from_faces(F)
+    m = len(t.F)
+    _, h1, h2 = t.face_pairs()
+    # the first face is the one whose half-edge comes first in corner-column order (k m + f)
+    swap = (h1 % 3) * m + h1 // 3 > (h2 % 3) * m + h2 // 3
+    h1, h2 = np.where(swap, h2, h1), np.where(swap, h1, h2)
+    src, dst = t.halfedge_vertices()
     edges = np.stack([src[h1], dst[h1]], axis=1)
-    faces = np.stack([face[h1], face[h2]], axis=1)
-    consistent = src[h2] == dst[h1]
-    return EdgeFaces(edges, faces, consistent)
+    faces = np.stack([h1 // 3, h2 // 3], axis=1)
+    return EdgeFaces(edges, faces, src[h2] == dst[h1])
 
 
 def dihedral_angles(V: FloatArray, F: IntArray, adjacency: EdgeFaces | None = None) -> FloatArray:
