@@ -1,18 +1,60 @@
-"""Ordered one-rings of every vertex at once."""
+"""Ordered one-rings of every vertex at once, split into fans at non-manifold vertices.
+
+A *fan* of a vertex ``v`` is a maximal sequence of faces around ``v`` in which consecutive faces
+share an edge at ``v`` that exactly two faces use, traversed in opposite directions (a manifold,
+consistently oriented edge). A manifold vertex has one fan: closed (interior vertex) or open
+(boundary vertex). Two spheres touching at a point, tetrahedra sharing a vertex or a torus with
+two vertices glued have vertices with several fans; every corner of a vertex lies in exactly one
+of its fans.
+"""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
+from scipy.sparse import csr_matrix
+from scipy.sparse.csgraph import connected_components
 
 from ..errors import MeshError
 from ..types import BoolArray, IntArray, as_faces
+from .edges import EdgeTable
+
+
+class Fan(NamedTuple):
+    """One fan of faces around a vertex ``v``.
+
+    Attributes
+    ----------
+    neighbors : (k,) int
+        Ring vertices in order; ``(v, neighbors[j], neighbors[j+1])`` is the face ``faces[j]``
+        (counter-clockwise rings; wrapping around when ``closed``).
+    faces : (k,) or (k-1,) int
+        The faces between consecutive neighbours (``k`` for a closed fan, ``k - 1`` for an open
+        one).
+    closed : bool
+        ``True`` for a closed cycle (no boundary at ``v`` on this fan).
+    """
+
+    neighbors: IntArray
+    faces: IntArray
+    closed: bool
+
+
+def _reverse_segments(ptr: IntArray, values: IntArray) -> IntArray:
+    """``values`` with every CSR segment ``values[ptr[s]:ptr[s+1]]`` reversed."""
+    counts = np.diff(ptr)
+    seg = np.repeat(np.arange(len(counts)), counts)
+    pos = np.arange(len(values)) - ptr[seg]
+    out = np.empty_like(values)
+    out[ptr[seg] + counts[seg] - 1 - pos] = values
+    return out
 
 
 @dataclass(frozen=True)
 class OneRing:
-    """Ordered one-rings of all vertices, stored like a CSR matrix.
+    """Ordered one-rings of all vertices, stored like a CSR matrix, with every vertex's fans.
 
     ``ring[i]`` (``indices[offsets[i]:offsets[i+1]]``) lists the neighbours of vertex ``i`` in
     order. With ``ccw=True`` consecutive neighbours ``(a, b)`` satisfy: ``(i, a, b)`` is a face,
@@ -20,14 +62,24 @@ class OneRing:
     interior vertex's list is a closed cycle (the first neighbour follows the last); a boundary
     vertex's list is an open fan from one boundary neighbour to the other. Vertices whose
     neighbourhood is not a single disk or half-disk (non-manifold, inconsistently oriented) have
-    ``regular[i] = False`` and their neighbours sorted by index instead.
+    ``regular[i] = False`` and their neighbours sorted by index instead; their fans, each in
+    order, are :meth:`fans` ``(i)``.
 
     Attributes
     ----------
     offsets : (n+1,) int
     indices : (k,) int
     boundary : (n,) bool
+        The vertex has an open fan.
     regular : (n,) bool
+        One fan (or none), bounded only by boundary edges: a disk or half-disk.
+    fan_offsets : (n+1,) int
+        Fans of vertex ``i`` are ``fan_offsets[i]:fan_offsets[i+1]``.
+    fan_ptr, fan_indices : (f+1,) int, (q,) int
+        Ring vertices of fan ``s``: ``fan_indices[fan_ptr[s]:fan_ptr[s+1]]``.
+    fan_face_ptr, fan_faces : (f+1,) int, (r,) int
+        Faces of fan ``s``: ``fan_faces[fan_face_ptr[s]:fan_face_ptr[s+1]]``.
+    fan_closed : (f,) bool
     ccw : bool
     """
 
@@ -35,16 +87,25 @@ class OneRing:
     indices: IntArray
     boundary: BoolArray
     regular: BoolArray
+    fan_offsets: IntArray
+    fan_ptr: IntArray
+    fan_indices: IntArray
+    fan_face_ptr: IntArray
+    fan_faces: IntArray
+    fan_closed: BoolArray
     ccw: bool = True
 
     def __len__(self) -> int:
         return len(self.offsets) - 1
 
-    def __getitem__(self, i: int) -> IntArray:
+    def _vertex(self, i: int) -> int:
         n = len(self)
         if not -n <= i < n:
             raise MeshError(f"vertex {i} is out of range (the mesh has {n} vertices)", "vertex")
-        i %= n
+        return i % n
+
+    def __getitem__(self, i: int) -> IntArray:
+        i = self._vertex(i)
         return self.indices[self.offsets[i] : self.offsets[i + 1]]
 
     @property
@@ -52,27 +113,115 @@ class OneRing:
         """Number of distinct neighbours of each vertex, ``(n,) int``."""
         return np.diff(self.offsets)
 
+    @property
+    def manifold(self) -> BoolArray:
+        """``(n,) bool``: the vertex's faces form one disk or half-disk (same as ``regular``)."""
+        return self.regular
+
+    @property
+    def n_fans(self) -> IntArray:
+        """Number of fans of each vertex, ``(n,) int`` (0 for a vertex in no face)."""
+        return np.diff(self.fan_offsets)
+
+    def fans(self, i: int) -> list[Fan]:
+        """The fans of vertex ``i``, each in ring order (see :class:`Fan`)."""
+        i = self._vertex(i)
+        out = []
+        for s in range(int(self.fan_offsets[i]), int(self.fan_offsets[i + 1])):
+            out.append(
+                Fan(
+                    self.fan_indices[self.fan_ptr[s] : self.fan_ptr[s + 1]],
+                    self.fan_faces[self.fan_face_ptr[s] : self.fan_face_ptr[s + 1]],
+                    bool(self.fan_closed[s]),
+                )
+            )
+        return out
+
     def reversed(self) -> OneRing:
-        """The same rings in the opposite (clockwise) order."""
-        n = len(self)
-        counts = np.diff(self.offsets)
-        vert = np.repeat(np.arange(n), counts)
-        pos = np.arange(len(self.indices)) - self.offsets[vert]
-        new_pos = self.offsets[vert] + counts[vert] - 1 - pos
-        idx = np.empty_like(self.indices)
-        idx[new_pos] = self.indices
-        return OneRing(self.offsets, idx, self.boundary, self.regular, not self.ccw)
+        """The same rings and fans in the opposite (clockwise) order."""
+        faces = _reverse_segments(self.fan_face_ptr, self.fan_faces)
+        # a closed fan's face j lies between neighbours j and j+1: after reversing the ring the
+        # reversed face list is one step behind
+        counts = np.diff(self.fan_face_ptr)
+        seg = np.repeat(np.arange(len(counts)), counts)
+        closed = self.fan_closed[seg]
+        pos = np.arange(len(faces)) - self.fan_face_ptr[seg]
+        target = np.where(
+            closed, self.fan_face_ptr[seg] + (pos - 1) % np.maximum(counts[seg], 1), 0
+        )
+        rolled = faces.copy()
+        rolled[target[closed]] = faces[closed]
+        return OneRing(
+            self.offsets,
+            _reverse_segments(self.offsets, self.indices),
+            self.boundary,
+            self.regular,
+            self.fan_offsets,
+            self.fan_ptr,
+            _reverse_segments(self.fan_ptr, self.fan_indices),
+            self.fan_face_ptr,
+            rolled,
+            self.fan_closed,
+            not self.ccw,
+        )
+
+
+def _corner_successors(t: EdgeTable) -> tuple[IntArray, IntArray]:
+    """Successor and predecessor of every corner around its vertex (``-1``: none).
+
+    Corner ``c = 3f + k`` of face ``(v, a, b)`` (rotated so ``v`` is corner ``k``) is followed
+    by the corner at ``v`` of the face across the edge ``v–b``, when that edge has exactly two
+    faces that traverse it in opposite directions (``b → v`` here, ``v → b`` there). The map is
+    injective, so the corners of a vertex form disjoint paths and cycles.
+    """
+    nc = 3 * len(t.F)
+    src = t.F.ravel()
+    corner = np.arange(nc, dtype=np.int64)
+    h_in = corner - corner % 3 + (corner + 2) % 3  # half-edge b → v of the corner's face
+    e = t.halfedge_edge[h_in]
+    two = t.counts[e] == 2
+    first = t.edge_halfedges[t.edge_ptr[e[two]]]
+    second = t.edge_halfedges[t.edge_ptr[e[two]] + 1]
+    other = np.full(nc, -1, dtype=np.int64)
+    other[two] = first + second - h_in[two]
+    ok = two.copy()
+    ok[two] = src[other[two]] == src[two]  # the other half-edge leaves v: consistent
+    succ = np.where(ok, other, -1)
+    pred = np.full(nc, -1, dtype=np.int64)
+    pred[succ[ok]] = corner[ok]
+    return succ, pred
+
+
+def _rank_paths(pred: IntArray) -> IntArray:
+    """Distance of every node to the head of its path (pointer jumping, ``O(log L)`` rounds).
+
+    ``pred`` must describe disjoint simple paths (no cycle); the round count is capped at
+    ``bit_length(len(pred)) + 1``, which suffices for any path, so the loop always ends.
+    """
+    rank = (pred >= 0).astype(np.int64)
+    p = pred.copy()
+    for _ in range(len(pred).bit_length() + 1):
+        live = np.flatnonzero(p >= 0)
+        if len(live) == 0:
+            return rank
+        pl = p[live]
+        rank_new = rank.copy()
+        rank_new[live] += rank[pl]
+        p[live] = p[pl]
+        rank = rank_new
+    raise RuntimeError("one_ring: a corner chain did not end (cycle left uncut)")
 
 
 def one_ring(F: IntArray, n: int) -> OneRing:
-    """Ordered one-ring of every vertex at once, in ``O(m log m)`` vectorized work.
+    """Ordered one-ring and fans of every vertex at once, in ``O(m log m)`` vectorized work.
 
     Each face corner ``(v, a, b)`` says "after ``a`` comes ``b`` around ``v``". Corners around
-    ``v`` are linked by successor pointers (the corner ``(v, b, c)`` follows ``(v, a, b)``),
-    and the position of every corner in its chain is found by pointer jumping (list ranking,
-    ``O(log valence)`` vectorized rounds), with no per-vertex Python loop. Interior cycles are cut
-    at their first corner; boundary fans start at the corner with no predecessor and end with
-    the last corner's ``b``.
+    ``v`` are linked across the manifold, consistently oriented edges of the
+    :class:`EdgeTable` (:func:`_corner_successors`); the components of that link graph are the
+    fans. A fan whose corners form a cycle is closed and cut at its first corner (in the order
+    of ``F``'s columns, then rows); an open fan starts at the corner with no predecessor. The
+    position of every corner in its fan comes from pointer jumping (list ranking) with a
+    bounded number of rounds, so the function terminates on any triangle list.
 
     Parameters
     ----------
@@ -83,104 +232,128 @@ def one_ring(F: IntArray, n: int) -> OneRing:
     Returns
     -------
     OneRing
-        Counter-clockwise rings (see :class:`OneRing`); ``.reversed()`` gives clockwise ones.
+        Counter-clockwise rings and fans (see :class:`OneRing`); ``.reversed()`` gives
+        clockwise ones.
     """
     F = as_faces(F, n)
-    v = F.T.ravel()  # corners of column 0, then 1, then 2
-    a = np.roll(F, -1, axis=1).T.ravel()
-    b = np.roll(F, -2, axis=1).T.ravel()
-    nc = len(v)
-    regular = np.ones(n, dtype=bool)
-    if nc == 0:
-        return OneRing(np.zeros(n + 1, np.int64), np.zeros(0, np.int64), np.zeros(n, bool), regular)
+    m = len(F)
+    t = EdgeTable.from_faces(F, n)
+    nc = 3 * m
+    v = F.ravel()
+    a = np.roll(F, -1, axis=1).ravel()
+    b = np.roll(F, -2, axis=1).ravel()
+    succ, pred = _corner_successors(t)
+    order_key = (np.arange(nc) % 3) * m + np.arange(nc) // 3  # column-major corner order
 
-    key_a = v * n + a
-    order = np.argsort(key_a, kind="stable")
-    sk = key_a[order]
-    dup = np.zeros(nc, dtype=bool)
-    dup[order[1:]] = sk[1:] == sk[:-1]
-    dup[order[:-1]] |= sk[1:] == sk[:-1]
-    regular[v[dup]] = False  # an (v, a) used twice: non-manifold edge or flipped face
-
-    key_b = v * n + b
-    pos = np.searchsorted(sk, key_b)
-    pos_c = np.minimum(pos, nc - 1)
-    succ = np.where(sk[pos_c] == key_b, order[pos_c], -1)
-    pred = np.full(nc, -1, dtype=np.int64)
-    has = succ >= 0
-    pred[succ[has]] = np.flatnonzero(has)
-
-    # boundary fans start where a corner has no predecessor; a vertex with 2+ starts is not a
-    # half-disk. Interior cycles are cut at the vertex's first corner.
-    heads = pred < 0
-    n_heads = np.bincount(v[heads], minlength=n)
-    boundary = n_heads > 0
-    regular &= n_heads <= 1
-    first = np.full(n, nc, dtype=np.int64)
-    np.minimum.at(first, v, np.arange(nc))
-    cut = first[v] == np.arange(nc)
-    cut &= ~boundary[v]
-    prev_of_cut = pred[cut]
-    pred[cut] = -1
-    succ[prev_of_cut[prev_of_cut >= 0]] = -1
-
-    # list ranking by pointer jumping: rank = distance to the head of the chain
-    rank = (pred >= 0).astype(np.int64)
-    p = pred.copy()
-    while True:
-        live = p >= 0
-        if not live.any():
-            break
-        pl = p[live]
-        rank_new = rank.copy()
-        rank_new[live] += rank[pl]
-        p_new = p.copy()
-        p_new[live] = p[pl]
-        rank, p = rank_new, p_new
-
-    counts_faces = np.bincount(v, minlength=n)
-    # a regular vertex's chain covers all its corners: every rank distinct from 0..count-1
-    srt = np.lexsort((rank, v))
-    vs, rs = v[srt], rank[srt]
-    starts = np.concatenate([[0], np.cumsum(counts_faces)])
-    expected = np.arange(nc) - starts[vs]
-    bad_rank = np.zeros(n, dtype=bool)
-    bad_rank[vs[rs != expected]] = True
-    regular &= ~bad_rank
-    # cycle check for interior vertices: the last corner's b must be the first corner's a
-    last_b = np.full(n, -1, np.int64)
-    first_a = np.full(n, -1, np.int64)
-    nonempty = counts_faces > 0
-    last_b[nonempty] = b[srt][starts[1:][nonempty] - 1]
-    first_a[nonempty] = a[srt][starts[:-1][nonempty]]
-    regular &= boundary | (last_b == first_a) | ~nonempty
-
-    counts = counts_faces + boundary.astype(np.int64)
-    ring_offsets = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
-    idx = np.empty(ring_offsets[-1], dtype=np.int64)
-    # corner k of vertex w goes to ring_offsets[w] + k; a boundary fan ends with the last b
-    idx[ring_offsets[vs] + expected] = a[srt]
-    bv = np.flatnonzero(boundary & nonempty)
-    idx[ring_offsets[bv + 1] - 1] = last_b[bv]
-
-    if not regular.all():
-        # irregular neighbourhoods: plain sorted neighbour sets instead of an order
-        irr = np.flatnonzero(~regular)
-        Es = np.concatenate([np.stack([v, a], 1), np.stack([v, b], 1)])
-        Es = np.unique(Es[np.isin(Es[:, 0], irr)], axis=0)
-        regular_counts = np.where(regular, counts, 0)
-        counts = regular_counts + np.bincount(Es[:, 0], minlength=n)
-        new_off = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
-        new_idx = np.empty(new_off[-1], dtype=np.int64)
-        keep = np.flatnonzero(regular)
-        src = np.repeat(keep, regular_counts[keep])
-        k_in = np.arange(len(src)) - np.repeat(
-            np.concatenate([[0], np.cumsum(regular_counts[keep])])[:-1], regular_counts[keep]
+    # fans = components of the successor graph; a component without a head is a cycle
+    if nc:
+        G = csr_matrix(
+            (
+                np.ones(int(np.count_nonzero(succ >= 0)), np.int8),
+                (np.flatnonzero(succ >= 0), succ[succ >= 0]),
+            ),
+            shape=(nc, nc),
         )
-        new_idx[new_off[src] + k_in] = idx[ring_offsets[src] + k_in]
-        e_start = np.concatenate([[0], np.cumsum(np.bincount(Es[:, 0], minlength=n))])
-        k_e = np.arange(len(Es)) - e_start[Es[:, 0]]
-        new_idx[new_off[Es[:, 0]] + k_e] = Es[:, 1]
-        ring_offsets, idx = new_off, new_idx
+        n_fans, label = connected_components(G, directed=True, connection="weak")
+    else:
+        n_fans, label = 0, np.zeros(0, dtype=np.int64)
+    open_fan = np.zeros(n_fans, dtype=bool)
+    open_fan[label[pred < 0]] = True
+    fan_key = np.full(n_fans, nc, dtype=np.int64)
+    np.minimum.at(fan_key, label, order_key)
+    cut = ~open_fan[label] & (order_key == fan_key[label])  # first corner of each cycle
+    pred = pred.copy()
+    pred[cut] = -1
+    rank = _rank_paths(pred)
 
-    return OneRing(ring_offsets, idx, boundary, regular, True)
+    # corners sorted by vertex, fan (by its first corner), position in the fan
+    srt = np.lexsort((rank, fan_key[label], v))
+    fan_order = np.unique(label[srt], return_index=True)  # fans in first-appearance order
+    fan_seq = fan_order[0][np.argsort(fan_order[1])]
+    fan_vertex = v[srt][np.sort(fan_order[1])] if n_fans else np.zeros(0, np.int64)
+    corners_per_fan = np.bincount(label, minlength=n_fans)[fan_seq]
+    closed = ~open_fan[fan_seq]
+    face_ptr = np.concatenate([[0], np.cumsum(corners_per_fan)]).astype(np.int64)
+    ring_len = corners_per_fan + (~closed)
+    ptr = np.concatenate([[0], np.cumsum(ring_len)]).astype(np.int64)
+    fan_index = np.arange(len(srt)) - np.repeat(face_ptr[:-1], corners_per_fan)
+    fan_of_sorted = np.repeat(np.arange(n_fans), corners_per_fan)
+    fan_idx = np.empty(int(ptr[-1]), dtype=np.int64)
+    fan_idx[ptr[fan_of_sorted] + fan_index] = a[srt]
+    last = face_ptr[1:][~closed] - 1  # an open fan ends with its last corner's b
+    fan_idx[ptr[1:][~closed] - 1] = b[srt][last]
+    fan_offsets = np.concatenate([[0], np.cumsum(np.bincount(fan_vertex, minlength=n))])
+
+    regular, boundary = _regular_boundary(t, v, a, b, srt, face_ptr, closed, fan_vertex, n)
+    offsets, indices = _rings(regular, fan_vertex, ptr, fan_idx, v, a, b, n)
+    return OneRing(
+        offsets,
+        indices,
+        boundary,
+        regular,
+        fan_offsets.astype(np.int64),
+        ptr,
+        fan_idx,
+        face_ptr,
+        (srt // 3).astype(np.int64),
+        closed,
+        True,
+    )
+
+
+def _regular_boundary(
+    t: EdgeTable,
+    v: IntArray,
+    a: IntArray,
+    b: IntArray,
+    srt: IntArray,
+    face_ptr: IntArray,
+    closed: BoolArray,
+    fan_vertex: IntArray,
+    n: int,
+) -> tuple[BoolArray, BoolArray]:
+    """A vertex is regular when it has at most one fan and an open fan ends on boundary edges
+    (one face) at both sides; it is a boundary vertex when it has an open fan."""
+    n_fans = np.bincount(fan_vertex, minlength=n)
+    boundary = np.zeros(n, dtype=bool)
+    boundary[fan_vertex[~closed]] = True
+    regular = n_fans <= 1
+    open_ids = np.flatnonzero(~closed)
+    if len(open_ids):
+        head = srt[face_ptr[open_ids]]  # its outgoing half-edge v → a has no partner
+        tail = srt[face_ptr[open_ids + 1] - 1]  # its incoming half-edge b → v has none
+        tail_in = tail - tail % 3 + (tail + 2) % 3
+        ends_ok = (t.counts[t.halfedge_edge[head]] == 1) & (t.counts[t.halfedge_edge[tail_in]] == 1)
+        regular[fan_vertex[open_ids[~ends_ok]]] = False
+    return regular, boundary
+
+
+def _rings(
+    regular: BoolArray,
+    fan_vertex: IntArray,
+    ptr: IntArray,
+    fan_idx: IntArray,
+    v: IntArray,
+    a: IntArray,
+    b: IntArray,
+    n: int,
+) -> tuple[IntArray, IntArray]:
+    """Per-vertex rings: the single fan of a regular vertex, the sorted neighbours otherwise."""
+    keep = regular[fan_vertex]
+    lens = np.diff(ptr)[keep]
+    rv = np.repeat(fan_vertex[keep], lens)
+    starts = ptr[:-1][keep]
+    rpos = np.arange(int(lens.sum())) - np.repeat(np.cumsum(lens) - lens, lens)
+    rval = fan_idx[np.repeat(starts, lens) + rpos]
+    irr = ~regular[v]
+    if irr.any():
+        keys = np.unique(np.concatenate([v[irr] * n + a[irr], v[irr] * n + b[irr]]))
+        iv, ij = keys // n, keys % n
+        rv, rpos, rval = (
+            np.concatenate([rv, iv]),
+            np.concatenate([rpos, ij]),
+            np.concatenate([rval, ij]),
+        )
+    order = np.lexsort((rpos, rv))
+    offsets = np.concatenate([[0], np.cumsum(np.bincount(rv, minlength=n))]).astype(np.int64)
+    return offsets, rval[order].astype(np.int64)
