@@ -169,10 +169,34 @@ def volume_undefined_reason(F: IntArray) -> str | None:
     return None
 
 
+def percent_volume_change(volume: float, volume_ref: float) -> float | None:
+    """Change of the enclosed volume in percent, ``100 (|v| − |v_ref|) / |v_ref|``.
+
+    The enclosed volume of a closed mesh is the absolute value of its signed (divergence
+    theorem) volume, so an inward-oriented mesh that shrinks gives a negative change, as an
+    outward one does.
+
+    Parameters
+    ----------
+    volume, volume_ref : float
+        Signed volumes (:func:`signed_volume`) of the mesh and of the reference.
+
+    Returns
+    -------
+    float or None
+        ``None`` when the reference volume is 0.
+    """
+    if volume_ref == 0.0:
+        return None
+    return 100.0 * (abs(volume) - abs(volume_ref)) / abs(volume_ref)
+
+
 def volume_change_pct(
     V: FloatArray, V_ref: FloatArray, F: IntArray
 ) -> tuple[float | None, str | None]:
-    """Percentage change of the enclosed volume, ``100 (vol(V) − vol(V_ref)) / |vol(V_ref)|``.
+    """Percentage change of the enclosed volume, ``100 (|vol(V)| − |vol(V_ref)|) / |vol(V_ref)|``
+    (see :func:`percent_volume_change`; the sign says whether the enclosed volume grew, whatever
+    the orientation of the faces).
 
     Parameters
     ----------
@@ -192,10 +216,10 @@ def volume_change_pct(
     reason = volume_undefined_reason(F)
     if reason is not None:
         return None, reason
-    v0 = _signed_volume_unchecked(V_ref, F)
-    if v0 == 0.0:
+    pct = percent_volume_change(_signed_volume_unchecked(V, F), _signed_volume_unchecked(V_ref, F))
+    if pct is None:
         return None, "undefined: the reference volume is 0"
-    return 100.0 * (_signed_volume_unchecked(V, F) - v0) / abs(v0), None
+    return pct, None
 
 
 # --------------------------------------------------------------------------- normals, dihedrals
@@ -451,7 +475,7 @@ class Reference:
         else:
             vol = _signed_volume_unchecked(V, self.F)
             out["volume"] = vol
-            out["volume_change_pct"] = 100.0 * (vol - self.volume) / abs(self.volume)
+            out["volume_change_pct"] = percent_volume_change(vol, self.volume)
         d = _wrapped_abs_diff(_dihedral_unchecked(V, self.F, self.adjacency), self.dihedral)
         d = d[np.isfinite(d)]
         out["dihedral_mae_deg"] = float(np.degrees(d.mean())) if d.size else float("nan")

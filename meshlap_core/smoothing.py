@@ -56,7 +56,7 @@ import scipy.sparse.linalg as sla
 from .errors import MeshError, MeshWarning
 from .laplacian import adjacency_matrix, cotan_stiffness, vertex_areas
 from .linalg.blas import blas_threads
-from .metrics import Reference, _signed_volume_unchecked, n_boundary_edges
+from .metrics import Reference, _signed_volume_unchecked, n_boundary_edges, percent_volume_change
 from .noise import NOISE_MODES, add_noise, bbox_diagonal
 from .options import AREA_KINDS, LAPLACIAN_KINDS, MASS_AREA, AreaKind, LaplacianKind
 from .topology import boundary_vertex_mask
@@ -960,9 +960,7 @@ class Smoother:
         if self.closed and self.volume0 is not None:
             vol = _signed_volume_unchecked(x, self.F, self._FT)
             entry["volume"] = vol
-            entry["volume_change_pct"] = (
-                100.0 * (vol - self.volume0) / abs(self.volume0) if self.volume0 else None
-            )
+            entry["volume_change_pct"] = percent_volume_change(vol, self.volume0)
         else:
             entry["volume"] = None
             entry["volume_change_pct"] = None

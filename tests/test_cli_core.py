@@ -121,3 +121,17 @@ def test_console_script(cube_obj):
         [exe, "info", str(cube_obj) + ".nope"], capture_output=True, text=True, timeout=120
     )
     assert res.returncode == 2 and "Traceback" not in res.stderr
+
+
+def test_smooth_inside_out_sphere_reports_the_volume_lost(capsys, tmp_path):
+    """Uniform smoothing shrinks a sphere; an inside-out (inward-oriented) copy used to report
+    +99.99 % volume change."""
+    V, F = primitives.icosphere(2)
+    pcts = []
+    for name, G in (("out.obj", F), ("in.obj", F[:, ::-1])):
+        path = tmp_path / name
+        save_mesh(path, V, G)
+        code, out, err = run_cli(capsys, "smooth", path, "--iters", "5", "--json")
+        assert code == 0, err
+        pcts.append(json.loads(out)["volume_change_pct"])
+    assert pcts[1] < 0 and pcts[1] == pytest.approx(pcts[0], rel=1e-9)
