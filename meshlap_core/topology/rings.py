@@ -140,17 +140,14 @@ class OneRing:
     def reversed(self) -> OneRing:
         """The same rings and fans in the opposite (clockwise) order."""
         faces = _reverse_segments(self.fan_face_ptr, self.fan_faces)
-        # a closed fan's face j lies between neighbours j and j+1: after reversing the ring the
-        # reversed face list is one step behind
-        counts = np.diff(self.fan_face_ptr)
+        # a closed fan's face j lies between neighbours j and j+1 (wrapping): once the ring is
+        # reversed, its reversed face list must move one step forward
+        ptr = self.fan_face_ptr
+        counts = np.diff(ptr)
         seg = np.repeat(np.arange(len(counts)), counts)
-        closed = self.fan_closed[seg]
-        pos = np.arange(len(faces)) - self.fan_face_ptr[seg]
-        target = np.where(
-            closed, self.fan_face_ptr[seg] + (pos - 1) % np.maximum(counts[seg], 1), 0
-        )
-        rolled = faces.copy()
-        rolled[target[closed]] = faces[closed]
+        pos = np.arange(len(faces)) - ptr[seg]
+        nxt = ptr[seg] + (pos + 1) % np.maximum(counts[seg], 1)
+        rolled = np.where(self.fan_closed[seg], faces[nxt], faces)
         return OneRing(
             self.offsets,
             _reverse_segments(self.offsets, self.indices),
@@ -268,9 +265,9 @@ def one_ring(F: IntArray, n: int) -> OneRing:
 
     # corners sorted by vertex, fan (by its first corner), position in the fan
     srt = np.lexsort((rank, fan_key[label], v))
-    fan_order = np.unique(label[srt], return_index=True)  # fans in first-appearance order
-    fan_seq = fan_order[0][np.argsort(fan_order[1])]
-    fan_vertex = v[srt][np.sort(fan_order[1])] if n_fans else np.zeros(0, np.int64)
+    ls = label[srt]
+    start = np.flatnonzero(np.concatenate([[True], ls[1:] != ls[:-1]])) if nc else ls
+    fan_seq, fan_vertex = ls[start], v[srt][start]  # each fan's corners are contiguous in srt
     corners_per_fan = np.bincount(label, minlength=n_fans)[fan_seq]
     closed = ~open_fan[fan_seq]
     face_ptr = np.concatenate([[0], np.cumsum(corners_per_fan)]).astype(np.int64)
@@ -284,7 +281,7 @@ def one_ring(F: IntArray, n: int) -> OneRing:
     fan_idx[ptr[1:][~closed] - 1] = b[srt][last]
     fan_offsets = np.concatenate([[0], np.cumsum(np.bincount(fan_vertex, minlength=n))])
 
-    regular, boundary = _regular_boundary(t, v, a, b, srt, face_ptr, closed, fan_vertex, n)
+    regular, boundary = _regular_boundary(t, srt, face_ptr, closed, fan_vertex, n)
     offsets, indices = _rings(regular, fan_vertex, ptr, fan_idx, v, a, b, n)
     return OneRing(
         offsets,
@@ -303,9 +300,6 @@ def one_ring(F: IntArray, n: int) -> OneRing:
 
 def _regular_boundary(
     t: EdgeTable,
-    v: IntArray,
-    a: IntArray,
-    b: IntArray,
     srt: IntArray,
     face_ptr: IntArray,
     closed: BoolArray,
