@@ -8,6 +8,7 @@ sort of the half-edges.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -63,8 +64,6 @@ class EdgeTable:
     counts : (e,) int
         Faces per edge: 1 on a boundary edge, 2 on an interior manifold edge, more on a
         non-manifold edge.
-    halfedge_edge : (3m,) int
-        Edge of every half-edge.
     edge_ptr : (e+1,) int
         ``edge_halfedges[edge_ptr[k]:edge_ptr[k+1]]`` are the half-edges on edge ``k``.
     edge_halfedges : (3m,) int
@@ -80,7 +79,6 @@ class EdgeTable:
     n: int
     edges: IntArray
     counts: IntArray
-    halfedge_edge: IntArray
     edge_ptr: IntArray
     edge_halfedges: IntArray
 
@@ -105,9 +103,14 @@ class EdgeTable:
         ptr = np.append(starts, len(ks)).astype(np.int64)
         kk = ks[starts]
         edges = np.stack([kk // max(n, 1), kk % max(n, 1)], axis=1).astype(np.int64)
-        he_edge = np.empty(len(ks), dtype=np.int64)
-        he_edge[order] = np.cumsum(new) - 1
-        return cls(F, n, edges, np.diff(ptr), he_edge, ptr, order.astype(np.int64))
+        return cls(F, n, edges, np.diff(ptr), ptr, order.astype(np.int64))
+
+    @cached_property
+    def halfedge_edge(self) -> IntArray:
+        """Edge of every half-edge, ``(3m,) int`` (computed on first use)."""
+        he_edge = np.empty(len(self.edge_halfedges), dtype=np.int64)
+        he_edge[self.edge_halfedges] = np.repeat(np.arange(self.n_edges), self.counts)
+        return he_edge
 
     @property
     def n_edges(self) -> int:
@@ -166,9 +169,8 @@ class EdgeTable:
         """
         m = len(self.F)
         order = self.edge_halfedges
-        same = np.zeros(max(len(order) - 1, 0), dtype=bool)
-        he_sorted = self.halfedge_edge[order]
-        np.equal(he_sorted[1:], he_sorted[:-1], out=same)
+        same = np.ones(max(len(order) - 1, 0), dtype=bool)  # order[i], order[i+1]: same edge
+        same[self.edge_ptr[1:-1] - 1] = False
         idx = np.int32 if 3 * m < 2**31 else np.int64  # corner ids: halve the memory
         ha, hb = order[:-1][same].astype(idx), order[1:][same].astype(idx)
         src, dst = self.halfedge_vertices()
