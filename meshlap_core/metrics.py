@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from .errors import MeshError
-from .topology import edge_face_counts
+from .topology import EdgeTable
 from .types import FloatArray, IntArray, as_faces, as_mesh, as_vertices
 
 
@@ -79,8 +79,7 @@ def max_error(V: FloatArray, V_ref: FloatArray) -> float:
 
 def n_boundary_edges(F: IntArray) -> int:
     """Number of undirected edges used by exactly one face."""
-    _, count = edge_face_counts(as_faces(F))
-    return int(np.count_nonzero(count == 1))
+    return int(np.count_nonzero(EdgeTable.from_faces(F).counts == 1))
 
 
 def is_closed(F: IntArray) -> bool:
@@ -170,10 +169,34 @@ def volume_undefined_reason(F: IntArray) -> str | None:
     return None
 
 
+def percent_volume_change(volume: float, volume_ref: float) -> float | None:
+    """Change of the enclosed volume in percent, ``100 (|v| − |v_ref|) / |v_ref|``.
+
+    The enclosed volume of a closed mesh is the absolute value of its signed (divergence
+    theorem) volume, so an inward-oriented mesh that shrinks gives a negative change, as an
+    outward one does.
+
+    Parameters
+    ----------
+    volume, volume_ref : float
+        Signed volumes (:func:`signed_volume`) of the mesh and of the reference.
+
+    Returns
+    -------
+    float or None
+        ``None`` when the reference volume is 0.
+    """
+    if volume_ref == 0.0:
+        return None
+    return 100.0 * (abs(volume) - abs(volume_ref)) / abs(volume_ref)
+
+
 def volume_change_pct(
     V: FloatArray, V_ref: FloatArray, F: IntArray
 ) -> tuple[float | None, str | None]:
-    """Percentage change of the enclosed volume, ``100 (vol(V) − vol(V_ref)) / |vol(V_ref)|``.
+    """Percentage change of the enclosed volume, ``100 (|vol(V)| − |vol(V_ref)|) / |vol(V_ref)|``
+    (see :func:`percent_volume_change`; the sign says whether the enclosed volume grew, whatever
+    the orientation of the faces).
 
     Parameters
     ----------
@@ -193,10 +216,10 @@ def volume_change_pct(
     reason = volume_undefined_reason(F)
     if reason is not None:
         return None, reason
-    v0 = _signed_volume_unchecked(V_ref, F)
-    if v0 == 0.0:
+    pct = percent_volume_change(_signed_volume_unchecked(V, F), _signed_volume_unchecked(V_ref, F))
+    if pct is None:
         return None, "undefined: the reference volume is 0"
-    return 100.0 * (_signed_volume_unchecked(V, F) - v0) / abs(v0), None
+    return pct, None
 
 
 # --------------------------------------------------------------------------- normals, dihedrals
@@ -265,27 +288,16 @@ def edge_faces(F: IntArray) -> EdgeFaces:
     -------
     EdgeFaces
     """
-    F = as_faces(F)
-    m = len(F)
-    if m == 0:
-        z = np.zeros((0, 2), dtype=np.int64)
-        return EdgeFaces(z, z.copy(), np.zeros(0, dtype=bool))
-    src = np.concatenate([F[:, 0], F[:, 1], F[:, 2]])
-    dst = np.concatenate([F[:, 1], F[:, 2], F[:, 0]])
-    face = np.tile(np.arange(m, dtype=np.int64), 3)
-    lo, hi = np.minimum(src, dst), np.maximum(src, dst)
-    order = np.lexsort((hi, lo))
-    lo_s, hi_s = lo[order], hi[order]
-    new_group = np.ones(len(order), dtype=bool)
-    new_group[1:] = (lo_s[1:] != lo_s[:-1]) | (hi_s[1:] != hi_s[:-1])
-    starts = np.flatnonzero(new_group)
-    counts = np.diff(np.append(starts, len(order)))
-    first = starts[counts == 2]
-    h1, h2 = order[first], order[first + 1]
+    t = EdgeTable.from_faces(F)
+    m = len(t.F)
+    _, h1, h2 = t.face_pairs()
+    # the first face is the one whose half-edge comes first in corner-column order (k m + f)
+    swap = (h1 % 3) * m + h1 // 3 > (h2 % 3) * m + h2 // 3
+    h1, h2 = np.where(swap, h2, h1), np.where(swap, h1, h2)
+    src, dst = t.halfedge_vertices()
     edges = np.stack([src[h1], dst[h1]], axis=1)
-    faces = np.stack([face[h1], face[h2]], axis=1)
-    consistent = src[h2] == dst[h1]
-    return EdgeFaces(edges, faces, consistent)
+    faces = np.stack([h1 // 3, h2 // 3], axis=1)
+    return EdgeFaces(edges, faces, src[h2] == dst[h1])
 
 
 def dihedral_angles(V: FloatArray, F: IntArray, adjacency: EdgeFaces | None = None) -> FloatArray:
@@ -463,7 +475,7 @@ class Reference:
         else:
             vol = _signed_volume_unchecked(V, self.F)
             out["volume"] = vol
-            out["volume_change_pct"] = 100.0 * (vol - self.volume) / abs(self.volume)
+            out["volume_change_pct"] = percent_volume_change(vol, self.volume)
         d = _wrapped_abs_diff(_dihedral_unchecked(V, self.F, self.adjacency), self.dihedral)
         d = d[np.isfinite(d)]
         out["dihedral_mae_deg"] = float(np.degrees(d.mean())) if d.size else float("nan")

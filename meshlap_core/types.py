@@ -12,6 +12,7 @@ import numpy as np
 import numpy.typing as npt
 
 from .errors import MeshError
+from .options import MAX_COORDINATE
 
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
@@ -24,14 +25,27 @@ def as_vertices(V: Any, name: str = "V") -> FloatArray:
     Raises
     ------
     MeshError
-        If the shape is not ``(n,3)`` or a coordinate is NaN or infinite.
+        If the shape is not ``(n,3)``, a coordinate is NaN or infinite, or beyond
+        ``±MAX_COORDINATE`` (1e75, as the loader: squared lengths overflow, and libigl can
+        crash the interpreter on such input).
     """
-    arr = np.array(V, dtype=np.float64, copy=True, order="C")
+    try:
+        arr = np.array(V, dtype=np.float64, copy=True, order="C")
+    except (TypeError, ValueError) as exc:
+        raise MeshError(f"vertex coordinates are not numbers ({exc})", name) from None
     if arr.ndim != 2 or arr.shape[1] != 3:
         raise MeshError(f"should have shape (n,3); shape is {arr.shape}", name)
-    if not np.isfinite(arr).all():
-        bad = int(np.flatnonzero(~np.isfinite(arr).all(axis=1))[0])
-        raise MeshError(f"vertex {bad} has a NaN or infinite coordinate", name)
+    if arr.size and not np.abs(arr).max() <= MAX_COORDINATE:  # NaN fails the test too
+        if not np.isfinite(arr).all():
+            bad = int(np.flatnonzero(~np.isfinite(arr).all(axis=1))[0])
+            raise MeshError(f"vertex {bad} has a NaN or infinite coordinate", name)
+        big = np.abs(arr).max(axis=1)
+        bad = int(np.argmax(big))
+        raise MeshError(
+            f"vertex {bad} has coordinate {float(big[bad]):.3g}; coordinates beyond "
+            f"±{MAX_COORDINATE:.0e} overflow squared-length computations (rescale the mesh)",
+            name,
+        )
     return arr
 
 

@@ -21,313 +21,32 @@ need a manifold.
 from __future__ import annotations
 
 import os
-from collections.abc import Iterator, Sequence
-from dataclasses import dataclass, field
-from typing import Any, NamedTuple
+from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
-import scipy.sparse as sp
-from scipy.sparse.csgraph import connected_components
 
 from .errors import MeshError
+from .mesh import Mesh, MeshReport, Polygons
+from .mesh import count_phrase as _count
 from .options import DEGENERATE_REL, MAX_COORDINATE, MIN_EXTENT, SLIVER_ANGLE
+from .topology import sort_with_order as _sort_with_order
+from .topology import topology_report
 from .types import BoolArray, FloatArray, IntArray
 
-
-def _count(n: int, singular: str, plural: str | None = None) -> str:
-    """``"1 face"`` / ``"1,489 faces"``."""
-    return f"{n:,} {singular if n == 1 else (plural or singular + 's')}"
-
-
-class Polygons(NamedTuple):
-    """Ragged polygon list in flat form (what the file parsers produce).
-
-    Attributes
-    ----------
-    indices : (k,) int
-        All corner indices (0-based), polygon after polygon.
-    sizes : (p,) int
-        Number of corners of each polygon (``sizes.sum() == len(indices)``).
-    """
-
-    indices: IntArray
-    sizes: IntArray
-
-
-@dataclass(eq=False)
-class MeshReport:
-    """What :func:`validate_mesh` repaired and found.
-
-    Attributes
-    ----------
-    repairs : list of str
-        One sentence per repair applied, e.g. ``"removed 43 unreferenced vertices"``.
-    warnings : list of str
-        Problems detected but not repaired (non-manifold, orientation, ...).
-    n_input_vertices, n_input_faces : int
-        Counts before any repair (faces = polygons as given).
-    n_edges : int
-        Unique undirected edges of the repaired mesh.
-    n_boundary_edges : int
-        Edges with exactly one incident face.
-    n_nonmanifold_edges : int
-        Edges with more than two incident faces.
-    n_nonmanifold_vertices : int
-        Vertices whose incident faces form more than one edge-connected fan (the libigl
-        ``is_vertex_manifold`` definition: vertices on non-manifold edges are counted by
-        ``n_nonmanifold_edges``, not here).
-    n_inconsistent_edges : int
-        Two-face edges that both faces traverse in the same direction.
-    consistently_oriented : bool
-        ``n_inconsistent_edges == 0``.
-    n_components : int
-        Connected components of the faces (faces sharing a vertex are connected).
-    nonmanifold_edges : (k,2) int
-        The non-manifold edges (vertex pairs, ``i < j``).
-    nonmanifold_vertices : (k,) int
-        The non-manifold vertices.
-    """
-
-    repairs: list[str] = field(default_factory=list)
-    warnings: list[str] = field(default_factory=list)
-    n_input_vertices: int = 0
-    n_input_faces: int = 0
-    n_edges: int = 0
-    n_boundary_edges: int = 0
-    n_nonmanifold_edges: int = 0
-    n_nonmanifold_vertices: int = 0
-    n_inconsistent_edges: int = 0
-    consistently_oriented: bool = True
-    n_components: int = 0
-    nonmanifold_edges: IntArray = field(
-        default_factory=lambda: np.zeros((0, 2), dtype=np.int64), repr=False
-    )
-    nonmanifold_vertices: IntArray = field(
-        default_factory=lambda: np.zeros(0, dtype=np.int64), repr=False
-    )
-
-    @property
-    def is_manifold(self) -> bool:
-        """No non-manifold edge and no non-manifold vertex."""
-        return self.n_nonmanifold_edges == 0 and self.n_nonmanifold_vertices == 0
-
-    @property
-    def is_closed(self) -> bool:
-        """No boundary edge."""
-        return self.n_boundary_edges == 0
-
-    def to_dict(self) -> dict[str, Any]:
-        """Plain-Python summary (for ``--json`` output); the index arrays are left out."""
-        return {
-            "repairs": list(self.repairs),
-            "warnings": list(self.warnings),
-            "n_input_vertices": self.n_input_vertices,
-            "n_input_faces": self.n_input_faces,
-            "n_edges": self.n_edges,
-            "n_boundary_edges": self.n_boundary_edges,
-            "n_nonmanifold_edges": self.n_nonmanifold_edges,
-            "n_nonmanifold_vertices": self.n_nonmanifold_vertices,
-            "n_inconsistent_edges": self.n_inconsistent_edges,
-            "consistently_oriented": self.consistently_oriented,
-            "n_components": self.n_components,
-            "is_manifold": self.is_manifold,
-            "is_closed": self.is_closed,
-        }
-
-
-@dataclass(eq=False)
-class Mesh:
-    """A validated triangle mesh.
-
-    Attributes
-    ----------
-    V : (n,3) float64
-    F : (m,3) int64
-        0-based, every index in ``[0, n)``, no degenerate or duplicate face after repair.
-    source : str or None
-        The file (or label) the mesh came from; used in error messages.
-    report : MeshReport
-    vertex_map : (n,) int64
-        ``vertex_map[i]`` is the index in the input (0-based order of the file's vertices;
-        for STL the index of the first triangle corner welded into vertex ``i``).
-    face_map : (m,) int64
-        ``face_map[f]`` is the index of the input face (polygon) that triangle ``f`` comes from.
-    """
-
-    V: FloatArray
-    F: IntArray
-    source: str | None
-    report: MeshReport
-    vertex_map: IntArray = field(repr=False, default_factory=lambda: np.zeros(0, np.int64))
-    face_map: IntArray = field(repr=False, default_factory=lambda: np.zeros(0, np.int64))
-
-    @property
-    def n_vertices(self) -> int:
-        """Number of vertices ``n``."""
-        return int(self.V.shape[0])
-
-    @property
-    def n_faces(self) -> int:
-        """Number of triangles ``m``."""
-        return int(self.F.shape[0])
-
-    def __iter__(self) -> Iterator[np.ndarray]:  # allows ``V, F = load_mesh(path)``
-        yield self.V
-        yield self.F
-
-
-# --------------------------------------------------------------------------------------------
-# topology
-
-
-def _edge_key(a: IntArray, b: IntArray, n: int) -> IntArray:
-    lo = np.minimum(a, b)
-    hi = np.maximum(a, b)
-    return lo * np.int64(n) + hi
-
-
-def _sort_with_order(key: IntArray) -> tuple[IntArray, IntArray]:
-    """``(order, key[order])`` for non-negative int64 keys (order within ties arbitrary).
-
-    When ``key.max() * len(key)`` fits in int64 the position is packed into the low digits and
-    one plain ``np.sort`` does the work (about 3x faster than ``argsort`` plus a gather).
-    """
-    k = len(key)
-    if k == 0:
-        return np.zeros(0, dtype=np.int64), key
-    top = int(key.max())
-    if top < (2**62) // max(k, 1):
-        packed = key * np.int64(k)  # in place from here on: three arrays of k at the peak
-        packed += np.arange(k, dtype=np.int64)
-        packed.sort()
-        order = packed % k
-        packed //= k
-        return order, packed
-    order = np.argsort(key)
-    return order, key[order]
-
-
-def topology_report(F: Any, n_vertices: int | None = None) -> MeshReport:
-    """Edge / vertex manifoldness, orientation, boundary and components of a triangle list.
-
-    Parameters
-    ----------
-    F : (m,3) int
-        Triangles, 0-based.
-    n_vertices : int, optional
-        Number of vertices (default ``F.max() + 1``).
-
-    Returns
-    -------
-    report : MeshReport
-        With the topology fields and warnings filled in and no repairs.
-
-    Notes
-    -----
-    Half-edges are grouped by undirected edge (one sort). An edge with more than two faces is
-    non-manifold; a two-face edge traversed in the same direction by both faces is
-    inconsistently oriented. For vertex manifoldness every face corner is a graph node, and the
-    two corners at the same endpoint of faces sharing an edge are joined; the connected
-    components of that graph are the "wedges" (fans) at each vertex, and a vertex with more than
-    one wedge is non-manifold (libigl ``is_vertex_manifold``). All steps are vectorised.
-    """
-    F = np.asarray(F, dtype=np.int64).reshape(-1, 3)
-    m = len(F)
-    n = int(F.max()) + 1 if n_vertices is None and m else int(n_vertices or 0)
-    rep = MeshReport(n_input_vertices=n, n_input_faces=m)
-    if m == 0:
-        return rep
-    # half-edge h = 3 f + k goes from corner k to corner k+1 of face f
-    src = F.ravel()
-    dst = F[:, [1, 2, 0]].ravel()
-    forward = src < dst  # direction of each half-edge relative to (lo, hi)
-    key = np.minimum(src, dst)
-    key *= np.int64(n)
-    key += np.maximum(src, dst)
-    del dst
-    order, ks = _sort_with_order(key)
-    del key
-    new = np.empty(len(ks), dtype=bool)
-    new[0] = True
-    np.not_equal(ks[1:], ks[:-1], out=new[1:])
-    starts = np.flatnonzero(new)
-    counts = np.diff(np.append(starts, len(ks)))
-    rep.n_edges = len(starts)
-    rep.n_boundary_edges = int(np.count_nonzero(counts == 1))
-    bad = counts > 2
-    rep.n_nonmanifold_edges = int(np.count_nonzero(bad))
-    if rep.n_nonmanifold_edges:
-        kb = ks[starts[bad]]
-        rep.nonmanifold_edges = np.stack([kb // n, kb % n], axis=1)
-    del ks
-
-    # orientation on two-face edges
-    two = starts[counts == 2]
-    rep.n_inconsistent_edges = int(np.count_nonzero(forward[order[two]] == forward[order[two + 1]]))
-    rep.consistently_oriented = rep.n_inconsistent_edges == 0
-    del two, starts, counts, bad
-
-    # wedges: join consecutive half-edges of the same undirected edge at both endpoints
-    same = ~new[1:]  # pair (order[i], order[i+1]) on the same edge
-    del new
-    idx = np.int32 if 3 * m < 2**31 else np.int64  # corner ids: halve the memory when possible
-    ha, hb = order[:-1][same].astype(idx), order[1:][same].astype(idx)
-    del order, same
-
-    def ends(h: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        # the corners at the lower- and higher-index endpoints of half-edge h: h itself is the
-        # corner at its source, the next corner of the face (h + 1, wrapping) at its target
-        nxt = h + 1
-        nxt[h % 3 == 2] -= 3
-        fw = forward[h]
-        return np.where(fw, h, nxt), np.where(fw, nxt, h)
-
-    a_lo, a_hi = ends(ha)
-    del ha
-    b_lo, b_hi = ends(hb)
-    del hb
-    rows = np.concatenate([a_lo, a_hi])
-    del a_lo, a_hi
-    cols = np.concatenate([b_lo, b_hi])
-    del b_lo, b_hi
-    G = sp.csr_matrix((np.ones(len(rows), dtype=np.int8), (rows, cols)), shape=(3 * m, 3 * m))
-    del rows, cols
-    # weak components of the one-directional graph = components of the undirected one
-    n_wedges, labels = connected_components(G, directed=True, connection="weak")
-    del G
-    wedge_vertex = np.empty(n_wedges, dtype=np.int64)
-    wedge_vertex[labels] = src
-    del labels
-    wedges_per_vertex = np.bincount(wedge_vertex, minlength=n)
-    nm_v = np.flatnonzero(wedges_per_vertex > 1)
-    rep.n_nonmanifold_vertices = len(nm_v)
-    rep.nonmanifold_vertices = nm_v.astype(np.int64)
-
-    # components of faces (through shared vertices), ignoring unreferenced vertices
-    # (two edges per face suffice for connectivity; each unreferenced vertex is its own component)
-    A = sp.csr_matrix(
-        (np.ones(2 * m, dtype=np.int8), (F[:, :2].ravel(), F[:, 1:].ravel())), shape=(n, n)
-    )
-    n_all, _ = connected_components(A, directed=True, connection="weak")
-    rep.n_components = n_all - int(np.count_nonzero(wedges_per_vertex == 0))
-
-    if rep.n_nonmanifold_edges:
-        rep.warnings.append(
-            f"{_count(rep.n_nonmanifold_edges, 'non-manifold edge')} "
-            "(shared by more than two faces; not repaired)"
-        )
-    if rep.n_nonmanifold_vertices:
-        rep.warnings.append(
-            f"{_count(rep.n_nonmanifold_vertices, 'non-manifold vertex', 'non-manifold vertices')}"
-            " (their faces form more than one fan; not repaired)"
-        )
-    if not rep.consistently_oriented:
-        rep.warnings.append(
-            "faces are not consistently oriented: "
-            f"{_count(rep.n_inconsistent_edges, 'edge is', 'edges are')} traversed in the same "
-            "direction by both of their faces (not repaired)"
-        )
-    return rep
+__all__ = [
+    "SLIVER_ANGLE",
+    "Mesh",
+    "MeshReport",
+    "Polygons",
+    "degenerate_faces",
+    "duplicate_faces",
+    "duplicate_positions",
+    "require_manifold",
+    "sliver_faces",
+    "topology_report",
+    "validate_mesh",
+]
 
 
 def require_manifold(mesh_or_F: Mesh | Any, operation: str, source: str | None = None) -> None:
@@ -641,6 +360,127 @@ def duplicate_faces(F: IntArray, n: int) -> BoolArray:
     return dup
 
 
+def _check_faces(tri_or_flat: IntArray, sizes: IntArray | None, n: int, flabel: str) -> IntArray:
+    """Refuse faces with fewer than 3 corners and indices outside ``[0, n)``; the flat indices."""
+    if sizes is not None:
+        small = np.flatnonzero(sizes < 3)
+        if len(small):
+            f = int(small[0])
+            raise MeshError(
+                f"face {f} has {int(sizes[f])} {'corner' if sizes[f] == 1 else 'corners'}; "
+                f"a face needs at least 3"
+                + (f" ({_count(len(small), 'face')} like this)" if len(small) > 1 else ""),
+                flabel,
+            )
+    flat = tri_or_flat.ravel()
+    lo, hi = int(flat.min()), int(flat.max())
+    if lo < 0 or hi >= n:
+        bad_idx = lo if lo < 0 else hi
+        pos = int(np.flatnonzero(flat == bad_idx)[0])
+        if sizes is None:
+            f = pos // 3
+        else:
+            f = int(np.searchsorted(np.cumsum(sizes), pos, side="right"))
+        raise MeshError(
+            f"face {f} has index {bad_idx} but the mesh has {_count(n, 'vertex', 'vertices')} "
+            f"(valid indices 0..{n - 1})",
+            flabel,
+        )
+
+    return flat
+
+
+def _drop_degenerate(
+    V: FloatArray,
+    F: IntArray,
+    face_map: IntArray,
+    repair: bool,
+    rep_list: list[str],
+    warn_list: list[str],
+    flabel: str,
+) -> tuple[IntArray, IntArray, BoolArray]:
+    """Remove (or, without ``repair``, report) degenerate faces; refuse a mesh of only those.
+
+    Returns the kept faces, their input face indices and their sliver mask.
+    """
+    repeated, zero, sliver = _face_flags(V, F)
+    n_rep, n_zero = int(repeated.sum()), int(zero.sum())
+    if n_rep + n_zero == len(F):
+        raise MeshError(
+            f"all {_count(len(F), 'face')} are degenerate "
+            f"({n_rep:,} with a repeated vertex, {n_zero:,} with zero area)",
+            flabel,
+        )
+    if n_rep + n_zero:
+        parts = []
+        if n_rep:
+            parts.append(f"{n_rep:,} with a repeated vertex")
+        if n_zero:
+            parts.append(f"{n_zero:,} with zero area")
+        what = f"{_count(n_rep + n_zero, 'degenerate face')} ({', '.join(parts)})"
+        if repair:
+            keep = ~(repeated | zero)
+            F, face_map, sliver = F[keep], face_map[keep], sliver[keep]
+            rep_list.append(f"removed {what}")
+        else:
+            sliver &= ~(repeated | zero)  # reported as degenerate already
+            warn_list.append(f"{what} (not removed: repair=False)")
+
+    return F, face_map, sliver
+
+
+def _drop_duplicates_and_unused(
+    V: FloatArray,
+    F: IntArray,
+    face_map: IntArray,
+    sliver: BoolArray,
+    vmap0: IntArray,
+    flat: IntArray,
+    repair: bool,
+    rep_list: list[str],
+    warn_list: list[str],
+) -> tuple[IntArray, IntArray, BoolArray, FloatArray, IntArray]:
+    """Remove (or report) duplicate faces, then unreferenced vertices (``flat`` are the input
+    face indices, to tell vertices orphaned by removed faces)."""
+    n = len(V)
+    dup = duplicate_faces(F, n)
+    n_dup = int(dup.sum())
+    if n_dup:
+        what = (
+            f"{_count(n_dup, 'duplicate face')} "
+            "(same three vertices as an earlier face, in any order)"
+        )
+        if repair:
+            F, face_map, sliver = F[~dup], face_map[~dup], sliver[~dup]
+            rep_list.append(f"removed {what}")
+        else:
+            warn_list.append(f"{what} (not removed: repair=False)")
+
+    used = np.zeros(n, dtype=bool)
+    used[F.ravel()] = True
+    n_unused = n - int(used.sum())
+    if n_unused:
+        if repair:
+            used_in_input = np.zeros(n, dtype=bool)
+            used_in_input[flat] = True
+            orphaned = int(np.count_nonzero(used_in_input & ~used))
+            new_index = np.cumsum(used) - 1
+            F = new_index[F]
+            V = V[used]
+            vmap0 = vmap0[used]
+            msg = f"removed {_count(n_unused, 'unreferenced vertex', 'unreferenced vertices')}"
+            if orphaned:
+                msg += f" ({orphaned:,} of them used only by removed faces)"
+            rep_list.append(msg)
+        else:
+            warn_list.append(
+                f"{_count(n_unused, 'unreferenced vertex', 'unreferenced vertices')} "
+                "(not removed: repair=False)"
+            )
+
+    return F, face_map, sliver, V, vmap0
+
+
 def validate_mesh(
     V: Any,
     F_or_polygons: Any,
@@ -704,30 +544,7 @@ def validate_mesh(
     if n_faces_in == 0:
         raise MeshError("the mesh has no faces", flabel)
 
-    if sizes is not None:
-        small = np.flatnonzero(sizes < 3)
-        if len(small):
-            f = int(small[0])
-            raise MeshError(
-                f"face {f} has {int(sizes[f])} {'corner' if sizes[f] == 1 else 'corners'}; "
-                f"a face needs at least 3"
-                + (f" ({_count(len(small), 'face')} like this)" if len(small) > 1 else ""),
-                flabel,
-            )
-    flat = tri_or_flat.ravel()
-    lo, hi = int(flat.min()), int(flat.max())
-    if lo < 0 or hi >= n:
-        bad_idx = lo if lo < 0 else hi
-        pos = int(np.flatnonzero(flat == bad_idx)[0])
-        if sizes is None:
-            f = pos // 3
-        else:
-            f = int(np.searchsorted(np.cumsum(sizes), pos, side="right"))
-        raise MeshError(
-            f"face {f} has index {bad_idx} but the mesh has {_count(n, 'vertex', 'vertices')} "
-            f"(valid indices 0..{n - 1})",
-            flabel,
-        )
+    flat = _check_faces(tri_or_flat, sizes, n, flabel)
 
     if sizes is None:
         F = tri_or_flat
@@ -741,63 +558,11 @@ def validate_mesh(
                 f"{_count(int((sizes[sizes > 3] - 2).sum()), 'triangle')} (fan triangulation)"
             )
 
-    repeated, zero, sliver = _face_flags(V, F)
-    n_rep, n_zero = int(repeated.sum()), int(zero.sum())
-    if n_rep + n_zero == len(F):
-        raise MeshError(
-            f"all {_count(len(F), 'face')} are degenerate "
-            f"({n_rep:,} with a repeated vertex, {n_zero:,} with zero area)",
-            flabel,
-        )
-    if n_rep + n_zero:
-        parts = []
-        if n_rep:
-            parts.append(f"{n_rep:,} with a repeated vertex")
-        if n_zero:
-            parts.append(f"{n_zero:,} with zero area")
-        what = f"{_count(n_rep + n_zero, 'degenerate face')} ({', '.join(parts)})"
-        if repair:
-            keep = ~(repeated | zero)
-            F, face_map, sliver = F[keep], face_map[keep], sliver[keep]
-            rep_list.append(f"removed {what}")
-        else:
-            sliver &= ~(repeated | zero)  # reported as degenerate already
-            warn_list.append(f"{what} (not removed: repair=False)")
+    F, face_map, sliver = _drop_degenerate(V, F, face_map, repair, rep_list, warn_list, flabel)
 
-    dup = duplicate_faces(F, n)
-    n_dup = int(dup.sum())
-    if n_dup:
-        what = (
-            f"{_count(n_dup, 'duplicate face')} "
-            "(same three vertices as an earlier face, in any order)"
-        )
-        if repair:
-            F, face_map, sliver = F[~dup], face_map[~dup], sliver[~dup]
-            rep_list.append(f"removed {what}")
-        else:
-            warn_list.append(f"{what} (not removed: repair=False)")
-
-    used = np.zeros(n, dtype=bool)
-    used[F.ravel()] = True
-    n_unused = n - int(used.sum())
-    if n_unused:
-        if repair:
-            used_in_input = np.zeros(n, dtype=bool)
-            used_in_input[flat] = True
-            orphaned = int(np.count_nonzero(used_in_input & ~used))
-            new_index = np.cumsum(used) - 1
-            F = new_index[F]
-            V = V[used]
-            vmap0 = vmap0[used]
-            msg = f"removed {_count(n_unused, 'unreferenced vertex', 'unreferenced vertices')}"
-            if orphaned:
-                msg += f" ({orphaned:,} of them used only by removed faces)"
-            rep_list.append(msg)
-        else:
-            warn_list.append(
-                f"{_count(n_unused, 'unreferenced vertex', 'unreferenced vertices')} "
-                "(not removed: repair=False)"
-            )
+    F, face_map, sliver, V, vmap0 = _drop_duplicates_and_unused(
+        V, F, face_map, sliver, vmap0, flat, repair, rep_list, warn_list
+    )
 
     n_sliver = int(np.count_nonzero(sliver))
     if n_sliver:

@@ -963,6 +963,59 @@ CORPUS: list[Hostile] = [
         closed=True,
     ),
     Hostile("stream.obj", _stream, "error", ("streams more than", "no such file")),
+    # round 2: topology
+    Hostile(
+        "touching_spheres.obj",
+        _text("touching_spheres.obj", lambda: obj_text(*touching_spheres())),
+        "ok",
+        n_vertices=83,
+        n_faces=160,
+        warnings=("1 non-manifold vertex",),
+        closed=True,
+    ),
+    Hostile(
+        "two_tetrahedra_vertex.obj",
+        _text("two_tetrahedra_vertex.obj", lambda: obj_text(*tetrahedra_sharing_vertex(2))),
+        "ok",
+        n_vertices=7,
+        n_faces=8,
+        warnings=("1 non-manifold vertex",),
+        closed=True,
+    ),
+    Hostile(
+        "three_tetrahedra_vertex.off",
+        _text("three_tetrahedra_vertex.off", lambda: off_text(*tetrahedra_sharing_vertex(3))),
+        "ok",
+        n_vertices=10,
+        n_faces=12,
+        warnings=("1 non-manifold vertex",),
+        closed=True,
+    ),
+    Hostile(
+        "glued_torus.obj",
+        _text("glued_torus.obj", lambda: obj_text(*glued_torus())),
+        "ok",
+        n_vertices=8 * 6 - 1,
+        n_faces=2 * 8 * 6,
+        warnings=("1 non-manifold vertex",),
+        closed=True,
+    ),
+    Hostile(
+        "sphere_touching_disk.obj",
+        _text("sphere_touching_disk.obj", lambda: obj_text(*sphere_touching_disk())),
+        "ok",
+        n_vertices=42 + 16 - 1,
+        n_faces=80 + 18,
+        warnings=("1 non-manifold vertex",),
+    ),
+    Hostile(
+        "inside_out_sphere.obj",
+        _text("inside_out_sphere.obj", lambda: obj_text(*inside_out_sphere())),
+        "ok",
+        n_vertices=162,
+        n_faces=320,
+        closed=True,
+    ),
 ]
 
 BY_NAME: dict[str, Hostile] = {h.name: h for h in CORPUS}
@@ -992,3 +1045,87 @@ def _surface_mesh(name: str, res, **params: float) -> tuple[np.ndarray, np.ndarr
 
     m = mesh_surface(get_surface(name, **params), res)
     return m.V, m.F
+
+
+# ------------------------------------------------------------------------------ round 2: topology
+# meshes whose vertices have several fans (one-rings used to hang on them), and an inside-out
+# sphere (volume change used to take the sign of the signed volume)
+
+
+def glue(V: np.ndarray, F: np.ndarray, keep: int, drop: int) -> tuple[np.ndarray, np.ndarray]:
+    """Merge vertex ``drop`` into ``keep`` (faces of ``drop`` now use ``keep``)."""
+    F = np.where(F == drop, keep, F)
+    F = F - (F > drop)
+    return np.delete(V, drop, axis=0), F
+
+
+def first_face_at(V: np.ndarray, F: np.ndarray, v: int) -> tuple[np.ndarray, np.ndarray]:
+    """Reorder faces so the first face has vertex ``v`` as its first corner (the robustness
+    tests ask for the one-ring of ``F[0, 0]``)."""
+    F = np.array(F)
+    f = int(np.flatnonzero((F == v).any(axis=1))[0])
+    F[[0, f]] = F[[f, 0]]
+    F[0] = np.roll(F[0], -int(np.flatnonzero(F[0] == v)[0]))
+    return V, F
+
+
+def touching_spheres() -> tuple[np.ndarray, np.ndarray]:
+    """Two outward icospheres touching at one shared vertex (two closed fans there)."""
+    V, F = primitives.icosphere(1)
+    top = int(np.argmax(V[:, 2]))
+    V2 = V * np.array([1.0, 1.0, -1.0]) + np.array([0.0, 0.0, 2.0 * V[top, 2]])
+    n = len(V)
+    W, G = glue(np.vstack([V, V2]), np.vstack([F, F[:, ::-1] + n]), top, top + n)
+    return first_face_at(W, G, top)
+
+
+def _tetra_at(direction: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Outward tetrahedron with apex 0 at the origin and its base towards ``direction``."""
+    d = direction / np.linalg.norm(direction)
+    p = np.cross(d, [0.3, 0.5, 0.7])
+    p /= np.linalg.norm(p)
+    q = np.cross(d, p)
+    t = 2 * np.pi * np.arange(3) / 3
+    base = d + 0.5 * (np.cos(t)[:, None] * p + np.sin(t)[:, None] * q)
+    V = np.vstack([np.zeros(3), base])
+    F = np.array([[0, 1, 2], [0, 2, 3], [0, 3, 1], [1, 3, 2]])
+    if np.linalg.det(V[1:] - V[0]) > 0:  # base counter-clockwise seen from the apex: inward
+        F = F[:, ::-1]
+    return V, F
+
+
+def tetrahedra_sharing_vertex(k: int) -> tuple[np.ndarray, np.ndarray]:
+    """``k`` closed tetrahedra sharing only their apex, vertex 0 (``k`` closed fans)."""
+    dirs = [np.array(d, float) for d in ([1, 0, 0], [-1, 0.2, 0], [0, -1, 0.3], [0.1, 1, 1])]
+    Vs, Fs = [], []
+    for j in range(k):
+        V, F = _tetra_at(dirs[j])
+        Fs.append(np.where(F == 0, 0, F + 3 * j))
+        Vs.append(V[1:] if j else V)
+    return first_face_at(np.vstack(Vs), np.vstack(Fs), 0)
+
+
+def glued_torus() -> tuple[np.ndarray, np.ndarray]:
+    """An 8 x 6 torus with two far-apart vertices glued (two closed fans at one vertex)."""
+    V, F = primitives.torus(8, 6)
+    far = int(np.argmax(np.linalg.norm(V - V[0], axis=1)))
+    V, F = glue(V, F, 0, far)
+    return first_face_at(V, F, 0)
+
+
+def sphere_touching_disk() -> tuple[np.ndarray, np.ndarray]:
+    """An icosphere whose south pole is a boundary vertex of a 4 x 4 grid: a closed and an open
+    fan at one vertex."""
+    V, F = primitives.icosphere(1)
+    bottom = int(np.argmin(V[:, 2]))
+    Vg, Fg = primitives.grid(4, 4)
+    Vg = Vg - Vg[1] + V[bottom]  # grid vertex 1 is on the grid's boundary
+    n = len(V)
+    W, G = glue(np.vstack([V, Vg]), np.vstack([F, Fg + n]), bottom, 1 + n)
+    return first_face_at(W, G, bottom)
+
+
+def inside_out_sphere() -> tuple[np.ndarray, np.ndarray]:
+    """An icosphere with every face reversed: closed, consistently but inward oriented."""
+    V, F = primitives.icosphere(2)
+    return V, F[:, ::-1].copy()

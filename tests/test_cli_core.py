@@ -121,3 +121,65 @@ def test_console_script(cube_obj):
         [exe, "info", str(cube_obj) + ".nope"], capture_output=True, text=True, timeout=120
     )
     assert res.returncode == 2 and "Traceback" not in res.stderr
+
+
+def test_smooth_inside_out_sphere_reports_the_volume_lost(capsys, tmp_path):
+    """Uniform smoothing shrinks a sphere; an inside-out (inward-oriented) copy used to report
+    +99.99 % volume change."""
+    V, F = primitives.icosphere(2)
+    pcts = []
+    for name, G in (("out.obj", F), ("in.obj", F[:, ::-1])):
+        path = tmp_path / name
+        save_mesh(path, V, G)
+        code, out, err = run_cli(capsys, "smooth", path, "--iters", "5", "--json")
+        assert code == 0, err
+        pcts.append(json.loads(out)["volume_change_pct"])
+    assert pcts[1] < 0 and pcts[1] == pytest.approx(pcts[0], rel=1e-9)
+
+
+@pytest.mark.parametrize("out", ["", "  "])
+def test_curvature_empty_out_is_an_error_naming_the_flag(capsys, cube_obj, out):
+    code, stdout, err = run_cli(capsys, "curvature", cube_obj, "--out", out)
+    assert code == 2 and stdout == ""
+    assert err.count("\n") == 1 and err.startswith("meshlap: error: --out:")
+    assert "empty" in err
+
+
+def _interrupt_during_startup(argv, trigger):
+    """Start ``argv`` with ``-X importtime``, send SIGINT as soon as the module ``trigger`` has
+    been imported (start-up still under way), and return ``(returncode, stderr lines that are
+    not import timings)``."""
+    import signal
+
+    proc = subprocess.Popen(
+        [sys.executable, "-X", "importtime", *argv],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    lines = []
+    for line in proc.stderr:
+        lines.append(line)
+        if line.startswith("import time:") and line.split("|")[-1].strip() == trigger:
+            proc.send_signal(signal.SIGINT)
+            break
+    _, rest = proc.communicate(timeout=600)
+    lines += rest.splitlines(keepends=True)
+    return proc.returncode, [x for x in lines if not x.startswith("import time:")]
+
+
+@pytest.mark.parametrize("trigger", ["meshlap_core.cli", "numpy", "scipy.sparse", "igl"])
+@pytest.mark.parametrize("how", ["module", "script"])
+def test_sigint_during_startup_exits_130_quietly(cube_obj, trigger, how):
+    """SIGINT while numpy / scipy / libigl are being imported: exit 130, at most one line,
+    no traceback (it printed a 52-line traceback)."""
+    if how == "module":
+        argv = ["-m", "meshlap_core.cli", "info", str(cube_obj)]
+    else:
+        if _console_script() is None:
+            pytest.skip("console script `meshlap` not installed")
+        argv = [_console_script(), "info", str(cube_obj)]
+    code, err = _interrupt_during_startup(argv, trigger)
+    assert code == 130, err
+    assert len(err) <= 1 and not any("Traceback" in x for x in err), err
+    assert err == [] or err[0] == "meshlap: interrupted\n"

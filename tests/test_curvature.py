@@ -143,3 +143,48 @@ def test_degenerate_faces_never_give_nan():
     for area in ("barycentric", "voronoi"):
         assert np.isfinite(curv.curvature_fields(V, F, area)["gaussian"]).all()
     assert np.isfinite(curv.vertex_normals(V, F)).all()
+
+
+HUGE_INPUT = """
+import numpy as np
+from meshlap_core import curvature, laplacian, primitives
+from meshlap_core.errors import MeshError
+V, F = primitives.icosphere(2)
+for fn in (curvature.principal_curvature_quadric, curvature.curvature_fields,
+           laplacian.cotan_stiffness, laplacian.mass_matrix):
+    try:
+        fn(V * {scale}, F)
+    except MeshError as exc:
+        print("refused", fn.__name__, exc)
+    else:
+        print("accepted", fn.__name__)
+"""
+
+
+@pytest.mark.parametrize("scale", ["1e80", "-1e300"])
+def test_libigl_entry_points_refuse_huge_coordinates_in_a_subprocess(scale):
+    """A valid-looking mesh with coordinates near 1e80 made libigl's quadric fit segfault the
+    interpreter; every public entry point coerces through ``types.as_vertices``, which refuses
+    |x| > MAX_COORDINATE as the loader does. Run in a subprocess: a crash fails this test
+    (non-zero return code) instead of killing pytest."""
+    import subprocess
+    import sys
+
+    r = subprocess.run(
+        [sys.executable, "-c", HUGE_INPUT.format(scale=scale)],
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert r.returncode == 0, r.stderr
+    lines = r.stdout.splitlines()
+    assert len(lines) == 4 and all(line.startswith("refused") for line in lines), lines
+    assert all("1e+75" in line for line in lines)
+
+
+def test_coordinates_at_the_limit_are_accepted():
+    from meshlap_core.options import MAX_COORDINATE
+    from meshlap_core.types import as_vertices
+
+    V = np.array([[MAX_COORDINATE, -MAX_COORDINATE, 0.0]])
+    np.testing.assert_array_equal(as_vertices(V), V)

@@ -191,3 +191,33 @@ def test_edge_faces_agree_with_topology_counts():
     got = {tuple(sorted(e)) for e in adj.edges.tolist()}
     want = {tuple(e) for e in E[count == 2].tolist()}
     assert got == want
+
+
+@pytest.mark.parametrize("flip", [False, True])
+def test_volume_change_is_signed_by_the_enclosed_volume(flip):
+    """Shrinking an icosphere by 10 % loses 27.1 % of its enclosed volume, whichever way its
+    faces point (an inside-out sphere has a negative signed volume)."""
+    V, F = icosphere(3)
+    if flip:
+        F = F[:, ::-1].copy()
+    assert (M.signed_volume(V, F) < 0) == flip
+    pct, reason = M.volume_change_pct(0.9 * V, V, F)
+    assert reason is None and pct == pytest.approx(100 * (0.9**3 - 1))
+    pct, _ = M.volume_change_pct(1.1 * V, V, F)
+    assert pct == pytest.approx(100 * (1.1**3 - 1))
+    ref = M.Reference(V, F)
+    assert ref.compare(0.9 * V)["volume_change_pct"] == pytest.approx(100 * (0.9**3 - 1))
+
+
+def test_smoothing_an_inside_out_sphere_reports_shrinkage():
+    from meshlap_core.smoothing import Smoother
+
+    V, F = icosphere(2)
+    out = {}
+    for flip in (False, True):
+        G = F[:, ::-1].copy() if flip else F
+        s = Smoother(V, G, "explicit", "uniform", 0.5, warn=False)
+        for _ in range(5):
+            s.step()
+        out[flip] = s.history[-1]["volume_change_pct"]
+    assert out[True] < 0 and out[True] == pytest.approx(out[False], rel=1e-12)

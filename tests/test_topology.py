@@ -2,6 +2,7 @@
 
 import itertools
 
+import hostile
 import numpy as np
 import pytest
 
@@ -132,3 +133,44 @@ def test_vertex_out_of_range_message():
     _, F = primitives.cube()
     with pytest.raises(MeshError, match="out of range"):
         topology.one_ring(F, 8)[8]
+
+
+@pytest.mark.parametrize(
+    "make, fans",
+    [
+        (hostile.touching_spheres, [True, True]),
+        (lambda: hostile.tetrahedra_sharing_vertex(2), [True, True]),
+        (lambda: hostile.tetrahedra_sharing_vertex(3), [True, True, True]),
+        (hostile.glued_torus, [True, True]),
+        (hostile.sphere_touching_disk, [True, False]),
+    ],
+)
+def test_nonmanifold_vertex_fans_listed_in_order(make, fans):
+    """Vertices with several fans (the one-ring walk used to loop forever on them): each fan is
+    listed separately, in counter-clockwise order, and the vertex is flagged."""
+    V, F = make()
+    n = len(V)
+    ring = topology.one_ring(F, n)
+    v = int(F[0, 0])  # the glued vertex
+    assert not ring.manifold[v] and ring.n_fans[v] == len(fans)
+    got = ring.fans(v)
+    assert [f.closed for f in got] == fans
+    faces = face_set(F)
+    seen = []
+    for fan in got:
+        r = fan.neighbors.tolist()
+        for a, b in consecutive(r, closed=fan.closed):
+            assert rot([v, a, b]) in faces
+        seen += fan.faces.tolist()
+    assert sorted(seen) == np.flatnonzero((F == v).any(axis=1)).tolist()
+    assert sorted(ring[v].tolist()) == ring[v].tolist()  # not a disk: listed by index
+    others = np.ones(n, dtype=bool)
+    others[v] = False
+    assert ring.manifold[others].all() and (ring.n_fans[others] == 1).all()
+    assert ring.boundary[v] == (False in fans)
+
+
+def test_one_ring_of_a_vertex_in_no_face():
+    ring = topology.one_ring(np.array([[0, 1, 2]]), 4)
+    assert ring.n_fans[3] == 0 and ring.fans(3) == [] and ring.manifold[3]
+    assert ring[3].tolist() == []

@@ -8,15 +8,36 @@ files) into one line ``meshlap: error: <file>: <problem>`` on stderr and exit co
 
 from __future__ import annotations
 
-import argparse
-import importlib
 import os
+import signal
 import sys
-import warnings
-from collections.abc import Sequence
+import threading
 
-from .._version import __version__
-from ..errors import MeshError, MeshWarning
+
+def _quiet_interrupt(signum: int, frame: object) -> None:
+    """SIGINT while this package is being imported: one line, exit 130, no traceback."""
+    sys.stderr.write("meshlap: interrupted\n")
+    os._exit(130)
+
+
+# Run as the program (the ``meshlap`` script, or ``python -m meshlap_core.cli`` while runpy
+# locates the module, when ``sys.argv[0]`` is still "-m"): until ``main`` starts the command,
+# SIGINT exits 130 with one line instead of a traceback from inside numpy / scipy / libigl.
+# A program that merely imports this package keeps Python's handler.
+if (
+    os.path.basename(sys.argv[0] if sys.argv else "") in ("meshlap", "-m")
+    and threading.current_thread() is threading.main_thread()
+    and signal.getsignal(signal.SIGINT) is signal.default_int_handler
+):
+    signal.signal(signal.SIGINT, _quiet_interrupt)
+
+import argparse  # noqa: E402
+import importlib  # noqa: E402
+import warnings  # noqa: E402
+from collections.abc import Sequence  # noqa: E402
+
+from .._version import __version__  # noqa: E402
+from ..errors import MeshError, MeshWarning  # noqa: E402
 
 # subcommand modules, in the order ``meshlap --help`` lists them
 COMMANDS: tuple[str, ...] = (
@@ -60,8 +81,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     traceback); 130 interrupted. Warnings raised while a command runs are printed after it
     succeeds, one line ``meshlap: warning: ...`` each, and dropped when it fails.
     """
-    parser = build_parser()
+    try:
+        parser = build_parser()  # imports numpy, scipy and libigl: the slow part of start-up
+    except KeyboardInterrupt:
+        sys.stderr.write("meshlap: interrupted\n")
+        return 130
     args = parser.parse_args(argv)
+    if signal.getsignal(signal.SIGINT) is _quiet_interrupt:  # the command handles it from here
+        signal.signal(signal.SIGINT, signal.default_int_handler)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", MeshWarning)
         try:

@@ -1,5 +1,11 @@
 """``python -m meshlap_core.cli``."""
 
-from . import main
+try:
+    from . import main
+except KeyboardInterrupt:  # interrupted while importing: one line, no traceback
+    import sys
+
+    sys.stderr.write("meshlap: interrupted\n")
+    raise SystemExit(130) from None
 
 raise SystemExit(main())

@@ -45,7 +45,9 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    out = Path(args.out) if args.out else None
+    if args.out is not None and not args.out.strip():
+        raise MeshError("the output path is empty (give a file name or leave --out out)", "--out")
+    out = Path(args.out) if args.out is not None else None
     if out is not None:  # checked first: a doomed run fails at once and writes nothing
         check_output_path(out, overwrite_inputs=(args.mesh,), suffixes=OUT_SUFFIXES)
     mesh = load_mesh(args.mesh)

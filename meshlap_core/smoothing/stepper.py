@@ -19,7 +19,7 @@ import scipy.sparse as sp
 from ..errors import MeshError, MeshWarning
 from ..laplacian import vertex_areas
 from ..linalg.spd import SPDSolver
-from ..metrics import _signed_volume_unchecked, n_boundary_edges
+from ..metrics import _signed_volume_unchecked, n_boundary_edges, percent_volume_change
 from ..noise import bbox_diagonal
 from ..options import AREA_KINDS, MASS_AREA, AreaKind, LaplacianKind
 from ..topology import boundary_vertex_mask
@@ -540,9 +540,7 @@ class Smoother:
         if self.closed and self.volume0 is not None:
             vol = _signed_volume_unchecked(x, self.F, self._FT)
             entry["volume"] = vol
-            entry["volume_change_pct"] = (
-                100.0 * (vol - self.volume0) / abs(self.volume0) if self.volume0 else None
-            )
+            entry["volume_change_pct"] = percent_volume_change(vol, self.volume0)
         else:
             entry["volume"] = None
             entry["volume_change_pct"] = None
