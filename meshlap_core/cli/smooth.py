@@ -104,6 +104,10 @@ def _int_arg(text: str, name: str) -> int:
 
 
 def run(args: argparse.Namespace) -> int:
+    """Check the arguments, smooth, write, and report.
+
+    Long because the result's JSON object is spelled out key by key in one place (32 lines).
+    """
     from ..io import load_mesh  # imported here so --help never loads the mesh readers
 
     lam = check_lam(_float_arg(args.lam, "--lam"), "--lam")
