@@ -73,7 +73,7 @@ def test_equilateral_triangle_by_hand():
     V = np.array([[0.0, 0, 0], [1, 0, 0], [0.5, np.sqrt(3) / 2, 0]])
     F = np.array([[0, 1, 2]])
     for mass in S.MASS_KINDS:
-        lam, U, _ = S.laplacian_eigenpairs(V, F, 3, mass=mass)
+        lam, U, _ = S.laplacian_eigenpairs(V, F, 3, area=mass)
         np.testing.assert_allclose(lam, [0.0, 6.0, 6.0], atol=1e-12)
         np.testing.assert_allclose(U[:, 0], 1 / np.sqrt(np.sqrt(3) / 4), rtol=1e-12)
 
@@ -416,7 +416,7 @@ def test_save_and_load_roundtrip(tmp_path):
     c = S.SpectralBasis.load(tmp_path / "b.npz", V, F)
     np.testing.assert_array_equal(c.vectors, b.vectors)
     with pytest.raises(MeshError, match="stale"):
-        S.SpectralBasis.load(tmp_path / "b.npz", V, F, mass="barycentric")
+        S.SpectralBasis.load(tmp_path / "b.npz", V, F, area="barycentric")
 
 
 # ----------------------------------------------------------------------------- CLI
@@ -495,3 +495,30 @@ def test_cleaned_dragon_nonmanifold_seven_components(shared_mesh):
     # (relative residuals in the original pencil are amplified by λ_max/λ, ~1e9 on this mesh
     # of slivers; 1e-3 means the vectors are eigenvectors, the eigenvalues far better)
     assert _orth(U, m) <= 1e-10 and info.max_residual < 1e-3
+
+
+def test_the_pencil_is_assembled_once_per_cache_miss(monkeypatch, tmp_path):
+    from meshlap_core import laplacian
+
+    calls = {"stiffness": 0, "areas": 0}
+    stiffness, areas = laplacian.cotan_stiffness, laplacian.vertex_areas
+
+    def counted_stiffness(*args, **kw):
+        calls["stiffness"] += 1
+        return stiffness(*args, **kw)
+
+    def counted_areas(*args, **kw):
+        calls["areas"] += 1
+        return areas(*args, **kw)
+
+    monkeypatch.setattr(laplacian, "cotan_stiffness", counted_stiffness)
+    monkeypatch.setattr(laplacian, "vertex_areas", counted_areas)
+    V, F = icosphere(2)
+    basis = S.SpectralBasis.compute(V, F, 4, cache_dir=tmp_path)
+    assert not basis.info.from_cache
+    assert calls == {"stiffness": 1, "areas": 1}
+    # an extension beyond the cached modes: once more
+    basis.ensure(10)
+    assert calls == {"stiffness": 2, "areas": 2}
+    # the result is the sphere's spectrum: 0, then l(l+1) = 2 three times
+    np.testing.assert_allclose(basis.eigenvalues[1:4], 2.0, rtol=0.02)

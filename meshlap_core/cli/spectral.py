@@ -134,7 +134,7 @@ def run(args: argparse.Namespace) -> int:
             F,
             k,
             laplacian=args.laplacian,
-            mass=args.mass,
+            area=args.mass,
             cache=not args.no_cache,
             progress=_Progress(),
         )
