@@ -45,9 +45,9 @@ from scipy.linalg import blas
 
 from ..errors import MeshError
 from .blas import blas_threads as limit_blas_threads
-from .checks import max_residual, orthogonality
-from .common import FloatArray, ProgressCallback, SolveInfo, report_progress
-from .components import components, null_space
+from .checks import RESIDUAL_TOL, inertia_check, orthogonality, pair_residuals
+from .common import FloatArray, IntArray, ProgressCallback, SolveInfo, report_progress
+from .components import component_scales, components, null_space, scale_groups, solve_by_groups
 from .slicing import SlicedLanczos, default_workers
 
 # Dense solver below this many vertices (or when k is a large fraction of n).
@@ -210,21 +210,158 @@ def pencil_eigenpairs(
     Sylvester inertia counts at every shift, plus one in a gap just above ``λ_k``, prove that
     no eigenvalue was skipped.
 
-    (Over 80 lines only because of this docstring: the body is ~40 lines, the two solver
-    paths being :func:`dense_eigenpairs` and ``_sparse_eigenpairs``.)
+    Components whose frequency scales differ by more than
+    :data:`~meshlap_core.linalg.components.SCALE_GAP` are solved group by group, each with its
+    own shifts. Every result is checked before it is returned: the residual of every pair
+    (at most :data:`~meshlap_core.linalg.checks.RESIDUAL_TOL`) and, for the dense solver,
+    Sylvester's inertia at a gap; a result that fails raises :class:`MeshError`.
+
+    (Over 80 lines only because of this docstring: the body is ~35 lines.)
     """
     t0 = time.perf_counter()
     K, m, k = _checked_pencil(K, m, k)
+    ncomp, labels = components(K)
+    groups = scale_groups(component_scales(K, m, labels, ncomp)) if ncomp > 1 else []
+    tuning = {"tol": tol, "block": block, "slice_size": slice_size, "first_slice": first_slice}
+    if len(groups) > 1:
+        _use_dense(method, len(m), k)  # (checks the method's name)
+        lam, U, info = _grouped_eigenpairs(
+            K,
+            m,
+            k,
+            labels,
+            groups,
+            method=method,
+            progress=progress,
+            tuning=tuning,
+            workers=workers,
+            blas_threads_=blas_threads,
+        )
+    else:
+        lam, U, info = _solve(
+            K,
+            m,
+            k,
+            labels,
+            ncomp,
+            method=method,
+            progress=progress,
+            known=known,
+            tuning=tuning,
+            workers=workers,
+            blas_threads_=blas_threads,
+            density=density,
+        )
+    info.timings["eigensolve"] = time.perf_counter() - t0
+    _check_result(K, m, lam, U, labels, info)
+    return lam, U, info
+
+
+def _grouped_eigenpairs(
+    K: sp.csr_matrix,
+    m: FloatArray,
+    k: int,
+    labels: IntArray,
+    groups: list[IntArray],
+    *,
+    method: str,
+    progress: ProgressCallback | None,
+    tuning: dict[str, Any],
+    workers: int | None,
+    blas_threads_: int | None,
+) -> tuple[FloatArray, FloatArray, SolveInfo]:
+    """:func:`pencil_eigenpairs` group by group (components of very different scale, see
+    :func:`~meshlap_core.linalg.components.solve_by_groups`): each group's sub-pencil gets its
+    own solve, shifts and checks; known pairs are not reused."""
+
+    def solve(Kg: sp.csr_matrix, mg: FloatArray, kg: int, g: int) -> Any:
+        sub = method if method != "sparse" or kg <= SPARSE_MAX_FRACTION * len(mg) else "auto"
+        return pencil_eigenpairs(
+            Kg,
+            mg,
+            kg,
+            method=sub,  # type: ignore[arg-type]
+            progress=_group_progress(progress, g, len(groups)),
+            workers=workers,
+            blas_threads=blas_threads_,
+            **tuning,
+        )
+
+    lam, U, info = solve_by_groups(K, m, k, labels, groups, solve)
+    info.messages.insert(
+        0,
+        f"components of very different scale: solved in {len(groups)} groups, each with "
+        "its own shifts (one solve would lose the small eigenvalues to round-off)",
+    )
+    return lam, U, info
+
+
+def _group_progress(
+    progress: ProgressCallback | None, g: int, count: int
+) -> ProgressCallback | None:
+    """``progress`` for group ``g`` of ``count``: its fractions mapped into ``[g, g+1]/count``."""
+    if progress is None:
+        return None
+    outer = progress
+    return lambda f, msg: outer((g + f) / count, f"group {g + 1}/{count}: {msg}")
+
+
+def _check_result(
+    K: sp.csr_matrix,
+    m: FloatArray,
+    lam: FloatArray,
+    U: FloatArray,
+    labels: IntArray,
+    info: SolveInfo,
+) -> None:
+    """Measure every pair's residual (one sparse product) and the orthonormality into
+    ``info``; refuse the result (:class:`MeshError`) if a pair misses :data:`RESIDUAL_TOL`."""
+    t1 = time.perf_counter()
+    res = pair_residuals(K, m, lam, U, labels)
+    info.max_residual = float(res.max(initial=0.0))
+    info.orthogonality_error = orthogonality(U, m)
+    info.timings["residual_check"] = time.perf_counter() - t1
+    bad = np.flatnonzero(~(res <= RESIDUAL_TOL))
+    if len(bad):
+        j = int(bad[np.argmax(np.where(np.isfinite(res[bad]), res[bad], np.inf))])
+        raise MeshError(
+            f"the eigensolver's result fails its check: {len(bad)} of {len(lam)} eigenpairs "
+            f"have a relative residual above {RESIDUAL_TOL:.0e} (pair {j}, lambda = "
+            f"{lam[j]:.6g}: {res[j]:.1e}); the eigenproblem is too badly conditioned to "
+            "solve accurately, so no basis is given",
+            "K",
+        )
+
+
+def _solve(
+    K: sp.csr_matrix,
+    m: FloatArray,
+    k: int,
+    labels: IntArray,
+    ncomp: int,
+    *,
+    method: str,
+    progress: ProgressCallback | None,
+    known: tuple[FloatArray, FloatArray] | None,
+    tuning: dict[str, Any],
+    workers: int | None,
+    blas_threads_: int | None,
+    density: float | None,
+) -> tuple[FloatArray, FloatArray, SolveInfo]:
+    """:func:`pencil_eigenpairs` on a pencil whose components have comparable scales: the
+    exact null space, then the dense or the sparse solver; ``(lam, U, info)``."""
     n = len(m)
     info = SolveInfo(n_vertices=n, k=k)
-    ncomp, labels = components(K)
     Z = null_space(m, labels, ncomp)
     info.n_components = ncomp
     if _use_dense(method, n, k):
         info.method = "dense"
         report_progress(progress, 0.0, f"eigensolver: dense, {n} vertices")
         with limit_blas_threads(1):
-            lam, Y = dense_eigenpairs(K, m, k, Z)
+            lam, Y = dense_eigenpairs(K, m, min(n, k + 2 + k // 50), Z)
+            inertia_check(K, m, lam, k)
+            info.n_factorizations += 1
+            lam, Y = lam[:k], np.asfortranarray(Y[:, :k])
             lowdin(Y)
         report_progress(progress, 1.0, "eigensolver: done")
     else:
@@ -236,22 +373,12 @@ def pencil_eigenpairs(
             info,
             progress=progress,
             known=known,
-            tuning={
-                "tol": tol,
-                "block": block,
-                "slice_size": slice_size,
-                "first_slice": first_slice,
-            },
+            tuning=tuning,
             workers=workers,
-            blas_threads_=blas_threads,
+            blas_threads_=blas_threads_,
             density=density,
         )
     lam, U = _finish(K, m, lam, Y, info)
-    info.timings["eigensolve"] = time.perf_counter() - t0
-    t1 = time.perf_counter()
-    info.max_residual = max_residual(K, m, lam, U)
-    info.orthogonality_error = orthogonality(U, m)
-    info.timings["residual_check"] = time.perf_counter() - t1
     return lam, U, info
 
 
@@ -330,19 +457,26 @@ def _sparse_eigenpairs(
         nb = 1 if blas_threads_ is None else max(1, int(blas_threads_))
         info.messages.append(f"{nw} slice worker(s), {nb} BLAS thread(s)")
         rho = float(density) if density else float(m.sum() / (4 * np.pi))
-        with limit_blas_threads(nb):
-            lam, Y = SlicedLanczos(
-                K,
-                m,
-                k,
-                Z,
-                info,
-                known=kn,
-                progress=progress,
-                workers=nw,
-                weyl_density=rho,
-                **tuning,
-            ).solve()
+        try:
+            with limit_blas_threads(nb):
+                lam, Y = SlicedLanczos(
+                    K,
+                    m,
+                    k,
+                    Z,
+                    info,
+                    known=kn,
+                    progress=progress,
+                    workers=nw,
+                    weyl_density=rho,
+                    **tuning,
+                ).solve()
+        except RuntimeError as exc:  # (inertia counts that cannot be reconciled, no factor)
+            raise MeshError(
+                f"{exc}; the eigenproblem is too badly conditioned for the solver, so no "
+                "basis is given",
+                "K",
+            ) from None
     t1 = time.perf_counter()
     with limit_blas_threads(1):
         if nw >= 2:

@@ -15,7 +15,15 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 
-from ..linalg.checks import max_residual, orthogonality
+from ..errors import MeshError
+from ..linalg.checks import (
+    RESIDUAL_TOL,
+    inertia_check,
+    orthogonality,
+    orthonormality_probe,
+    pair_residuals,
+)
+from ..linalg.components import components
 from ..types import FloatArray, IntArray, as_mesh
 
 CACHE_FORMAT = 1
@@ -60,9 +68,12 @@ def write_npz(path: Path, arrays: dict[str, Any], overwrite_inputs: Any = ()) ->
 def validate_arrays(
     data: Any, key: str, options: dict[str, str], K: sp.csr_matrix, m: FloatArray
 ) -> tuple[FloatArray, FloatArray, float]:
-    """Check a loaded basis thoroughly (format, hash, options, shapes, finite values, ascending
-    non-negative eigenvalues, the mass, ``M``-orthonormality of a sample of columns against all,
-    eigen-residuals of the sample); raise ``ValueError`` with the reason if anything is off.
+    """Check a loaded basis in full before it is trusted (format, hash, options, shapes, finite
+    values, ascending non-negative eigenvalues, the mass; ``M``-orthonormality: a sample of
+    columns against all, every column's norm and random probes of the whole ``UᵀMU = I``; the
+    residual of every pair, one sparse product; Sylvester's inertia at a gap, so that no
+    eigenvalue is missing below it); raise ``ValueError`` with the reason if anything is off.
+    A file whose key and checksum are right but whose numbers were altered is refused.
     Returns the eigenvalues, vectors and the sampled orthogonality error."""
     need = ("format", "key", "options", "eigenvalues", "vectors", "mass")
     missing = [x for x in need if x not in data]
@@ -89,10 +100,24 @@ def validate_arrays(
     if not np.allclose(mm, m, rtol=1e-12, atol=0):
         raise ValueError("mass differs")
     orth = orthogonality(U, m)
-    if orth > 1e-8:
-        raise ValueError("vectors are not M-orthonormal")
-    if max_residual(K, m, lam, U) > 1e-5:  # (on up to 64 columns spread evenly)
-        raise ValueError("vectors are not eigenvectors")
+    probe = orthonormality_probe(U, m, np.random.default_rng())  # (unseeded: unpredictable)
+    if orth > 1e-8 or probe > 1e-6:
+        raise ValueError(
+            f"vectors are not M-orthonormal (max|U^T M U - I| {orth:.1e}, probe {probe:.1e})"
+        )
+    _, labels = components(K)
+    res = pair_residuals(K, m, lam, U, labels)
+    bad = np.flatnonzero(~(res <= RESIDUAL_TOL))
+    if len(bad):
+        j = int(bad[0])
+        raise ValueError(
+            f"{len(bad)} of {len(lam)} pairs are not eigenpairs of this mesh (pair {j}, "
+            f"lambda = {lam[j]:.6g}: relative residual {res[j]:.1e} > {RESIDUAL_TOL:.0e})"
+        )
+    try:
+        inertia_check(K, m, lam, len(lam))
+    except MeshError as exc:
+        raise ValueError(exc.problem) from None
     return lam, np.asfortranarray(U), orth
 
 
