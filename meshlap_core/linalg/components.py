@@ -20,11 +20,13 @@ GroupSolver = Callable[
 ]
 """``solve(K_g, m_g, k_g, group_index) -> (lam, U, info)`` for one group's sub-pencil."""
 
-SCALE_GAP = 1e4
+SCALE_GAP = 1e3
 """Components whose frequency scales (:func:`component_scales`) differ by more than this
 factor are solved separately (:func:`scale_groups`). In one solve, round-off of the order of
-``ε·λ_max`` of the coarsest component swamps the low eigenvalues of the others: at a ratio of
-1e4 the dense solver's residuals are still ~1e-8, at 1e6 already ~1e-6."""
+``ε·λ_max`` of the finest component swamps the low eigenvalues of the others. Measured on two
+642-vertex icospheres of radii 1 and r solved as one pencil (scale ratio r²): the sliced
+Lanczos solver keeps every residual below 4e-7 up to r = 100 and misses the tolerance at
+r = 1000; dense ``eigh`` of radii 1e-6 and 1e6 returns accurate pairs but not the smallest."""
 
 
 def components(K: sp.csr_matrix) -> tuple[int, IntArray]:
