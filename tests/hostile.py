@@ -1014,6 +1014,21 @@ CORPUS: list[Hostile] = [
         "ok",
         n_vertices=162,
         n_faces=320,
+    # round 2: spectral
+    Hostile(
+        "two_scales_1e-6_1e6.obj",
+        _text("two_scales_1e-6_1e6.obj", lambda: _two_scales(1e-6, 1e6)),
+        "ok",
+        n_vertices=84,
+        n_faces=160,
+        closed=True,
+    ),
+    Hostile(
+        "two_scales_1e-12_1.obj",
+        _text("two_scales_1e-12_1.obj", lambda: _two_scales(1e-12, 1.0)),
+        "ok",
+        n_vertices=84,
+        n_faces=160,
         closed=True,
     ),
 ]
@@ -1129,3 +1144,9 @@ def inside_out_sphere() -> tuple[np.ndarray, np.ndarray]:
     """An icosphere with every face reversed: closed, consistently but inward oriented."""
     V, F = primitives.icosphere(2)
     return V, F[:, ::-1].copy()
+# round 2: spectral (built lazily by the CORPUS entries above)
+def _two_scales(small: float, big: float) -> str:
+    """Two icospheres of radii ``small`` and ``big`` side by side (round 2: the spectrum of a
+    pencil whose components differ in scale by many orders)."""
+    V, F = primitives.icosphere(1)
+    return obj_text(np.vstack([V * small, V * big + [3.0 * big, 0, 0]]), np.vstack([F, F + len(V)]))

@@ -1,4 +1,4 @@
-"""Tests of the eigensolver's building blocks in meshlap_core.spectral.
+"""Tests of the eigensolver's building blocks in meshlap_core.linalg.
 
 The pieces: block Lanczos with delayed classical Gram–Schmidt (DCGS2), Cholesky QR, the QDLDL
 ``LDLᵀ`` with its inertia (and the SuperLU fallback), the Löwdin orthonormalization (on two
@@ -16,6 +16,11 @@ import pytest
 import scipy.sparse as sp
 
 from meshlap_core import spectral as S
+from meshlap_core.linalg import factor
+from meshlap_core.linalg.blas import gemm_update, right_solve
+from meshlap_core.linalg.eigsolve import lowdin
+from meshlap_core.linalg.factor import QDLDLFactor, ShiftInvert, SuperLUFactor, qdldl_inertia
+from meshlap_core.linalg.lanczos import BlockLanczos, chol_qr
 from meshlap_core.primitives import bumpy_sphere
 
 
@@ -27,7 +32,7 @@ def _diag_lanczos(theta, *, delayed, X=None, steps, block=4, seed=0):
         out[...] = theta[:, None] * Y
 
     rng = np.random.default_rng(seed)
-    lz = S._BlockLanczos(op, n, block, X, rng, capacity=steps * block + 2 * block)
+    lz = BlockLanczos(op, n, block, X, rng, capacity=steps * block + 2 * block)
     lz.delayed = delayed
     for _ in range(steps):
         lz.step()
@@ -102,7 +107,7 @@ def test_cholesky_qr_orthonormalizes_and_refuses_ill_conditioned_blocks():
     rng = np.random.default_rng(1)
     W = np.asfortranarray(rng.standard_normal((5000, 4)))
     W0 = W.copy()
-    R = S._chol_qr(W, 2, 1e-4)
+    R = chol_qr(W, 2, 1e-4)
     assert R is not None and np.allclose(R, np.triu(R))
     np.testing.assert_allclose(W.T @ W, np.eye(4), atol=1e-14)
     np.testing.assert_allclose(W @ R, W0, atol=1e-12)
@@ -112,7 +117,7 @@ def test_cholesky_qr_orthonormalizes_and_refuses_ill_conditioned_blocks():
     bad = np.asfortranarray(W0.copy())
     bad[:, 3] = bad[:, 0] + 1e-9 * bad[:, 1]  # nearly dependent: Cholesky QR would be wrong
     keep = bad.copy()
-    assert S._chol_qr(bad, 2, 1e-4) is None
+    assert chol_qr(bad, 2, 1e-4) is None
     np.testing.assert_array_equal(bad, keep)  # untouched when refused
 
 
@@ -122,11 +127,11 @@ def test_gemm_update_and_right_solve_in_place():
     A = np.asfortranarray(rng.standard_normal((300, 1)))  # inner dimension 1
     B = rng.standard_normal((1, 4))
     expect = C - A @ B
-    S._gemm_update(C, A, B)
+    gemm_update(C, A, B)
     np.testing.assert_allclose(C, expect, atol=1e-13)
     R = np.triu(rng.standard_normal((4, 4))) + 4 * np.eye(4)
     expect = C @ np.linalg.inv(R)
-    S._right_solve(C, R)
+    right_solve(C, R)
     np.testing.assert_allclose(C, expect, atol=1e-12)
 
 
@@ -140,7 +145,7 @@ def test_lowdin_orthonormalizes_with_the_smallest_change(perturbation, threads):
     Y0 = Y.copy()
     helper = cf.ThreadPoolExecutor(max_workers=1) if threads == 2 else None
     try:
-        err = S._lowdin(Y, helper)
+        err = lowdin(Y, helper)
     finally:
         if helper is not None:
             helper.shutdown()
@@ -164,7 +169,7 @@ def _indefinite(n=400, seed=6):
 def test_qdldl_inertia_counts_the_negative_eigenvalues_and_solves():
     A = _indefinite()
     rng = np.random.default_rng(0)
-    ldl, neg = S._qdldl_inertia(A, rng)
+    ldl, neg = qdldl_inertia(A, rng)
     assert neg == np.count_nonzero(np.linalg.eigvalsh(A.toarray()) < 0)
     b = rng.standard_normal((A.shape[0], 3))
     np.testing.assert_allclose(A @ ldl.solve(b), b, atol=1e-9)
@@ -173,14 +178,14 @@ def test_qdldl_inertia_counts_the_negative_eigenvalues_and_solves():
 def test_shift_invert_falls_back_to_superlu_without_qdldl(monkeypatch):
     A = _indefinite()
     rng = np.random.default_rng(0)
-    op_q = S._ShiftInvert(A, 0.25, rng=rng, spacing=1.0)
+    op_q = ShiftInvert(A, 0.25, rng=rng, spacing=1.0)
 
     def unavailable(*args):
         raise ImportError("no qdldl")
 
-    monkeypatch.setattr(S, "_qdldl_inertia", unavailable)
-    op_s = S._ShiftInvert(A, 0.25, rng=rng, spacing=1.0)
-    assert isinstance(op_q._lu, S._QDLDL) and isinstance(op_s._lu, S._LDL)
+    monkeypatch.setattr(factor, "qdldl_inertia", unavailable)
+    op_s = ShiftInvert(A, 0.25, rng=rng, spacing=1.0)
+    assert isinstance(op_q.factor, QDLDLFactor) and isinstance(op_s.factor, SuperLUFactor)
     assert (
         op_q.n_below
         == op_s.n_below
@@ -196,7 +201,7 @@ def test_shift_invert_falls_back_to_superlu_without_qdldl(monkeypatch):
 def test_a_shift_on_an_eigenvalue_is_moved_not_factored():
     # A − σI exactly singular at σ = 2: QDLDL hits a zero pivot and the shift moves
     A = sp.diags([1.0, 2.0, 3.0, 4.0]).tocsr()
-    op = S._ShiftInvert(A, 2.0, rng=np.random.default_rng(0), spacing=1.0)
+    op = ShiftInvert(A, 2.0, rng=np.random.default_rng(0), spacing=1.0)
     assert op.sigma != 2.0 and abs(op.sigma - 2.0) < 0.1
     assert op.n_below == (1 if op.sigma > 2.0 else 0) + 1
 
@@ -218,8 +223,8 @@ def test_qdldl_refactors_a_spare_factorization_of_the_same_pattern():
     A = _indefinite()
     eye = sp.identity(A.shape[0], format="csr")
     rng = np.random.default_rng(0)
-    first, _ = S._qdldl_inertia((A - 0.5 * eye).tocsr(), rng)
-    again, neg = S._qdldl_inertia((A - 1.5 * eye).tocsr(), rng, reuse=first)
+    first, _ = qdldl_inertia((A - 0.5 * eye).tocsr(), rng)
+    again, neg = qdldl_inertia((A - 1.5 * eye).tocsr(), rng, reuse=first)
     assert again.solver is first.solver  # refactored in place
     assert neg == np.count_nonzero(np.linalg.eigvalsh(A.toarray()) < 1.5)
     b = rng.standard_normal(A.shape[0])
@@ -231,6 +236,6 @@ def test_qdldl_refactors_a_spare_factorization_of_the_same_pattern():
     B[i[off], j[off]] = B[j[off], i[off]] = 0.0
     B = B.tocsr()
     B.eliminate_zeros()
-    other, neg_b = S._qdldl_inertia(B, rng, reuse=again)
+    other, neg_b = qdldl_inertia(B, rng, reuse=again)
     assert other.solver is not again.solver
     assert neg_b == np.count_nonzero(np.linalg.eigvalsh(B.toarray()) < 0)

@@ -73,7 +73,7 @@ def test_equilateral_triangle_by_hand():
     V = np.array([[0.0, 0, 0], [1, 0, 0], [0.5, np.sqrt(3) / 2, 0]])
     F = np.array([[0, 1, 2]])
     for mass in S.MASS_KINDS:
-        lam, U, _ = S.laplacian_eigenpairs(V, F, 3, mass=mass)
+        lam, U, _ = S.laplacian_eigenpairs(V, F, 3, area=mass)
         np.testing.assert_allclose(lam, [0.0, 6.0, 6.0], atol=1e-12)
         np.testing.assert_allclose(U[:, 0], 1 / np.sqrt(np.sqrt(3) / 4), rtol=1e-12)
 
@@ -416,7 +416,7 @@ def test_save_and_load_roundtrip(tmp_path):
     c = S.SpectralBasis.load(tmp_path / "b.npz", V, F)
     np.testing.assert_array_equal(c.vectors, b.vectors)
     with pytest.raises(MeshError, match="stale"):
-        S.SpectralBasis.load(tmp_path / "b.npz", V, F, mass="barycentric")
+        S.SpectralBasis.load(tmp_path / "b.npz", V, F, area="barycentric")
 
 
 # ----------------------------------------------------------------------------- CLI
@@ -495,3 +495,184 @@ def test_cleaned_dragon_nonmanifold_seven_components(shared_mesh):
     # (relative residuals in the original pencil are amplified by λ_max/λ, ~1e9 on this mesh
     # of slivers; 1e-3 means the vectors are eigenvectors, the eigenvalues far better)
     assert _orth(U, m) <= 1e-10 and info.max_residual < 1e-3
+
+
+def test_the_pencil_is_assembled_once_per_cache_miss(monkeypatch, tmp_path):
+    from meshlap_core import laplacian
+
+    calls = {"stiffness": 0, "areas": 0}
+    stiffness, areas = laplacian.cotan_stiffness, laplacian.vertex_areas
+
+    def counted_stiffness(*args, **kw):
+        calls["stiffness"] += 1
+        return stiffness(*args, **kw)
+
+    def counted_areas(*args, **kw):
+        calls["areas"] += 1
+        return areas(*args, **kw)
+
+    monkeypatch.setattr(laplacian, "cotan_stiffness", counted_stiffness)
+    monkeypatch.setattr(laplacian, "vertex_areas", counted_areas)
+    V, F = icosphere(2)
+    basis = S.SpectralBasis.compute(V, F, 4, cache_dir=tmp_path)
+    assert not basis.info.from_cache
+    assert calls == {"stiffness": 1, "areas": 1}
+    # an extension beyond the cached modes: once more
+    basis.ensure(10)
+    assert calls == {"stiffness": 2, "areas": 2}
+    # the result is the sphere's spectrum: 0, then l(l+1) = 2 three times
+    np.testing.assert_allclose(basis.eigenvalues[1:4], 2.0, rtol=0.02)
+
+
+# ------------------------------------------------------------------ badly scaled input (issue 14)
+
+
+def _two_spheres(small: float, big: float):
+    """A fine icosphere of radius ``small`` beside a coarse one of radius ``big``."""
+    Vs, Fs = icosphere(3)  # 642 vertices
+    Vb, Fb = icosphere(1)  # 42 vertices
+    V = np.vstack([Vs * small, Vb * big + [3.0 * big, 0.0, 0.0]])
+    F = np.vstack([Fs, Fb + len(Vs)])
+    return V, F, (Vs * small, Fs), (Vb * big, Fb)
+
+
+@pytest.mark.parametrize("radii", [(1e-6, 1e6), (1e-12, 1.0)], ids=["1e-6,1e6", "1e-12,1"])
+@pytest.mark.parametrize("method", ["dense", "sparse"])
+def test_two_spheres_of_very_different_size_give_each_spectrum(radii, method):
+    """0, 0, then the l(l+1)/r² series of each sphere: the coarse big sphere's 41 non-zero
+    eigenvalues lie far below the small sphere's first, 2/r_small²; each as when the sphere
+    is solved alone."""
+    small, big = radii
+    V, F, alone_small, alone_big = _two_spheres(small, big)
+    k = 60
+    lam, U, info = S.laplacian_eigenpairs(V, F, k, method=method)
+    assert info.n_components == 2 and "per scale group" in info.method
+    if method == "sparse":
+        assert "Lanczos" in info.method
+    lam_s, _, _ = S.laplacian_eigenpairs(*alone_small, k, method="dense")
+    lam_b, _, _ = S.laplacian_eigenpairs(*alone_big, 42, method="dense")
+    ref = np.sort(np.r_[lam_s, lam_b])[:k]
+    assert lam[0] == lam[1] == 0.0
+    np.testing.assert_allclose(lam[2:], ref[2:], rtol=1e-8)
+    # the series: l(l+1)/r², l = 1 three times, for each sphere (as the meshes allow)
+    np.testing.assert_allclose(lam[2:5], 2.0 / big**2, rtol=0.15)
+    np.testing.assert_allclose(lam[43:46], 2.0 / small**2, rtol=1e-3)
+    assert lam[42] < 1e-6 * lam[43]  # every big-sphere mode before the small sphere's first
+    # M-orthonormal; every non-zero mode lives on one sphere
+    _, m = S.spectral_operators(V, F)
+    assert _orth(U, m) < 1e-10
+    n_small = len(alone_small[0])
+    on_small = np.sum(m[:n_small, None] * U[:n_small] ** 2, axis=0)
+    assert np.all((on_small < 1e-12) | (on_small > 1 - 1e-12))
+    assert info.max_residual <= 1e-8
+
+
+def _same_two_spheres(small: float, big: float):
+    """Two icospheres of 162 vertices, radii ``small`` and ``big``."""
+    V, F = icosphere(2)
+    return np.vstack([V * small, V * big + [3.0 * big, 0.0, 0.0]]), np.vstack([F, F + len(V)])
+
+
+@pytest.mark.parametrize("method", ["dense", "sparse"])
+def test_a_badly_scaled_pencil_solved_in_one_piece_is_refused(monkeypatch, method):
+    """Without the per-scale groups the solvers lose the big sphere's eigenvalues (dense
+    ``eigh``: pairs that are accurate but not the smallest; Lanczos: inertia counts that do
+    not match): the checks refuse the result instead of returning it."""
+    from meshlap_core.linalg import eigsolve
+
+    monkeypatch.setattr(eigsolve, "scale_groups", lambda s, gap=0: [np.arange(len(s))])
+    V, F = _same_two_spheres(1e-6, 1e6)
+    with pytest.raises(MeshError, match="badly conditioned"):
+        S.laplacian_eigenpairs(V, F, 20, method=method)
+
+
+def test_spectral_command_on_two_scales_is_right_or_refused(capsys, tmp_path, monkeypatch):
+    from meshlap_core.io import save_mesh
+    from meshlap_core.linalg import eigsolve
+
+    V, F, _, alone_big = _two_spheres(1e-12, 1.0)
+    path = tmp_path / "two.obj"
+    save_mesh(path, V, F)
+    code = main(["spectral", str(path), "--k", "50", "--json", "--no-cache"])
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    r = json.loads(out)
+    lam_b, _, _ = S.laplacian_eigenpairs(*alone_big, 42, method="dense")
+    np.testing.assert_allclose(r["eigenvalues"][2:43], lam_b[1:], rtol=1e-8)
+    assert r["max_residual"] <= 1e-8 and any("very different scale" in x for x in r["messages"])
+    # the same solve without the groups: one error line naming the file, exit 2
+    monkeypatch.setattr(eigsolve, "scale_groups", lambda s, gap=0: [np.arange(len(s))])
+    path = tmp_path / "same.obj"
+    save_mesh(path, *_same_two_spheres(1e-12, 1.0))
+    code = main(["spectral", str(path), "--k", "20", "--no-cache"])
+    out, err = capsys.readouterr()
+    assert code == 2 and out == "" and err.count("\n") == 1
+    assert err.startswith(f"meshlap: error: {path}: ") and "badly conditioned" in err
+
+
+# ------------------------------------------------------------------ the cache is verified in full
+
+
+def _tamper(path, change):
+    with np.load(path, allow_pickle=False) as data:
+        arrays = {key: data[key] for key in data.files}
+    change(arrays)
+    with open(path, "wb") as f:
+        np.savez(f, **arrays)
+
+
+def _shift_last(a):
+    a["eigenvalues"] = a["eigenvalues"].copy()
+    a["eigenvalues"][-1] *= 1.2  # (still ascending; not one of the sampled columns' checks)
+
+
+def _swap_vector(a):
+    U = a["vectors"].copy()
+    U[:, 11] = U[:, 12]  # an unsampled column replaced by its neighbour (same λ: l = 3)
+    a["vectors"] = U
+
+
+def _drop_pair(a):
+    keep = np.r_[0:5, 6 : len(a["eigenvalues"])]  # pair 5 lost: the rest are genuine
+    a["eigenvalues"] = a["eigenvalues"][keep]
+    a["vectors"] = np.asfortranarray(a["vectors"][:, keep])
+
+
+@pytest.mark.parametrize(
+    "change, words",
+    [(_shift_last, "not eigenpairs"), (_swap_vector, "orthonormal"), (_drop_pair, "inertia")],
+    ids=["eigenvalue+20%", "vector", "missing-pair"],
+)
+def test_an_altered_cache_file_is_refused_and_recomputed(tmp_path, change, words):
+    """A cache file whose key and format are right but whose numbers were altered (where the
+    old sampled checks did not look) is verified in full, ignored, said so and recomputed."""
+    V, F = icosphere(3)
+    good = S.SpectralBasis.compute(V, F, 41, cache_dir=tmp_path)
+    path = good.info.cache_path
+    _tamper(path, change)
+    again = S.SpectralBasis.compute(V, F, 40, cache_dir=tmp_path)
+    assert not again.info.from_cache
+    notes = [x for x in again.info.messages if x.startswith("ignored cache file")]
+    assert len(notes) == 1 and words in notes[0], again.info.messages
+    np.testing.assert_allclose(again.eigenvalues, good.eigenvalues[:40], rtol=1e-9, atol=1e-12)
+    # the rewritten file is trusted again
+    third = S.SpectralBasis.compute(V, F, 40, cache_dir=tmp_path)
+    assert third.info.from_cache
+    np.testing.assert_array_equal(third.eigenvalues, again.eigenvalues)
+
+
+def test_spectral_command_says_when_it_ignores_an_altered_cache(capsys, tmp_path, monkeypatch):
+    from meshlap_core.io import save_mesh
+
+    monkeypatch.setenv("MESHLAP_CACHE_DIR", str(tmp_path / "c"))
+    V, F = icosphere(3)
+    path = tmp_path / "s.obj"
+    save_mesh(path, V, F)
+    assert main(["spectral", str(path), "--k", "20", "--json"]) == 0
+    first = json.loads(capsys.readouterr().out)
+    _tamper(first["cache_file"], _shift_last)
+    assert main(["spectral", str(path), "--k", "20", "--json"]) == 0
+    out, err = capsys.readouterr()
+    r = json.loads(out)
+    assert r["from_cache"] is False and r["eigenvalues"] == pytest.approx(first["eigenvalues"])
+    assert "ignored cache file" in err and "not eigenpairs" in err

@@ -94,10 +94,11 @@ def _parse_k(text: str) -> int:
     return k
 
 
-def run(args: argparse.Namespace) -> int:
-    from ..io import check_output_path, load_mesh, save_mesh
+def _check_args(args: argparse.Namespace) -> tuple[int, list[int] | None, Path | None]:
+    """``(k, reconstruct list or None, reconstruction folder or None)``, every output checked
+    before the work (a doomed run fails at once)."""
+    from ..io import check_output_path
 
-    t_start = time.perf_counter()
     k = _parse_k(args.k)
     recon = None
     if args.reconstruct is not None:
@@ -107,14 +108,46 @@ def run(args: argparse.Namespace) -> int:
             raise MeshError(
                 f"each value must be between 1 and --k = {k}; got {bad[0]}", "--reconstruct"
             )
-    if args.out is not None:  # checked before the work: a doomed run fails at once
+    if args.out is not None:
         check_output_path(args.out, overwrite_inputs=[args.mesh], suffixes=(".npz",))
     out_dir = None
     if args.save_reconstruction is not None:
         out_dir = Path(args.save_reconstruction)
         if out_dir.exists() and not out_dir.is_dir():
             raise MeshError("exists and is not a directory", args.save_reconstruction)
+    return k, recon, out_dir
 
+
+def _compute(args: argparse.Namespace, V: Any, F: Any, k: int) -> SpectralBasis:
+    """The basis, errors attributed to the mesh file or ``--k``; a cache file that failed its
+    checks (and was recomputed) is said on stderr."""
+    try:
+        basis = SpectralBasis.compute(
+            V,
+            F,
+            k,
+            laplacian=args.laplacian,
+            area=args.mass,
+            cache=not args.no_cache,
+            progress=_Progress(),
+        )
+    except MeshError as exc:
+        if exc.source in ("k", "--k"):
+            raise MeshError(exc.problem, "--k") from None
+        if exc.source in ("K", "m"):  # the pencil of this mesh: the solver's checks
+            raise MeshError(exc.problem, args.mesh) from None
+        raise exc.with_source(args.mesh) from None
+    for msg in basis.info.messages:
+        if msg.startswith("ignored cache file"):
+            sys.stderr.write(f"meshlap spectral: {msg}; recomputed\n")
+    return basis
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..io import load_mesh, save_mesh
+
+    t_start = time.perf_counter()
+    k, recon, out_dir = _check_args(args)
     mesh = load_mesh(args.mesh)
     V, F = mesh.V, mesh.F
     n = len(V)
@@ -128,20 +161,7 @@ def run(args: argparse.Namespace) -> int:
         recon = sorted({r for r in _DEFAULT_RECONSTRUCT if r < k} | {k})
     t_load = time.perf_counter() - t_start
 
-    try:
-        basis = SpectralBasis.compute(
-            V,
-            F,
-            k,
-            laplacian=args.laplacian,
-            mass=args.mass,
-            cache=not args.no_cache,
-            progress=_Progress(),
-        )
-    except MeshError as exc:
-        if exc.source in ("k", "--k"):
-            raise MeshError(exc.problem, "--k") from None
-        raise exc.with_source(args.mesh) from None
+    basis = _compute(args, V, F, k)
     info = basis.info
 
     t0 = time.perf_counter()

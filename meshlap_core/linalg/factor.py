@@ -1,0 +1,221 @@
+"""Sparse symmetric ``LDLᵀ`` factorizations with their inertia, and the shift-invert operator.
+
+Sylvester's law of inertia: for ``PAPᵀ = LDLᵀ`` (no pivoting, ``D`` diagonal) the number of
+negative eigenvalues of ``A`` is the number of negative entries of ``D``. Two back ends: QDLDL
+(AMD ordering, the factorization of the OSQP solver) and SuperLU in symmetric mode without
+pivoting as a fallback. Every factor is checked by a solve with a random right-hand side, so a
+tiny pivot (a shift on an eigenvalue) is detected and the shift moved.
+
+Mesh-free: matrices in, numbers out.
+"""
+
+from __future__ import annotations
+
+import threading
+from typing import Any
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from .common import FloatArray, IntArray
+
+
+class UnstableFactorization(Exception):
+    """An LDLᵀ factorization that cannot be trusted (zero or tiny pivot)."""
+
+
+class SymbolicOrdering:
+    """The fill-reducing symmetric ordering shared by every ``LDLᵀ`` of one pencil.
+
+    All shifted matrices ``A − σI`` have the same pattern, and SuperLU's minimum degree
+    ordering depends on the pattern only, so it is computed once (on a fixed random
+    relabelling: on the very regular numbering of subdivided meshes MMD takes 20× longer)
+    and later factorizations skip it. Thread-safe.
+    """
+
+    def __init__(self, n: int) -> None:
+        self.n = n
+        self.perm: IntArray | None = None
+        self.lock = threading.Lock()
+
+
+class SuperLUFactor:
+    """SuperLU ``LDLᵀ`` of a symmetric matrix, with its inertia; see :func:`superlu_ldl_inertia`."""
+
+    def __init__(self, lu: Any, perm: IntArray) -> None:
+        self.lu, self.perm = lu, perm
+
+    def solve(self, B: FloatArray) -> FloatArray:
+        Y = self.lu.solve(np.ascontiguousarray(B[self.perm]))
+        X = np.empty_like(Y)
+        X[self.perm] = Y
+        return X
+
+
+def superlu_ldl_inertia(
+    A: sp.csr_matrix, rng: np.random.Generator, ordering: SymbolicOrdering
+) -> tuple[SuperLUFactor, int]:
+    """SuperLU ``LDLᵀ`` of a symmetric matrix and the number of its negative eigenvalues.
+
+    SuperLU in symmetric mode with ``diag_pivot_thresh=0`` permutes rows and columns alike
+    and does not pivot, so ``PAPᵀ = L U`` with ``U = D Lᵀ`` and Sylvester's law of inertia
+    gives ``#{λ(A) < 0} = #{U_ii < 0}``. A solve with a random right-hand side checks that no
+    small pivot spoiled the factor.
+    """
+    n = A.shape[0]
+
+    def factor(p: IntArray, spec: str) -> Any:
+        try:
+            return spla.splu(
+                A[p][:, p].tocsc(),
+                permc_spec=spec,
+                diag_pivot_thresh=0.0,
+                options={"SymmetricMode": True},
+            )
+        except RuntimeError as exc:  # exactly singular
+            raise UnstableFactorization(str(exc)) from None
+
+    lu = None
+    with ordering.lock:  # the first factorization orders; the others wait for its ordering
+        perm = ordering.perm
+        if perm is None:
+            p0 = np.random.default_rng(12345).permutation(n)
+            lu = factor(p0, "MMD_AT_PLUS_A")
+            if not np.array_equal(lu.perm_r, lu.perm_c):
+                raise UnstableFactorization("SuperLU pivoted")
+            ordering.perm = p0[np.argsort(lu.perm_c)]
+            ldl = SuperLUFactor(lu, p0)  # lu.solve applies SuperLU's own permutation
+    if lu is None:
+        assert perm is not None
+        lu = factor(perm, "NATURAL")
+        if not (np.array_equal(lu.perm_r, lu.perm_c) and np.array_equal(lu.perm_c, np.arange(n))):
+            raise UnstableFactorization("SuperLU pivoted")
+        ldl = SuperLUFactor(lu, perm)
+    return ldl, checked_inertia(A, ldl, lu.U.diagonal(), rng)
+
+
+def checked_inertia(A: sp.csr_matrix, ldl: Any, piv: FloatArray, rng: np.random.Generator) -> int:
+    """The number of negative pivots of an ``LDLᵀ`` of ``A`` (its negative eigenvalues, by
+    Sylvester's law of inertia), after checking the factor: no zero or non-finite pivot, and a
+    solve with a random right-hand side accurate to ``1e-10`` (a tiny pivot spoils it).
+
+    Raises
+    ------
+    UnstableFactorization
+    """
+    piv = np.asarray(piv)
+    if not np.all(np.isfinite(piv)) or np.any(piv == 0):
+        raise UnstableFactorization("zero pivot")
+    b = rng.standard_normal(A.shape[0])
+    x = ldl.solve(b)
+    scale = abs(A).sum(axis=1).max() * np.abs(x).max() + np.abs(b).max()
+    if not np.all(np.isfinite(x)) or np.abs(A @ x - b).max() > 1e-10 * scale:
+        raise UnstableFactorization("inaccurate solve")
+    return int(np.count_nonzero(piv < 0))
+
+
+class QDLDLFactor:
+    """``LDLᵀ`` of a symmetric matrix by QDLDL (AMD ordering, no pivoting), with its inertia.
+
+    QDLDL (the factorization of the OSQP solver) factors ``PAPᵀ = LDLᵀ`` with ``D`` diagonal
+    and no pivoting, so Sylvester's law of inertia gives ``#{λ(A) < 0} = #{D_ii < 0}``. It
+    computes its own AMD ordering, factors 2–4× faster than SuperLU's ``LU`` (which does the
+    work twice: ``L`` and ``U = DLᵀ``) and its solves release the GIL.
+    """
+
+    def __init__(self, solver: Any, pattern: tuple[IntArray, IntArray]) -> None:
+        self.solver = solver
+        self.pattern = pattern  # (indptr, indices) of the factored upper triangle
+
+    def solve(self, B: FloatArray) -> FloatArray:
+        if B.ndim == 1:
+            return np.asarray(self.solver.solve(np.ascontiguousarray(B)))
+        X = np.empty(B.shape, order="F")
+        for c in range(B.shape[1]):
+            X[:, c] = self.solver.solve(np.ascontiguousarray(B[:, c]))
+        return X
+
+
+def qdldl_inertia(
+    A: sp.csr_matrix, rng: np.random.Generator, reuse: QDLDLFactor | None = None
+) -> tuple[QDLDLFactor, int]:
+    """QDLDL ``LDLᵀ`` of a symmetric matrix and the number of its negative eigenvalues; a
+    solve with a random right-hand side checks that no small pivot spoiled the factor.
+
+    ``reuse``: a factorization no longer needed of a matrix with the same pattern (another
+    shift): refactored in place, skipping the AMD ordering and symbolic analysis (0.04 s
+    instead of 0.1 s at 40k vertices).
+
+    Raises
+    ------
+    ImportError
+        ``qdldl`` is not installed (the caller falls back to SuperLU).
+    UnstableFactorization
+        A zero, tiny or non-finite pivot.
+    """
+    import qdldl
+
+    U = sp.triu(A, format="csc")
+    pattern = (U.indptr, U.indices)
+    try:
+        if (
+            reuse is not None
+            and np.array_equal(reuse.pattern[0], U.indptr)
+            and np.array_equal(reuse.pattern[1], U.indices)
+        ):
+            solver = reuse.solver
+            solver.update(U, upper=True)
+        else:
+            solver = qdldl.Solver(U, upper=True)
+        _, D, _ = solver.factors()
+    except (ValueError, RuntimeError) as exc:  # zero pivot
+        raise UnstableFactorization(str(exc)) from None
+    ldl = QDLDLFactor(solver, pattern)
+    return ldl, checked_inertia(A, ldl, D, rng)
+
+
+class ShiftInvert:
+    """``Op(Y) = (A − σI)⁻¹ Y`` for the scaled pencil ``A = M^-½ K M^-½`` (symmetric, same
+    eigenvalues ``λ`` as ``K u = λ M u`` with ``y = M^½ u``); ``Op`` has eigenvalues
+    ``θ = 1/(λ − σ)``.
+
+    ``LDLᵀ`` without pivoting (QDLDL, else SuperLU in symmetric mode) with its inertia:
+    ``n_below`` is the number of eigenvalues ``λ < σ``. A shift that lands (numerically) on an
+    eigenvalue (zero or tiny pivot, inaccurate solve) is moved by a small fraction of
+    ``spacing``: a singular matrix is never used.
+    """
+
+    def __init__(
+        self,
+        A: sp.csr_matrix,
+        sigma: float,
+        *,
+        rng: np.random.Generator,
+        spacing: float,
+        ordering: SymbolicOrdering | None = None,
+        reuse: Any | None = None,
+    ) -> None:
+        n = A.shape[0]
+        eye = sp.identity(n, format="csr")
+        if ordering is None:
+            ordering = SymbolicOrdering(n)
+        for attempt in range(6):
+            s = sigma + (0.0 if attempt == 0 else (-1) ** attempt * 1e-3 * attempt * spacing)
+            S = (A - s * eye).tocsr()
+            try:
+                try:
+                    r, reuse = (reuse if isinstance(reuse, QDLDLFactor) else None), None
+                    self.factor, self.n_below = qdldl_inertia(S, rng, r)
+                except (ImportError, UnstableFactorization):
+                    self.factor, self.n_below = superlu_ldl_inertia(S, rng, ordering)
+                sigma = s
+                break
+            except UnstableFactorization:
+                continue
+        else:
+            raise RuntimeError(f"could not factor A - sigma I near sigma = {sigma:.6g}")
+        self.sigma = float(sigma)
+
+    def __call__(self, Y: FloatArray, out: FloatArray) -> None:
+        out[...] = self.factor.solve(Y)
