@@ -1014,6 +1014,8 @@ CORPUS: list[Hostile] = [
         "ok",
         n_vertices=162,
         n_faces=320,
+        closed=True,
+    ),
     # round 2: spectral
     Hostile(
         "two_scales_1e-6_1e6.obj",
