@@ -24,10 +24,9 @@ import polyscope as ps
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from _util import print_table, shared_mesh
-
-from app.smoothing_state import SmoothingState
-from app.state import CurvatureState, MeshState
-from app.viewer import Viewer, _init
+from meshlap_app.state import CurvatureState, MeshState
+from meshlap_app.state.smoothing import SmoothingState
+from meshlap_app.viewer import Viewer, _init
 
 
 def main() -> None:
@@ -49,7 +48,7 @@ def main() -> None:
     rows = []
 
     # ---- k slider ------------------------------------------------------------------
-    spec = viewer.extra["spectral"]
+    spec = viewer.panels["spectral"]
     st = spec.state
     st.k_request = args.kmax
     t0 = time.perf_counter()
@@ -100,7 +99,7 @@ def main() -> None:
 
     # ---- live implicit smoothing -----------------------------------------------------
     viewer.panel = "smoothing"
-    sm = viewer.extra["smoothing"]
+    sm = viewer.panels["smoothing"]
     sm.state = SmoothingState(method="implicit", laplacian="uniform", lam=0.5)
     sm.rebuild(viewer)
     sm.state.step()  # the first step includes the one factorization

@@ -26,8 +26,8 @@ def mock_backend(tmp_path_factory):
 
 
 def test_every_panel_runs_frames_on_mock(mock_backend, tmp_path):
-    from app.state import CurvatureState, MeshState
-    from app.viewer import PANELS, Viewer
+    from meshlap_app.state import PANELS, CurvatureState, MeshState
+    from meshlap_app.viewer import Viewer
 
     mesh = MeshState()
     assert mesh.load(None)
@@ -47,7 +47,8 @@ def test_every_panel_runs_frames_on_mock(mock_backend, tmp_path):
     assert ps.has_curve_network("one-ring order")
     assert viewer.ring.valence == len(viewer.ring.neighbors) > 2
     # side-by-side curvature registers a second copy of the mesh
-    viewer.panel, viewer.side_by_side = "curvature", True
+    viewer.panel = "curvature"
+    viewer.panels["curvature"].side_by_side = True
     viewer.push_curvature()
     ps.frame_tick()
     assert ps.has_surface_mesh("mesh (second estimator)")
@@ -55,15 +56,15 @@ def test_every_panel_runs_frames_on_mock(mock_backend, tmp_path):
     viewer.panel = "surfaces"
     viewer.show_panel()
     assert viewer.surf.set_uv(0.5, 1.0)
-    viewer.push_surface_point()
+    viewer.panels["surfaces"].push_point(viewer)
     ps.frame_tick()
     assert ps.has_point_cloud("surface point")
     ps.clear_user_callback()
 
 
 def test_bad_file_in_mesh_panel_keeps_mesh(mock_backend, tmp_path):
-    from app.state import CurvatureState, MeshState
-    from app.viewer import Viewer
+    from meshlap_app.state import CurvatureState, MeshState
+    from meshlap_app.viewer import Viewer
 
     mesh = MeshState()
     assert mesh.load(None)
@@ -81,8 +82,9 @@ def test_bad_file_in_mesh_panel_keeps_mesh(mock_backend, tmp_path):
 
 
 def test_export_writes_mesh_and_field(mock_backend, tmp_path):
-    from app.state import CurvatureState, MeshState
-    from app.viewer import Viewer
+    from meshlap_app.state import CurvatureState, MeshState
+    from meshlap_app.viewer import Viewer
+
     from meshlap_core.io import load_mesh
 
     mesh = MeshState()
@@ -140,9 +142,9 @@ PICK_SCRIPT = """
 import json, sys
 import numpy as np
 import polyscope as ps
-from app.camera import project_to_screen
-from app.state import CurvatureState, MeshState
-from app.viewer import Viewer, _init
+from meshlap_app.camera import project_to_screen
+from meshlap_app.state import CurvatureState, MeshState
+from meshlap_app.viewer import Viewer, _init
 
 mesh = MeshState(); mesh.load(None)
 _init("openGL3_egl")
@@ -168,7 +170,8 @@ def test_picking_a_projected_vertex_selects_its_one_ring(tmp_path):
         pytest.skip("polyscope's EGL backend cannot start on this machine (no EGL/Mesa)")
     import json
 
-    from app.state import MeshState
+    from meshlap_app.state import MeshState
+
     from meshlap_core.curvature import vertex_normals
 
     mesh = MeshState()
@@ -206,11 +209,11 @@ def test_no_display_is_one_clear_error(tmp_path):
         assert "--screenshot" in lines[0]
 
 
-def test_cli_choices_match_the_viewer():
-    """`meshlap view` lists its panels and fields without importing polyscope: keep in sync."""
-    from app.state import FIELD_LABELS
-    from app.viewer import PANELS
+def test_cli_uses_the_viewers_single_definition_of_panels_and_fields():
+    """`meshlap view` imports its choices from meshlap_app.state (pure data, no polyscope)."""
+    from meshlap_app import state
+
     from meshlap_core.cli import view
 
-    assert view.PANELS == PANELS
-    assert view.FIELDS == tuple(FIELD_LABELS)
+    assert view.PANELS is state.PANELS
+    assert view.FIELDS is state.FIELDS == tuple(state.FIELD_LABELS)

@@ -1,15 +1,12 @@
-"""``meshlap view [MESH] [--screenshot OUT.png]``: the polyscope viewer (``app.viewer``)."""
+"""``meshlap view [MESH] [--screenshot OUT.png]``: the polyscope viewer (``meshlap_app.viewer``)."""
 
 from __future__ import annotations
 
 import argparse
 
-from ..errors import MeshError
+from meshlap_app.state.names import FIELDS, PANELS  # pure data: no polyscope, no numpy
 
-# the viewer's names (app.viewer imports polyscope, so they are repeated here; a test keeps them
-# in sync)
-FIELDS = ("uniform", "cotan", "gaussian", "k1", "k2", "difference")
-PANELS = ("curvature", "onering", "spectral", "smoothing", "surfaces")
+from ..errors import MeshError
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -41,8 +38,8 @@ def run(args: argparse.Namespace) -> int:
             overwrite_inputs=[args.mesh] if args.mesh else [],
             suffixes=(".png",),
         )
-    # a bad mesh fails in app.viewer.run before any window or EGL context is created
-    from app.viewer import run as run_viewer  # the core CLI imports the GUI only here
+    # a bad mesh fails in meshlap_app.viewer.run before any window or EGL context is created
+    from meshlap_app.viewer import run as run_viewer  # the CLI imports the GUI only here
 
     return run_viewer(
         args.mesh,

@@ -4,7 +4,7 @@ noise first, live figures and the amplification curve. No polyscope import.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -15,6 +15,8 @@ from meshlap_core.smoothing import Smoother, amplification_curve
 from meshlap_core.types import FloatArray, IntArray
 
 METHODS = ("explicit", "implicit", "taubin")
+_EMPTY_V = np.zeros((0, 3))
+_EMPTY_F = np.zeros((0, 3), dtype=np.int64)
 
 
 @dataclass
@@ -29,16 +31,17 @@ class SmoothingState:
     playing: bool = False
     error: str = ""
     smoother: Smoother | None = None
-    V_original: FloatArray = field(default_factory=lambda: np.zeros((0, 3)))
-    V_start: FloatArray = field(default_factory=lambda: np.zeros((0, 3)))  # original + noise
-    F: IntArray = field(default_factory=lambda: np.zeros((0, 3), dtype=np.int64))
     version: int = 0  # bumped when the stepper is rebuilt (connectivity may need re-upload)
 
     def rebuild(self, V: FloatArray, F: IntArray) -> bool:
-        """Build the stepper for the current options from the clean mesh ``V`` (+ noise)."""
+        """Build the stepper for the current options from the clean mesh ``V`` (+ noise).
+
+        ``V`` and ``F`` are passed on once: the smoother keeps its own validated copies
+        (``V0``, ``F``, ``reference``) and this state reads them from there.
+        """
         try:
             start = add_noise(V, F, self.noise_alpha, seed=self.seed) if self.noise_alpha else V
-            self.smoother = Smoother(
+            smoother = Smoother(
                 start,
                 F,
                 self.method,
@@ -52,10 +55,26 @@ class SmoothingState:
             self.error = str(exc)
             self.playing = False
             return False
-        self.V_original, self.V_start, self.F = np.asarray(V), np.asarray(start), np.asarray(F)
+        self.smoother = smoother
         self.error = ""
         self.version += 1
         return True
+
+    @property
+    def V_original(self) -> FloatArray:
+        """The clean mesh the smoother measures its RMSE against ``(n,3)``."""
+        s = self.smoother
+        return s.reference if s is not None and s.reference is not None else _EMPTY_V
+
+    @property
+    def V_start(self) -> FloatArray:
+        """The smoother's input: the clean mesh plus the noise ``(n,3)``."""
+        return self.smoother.V0 if self.smoother is not None else _EMPTY_V
+
+    @property
+    def F(self) -> IntArray:
+        """Faces of the smoothed mesh ``(m,3)``."""
+        return self.smoother.F if self.smoother is not None else _EMPTY_F
 
     def step(self) -> bool:
         """One iteration; stops playing (and says why) when the explicit flow diverges."""

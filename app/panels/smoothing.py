@@ -1,4 +1,5 @@
-"""Polyscope layer of the smoothing panel (state in :mod:`app.smoothing_state`)."""
+"""The Smoothing panel: a smoother stepped live beside its input (state in
+:mod:`..state.smoothing`)."""
 
 from __future__ import annotations
 
@@ -11,17 +12,14 @@ import polyscope.implot as psimplot
 
 from meshlap_core.options import LAPLACIAN_KINDS as LAPLACIANS
 
-from .smoothing_state import METHODS, SmoothingState
+from ..scene import INPUT_COLOR, MESH, RED, SMOOTH_INPUT, SMOOTHED, SMOOTHED_COLOR, side_offset
+from ..state.smoothing import METHODS, SmoothingState
 
 if TYPE_CHECKING:
-    from .viewer import Viewer
-
-SMOOTHED = "smoothed"
-INPUT = "smoothing input"
-RED = (1.0, 0.35, 0.35, 1.0)
+    from ..viewer import Viewer
 
 
-class Panel:
+class SmoothingPanel:
     """Method, Laplacian, λ, noise; step / play / pause / reset; live figures; g(μ)."""
 
     def __init__(self) -> None:
@@ -33,7 +31,7 @@ class Panel:
     def on_new_mesh(self, viewer: Viewer) -> None:
         self.state.smoother = None
         self.state.playing = False
-        for name in (SMOOTHED, INPUT):
+        for name in (SMOOTHED, SMOOTH_INPUT):
             if ps.has_surface_mesh(name):
                 ps.remove_surface_mesh(name)
         self._registered = -1
@@ -41,11 +39,11 @@ class Panel:
     def show(self, viewer: Viewer, panel: str) -> None:
         if panel == "smoothing" and self.state.smoother is None:
             self.rebuild(viewer)
-        for name in (SMOOTHED, INPUT):
+        for name in (SMOOTHED, SMOOTH_INPUT):
             if ps.has_surface_mesh(name):
                 ps.get_surface_mesh(name).set_enabled(panel == "smoothing")
-        if ps.has_surface_mesh("mesh") and panel == "smoothing":
-            ps.get_surface_mesh("mesh").set_enabled(False)
+        if ps.has_surface_mesh(MESH) and panel == "smoothing":
+            ps.get_surface_mesh(MESH).set_enabled(False)
 
     def rebuild(self, viewer: Viewer) -> None:
         if self.state.rebuild(viewer.mesh.V, viewer.mesh.F):
@@ -56,15 +54,13 @@ class Panel:
         st = self.state
         if st.smoother is None:
             return
-        from .viewer import side_offset
-
         self._shift = side_offset(st.V_start)
         if self._registered != st.version:
             # the input (with its noise) stays put; the smoothed copy moves beside it
-            inp = ps.register_surface_mesh(INPUT, st.V_start, st.F, smooth_shade=True)
-            inp.set_color((0.85, 0.75, 0.6))
+            inp = ps.register_surface_mesh(SMOOTH_INPUT, st.V_start, st.F, smooth_shade=True)
+            inp.set_color(INPUT_COLOR)
             sm = ps.register_surface_mesh(SMOOTHED, st.V + self._shift, st.F, smooth_shade=True)
-            sm.set_color((0.55, 0.7, 0.9))
+            sm.set_color(SMOOTHED_COLOR)
             self._registered = st.version
         elif force or st.smoother.iteration != self._shown_iteration:
             ps.get_surface_mesh(SMOOTHED).update_vertex_positions(st.V + self._shift)
@@ -76,7 +72,7 @@ class Panel:
             return None
         if name == SMOOTHED:
             return self.state.V + self._shift
-        return self.state.V_start if name == INPUT else None
+        return self.state.V_start if name == SMOOTH_INPUT else None
 
     def prepare_screenshot(self, viewer: Viewer, iterations: int = 10) -> None:
         """Add a little noise, smooth a few steps and show the result (headless render)."""

@@ -1,4 +1,5 @@
-"""Polyscope layer of the spectral panel (state in :mod:`app.spectral_state`)."""
+"""The Spectral panel: eigenmodes and the k-reconstruction beside the mesh (state in
+:mod:`..state.spectral`)."""
 
 from __future__ import annotations
 
@@ -9,17 +10,14 @@ import polyscope as ps
 import polyscope.imgui as psim
 import polyscope.implot as psimplot
 
-from .spectral_state import SpectralState
+from ..scene import EIGEN, MESH, RECON, RED, side_offset
+from ..state.spectral import SpectralState
 
 if TYPE_CHECKING:
-    from .viewer import Viewer
-
-RECON = "reconstruction"
-EIGEN = "eigenfunction"
-RED = (1.0, 0.35, 0.35, 1.0)
+    from ..viewer import Viewer
 
 
-class Panel:
+class SpectralPanel:
     """Eigenmode browser and k slider; the reconstruction sits beside the original."""
 
     def __init__(self) -> None:
@@ -40,8 +38,6 @@ class Panel:
             self.push_mode(viewer, force=True)
 
     def _offset(self, viewer: Viewer) -> np.ndarray:
-        from .viewer import side_offset
-
         return side_offset(viewer.mesh.V)
 
     def push_mode(self, viewer: Viewer, force: bool = False) -> None:
@@ -51,7 +47,7 @@ class Panel:
         self._shown_mode = st.mode
         f, _ = st.eigenfunction()
         r = float(np.abs(f).max()) or 1.0
-        ps.get_surface_mesh("mesh").add_scalar_quantity(
+        ps.get_surface_mesh(MESH).add_scalar_quantity(
             EIGEN, f, cmap="coolwarm", vminmax=(-r, r), enabled=True
         )
 

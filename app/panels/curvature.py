@@ -1,0 +1,108 @@
+"""The Curvature panel: a curvature field as a colour map, optionally a second one beside it."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import polyscope as ps
+import polyscope.imgui as psim
+import polyscope.implot as psimplot
+
+from meshlap_core.options import AREA_KINDS as AREAS
+from meshlap_core.options import BOUNDARY_RULES
+
+from ..scene import MESH, MESH_B, side_offset
+from ..state.names import FIELD_LABELS
+
+if TYPE_CHECKING:
+    from ..viewer import Viewer
+
+
+def combo(label: str, current: str, items: tuple[str, ...] | list[str]) -> tuple[bool, str]:
+    """A combo over strings: (changed, chosen item)."""
+    changed, idx = psim.Combo(label, list(items).index(current), list(items))
+    return changed, items[idx]
+
+
+class CurvaturePanel:
+    """Field, area, boundary rule, clip percentage, side-by-side second estimator, histogram."""
+
+    def __init__(self) -> None:
+        self.side_by_side = False
+        self.second_field = "uniform"
+        self.shown: Any = ""
+
+    def on_new_mesh(self, viewer: Viewer) -> None:
+        self.shown = ""
+
+    def show(self, viewer: Viewer, panel: str) -> None:
+        if ps.has_surface_mesh(MESH_B):
+            ps.get_surface_mesh(MESH_B).set_enabled(panel == "curvature")
+
+    def points(self, viewer: Viewer, name: str) -> np.ndarray | None:
+        if name == MESH:
+            return viewer.mesh.V
+        if name == MESH_B:
+            return viewer.mesh.V + side_offset(viewer.mesh.V)
+        return None
+
+    def push(self, viewer: Viewer, force: bool = False) -> None:
+        """Add the selected curvature field(s) as colour maps (only when they changed)."""
+        curv = viewer.curv
+        changed = curv.update(viewer.mesh) or force
+        key = (curv.field_name, curv.percentile, self.side_by_side, self.second_field)
+        if not changed and key == self.shown:
+            return
+        self.shown = key
+        self._add_field(viewer, ps.get_surface_mesh(MESH), curv.field_name)
+        if self.side_by_side:
+            if not ps.has_surface_mesh(MESH_B):
+                V = viewer.mesh.V
+                ps.register_surface_mesh(
+                    MESH_B, V + side_offset(V), viewer.mesh.F, smooth_shade=True
+                )
+            self._add_field(viewer, ps.get_surface_mesh(MESH_B), self.second_field)
+        elif ps.has_surface_mesh(MESH_B):
+            ps.remove_surface_mesh(MESH_B)
+
+    @staticmethod
+    def _add_field(viewer: Viewer, sm: Any, name: str) -> None:
+        label, signed = FIELD_LABELS[name]
+        lo, hi = viewer.curv.color_range(name)
+        sm.add_scalar_quantity(
+            label,
+            viewer.curv.fields[name],
+            defined_on="vertices",
+            cmap="coolwarm" if signed else "viridis",
+            vminmax=(lo, hi),
+            enabled=True,
+        )
+
+    def draw(self, viewer: Viewer) -> None:
+        if not psim.CollapsingHeader("Curvature", psim.ImGuiTreeNodeFlags_DefaultOpen):
+            return
+        c = viewer.curv
+        names = tuple(FIELD_LABELS)
+        ch1, c.field_name = combo("field", c.field_name, names)
+        ch2, c.area = combo("area", c.area, AREAS)
+        ch3, c.boundary = combo("boundary rule", c.boundary, BOUNDARY_RULES)
+        ch4, c.percentile = psim.SliderFloat("clip %", c.percentile, 0.0, 20.0, "%.1f")
+        ch5, self.side_by_side = psim.Checkbox("side by side", self.side_by_side)
+        ch6 = False
+        if self.side_by_side:
+            ch6, self.second_field = combo("second field", self.second_field, names)
+        if ch1 or ch2 or ch3 or ch4 or ch5 or ch6:
+            self.push(viewer, force=ch2 or ch3)
+            viewer.show_panel()
+        if c.field_name not in c.fields:
+            return
+        st = c.summary()
+        lo, hi = st["range"]
+        psim.TextUnformatted(
+            f"min {st['min']:.4g}  max {st['max']:.4g}  colour range [{lo:.4g}, {hi:.4g}]"
+        )
+        psim.TextUnformatted(FIELD_LABELS[c.field_name][0])
+        if psimplot.BeginPlot("histogram (clipped to the colour range)", (-1, 160)):
+            psimplot.PlotBars("vertices", st["centers"], st["counts"], st["width"])
+            psimplot.EndPlot()

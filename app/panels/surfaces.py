@@ -1,0 +1,114 @@
+"""The Surfaces panel: a parametric surface, its exact K, and the geometry at a point (u, v)."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+import polyscope as ps
+import polyscope.imgui as psim
+import polyscope.implot as psimplot
+
+from ..scene import RED, SURFACE, SURFACE_POINT, Z_TO_Y
+from .curvature import combo
+
+if TYPE_CHECKING:
+    from ..viewer import Viewer
+
+
+class SurfacesPanel:
+    """Surface choice, (u, v) sliders, fundamental forms, principal directions, k_n(θ)."""
+
+    def __init__(self) -> None:
+        self._version = -1
+
+    def on_new_mesh(self, viewer: Viewer) -> None:
+        return None
+
+    def show(self, viewer: Viewer, panel: str) -> None:
+        if panel == "surfaces":
+            self.push(viewer)
+        if ps.has_surface_mesh(SURFACE):
+            ps.get_surface_mesh(SURFACE).set_enabled(panel == "surfaces")
+        if ps.has_point_cloud(SURFACE_POINT):
+            ps.get_point_cloud(SURFACE_POINT).set_enabled(panel == "surfaces")
+
+    def points(self, viewer: Viewer, name: str) -> np.ndarray | None:
+        if name == SURFACE and viewer.surf.mesh is not None:
+            return viewer.surf.mesh.V @ Z_TO_Y[:3, :3].T
+        return None
+
+    def push(self, viewer: Viewer) -> None:
+        surf = viewer.surf
+        if surf.mesh is None:
+            surf.set_surface(surf.name)
+        sm = surf.mesh
+        if sm is None:
+            return
+        if self._version != surf.version:
+            self._version = surf.version
+            s = ps.register_surface_mesh(SURFACE, sm.V, sm.F, smooth_shade=True)
+            s.set_transform(Z_TO_Y)
+            from meshlap_core.surfaces import curvature_fields as surface_curvature
+
+            cf = surface_curvature(surf.name, sm.uv[:, 0], sm.uv[:, 1])
+            K = np.nan_to_num(np.asarray(cf.K, dtype=float))
+            r = float(np.percentile(np.abs(K), 98)) or 1.0
+            s.add_scalar_quantity(
+                "Gaussian curvature K (exact)", K, cmap="coolwarm", vminmax=(-r, r), enabled=True
+            )
+        self.push_point(viewer)
+
+    def push_point(self, viewer: Viewer) -> None:
+        surf = viewer.surf
+        if surf.point is None:
+            return
+        size = float(np.ptp(surf.mesh.V, axis=0).max()) if surf.mesh is not None else 1.0
+        base, d1, d2 = surf.direction_vectors(scale=0.15 * size)
+        pc = ps.register_point_cloud(SURFACE_POINT, base, radius=0.01)
+        pc.set_transform(Z_TO_Y)
+        pc.set_color((0.9, 0.1, 0.1))
+        pc.add_vector_quantity(
+            "k1 direction", d1, vectortype="ambient", enabled=True, color=(0.85, 0.2, 0.1)
+        )
+        pc.add_vector_quantity(
+            "k2 direction", d2, vectortype="ambient", enabled=True, color=(0.1, 0.3, 0.85)
+        )
+        pc.add_vector_quantity(
+            "normal",
+            0.15 * size * surf.point.n[None, :],
+            vectortype="ambient",
+            enabled=True,
+            color=(0.2, 0.7, 0.2),
+        )
+
+    def draw(self, viewer: Viewer) -> None:
+        if not psim.CollapsingHeader("Surfaces", psim.ImGuiTreeNodeFlags_DefaultOpen):
+            return
+        s = viewer.surf
+        ch, name = combo("surface", s.name, s.names)
+        if ch and s.set_surface(name):
+            self.push(viewer)
+            ps.reset_camera_to_home_view()
+        u0, u1, v0, v1 = s.domain
+        ch1, u = psim.SliderFloat("u", s.u, u0, u1)
+        ch2, v = psim.SliderFloat("v", s.v, v0, v1)
+        if (ch1 or ch2) and s.set_uv(u, v):
+            self.push_point(viewer)
+        if s.error:
+            psim.TextColored(RED, s.error)
+        p = s.point
+        if p is None:
+            return
+        psim.TextUnformatted(f"I:  E = {p.E:.4g}  F = {p.F:.4g}  G = {p.G:.4g}")
+        psim.TextUnformatted(f"II: e = {p.e:.4g}  f = {p.f:.4g}  g = {p.g:.4g}")
+        psim.TextUnformatted(f"K = {p.K:.4g}  H = {p.H:.4g}  ({p.classification})")
+        psim.TextUnformatted(
+            f"k1 = {p.k1:.4g} at {np.degrees(p.theta_max):.1f} deg,  "
+            f"k2 = {p.k2:.4g} at {np.degrees(p.theta_min):.1f} deg"
+        )
+        psim.TextUnformatted("signs: e = p_uu . n with n = p_u x p_v (do Carmo)")
+        if psimplot.BeginPlot("normal curvature k_n(theta)", (-1, 180)):
+            psimplot.PlotLine("k_n", s.theta, s.kn)
+            psimplot.PlotInfLines("theta max/min", np.array([p.theta_max, p.theta_min]))
+            psimplot.EndPlot()
