@@ -7,9 +7,12 @@ Every panel registers its structures under the names defined here and places cop
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable
+from pathlib import Path
 
 import numpy as np
 import polyscope as ps
+
+from meshlap_core.io import atomic_write
 
 # ---------------------------------------------------------------- structure names
 MESH = "mesh"
@@ -84,3 +87,19 @@ def frame_scene_left(
     shift = (0.5 - 0.5 * fraction) * 2 * d * tan_h
     eye = np.array([c[0] - shift, c[1] + 0.15 * (hi[1] - lo[1]), lo[2] - d])
     ps.look_at(eye, np.array([c[0] - shift, c[1], c[2]]))
+
+
+def save_screenshot(path: Path) -> None:
+    """Render the window (with meshlap's panel) into the PNG ``path``, atomically."""
+    write_png(path, ps.screenshot_to_buffer(transparent_bg=False, include_UI=True))
+
+
+def write_png(path: Path, rgba: np.ndarray) -> None:
+    """Write an RGBA buffer as PNG atomically (matplotlib's encoder, no extra dependency)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.image as mpimg
+
+    with atomic_write(path, mode="wb") as fh:
+        mpimg.imsave(fh, rgba, format="png")

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import os
 import sys
+import traceback
 from pathlib import Path
 from typing import Any
 
@@ -21,7 +22,6 @@ import polyscope as ps
 import polyscope.imgui as psim
 
 from meshlap_core.errors import MeshError
-from meshlap_core.io import atomic_write
 
 from . import scene
 from .panels.curvature import CurvaturePanel
@@ -37,6 +37,7 @@ from .state.mesh import MeshState
 from .state.names import FIELD_LABELS, PANELS
 from .state.onering import OneRingState
 from .state.surface import SurfaceState
+from .ui import UI
 
 NO_DISPLAY = (
     "no display could be opened for the viewer window; render headless with "
@@ -89,7 +90,12 @@ class Viewer:
         mesh: MeshState,
         curv: CurvatureState | None = None,
         panel: str = "curvature",
+        ui: UI | None = None,
+        export_dir: Path | None = None,
     ) -> None:
+        self.ui = ui or UI()
+        self.errors: dict[str, str] = {}  # section -> the message shown in red there
+        self._logged: set[tuple[str, str]] = set()
         self.mesh = mesh
         self.curv = curv or CurvatureState()
         self.ring = OneRingState()
@@ -101,7 +107,7 @@ class Viewer:
             "spectral": SpectralPanel(),
             "smoothing": SmoothingPanel(),
             "surfaces": SurfacesPanel(),
-            "export": ExportPanel(),
+            "export": ExportPanel(export_dir),
         }
         self.panel = panel
         self._mesh_version = -1
@@ -186,22 +192,84 @@ class Viewer:
 
     # ------------------------------------------------------------------ the frame
     def callback(self) -> None:
-        """The per-frame user callback: draw the panels, react to changes only."""
-        psim.PushItemWidth(200)
-        self.panels["mesh"].draw(self)
-        changed, idx = psim.Combo("view", PANELS.index(self.panel), list(PANELS))
-        if changed:
-            self.panel = PANELS[idx]
-            self.show_panel()
-        self.panels[self.panel].draw(self)
-        self.panels["export"].draw(self)
-        psim.PopItemWidth()
-        self.handle_click()
+        """The per-frame user callback: draw the panels, react to changes only.
+
+        Every section runs guarded (:meth:`draw_guarded`): no exception of a widget handler
+        leaves this function, so none ends the session.
+        """
+        ui = self.ui
+        ui.push_width(200)
+        try:
+            self.draw_guarded("mesh", self.panels["mesh"].draw)
+            self.draw_guarded("view", self.draw_view_combo)
+            self.draw_guarded(self.panel, self.panels[self.panel].draw)
+            self.draw_guarded("export", self.panels["export"].draw)
+        finally:
+            ui.pop_width()
+        self.draw_guarded("picking", lambda viewer: viewer.handle_click())
         if self.panel == "onering":
-            self.panels["onering"].draw_labels(self)
+            self.draw_guarded("labels", self.panels["onering"].draw_labels)
+
+    def draw_view_combo(self, viewer: Viewer) -> None:
+        changed, panel = self.ui.combo(
+            "view", self.panel, PANELS, "which panel: curvature, one-ring, spectral, ..."
+        )
+        if changed:
+            self.set_panel(panel)
+
+    def set_panel(self, panel: str) -> None:
+        """Switch to ``panel`` and show its structures."""
+        if panel not in PANELS:
+            raise MeshError(f"unknown panel {panel!r}; choose one of {', '.join(PANELS)}", "view")
+        self.panel = panel
+        self.show_panel()
+
+    def draw_guarded(self, section: str, draw: Any) -> None:
+        """Run ``draw(self)``; an exception is shown in red in that section, never raised.
+
+        A ``MeshError``/``ValueError`` (bad widget input) shows its message and the state keeps
+        its last good values (the state objects validate before they change). Anything else is
+        an internal error: shown with a "details" line and logged once on stderr (with the
+        traceback when ``MESHLAP_DEBUG=1``). The message stays until a widget of the section
+        changes something without an error.
+        """
+        ui = self.ui
+        outer = (ui.section, ui.changed)  # a screenshot re-runs the callback from inside one
+        ui.begin_section(section)
+        try:
+            draw(self)
+        except ValueError as exc:  # MeshError is a ValueError: bad input, said in its message
+            self.errors[section] = str(exc)
+        except Exception as exc:  # a bug or an API change: keep the session, say what failed
+            self.errors[section] = self._internal_error(section, exc)
+        else:
+            if ui.changed:
+                self.errors.pop(section, None)
+        message = self.errors.get(section)
+        if message:
+            ui.error(message)
+        ui.section, ui.changed = outer[0], outer[1] or ui.changed
+
+    def _internal_error(self, section: str, exc: Exception) -> str:
+        tb = traceback.extract_tb(exc.__traceback__)
+        where = f" at {Path(tb[-1].filename).name}:{tb[-1].lineno}" if tb else ""
+        text = f"internal error: {type(exc).__name__}: {exc}"
+        key = (section, f"{type(exc).__name__}{where}")
+        if key not in self._logged:
+            self._logged.add(key)
+            print(f"meshlap: {section} panel: {text}{where}", file=sys.stderr)
+            if os.environ.get("MESHLAP_DEBUG") == "1":
+                traceback.print_exception(exc, file=sys.stderr)
+        return (
+            f"{text}\ndetails: {type(exc).__name__}{where}; the last good state is kept "
+            "(MESHLAP_DEBUG=1 prints the traceback)"
+        )
 
     def open(self, path: Path | None) -> bool:
+        """Load ``path``; on failure the error is shown in the Mesh panel, the mesh stays."""
         if self.mesh.load(path):
+            if path is not None:
+                self.panels["mesh"].remember(Path(path))
             self.sync_mesh()
             ps.reset_camera_to_home_view()
             return True
@@ -238,6 +306,7 @@ def run(
     With ``screenshot`` a single frame is rendered headless (EGL) into that PNG and the
     function returns.
     """
+    cwd = Path.cwd()  # before polyscope.init(), which may change it: the export folder
     path = Path(path).resolve() if path is not None else None
     shot = Path(screenshot).resolve() if screenshot is not None else None
     if shot is not None and not shot.parent.is_dir():
@@ -256,7 +325,7 @@ def run(
             f"vertex {vertex} is out of range (the mesh has {len(mesh.V)} vertices)", "--vertex"
         )
     _init(backend or ("openGL3_egl" if shot else "auto"))
-    viewer = Viewer(mesh, CurvatureState(field_name=field), panel=panel)
+    viewer = Viewer(mesh, CurvatureState(field_name=field), panel=panel, export_dir=cwd)
     viewer.sync_mesh()
     if shot is not None:
         ps.set_window_size(1600, 900)
@@ -275,21 +344,9 @@ def run(
             viewer.frame()
         ps.frame_tick()
         ps.frame_tick()  # ImPlot fits its axes on the second frame
-        buf = ps.screenshot_to_buffer(transparent_bg=False, include_UI=True)
-        _write_png(shot, buf)
+        scene.save_screenshot(shot)
         ps.clear_user_callback()
         ps.remove_all_structures()
         return 0
     ps.show()
     return 0
-
-
-def _write_png(path: Path, rgba: np.ndarray) -> None:
-    """Write an RGBA buffer as PNG atomically (matplotlib's encoder, no extra dependency)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.image as mpimg
-
-    with atomic_write(path, mode="wb") as fh:
-        mpimg.imsave(fh, rgba, format="png")

@@ -6,8 +6,6 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import polyscope as ps
-import polyscope.imgui as psim
-import polyscope.implot as psimplot
 
 from meshlap_core.options import AREA_KINDS as AREAS
 from meshlap_core.options import BOUNDARY_RULES
@@ -19,10 +17,10 @@ if TYPE_CHECKING:
     from ..viewer import Viewer
 
 
-def combo(label: str, current: str, items: tuple[str, ...] | list[str]) -> tuple[bool, str]:
-    """A combo over strings: (changed, chosen item)."""
-    changed, idx = psim.Combo(label, list(items).index(current), list(items))
-    return changed, items[idx]
+FIELD_HELP = (
+    "H = |Lx|/2 with the uniform or cotangent Laplacian (signed by the normal); "
+    "K = (2 pi - sum of angles) / A_i; k1,2 = H +- sqrt(H^2 - K)"
+)
 
 
 class CurvaturePanel:
@@ -80,18 +78,40 @@ class CurvaturePanel:
         )
 
     def draw(self, viewer: Viewer) -> None:
-        if not psim.CollapsingHeader("Curvature", psim.ImGuiTreeNodeFlags_DefaultOpen):
+        ui = viewer.ui
+        if not ui.header("Curvature"):
             return
         c = viewer.curv
         names = tuple(FIELD_LABELS)
-        ch1, c.field_name = combo("field", c.field_name, names)
-        ch2, c.area = combo("area", c.area, AREAS)
-        ch3, c.boundary = combo("boundary rule", c.boundary, BOUNDARY_RULES)
-        ch4, c.percentile = psim.SliderFloat("clip %", c.percentile, 0.0, 20.0, "%.1f")
-        ch5, self.side_by_side = psim.Checkbox("side by side", self.side_by_side)
+        ch1, c.field_name = ui.combo("field", c.field_name, names, FIELD_HELP)
+        ch2, c.area = ui.combo(
+            "area", c.area, AREAS, "vertex area A_i: barycentric (1/3 of each face) or Voronoi"
+        )
+        ch3, c.boundary = ui.combo(
+            "boundary rule",
+            c.boundary,
+            BOUNDARY_RULES,
+            "Gaussian curvature at boundary vertices: pi - sum(angles) (geodesic curvature) "
+            "or not defined",
+        )
+        ch4, pct = ui.slider_float(
+            "clip %",
+            c.percentile,
+            0.0,
+            20.0,
+            "%.1f",
+            "colour range clips this percentage of vertices at each end (0 to 49)",
+        )
+        if ch4:
+            c.set_percentile(pct)
+        ch5, self.side_by_side = ui.checkbox(
+            "side by side", self.side_by_side, "show a second field on a copy beside the mesh"
+        )
         ch6 = False
         if self.side_by_side:
-            ch6, self.second_field = combo("second field", self.second_field, names)
+            ch6, self.second_field = ui.combo(
+                "second field", self.second_field, names, "the field on the copy"
+            )
         if ch1 or ch2 or ch3 or ch4 or ch5 or ch6:
             self.push(viewer, force=ch2 or ch3)
             viewer.show_panel()
@@ -99,10 +119,13 @@ class CurvaturePanel:
             return
         st = c.summary()
         lo, hi = st["range"]
-        psim.TextUnformatted(
-            f"min {st['min']:.4g}  max {st['max']:.4g}  colour range [{lo:.4g}, {hi:.4g}]"
-        )
-        psim.TextUnformatted(FIELD_LABELS[c.field_name][0])
-        if psimplot.BeginPlot("histogram (clipped to the colour range)", (-1, 160)):
-            psimplot.PlotBars("vertices", st["centers"], st["counts"], st["width"])
-            psimplot.EndPlot()
+        ui.text(f"min {st['min']:.4g}  max {st['max']:.4g}  colour range [{lo:.4g}, {hi:.4g}]")
+        ui.text(FIELD_LABELS[c.field_name][0])
+        with ui.plot(
+            "histogram (clipped to the colour range)",
+            160,
+            FIELD_LABELS[c.field_name][0],
+            "vertices",
+        ) as shown:
+            if shown:
+                ui.plot_bars("vertices", st["centers"], st["counts"], st["width"])

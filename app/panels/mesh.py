@@ -5,9 +5,6 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-import polyscope.imgui as psim
-
-from ..scene import RED
 from ..state.mesh import list_meshes
 from .base import NoStructures
 
@@ -20,32 +17,48 @@ class MeshPanel(NoStructures):
 
     def __init__(self) -> None:
         self.path_text = ""
+        self.recent: list[Path] = []  # the last meshes opened, newest first
 
     def draw(self, viewer: Viewer) -> None:
-        if not psim.CollapsingHeader("Mesh", psim.ImGuiTreeNodeFlags_DefaultOpen):
+        ui = viewer.ui
+        if not ui.header("Mesh"):
             return
         mesh = viewer.mesh
         info = mesh.info
-        psim.TextUnformatted(
+        ui.text(
             f"{mesh.name}: {info.get('n_vertices', 0)} vertices, "
             f"{info.get('n_faces', 0)} faces, chi = {info.get('euler_characteristic')}, "
             f"genus = {info.get('genus')}"
         )
-        psim.TextUnformatted(
+        ui.text(
             f"boundary loops {info.get('n_boundary_loops')}, components "
             f"{info.get('n_components')}, manifold {'yes' if info.get('manifold') else 'no'}"
         )
         for r in info.get("repairs", []):
-            psim.TextUnformatted(f"repaired: {r}")
-        _, self.path_text = psim.InputText("path", self.path_text)
-        psim.SameLine()
-        if psim.Button("Open") and self.path_text:
-            viewer.open(Path(self.path_text).expanduser())
-        choices = list_meshes()
-        if choices and psim.BeginCombo("bundled / shared", "choose a mesh"):
-            for label, path in choices:
-                if psim.Selectable(label)[0]:
-                    viewer.open(path)
-            psim.EndCombo()
+            ui.text(f"repaired: {r}")
+        entered, self.path_text = ui.input_text(
+            "path", self.path_text, "a mesh file (.obj .off .ply .stl); Enter or Open loads it"
+        )
+        ui.same_line()
+        if (ui.button("Open", "load the file named in the path field") or entered) and (
+            self.path_text.strip()
+        ):
+            viewer.open(Path(self.path_text.strip()).expanduser())
+        choices = dict(list_meshes())
+        for p in self.recent:
+            choices.setdefault(f"recent: {p.name}", p)
+        picked = ui.choose(
+            "bundled / shared",
+            "choose a mesh",
+            list(choices),
+            "the bundled assets, ../shared/meshes and recently opened files",
+        )
+        if picked:
+            viewer.open(choices[picked])
         if mesh.error:
-            psim.TextColored(RED, mesh.error)
+            ui.error(mesh.error)
+
+    def remember(self, path: Path) -> None:
+        """Put ``path`` first in the recent-files list (at most 8)."""
+        path = Path(path).resolve()
+        self.recent = [path, *(p for p in self.recent if p != path)][:8]

@@ -6,10 +6,11 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 import polyscope as ps
-import polyscope.imgui as psim
+
+from meshlap_core.errors import MeshError
 
 from ..camera import project_to_screen
-from ..scene import RED, RING_CENTER, RING_CURVE, RING_POINTS
+from ..scene import RING_CENTER, RING_CURVE, RING_POINTS
 
 if TYPE_CHECKING:
     from ..viewer import Viewer
@@ -97,29 +98,34 @@ class OneRingPanel:
     def draw_labels(self, viewer: Viewer) -> None:
         """Write the order numbers next to the neighbours (over the 3D view)."""
         self.labels = self.ring_labels(viewer)
-        dl = psim.GetForegroundDrawList()
-        col = psim.GetColorU32((0.05, 0.05, 0.05, 1.0))
         for pos, text in self.labels:
-            dl.AddText(pos, col, text)
+            viewer.ui.overlay_text(pos, text)
 
     def draw(self, viewer: Viewer) -> None:
-        if not psim.CollapsingHeader("One-ring", psim.ImGuiTreeNodeFlags_DefaultOpen):
+        ui = viewer.ui
+        if not ui.header("One-ring"):
             return
-        psim.TextUnformatted("click a vertex of the mesh")
+        ui.text("click a vertex of the mesh")
         n = len(viewer.mesh.V)
         r = viewer.ring
-        ch, v = psim.InputInt("vertex", max(r.vertex, 0))
-        if ch and 0 <= v < n:
+        ch, v = ui.input_int(
+            "vertex", max(r.vertex, 0), f"vertex index, 0 to {n - 1}; Enter or -/+ selects it"
+        )
+        if ch:
+            if not 0 <= v < n:
+                raise MeshError(f"{v} is out of range (the mesh has {n} vertices)", "vertex")
             self.select(viewer, v)
-        ch, _ = psim.Checkbox("clockwise (reverse)", r.reverse)
+        ch, _ = ui.checkbox(
+            "clockwise (reverse)", r.reverse, "list the neighbours clockwise instead"
+        )
         if ch:
             r.toggle_reverse(viewer.mesh, viewer.curv)
             self.push(viewer)
         if r.vertex < 0:
             return
         kind = "boundary vertex (open fan)" if r.boundary else "interior vertex (closed cycle)"
-        psim.TextUnformatted(f"vertex {r.vertex}: {kind}, valence {r.valence}")
-        psim.TextUnformatted(f"H (cotan) = {r.H + 0.0:.5g}   K (angle deficit) = {r.K + 0.0:.5g}")
+        ui.text(f"vertex {r.vertex}: {kind}, valence {r.valence}")
+        ui.text(f"H (cotan) = {r.H + 0.0:.5g}   K (angle deficit) = {r.K + 0.0:.5g}")
         if not r.ordered:
-            psim.TextColored(RED, "not a disk: neighbours listed by index, not in order")
-        psim.TextUnformatted("order: " + " -> ".join(str(j) for j in r.neighbors[:40]))
+            ui.error("not a disk: neighbours listed by index, not in order")
+        ui.text("order: " + " -> ".join(str(j) for j in r.neighbors[:40]))

@@ -7,15 +7,14 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 import polyscope as ps
-import polyscope.imgui as psim
-import polyscope.implot as psimplot
 
 from meshlap_core.options import LAPLACIAN_KINDS as LAPLACIANS
 
-from ..scene import INPUT_COLOR, MESH, RED, SMOOTH_INPUT, SMOOTHED, SMOOTHED_COLOR, side_offset
+from ..scene import INPUT_COLOR, MESH, SMOOTH_INPUT, SMOOTHED, SMOOTHED_COLOR, side_offset
 from ..state.smoothing import METHODS, SmoothingState
 
 if TYPE_CHECKING:
+    from ..ui import UI
     from ..viewer import Viewer
 
 
@@ -85,57 +84,96 @@ class SmoothingPanel:
         viewer.show_panel()
 
     def draw(self, viewer: Viewer) -> None:
-        if not psim.CollapsingHeader("Smoothing", psim.ImGuiTreeNodeFlags_DefaultOpen):
+        ui = viewer.ui
+        if not ui.header("Smoothing"):
             return
         st = self.state
-        c1, idx = psim.Combo("method", METHODS.index(st.method), list(METHODS))
-        c2, jdx = psim.Combo("Laplacian", LAPLACIANS.index(st.laplacian), list(LAPLACIANS))
-        c3, lam = psim.InputFloat("lambda", st.lam, 0.0, 0.0, "%.4g")
-        c4, alpha = psim.SliderFloat("noise alpha", st.noise_alpha, 0.0, 0.05, "%.4f")
-        c5, seed = psim.InputInt("noise seed", st.seed)
-        if c1 or c2 or c3 or c4 or c5:
-            st.method, st.laplacian = METHODS[idx], LAPLACIANS[jdx]
-            st.lam, st.noise_alpha, st.seed = float(lam), float(alpha), max(int(seed), 0)
-            self.rebuild(viewer)
-        if psim.Button("step"):
+        V, F = viewer.mesh.V, viewer.mesh.F
+        ch, method = ui.combo(
+            "method",
+            st.method,
+            METHODS,
+            "explicit: x <- x + lam L x;  implicit: (I - lam L) x' = x (backward Euler);  "
+            "taubin: lam step, then a negative nu step (no shrinkage)",
+        )
+        if ch:
+            st.configure(V, F, method=method)
+            self.push(force=True)
+        ch, lap = ui.combo(
+            "Laplacian",
+            st.laplacian,
+            LAPLACIANS,
+            "uniform: L = D^-1 A - I (lam dimensionless);  cotan: L = M^-1 C (lam in length^2)",
+        )
+        if ch:
+            st.configure(V, F, laplacian=lap)
+            self.push(force=True)
+        ch, lam = ui.input_float(
+            "lambda",
+            st.lam,
+            "%.4g",
+            "step size lam > 0; type a number and press Enter (keeps the current mesh)",
+        )
+        if ch:
+            st.set_lam(lam)
+        ch, alpha = ui.slider_float(
+            "noise alpha",
+            st.noise_alpha,
+            0.0,
+            0.05,
+            "%.4f",
+            "Gaussian noise along the normals, sigma = alpha x mean edge length "
+            "(rebuilds the input)",
+        )
+        if ch:
+            st.configure(V, F, noise_alpha=alpha)
+            self.push(force=True)
+        ch, seed = ui.input_int("noise seed", st.seed, "seed of the noise (an integer >= 0)")
+        if ch:
+            st.configure(V, F, seed=seed)
+            self.push(force=True)
+        if ui.button("step", "one iteration"):
             st.step()
-        psim.SameLine()
-        if psim.Button("pause" if st.playing else "play"):
+        ui.same_line()
+        if ui.button("pause" if st.playing else "play", "step every frame (space)"):
             st.playing = not st.playing
-        psim.SameLine()
-        if psim.Button("reset"):
+        ui.same_line()
+        if ui.button("reset", "back to the (noisy) input, iteration 0"):
             st.reset()
             self.push(force=True)
         if st.playing:
             st.step()
         self.push()
         if st.error:
-            psim.TextColored(RED, st.error)
+            ui.error(st.error)
+        self.draw_figures(ui)
+
+    def draw_figures(self, ui: UI) -> None:
+        """Iteration, RMSE, volume change, the stable limit and the amplification plot."""
+        st = self.state
         fig = st.figures()
         if not fig:
             return
         vol = fig["volume_change_pct"]
-        psim.TextUnformatted(
+        ui.text(
             f"iteration {fig['iteration']}   RMSE vs original "
             f"{fig['rmse']:.4g}   volume change "
             + (f"{vol:+.3f}%" if vol is not None else f"undefined ({fig['volume_note']})")
         )
         limit = fig["stable_limit"]
-        psim.TextUnformatted(
+        ui.text(
             "largest stable explicit lambda: "
             + ("unconditionally stable" if limit is None else f"{limit:.4g}")
         )
         if fig["warning"]:
-            psim.TextColored(RED, fig["warning"])
+            ui.error(fig["warning"])
         mu, g = st.amplification()
-        if psimplot.BeginPlot("amplification g(mu) per step", (-1, 170)):
-            lo = min(-1.2, float(np.min(g)) - 0.1)
-            hi = max(1.2, float(np.max(g)) + 0.1)
-            psimplot.SetupAxisLimits(psimplot.ImAxis_Y1, lo, hi, psimplot.ImPlotCond_Always)
-            psimplot.PlotLine(
-                "g", np.asarray(mu, dtype=np.float64), np.asarray(g, dtype=np.float64)
-            )
-            psimplot.PlotInfLines(
-                "|g| = 1", np.array([-1.0, 1.0]), psimplot.ImPlotInfLinesFlags_Horizontal
-            )
-            psimplot.EndPlot()
+        with ui.plot(
+            "amplification g(mu) per step", 170, "mu (eigenvalue of L)", "g(mu)", fit_y=False
+        ) as shown:
+            if shown:
+                lo = min(-1.2, float(np.min(g)) - 0.1)
+                hi = max(1.2, float(np.max(g)) + 0.1)
+                ui.plot_y_limits(lo, hi)
+                ui.plot_line("g", mu, g)
+                ui.plot_hlines("|g| = 1", np.array([-1.0, 1.0]))

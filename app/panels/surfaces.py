@@ -6,11 +6,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 import polyscope as ps
-import polyscope.imgui as psim
-import polyscope.implot as psimplot
 
-from ..scene import RED, SURFACE, SURFACE_POINT, Z_TO_Y
-from .curvature import combo
+from ..scene import SURFACE, SURFACE_POINT, Z_TO_Y
 
 if TYPE_CHECKING:
     from ..viewer import Viewer
@@ -83,32 +80,37 @@ class SurfacesPanel:
         )
 
     def draw(self, viewer: Viewer) -> None:
-        if not psim.CollapsingHeader("Surfaces", psim.ImGuiTreeNodeFlags_DefaultOpen):
+        ui = viewer.ui
+        if not ui.header("Surfaces"):
             return
         s = viewer.surf
-        ch, name = combo("surface", s.name, s.names)
+        ch, name = ui.combo("surface", s.name, s.names, "a parametric surface p(u, v)")
         if ch and s.set_surface(name):
             self.push(viewer)
             ps.reset_camera_to_home_view()
+        ch, res = ui.input_int("resolution", s.res, "cells per parameter direction; Enter applies")
+        if ch:
+            s.set_resolution(res)
+            self.push(viewer)
         u0, u1, v0, v1 = s.domain
-        ch1, u = psim.SliderFloat("u", s.u, u0, u1)
-        ch2, v = psim.SliderFloat("v", s.v, v0, v1)
+        ch1, u = ui.slider_float("u", s.u, u0, u1, "%.3f", "first parameter of the point")
+        ch2, v = ui.slider_float("v", s.v, v0, v1, "%.3f", "second parameter of the point")
         if (ch1 or ch2) and s.set_uv(u, v):
             self.push_point(viewer)
         if s.error:
-            psim.TextColored(RED, s.error)
+            ui.error(s.error)
         p = s.point
         if p is None:
             return
-        psim.TextUnformatted(f"I:  E = {p.E:.4g}  F = {p.F:.4g}  G = {p.G:.4g}")
-        psim.TextUnformatted(f"II: e = {p.e:.4g}  f = {p.f:.4g}  g = {p.g:.4g}")
-        psim.TextUnformatted(f"K = {p.K:.4g}  H = {p.H:.4g}  ({p.classification})")
-        psim.TextUnformatted(
+        ui.text(f"I:  E = {p.E:.4g}  F = {p.F:.4g}  G = {p.G:.4g}")
+        ui.text(f"II: e = {p.e:.4g}  f = {p.f:.4g}  g = {p.g:.4g}")
+        ui.text(f"K = {p.K:.4g}  H = {p.H:.4g}  ({p.classification})")
+        ui.text(
             f"k1 = {p.k1:.4g} at {np.degrees(p.theta_max):.1f} deg,  "
             f"k2 = {p.k2:.4g} at {np.degrees(p.theta_min):.1f} deg"
         )
-        psim.TextUnformatted("signs: e = p_uu . n with n = p_u x p_v (do Carmo)")
-        if psimplot.BeginPlot("normal curvature k_n(theta)", (-1, 180)):
-            psimplot.PlotLine("k_n", s.theta, s.kn)
-            psimplot.PlotInfLines("theta max/min", np.array([p.theta_max, p.theta_min]))
-            psimplot.EndPlot()
+        ui.text("signs: e = p_uu . n with n = p_u x p_v (do Carmo)")
+        with ui.plot("normal curvature k_n(theta)", 180, "theta (rad)", "k_n") as shown:
+            if shown:
+                ui.plot_line("k_n", s.theta, s.kn)
+                ui.plot_vlines("theta max/min", np.array([p.theta_max, p.theta_min]))

@@ -8,6 +8,7 @@ from typing import Any
 import numpy as np
 
 from meshlap_core.curvature import curvature_fields
+from meshlap_core.errors import MeshError
 from meshlap_core.types import FloatArray
 
 from .mesh import MeshState
@@ -65,6 +66,19 @@ class CurvatureState:
         self.fields = curvature_fields(mesh.V, mesh.F, self.area, self.boundary)
         self._key = key
         return True
+
+    def set_percentile(self, percentile: float) -> None:
+        """Clip percentage of the colour range, in ``[0, 49]``.
+
+        Raises
+        ------
+        MeshError
+            ``percentile`` is not a finite number (the previous one stays).
+        """
+        p = float(percentile)
+        if not np.isfinite(p):
+            raise MeshError(f"must be a finite number, got {percentile!r}", "clip %")
+        self.percentile = float(np.clip(p, 0.0, 49.0))
 
     def color_range(self, name: str | None = None) -> tuple[float, float]:
         """Robust colour range of a field (symmetric around 0 for signed fields)."""

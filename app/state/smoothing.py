@@ -11,7 +11,7 @@ import numpy as np
 
 from meshlap_core.errors import MeshError
 from meshlap_core.noise import add_noise
-from meshlap_core.smoothing import Smoother, amplification_curve
+from meshlap_core.smoothing import Smoother, amplification_curve, check_lam
 from meshlap_core.types import FloatArray, IntArray
 
 METHODS = ("explicit", "implicit", "taubin")
@@ -28,6 +28,8 @@ class SmoothingState:
     lam: float = 0.5
     noise_alpha: float = 0.0
     seed: int = 0
+    diagonal: float = 0.0  # bounding-box diagonal of the input: the divergence bound
+    stopped: bool = False  # a diverging run stopped; reset to go on
     playing: bool = False
     error: str = ""
     smoother: Smoother | None = None
@@ -56,9 +58,61 @@ class SmoothingState:
             self.playing = False
             return False
         self.smoother = smoother
+        self.diagonal = float(np.linalg.norm(np.ptp(smoother.V0, axis=0))) if len(V) else 0.0
+        self.stopped = False
         self.error = ""
         self.version += 1
         return True
+
+    def set_lam(self, lam: float) -> None:
+        """Change ``λ`` keeping the current positions, noise and iteration count
+        (:meth:`Smoother.set_lam`: the implicit system is refactorized, nothing else).
+
+        Raises
+        ------
+        MeshError
+            ``λ`` is not a finite number > 0 (the state keeps the previous ``λ``).
+        """
+        lam = check_lam(lam, "lambda")
+        if self.smoother is not None:
+            self.smoother.set_lam(lam)
+        self.lam = lam
+        self.error = ""
+
+    def configure(
+        self,
+        V: FloatArray,
+        F: IntArray,
+        *,
+        method: str | None = None,
+        laplacian: str | None = None,
+        noise_alpha: float | None = None,
+        seed: int | None = None,
+    ) -> None:
+        """Rebuild the stepper with new options; on bad options nothing changes.
+
+        Raises
+        ------
+        MeshError
+            A bad option (named), e.g. a negative noise α or seed; the previous options and
+            stepper stay.
+        """
+        if seed is not None and not (isinstance(seed, int) and seed >= 0):
+            raise MeshError(f"must be an integer >= 0, got {seed!r}", "noise seed")
+        old = (self.method, self.laplacian, self.noise_alpha, self.seed)
+        if method is not None:
+            self.method = method
+        if laplacian is not None:
+            self.laplacian = laplacian
+        if noise_alpha is not None:
+            self.noise_alpha = float(noise_alpha)
+        if seed is not None:
+            self.seed = seed
+        if not self.rebuild(V, F):
+            message = self.error
+            self.method, self.laplacian, self.noise_alpha, self.seed = old
+            self.error = ""
+            raise MeshError(message)
 
     @property
     def V_original(self) -> FloatArray:
@@ -77,24 +131,48 @@ class SmoothingState:
         return self.smoother.F if self.smoother is not None else _EMPTY_F
 
     def step(self) -> bool:
-        """One iteration; stops playing (and says why) when the explicit flow diverges."""
+        """One iteration; stops (and says why, with the stable λ) when the flow diverges.
+
+        A step counts as diverging when the smoother blows up, when its RMSE against the clean
+        mesh exceeds the bounding-box diagonal, or when the enclosed volume changed by more than
+        100 %: no smoothing of a sane mesh does either, an explicit λ above the limit does within
+        a few steps.
+        """
         s = self.smoother
         if s is None:
             return False
-        if s.diverged:
+        if s.diverged or self.stopped:
             self.playing = False
             return False
         s.step()
-        if s.diverged:
+        last = s.history[-1] if s.history else {}
+        rmse, vol = last.get("rmse"), last.get("volume_change_pct")
+        too_far = rmse is not None and not rmse <= self.diagonal
+        too_much = vol is not None and not abs(vol) <= 100.0
+        if s.diverged or too_far or too_much:
             self.playing = False
-            self.error = "diverged: this explicit λ is above the stable limit (see below)"
+            self.stopped = True
+            what = (
+                "the step blew up"
+                if s.diverged
+                else (
+                    f"RMSE {rmse:.3g} exceeds the bounding-box diagonal {self.diagonal:.3g}"
+                    if too_far
+                    else f"the volume changed by {vol:+.0f} % (more than 100 %)"
+                )
+            )
+            limit = s.stability.max_stable_lam
+            hint = f"; the stable λ on this mesh is below {limit:.4g}" if limit else ""
+            self.error = f"diverged at iteration {s.iteration}: {what}{hint}; press reset"
             return False
         return True
 
     def reset(self) -> None:
+        """Back to the noisy input (the noise itself stays)."""
         if self.smoother is not None:
             self.smoother.reset()
         self.playing = False
+        self.stopped = False
         self.error = ""
 
     @property
