@@ -48,6 +48,30 @@ EXPECTED: dict[str, tuple[type, ...]] = {
 }
 
 
+KEYS = {
+    "space": "ImGuiKey_Space",
+    "left": "ImGuiKey_LeftArrow",
+    "right": "ImGuiKey_RightArrow",
+    "1": "ImGuiKey_1",
+    "2": "ImGuiKey_2",
+    "3": "ImGuiKey_3",
+    "4": "ImGuiKey_4",
+    "5": "ImGuiKey_5",
+    "f": "ImGuiKey_F",
+    "h": "ImGuiKey_H",
+    "r": "ImGuiKey_R",
+}
+"""The viewer's shortcut keys and their imgui names."""
+
+
+def sig(x: float, scale: float, digits: int = 4) -> str:
+    """``x`` to ``digits`` significant digits, or ``0`` when ``|x| < 1e-12 · scale`` (round-off
+    of a quantity whose size is ``scale``, e.g. ``F = -3.5e-18`` beside ``E = 1``)."""
+    if abs(x) < 1e-12 * abs(scale) or x == 0:
+        return "0"
+    return f"{x:.{digits}g}"
+
+
 class UIApiMismatch(TypeError):
     """polyscope's imgui returned a type this adapter does not expect (its API changed)."""
 
@@ -202,9 +226,12 @@ class UI:
         self.im.PopItemWidth()
 
     # ------------------------------------------------------------------ widgets
-    def header(self, label: str, default_open: bool = True) -> bool:
-        """A collapsing header; scripting ``label`` with a bool opens/closes it for one frame."""
+    def header(self, label: str, default_open: bool = True, force: bool | None = None) -> bool:
+        """A collapsing header (``force``: open or close it now); scripting ``label`` with a
+        bool opens/closes it for one frame."""
         flags = self.im.ImGuiTreeNodeFlags_DefaultOpen if default_open else 0
+        if force is not None:
+            self.im.SetNextItemOpen(bool(force))
         result = check_return("CollapsingHeader", self.im.CollapsingHeader(label, flags))
         queue = self._script.get(label)
         if queue:
@@ -357,6 +384,32 @@ class UI:
         self.ip.PlotInfLines(label, _f64(y), self.ip.ImPlotInfLinesFlags_Horizontal)
 
     # ------------------------------------------------------------------ overlay, keys
+    def key(self, name: str) -> bool:
+        """Was the shortcut key ``name`` (see :data:`KEYS`) pressed this frame, outside a text
+        field? Scripted as the label ``"key <name>"``."""
+        label = f"key {name}"
+        self.seen[("keys", label)] = "key"
+        queue = self._script.get(label)
+        if queue:
+            self.driven.add(("keys", label))
+            return bool(queue.popleft())
+        if self.im.GetIO().WantCaptureKeyboard:
+            return False
+        return bool(self.im.IsKeyPressed(getattr(self.im, KEYS[name]), False))
+
+    def scene_click(self) -> tuple[float, float] | None:
+        """Window position of a left click on the 3D view this frame (not on a panel), or
+        ``None``. Scripted as the label ``"click"`` with an ``(x, y)``."""
+        self.seen[("scene", "click")] = "click"
+        queue = self._script.get("click")
+        if queue:
+            self.driven.add(("scene", "click"))
+            return tuple(queue.popleft())
+        io = self.im.GetIO()
+        if io.WantCaptureMouse or not self.im.IsMouseClicked(0):
+            return None
+        return tuple(io.MousePos)
+
     def overlay_text(self, pos: tuple[float, float], text: str) -> None:
         """Text drawn over the 3D view at window pixel ``pos``."""
         dl = self.im.GetForegroundDrawList()

@@ -13,19 +13,20 @@ from __future__ import annotations
 
 import os
 import sys
+import time
 import traceback
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import polyscope as ps
-import polyscope.imgui as psim
 
 from meshlap_core.errors import MeshError
 
 from . import scene
 from .panels.curvature import CurvaturePanel
 from .panels.export import ExportPanel
+from .panels.help import HelpPanel
 from .panels.mesh import MeshPanel
 from .panels.onering import OneRingPanel
 from .panels.smoothing import SmoothingPanel
@@ -36,6 +37,7 @@ from .state.curvature import CurvatureState
 from .state.mesh import MeshState
 from .state.names import FIELD_LABELS, PANELS
 from .state.onering import OneRingState
+from .state.spectral import SCREENSHOT_K
 from .state.surface import SurfaceState
 from .ui import UI
 
@@ -43,6 +45,13 @@ NO_DISPLAY = (
     "no display could be opened for the viewer window; render headless with "
     "`meshlap view MESH --screenshot out.png`"
 )
+
+PANEL_PX = 520
+"""Width of meshlap's panel on the right (pixels at UI scale 1): framing keeps clear of it."""
+
+BUSY_FRAME_S = 0.35
+"""While the eigen worker runs, each frame waits this long (about 5 frames/s): the render loop
+then leaves the cores to the solver, so the basis takes about as long as ``meshlap spectral``."""
 
 FRAMED = (
     scene.MESH,
@@ -75,7 +84,6 @@ def _init(backend: str) -> None:
         # so scripted frame_tick loops would silently skip the callback)
         ps.set_max_fps(-1)
         ps.set_frame_tick_limit_fps_mode("ignore_limits")
-    ps.set_program_name("meshlap")
     ps.set_up_dir("y_up")  # scans and the course meshes are y-up (polyscope's default)
     ps.set_front_dir("neg_z_front")
     ps.set_ground_plane_mode("shadow_only")
@@ -94,6 +102,8 @@ class Viewer:
         export_dir: Path | None = None,
     ) -> None:
         self.ui = ui or UI()
+        self.display = scene.Display()  # world -> display coordinates (float32-safe uploads)
+        self.busy_frame_s = BUSY_FRAME_S
         self.errors: dict[str, str] = {}  # section -> the message shown in red there
         self._logged: set[tuple[str, str]] = set()
         self.mesh = mesh
@@ -108,9 +118,13 @@ class Viewer:
             "smoothing": SmoothingPanel(),
             "surfaces": SurfacesPanel(),
             "export": ExportPanel(export_dir),
+            "help": HelpPanel(),
         }
         self.panel = panel
         self._mesh_version = -1
+        self.reframe = True  # frame the visible structures at the end of the next frame
+        self._window_size: tuple[int, int] = (0, 0)
+        self._caption_boxes: dict[str, tuple[np.ndarray, np.ndarray]] = {}
 
     # ------------------------------------------------------------------ registration
     def sync_mesh(self) -> None:
@@ -125,7 +139,9 @@ class Viewer:
                 scene.RING_CENTER,
             ):
                 scene.remove_structure(name)
-            ps.register_surface_mesh(MESH, self.mesh.V, self.mesh.F, smooth_shade=True)
+            self.display.fit(self.mesh.V)
+            shown = self.display.points(self.mesh.V)
+            ps.register_surface_mesh(MESH, shown, self.mesh.F, smooth_shade=True)
             self.ring = OneRingState(reverse=self.ring.reverse)
             for p in self.panels.values():
                 p.on_new_mesh(self)
@@ -155,10 +171,50 @@ class Viewer:
 
     # ------------------------------------------------------------------ picking
     def handle_click(self) -> None:
-        io = psim.GetIO()
-        if io.WantCaptureMouse or not psim.IsMouseClicked(0):
+        xy = self.ui.scene_click()
+        if xy is not None:
+            self.pick_at(xy)
+
+    def handle_keys(self) -> None:
+        """The shortcuts (listed in the Help panel)."""
+        ui = self.ui
+        for i, name in enumerate(PANELS):
+            if ui.key(str(i + 1)):
+                self.set_panel(name)
+        smoothing, spectral = self.panels["smoothing"], self.panels["spectral"]
+        if ui.key("space") and self.panel == "smoothing":
+            smoothing.state.playing = not smoothing.state.playing
+        for key, dk in (("right", 1), ("left", -1)):
+            if not ui.key(key):
+                continue
+            if self.panel == "smoothing" and dk > 0:
+                smoothing.state.step()
+            elif self.panel == "spectral" and spectral.state.basis is not None:
+                spectral.state.set_k(spectral.state.k + dk)
+                spectral.push_k(self)
+        if ui.key("f"):
+            self.reframe = True
+        if ui.key("h"):
+            self.panels["help"].toggle()
+        if ui.key("r"):
+            if self.panel == "smoothing":
+                smoothing.state.reset()
+                smoothing.push(force=True)
+            else:
+                self.reframe = True
+
+    def files_dropped(self, paths: list[str]) -> None:
+        """polyscope's drag-and-drop callback: open the first file dropped on the window.
+
+        Runs outside the imgui frame, so it draws nothing: a failure is kept for the Mesh panel
+        (``mesh.error``, or ``errors["mesh"]`` for an internal error) and never raised.
+        """
+        if not paths:
             return
-        self.pick_at(io.MousePos)
+        try:
+            self.open(Path(paths[0]))
+        except Exception as exc:  # a callback from C++ must not raise
+            self.errors["mesh"] = self._internal_error("mesh", exc)
 
     def pick_at(self, screen_xy: tuple[float, float]) -> bool:
         """Pick at window coordinates; a vertex of the mesh selects its one-ring (or a point
@@ -168,7 +224,8 @@ class Viewer:
             return False
         data = res.structure_data
         if res.structure_name == MESH and self.panel in ("onering", "curvature"):
-            idx = self._vertex_of(data, res.position, self.mesh.V, self.mesh.F)
+            shown = self.display.points(self.mesh.V)  # picked positions are display positions
+            idx = self._vertex_of(data, res.position, shown, self.mesh.F)
             if idx is not None:
                 self.panel = "onering"
                 return self.select_vertex(idx)
@@ -198,17 +255,31 @@ class Viewer:
         leaves this function, so none ends the session.
         """
         ui = self.ui
+        if self.panels["spectral"].state.busy and self.busy_frame_s > 0:
+            time.sleep(self.busy_frame_s)  # releases the GIL too
         ui.push_width(200)
         try:
             self.draw_guarded("mesh", self.panels["mesh"].draw)
             self.draw_guarded("view", self.draw_view_combo)
             self.draw_guarded(self.panel, self.panels[self.panel].draw)
             self.draw_guarded("export", self.panels["export"].draw)
+            self.draw_guarded("help", self.panels["help"].draw)
         finally:
             ui.pop_width()
         self.draw_guarded("picking", lambda viewer: viewer.handle_click())
+        self.draw_guarded("keys", lambda viewer: viewer.handle_keys())
         if self.panel == "onering":
             self.draw_guarded("labels", self.panels["onering"].draw_labels)
+        self.draw_guarded("layout", lambda viewer: viewer.layout())
+
+    def layout(self) -> None:
+        """Re-frame after a change of what is shown or of the window size; draw captions."""
+        size = tuple(ps.get_window_size())
+        if self.reframe or size != self._window_size:
+            self._window_size = size
+            self.reframe = False
+            self.frame()
+        self.draw_captions()
 
     def draw_view_combo(self, viewer: Viewer) -> None:
         changed, panel = self.ui.combo(
@@ -218,11 +289,12 @@ class Viewer:
             self.set_panel(panel)
 
     def set_panel(self, panel: str) -> None:
-        """Switch to ``panel`` and show its structures."""
+        """Switch to ``panel``, show its structures and frame them."""
         if panel not in PANELS:
             raise MeshError(f"unknown panel {panel!r}; choose one of {', '.join(PANELS)}", "view")
         self.panel = panel
         self.show_panel()
+        self.reframe = True
 
     def draw_guarded(self, section: str, draw: Any) -> None:
         """Run ``draw(self)``; an exception is shown in red in that section, never raised.
@@ -271,7 +343,7 @@ class Viewer:
             if path is not None:
                 self.panels["mesh"].remember(Path(path))
             self.sync_mesh()
-            ps.reset_camera_to_home_view()
+            self.reframe = True
             return True
         return False
 
@@ -280,16 +352,77 @@ class Viewer:
         return self.panels["export"].export(self, folder)
 
     def structure_points(self, name: str) -> np.ndarray | None:
-        """World positions of a structure some panel registered (for camera framing)."""
+        """Display positions of a structure some panel registered (for camera framing)."""
         for p in self.panels.values():
             P = p.points(self, name)
             if P is not None:
                 return P
         return None
 
-    def frame(self, fraction: float = 0.6) -> None:
-        """Frame the enabled structures in the left ``fraction`` of the window."""
-        scene.frame_scene_left(FRAMED, self.structure_points, fraction)
+    def frame(self) -> None:
+        """Frame what the current panel shows in the part of the window left of meshlap's panel
+        (the one-ring: its selected vertex; the surfaces: obliquely from above; a mesh: from its
+        front, see ``scene.FRONT_VIEWS``). The same code serves the window and screenshots."""
+        if self.panel == "onering" and self.ring.valence:
+            self.focus_ring()
+            return
+        w, _ = ps.get_window_size()
+        fraction = min(max((w - PANEL_PX * self.ui.scale) / max(w, 1), 0.3), 0.95)
+        if self.panel == "surfaces":
+            view = scene.OBLIQUE_VIEW
+        else:
+            view = scene.FRONT_VIEWS.get(self.mesh.name, scene.DEFAULT_VIEW)
+        scene.frame_scene_left(FRAMED, self.structure_points, fraction, view)
+        self._caption_boxes = {}
+        for name in FRAMED:
+            if ps.has_surface_mesh(name) and ps.get_surface_mesh(name).is_enabled():
+                P = self.structure_points(name)
+                if P is not None and len(P):
+                    self._caption_boxes[name] = (P.min(axis=0), P.max(axis=0))
+
+    def captions(self) -> dict[str, str]:
+        """Caption of each structure shown side by side in the current panel."""
+        out: dict[str, str] = {}
+        curv = self.panels["curvature"]
+        if self.panel == "curvature" and curv.side_by_side:
+            out[MESH] = FIELD_LABELS[self.curv.field_name][0]
+            out[scene.MESH_B] = FIELD_LABELS[curv.second_field][0]
+        spec = self.panels["spectral"].state
+        if self.panel == "spectral" and spec.basis is not None:
+            out[MESH] = f"eigenfunction u_{spec.mode}"
+            out[scene.RECON] = f"k = {spec.k} of {spec.basis.k_max} modes"
+        sm = self.panels["smoothing"].state
+        if self.panel == "smoothing" and sm.smoother is not None:
+            noisy = f"noisy alpha = {sm.noise_alpha:g}" if sm.noise_alpha else "no noise"
+            out[scene.SMOOTH_INPUT] = f"input, {noisy}"
+            out[scene.SMOOTHED] = f"{sm.method}, lambda = {sm.lam:g}, {sm.smoother.iteration} steps"
+        return out
+
+    def draw_captions(self) -> None:
+        """Write each caption under its structure (the bottom of its bounding box on screen)."""
+        texts = self.captions()
+        if not texts:
+            return
+        from .camera import project_to_screen
+
+        params = ps.get_view_camera_parameters()
+        w, h = ps.get_window_size()
+        for name, text in texts.items():
+            box = self._caption_boxes.get(name)
+            if box is None:
+                continue
+            lo, hi = box
+            corners = np.array(
+                [[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])]
+            )
+            xy, front = project_to_screen(
+                corners, params.get_view_mat(), params.get_fov_vertical_deg(), w, h
+            )
+            if not front.all():
+                continue
+            x = float(xy[:, 0].mean()) - 3.5 * len(text) * self.ui.scale
+            y = float(min(xy[:, 1].max() + 8, h - 24))
+            self.ui.overlay_text((x, y), text)
 
 
 def run(
@@ -300,6 +433,7 @@ def run(
     vertex: int | None = None,
     k: int | None = None,
     backend: str | None = None,
+    ui_scale: float = 1.0,
 ) -> int:
     """Open the viewer on ``path`` (the bundled default mesh when ``None``).
 
@@ -324,24 +458,29 @@ def run(
         raise MeshError(
             f"vertex {vertex} is out of range (the mesh has {len(mesh.V)} vertices)", "--vertex"
         )
+    if not 0.5 <= ui_scale <= 3.0:  # also refuses NaN
+        raise MeshError(f"must be between 0.5 and 3, got {ui_scale}", "--ui-scale")
+    ps.set_program_name(f"meshlap — {mesh.name}")  # the window title (set before init)
     _init(backend or ("openGL3_egl" if shot else "auto"))
     viewer = Viewer(mesh, CurvatureState(field_name=field), panel=panel, export_dir=cwd)
+    ps.set_build_default_gui_panels(False)  # polyscope's own panels: a toggle in Help
+    if ui_scale != 1.0:
+        viewer.panels["help"].set_scale(viewer, ui_scale)
     viewer.sync_mesh()
     if shot is not None:
         ps.set_window_size(1600, 900)
-        ps.set_build_default_gui_panels(False)  # the screenshot shows our panel only
     if panel == "onering":
         viewer.select_vertex(vertex if vertex is not None else 0)
+    if k is None and shot is not None and panel == "spectral":
+        k = SCREENSHOT_K  # a spectral screenshot shows a reconstruction, not an empty panel
     if k is not None:
         viewer.panels["spectral"].prepare_screenshot(viewer, k)
     if panel == "smoothing":
         viewer.panels["smoothing"].prepare_screenshot(viewer)
     ps.set_user_callback(viewer.callback)
+    ps.set_files_dropped_callback(viewer.files_dropped)
     if shot is not None:
-        if panel == "onering":
-            viewer.focus_ring()
-        else:
-            viewer.frame()
+        viewer.frame()
         ps.frame_tick()
         ps.frame_tick()  # ImPlot fits its axes on the second frame
         scene.save_screenshot(shot)

@@ -138,6 +138,42 @@ def test_screenshot_shows_a_colour_map(tmp_path):
     assert np.sum(fg[:, 0] > fg[:, 2] + 0.15) > 100 and np.sum(fg[:, 2] > fg[:, 0] + 0.15) > 100
 
 
+def _scene_fraction(png) -> float:
+    """Fraction of the left 55 % of the picture (the 3D view; the panel is on the right) that
+    differs from the background."""
+    import matplotlib.image as mpimg
+
+    img = mpimg.imread(png)[..., :3]
+    left = img[:, : int(0.55 * img.shape[1])]
+    return float(np.mean(np.abs(left - img[0, 0]).sum(axis=2) > 0.05))
+
+
+@pytest.mark.egl
+@pytest.mark.parametrize("scale", [1e74, 1e-55])
+def test_screenshot_of_extreme_but_accepted_coordinates_is_not_blank(tmp_path, scale):
+    """float32 holds at most 3.4e38: the viewer centres and scales before every upload."""
+    if not _egl_available():
+        pytest.skip("polyscope's EGL backend cannot start on this machine (no EGL/Mesa)")
+    from meshlap_core import primitives
+    from meshlap_core.io import save_mesh
+
+    V, F = primitives.bumpy_sphere(3)
+    mesh = tmp_path / "extreme.ply"
+    save_mesh(mesh, V * scale + 3 * scale, F)
+    for panel in ("curvature", "smoothing"):
+        out = tmp_path / f"{panel}.png"
+        cmd = [sys.executable, "-m", "meshlap_core.cli", "view", str(mesh), "--panel", panel]
+        res = subprocess.run(
+            [*cmd, "--screenshot", str(out)],
+            capture_output=True,
+            text=True,
+            timeout=300,
+            cwd=tmp_path,
+        )
+        assert res.returncode == 0, res.stderr
+        assert _scene_fraction(out) > 0.05  # the mesh is drawn (before the fix: 0.0)
+
+
 PICK_SCRIPT = """
 import json, sys
 import numpy as np
@@ -156,7 +192,7 @@ ps.frame_tick()
 target = int(sys.argv[1])
 params = ps.get_view_camera_parameters()
 w, h = ps.get_window_size()
-xy, front = project_to_screen(mesh.V[[target]], params.get_view_mat(),
+xy, front = project_to_screen(viewer.display.points(mesh.V[[target]]), params.get_view_mat(),
                               params.get_fov_vertical_deg(), w, h)
 hit = viewer.pick_at((float(xy[0, 0]), float(xy[0, 1])))
 print(json.dumps({"hit": hit, "vertex": viewer.ring.vertex, "front": bool(front[0]),

@@ -78,11 +78,14 @@ def drive(viewer: Viewer, label: str, *values, panel: str | None = None) -> None
         viewer.ui.script(label, value)
         if label in EXPORT_WIDGETS:
             viewer.ui.script("Export", True)
+        if label in HELP_WIDGETS:
+            viewer.ui.script("Help and window (H)", True)
         frames(viewer)
         assert not viewer.ui.pending(), f"widget {label!r} was not drawn"
 
 
 EXPORT_WIDGETS = ("folder", "screenshot", "export what is shown")
+HELP_WIDGETS = ("polyscope's own panels", "UI scale")
 
 
 # ---------------------------------------------------------------- the adapter itself
@@ -387,6 +390,92 @@ def test_internal_error_is_shown_and_logged_once(viewer, capsys, monkeypatch):
     assert "curvature" not in viewer.errors  # a good change clears the message
 
 
+# ---------------------------------------------------------------- Help, shortcuts, mouse, drop
+def test_help_widgets(viewer):
+    help_panel = viewer.panels["help"]
+    frames(viewer)
+    before = help_panel.shown
+    drive(viewer, "key h", True)
+    frames(viewer)  # the header follows on the next frame
+    assert help_panel.shown == (not before)
+    drive(viewer, "polyscope's own panels", True)
+    assert help_panel.polyscope_panels
+    drive(viewer, "polyscope's own panels", False)
+    drive(viewer, "UI scale", 1.5)
+    assert help_panel.ui_scale == 1.5 and viewer.ui.scale == 1.5
+    drive(viewer, "UI scale", 10.0)
+    assert help_panel.ui_scale == 3.0  # clamped
+    for bad in ("nan", -1.0, "1e309"):
+        drive(viewer, "UI scale", bad)
+        assert help_panel.ui_scale == 3.0 and "UI scale" in viewer.errors["help"]
+    drive(viewer, "UI scale", 1.0)
+    drive(viewer, "key h", True)
+    frames(viewer)
+    assert help_panel.shown == before
+
+
+def test_shortcuts(viewer):
+    from meshlap_app.state import PANELS
+
+    for i, panel in enumerate(PANELS):
+        drive(viewer, f"key {i + 1}", True)
+        assert viewer.panel == panel
+    drive(viewer, "key 4", True)  # smoothing
+    st = viewer.panels["smoothing"].state
+    it0 = st.smoother.iteration
+    drive(viewer, "key right", True, True)
+    assert st.smoother.iteration == it0 + 2
+    drive(viewer, "key space", True)
+    assert st.playing
+    drive(viewer, "key space", True)
+    assert not st.playing
+    drive(viewer, "key r", True)
+    assert st.smoother.iteration == 0
+    drive(viewer, "key 3", True)  # spectral: arrows move k once a basis exists
+    spec = viewer.panels["spectral"].state
+    spec.k_request = 12
+    spec.start(viewer.mesh.V, viewer.mesh.F, background=False)
+    frames(viewer)
+    spec.set_k(5)
+    drive(viewer, "key right", True)
+    assert spec.k == 6
+    drive(viewer, "key left", True, True)
+    assert spec.k == 4
+    drive(viewer, "key f", True)
+    assert not viewer.reframe  # framed at the end of that frame
+    drive(viewer, "key 1", True)
+    drive(viewer, "key r", True)  # outside the smoothing panel: re-frame the camera
+
+
+def test_click_and_drop(viewer, tmp_path, sphere):
+    before = viewer.ring.vertex
+    drive(viewer, "click", (10.0, 10.0), (-5.0, 1e9))  # nothing there: nothing happens
+    assert viewer.ring.vertex == before
+    bad = tmp_path / "bad.obj"
+    bad.write_text("v 0 0 0\nf 1 2 3\n")
+    n = len(viewer.mesh.V)
+    viewer.files_dropped([str(bad)])
+    assert "bad.obj" in viewer.mesh.error and len(viewer.mesh.V) == n
+    viewer.files_dropped([])
+    viewer.files_dropped([str(tmp_path / "assets_missing.ply")])
+    frames(viewer)
+    viewer.files_dropped([str(sphere)])
+    assert viewer.mesh.name == "sphere.obj" and not viewer.mesh.error
+
+
+def test_captions_name_what_is_side_by_side(viewer):
+    viewer.set_panel("smoothing")
+    drive(viewer, "noise alpha", 0.004)
+    drive(viewer, "step", True, True)
+    caps = viewer.captions()
+    assert caps["smoothing input"] == "input, noisy alpha = 0.004"
+    assert caps["smoothed"] == "implicit, lambda = 0.5, 2 steps"
+    viewer.set_panel("curvature")
+    drive(viewer, "side by side", True)
+    caps = viewer.captions()
+    assert caps["mesh"].startswith("mean curvature H") and "second estimator" in " ".join(caps)
+
+
 # ---------------------------------------------------------------- coverage
 def test_every_widget_is_driven(viewer, tmp_path, sphere):
     """Run the whole tour on one adapter: every widget label drawn must have been scripted."""
@@ -399,9 +488,13 @@ def test_every_widget_is_driven(viewer, tmp_path, sphere):
     test_smoothing_lambda_typed_keeps_the_mesh(viewer)
     test_surfaces_widgets(viewer)
     test_export_writes_what_is_on_screen(viewer, tmp_path)
+    test_help_widgets(viewer)
+    test_shortcuts(viewer)
+    test_click_and_drop(viewer, tmp_path, sphere)
     ui = viewer.ui
     undriven = sorted(set(ui.seen) - ui.driven)
     assert not undriven, f"widgets no test drives: {undriven}"
-    untipped = sorted(set(ui.seen) - set(ui.tooltips))
+    untipped = sorted(k for k, kind in ui.seen.items() if kind not in ("key", "click"))
+    untipped = sorted(set(untipped) - set(ui.tooltips))
     assert not untipped, f"widgets without a tooltip: {untipped}"
     assert len(ui.seen) >= 25

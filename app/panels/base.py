@@ -16,7 +16,7 @@ class Panel(Protocol):
     ``draw`` runs every frame while the panel is shown (it reads widgets, calls its state's
     methods and pushes arrays only when something changed); ``on_new_mesh`` forgets what
     belonged to the previous mesh; ``show`` enables this panel's structures when ``panel`` is the
-    current panel and disables them otherwise; ``points`` gives the world positions of a
+    current panel and disables them otherwise; ``points`` gives the display positions of a
     structure this panel registered (for camera framing), ``None`` for other names.
     """
 

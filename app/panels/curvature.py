@@ -10,7 +10,7 @@ import polyscope as ps
 from meshlap_core.options import AREA_KINDS as AREAS
 from meshlap_core.options import BOUNDARY_RULES
 
-from ..scene import MESH, MESH_B, side_offset
+from ..scene import COLORBAR_AT, MESH, MESH_B, scalar_for_upload, side_offset
 from ..state.names import FIELD_LABELS
 
 if TYPE_CHECKING:
@@ -30,19 +30,25 @@ class CurvaturePanel:
         self.side_by_side = False
         self.second_field = "uniform"
         self.shown: Any = ""
+        self.colorbar = True  # the main field's colour bar: on in this panel and the one-ring's
 
     def on_new_mesh(self, viewer: Viewer) -> None:
         self.shown = ""
 
     def show(self, viewer: Viewer, panel: str) -> None:
+        want = panel in ("curvature", "onering")
+        if want != self.colorbar and ps.has_surface_mesh(MESH):
+            self.colorbar = want
+            self.push(viewer, force=True)
         if ps.has_surface_mesh(MESH_B):
             ps.get_surface_mesh(MESH_B).set_enabled(panel == "curvature")
 
     def points(self, viewer: Viewer, name: str) -> np.ndarray | None:
+        shown = viewer.display.points(viewer.mesh.V)
         if name == MESH:
-            return viewer.mesh.V
+            return shown
         if name == MESH_B:
-            return viewer.mesh.V + side_offset(viewer.mesh.V)
+            return shown + side_offset(shown)
         return None
 
     def push(self, viewer: Viewer, force: bool = False) -> None:
@@ -53,10 +59,10 @@ class CurvaturePanel:
         if not changed and key == self.shown:
             return
         self.shown = key
-        self._add_field(viewer, ps.get_surface_mesh(MESH), curv.field_name)
+        self._add_field(viewer, ps.get_surface_mesh(MESH), curv.field_name, self.colorbar)
         if self.side_by_side:
             if not ps.has_surface_mesh(MESH_B):
-                V = viewer.mesh.V
+                V = viewer.display.points(viewer.mesh.V)
                 ps.register_surface_mesh(
                     MESH_B, V + side_offset(V), viewer.mesh.F, smooth_shade=True
                 )
@@ -65,16 +71,21 @@ class CurvaturePanel:
             ps.remove_surface_mesh(MESH_B)
 
     @staticmethod
-    def _add_field(viewer: Viewer, sm: Any, name: str) -> None:
+    def _add_field(viewer: Viewer, sm: Any, name: str, colorbar: bool = False) -> None:
         label, signed = FIELD_LABELS[name]
-        lo, hi = viewer.curv.color_range(name)
+        label += " [1/length^2]" if name == "gaussian" else " [1/length]"
+        values, (lo, hi), factor = scalar_for_upload(
+            viewer.curv.fields[name], viewer.curv.color_range(name)
+        )
         sm.add_scalar_quantity(
-            label,
-            viewer.curv.fields[name],
+            label + factor,
+            values,
             defined_on="vertices",
             cmap="coolwarm" if signed else "viridis",
             vminmax=(lo, hi),
             enabled=True,
+            onscreen_colorbar_enabled=colorbar,
+            onscreen_colorbar_location=COLORBAR_AT,
         )
 
     def draw(self, viewer: Viewer) -> None:
@@ -115,6 +126,7 @@ class CurvaturePanel:
         if ch1 or ch2 or ch3 or ch4 or ch5 or ch6:
             self.push(viewer, force=ch2 or ch3)
             viewer.show_panel()
+            viewer.reframe = viewer.reframe or ch5
         if c.field_name not in c.fields:
             return
         st = c.summary()

@@ -46,17 +46,22 @@ class OneRingPanel:
         r = viewer.ring
         if r.valence == 0:
             return
-        center = viewer.mesh.V[[r.vertex]]
+        d = viewer.display
+        center, ring = d.points(viewer.mesh.V[[r.vertex]]), d.points(r.polyline)
         # sizes follow the ring's own edge length, so any mesh and zoom level looks the same
-        scale = 0.08 * float(np.linalg.norm(r.polyline - center, axis=1).mean())
-        cn = ps.register_curve_network(RING_CURVE, r.polyline, r.edges, radius=0.5 * scale)
+        scale = 0.08 * float(np.linalg.norm(ring - center, axis=1).mean())
+        cn = ps.register_curve_network(RING_CURVE, ring, r.edges, radius=0.5 * scale)
         cn.set_radius(0.5 * scale, relative=False)
         cn.set_color((0.1, 0.1, 0.1))
-        pc = ps.register_point_cloud(RING_POINTS, r.polyline, radius=1.5 * scale)
+        pc = ps.register_point_cloud(RING_POINTS, ring, radius=1.5 * scale)
         pc.set_radius(1.5 * scale, relative=False)
         pc.add_scalar_quantity("order", r.order_t, cmap="viridis", enabled=True, vminmax=(0, 1))
         pc.add_vector_quantity(
-            "direction", 0.85 * r.arrows, vectortype="ambient", enabled=True, color=(0.9, 0.5, 0.0)
+            "direction",
+            0.85 * d.vectors(r.arrows),
+            vectortype="ambient",
+            enabled=True,
+            color=(0.9, 0.5, 0.0),
         )
         c = ps.register_point_cloud(RING_CENTER, center, radius=2.0 * scale)
         c.set_radius(2.0 * scale, relative=False)
@@ -68,8 +73,9 @@ class OneRingPanel:
         r = viewer.ring
         if r.valence == 0:
             return
-        center = viewer.mesh.V[r.vertex]
-        size = float(np.linalg.norm(r.polyline - center, axis=1).max()) or 1.0
+        center = viewer.display.points(viewer.mesh.V[[r.vertex]])[0]
+        ring = viewer.display.points(r.polyline)
+        size = float(np.linalg.norm(ring - center, axis=1).max()) or 1.0
         normal = r.normal if np.linalg.norm(r.normal) > 0 else np.array([0.0, 0.0, 1.0])
         # tilt a little towards the up axis inside the tangent plane: looking straight along
         # the up axis (a flat mesh seen from above) is a degenerate camera frame
@@ -87,7 +93,11 @@ class OneRingPanel:
         params = ps.get_view_camera_parameters()
         w, h = ps.get_window_size()
         xy, front = project_to_screen(
-            r.polyline, params.get_view_mat(), params.get_fov_vertical_deg(), w, h
+            viewer.display.points(r.polyline),
+            params.get_view_mat(),
+            params.get_fov_vertical_deg(),
+            w,
+            h,
         )
         return [
             ((float(x) + 12, float(y) - 22), str(k))

@@ -10,7 +10,15 @@ import polyscope as ps
 
 from meshlap_core.options import LAPLACIAN_KINDS as LAPLACIANS
 
-from ..scene import INPUT_COLOR, MESH, SMOOTH_INPUT, SMOOTHED, SMOOTHED_COLOR, side_offset
+from ..scene import (
+    INPUT_COLOR,
+    MESH,
+    SMOOTH_INPUT,
+    SMOOTHED,
+    SMOOTHED_COLOR,
+    Display,
+    side_offset,
+)
 from ..state.smoothing import METHODS, SmoothingState
 
 if TYPE_CHECKING:
@@ -26,8 +34,11 @@ class SmoothingPanel:
         self._registered = -1
         self._shown_iteration = -1
         self._shift = np.zeros(3)
+        self.new_copy = False
+        self.display = Display()  # the viewer's, set in on_new_mesh
 
     def on_new_mesh(self, viewer: Viewer) -> None:
+        self.display = viewer.display
         self.state.smoother = None
         self.state.playing = False
         for name in (SMOOTHED, SMOOTH_INPUT):
@@ -53,25 +64,30 @@ class SmoothingPanel:
         st = self.state
         if st.smoother is None:
             return
-        self._shift = side_offset(st.V_start)
+        d = self.display
+        start = d.points(st.V_start)
+        self._shift = side_offset(start)
         if self._registered != st.version:
             # the input (with its noise) stays put; the smoothed copy moves beside it
-            inp = ps.register_surface_mesh(SMOOTH_INPUT, st.V_start, st.F, smooth_shade=True)
+            inp = ps.register_surface_mesh(SMOOTH_INPUT, start, st.F, smooth_shade=True)
             inp.set_color(INPUT_COLOR)
-            sm = ps.register_surface_mesh(SMOOTHED, st.V + self._shift, st.F, smooth_shade=True)
+            sm = ps.register_surface_mesh(
+                SMOOTHED, d.points(st.V) + self._shift, st.F, smooth_shade=True
+            )
             sm.set_color(SMOOTHED_COLOR)
             self._registered = st.version
+            self.new_copy = True  # the viewer re-frames
         elif force or st.smoother.iteration != self._shown_iteration:
-            ps.get_surface_mesh(SMOOTHED).update_vertex_positions(st.V + self._shift)
+            ps.get_surface_mesh(SMOOTHED).update_vertex_positions(d.points(st.V) + self._shift)
         self._shown_iteration = st.smoother.iteration
 
     def points(self, viewer: Viewer, name: str) -> np.ndarray | None:
-        """World positions of a structure this panel registered (for camera framing)."""
+        """Display positions of a structure this panel registered (for camera framing)."""
         if self.state.smoother is None:
             return None
         if name == SMOOTHED:
-            return self.state.V + self._shift
-        return self.state.V_start if name == SMOOTH_INPUT else None
+            return self.display.points(self.state.V) + self._shift
+        return self.display.points(self.state.V_start) if name == SMOOTH_INPUT else None
 
     def prepare_screenshot(self, viewer: Viewer, iterations: int = 10) -> None:
         """Add a little noise, smooth a few steps and show the result (headless render)."""
@@ -144,6 +160,8 @@ class SmoothingPanel:
         if st.playing:
             st.step()
         self.push()
+        if self.new_copy:
+            viewer.reframe, self.new_copy = True, False
         if st.error:
             ui.error(st.error)
         self.draw_figures(ui)

@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import polyscope as ps
 
-from ..scene import EIGEN, MESH, RECON, side_offset
+from ..scene import COLORBAR_AT, EIGEN, MESH, RECON, side_offset
 from ..state.spectral import SpectralState
 
 if TYPE_CHECKING:
@@ -36,7 +36,7 @@ class SpectralPanel:
             self.push_mode(viewer, force=True)
 
     def _offset(self, viewer: Viewer) -> np.ndarray:
-        return side_offset(viewer.mesh.V)
+        return side_offset(viewer.display.points(viewer.mesh.V))
 
     def push_mode(self, viewer: Viewer, force: bool = False) -> None:
         st = self.state
@@ -46,7 +46,13 @@ class SpectralPanel:
         f, _ = st.eigenfunction()
         r = float(np.abs(f).max()) or 1.0
         ps.get_surface_mesh(MESH).add_scalar_quantity(
-            EIGEN, f, cmap="coolwarm", vminmax=(-r, r), enabled=True
+            EIGEN,
+            f,
+            cmap="coolwarm",
+            vminmax=(-r, r),
+            enabled=True,
+            onscreen_colorbar_enabled=True,
+            onscreen_colorbar_location=COLORBAR_AT,
         )
 
     def push_k(self, viewer: Viewer, force: bool = False) -> None:
@@ -54,9 +60,10 @@ class SpectralPanel:
         if st.basis is None or (st.k == self._shown_k and not force):
             return
         self._shown_k = st.k
-        X = st.reconstruction + self._offset(viewer)
+        X = viewer.display.points(st.reconstruction) + self._offset(viewer)
         if not ps.has_surface_mesh(RECON):
             ps.register_surface_mesh(RECON, X, viewer.mesh.F, smooth_shade=True)
+            viewer.reframe = True  # a new copy beside the mesh
         else:
             ps.get_surface_mesh(RECON).update_vertex_positions(X)
         hi = float(st.errors.max[st.k]) or 1.0  # precomputed for every k
@@ -65,9 +72,9 @@ class SpectralPanel:
         )
 
     def points(self, viewer: Viewer, name: str) -> np.ndarray | None:
-        """World positions of a structure this panel registered (for camera framing)."""
+        """Display positions of a structure this panel registered (for camera framing)."""
         if name == RECON and self.state.basis is not None:
-            return self.state.reconstruction + self._offset(viewer)
+            return viewer.display.points(self.state.reconstruction) + self._offset(viewer)
         return None
 
     def adopt(self, viewer: Viewer) -> None:

@@ -7,7 +7,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 import polyscope as ps
 
-from ..scene import SURFACE, SURFACE_POINT, Z_TO_Y
+from ..scene import COLORBAR_AT, SURFACE, SURFACE_POINT, Z_TO_Y
+from ..ui import sig
 
 if TYPE_CHECKING:
     from ..viewer import Viewer
@@ -52,7 +53,13 @@ class SurfacesPanel:
             K = np.nan_to_num(np.asarray(cf.K, dtype=float))
             r = float(np.percentile(np.abs(K), 98)) or 1.0
             s.add_scalar_quantity(
-                "Gaussian curvature K (exact)", K, cmap="coolwarm", vminmax=(-r, r), enabled=True
+                "Gaussian curvature K (exact) [1/length^2]",
+                K,
+                cmap="coolwarm",
+                vminmax=(-r, r),
+                enabled=True,
+                onscreen_colorbar_enabled=True,
+                onscreen_colorbar_location=COLORBAR_AT,
             )
         self.push_point(viewer)
 
@@ -87,7 +94,7 @@ class SurfacesPanel:
         ch, name = ui.combo("surface", s.name, s.names, "a parametric surface p(u, v)")
         if ch and s.set_surface(name):
             self.push(viewer)
-            ps.reset_camera_to_home_view()
+            viewer.reframe = True
         ch, res = ui.input_int("resolution", s.res, "cells per parameter direction; Enter applies")
         if ch:
             s.set_resolution(res)
@@ -102,15 +109,18 @@ class SurfacesPanel:
         p = s.point
         if p is None:
             return
-        ui.text(f"I:  E = {p.E:.4g}  F = {p.F:.4g}  G = {p.G:.4g}")
-        ui.text(f"II: e = {p.e:.4g}  f = {p.f:.4g}  g = {p.g:.4g}")
-        ui.text(f"K = {p.K:.4g}  H = {p.H:.4g}  ({p.classification})")
+        s1 = max(abs(p.E), abs(p.F), abs(p.G))
+        s2 = max(abs(p.e), abs(p.f), abs(p.g))
+        sk = max(abs(p.k1), abs(p.k2))
+        ui.text(f"I:  E = {sig(p.E, s1)}  F = {sig(p.F, s1)}  G = {sig(p.G, s1)}")
+        ui.text(f"II: e = {sig(p.e, s2)}  f = {sig(p.f, s2)}  g = {sig(p.g, s2)}")
+        ui.text(f"K = {sig(p.K, sk * sk)}  H = {sig(p.H, sk)}  ({p.classification})")
         ui.text(
-            f"k1 = {p.k1:.4g} at {np.degrees(p.theta_max):.1f} deg,  "
-            f"k2 = {p.k2:.4g} at {np.degrees(p.theta_min):.1f} deg"
+            f"k1 = {sig(p.k1, sk)} at {np.degrees(p.theta_max):.1f} deg,  "
+            f"k2 = {sig(p.k2, sk)} at {np.degrees(p.theta_min):.1f} deg"
         )
         ui.text("signs: e = p_uu . n with n = p_u x p_v (do Carmo)")
-        with ui.plot("normal curvature k_n(theta)", 180, "theta (rad)", "k_n") as shown:
+        with ui.plot("normal curvature k_n(theta)", 180, "theta (deg)", "k_n") as shown:
             if shown:
-                ui.plot_line("k_n", s.theta, s.kn)
-                ui.plot_vlines("theta max/min", np.array([p.theta_max, p.theta_min]))
+                ui.plot_line("k_n", np.degrees(s.theta), s.kn)
+                ui.plot_vlines("theta max/min", np.degrees([p.theta_max, p.theta_min]))

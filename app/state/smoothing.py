@@ -133,10 +133,11 @@ class SmoothingState:
     def step(self) -> bool:
         """One iteration; stops (and says why, with the stable λ) when the flow diverges.
 
-        A step counts as diverging when the smoother blows up, when its RMSE against the clean
-        mesh exceeds the bounding-box diagonal, or when the enclosed volume changed by more than
-        100 %: no smoothing of a sane mesh does either, an explicit λ above the limit does within
-        a few steps.
+        A step counts as diverging when the smoother blows up or, for the explicit method, when
+        its RMSE against the clean mesh exceeds the bounding-box diagonal or the enclosed volume
+        changed by more than 100 %: a stable explicit flow does neither (it shrinks), an explicit
+        λ above the limit does within a few steps. (Taubin's stable flow may slowly grow the
+        volume past +100 % over hundreds of steps, so only a blow-up stops it.)
         """
         s = self.smoother
         if s is None:
@@ -145,7 +146,7 @@ class SmoothingState:
             self.playing = False
             return False
         s.step()
-        last = s.history[-1] if s.history else {}
+        last = s.history[-1] if s.history and s.method == "explicit" else {}
         rmse, vol = last.get("rmse"), last.get("volume_change_pct")
         too_far = rmse is not None and not rmse <= self.diagonal
         too_much = vol is not None and not abs(vol) <= 100.0

@@ -18,6 +18,9 @@ from meshlap_core.errors import MeshError
 from meshlap_core.spectral import SpectralBasis
 from meshlap_core.types import FloatArray, IntArray
 
+SCREENSHOT_K = 30
+"""k of ``meshlap view --panel spectral --screenshot`` without ``--k``."""
+
 
 @dataclass
 class SpectralState:

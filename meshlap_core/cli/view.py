@@ -21,6 +21,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--panel", choices=PANELS, default="curvature", help="panel shown first")
     p.add_argument("--vertex", type=int, help="one-ring panel: the selected vertex")
     p.add_argument("--k", type=int, help="spectral panel: reconstruct from k eigenvectors")
+    p.add_argument(
+        "--ui-scale",
+        type=float,
+        default=1.0,
+        help="size of the panel's text and widgets, 0.5 to 3 (projectors: 1.5-2)",
+    )
     p.set_defaults(func=run)
 
 
@@ -48,4 +54,5 @@ def run(args: argparse.Namespace) -> int:
         panel=args.panel,
         vertex=args.vertex,
         k=args.k,
+        ui_scale=args.ui_scale,
     )
