@@ -63,7 +63,9 @@ FRAMED = (
 )
 
 
-def _init(backend: str) -> None:
+def init_polyscope(backend: str) -> None:
+    """Start polyscope on ``backend`` ("auto", "openGL3_egl", "openGL_mock") with meshlap's scene
+    options; a missing display or a failed backend is a ``MeshError`` (one line, exit 2)."""
     if (
         backend == "auto"
         and sys.platform.startswith("linux")
@@ -461,7 +463,7 @@ def run(
     if not 0.5 <= ui_scale <= 3.0:  # also refuses NaN
         raise MeshError(f"must be between 0.5 and 3, got {ui_scale}", "--ui-scale")
     ps.set_program_name(f"meshlap — {mesh.name}")  # the window title (set before init)
-    _init(backend or ("openGL3_egl" if shot else "auto"))
+    init_polyscope(backend or ("openGL3_egl" if shot else "auto"))
     viewer = Viewer(mesh, CurvatureState(field_name=field), panel=panel, export_dir=cwd)
     ps.set_build_default_gui_panels(False)  # polyscope's own panels: a toggle in Help
     if ui_scale != 1.0:

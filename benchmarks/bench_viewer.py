@@ -32,7 +32,7 @@ import scipy.sparse.linalg as spla
 from _util import print_table, shared_mesh
 from meshlap_app.state import CurvatureState, MeshState
 from meshlap_app.state.smoothing import SmoothingState
-from meshlap_app.viewer import BUSY_FRAME_S, Viewer, _init
+from meshlap_app.viewer import BUSY_FRAME_S, Viewer, init_polyscope
 
 
 def eigen_in_window(viewer: Viewer, k: int, throttle: float) -> float:
@@ -73,7 +73,7 @@ def main() -> None:
     mesh = MeshState()
     mesh.load(path)
     print(f"mesh: {mesh.name}, {len(mesh.V)} vertices")
-    _init("openGL3_egl")
+    init_polyscope("openGL3_egl")
     viewer = Viewer(mesh, CurvatureState(), panel="spectral")
     viewer.sync_mesh()
     ps.set_user_callback(viewer.callback)

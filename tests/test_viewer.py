@@ -180,10 +180,10 @@ import numpy as np
 import polyscope as ps
 from meshlap_app.camera import project_to_screen
 from meshlap_app.state import CurvatureState, MeshState
-from meshlap_app.viewer import Viewer, _init
+from meshlap_app.viewer import Viewer, init_polyscope
 
 mesh = MeshState(); mesh.load(None)
-_init("openGL3_egl")
+init_polyscope("openGL3_egl")
 viewer = Viewer(mesh, CurvatureState(), panel="onering")
 viewer.sync_mesh()
 ps.set_user_callback(viewer.callback)
