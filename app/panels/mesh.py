@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import time
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -18,6 +19,7 @@ class MeshPanel(NoStructures):
     def __init__(self) -> None:
         self.path_text = ""
         self.recent: list[Path] = []  # the last meshes opened, newest first
+        self._listed: tuple[float, list[tuple[str, Path]]] = (-1e9, [])
 
     def draw(self, viewer: Viewer) -> None:
         ui = viewer.ui
@@ -44,7 +46,10 @@ class MeshPanel(NoStructures):
             self.path_text.strip()
         ):
             viewer.open(Path(self.path_text.strip()).expanduser())
-        choices = dict(list_meshes())
+        now = time.monotonic()
+        if now - self._listed[0] > 2.0:  # the folders are listed at most every 2 s, not per frame
+            self._listed = (now, list_meshes())
+        choices = dict(self._listed[1])
         for p in self.recent:
             choices.setdefault(f"recent: {p.name}", p)
         picked = ui.choose(

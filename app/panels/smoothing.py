@@ -65,9 +65,9 @@ class SmoothingPanel:
         if st.smoother is None:
             return
         d = self.display
-        start = d.points(st.V_start)
-        self._shift = side_offset(start)
         if self._registered != st.version:
+            start = d.points(st.V_start)
+            self._shift = side_offset(start)
             # the input (with its noise) stays put; the smoothed copy moves beside it
             inp = ps.register_surface_mesh(SMOOTH_INPUT, start, st.F, smooth_shade=True)
             inp.set_color(INPUT_COLOR)
