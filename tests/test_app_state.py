@@ -4,8 +4,8 @@ import itertools
 
 import numpy as np
 import pytest
+from meshlap_app.state import CurvatureState, MeshState, robust_range
 
-from app.state import CurvatureState, MeshState, robust_range
 from meshlap_core import primitives
 from meshlap_core.curvature import curvature_fields
 from meshlap_core.io import save_mesh
@@ -55,7 +55,8 @@ def test_robust_range_ignores_one_spike():
 
 
 def test_one_ring_state_draws_the_ordered_ring():
-    from app.state import OneRingState
+    from meshlap_app.state import OneRingState
+
     from meshlap_core.topology import one_ring
 
     m = MeshState()
@@ -75,7 +76,7 @@ def test_one_ring_state_draws_the_ordered_ring():
 
 
 def test_one_ring_state_open_fan(tmp_path):
-    from app.state import OneRingState
+    from meshlap_app.state import OneRingState
 
     path = tmp_path / "grid.obj"
     save_mesh(path, *primitives.grid(4, 4))
@@ -88,7 +89,7 @@ def test_one_ring_state_open_fan(tmp_path):
 
 
 def test_spectral_state_k_slider(tmp_path, monkeypatch):
-    from app.spectral_state import SpectralState
+    from meshlap_app.state.spectral import SpectralState
 
     monkeypatch.setenv("MESHLAP_CACHE_DIR", str(tmp_path))
     V, F = primitives.icosphere(2)
@@ -114,7 +115,7 @@ def test_spectral_state_k_slider(tmp_path, monkeypatch):
 def test_spectral_state_background_thread(tmp_path, monkeypatch):
     import time
 
-    from app.spectral_state import SpectralState
+    from meshlap_app.state.spectral import SpectralState
 
     monkeypatch.setenv("MESHLAP_CACHE_DIR", str(tmp_path))
     V, F = primitives.icosphere(2)
@@ -128,7 +129,7 @@ def test_spectral_state_background_thread(tmp_path, monkeypatch):
 
 
 def test_smoothing_state_steps_and_reports(tmp_path):
-    from app.smoothing_state import SmoothingState
+    from meshlap_app.state.smoothing import SmoothingState
 
     V, F = primitives.icosphere(3)
     s = SmoothingState(method="implicit", lam=1.0, noise_alpha=0.01, seed=1)
@@ -146,7 +147,7 @@ def test_smoothing_state_steps_and_reports(tmp_path):
 
 
 def test_smoothing_state_unstable_explicit_stops():
-    from app.smoothing_state import SmoothingState
+    from meshlap_app.state.smoothing import SmoothingState
 
     V, F = primitives.icosphere(2)
     s = SmoothingState(method="explicit", laplacian="uniform", lam=5.0)

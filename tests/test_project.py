@@ -32,7 +32,7 @@ def test_core_never_imports_polyscope():
         "for m in pkgutil.walk_packages(meshlap_core.__path__, 'meshlap_core.'):\n"
         "    if not m.name.endswith('__main__'):\n"
         "        importlib.import_module(m.name)\n"
-        "import app.state\n"
+        "import meshlap_app.state\n"
         "assert 'polyscope' not in sys.modules, 'polyscope imported'\n"
     )
     res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)

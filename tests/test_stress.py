@@ -1,7 +1,7 @@
 """Stress (issue 8): the viewer's state objects under long use, and a 2 M-face mesh.
 
-Headless: the viewer's panels keep their state in plain objects (``app.state``,
-``app.smoothing_state``, ``app.spectral_state``) that these tests drive without polyscope.
+Headless: the viewer's panels keep their state in plain objects (``meshlap_app.state``:
+``MeshState``, ``SmoothingState``, ``SpectralState``) that these tests drive without polyscope.
 Memory is measured, never time: ``tracemalloc`` counts what Python and NumPy allocate (and
 still hold), ``/proc/self/statm`` / ``getrusage`` the resident size.
 """
@@ -62,7 +62,7 @@ def held_mb(run) -> tuple[float, float]:
 
 def test_mesh_panel_keeps_the_previous_mesh_on_every_bad_file(tmp_path):
     """``MeshState.load`` of each hostile file fails, names the file, keeps the mesh shown."""
-    from app.state import MeshState
+    from meshlap_app.state import MeshState
 
     good = tmp_path / "good.obj"
     save_mesh(good, *primitives.torus(12, 6))
@@ -80,7 +80,7 @@ def test_mesh_panel_keeps_the_previous_mesh_on_every_bad_file(tmp_path):
 
 
 def test_mesh_panel_loads_every_hostile_but_valid_file(tmp_path):
-    from app.state import CurvatureState, MeshState
+    from meshlap_app.state import CurvatureState, MeshState
 
     state, curv = MeshState(), CurvatureState()
     for case in hostile.LOADABLE:
@@ -98,7 +98,7 @@ def test_mesh_panel_loads_every_hostile_but_valid_file(tmp_path):
 
 
 def _panel(method: str, laplacian: str, lam: float):
-    from app.smoothing_state import SmoothingState
+    from meshlap_app.state.smoothing import SmoothingState
 
     V, F = primitives.bumpy_sphere(3)
     state = SmoothingState(method=method, laplacian=laplacian, lam=lam)
@@ -177,7 +177,7 @@ def test_spectral_panel_k_slider_through_its_range_without_leaks(tmp_path, monke
     """Slide k from 1 to k_max and back, then at random, 6 times: nothing accumulates, and
     the reconstruction at each k does not depend on the path the slider took."""
     monkeypatch.setenv("MESHLAP_CACHE_DIR", str(tmp_path))
-    from app.spectral_state import SpectralState
+    from meshlap_app.state.spectral import SpectralState
 
     V, F = primitives.bumpy_sphere(3)
     state = SpectralState(k_request=60)

@@ -26,8 +26,8 @@ def mock_backend(tmp_path_factory):
 
 
 def test_every_panel_runs_frames_on_mock(mock_backend, tmp_path):
-    from app.state import CurvatureState, MeshState
-    from app.viewer import PANELS, Viewer
+    from meshlap_app.state import PANELS, CurvatureState, MeshState
+    from meshlap_app.viewer import Viewer
 
     mesh = MeshState()
     assert mesh.load(None)
@@ -47,7 +47,8 @@ def test_every_panel_runs_frames_on_mock(mock_backend, tmp_path):
     assert ps.has_curve_network("one-ring order")
     assert viewer.ring.valence == len(viewer.ring.neighbors) > 2
     # side-by-side curvature registers a second copy of the mesh
-    viewer.panel, viewer.side_by_side = "curvature", True
+    viewer.panel = "curvature"
+    viewer.panels["curvature"].side_by_side = True
     viewer.push_curvature()
     ps.frame_tick()
     assert ps.has_surface_mesh("mesh (second estimator)")
@@ -55,15 +56,15 @@ def test_every_panel_runs_frames_on_mock(mock_backend, tmp_path):
     viewer.panel = "surfaces"
     viewer.show_panel()
     assert viewer.surf.set_uv(0.5, 1.0)
-    viewer.push_surface_point()
+    viewer.panels["surfaces"].push_point(viewer)
     ps.frame_tick()
     assert ps.has_point_cloud("surface point")
     ps.clear_user_callback()
 
 
 def test_bad_file_in_mesh_panel_keeps_mesh(mock_backend, tmp_path):
-    from app.state import CurvatureState, MeshState
-    from app.viewer import Viewer
+    from meshlap_app.state import CurvatureState, MeshState
+    from meshlap_app.viewer import Viewer
 
     mesh = MeshState()
     assert mesh.load(None)
@@ -81,8 +82,9 @@ def test_bad_file_in_mesh_panel_keeps_mesh(mock_backend, tmp_path):
 
 
 def test_export_writes_mesh_and_field(mock_backend, tmp_path):
-    from app.state import CurvatureState, MeshState
-    from app.viewer import Viewer
+    from meshlap_app.state import CurvatureState, MeshState
+    from meshlap_app.viewer import Viewer
+
     from meshlap_core.io import load_mesh
 
     mesh = MeshState()
@@ -136,16 +138,52 @@ def test_screenshot_shows_a_colour_map(tmp_path):
     assert np.sum(fg[:, 0] > fg[:, 2] + 0.15) > 100 and np.sum(fg[:, 2] > fg[:, 0] + 0.15) > 100
 
 
+def _scene_fraction(png) -> float:
+    """Fraction of the left 55 % of the picture (the 3D view; the panel is on the right) that
+    differs from the background."""
+    import matplotlib.image as mpimg
+
+    img = mpimg.imread(png)[..., :3]
+    left = img[:, : int(0.55 * img.shape[1])]
+    return float(np.mean(np.abs(left - img[0, 0]).sum(axis=2) > 0.05))
+
+
+@pytest.mark.egl
+@pytest.mark.parametrize("scale", [1e74, 1e-55])
+def test_screenshot_of_extreme_but_accepted_coordinates_is_not_blank(tmp_path, scale):
+    """float32 holds at most 3.4e38: the viewer centres and scales before every upload."""
+    if not _egl_available():
+        pytest.skip("polyscope's EGL backend cannot start on this machine (no EGL/Mesa)")
+    from meshlap_core import primitives
+    from meshlap_core.io import save_mesh
+
+    V, F = primitives.bumpy_sphere(3)
+    mesh = tmp_path / "extreme.ply"
+    save_mesh(mesh, V * scale + 3 * scale, F)
+    for panel in ("curvature", "smoothing"):
+        out = tmp_path / f"{panel}.png"
+        cmd = [sys.executable, "-m", "meshlap_core.cli", "view", str(mesh), "--panel", panel]
+        res = subprocess.run(
+            [*cmd, "--screenshot", str(out)],
+            capture_output=True,
+            text=True,
+            timeout=300,
+            cwd=tmp_path,
+        )
+        assert res.returncode == 0, res.stderr
+        assert _scene_fraction(out) > 0.05  # the mesh is drawn (before the fix: 0.0)
+
+
 PICK_SCRIPT = """
 import json, sys
 import numpy as np
 import polyscope as ps
-from app.camera import project_to_screen
-from app.state import CurvatureState, MeshState
-from app.viewer import Viewer, _init
+from meshlap_app.camera import project_to_screen
+from meshlap_app.state import CurvatureState, MeshState
+from meshlap_app.viewer import Viewer, init_polyscope
 
 mesh = MeshState(); mesh.load(None)
-_init("openGL3_egl")
+init_polyscope("openGL3_egl")
 viewer = Viewer(mesh, CurvatureState(), panel="onering")
 viewer.sync_mesh()
 ps.set_user_callback(viewer.callback)
@@ -154,7 +192,7 @@ ps.frame_tick()
 target = int(sys.argv[1])
 params = ps.get_view_camera_parameters()
 w, h = ps.get_window_size()
-xy, front = project_to_screen(mesh.V[[target]], params.get_view_mat(),
+xy, front = project_to_screen(viewer.display.points(mesh.V[[target]]), params.get_view_mat(),
                               params.get_fov_vertical_deg(), w, h)
 hit = viewer.pick_at((float(xy[0, 0]), float(xy[0, 1])))
 print(json.dumps({"hit": hit, "vertex": viewer.ring.vertex, "front": bool(front[0]),
@@ -168,7 +206,8 @@ def test_picking_a_projected_vertex_selects_its_one_ring(tmp_path):
         pytest.skip("polyscope's EGL backend cannot start on this machine (no EGL/Mesa)")
     import json
 
-    from app.state import MeshState
+    from meshlap_app.state import MeshState
+
     from meshlap_core.curvature import vertex_normals
 
     mesh = MeshState()
@@ -206,11 +245,11 @@ def test_no_display_is_one_clear_error(tmp_path):
         assert "--screenshot" in lines[0]
 
 
-def test_cli_choices_match_the_viewer():
-    """`meshlap view` lists its panels and fields without importing polyscope: keep in sync."""
-    from app.state import FIELD_LABELS
-    from app.viewer import PANELS
+def test_cli_uses_the_viewers_single_definition_of_panels_and_fields():
+    """`meshlap view` imports its choices from meshlap_app.state (pure data, no polyscope)."""
+    from meshlap_app import state
+
     from meshlap_core.cli import view
 
-    assert view.PANELS == PANELS
-    assert view.FIELDS == tuple(FIELD_LABELS)
+    assert view.PANELS is state.PANELS
+    assert view.FIELDS is state.FIELDS == tuple(state.FIELD_LABELS)

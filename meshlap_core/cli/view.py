@@ -1,15 +1,12 @@
-"""``meshlap view [MESH] [--screenshot OUT.png]``: the polyscope viewer (``app.viewer``)."""
+"""``meshlap view [MESH] [--screenshot OUT.png]``: the polyscope viewer (``meshlap_app.viewer``)."""
 
 from __future__ import annotations
 
 import argparse
 
-from ..errors import MeshError
+from meshlap_app.state.names import FIELDS, PANELS  # pure data: no polyscope, no numpy
 
-# the viewer's names (app.viewer imports polyscope, so they are repeated here; a test keeps them
-# in sync)
-FIELDS = ("uniform", "cotan", "gaussian", "k1", "k2", "difference")
-PANELS = ("curvature", "onering", "spectral", "smoothing", "surfaces")
+from ..errors import MeshError
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -24,6 +21,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--panel", choices=PANELS, default="curvature", help="panel shown first")
     p.add_argument("--vertex", type=int, help="one-ring panel: the selected vertex")
     p.add_argument("--k", type=int, help="spectral panel: reconstruct from k eigenvectors")
+    p.add_argument(
+        "--ui-scale",
+        type=float,
+        default=1.0,
+        help="size of the panel's text and widgets, 0.5 to 3 (projectors: 1.5-2)",
+    )
     p.set_defaults(func=run)
 
 
@@ -41,8 +44,8 @@ def run(args: argparse.Namespace) -> int:
             overwrite_inputs=[args.mesh] if args.mesh else [],
             suffixes=(".png",),
         )
-    # a bad mesh fails in app.viewer.run before any window or EGL context is created
-    from app.viewer import run as run_viewer  # the core CLI imports the GUI only here
+    # a bad mesh fails in meshlap_app.viewer.run before any window or EGL context is created
+    from meshlap_app.viewer import run as run_viewer  # the CLI imports the GUI only here
 
     return run_viewer(
         args.mesh,
@@ -51,4 +54,5 @@ def run(args: argparse.Namespace) -> int:
         panel=args.panel,
         vertex=args.vertex,
         k=args.k,
+        ui_scale=args.ui_scale,
     )

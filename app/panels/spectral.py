@@ -1,4 +1,5 @@
-"""Polyscope layer of the spectral panel (state in :mod:`app.spectral_state`)."""
+"""The Spectral panel: eigenmodes and the k-reconstruction beside the mesh (state in
+:mod:`..state.spectral`)."""
 
 from __future__ import annotations
 
@@ -6,20 +7,15 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 import polyscope as ps
-import polyscope.imgui as psim
-import polyscope.implot as psimplot
 
-from .spectral_state import SpectralState
+from ..scene import COLORBAR_AT, EIGEN, MESH, RECON, side_offset
+from ..state.spectral import SpectralState
 
 if TYPE_CHECKING:
-    from .viewer import Viewer
-
-RECON = "reconstruction"
-EIGEN = "eigenfunction"
-RED = (1.0, 0.35, 0.35, 1.0)
+    from ..viewer import Viewer
 
 
-class Panel:
+class SpectralPanel:
     """Eigenmode browser and k slider; the reconstruction sits beside the original."""
 
     def __init__(self) -> None:
@@ -40,9 +36,7 @@ class Panel:
             self.push_mode(viewer, force=True)
 
     def _offset(self, viewer: Viewer) -> np.ndarray:
-        from .viewer import side_offset
-
-        return side_offset(viewer.mesh.V)
+        return side_offset(viewer.display.points(viewer.mesh.V))
 
     def push_mode(self, viewer: Viewer, force: bool = False) -> None:
         st = self.state
@@ -51,8 +45,14 @@ class Panel:
         self._shown_mode = st.mode
         f, _ = st.eigenfunction()
         r = float(np.abs(f).max()) or 1.0
-        ps.get_surface_mesh("mesh").add_scalar_quantity(
-            EIGEN, f, cmap="coolwarm", vminmax=(-r, r), enabled=True
+        ps.get_surface_mesh(MESH).add_scalar_quantity(
+            EIGEN,
+            f,
+            cmap="coolwarm",
+            vminmax=(-r, r),
+            enabled=True,
+            onscreen_colorbar_enabled=True,
+            onscreen_colorbar_location=COLORBAR_AT,
         )
 
     def push_k(self, viewer: Viewer, force: bool = False) -> None:
@@ -60,9 +60,10 @@ class Panel:
         if st.basis is None or (st.k == self._shown_k and not force):
             return
         self._shown_k = st.k
-        X = st.reconstruction + self._offset(viewer)
+        X = viewer.display.points(st.reconstruction) + self._offset(viewer)
         if not ps.has_surface_mesh(RECON):
             ps.register_surface_mesh(RECON, X, viewer.mesh.F, smooth_shade=True)
+            viewer.reframe = True  # a new copy beside the mesh
         else:
             ps.get_surface_mesh(RECON).update_vertex_positions(X)
         hi = float(st.errors.max[st.k]) or 1.0  # precomputed for every k
@@ -71,9 +72,9 @@ class Panel:
         )
 
     def points(self, viewer: Viewer, name: str) -> np.ndarray | None:
-        """World positions of a structure this panel registered (for camera framing)."""
+        """Display positions of a structure this panel registered (for camera framing)."""
         if name == RECON and self.state.basis is not None:
-            return self.state.reconstruction + self._offset(viewer)
+            return viewer.display.points(self.state.reconstruction) + self._offset(viewer)
         return None
 
     def adopt(self, viewer: Viewer) -> None:
@@ -95,41 +96,58 @@ class Panel:
         viewer.show_panel()
 
     def draw(self, viewer: Viewer) -> None:
-        if not psim.CollapsingHeader("Spectral", psim.ImGuiTreeNodeFlags_DefaultOpen):
+        ui = viewer.ui
+        if not ui.header("Spectral"):
             return
         st = self.state
         self.adopt(viewer)
-        _, st.k_request = psim.InputInt("modes to compute", st.k_request)
-        st.k_request = int(np.clip(st.k_request, 2, max(len(viewer.mesh.V), 2)))
+        n = len(viewer.mesh.V)
+        ch, k_request = ui.input_int(
+            "modes to compute",
+            st.k_request,
+            f"number of eigenpairs of -C u = lambda M u to compute (2 to {n}); Enter applies",
+        )
+        if ch:
+            st.set_k_request(k_request, n)
         if st.busy:
-            psim.ProgressBar(st.progress, (-1, 0), st.message or "working")
-        elif psim.Button("compute eigenbasis"):
+            ui.progress(st.progress, st.message or "working")
+        elif ui.button("compute eigenbasis", "solve for the modes in the background"):
             st.start(viewer.mesh.V, viewer.mesh.F)
         if st.error:
-            psim.TextColored(RED, st.error)
+            ui.error(st.error)
         if st.basis is None:
             if not st.busy:
-                psim.TextUnformatted("-C u = lambda M u (cotangent stiffness, Voronoi mass)")
+                ui.text("-C u = lambda M u (cotangent stiffness, Voronoi mass)")
             return
-        psim.TextUnformatted(st.message)
-        ch, mode = psim.SliderInt("eigenmode i", st.mode, 0, st.basis.k_max - 1)
+        ui.text(st.message)
+        ch, mode = ui.slider_int(
+            "eigenmode i",
+            st.mode,
+            0,
+            st.basis.k_max - 1,
+            "eigenfunction u_i shown as a colour map (i = 0 is constant)",
+        )
         if ch:
-            st.mode = mode
+            st.set_mode(mode)
             self.push_mode(viewer)
         _, lam = st.eigenfunction()
-        psim.TextUnformatted(f"lambda_{st.mode} = {lam:.6g}  (frequency of -Laplacian, >= 0)")
-        ch, k = psim.SliderInt("k (reconstruct)", st.k, 1, st.basis.k_max)
+        ui.text(f"lambda_{st.mode} = {lam:.6g}  (frequency of -Laplacian, >= 0)")
+        ch, k = ui.slider_int(
+            "k (reconstruct)",
+            st.k,
+            1,
+            st.basis.k_max,
+            "x_k = sum_{i<k} u_i (u_i^T M x): the shape from its first k modes",
+        )
         if ch:
             st.set_k(k)
             self.push_k(viewer)
         e = st.errors
-        psim.TextUnformatted(
+        ui.text(
             f"k = {st.k}: mean error {e.mean[st.k]:.4g}, max {e.max[st.k]:.4g} "
             f"({100 * e.relative_mean[st.k]:.3g}% of the diagonal)"
         )
-        if psimplot.BeginPlot("mean error vs k (log scale)", (-1, 170)):
-            psimplot.SetupAxisScale(psimplot.ImAxis_Y1, psimplot.ImPlotScale_Log10)
-            ks = np.asarray(e.k, dtype=np.float64)[1:]
-            psimplot.PlotLine("mean |x - x_k|", ks, np.asarray(e.mean[1:], dtype=np.float64))
-            psimplot.PlotInfLines("current k", np.array([float(st.k)]))
-            psimplot.EndPlot()
+        with ui.plot("mean error vs k (log scale)", 170, "k", "mean |x - x_k|", y_log=True) as ok:
+            if ok:
+                ui.plot_line("mean |x - x_k|", e.k[1:], e.mean[1:])
+                ui.plot_vlines("current k", np.array([float(st.k)]))

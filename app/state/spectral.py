@@ -18,6 +18,9 @@ from meshlap_core.errors import MeshError
 from meshlap_core.spectral import SpectralBasis
 from meshlap_core.types import FloatArray, IntArray
 
+SCREENSHOT_K = 30
+"""k of ``meshlap view --panel spectral --screenshot`` without ``--k``."""
+
 
 @dataclass
 class SpectralState:
@@ -99,6 +102,15 @@ class SpectralState:
         if self.basis is None:
             raise MeshError("no eigenbasis computed yet", "spectral")
         return self.basis.eigenfunction(self.mode), float(self.basis.eigenvalues[self.mode])
+
+    def set_k_request(self, k: int, n: int) -> None:
+        """How many eigenpairs the next computation asks for, clamped to ``[2, n]``."""
+        self.k_request = int(np.clip(int(k), 2, max(n, 2)))
+
+    def set_mode(self, mode: int) -> None:
+        """Select eigenmode ``mode`` (clamped to the basis)."""
+        top = self.basis.k_max - 1 if self.basis is not None else 0
+        self.mode = int(np.clip(int(mode), 0, top))
 
     def set_k(self, k: int) -> None:
         """Rebuild the shape from the first ``k`` eigenvectors (incremental, O(n·|Δk|))."""

@@ -15,6 +15,8 @@ from meshlap_core import surfaces
 from meshlap_core.errors import MeshError
 from meshlap_core.types import FloatArray
 
+MAX_RES = 512  # cells per direction the viewer meshes (512² cells: 0.5 M triangles)
+
 
 @dataclass
 class SurfaceState:
@@ -43,18 +45,40 @@ class SurfaceState:
         """Switch surface (and resolution); (u, v) goes to the surface's default point."""
         try:
             surf = surfaces.get_surface(name)
-            mesh = surfaces.mesh_surface(surf, res or self.res)
+            mesh = surfaces.mesh_surface(surf, res if res is not None else self.res)
         except MeshError as exc:
             self.error = str(exc)
             return False
         self.name, self.mesh = name, mesh
-        self.res = res or self.res
+        self.res = res if res is not None else self.res
         self.version += 1
         u, v = surf.default_uv
         return self.set_uv(u, v)
 
+    def set_resolution(self, res: int) -> None:
+        """Re-mesh the surface with ``res`` cells per direction.
+
+        Raises
+        ------
+        MeshError
+            ``res`` too small or too large for this surface (the old mesh stays).
+        """
+        if res > MAX_RES:
+            raise MeshError(f"at most {MAX_RES} in the viewer, got {res}", "resolution")
+        if not self.set_surface(self.name, int(res)):
+            message, self.error = self.error, ""
+            raise MeshError(message)
+
     def set_uv(self, u: float, v: float) -> bool:
-        """Move the point (clamped into the domain); singular points keep the old point."""
+        """Move the point (clamped into the domain); singular points keep the old point.
+
+        Raises
+        ------
+        MeshError
+            ``u`` or ``v`` is not a finite number (the point stays).
+        """
+        if not (np.isfinite(u) and np.isfinite(v)):
+            raise MeshError(f"must be finite numbers, got u = {u!r}, v = {v!r}", "(u, v)")
         u0, u1, v0, v1 = self.domain
         u = float(np.clip(u, u0, u1))
         v = float(np.clip(v, v0, v1))

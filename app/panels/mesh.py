@@ -1,0 +1,69 @@
+"""The Mesh panel: what the mesh is, a path field and the list of bundled / shared meshes."""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from ..state.mesh import list_meshes
+from .base import NoStructures
+
+if TYPE_CHECKING:
+    from ..viewer import Viewer
+
+
+class MeshPanel(NoStructures):
+    """Counts and topology of the current mesh; open a file by path or from the list."""
+
+    def __init__(self) -> None:
+        self.path_text = ""
+        self.recent: list[Path] = []  # the last meshes opened, newest first
+        self._listed: tuple[float, list[tuple[str, Path]]] = (-1e9, [])
+
+    def draw(self, viewer: Viewer) -> None:
+        ui = viewer.ui
+        if not ui.header("Mesh"):
+            return
+        mesh = viewer.mesh
+        info = mesh.info
+        ui.text(
+            f"{mesh.name}: {info.get('n_vertices', 0)} vertices, "
+            f"{info.get('n_faces', 0)} faces, chi = {info.get('euler_characteristic')}, "
+            f"genus = {info.get('genus')}"
+        )
+        ui.text(
+            f"boundary loops {info.get('n_boundary_loops')}, components "
+            f"{info.get('n_components')}, manifold {'yes' if info.get('manifold') else 'no'}"
+        )
+        for r in info.get("repairs", []):
+            ui.text(f"repaired: {r}")
+        entered, self.path_text = ui.input_text(
+            "path", self.path_text, "a mesh file (.obj .off .ply .stl); Enter or Open loads it"
+        )
+        ui.same_line()
+        if (ui.button("Open", "load the file named in the path field") or entered) and (
+            self.path_text.strip()
+        ):
+            viewer.open(Path(self.path_text.strip()).expanduser())
+        now = time.monotonic()
+        if now - self._listed[0] > 2.0:  # the folders are listed at most every 2 s, not per frame
+            self._listed = (now, list_meshes())
+        choices = dict(self._listed[1])
+        for p in self.recent:
+            choices.setdefault(f"recent: {p.name}", p)
+        picked = ui.choose(
+            "bundled / shared",
+            "choose a mesh",
+            list(choices),
+            "the bundled assets, ../shared/meshes and recently opened files",
+        )
+        if picked:
+            viewer.open(choices[picked])
+        if mesh.error:
+            ui.error(mesh.error)
+
+    def remember(self, path: Path) -> None:
+        """Put ``path`` first in the recent-files list (at most 8)."""
+        path = Path(path).resolve()
+        self.recent = [path, *(p for p in self.recent if p != path)][:8]

@@ -1,0 +1,126 @@
+"""The Surfaces panel: a parametric surface, its exact K, and the geometry at a point (u, v)."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+import polyscope as ps
+
+from ..scene import COLORBAR_AT, SURFACE, SURFACE_POINT, Z_TO_Y
+from ..ui import sig
+
+if TYPE_CHECKING:
+    from ..viewer import Viewer
+
+
+class SurfacesPanel:
+    """Surface choice, (u, v) sliders, fundamental forms, principal directions, k_n(θ)."""
+
+    def __init__(self) -> None:
+        self._version = -1
+
+    def on_new_mesh(self, viewer: Viewer) -> None:
+        return None
+
+    def show(self, viewer: Viewer, panel: str) -> None:
+        if panel == "surfaces":
+            self.push(viewer)
+        if ps.has_surface_mesh(SURFACE):
+            ps.get_surface_mesh(SURFACE).set_enabled(panel == "surfaces")
+        if ps.has_point_cloud(SURFACE_POINT):
+            ps.get_point_cloud(SURFACE_POINT).set_enabled(panel == "surfaces")
+
+    def points(self, viewer: Viewer, name: str) -> np.ndarray | None:
+        if name == SURFACE and viewer.surf.mesh is not None:
+            return viewer.surf.mesh.V @ Z_TO_Y[:3, :3].T
+        return None
+
+    def push(self, viewer: Viewer) -> None:
+        surf = viewer.surf
+        if surf.mesh is None:
+            surf.set_surface(surf.name)
+        sm = surf.mesh
+        if sm is None:
+            return
+        if self._version != surf.version:
+            self._version = surf.version
+            s = ps.register_surface_mesh(SURFACE, sm.V, sm.F, smooth_shade=True)
+            s.set_transform(Z_TO_Y)
+            from meshlap_core.surfaces import curvature_fields as surface_curvature
+
+            cf = surface_curvature(surf.name, sm.uv[:, 0], sm.uv[:, 1])
+            K = np.nan_to_num(np.asarray(cf.K, dtype=float))
+            r = float(np.percentile(np.abs(K), 98)) or 1.0
+            s.add_scalar_quantity(
+                "Gaussian curvature K (exact) [1/length^2]",
+                K,
+                cmap="coolwarm",
+                vminmax=(-r, r),
+                enabled=True,
+                onscreen_colorbar_enabled=True,
+                onscreen_colorbar_location=COLORBAR_AT,
+            )
+        self.push_point(viewer)
+
+    def push_point(self, viewer: Viewer) -> None:
+        surf = viewer.surf
+        if surf.point is None:
+            return
+        size = float(np.ptp(surf.mesh.V, axis=0).max()) if surf.mesh is not None else 1.0
+        base, d1, d2 = surf.direction_vectors(scale=0.15 * size)
+        pc = ps.register_point_cloud(SURFACE_POINT, base, radius=0.01)
+        pc.set_transform(Z_TO_Y)
+        pc.set_color((0.9, 0.1, 0.1))
+        pc.add_vector_quantity(
+            "k1 direction", d1, vectortype="ambient", enabled=True, color=(0.85, 0.2, 0.1)
+        )
+        pc.add_vector_quantity(
+            "k2 direction", d2, vectortype="ambient", enabled=True, color=(0.1, 0.3, 0.85)
+        )
+        pc.add_vector_quantity(
+            "normal",
+            0.15 * size * surf.point.n[None, :],
+            vectortype="ambient",
+            enabled=True,
+            color=(0.2, 0.7, 0.2),
+        )
+
+    def draw(self, viewer: Viewer) -> None:
+        ui = viewer.ui
+        if not ui.header("Surfaces"):
+            return
+        s = viewer.surf
+        ch, name = ui.combo("surface", s.name, s.names, "a parametric surface p(u, v)")
+        if ch and s.set_surface(name):
+            self.push(viewer)
+            viewer.reframe = True
+        ch, res = ui.input_int("resolution", s.res, "cells per parameter direction; Enter applies")
+        if ch:
+            s.set_resolution(res)
+            self.push(viewer)
+        u0, u1, v0, v1 = s.domain
+        ch1, u = ui.slider_float("u", s.u, u0, u1, "%.3f", "first parameter of the point")
+        ch2, v = ui.slider_float("v", s.v, v0, v1, "%.3f", "second parameter of the point")
+        if (ch1 or ch2) and s.set_uv(u, v):
+            self.push_point(viewer)
+        if s.error:
+            ui.error(s.error)
+        p = s.point
+        if p is None:
+            return
+        s1 = max(abs(p.E), abs(p.F), abs(p.G))
+        s2 = max(abs(p.e), abs(p.f), abs(p.g))
+        sk = max(abs(p.k1), abs(p.k2))
+        ui.text(f"I:  E = {sig(p.E, s1)}  F = {sig(p.F, s1)}  G = {sig(p.G, s1)}")
+        ui.text(f"II: e = {sig(p.e, s2)}  f = {sig(p.f, s2)}  g = {sig(p.g, s2)}")
+        ui.text(f"K = {sig(p.K, sk * sk)}  H = {sig(p.H, sk)}  ({p.classification})")
+        ui.text(
+            f"k1 = {sig(p.k1, sk)} at {np.degrees(p.theta_max):.1f} deg,  "
+            f"k2 = {sig(p.k2, sk)} at {np.degrees(p.theta_min):.1f} deg"
+        )
+        ui.text("signs: e = p_uu . n with n = p_u x p_v (do Carmo)")
+        with ui.plot("normal curvature k_n(theta)", 180, "theta (deg)", "k_n") as shown:
+            if shown:
+                ui.plot_line("k_n", np.degrees(s.theta), s.kn)
+                ui.plot_vlines("theta max/min", np.degrees([p.theta_max, p.theta_min]))

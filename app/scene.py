@@ -1,0 +1,184 @@
+"""What the viewer puts in polyscope's scene: structure names, offsets, colours, framing.
+
+Every panel registers its structures under the names defined here and places copies with
+:func:`side_offset`; the camera is framed by :func:`frame_scene_left`. Imports polyscope.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable
+from pathlib import Path
+
+import numpy as np
+import polyscope as ps
+
+from meshlap_core.io import atomic_write
+
+# ---------------------------------------------------------------- structure names
+MESH = "mesh"
+MESH_B = "mesh (second estimator)"
+RING_CURVE = "one-ring order"
+RING_POINTS = "one-ring neighbours"
+RING_CENTER = "selected vertex"
+SURFACE = "surface"
+SURFACE_POINT = "surface point"
+RECON = "reconstruction"
+EIGEN = "eigenfunction"
+SMOOTHED = "smoothed"
+SMOOTH_INPUT = "smoothing input"
+
+# ---------------------------------------------------------------- colours (RGBA / RGB)
+RED = (1.0, 0.35, 0.35, 1.0)
+COLORBAR_AT = (15.0, 15.0)  # polyscope's on-screen colour bar: top-left, clear of the panel
+INPUT_COLOR = (0.85, 0.75, 0.6)
+SMOOTHED_COLOR = (0.55, 0.7, 0.9)
+
+# parametric surfaces are written z-up; the viewer is y-up: display them rotated (x, y, z) ->
+# (x, z, -y) with a polyscope transform, so the data (and the numbers in the panel) are unchanged
+Z_TO_Y = np.array([[1.0, 0, 0, 0], [0, 0, 1, 0], [0, -1, 0, 0], [0, 0, 0, 1]])
+
+
+class Display:
+    """World → display coordinates ``x_d = (x − c) · s`` for everything uploaded from the mesh.
+
+    polyscope stores positions as float32 (largest 3.4e38, smallest normal 1.2e-38), while the
+    loader accepts coordinates up to ``MAX_COORDINATE`` = 1e75 and extents down to 1e-60: a mesh
+    near 1e74 would upload as ``inf`` and render a blank frame. Centring on the bounding box and
+    scaling by a power of two (exact in float64) to a diagonal near 1 makes every accepted mesh
+    representable. The panels' numbers stay in world units; only uploads go through this.
+    """
+
+    def __init__(self) -> None:
+        self.centre = np.zeros(3)
+        self.scale = 1.0
+
+    def fit(self, V: np.ndarray) -> None:
+        """Fit to the positions ``V (n,3)`` (bounding-box centre; diagonal → about 1)."""
+        V = np.asarray(V, dtype=np.float64)
+        if len(V) == 0:
+            self.centre, self.scale = np.zeros(3), 1.0
+            return
+        lo, hi = V.min(axis=0), V.max(axis=0)
+        self.centre = 0.5 * lo + 0.5 * hi  # no overflow of lo + hi near the float64 limit
+        half = 0.5 * hi - 0.5 * lo
+        diag = 2.0 * float(np.linalg.norm(half))
+        self.scale = float(2.0 ** -np.round(np.log2(diag))) if diag > 0 else 1.0
+
+    def points(self, P: np.ndarray) -> np.ndarray:
+        """Display positions of world points ``P (k,3)``."""
+        return (np.asarray(P, dtype=np.float64) - self.centre) * self.scale
+
+    def vectors(self, D: np.ndarray) -> np.ndarray:
+        """Display vectors of world displacements ``D (k,3)`` (scaled, not shifted)."""
+        return np.asarray(D, dtype=np.float64) * self.scale
+
+
+def scalar_for_upload(
+    values: np.ndarray, vminmax: tuple[float, float]
+) -> tuple[np.ndarray, tuple[float, float], str]:
+    """Scalars safe for float32: rescaled by a power of ten when their range is beyond
+    ``[1e-30, 1e30]``; returns the values, range and a label suffix such as ``" (x 1e-74)"``."""
+    r = max(abs(float(vminmax[0])), abs(float(vminmax[1])))
+    if r == 0 or 1e-30 <= r <= 1e30 or not np.isfinite(r):
+        return values, vminmax, ""
+    e = int(np.floor(np.log10(r)))
+    f = 10.0**-e
+    return np.asarray(values) * f, (vminmax[0] * f, vminmax[1] * f), f" (x 1e{e})"
+
+
+def side_offset(V: np.ndarray) -> np.ndarray:
+    """Offset of a copy shown beside a mesh: to its right as seen from the default camera."""
+    return np.array([-1.15 * float(np.ptp(V[:, 0])) - 1e-9, 0.0, 0.0])
+
+
+def remove_structure(name: str) -> None:
+    """Remove a registered structure of any of the kinds the viewer uses (no-op if absent)."""
+    for has, remove in (
+        (ps.has_surface_mesh, ps.remove_surface_mesh),
+        (ps.has_curve_network, ps.remove_curve_network),
+        (ps.has_point_cloud, ps.remove_point_cloud),
+    ):
+        if has(name):
+            remove(name)
+
+
+# the direction from a mesh towards the camera (y up): scans face -z; meshes known to face +z
+# get their front; the parametric surfaces (torus, helicoid, ...) are seen obliquely from above
+DEFAULT_VIEW = (0.0, 0.15, -1.0)
+FRONT_VIEWS: dict[str, tuple[float, float, float]] = {
+    "armadillo_igl.obj": (0.0, 0.15, 1.0),
+}
+OBLIQUE_VIEW = (0.55, 0.75, -1.0)
+
+
+def frame_points(
+    P: np.ndarray,
+    toward_eye: tuple[float, float, float] = DEFAULT_VIEW,
+    fraction: float = 0.6,
+) -> None:
+    """Point the camera at the points ``P (k,3)`` (display coordinates) from the direction
+    ``toward_eye`` so that they fill the left ``fraction`` of the window (meshlap's panel covers
+    the rest, on the right), with y up.
+
+    The distance ``d`` fits the bounding box's extent across (``w``) and up (``h``) the view:
+    ``d = max(w / (2 f tan(fov_h/2)), h / (2 · 0.85 tan(fov_v/2))) + depth/2``, and the target
+    moves right by ``(1 − f) d tan(fov_h/2)`` so the box's centre lands at ``f/2`` of the width.
+    """
+    P = np.asarray(P, dtype=np.float64)
+    if len(P) == 0:
+        ps.reset_camera_to_home_view()
+        return
+    lo, hi = P.min(axis=0), P.max(axis=0)
+    c = 0.5 * (lo + hi)
+    back = np.asarray(toward_eye, dtype=np.float64)
+    back /= np.linalg.norm(back)
+    right = np.cross(np.array([0.0, 1.0, 0.0]), back)  # camera x (looking along -back)
+    right /= np.linalg.norm(right)
+    up = np.cross(back, right)
+    corners = np.array(
+        [[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])]
+    )
+    rel = corners - c
+    w = np.ptp(rel @ right)
+    h = np.ptp(rel @ up)
+    depth = np.ptp(rel @ back)
+    width, height = ps.get_window_size()
+    fov = np.radians(ps.get_view_camera_parameters().get_fov_vertical_deg())
+    tan_v = np.tan(fov / 2.0)
+    tan_h = tan_v * width / max(height, 1)
+    d = max(w / (2 * fraction * tan_h), h / (2 * 0.85 * tan_v), 1e-12) + 0.5 * depth
+    target = c + (1.0 - fraction) * d * tan_h * right
+    ps.look_at(target + d * back, target)
+
+
+def frame_scene_left(
+    names: Iterable[str],
+    points: Callable[[str], np.ndarray | None],
+    fraction: float = 0.6,
+    toward_eye: tuple[float, float, float] = DEFAULT_VIEW,
+) -> None:
+    """Frame the enabled structures among ``names`` (:func:`frame_points`); ``points(name)``
+    gives a structure's display positions ``(k,3)`` (``None``: unknown)."""
+    pts = []
+    for name in names:
+        if ps.has_surface_mesh(name) and ps.get_surface_mesh(name).is_enabled():
+            P = points(name)
+            if P is not None:
+                pts.append(P)
+    frame_points(np.vstack(pts) if pts else np.zeros((0, 3)), toward_eye, fraction)
+
+
+def save_screenshot(path: Path) -> None:
+    """Render the window (with meshlap's panel) into the PNG ``path``, atomically."""
+    write_png(path, ps.screenshot_to_buffer(transparent_bg=False, include_UI=True))
+
+
+def write_png(path: Path, rgba: np.ndarray) -> None:
+    """Write an RGBA buffer as PNG atomically (matplotlib's encoder, no extra dependency)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.image as mpimg
+
+    with atomic_write(path, mode="wb") as fh:
+        mpimg.imsave(fh, rgba, format="png")

@@ -1,0 +1,107 @@
+"""Curvature fields of the current mesh (``CurvatureState``) and their colour ranges."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from meshlap_core.curvature import curvature_fields
+from meshlap_core.errors import MeshError
+from meshlap_core.types import FloatArray
+
+from .mesh import MeshState
+from .names import FIELD_LABELS
+
+
+def robust_range(values: FloatArray, signed: bool, percentile: float = 2.0) -> tuple[float, float]:
+    """Colour-map range that one outlier cannot wash out.
+
+    Parameters
+    ----------
+    values : (n,) float
+    signed : bool
+        Symmetric range ``[-r, r]`` around zero (diverging maps) when true.
+    percentile : float
+        Clip this percentage at each end (0 = full range).
+
+    Returns
+    -------
+    lo, hi : float
+        ``lo < hi`` always (a constant field gets a small symmetric range).
+    """
+    v = np.asarray(values, dtype=np.float64)
+    v = v[np.isfinite(v)]
+    if v.size == 0:
+        return -1.0, 1.0
+    p = float(np.clip(percentile, 0.0, 49.0))
+    lo, hi = np.percentile(v, [p, 100.0 - p])
+    if signed:
+        r = max(abs(lo), abs(hi))
+        r = r if r > 0 else 1.0
+        return -float(r), float(r)
+    if hi <= lo:
+        return float(lo) - 0.5, float(lo) + 0.5
+    return float(lo), float(hi)
+
+
+@dataclass
+class CurvatureState:
+    """Curvature fields of the current mesh for the chosen area and boundary rule."""
+
+    area: str = "barycentric"
+    boundary: str = "pi"
+    field_name: str = "cotan"
+    percentile: float = 2.0
+    _key: tuple[Any, ...] = ()
+    fields: dict[str, FloatArray] = field(default_factory=dict)
+    _summaries: dict[tuple[Any, ...], dict[str, Any]] = field(default_factory=dict)
+
+    def update(self, mesh: MeshState) -> bool:
+        """Recompute when the mesh, area or boundary rule changed. Returns whether it did."""
+        key = (mesh.version, self.area, self.boundary)
+        if key == self._key:
+            return False
+        self.fields = curvature_fields(mesh.V, mesh.F, self.area, self.boundary)
+        self._key = key
+        return True
+
+    def set_percentile(self, percentile: float) -> None:
+        """Clip percentage of the colour range, in ``[0, 49]``.
+
+        Raises
+        ------
+        MeshError
+            ``percentile`` is not a finite number (the previous one stays).
+        """
+        p = float(percentile)
+        if not np.isfinite(p):
+            raise MeshError(f"must be a finite number, got {percentile!r}", "clip %")
+        self.percentile = float(np.clip(p, 0.0, 49.0))
+
+    def color_range(self, name: str | None = None) -> tuple[float, float]:
+        """Robust colour range of a field (symmetric around 0 for signed fields)."""
+        return self.summary(name)["range"]
+
+    def summary(self, name: str | None = None, bins: int = 60) -> dict[str, Any]:
+        """Range, min/max and histogram of a field, cached until the field or the clip
+        percentage changes (the panel reads it every frame)."""
+        name = name or self.field_name
+        key = (self._key, name, self.percentile, bins)
+        cached = self._summaries.get(key)
+        if cached is None:
+            values = self.fields[name]
+            lo, hi = robust_range(values, FIELD_LABELS[name][1], self.percentile)
+            counts, edges = np.histogram(np.clip(values, lo, hi), bins=bins, range=(lo, hi))
+            cached = {
+                "range": (lo, hi),
+                "min": float(values.min()),
+                "max": float(values.max()),
+                "centers": 0.5 * (edges[1:] + edges[:-1]),
+                "counts": counts.astype(np.float64),
+                "width": float(edges[1] - edges[0]),
+            }
+            self._summaries = {k: v for k, v in self._summaries.items() if k[0] == self._key}
+            self._summaries[key] = cached
+        return cached

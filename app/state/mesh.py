@@ -1,0 +1,76 @@
+"""The mesh on screen (``MeshState``) and the meshes offered in the viewer's list."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from meshlap_core import primitives
+from meshlap_core.describe import mesh_info
+from meshlap_core.errors import MeshError
+from meshlap_core.io import load_mesh
+from meshlap_core.types import FloatArray, IntArray
+from meshlap_core.validate import validate_mesh
+
+ROOT = Path(__file__).resolve().parents[2]  # the checkout (app/ sits beside assets/)
+ASSETS_DIR = ROOT / "assets"
+DEFAULT_ASSET = "bumpy.obj"
+
+SHARED_MESHES = ROOT.parent / "shared" / "meshes"
+
+
+def list_meshes() -> list[tuple[str, Path]]:
+    """Bundled assets and, when present, the meshes of ``../shared/meshes`` (label, path)."""
+    out = [(f"assets/{p.name}", p) for p in sorted(ASSETS_DIR.glob("*.obj"))]
+    if SHARED_MESHES.is_dir():
+        out += [(f"shared/{p.name}", p) for p in sorted(SHARED_MESHES.glob("*.obj"))]
+    return out
+
+
+def default_mesh_path() -> Path | None:
+    """The bundled default mesh, or ``None`` when ``assets/`` is not beside the package."""
+    path = ASSETS_DIR / DEFAULT_ASSET
+    return path if path.is_file() else None
+
+
+@dataclass
+class MeshState:
+    """The mesh on screen. ``load`` never raises: on failure ``error`` is set and the previous
+    mesh stays.
+    """
+
+    V: FloatArray = field(default_factory=lambda: np.zeros((0, 3)))
+    F: IntArray = field(default_factory=lambda: np.zeros((0, 3), dtype=np.int64))
+    name: str = ""
+    info: dict[str, Any] = field(default_factory=dict)
+    error: str = ""
+    version: int = 0  # bumped on every successful load, so panels know to recompute
+
+    def load(self, path: str | Path | None) -> bool:
+        """Load ``path`` (the bundled default when ``None``). Returns success."""
+        try:
+            if path is None:
+                default = default_mesh_path()
+                if default is not None:
+                    mesh = load_mesh(default)
+                    name = default.name
+                else:  # installed without assets/: generate the same shape
+                    mesh = validate_mesh(*primitives.bumpy_sphere(), source="bumpy (generated)")
+                    name = "bumpy (generated)"
+            else:
+                mesh = load_mesh(path)
+                name = Path(path).name
+        except MeshError as exc:
+            self.error = str(exc)
+            return False
+        except OSError as exc:
+            self.error = f"{path}: {exc.strerror or exc}"
+            return False
+        self.V, self.F, self.name = mesh.V, mesh.F, name
+        self.info = mesh_info(mesh.V, mesh.F, mesh.report, str(path) if path else name)
+        self.error = ""
+        self.version += 1
+        return True
