@@ -24,8 +24,8 @@ from typing import Any
 from ._version import __version__
 from .errors import MeshError, MeshWarning
 
-# public name -> module that defines it (relative to this package)
-_PUBLIC: dict[str, str] = {
+# public name -> module that defines it (relative to this package), or (module, its name there)
+_PUBLIC: dict[str, str | tuple[str, str]] = {
     # meshes: reading, writing, checking
     "Mesh": "mesh",
     "MeshReport": "mesh",
@@ -34,9 +34,10 @@ _PUBLIC: dict[str, str] = {
     "save_scalars": "io",
     "validate_mesh": "validate",
     "mesh_info": "describe",
+    "inspect_vertex": "inspector",
     # generated meshes
     "icosphere": "primitives",
-    "torus_mesh": "primitives",
+    "torus_mesh": ("primitives", "torus"),  # the triangle mesh; surfaces.torus is the surface
     "grid": "primitives",
     "cube": "primitives",
     # topology
@@ -72,10 +73,11 @@ __all__ = ["MeshError", "MeshWarning", "__version__", *_PUBLIC]
 
 
 def __getattr__(name: str) -> Any:
-    module = _PUBLIC.get(name)
-    if module is None:
+    where = _PUBLIC.get(name)
+    if where is None:
         raise AttributeError(f"module 'meshlap_core' has no attribute {name!r}")
-    value = getattr(importlib.import_module(f".{module}", __name__), name)
+    module, attr = (where, name) if isinstance(where, str) else where
+    value = getattr(importlib.import_module(f".{module}", __name__), attr)
     globals()[name] = value  # later look-ups skip this function
     return value
 

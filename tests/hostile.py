@@ -1146,6 +1146,8 @@ def inside_out_sphere() -> tuple[np.ndarray, np.ndarray]:
     """An icosphere with every face reversed: closed, consistently but inward oriented."""
     V, F = primitives.icosphere(2)
     return V, F[:, ::-1].copy()
+
+
 # round 2: spectral (built lazily by the CORPUS entries above)
 def _two_scales(small: float, big: float) -> str:
     """Two icospheres of radii ``small`` and ``big`` side by side (round 2: the spectrum of a

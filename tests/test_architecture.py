@@ -1,7 +1,8 @@
 """The shape of the code: an acyclic import graph pointing one way, small modules, short functions.
 
-- ``meshlap_core`` never imports the viewer (``meshlap_app`` / ``app``) nor polyscope, except
-  ``meshlap_core.cli.view``-style *lazy* imports inside functions of the CLI (the top layer);
+- ``meshlap_core`` never imports the viewer (``meshlap_app`` / ``app``) nor polyscope; only the
+  CLI (the top layer) reads the viewer's pure-data names (``meshlap_app.state``) and imports the
+  viewer lazily, inside the commands that open or render it;
 - ``meshlap_core.linalg`` is mesh-free: it imports only itself and ``meshlap_core.errors``;
 - the module import graph (module-level imports) has no cycle;
 - no module is longer than ``MAX_MODULE_LINES`` and no function longer than
@@ -83,10 +84,12 @@ def test_the_sources_were_found():
 @pytest.mark.parametrize("module", [m for m in SOURCES if m.startswith("meshlap_core")])
 def test_core_never_imports_the_viewer(module):
     imported = _imports(module, top_level_only=False)
-    lazy_ok = module.startswith("meshlap_core.cli")
     bad = {n for n in imported if n.split(".")[0] in {"polyscope", "meshlap_app", "app"}}
-    if lazy_ok:
+    if module.startswith("meshlap_core.cli"):
+        # the CLI is the top layer: it may read the viewer's pure-data names (panels, fields)
+        # at import time and import the viewer itself lazily, inside the command that runs it
         bad &= _imports(module, top_level_only=True)
+        bad = {n for n in bad if not n.startswith("meshlap_app.state")}
     assert not bad, f"{module} imports {sorted(bad)}"
 
 

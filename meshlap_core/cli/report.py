@@ -162,7 +162,7 @@ class ViewerScreenshots:
     ) -> bool:
         """Render one frame into ``out_png`` (see :class:`meshlap_core.study.Screenshot`);
         a failure raises with the viewer's message."""
-        from app.viewer import run as run_viewer  # the viewer's screenshot entry point
+        from meshlap_app.viewer import run as run_viewer  # the viewer's screenshot entry point
 
         if self._tmp is None:
             raise RuntimeError("ViewerScreenshots is used outside its `with` block")
