@@ -37,6 +37,7 @@ from .options import (
     BoundaryRule,
 )
 from .topology import one_ring
+from .topology.rings import Fan
 from .types import BoolArray, FloatArray, IntArray, as_mesh
 
 
@@ -95,7 +96,7 @@ class VertexInspection:
     K: float
     k1: float
     k2: float
-    fans: list[list[int]] = field(default_factory=list)
+    fans: list[Fan] = field(default_factory=list)
 
     @property
     def area(self) -> float:
@@ -127,7 +128,14 @@ class VertexInspection:
             "K": self.K,
             "k1": self.k1,
             "k2": self.k2,
-            "fans": self.fans,
+            "fans": [
+                {
+                    "neighbors": [int(j) for j in f.neighbors],
+                    "faces": [int(x) for x in f.faces],
+                    "closed": f.closed,
+                }
+                for f in self.fans
+            ],
             "neighbors": [
                 {
                     "index": t.index,
@@ -249,7 +257,7 @@ def inspect_vertex(
     # opposite angles per neighbour: neighbour a sees the angle at b, neighbour b the one at a
     nbr = np.concatenate([tri[:, 1], tri[:, 2]])
     opp = np.concatenate([ang[:, 2], ang[:, 1]])
-    ring = _ring_order(F, n, i, nbr)
+    ring, fans, manifold = _ring_and_fans(F, n, i, nbr)
     x_i = V[i]
     neighbours = []
     for j in ring:
@@ -278,20 +286,29 @@ def inspect_vertex(
         )
         for k, f in enumerate(rows)
     ]
-    return _vertex_terms(V, F, i, ring, neighbours, faces, ang, face_normal, area, boundary)
+    return _vertex_terms(
+        V, i, ring, neighbours, faces, ang, face_normal, area, boundary, fans, manifold
+    )
 
 
-def _ring_order(F: IntArray, n: int, i: int, nbr: IntArray) -> list[int]:
-    """Neighbours of ``i`` in ring order (the global one-ring), every distinct one once."""
-    # a vertex's ring depends on its own faces only (keeps this O(valence) on any mesh)
-    ring = [int(j) for j in one_ring(F[(F == i).any(axis=1)], n)[i]]
-    seen = set(ring)
-    return ring + sorted(int(j) for j in set(nbr.tolist()) - seen)
+def _ring_and_fans(F: IntArray, n: int, i: int, nbr: IntArray) -> tuple[list[int], list[Fan], bool]:
+    """Neighbours of ``i`` in ring order (fan after fan), its fans, and whether it is manifold.
+
+    The ring comes from the global one-ring code (:func:`meshlap_core.topology.one_ring`) run on
+    the vertex's own faces, so it costs O(valence) on any mesh; fan face indices refer to ``F``.
+    """
+    rows = np.flatnonzero((F == i).any(axis=1))
+    rings = one_ring(F[rows], n)
+    fans = [Fan(f.neighbors, rows[f.faces], f.closed) for f in rings.fans(i)]
+    order: list[int] = []
+    for f in fans:
+        order += [int(j) for j in f.neighbors if int(j) not in order]
+    rest = sorted(int(j) for j in set(nbr.tolist()) - set(order))  # corners in no fan
+    return order + rest, fans, bool(rings.manifold[i])
 
 
 def _vertex_terms(
     V: FloatArray,
-    F: IntArray,
     i: int,
     ring: list[int],
     neighbours: list[NeighbourTerm],
@@ -300,6 +317,8 @@ def _vertex_terms(
     face_normal: FloatArray,
     area: str,
     boundary: str,
+    fans: list[Fan],
+    manifold: bool,
 ) -> VertexInspection:
     """The vertex quantities from the per-neighbour and per-face terms."""
     x_i = V[i]
@@ -322,12 +341,11 @@ def _vertex_terms(
     K = deficit / A if A > 0 else 0.0
     H_c = -0.5 * float(lap_c @ normal)
     r = math.sqrt(max(H_c * H_c - K, 0.0))
-    fans = _fans(F, i)
     return VertexInspection(
         vertex=i,
         position=x_i.copy(),
         boundary=on_boundary,
-        manifold=len(fans) <= 1,
+        manifold=manifold,
         area_kind=area,
         boundary_rule=boundary,
         neighbors=neighbours,
@@ -348,33 +366,6 @@ def _vertex_terms(
     )
 
 
-def _fans(F: IntArray, i: int) -> list[list[int]]:
-    """The fans of ``i``: groups of incident faces joined through shared edges ``(i, j)``."""
-    rows = np.flatnonzero((F == i).any(axis=1))
-    parent = {int(f): int(f) for f in rows}
-
-    def find(f: int) -> int:
-        while parent[f] != f:
-            parent[f] = parent[parent[f]]
-            f = parent[f]
-        return f
-
-    by_edge: dict[int, int] = {}
-    for f in rows:
-        for j in F[f]:
-            j = int(j)
-            if j == i:
-                continue
-            if j in by_edge:
-                parent[find(int(f))] = find(by_edge[j])
-            else:
-                by_edge[j] = int(f)
-    groups: dict[int, list[int]] = {}
-    for f in rows:
-        groups.setdefault(find(int(f)), []).append(int(f))
-    return sorted(groups.values())
-
-
 def _num(x: float) -> str:
     """Four significant digits; round-off below 1e-12 of 1 shown as 0."""
     return "0" if abs(x) < 1e-12 else f"{x:.4g}"
@@ -393,7 +384,12 @@ def format_inspection(r: VertexInspection) -> str:
     lines = [
         f"vertex {r.vertex} at {_vec(r.position)}"
         + (", boundary" if r.boundary else "")
-        + ("" if r.manifold else f", NON-MANIFOLD: {len(r.fans)} fans {r.fans}"),
+        + ("" if r.manifold else f", NON-MANIFOLD: {len(r.fans)} fans"),
+        *(
+            f"  fan {k + 1} ({'closed' if f.closed else 'open'}): {[int(j) for j in f.neighbors]}"
+            for k, f in enumerate(r.fans)
+            if not r.manifold
+        ),
         f"neighbours in ring order (|N(i)| = {len(r.neighbors)}):",
         "   j   |x_j - x_i|   alpha     beta    w_ij = 1/2(cot a + cot b)    1/|N|"
         "   w_ij (x_j - x_i)",

@@ -115,6 +115,8 @@ def test_a_vertex_shared_by_two_tetrahedra_lists_two_fans():
     F = np.vstack([tet, np.array([[0, 5, 4], [0, 4, 6], [0, 6, 5], [4, 5, 6]])])
     r = inspect_vertex(V, F, 0)
     assert not r.manifold and len(r.fans) == 2
+    assert [sorted(int(j) for j in f.neighbors) for f in r.fans] == [[1, 2, 3], [4, 5, 6]]
+    assert all(f.closed for f in r.fans)
     assert sorted(t.index for t in r.neighbors) == [1, 2, 3, 4, 5, 6]
 
 
