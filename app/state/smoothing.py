@@ -28,8 +28,6 @@ class SmoothingState:
     lam: float = 0.5
     noise_alpha: float = 0.0
     seed: int = 0
-    diagonal: float = 0.0  # bounding-box diagonal of the input: the divergence bound
-    stopped: bool = False  # a diverging run stopped; reset to go on
     playing: bool = False
     error: str = ""
     smoother: Smoother | None = None
@@ -58,8 +56,6 @@ class SmoothingState:
             self.playing = False
             return False
         self.smoother = smoother
-        self.diagonal = float(np.linalg.norm(np.ptp(smoother.V0, axis=0))) if len(V) else 0.0
-        self.stopped = False
         self.error = ""
         self.version += 1
         return True
@@ -133,38 +129,18 @@ class SmoothingState:
     def step(self) -> bool:
         """One iteration; stops (and says why, with the stable λ) when the flow diverges.
 
-        A step counts as diverging when the smoother blows up or, for the explicit method, when
-        its RMSE against the clean mesh exceeds the bounding-box diagonal or the enclosed volume
-        changed by more than 100 %: a stable explicit flow does neither (it shrinks), an explicit
-        λ above the limit does within a few steps. (Taubin's stable flow may slowly grow the
-        volume past +100 % over hundreds of steps, so only a blow-up stops it.)
+        Divergence is the smoother's own rule (:meth:`Smoother.divergence_message`): an explicit
+        step that moves the vertices farther (RMS) than the bounding-box diagonal from the
+        input, or any step that blows up, is discarded, so the last good mesh stays on screen.
         """
         s = self.smoother
         if s is None:
             return False
-        if s.diverged or self.stopped:
+        if not s.diverged:
+            s.step()
+        if s.diverged:
             self.playing = False
-            return False
-        s.step()
-        last = s.history[-1] if s.history and s.method == "explicit" else {}
-        rmse, vol = last.get("rmse"), last.get("volume_change_pct")
-        too_far = rmse is not None and not rmse <= self.diagonal
-        too_much = vol is not None and not abs(vol) <= 100.0
-        if s.diverged or too_far or too_much:
-            self.playing = False
-            self.stopped = True
-            what = (
-                "the step blew up"
-                if s.diverged
-                else (
-                    f"RMSE {rmse:.3g} exceeds the bounding-box diagonal {self.diagonal:.3g}"
-                    if too_far
-                    else f"the volume changed by {vol:+.0f} % (more than 100 %)"
-                )
-            )
-            limit = s.stability.max_stable_lam
-            hint = f"; the stable λ on this mesh is below {limit:.4g}" if limit else ""
-            self.error = f"diverged at iteration {s.iteration}: {what}{hint}; press reset"
+            self.error = f"{s.divergence_message()}; press reset"
             return False
         return True
 
@@ -173,7 +149,6 @@ class SmoothingState:
         if self.smoother is not None:
             self.smoother.reset()
         self.playing = False
-        self.stopped = False
         self.error = ""
 
     @property
