@@ -176,7 +176,7 @@ class FrameWriter:
         if self.kind == ".gif":
             from PIL import Image
 
-            img = Image.fromarray(rgb).quantize(colors=256, method=Image.Quantize.MEDIANCUT)
+            img = Image.fromarray(rgb).quantize(colors=256, method=Image.Quantize.FASTOCTREE)
             self._gif.append(img)
         else:
             if self._video is None:

@@ -44,6 +44,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--fps", type=float, help="frames per second (default depends on the kind)")
     p.add_argument("--size", default="960x540", metavar="WxH", help="frame size in pixels")
     p.add_argument(
+        "--shadow",
+        action="store_true",
+        help="draw the ground shadow as the viewer does (slower: a second render pass)",
+    )
+    p.add_argument(
         "--session",
         metavar="FILE.json",
         help="animate a saved viewer session (needs `meshlap view --session`; not yet available)",
@@ -118,6 +123,7 @@ def run(args: argparse.Namespace) -> int:
         frames=args.frames,
         fps=args.fps,
         size=_size(args.size),
+        shadow=args.shadow,
     )
     check_spec(spec, None)  # options and output path first: a doomed run fails in a second
     mesh = load_mesh_state(spec) if spec.panel != "surfaces" else None
