@@ -188,10 +188,38 @@ def frame_count(spec: AnimationSpec) -> int:
     return spec.frames
 
 
-def frame_view(viewer: Viewer) -> None:
-    """Frame the current panel's structures across the whole window (no panel to avoid)."""
+COLORBAR_STRIP = 0.17
+"""Left fraction of a frame kept clear for polyscope's colour bar (top-left, ``COLORBAR_AT``)."""
+
+
+def frame_view(viewer: Viewer, strip: float = COLORBAR_STRIP) -> None:
+    """Frame the current panel's structures in the window right of a ``strip`` (fraction of
+    the width) kept for the colour bar (:func:`.scene.frame_scene_left` on the remaining width,
+    then the camera slides left)."""
     view = scene.OBLIQUE_VIEW if viewer.panel == "surfaces" else viewer_view(viewer)
-    scene.frame_scene_left(viewer_framed(), viewer.structure_points, 0.95, view)
+    scene.frame_scene_left(viewer_framed(), viewer.structure_points, 0.95 - strip, view)
+    if strip <= 0:
+        return
+    pts = [viewer.structure_points(n) for n in viewer_framed() if _shown(n)]
+    pts = [P for P in pts if P is not None and len(P)]
+    if not pts:
+        return
+    P = np.vstack(pts)
+    c = 0.5 * (P.min(axis=0) + P.max(axis=0))
+    cam = ps.get_view_camera_parameters()
+    pos, look, right = (
+        np.asarray(x, dtype=float)
+        for x in (cam.get_position(), cam.get_look_dir(), cam.get_right_dir())
+    )
+    w, h = ps.get_window_size()
+    tan_h = np.tan(np.radians(cam.get_fov_vertical_deg()) / 2.0) * w / max(h, 1)
+    depth = float(np.dot(c - pos, look))
+    pos = pos - strip * 2.0 * depth * tan_h * right  # the content moves right by the strip
+    ps.look_at(pos, pos + look)
+
+
+def _shown(name: str) -> bool:
+    return ps.has_surface_mesh(name) and ps.get_surface_mesh(name).is_enabled()
 
 
 def viewer_view(viewer: Viewer) -> tuple[float, float, float]:
@@ -214,7 +242,7 @@ def smoothing_frames(viewer: Viewer, spec: AnimationSpec) -> Iterator[str]:
         raise MeshError(st.error)
     panel.push(force=True)
     viewer.show_panel()
-    frame_view(viewer)
+    frame_view(viewer, strip=0.0)  # no colour map: no colour bar
     for it in range(spec.iters + 1):
         if it > 0 and not st.step():
             raise MeshError(st.error or "the smoothing stopped", "--lam")
@@ -247,7 +275,8 @@ def _basis(viewer: Viewer, k: int) -> Any:
 
 
 def k_frames(viewer: Viewer, spec: AnimationSpec) -> Iterator[str]:
-    """The reconstruction from the first k modes beside the mesh, k = A..B (fixed error scale)."""
+    """The reconstruction from the first k modes beside the mesh, k = A..B, coloured by the
+    error |x - x_k| on each k's own scale (the colour bar; the numbers are in the caption)."""
     a, b = spec.k  # type: ignore[misc]
     viewer.show_panel()  # before the basis exists: no eigenfunction on the mesh
     ps.get_surface_mesh(MESH).remove_all_quantities()  # the original plain beside x_k
@@ -257,7 +286,6 @@ def k_frames(viewer: Viewer, spec: AnimationSpec) -> Iterator[str]:
     panel.push_k(viewer, force=True)
     frame_view(viewer)
     e = st.errors
-    top = float(e.max[a]) or 1.0
     for k in range(a, b + 1):
         st.set_k(k)
         panel.push_k(viewer)
@@ -265,7 +293,7 @@ def k_frames(viewer: Viewer, spec: AnimationSpec) -> Iterator[str]:
             "error |x - x_k|",
             st.vertex_error,
             cmap="reds",
-            vminmax=(0.0, top),
+            vminmax=(0.0, float(e.max[k]) or 1.0),  # as the viewer: this k's largest error
             enabled=True,
             onscreen_colorbar_enabled=True,
             onscreen_colorbar_location=COLORBAR_AT,
