@@ -129,7 +129,11 @@ def burn_caption(frame: np.ndarray, text: str) -> np.ndarray:
     x0, y0, x1, y1 = caption_box(h, w)
     draw = ImageDraw.Draw(img)
     draw.rectangle((x0, y0, x1, y1), fill=(245, 245, 245))
-    font = _font(max(10, int((y1 - y0) * 0.62)))
+    size = max(10, int((y1 - y0) * 0.62))
+    font = _font(size)
+    while size > 8 and font.getlength(text) > w - 24:  # shrink to fit a narrow frame
+        size -= 1
+        font = _font(size)
     draw.text((x0 + 12, (y0 + y1) // 2), text, fill=(20, 20, 20), font=font, anchor="lm")
     return np.asarray(img)
 
@@ -148,8 +152,10 @@ class FrameWriter:
 
     Notes
     -----
-    GIF frames are quantized to a 256-colour palette as they arrive (a frame costs ``w·h``
-    bytes while collecting); MP4 frames are streamed to a temporary file beside the target.
+    GIF frames are quantized as they arrive (a frame costs ``w·h`` bytes while collecting) to
+    one 256-colour palette taken from the first frame (median cut; the colour bar, when shown,
+    brings its whole colour map into it), with Floyd-Steinberg dithering against banding;
+    MP4 frames are streamed to a temporary file beside the target.
     Nothing appears at ``path`` until :meth:`close` succeeds; :meth:`abort` removes the rest.
     """
 
@@ -162,6 +168,7 @@ class FrameWriter:
         self.count = 0
         self.size: tuple[int, int] | None = None  # (width, height)
         self._gif: list[Any] = []
+        self._palette: Any = None
         self._tmp: Path | None = None
         self._video: Any = None
 
@@ -176,8 +183,12 @@ class FrameWriter:
         if self.kind == ".gif":
             from PIL import Image
 
-            img = Image.fromarray(rgb).quantize(colors=256, method=Image.Quantize.FASTOCTREE)
-            self._gif.append(img)
+            img = Image.fromarray(rgb)
+            if self._palette is None:  # one palette for all frames: no flicker between frames
+                self._palette = img.quantize(colors=256, method=Image.Quantize.MEDIANCUT)
+            self._gif.append(
+                img.quantize(palette=self._palette, dither=Image.Dither.FLOYDSTEINBERG)
+            )
         else:
             if self._video is None:
                 iio = require_video()
