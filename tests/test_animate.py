@@ -170,6 +170,20 @@ def test_writer_refuses_mixed_sizes_and_abort_leaves_nothing(tmp_path):
         FrameWriter(path, fps=0)
 
 
+def test_mp4_writer_when_the_video_extra_is_installed(tmp_path):
+    pytest.importorskip("imageio_ffmpeg", reason="the optional extra meshlap[video]")
+    iio = pytest.importorskip("imageio.v2")
+    path = tmp_path / "x.mp4"
+    w = FrameWriter(path, fps=5)
+    for f in _frames(6, h=61, w=81):  # odd sizes are cropped to even ones for H.264
+        w.add(f)
+    assert not path.exists()
+    w.close()
+    reader = iio.get_reader(path)
+    assert reader.count_frames() == 6 and reader.get_data(0).shape == (60, 80, 3)
+    assert [p.name for p in tmp_path.iterdir()] == ["x.mp4"]
+
+
 def test_caption_is_burned_into_the_bottom_band():
     frame = np.full((180, 320, 4), 255, dtype=np.uint8)
     frame[:, :, :3] = 90  # a grey scene
