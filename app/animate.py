@@ -14,6 +14,7 @@ reconstruction from the first k modes, k = A..B) or ``modes`` (the eigenmodes A.
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -268,6 +269,7 @@ def _basis(viewer: Viewer, k: int) -> Any:
     """Compute (or read from the cache) ``k`` eigenpairs synchronously."""
     st = viewer.panels["spectral"].state
     st.k_request = k
+    sys.stderr.write(f"meshlap: animate: {k} eigenpairs (from the cache after the first run)\n")
     st.start(viewer.mesh.V, viewer.mesh.F, background=False)
     if st.error or st.basis is None:
         raise MeshError(st.error or "the eigenbasis could not be computed", "spectral")
