@@ -10,6 +10,7 @@ import polyscope as ps
 
 from meshlap_core.options import LAPLACIAN_KINDS as LAPLACIANS
 
+from ..animate import Recorder, draw_record, smoothing_caption
 from ..scene import (
     INPUT_COLOR,
     MESH,
@@ -36,6 +37,7 @@ class SmoothingPanel:
         self._shift = np.zeros(3)
         self.new_copy = False
         self.display = Display()  # the viewer's, set in on_new_mesh
+        self.recorder = Recorder("smoothing.gif")
 
     def on_new_mesh(self, viewer: Viewer) -> None:
         self.display = viewer.display
@@ -165,6 +167,8 @@ class SmoothingPanel:
         if st.error:
             ui.error(st.error)
         self.draw_figures(ui)
+        it = st.smoother.iteration if st.smoother is not None else None
+        draw_record(viewer, self.recorder, (st.version, it), lambda: smoothing_caption(st))
 
     def draw_figures(self, ui: UI) -> None:
         """Iteration, RMSE, volume change, the stable limit and the amplification plot."""

@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import polyscope as ps
 
+from ..animate import Recorder, draw_record
 from ..scene import COLORBAR_AT, EIGEN, MESH, RECON, side_offset
 from ..state.spectral import SpectralState
 
@@ -22,6 +23,7 @@ class SpectralPanel:
         self.state = SpectralState()
         self._shown_k = -1
         self._shown_mode = -1
+        self.recorder = Recorder("spectral.gif")
 
     def on_new_mesh(self, viewer: Viewer) -> None:
         self.state.clear()
@@ -151,3 +153,5 @@ class SpectralPanel:
             if ok:
                 ui.plot_line("mean |x - x_k|", e.k[1:], e.mean[1:])
                 ui.plot_vlines("current k", np.array([float(st.k)]))
+        caption = f"k = {st.k}: mean error {e.mean[st.k]:.3g};  eigenmode u_{st.mode}"
+        draw_record(viewer, self.recorder, (st.k, st.mode), lambda: caption)

@@ -51,6 +51,7 @@ COMMANDS: tuple[str, ...] = (
     "denoise_eval",
     "report",
     "spectral",
+    "animate",
 )
 
 

@@ -1,0 +1,470 @@
+"""Animations for slides: ``meshlap animate`` (headless, EGL) and the viewer's *record* button.
+
+Frames come from the viewer's own scene code: a :class:`~.viewer.Viewer` is built on the mesh
+and its panels register and update the structures exactly as in the window (``push``,
+``push_k``, ``push_mode``, the Surfaces panel's ``push``); the camera is framed with
+:func:`.scene.frame_scene_left`; polyscope renders each frame (``screenshot_to_buffer`` with its
+on-screen colour bar) and :mod:`meshlap_core.frames` burns the caption in and writes the GIF or
+MP4 atomically.
+
+Kinds: ``smoothing`` (one frame per iteration, 0 to ``iters``), ``spectral`` with ``k`` (the
+reconstruction from the first k modes, k = A..B) or ``modes`` (the eigenmodes A..B one by one),
+``surfaces`` with ``theta`` (the normal section at (u, v) turning through 360°, κₙ(θ)).
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import polyscope as ps
+
+from meshlap_core.errors import MeshError
+from meshlap_core.frames import FrameWriter, Progress, burn_caption, check_animation_output
+from meshlap_core.frames import parse_range as parse_range
+
+from . import scene
+from .scene import COLORBAR_AT, MESH, RECON, SURFACE_POINT, Z_TO_Y
+from .state.mesh import MeshState
+
+if TYPE_CHECKING:
+    from .viewer import Viewer
+
+KINDS = ("smoothing", "spectral", "surfaces")
+NORMAL_SECTION = "normal section"
+SECTION_DIRECTION = "normal section direction"
+RECORD_HEADER = "record (GIF / MP4)"
+DEFAULT_FPS = {"smoothing": 10.0, "k": 15.0, "modes": 1.5, "theta": 15.0}
+
+
+@dataclass
+class AnimationSpec:
+    """What ``meshlap animate`` renders (validated by :func:`check_spec` before any rendering).
+
+    ``k`` / ``modes`` are inclusive ranges ``(A, B)``; ``size`` is ``(width, height)`` pixels.
+    """
+
+    panel: str
+    out: Path
+    mesh: Path | None = None
+    method: str = "implicit"
+    laplacian: str = "uniform"
+    lam: float = 1.0
+    iters: int = 30
+    noise: float = 0.0
+    seed: int = 0
+    k: tuple[int, int] | None = None
+    modes: tuple[int, int] | None = None
+    theta: bool = False
+    surface: str = "saddle"
+    uv: tuple[float, float] | None = None
+    frames: int = 72
+    fps: float | None = None
+    size: tuple[int, int] = (960, 540)
+    shadow: bool = False
+
+    @property
+    def what(self) -> str:
+        """``smoothing``, ``k``, ``modes`` or ``theta``."""
+        if self.panel == "spectral":
+            return "modes" if self.modes is not None else "k"
+        return "theta" if self.panel == "surfaces" else "smoothing"
+
+
+def check_spec(spec: AnimationSpec, mesh: MeshState | None) -> None:
+    """Every check that does not need a renderer (the CLI calls it before starting EGL).
+
+    Raises
+    ------
+    MeshError
+        An inconsistent or out-of-range option, naming it.
+    """
+    if spec.panel not in KINDS:
+        raise MeshError(
+            f"unknown panel {spec.panel!r}; choose one of {', '.join(KINDS)}", "--panel"
+        )
+    w, h = spec.size
+    if not (64 <= w <= 4096 and 64 <= h <= 4096):
+        raise MeshError(f"each side must be 64 to 4096 pixels, got {w}x{h}", "--size")
+    if spec.panel == "spectral" and (spec.k is None) == (spec.modes is None):
+        raise MeshError("give exactly one of --k A:B (reconstruction) or --modes A:B", "--panel")
+    if spec.panel == "surfaces" and not spec.theta:
+        raise MeshError("the surfaces animation is the normal section: add --theta", "--panel")
+    if spec.panel == "surfaces":
+        from meshlap_core import surfaces
+
+        if spec.surface not in surfaces.SURFACES:
+            names = ", ".join(surfaces.SURFACES)
+            raise MeshError(f"unknown surface {spec.surface!r}; choose one of {names}", "--surface")
+    if spec.panel == "surfaces" and not 2 <= spec.frames <= 2000:
+        raise MeshError(f"must be 2 to 2000, got {spec.frames}", "--frames")
+    if mesh is not None and spec.panel == "spectral":
+        n = len(mesh.V)
+        if spec.k is not None and spec.k[1] > n:
+            raise MeshError(f"must end at {n} or less (the mesh has {n} vertices)", "--k")
+        if spec.modes is not None and spec.modes[1] > n - 1:
+            raise MeshError(f"must end at {n - 1} or less (the mesh has {n} vertices)", "--modes")
+    check_animation_output(spec.out, [spec.mesh] if spec.mesh else [])
+
+
+def load_mesh_state(spec: AnimationSpec) -> MeshState:
+    """Load the mesh of ``spec`` (the bundled default when ``None``) or raise its error."""
+    mesh = MeshState()
+    if not mesh.load(spec.mesh):
+        raise MeshError(mesh.error)
+    return mesh
+
+
+def render(spec: AnimationSpec, mesh: MeshState, progress: bool = True) -> Path:
+    """Render the animation of ``spec`` headless (EGL) into ``spec.out``; returns the path.
+
+    The viewer is built on ``mesh`` without a user callback (no meshlap panel in the frames)
+    and polyscope's own panels off: the frames show the 3D view and the colour bar only.
+    """
+    from .state.curvature import CurvatureState
+    from .viewer import Viewer, init_polyscope
+
+    writer = FrameWriter(spec.out, spec.fps or DEFAULT_FPS[spec.what], [spec.mesh or ""])
+    init_polyscope("openGL3_egl")
+    ps.set_build_default_gui_panels(False)
+    ps.set_window_size(*spec.size)
+    if not spec.shadow:  # the ground shadow is a second render pass: about 40 % of a frame
+        ps.set_ground_plane_mode("none")
+    colorbar = spec.what != "smoothing"  # polyscope draws its colour bar with imgui
+    viewer = Viewer(mesh, CurvatureState(), panel=spec.panel)
+    viewer.sync_mesh()
+    scenes = {"smoothing": smoothing_frames, "k": k_frames, "modes": mode_frames}
+    frames = scenes.get(spec.what, theta_frames)(viewer, spec)
+    bar = Progress(frame_count(spec)) if progress else None
+    try:
+        write_frames(frames, writer, colorbar, bar)
+        return writer.close()
+    except BaseException:
+        writer.abort()
+        raise
+    finally:
+        ps.remove_all_structures()
+
+
+def write_frames(
+    frames: Iterator[str], writer: FrameWriter, colorbar: bool, bar: Progress | None
+) -> None:
+    """Render each frame the generator sets up and hand it to the writer.
+
+    The caption and the GIF quantization run in a worker thread while the main thread computes
+    the next frame (a smoothing step, a reconstruction: numpy/scipy release the GIL), one frame
+    in flight, so the order is kept.
+    """
+    from concurrent.futures import Future, ThreadPoolExecutor
+
+    def add(buf: np.ndarray, caption: str) -> None:
+        writer.add(burn_caption(buf, caption))
+
+    pending: Future[None] | None = None
+    with ThreadPoolExecutor(max_workers=1) as pool:
+        for i, caption in enumerate(frames):
+            buf = ps.screenshot_to_buffer(transparent_bg=False, include_UI=colorbar)
+            if pending is not None:
+                pending.result()  # re-raises a failure of the previous frame
+            pending = pool.submit(add, buf, caption)
+            if bar is not None:
+                bar.update(i + 1)
+        if pending is not None:
+            pending.result()
+    if bar is not None:
+        bar.finish()
+
+
+def frame_count(spec: AnimationSpec) -> int:
+    """How many frames ``spec`` renders."""
+    if spec.what == "smoothing":
+        return spec.iters + 1
+    if spec.what in ("k", "modes"):
+        a, b = spec.k if spec.what == "k" else spec.modes  # type: ignore[misc]
+        return b - a + 1
+    return spec.frames
+
+
+COLORBAR_STRIP = 0.17
+"""Left fraction of a frame kept clear for polyscope's colour bar (top-left, ``COLORBAR_AT``)."""
+
+
+def frame_view(viewer: Viewer, strip: float = COLORBAR_STRIP) -> None:
+    """Frame the current panel's structures in the window right of a ``strip`` (fraction of
+    the width) kept for the colour bar (:func:`.scene.frame_scene_left` on the remaining width,
+    then the camera slides left)."""
+    view = scene.OBLIQUE_VIEW if viewer.panel == "surfaces" else viewer_view(viewer)
+    scene.frame_scene_left(viewer_framed(), viewer.structure_points, 0.95 - strip, view)
+    if strip <= 0:
+        return
+    pts = [viewer.structure_points(n) for n in viewer_framed() if _shown(n)]
+    pts = [P for P in pts if P is not None and len(P)]
+    if not pts:
+        return
+    P = np.vstack(pts)
+    c = 0.5 * (P.min(axis=0) + P.max(axis=0))
+    cam = ps.get_view_camera_parameters()
+    pos, look, right = (
+        np.asarray(x, dtype=float)
+        for x in (cam.get_position(), cam.get_look_dir(), cam.get_right_dir())
+    )
+    w, h = ps.get_window_size()
+    tan_h = np.tan(np.radians(cam.get_fov_vertical_deg()) / 2.0) * w / max(h, 1)
+    depth = float(np.dot(c - pos, look))
+    pos = pos - strip * 2.0 * depth * tan_h * right  # the content moves right by the strip
+    ps.look_at(pos, pos + look)
+
+
+def _shown(name: str) -> bool:
+    return ps.has_surface_mesh(name) and ps.get_surface_mesh(name).is_enabled()
+
+
+def viewer_view(viewer: Viewer) -> tuple[float, float, float]:
+    return scene.FRONT_VIEWS.get(viewer.mesh.name, scene.DEFAULT_VIEW)
+
+
+def viewer_framed() -> tuple[str, ...]:
+    from .viewer import FRAMED
+
+    return FRAMED
+
+
+def smoothing_frames(viewer: Viewer, spec: AnimationSpec) -> Iterator[str]:
+    """Iterations 0..iters of the Smoothing panel's stepper (input beside the smoothed copy)."""
+    panel = viewer.panels["smoothing"]
+    st = panel.state
+    st.method, st.laplacian, st.lam = spec.method, spec.laplacian, spec.lam
+    st.noise_alpha, st.seed = spec.noise, spec.seed
+    if not st.rebuild(viewer.mesh.V, viewer.mesh.F):
+        raise MeshError(st.error)
+    panel.push(force=True)
+    viewer.show_panel()
+    frame_view(viewer, strip=0.0)  # no colour map: no colour bar
+    for it in range(spec.iters + 1):
+        if it > 0 and not st.step():
+            raise MeshError(st.error or "the smoothing stopped", "--lam")
+        panel.push()
+        yield smoothing_caption(st, spec.iters)
+
+
+def smoothing_caption(st: Any, iters: int | None = None) -> str:
+    """``implicit (uniform L), λ = 1   iteration 3/30   RMSE 0.0012`` for a smoothing state
+    (read from the stepper's history: never the lazy stability estimate, an eigensolve)."""
+    s = st.smoother
+    last = s.history[-1] if s is not None and s.history else {}
+    rmse = last.get("rmse")
+    it = s.iteration if s is not None else 0
+    of = f"/{iters}" if iters is not None else ""
+    noise = f", noise α = {st.noise_alpha:g}" if st.noise_alpha else ""
+    return f"{st.method} ({st.laplacian} L), λ = {st.lam:g}{noise}   iteration {it}{of}" + (
+        f"   RMSE {rmse:.4g}" if rmse is not None else ""
+    )
+
+
+def _basis(viewer: Viewer, k: int) -> Any:
+    """Compute (or read from the cache) ``k`` eigenpairs synchronously."""
+    st = viewer.panels["spectral"].state
+    st.k_request = k
+    sys.stderr.write(f"meshlap: animate: {k} eigenpairs (from the cache after the first run)\n")
+    st.start(viewer.mesh.V, viewer.mesh.F, background=False)
+    if st.error or st.basis is None:
+        raise MeshError(st.error or "the eigenbasis could not be computed", "spectral")
+    return st
+
+
+def k_frames(viewer: Viewer, spec: AnimationSpec) -> Iterator[str]:
+    """The reconstruction from the first k modes beside the mesh, k = A..B, coloured by the
+    error |x - x_k| on each k's own scale (the colour bar; the numbers are in the caption)."""
+    a, b = spec.k  # type: ignore[misc]
+    viewer.show_panel()  # before the basis exists: no eigenfunction on the mesh
+    ps.get_surface_mesh(MESH).remove_all_quantities()  # the original plain beside x_k
+    panel = viewer.panels["spectral"]
+    st = _basis(viewer, max(b, 2))
+    st.set_k(a)
+    panel.push_k(viewer, force=True)
+    frame_view(viewer)
+    e = st.errors
+    for k in range(a, b + 1):
+        st.set_k(k)
+        panel.push_k(viewer)
+        ps.get_surface_mesh(RECON).add_scalar_quantity(
+            "error |x - x_k|",
+            st.vertex_error,
+            cmap="reds",
+            vminmax=(0.0, float(e.max[k]) or 1.0),  # as the viewer: this k's largest error
+            enabled=True,
+            onscreen_colorbar_enabled=True,
+            onscreen_colorbar_location=COLORBAR_AT,
+        )
+        yield (
+            f"k = {k} modes   mean error {e.mean[k]:.3g} "
+            f"({100 * e.relative_mean[k]:.3g}% of the diagonal)   max {e.max[k]:.3g}"
+        )
+
+
+def mode_frames(viewer: Viewer, spec: AnimationSpec) -> Iterator[str]:
+    """The eigenfunctions u_A..u_B as colour maps on the mesh, one per frame."""
+    a, b = spec.modes  # type: ignore[misc]
+    viewer.show_panel()
+    panel = viewer.panels["spectral"]
+    st = _basis(viewer, max(b + 1, 2))
+    scene.remove_structure(RECON)
+    frame_view(viewer)
+    for m in range(a, b + 1):
+        st.set_mode(m)
+        panel.push_mode(viewer, force=True)
+        _, lam = st.eigenfunction()
+        yield f"eigenmode u_{m}   λ_{m} = {lam:.5g}   (-C u = λ M u)"
+
+
+def section_arc(p: Any, t: np.ndarray, kn: float, length: float, n: int = 80) -> np.ndarray:
+    """Points ``(n,3)`` of the normal section's osculating arc at ``p.p``: the circle of
+    curvature ``kn`` in the plane of the unit tangent ``t`` and the normal ``p.n``
+    (``x(s) = p + t sin(κs)/κ + n (1 − cos(κs))/κ``, at most one full turn)."""
+    half = min(length, np.pi / abs(kn)) if abs(kn) > 1e-12 else length
+    s = np.linspace(-half, half, n)
+    if abs(kn) > 1e-9:
+        along, up = np.sin(kn * s) / kn, (1.0 - np.cos(kn * s)) / kn
+    else:
+        along, up = s, 0.5 * kn * s * s
+    return p.p[None, :] + along[:, None] * t[None, :] + up[:, None] * p.n[None, :]
+
+
+def theta_frames(viewer: Viewer, spec: AnimationSpec) -> Iterator[str]:
+    """The normal section at (u, v) turning: its tangent t(θ) and osculating arc, κₙ(θ)."""
+    from meshlap_core.surfaces import normal_curvature
+
+    surf = viewer.surf
+    if not surf.set_surface(spec.surface):
+        raise MeshError(surf.error, "--surface")
+    if spec.uv is not None and not surf.set_uv(*spec.uv):
+        raise MeshError(surf.error, "--uv")
+    viewer.show_panel()  # the Surfaces panel registers the surface, K and the point
+    frame_view(viewer)
+    p = surf.point
+    size = float(np.ptp(surf.mesh.V, axis=0).max())
+    for theta in np.linspace(0.0, 2 * np.pi, spec.frames, endpoint=False):
+        d = p.p_u * np.cos(theta) + p.p_v * np.sin(theta)
+        t = d / np.linalg.norm(d)
+        kn = float(normal_curvature(surf.name, surf.u, surf.v, np.array([theta]))[0])
+        arc = section_arc(p, t, kn, 0.3 * size)
+        edges = np.column_stack([np.arange(len(arc) - 1), np.arange(1, len(arc))])
+        cn = ps.register_curve_network(NORMAL_SECTION, arc, edges, radius=0.006)
+        cn.set_transform(Z_TO_Y)
+        cn.set_color((0.95, 0.55, 0.05))
+        pc = ps.get_point_cloud(SURFACE_POINT)
+        pc.add_vector_quantity(
+            SECTION_DIRECTION,
+            0.2 * size * t[None, :],
+            vectortype="ambient",
+            enabled=True,
+            color=(0.95, 0.55, 0.05),
+        )
+        yield (
+            f"{surf.name} at (u, v) = ({surf.u:.3g}, {surf.v:.3g})   θ = {np.degrees(theta):5.1f}°"
+            f"   κₙ(θ) = {kn:+.4g}   (κ₁ = {p.k1:.4g}, κ₂ = {p.k2:.4g})"
+        )
+
+
+# ---------------------------------------------------------------- the viewer's record button
+class Recorder:
+    """The *record* / *stop* buttons of a panel: while recording, every change of what the
+    panel plays (a smoothing step, a new k or mode) adds a frame of the 3D view; *stop* writes
+    the GIF/MP4 atomically and says where.
+
+    Parameters
+    ----------
+    stem : str
+        Default file name (without folder), e.g. ``smoothing.gif``.
+    """
+
+    def __init__(self, stem: str) -> None:
+        self.file_text = stem
+        self.writer: FrameWriter | None = None
+        self.status = ""
+        self._last: Any = None
+        self._capturing = False
+
+    @property
+    def recording(self) -> bool:
+        return self.writer is not None
+
+    def draw(self, viewer: Viewer) -> None:
+        """The collapsed *record* header: file name, record / stop, where the last one went."""
+        ui = viewer.ui
+        if not ui.header(RECORD_HEADER, default_open=False):
+            return
+        _, self.file_text = ui.input_text(
+            "record file",
+            self.file_text,
+            "a .gif or .mp4 name (in the Export folder unless a full path)",
+        )
+        if not self.recording:
+            if ui.button("record", "start recording what this panel plays"):
+                self.start(viewer)
+        elif ui.button("stop", "stop and write the file"):
+            self.status = self.stop()
+        if self.recording:
+            ui.text(f"recording: {self.writer.count} frames")  # type: ignore[union-attr]
+        if self.status:
+            ui.text(self.status)
+
+    def start(self, viewer: Viewer) -> None:
+        """Begin a recording into the file named in the field.
+
+        Raises
+        ------
+        MeshError
+            A bad name, extension or folder, or MP4 without the video extra.
+        """
+        path = Path(self.file_text.strip()).expanduser()
+        if not path.is_absolute():
+            path = viewer.panels["export"].folder / path
+        self.writer = FrameWriter(path, DEFAULT_FPS["smoothing"])
+        self._last = None
+        self.status = ""
+
+    def stop(self) -> str:
+        """Write the file; the message says where (or why not)."""
+        writer, self.writer = self.writer, None
+        if writer is None:
+            return ""
+        try:
+            return f"wrote {writer.count} frames to {writer.close()}"
+        except MeshError:
+            writer.abort()
+            raise
+
+    def capture(self, viewer: Viewer, key: Any, caption: str) -> None:
+        """Add a frame when recording and ``key`` (what the panel shows) changed."""
+        if self.writer is None or self._capturing or key == self._last:
+            return
+        self._capturing = True
+        try:
+            buf = ps.screenshot_to_buffer(transparent_bg=False, include_UI=False)
+            self.writer.add(burn_caption(crop_scene(viewer, buf), caption))
+            self._last = key
+        finally:
+            self._capturing = False
+
+
+def crop_scene(viewer: Viewer, buf: np.ndarray) -> np.ndarray:
+    """The part of a window buffer ``(h, w, 4)`` left of meshlap's panel (where the viewer
+    frames the scene)."""
+    from .viewer import PANEL_PX
+
+    w_win = max(ps.get_window_size()[0], 1)
+    w = buf.shape[1]
+    keep = int(w * min(max((w_win - PANEL_PX * viewer.ui.scale) / w_win, 0.3), 1.0))
+    return buf[:, : max(keep // 2 * 2, 2)]
+
+
+def draw_record(viewer: Viewer, recorder: Recorder, key: Any, caption: Callable[[], str]) -> None:
+    """The panels' hook: draw the record header, then capture a frame if recording."""
+    recorder.draw(viewer)
+    if recorder.recording:
+        recorder.capture(viewer, key, caption())
