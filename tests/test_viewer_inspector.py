@@ -110,14 +110,18 @@ def test_arrow_scales():
     assert arrow_scales(flat, 0.2)[1] == 0.0
 
 
-def test_hover_throttle_picks_only_when_moved_and_due():
+def test_hover_throttle_picks_once_the_cursor_rests():
     t = HoverThrottle(interval=0.1)
-    assert t.due(0.0, (10.0, 10.0))
-    assert not t.due(0.5, (10.0, 10.0))  # idle: the cursor did not move
-    assert t.due(0.55, (11.0, 10.0))  # moved
-    assert not t.due(0.6, (12.0, 10.0))  # moved, but 0.05 s after the last pick
-    assert t.due(0.66, (12.0, 10.0))
-    assert not t.due(0.67, (13.0, 10.0))
+    assert not t.due(0.0, (10.0, 10.0))  # just arrived
+    assert not t.due(0.05, (10.0, 10.0))
+    assert t.due(0.1, (10.0, 10.0)) and t.current((10.0, 10.0))  # rested 0.1 s: pick
+    assert not t.due(0.5, (10.0, 10.0))  # idle: picked there already
+    for k in range(10):  # moving: no picking
+        assert not t.due(0.5 + 0.05 * k, (11.0 + k, 10.0))
+        assert not t.current((11.0 + k, 10.0))
+    assert not t.due(0.99, (20.0, 10.0))
+    assert t.due(1.06, (20.0, 10.0))
+    assert not t.due(1.2, (20.0, 10.0))
 
 
 def test_state_follows_area_and_boundary_rule(tmp_path):
@@ -208,13 +212,17 @@ def drive_hover(viewer) -> None:
     panel = viewer.panels["onering"]
     panel.clock, panel.throttle = (clock := FakeClock()), HoverThrottle()
     picks0 = panel.picks
-    drive(viewer, "hover", (5.0, 5.0), (5.0, 5.0), (5.0, 5.0))  # over nothing, then idle
+    for _ in range(3):  # over nothing: one pick once the cursor rests, then idle
+        drive(viewer, "hover", (5.0, 5.0))
+        clock.t += 0.1
     assert panel.picks == picks0 + 1 and panel.hovered == ""
-    clock.t += 0.05
-    drive(viewer, "hover", (6.0, 5.0))  # moved too soon: no pick
+    for x in (6.0, 7.0, 8.0):  # moving: no picking
+        drive(viewer, "hover", (x, 5.0))
+        clock.t += 0.05
     assert panel.picks == picks0 + 1
+    drive(viewer, "hover", (-1e9, 1e9))  # off-screen: no hit, no error
     clock.t += 0.1
-    drive(viewer, "hover", (7.0, 5.0), (-1e9, 1e9))  # due; off-screen: no hit, no error
+    drive(viewer, "hover", (-1e9, 1e9))
     assert panel.picks == picks0 + 2 and panel.hovered == ""
     assert "labels" not in viewer.errors
 
@@ -242,13 +250,18 @@ def test_hover_shows_index_and_field_value(viewer, monkeypatch):
 
     monkeypatch.setattr(ps, "pick", fake_pick)
     drive(viewer, "hover", (100.0, 80.0))
+    clock.t = 0.1
+    drive(viewer, "hover", (100.0, 80.0))
+    assert "labels" not in viewer.errors, viewer.errors
     value = viewer.curv.fields[viewer.curv.field_name][11]
     assert panel.hovered == f"vertex 11: {viewer.curv.field_name} = {value:.4g}"
     drive(viewer, "hover", *[(100.0, 80.0)] * 5)  # idle frames: the answer stays, no picking
     assert len(calls) == 1 and panel.hovered.startswith("vertex 11")
-    clock.t = 1.0
     hit.structure_data = {"element_type": "face", "index": 0}
-    drive(viewer, "hover", (101.0, 80.0))  # a face: its nearest corner
+    drive(viewer, "hover", (101.0, 80.0))  # a face: its nearest corner, once rested
+    assert len(calls) == 1
+    clock.t = 1.0
+    drive(viewer, "hover", (101.0, 80.0))
     assert len(calls) == 2 and panel.hovered.startswith("vertex ")
     assert int(panel.hovered.split()[1].rstrip(":")) in viewer.mesh.F[0]
 

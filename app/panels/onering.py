@@ -196,14 +196,16 @@ class OneRingPanel:
             nc.set_color(scene.NEGATIVE_COLOR)
 
     def _push_arrows(self, viewer: Viewer, ins: VertexInspection, length: float, r: float) -> None:
-        """``n`` and ``Δ_cotan x`` as arrows at ``x_i``, both drawn ``length`` long (world)."""
+        """``n`` (``length`` long, world units) and ``Δ_cotan x`` (scaled to ``0.7 length``, so
+        both show when they are parallel, as ``Δx = −2Hn`` makes them) as arrows at ``x_i``."""
         d = viewer.display
-        s_n, s_lap = arrow_scales(ins, length)
+        s_n, _ = arrow_scales(ins, length)
+        _, s_lap = arrow_scales(ins, 0.7 * length)
         pc = ps.register_point_cloud(scene.INSPECT_ARROWS, d.points(ins.position[None, :]))
         pc.set_radius(0.01 * r, relative=False)
-        for name, vec, color in (
-            ("n (angle-weighted normal)", s_n * ins.normal, scene.NORMAL_COLOR),
-            ("Lx (cotan Laplacian)", s_lap * ins.laplacian_cotan, scene.LAPLACIAN_COLOR),
+        for name, vec, color, width in (
+            ("n (angle-weighted normal)", s_n * ins.normal, scene.NORMAL_COLOR, 0.25),
+            ("Lx (cotan Laplacian)", s_lap * ins.laplacian_cotan, scene.LAPLACIAN_COLOR, 0.4),
         ):
             pc.add_vector_quantity(
                 name,
@@ -211,11 +213,11 @@ class OneRingPanel:
                 vectortype="ambient",
                 enabled=True,
                 color=color,
-                radius=0.3 * r / max(ps.get_length_scale(), 1e-30),  # polyscope: relative
+                radius=width * r / max(ps.get_length_scale(), 1e-30),  # polyscope: relative
             )
         self.arrow_text = (
-            f"arrows at i: n drawn {length:.3g} long; Lx drawn x {s_lap:.3g} "
-            f"(|Lx| = {float(np.linalg.norm(ins.laplacian_cotan)):.4g}, world units)"
+            f"arrows at i: black n, {length:.3g} long; teal Lx, drawn x {s_lap:.3g} "
+            f"(|Lx| = {float(np.linalg.norm(ins.laplacian_cotan)):.4g}; world units)"
         )
 
     def focus(self, viewer: Viewer) -> None:
@@ -234,7 +236,23 @@ class OneRingPanel:
             tilt = np.array([1.0, 0.0, 0.0]) - normal[0] * normal
         tilt /= np.linalg.norm(tilt)
         # obliquely (about 40° off the normal), so the arrows n and Δx at the vertex show
-        ps.look_at(center + size * (3.2 * normal + 2.7 * tilt), center)
+        back = 2.4 * normal + 2.0 * tilt
+        if np.linalg.norm(np.cross([0.0, 1.0, 0.0], back)) < 1e-6 * np.linalg.norm(back):
+            ps.look_at(center + size * back, center)  # frame_points needs a non-vertical view
+            return
+        from ..viewer import PANEL_PX  # (imported here: the viewer imports this module)
+
+        w, _ = ps.get_window_size()
+        fraction = min(max((w - PANEL_PX * viewer.ui.scale) / max(w, 1), 0.3), 0.95)
+        # as scene.frame_points does: shift the target right so the vertex lands in the middle
+        # of the part of the window left of meshlap's panel
+        right = np.cross([0.0, 1.0, 0.0], back)
+        right /= np.linalg.norm(right)
+        fov = np.radians(ps.get_view_camera_parameters().get_fov_vertical_deg())
+        tan_h = np.tan(fov / 2.0) * w / max(ps.get_window_size()[1], 1)
+        d = size * float(np.linalg.norm(back))
+        target = center + (1.0 - fraction) * d * tan_h * right
+        ps.look_at(target + size * back, target)
 
     def ring_labels(self, viewer: Viewer) -> list[tuple[tuple[float, float], str]]:
         """Screen positions and texts of the order numbers ("0", "1", ...) of the one-ring."""
@@ -265,8 +283,8 @@ class OneRingPanel:
         self.draw_hover(viewer)
 
     def draw_hover(self, viewer: Viewer) -> None:
-        """Pick under the cursor at most every ``throttle.interval`` seconds and only when it
-        moved (an idle frame does no picking); show the last answer at the cursor."""
+        """Pick under the cursor once it rests ``throttle.interval`` seconds at a new position
+        (a moving cursor and an idle frame do no picking); show the answer at the cursor."""
         pos = viewer.ui.hover()
         if pos is None:
             self.hovered = ""
@@ -274,7 +292,7 @@ class OneRingPanel:
         if self.throttle.due(self.clock(), pos):
             self.picks += 1
             self.hovered = self.hover_text(viewer, pos)
-        if self.hovered:
+        if self.hovered and self.throttle.current(pos):  # nothing stale while moving
             viewer.ui.overlay_text((pos[0] + 16, pos[1] + 12), self.hovered)
 
     def hover_text(self, viewer: Viewer, pos: tuple[float, float]) -> str:
@@ -363,7 +381,7 @@ class OneRingPanel:
         if (w < 0).any():
             ui.colored(f"magenta edges: negative w_ij ({int((w < 0).sum())})", NEGATIVE_RGBA)
         if self.arrow_text:
-            ui.note(self.arrow_text + "; black n, teal Lx")
+            ui.note(self.arrow_text)
 
     def draw_neighbours(self, viewer: Viewer, ins: VertexInspection) -> None:
         ui = viewer.ui

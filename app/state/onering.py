@@ -277,16 +277,25 @@ def arrow_scales(ins: VertexInspection, length: float) -> tuple[float, float]:
 
 @dataclass
 class HoverThrottle:
-    """Decides when hovering picks the scene again: at most every ``interval`` seconds, and only
-    when the cursor moved, so an idle frame does no picking."""
+    """Decides when hovering picks the scene: once the cursor has rested ``interval`` seconds
+    at a position it has not picked at yet. So picks are at least ``interval`` apart, a moving
+    cursor does no picking (one pick renders a pick buffer: 0.12 s on a software-rendered EGL
+    context), and neither does an idle frame."""
 
     interval: float = 0.1
-    last_time: float = float("-inf")
-    last_pos: tuple[float, float] | None = None
+    last_pos: tuple[float, float] | None = None  # where the last pick was
+    rest_pos: tuple[float, float] | None = None  # where the cursor is resting
+    rest_since: float = float("-inf")
 
     def due(self, now: float, pos: tuple[float, float]) -> bool:
         """Whether to pick at ``pos`` at time ``now`` (seconds); records the pick when it is."""
-        if pos == self.last_pos or now - self.last_time < self.interval:
+        if pos != self.rest_pos:
+            self.rest_pos, self.rest_since = pos, now
+        if pos == self.last_pos or now - self.rest_since < self.interval:
             return False
-        self.last_time, self.last_pos = now, pos
+        self.last_pos = pos
         return True
+
+    def current(self, pos: tuple[float, float]) -> bool:
+        """Whether the last pick was made at ``pos`` (its answer describes the cursor)."""
+        return pos == self.last_pos
