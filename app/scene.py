@@ -20,6 +20,20 @@ MESH_B = "mesh (second estimator)"
 RING_CURVE = "one-ring order"
 RING_POINTS = "one-ring neighbours"
 RING_CENTER = "selected vertex"
+INSPECT_WEIGHTS = "inspector: w_ij"
+INSPECT_NEGATIVE = "inspector: negative w_ij"
+INSPECT_ARCS = "inspector: corner angles"
+INSPECT_CELL = "inspector: area cell"
+INSPECT_CELL_EDGE = "inspector: area cell outline"
+INSPECT_ARROWS = "inspector: n and Lx"
+INSPECTOR = (
+    INSPECT_WEIGHTS,
+    INSPECT_NEGATIVE,
+    INSPECT_ARCS,
+    INSPECT_CELL,
+    INSPECT_CELL_EDGE,
+    INSPECT_ARROWS,
+)
 SURFACE = "surface"
 SURFACE_POINT = "surface point"
 RECON = "reconstruction"
@@ -32,6 +46,11 @@ RED = (1.0, 0.35, 0.35, 1.0)
 COLORBAR_AT = (15.0, 15.0)  # polyscope's on-screen colour bar: top-left, clear of the panel
 INPUT_COLOR = (0.85, 0.75, 0.6)
 SMOOTHED_COLOR = (0.55, 0.7, 0.9)
+NEGATIVE_COLOR = (0.85, 0.1, 0.85)  # negative cotangent weights: outside the coolwarm map
+ARC_COLOR = (1.0, 0.6, 0.0)
+CELL_COLOR = (0.35, 0.8, 0.35)
+NORMAL_COLOR = (0.1, 0.1, 0.1)
+LAPLACIAN_COLOR = (0.0, 0.6, 0.6)
 
 # parametric surfaces are written z-up; the viewer is y-up: display them rotated (x, y, z) ->
 # (x, z, -y) with a polyscope transform, so the data (and the numbers in the panel) are unchanged

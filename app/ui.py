@@ -210,6 +210,12 @@ class UI:
         self.im.TextColored(GREY, text)
         self.im.PopTextWrapPos()
 
+    def colored(self, text: str, rgba: tuple[float, float, float, float]) -> None:
+        """Text in the colour ``rgba``, wrapped (a legend entry, a flagged row)."""
+        self.im.PushTextWrapPos(self.wrap_width * self.scale)
+        self.im.TextColored(rgba, text)
+        self.im.PopTextWrapPos()
+
     def same_line(self) -> None:
         self.im.SameLine()
 
@@ -407,6 +413,19 @@ class UI:
             return tuple(queue.popleft())
         io = self.im.GetIO()
         if io.WantCaptureMouse or not self.im.IsMouseClicked(0):
+            return None
+        return tuple(io.MousePos)
+
+    def hover(self) -> tuple[float, float] | None:
+        """Window position of the mouse over the 3D view this frame (``None`` over a panel).
+        Scripted as the label ``"hover"`` with an ``(x, y)``."""
+        self.seen[("scene", "hover")] = "hover"
+        queue = self._script.get("hover")
+        if queue:
+            self.driven.add(("scene", "hover"))
+            return tuple(queue.popleft())
+        io = self.im.GetIO()
+        if io.WantCaptureMouse:
             return None
         return tuple(io.MousePos)
 

@@ -1,7 +1,8 @@
 """Regenerate the README screenshots of every viewer panel (headless, EGL).
 
 Run: ``python docs/make_screenshots.py``. Uses ../shared/meshes/armadillo.obj for the spectral
-panel when present, the bundled assets otherwise.
+panel when present, the bundled assets otherwise. The inspector shot is taken on a perturbed grid
+(:func:`perturbed_grid`, seeded) at a vertex whose ring has a negative cotangent weight.
 """
 
 from __future__ import annotations
@@ -10,6 +11,11 @@ import subprocess
 import sys
 import tempfile
 from pathlib import Path
+
+import numpy as np
+
+from meshlap_core import primitives
+from meshlap_core.io import save_mesh
 
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "docs" / "img"
@@ -30,10 +36,32 @@ SHOTS = {
 }
 
 
+INSPECT_VERTEX = 54
+"""A vertex of :func:`perturbed_grid` near the centre with a negative weight (w = -0.50)."""
+
+
+def perturbed_grid(seed: int = 3) -> tuple[np.ndarray, np.ndarray]:
+    """A 10 x 10 grid with its vertices jittered in the plane (±0.3 of a cell, seeded) and a
+    gentle bump: some triangles become obtuse, so some cotangent weights are negative."""
+    V, F = primitives.grid(10, 10)
+    V = V.copy()
+    h = 1.0 / 9.0
+    V[:, :2] += np.random.default_rng(seed).uniform(-0.3, 0.3, (len(V), 2)) * h
+    V[:, 2] += 0.15 * h * np.sin(3 * V[:, 0]) * np.cos(2 * V[:, 1])
+    return V, F
+
+
 def main() -> None:
     OUT.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory() as tmp:  # polyscope writes .ini files into the cwd
-        for name, args in SHOTS.items():
+        grid = Path(tmp) / "perturbed_grid.obj"
+        save_mesh(grid, *perturbed_grid())
+        shots = dict(SHOTS)
+        shots["inspector"] = [str(grid), "--panel", "onering", "--vertex", str(INSPECT_VERTEX)]
+        only = sys.argv[1:]  # names of the shots to take (all when none)
+        for name, args in shots.items():
+            if only and name not in only:
+                continue
             out = OUT / f"{name}.png"
             cmd = [
                 sys.executable,

@@ -492,10 +492,13 @@ def test_every_widget_is_driven(viewer, tmp_path, sphere):
     test_help_widgets(viewer)
     test_shortcuts(viewer)
     test_click_and_drop(viewer, tmp_path, sphere)
+    from test_viewer_inspector import drive_inspector  # the inspector's widgets
+
+    drive_inspector(viewer)
     ui = viewer.ui
     undriven = sorted(set(ui.seen) - ui.driven)
     assert not undriven, f"widgets no test drives: {undriven}"
-    untipped = sorted(k for k, kind in ui.seen.items() if kind not in ("key", "click"))
+    untipped = sorted(k for k, kind in ui.seen.items() if kind not in ("key", "click", "hover"))
     untipped = sorted(set(untipped) - set(ui.tooltips))
     assert not untipped, f"widgets without a tooltip: {untipped}"
     assert len(ui.seen) >= 25

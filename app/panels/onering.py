@@ -1,29 +1,91 @@
-"""The One-ring panel: a clicked vertex, its neighbours numbered in order, H and K there."""
+"""The One-ring panel: a clicked vertex, its neighbours numbered in order, H and K there, and
+the vertex inspector (every term of the discrete operators at that vertex, listed and drawn)."""
 
 from __future__ import annotations
 
+import math
+import time
+from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 import numpy as np
 import polyscope as ps
 
 from meshlap_core.errors import MeshError
+from meshlap_core.inspector import VertexInspection, format_inspection
+from meshlap_core.options import AREA_KINDS, BOUNDARY_RULES
 
+from .. import scene
 from ..camera import project_to_screen
-from ..scene import RING_CENTER, RING_CURVE, RING_POINTS
+from ..scene import MESH, RING_CENTER, RING_CURVE, RING_POINTS
+from ..state.onering import (
+    HoverThrottle,
+    angle_arcs,
+    area_cell,
+    arrow_scales,
+    weight_segments,
+)
 
 if TYPE_CHECKING:
     from ..viewer import Viewer
 
 
-class OneRingPanel:
-    """Vertex field, clockwise toggle, the ring drawn as numbered points and arrows."""
+NEGATIVE_RGBA = (*scene.NEGATIVE_COLOR, 1.0)
+WEIGHTS_COLORBAR_AT = (15.0, 300.0)  # below the mesh field's colour bar (scene.COLORBAR_AT)
 
-    def __init__(self) -> None:
+# glyphs the viewer's font lacks, written out (the CLI prints the originals)
+ASCII_MATH = str.maketrans(
+    {
+        "Δ": "L",
+        "Σ": "sum ",
+        "θ": "theta",
+        "π": "pi",
+        "κ": "k",
+        "₁": "1",
+        "₂": "2",
+        "√": "sqrt",
+        "−": "-",
+        "—": "-",
+        "·": "*",
+        "²": "^2",
+    }
+)
+
+AREA_HELP = (
+    "A_i: barycentric = sum of A_f/3; mixed Voronoi (Meyer et al. 2003) = circumcentre cell, "
+    "A_f/2 when the face is obtuse at i, A_f/4 when obtuse elsewhere. Also the curvature fields'."
+)
+BOUNDARY_HELP = (
+    "angle deficit at a boundary vertex: pi - sum(theta) ('pi'), 2 pi - sum(theta) ('2pi'), "
+    "or K = 0 ('zero'). Also the curvature fields'."
+)
+
+
+class OneRingPanel:
+    """Vertex field, clockwise toggle, the ring drawn as numbered points and arrows, and the
+    inspector: its tables in the panel and its drawings in 3D (ring edges coloured by ``w_ij``,
+    corner-angle arcs, the area cell, ``n`` and ``Δx`` at the vertex).
+
+    Parameters
+    ----------
+    clock : callable
+        Seconds (monotonic) for the hover throttle; a test passes a fake clock.
+    """
+
+    def __init__(self, clock: Callable[[], float] = time.monotonic) -> None:
         self.labels: list[tuple[tuple[float, float], str]] = []  # the one-ring numbers drawn
+        self.clock = clock
+        self.throttle = HoverThrottle()
+        self.hovered = ""  # the text shown at the cursor ("" over nothing)
+        self.picks = 0  # hover picks done (the throttle keeps this low)
+        self.registered = False  # the inspector's structures are in the scene
+        self.arrow_text = ""
 
     def on_new_mesh(self, viewer: Viewer) -> None:
         self.labels = []
+        self.hovered = ""
+        self.throttle = HoverThrottle(self.throttle.interval)
+        self.remove_inspector()
 
     def show(self, viewer: Viewer, panel: str) -> None:
         if ps.has_curve_network(RING_CURVE):
@@ -31,6 +93,16 @@ class OneRingPanel:
         for name in (RING_POINTS, RING_CENTER):
             if ps.has_point_cloud(name):
                 ps.get_point_cloud(name).set_enabled(panel == "onering")
+        if panel != "onering":
+            self.remove_inspector()  # registered again when the panel comes back
+        elif not self.registered and viewer.ring.inspection is not None:
+            self.push_inspector(viewer)
+
+    def remove_inspector(self) -> None:
+        """Remove the inspector's structures from the scene."""
+        for name in scene.INSPECTOR:
+            scene.remove_structure(name)
+        self.registered = False
 
     def points(self, viewer: Viewer, name: str) -> np.ndarray | None:
         return None
@@ -66,7 +138,87 @@ class OneRingPanel:
         c = ps.register_point_cloud(RING_CENTER, center, radius=2.0 * scale)
         c.set_radius(2.0 * scale, relative=False)
         c.set_color((1.0, 0.1, 0.1))
+        self.push_inspector(viewer)
         viewer.show_panel()
+
+    def push_inspector(self, viewer: Viewer) -> None:
+        """Register the inspector's drawings for the selected vertex (on a selection change)."""
+        ins = viewer.ring.inspection
+        self.remove_inspector()
+        if ins is None or not ins.neighbors:
+            return
+        d, V, F = viewer.display, viewer.mesh.V, viewer.mesh.F
+        lengths = np.array([t.edge_length for t in ins.neighbors])
+        mean = float(lengths.mean())
+        r = 0.08 * mean * d.scale  # display radius unit, as the ring's
+        self._push_weights(viewer, ins, r)
+        lift = 0.02 * mean * ins.normal  # just above the surface (no z-fighting)
+        nodes, edges, theta = angle_arcs(ins, V, F, 0.4 * float(lengths.min()))
+        if len(edges):
+            arcs = ps.register_curve_network(scene.INSPECT_ARCS, d.points(nodes + lift), edges)
+            arcs.set_radius(0.18 * r, relative=False)
+            obtuse = (theta > np.pi / 2)[:, None]
+            rgb = np.where(obtuse, np.array([[0.9, 0.1, 0.1]]), np.array([scene.ARC_COLOR]))
+            arcs.add_color_quantity("corner angle (red: obtuse)", rgb, "edges", enabled=True)
+        nodes, tris, outline = area_cell(ins, V, F)
+        lifted = nodes + lift
+        cell = ps.register_surface_mesh(scene.INSPECT_CELL, d.points(lifted), tris)
+        cell.set_color(scene.CELL_COLOR)
+        cell.set_transparency(0.6)
+        cn = ps.register_curve_network(scene.INSPECT_CELL_EDGE, d.points(lifted), outline)
+        cn.set_radius(0.15 * r, relative=False)
+        cn.set_color((0.1, 0.5, 0.1))
+        self._push_arrows(viewer, ins, 1.5 * mean, r)
+        self.registered = True
+
+    def _push_weights(self, viewer: Viewer, ins: VertexInspection, r: float) -> None:
+        """The ring edges ``i–j`` coloured by ``w_ij`` (coolwarm, symmetric around 0), the
+        negative ones drawn over in their own colour."""
+        d = viewer.display
+        nodes, edges, w = weight_segments(ins, viewer.mesh.V)
+        m = float(np.abs(w).max()) or 1.0
+        cn = ps.register_curve_network(scene.INSPECT_WEIGHTS, d.points(nodes), edges)
+        cn.set_radius(0.35 * r, relative=False)
+        cn.add_scalar_quantity(
+            "cotangent weight w_ij",
+            w,
+            defined_on="edges",
+            cmap="coolwarm",
+            vminmax=(-m, m),
+            enabled=True,
+            onscreen_colorbar_enabled=True,
+            onscreen_colorbar_location=WEIGHTS_COLORBAR_AT,
+        )
+        neg = w < 0
+        if neg.any():
+            nc = ps.register_curve_network(scene.INSPECT_NEGATIVE, d.points(nodes), edges[neg])
+            nc.set_radius(0.45 * r, relative=False)
+            nc.set_color(scene.NEGATIVE_COLOR)
+
+    def _push_arrows(self, viewer: Viewer, ins: VertexInspection, length: float, r: float) -> None:
+        """``n`` (``length`` long, world units) and ``Δ_cotan x`` (scaled to ``0.7 length``, so
+        both show when they are parallel, as ``Δx = −2Hn`` makes them) as arrows at ``x_i``."""
+        d = viewer.display
+        s_n, _ = arrow_scales(ins, length)
+        _, s_lap = arrow_scales(ins, 0.7 * length)
+        pc = ps.register_point_cloud(scene.INSPECT_ARROWS, d.points(ins.position[None, :]))
+        pc.set_radius(0.01 * r, relative=False)
+        for name, vec, color, width in (
+            ("n (angle-weighted normal)", s_n * ins.normal, scene.NORMAL_COLOR, 0.25),
+            ("Lx (cotan Laplacian)", s_lap * ins.laplacian_cotan, scene.LAPLACIAN_COLOR, 0.4),
+        ):
+            pc.add_vector_quantity(
+                name,
+                d.vectors(vec[None, :]),
+                vectortype="ambient",
+                enabled=True,
+                color=color,
+                radius=width * r / max(ps.get_length_scale(), 1e-30),  # polyscope: relative
+            )
+        self.arrow_text = (
+            f"arrows at i: black n, {length:.3g} long; teal Lx, drawn x {s_lap:.3g} "
+            f"(|Lx| = {float(np.linalg.norm(ins.laplacian_cotan)):.4g}; world units)"
+        )
 
     def focus(self, viewer: Viewer) -> None:
         """Point the camera at the selected vertex, along its normal, framing the one-ring."""
@@ -83,7 +235,24 @@ class OneRingPanel:
         if np.linalg.norm(tilt) < 1e-6:
             tilt = np.array([1.0, 0.0, 0.0]) - normal[0] * normal
         tilt /= np.linalg.norm(tilt)
-        ps.look_at(center + size * (7.0 * normal + 2.0 * tilt), center)
+        # obliquely (about 40° off the normal), so the arrows n and Δx at the vertex show
+        back = 2.4 * normal + 2.0 * tilt
+        if np.linalg.norm(np.cross([0.0, 1.0, 0.0], back)) < 1e-6 * np.linalg.norm(back):
+            ps.look_at(center + size * back, center)  # frame_points needs a non-vertical view
+            return
+        from ..viewer import PANEL_PX  # (imported here: the viewer imports this module)
+
+        w, _ = ps.get_window_size()
+        fraction = min(max((w - PANEL_PX * viewer.ui.scale) / max(w, 1), 0.3), 0.95)
+        # as scene.frame_points does: shift the target right so the vertex lands in the middle
+        # of the part of the window left of meshlap's panel
+        right = np.cross([0.0, 1.0, 0.0], back)
+        right /= np.linalg.norm(right)
+        fov = np.radians(ps.get_view_camera_parameters().get_fov_vertical_deg())
+        tan_h = np.tan(fov / 2.0) * w / max(ps.get_window_size()[1], 1)
+        d = size * float(np.linalg.norm(back))
+        target = center + (1.0 - fraction) * d * tan_h * right
+        ps.look_at(target + size * back, target)
 
     def ring_labels(self, viewer: Viewer) -> list[tuple[tuple[float, float], str]]:
         """Screen positions and texts of the order numbers ("0", "1", ...) of the one-ring."""
@@ -106,10 +275,40 @@ class OneRingPanel:
         ]
 
     def draw_labels(self, viewer: Viewer) -> None:
-        """Write the order numbers next to the neighbours (over the 3D view)."""
+        """Write the order numbers next to the neighbours (over the 3D view), and the hovered
+        vertex's index and field value at the cursor."""
         self.labels = self.ring_labels(viewer)
         for pos, text in self.labels:
             viewer.ui.overlay_text(pos, text)
+        self.draw_hover(viewer)
+
+    def draw_hover(self, viewer: Viewer) -> None:
+        """Pick under the cursor once it rests ``throttle.interval`` seconds at a new position
+        (a moving cursor and an idle frame do no picking); show the answer at the cursor."""
+        pos = viewer.ui.hover()
+        if pos is None:
+            self.hovered = ""
+            return
+        if self.throttle.due(self.clock(), pos):
+            self.picks += 1
+            self.hovered = self.hover_text(viewer, pos)
+        if self.hovered and self.throttle.current(pos):  # nothing stale while moving
+            viewer.ui.overlay_text((pos[0] + 16, pos[1] + 12), self.hovered)
+
+    def hover_text(self, viewer: Viewer, pos: tuple[float, float]) -> str:
+        """``"vertex i: <field> = value"`` for the mesh vertex under ``pos``, else ``""``."""
+        res = ps.pick(screen_coords=pos)
+        if not res.is_hit or res.structure_name != MESH:
+            return ""
+        shown = viewer.display.points(viewer.mesh.V)
+        idx = viewer._vertex_of(res.structure_data, res.position, shown, viewer.mesh.F)
+        if idx is None:
+            return ""
+        curv = viewer.curv
+        values = curv.fields.get(curv.field_name)
+        if values is None:
+            return f"vertex {idx}"
+        return f"vertex {idx}: {curv.field_name} = {float(values[idx]):.4g}"
 
     def draw(self, viewer: Viewer) -> None:
         ui = viewer.ui
@@ -131,6 +330,13 @@ class OneRingPanel:
         if ch:
             r.toggle_reverse(viewer.mesh, viewer.curv)
             self.push(viewer)
+        c = viewer.curv
+        ch1, area = ui.combo("area kind", c.area, AREA_KINDS, AREA_HELP)
+        ch2, rule = ui.combo("boundary rule", c.boundary, BOUNDARY_RULES, BOUNDARY_HELP)
+        if ch1 or ch2:
+            r.set_rules(viewer.mesh, c, area, rule)
+            viewer.push_curvature(force=True)
+            self.push(viewer)
         if r.vertex < 0:
             return
         kind = "boundary vertex (open fan)" if r.boundary else "interior vertex (closed cycle)"
@@ -139,3 +345,65 @@ class OneRingPanel:
         if not r.ordered:
             ui.error("not a disk: neighbours listed by index, not in order")
         ui.text("order: " + " -> ".join(str(j) for j in r.neighbors[:40]))
+        if r.inspection is None:
+            if r.inspection_error:
+                ui.error(r.inspection_error)
+            return
+        self.draw_inspection(viewer, r.inspection)
+
+    def draw_inspection(self, viewer: Viewer, ins: VertexInspection) -> None:
+        """The inspector's tables and formulas, and the legend of its 3D drawings."""
+        ui = viewer.ui
+        if not ins.manifold:
+            ui.error(f"non-manifold vertex: {len(ins.fans)} fans (faces of each, ring per fan)")
+            for k, fan in enumerate(ins.fans):
+                ui.text(f"  fan {k}: faces {', '.join(str(f) for f in fan)}")
+        self.draw_legend(viewer, ins)
+        if ui.header("weights per neighbour (ring order)"):
+            self.draw_neighbours(viewer, ins)
+        if ui.header("incident faces", default_open=False):
+            self.draw_faces(viewer, ins)
+        if ui.header("the vertex: formulas with numbers"):
+            lines = format_inspection(ins).splitlines()
+            start = next(k for k, line in enumerate(lines) if line.startswith("A_i"))
+            for line in lines[start:]:
+                ui.text(line.translate(ASCII_MATH))
+
+    def draw_legend(self, viewer: Viewer, ins: VertexInspection) -> None:
+        ui = viewer.ui
+        w = np.array([t.weight_cotan for t in ins.neighbors])
+        m = float(np.abs(w).max()) if len(w) else 0.0
+        ui.note(
+            f"edges i-j: w_ij on blue-white-red over [-{m:.3g}, {m:.3g}] (colour bar); "
+            f"arcs: corner angles at i (red: obtuse); green: {ins.area_kind} area cell "
+            f"A_i = {ins.area:.4g}"
+        )
+        if (w < 0).any():
+            ui.colored(f"magenta edges: negative w_ij ({int((w < 0).sum())})", NEGATIVE_RGBA)
+        if self.arrow_text:
+            ui.note(self.arrow_text)
+
+    def draw_neighbours(self, viewer: Viewer, ins: VertexInspection) -> None:
+        ui = viewer.ui
+        ui.note("j  |x_j - x_i|  alpha  beta  w_ij = 1/2(cot a + cot b)  1/|N|")
+        for t in viewer.ring.rows():
+            beta = "-" if t.beta is None else f"{math.degrees(t.beta):.2f}°"
+            row = (
+                f"{t.index}:  {t.edge_length:.4g}   {math.degrees(t.alpha):.2f}°  {beta}   "
+                f"w = {t.weight_cotan:.4g}   {t.weight_uniform:.4g}"
+            )
+            if t.negative:
+                ui.colored(row + "  < 0 (obtuse)", NEGATIVE_RGBA)
+            else:
+                ui.text(row)
+
+    def draw_faces(self, viewer: Viewer, ins: VertexInspection) -> None:
+        ui = viewer.ui
+        ui.note("face  theta_f  area  obtuse  A_f/3  Voronoi share (rule)")
+        for f in ins.faces:
+            rule = "A/2" if f.obtuse_at_vertex else ("A/4" if f.obtuse else "cot")
+            ui.text(
+                f"{f.face}:  {math.degrees(f.angle):.2f}°  {f.area:.4g}  "
+                f"{'obtuse' if f.obtuse else 'acute'}  {f.share_barycentric:.4g}  "
+                f"{f.share_voronoi:.4g} ({rule})"
+            )
