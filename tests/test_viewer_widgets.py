@@ -491,6 +491,9 @@ def test_every_widget_is_driven(viewer, tmp_path, sphere):
     test_help_widgets(viewer)
     test_shortcuts(viewer)
     test_click_and_drop(viewer, tmp_path, sphere)
+    from test_session import drive_session_widgets  # the Mesh panel's session widgets
+
+    drive_session_widgets(viewer, tmp_path)
     ui = viewer.ui
     undriven = sorted(set(ui.seen) - ui.driven)
     assert not undriven, f"widgets no test drives: {undriven}"
