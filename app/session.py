@@ -94,8 +94,9 @@ def save(viewer: Viewer, path: str | Path) -> Path:
     return write_session(path, session)
 
 
-def load(viewer: Viewer, path: str | Path) -> Session:
-    """Read ``path`` and apply it to the viewer; on any error nothing changes.
+def load(viewer: Viewer, path: str | Path, resize: bool = False) -> Session:
+    """Read ``path`` and apply it to the viewer (an open window keeps its size unless
+    ``resize``); on any error nothing changes.
 
     Raises
     ------
@@ -104,20 +105,28 @@ def load(viewer: Viewer, path: str | Path) -> Session:
         or its one-ring vertex does not exist on that mesh.
     """
     session = read_session(path)
-    apply(viewer, session, Path(path))
+    apply(viewer, session, Path(path), resize)
     return session
 
 
-def apply(viewer: Viewer, session: Session, source: str | Path = "session") -> None:
+def apply(
+    viewer: Viewer, session: Session, source: str | Path = "session", resize: bool = True
+) -> None:
     """Restore ``session`` in ``viewer``: mesh, settings, replayed smoothing, basis, camera.
 
-    Everything that can fail (the mesh file, the vertex index) is checked before the viewer
-    changes, so a refused session leaves the window as it was.
+    Everything that can fail (the mesh file, the vertex index, an eigen computation still
+    running) is checked before the viewer changes, so a refused session leaves the window as
+    it was. ``resize``: take the window size saved with the camera (headless renders and a
+    window being opened); ``False`` keeps the size of an open window.
 
     Long because it restores every panel in the order their dependencies need (mesh, then the
     fields, one-ring, surfaces, basis and smoothing run, then the panel and the camera).
     """
     st = session.settings
+    if viewer.panels["spectral"].state.busy:
+        raise MeshError(
+            "the eigenbasis is still being computed; load the session when it is done", source
+        )
     mesh = MeshState()
     if not mesh.load(session.mesh):
         raise MeshError(f"cannot open its mesh: {mesh.error}", source)
@@ -148,12 +157,15 @@ def apply(viewer: Viewer, session: Session, source: str | Path = "session") -> N
     _apply_spectral(viewer, st["spectral"])
     _apply_smoothing(viewer, st["smoothing"], session.panel == "smoothing")
     viewer.set_panel(session.panel)
-    viewer.push_curvature(force=True)
     viewer.frame()  # caption boxes and a sensible view when the file has no camera
     viewer.reframe = viewer.panels["smoothing"].new_copy = False  # keep the saved camera
-    viewer._window_size = tuple(ps.get_window_size())
     if session.camera is not None:
-        ps.set_view_from_json(json.dumps(session.camera))
+        camera = dict(session.camera)
+        if not resize:  # an open window keeps its size; the view matrix is restored
+            size = ps.get_window_size()
+            camera["windowWidth"], camera["windowHeight"] = int(size[0]), int(size[1])
+        ps.set_view_from_json(json.dumps(camera))
+    viewer._window_size = tuple(ps.get_window_size())  # no re-frame for the (new) size
 
 
 def _apply_spectral(viewer: Viewer, sp: dict[str, Any]) -> None:

@@ -9,6 +9,7 @@ import os
 import subprocess
 import sys
 import tempfile
+import threading
 
 import numpy as np
 import pytest
@@ -359,6 +360,45 @@ def test_load_restores_every_setting_the_run_and_the_camera(mock, tmp_path, sphe
     assert not fresh.reframe  # the saved camera is kept, not re-framed
 
 
+def test_window_size_of_the_camera_and_a_busy_worker(mock, tmp_path, sphere, monkeypatch):
+    from meshlap_app import session
+
+    monkeypatch.setenv("MESHLAP_CACHE_DIR", str(tmp_path / "cache"))
+    viewer = new_viewer(sphere)
+    ps.look_at((2.0, 1.0, 2.0), (0.0, 0.0, 0.0))
+    tick(viewer)
+    saved = session.capture(viewer)
+    saved.camera["windowWidth"], saved.camera["windowHeight"] = 800, 600
+    path = write_session(tmp_path / "s.json", saved)
+    ps.set_window_size(1280, 720)
+    ps.look_at((0.0, 0.0, 5.0), (0.0, 0.0, 0.0))
+    tick(viewer)
+    session.load(viewer, path)  # the window's load button: the window keeps its size
+    tick(viewer)
+    assert tuple(ps.get_window_size()) == (1280, 720)
+    view = session.capture(viewer).camera["viewMat"]
+    np.testing.assert_allclose(view, saved.camera["viewMat"], atol=1e-6)
+    session.load(viewer, path, resize=True)  # `meshlap view --session`: the saved size
+    tick(viewer)
+    assert tuple(ps.get_window_size()) == (800, 600)
+    np.testing.assert_allclose(view, saved.camera["viewMat"], atol=1e-6)
+    ps.set_window_size(1280, 720)
+    # while the eigen worker runs, a session is refused and nothing changes
+    spec = viewer.panels["spectral"].state
+    done = threading.Event()
+    spec._thread = threading.Thread(target=done.wait, args=(60,))
+    spec._thread.start()
+    viewer.busy_frame_s = 0.0
+    tick(viewer)  # the re-frame for the new window size happens first
+    before = session.capture(viewer)
+    tick(viewer, "session file", str(path))
+    tick(viewer, "load session", True)
+    assert "still being computed" in viewer.errors["mesh"]
+    assert session.capture(viewer) == before
+    done.set()
+    spec._thread.join()
+
+
 # ---------------------------------------------------------------- real pixels (EGL)
 def _egl_available() -> bool:
     code = "import polyscope as ps; ps.set_allow_headless_backends(True); ps.init('openGL3_egl')"
@@ -393,11 +433,26 @@ sm.configure(mesh.V, mesh.F, noise_alpha=0.01, seed=3)
 for _ in range(4):
     sm.step()
 viewer.panels["smoothing"].push(force=True)
-viewer.set_panel(sys.argv[2])
+if sys.argv[2] == "spectral":
+    spec = viewer.panels["spectral"]
+    spec.state.k_request = 40
+    spec.state.start(mesh.V, mesh.F, background=False)
+    spec.state.set_mode(6)
+    spec.state.set_k(12)
+    spec.push_mode(viewer, force=True)
+    spec.push_k(viewer, force=True)
+if sys.argv[2] == "onering":
+    viewer.ring.reverse = True
+    viewer.select_vertex(123)
+if sys.argv[2] == "surfaces":
+    viewer.surf.set_surface("torus", 40)
+    viewer.surf.set_uv(1.0, 2.0)
 viewer.push_curvature(force=True)
+viewer.set_panel(sys.argv[2])
 ps.set_user_callback(viewer.callback)
 ps.frame_tick()
-ps.look_at((0.6, 1.6, 3.2), (0.2, 0.0, 0.0))
+far = 3.0 if sys.argv[2] == "surfaces" else 1.0  # the torus is larger than the mesh
+ps.look_at((0.6 * far, 1.6 * far, 3.2 * far), (0.2, 0.0, 0.0))
 ps.frame_tick()
 ps.frame_tick()
 scene.save_screenshot(Path(sys.argv[3]))
@@ -406,7 +461,7 @@ session.save(viewer, Path(sys.argv[4]))
 
 
 @pytest.mark.egl
-@pytest.mark.parametrize("panel", ["curvature", "smoothing"])
+@pytest.mark.parametrize("panel", ["curvature", "onering", "spectral", "smoothing", "surfaces"])
 def test_render_of_a_loaded_session_equals_the_render_when_saved(tmp_path, panel):
     if not _egl_available():
         pytest.skip("polyscope's EGL backend cannot start on this machine (no EGL/Mesa)")
