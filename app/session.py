@@ -110,14 +110,19 @@ def load(viewer: Viewer, path: str | Path, resize: bool = False) -> Session:
 
 
 def apply(
-    viewer: Viewer, session: Session, source: str | Path = "session", resize: bool = True
+    viewer: Viewer,
+    session: Session,
+    source: str | Path = "session",
+    resize: bool = True,
+    mesh: MeshState | None = None,
 ) -> None:
     """Restore ``session`` in ``viewer``: mesh, settings, replayed smoothing, basis, camera.
 
     Everything that can fail (the mesh file, the vertex index, an eigen computation still
     running) is checked before the viewer changes, so a refused session leaves the window as
     it was. ``resize``: take the window size saved with the camera (headless renders and a
-    window being opened); ``False`` keeps the size of an open window.
+    window being opened); ``False`` keeps the size of an open window. ``mesh``: the session's
+    mesh already loaded (``meshlap view --session`` loads it before the window opens).
 
     Long because it restores every panel in the order their dependencies need (mesh, then the
     fields, one-ring, surfaces, basis and smoothing run, then the panel and the camera).
@@ -127,17 +132,18 @@ def apply(
         raise MeshError(
             "the eigenbasis is still being computed; load the session when it is done", source
         )
-    mesh = MeshState()
-    if not mesh.load(session.mesh):
-        raise MeshError(f"cannot open its mesh: {mesh.error}", source)
+    if mesh is None:
+        mesh = MeshState()
+        if not mesh.load(session.mesh):
+            raise MeshError(f"cannot open its mesh: {mesh.error}", source)
     check_vertex(session, len(mesh.V), source)
     vertex = st["onering"]["vertex"]
-    # the new mesh goes into the viewer's MeshState (same object, bumped version)
     old = viewer.mesh
-    for name in ("V", "F", "name", "info", "path"):
-        setattr(old, name, getattr(mesh, name))
-    old.error = ""
-    old.version += 1
+    if mesh is not old:  # the new mesh goes into the viewer's MeshState (bumped version)
+        for name in ("V", "F", "name", "info", "path"):
+            setattr(old, name, getattr(mesh, name))
+        old.error = ""
+        old.version += 1
     if old.path is not None:
         viewer.panels["mesh"].remember(old.path)
     viewer.panels["help"].set_scale(viewer, session.ui_scale)

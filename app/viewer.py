@@ -206,7 +206,8 @@ class Viewer:
                 self.reframe = True
 
     def files_dropped(self, paths: list[str]) -> None:
-        """polyscope's drag-and-drop callback: open the first file dropped on the window.
+        """polyscope's drag-and-drop callback: open the first file dropped on the window (a
+        ``.json`` file is loaded as a saved session).
 
         Runs outside the imgui frame, so it draws nothing: a failure is kept for the Mesh panel
         (``mesh.error``, or ``errors["mesh"]`` for an internal error) and never raised.
@@ -214,7 +215,15 @@ class Viewer:
         if not paths:
             return
         try:
-            self.open(Path(paths[0]))
+            if Path(paths[0]).suffix.lower() == ".json":  # a saved session
+                from .session import load
+
+                load(self, paths[0])
+                self.errors.pop("mesh", None)
+            else:
+                self.open(Path(paths[0]))
+        except MeshError as exc:  # a refused session: said in the Mesh panel, nothing changes
+            self.errors["mesh"] = str(exc)
         except Exception as exc:  # a callback from C++ must not raise
             self.errors["mesh"] = self._internal_error("mesh", exc)
 
@@ -483,7 +492,7 @@ def run(
     if saved is not None:
         from .session import apply
 
-        apply(viewer, saved, session)
+        apply(viewer, saved, session, mesh=mesh)
     elif panel == "onering":
         viewer.select_vertex(vertex if vertex is not None else 0)
     if saved is None and k is None and shot is not None and panel == "spectral":

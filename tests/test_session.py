@@ -399,6 +399,23 @@ def test_window_size_of_the_camera_and_a_busy_worker(mock, tmp_path, sphere, mon
     spec._thread.join()
 
 
+def test_dropping_a_session_file_loads_it(mock, tmp_path, sphere, monkeypatch):
+    from meshlap_app import session
+
+    monkeypatch.setenv("MESHLAP_CACHE_DIR", str(tmp_path / "cache"))
+    viewer = new_viewer(sphere)
+    s = Session(mesh=sphere, panel="surfaces")
+    s.settings["surfaces"].update(surface="torus", u=0.5)
+    write_session(tmp_path / "drop.json", s)
+    (tmp_path / "bad.json").write_text("{")
+    viewer.files_dropped([str(tmp_path / "bad.json")])
+    assert "bad.json: not JSON" in viewer.errors["mesh"] and viewer.panel == "curvature"
+    viewer.files_dropped([str(tmp_path / "drop.json")])
+    tick(viewer)
+    assert viewer.panel == "surfaces" and viewer.surf.name == "torus" and viewer.surf.u == 0.5
+    assert session.capture(viewer).settings == s.settings and "mesh" not in viewer.errors
+
+
 # ---------------------------------------------------------------- real pixels (EGL)
 def _egl_available() -> bool:
     code = "import polyscope as ps; ps.set_allow_headless_backends(True); ps.init('openGL3_egl')"
