@@ -206,3 +206,38 @@ def _apply_smoothing(viewer: Viewer, sm: dict[str, Any], shown: bool) -> None:
         if not state.step():
             break  # a diverging run stops where it stopped when it was saved
     panel.push(force=True)
+
+
+class SessionWidgets:
+    """The *session file* field and the *save session* / *load session* buttons (drawn in the
+    Help and window section; a refused file is shown in red there and nothing changes)."""
+
+    def __init__(self) -> None:
+        self.text = ""  # the session file (relative: in the export folder)
+        self.status = ""
+
+    def draw(self, viewer: Viewer) -> None:
+        ui = viewer.ui
+        _, self.text = ui.input_text(
+            "session file",
+            self.text,
+            "a .json file: mesh, every panel's settings, UI scale and camera "
+            "(relative: in the export folder; empty: <mesh>.session.json there)",
+        )
+        save_it = ui.button("save session", "write the current view to the session file")
+        ui.same_line()
+        load_it = ui.button("load session", "restore the mesh, settings and camera of the file")
+        if save_it or load_it:
+            self.status = ""
+            text = self.text.strip() or f"{Path(viewer.mesh.name).stem}.session.json"
+            path = Path(text).expanduser()
+            if not path.is_absolute():
+                path = viewer.panels["export"].folder / path
+            if save_it:
+                self.text = str(save(viewer, path))
+                self.status = f"saved {self.text}"
+            else:
+                load(viewer, path)
+                self.status = f"loaded {path}"
+        if self.status:
+            ui.note(self.status)

@@ -252,8 +252,10 @@ def new_viewer(path):
 
 
 def tick(viewer, label=None, value=None):
+    """One frame; ``label`` (a widget of the Help and window section, opened) gets ``value``."""
     if label is not None:
         viewer.ui.script(label, value)
+        viewer.ui.script("Help and window (H)", True)
     ps.frame_tick()
     assert not viewer.ui.pending()
     internal = {k: m for k, m in viewer.errors.items() if "internal error" in m}
@@ -261,8 +263,8 @@ def tick(viewer, label=None, value=None):
 
 
 def drive_session_widgets(viewer, tmp_path) -> None:
-    """Drive the Mesh panel's session widgets with good and bad values (also run by the
-    every-widget tour of ``test_viewer_widgets.py``)."""
+    """Drive the session widgets (Help and window section) with good and bad values; the
+    every-widget tour of ``test_viewer_widgets.py`` runs this too."""
     from meshlap_app import session
 
     tick(viewer)
@@ -270,21 +272,21 @@ def drive_session_widgets(viewer, tmp_path) -> None:
     before = session.capture(viewer)
     tick(viewer, "session file", str(tmp_path / "no-such-folder" / "s.json"))
     tick(viewer, "save session", True)
-    assert "does not exist" in viewer.errors["mesh"]
+    assert "does not exist" in viewer.errors["help"]
     tick(viewer, "session file", "")  # empty: <mesh>.session.json in the export folder
     tick(viewer, "save session", True)
     saved = viewer.panels["export"].folder / f"{viewer.mesh.path.stem}.session.json"
-    assert saved.is_file() and viewer.panels["mesh"].session_text == str(saved.resolve())
-    assert "mesh" not in viewer.errors
+    assert saved.is_file() and viewer.panels["help"].session.text == str(saved.resolve())
+    assert "help" not in viewer.errors
     for bad in ("{", '{"format": "meshlap-session", "version": 3}', "[]"):
         (tmp_path / "bad.json").write_text(bad)
         tick(viewer, "session file", str(tmp_path / "bad.json"))
         tick(viewer, "load session", True)
-        assert str(tmp_path / "bad.json") in viewer.errors["mesh"]  # red, in the Mesh panel
+        assert str(tmp_path / "bad.json") in viewer.errors["help"]  # red, in that section
         assert session.capture(viewer) == before  # nothing changed
     tick(viewer, "session file", str(saved))
     tick(viewer, "load session", True)
-    assert "mesh" not in viewer.errors and session.capture(viewer).settings == before.settings
+    assert "help" not in viewer.errors and session.capture(viewer).settings == before.settings
 
 
 def test_session_widgets_save_and_load(mock, tmp_path, sphere, monkeypatch):
@@ -292,7 +294,7 @@ def test_session_widgets_save_and_load(mock, tmp_path, sphere, monkeypatch):
     viewer = new_viewer(sphere)
     drive_session_widgets(viewer, tmp_path)
     ui = viewer.ui
-    mine = {("mesh", "session file"), ("mesh", "save session"), ("mesh", "load session")}
+    mine = {("help", "session file"), ("help", "save session"), ("help", "load session")}
     assert mine <= set(ui.seen) and mine <= ui.driven and mine <= set(ui.tooltips)
 
 
@@ -393,7 +395,7 @@ def test_window_size_of_the_camera_and_a_busy_worker(mock, tmp_path, sphere, mon
     before = session.capture(viewer)
     tick(viewer, "session file", str(path))
     tick(viewer, "load session", True)
-    assert "still being computed" in viewer.errors["mesh"]
+    assert "still being computed" in viewer.errors["help"]
     assert session.capture(viewer) == before
     done.set()
     spec._thread.join()

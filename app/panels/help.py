@@ -24,13 +24,16 @@ SHORTCUTS = (
 
 
 class HelpPanel(NoStructures):
-    """Shortcut list, a toggle for polyscope's own panels, the UI scale."""
+    """Shortcut list, a toggle for polyscope's own panels, the UI scale, saved sessions."""
 
     def __init__(self, ui_scale: float = 1.0) -> None:
         self.open: bool | None = None  # H toggles: force the header open / closed once
         self.shown = False
         self.polyscope_panels = False
         self.ui_scale = ui_scale
+        from ..session import SessionWidgets
+
+        self.session = SessionWidgets()  # save / load a session (app/session.py)
 
     def toggle(self) -> None:
         self.shown = not self.shown
@@ -58,6 +61,7 @@ class HelpPanel(NoStructures):
         )
         if ch:
             self.set_scale(viewer, scale)
+        self.session.draw(viewer)
 
     def set_scale(self, viewer: Viewer, scale: float) -> None:
         """UI scale in [0.5, 3] (MeshError for a non-finite value)."""

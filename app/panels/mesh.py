@@ -20,8 +20,6 @@ class MeshPanel(NoStructures):
         self.path_text = ""
         self.recent: list[Path] = []  # the last meshes opened, newest first
         self._listed: tuple[float, list[tuple[str, Path]]] = (-1e9, [])
-        self.session_text = ""  # the session file (relative: in the export folder)
-        self.session_status = ""
 
     def draw(self, viewer: Viewer) -> None:
         ui = viewer.ui
@@ -64,36 +62,6 @@ class MeshPanel(NoStructures):
             viewer.open(choices[picked])
         if mesh.error:
             ui.error(mesh.error)
-        self.draw_session(viewer)
-
-    def draw_session(self, viewer: Viewer) -> None:
-        """The session file field and the *save session* / *load session* buttons."""
-        from .. import session
-
-        ui = viewer.ui
-        _, self.session_text = ui.input_text(
-            "session file",
-            self.session_text,
-            "a .json file: mesh, every panel's settings, UI scale and camera "
-            "(relative: in the export folder; empty: <mesh>.session.json there)",
-        )
-        save = ui.button("save session", "write the current view to the session file")
-        ui.same_line()
-        load = ui.button("load session", "restore the mesh, settings and camera of the file")
-        if save or load:
-            self.session_status = ""
-            text = self.session_text.strip() or f"{Path(viewer.mesh.name).stem}.session.json"
-            path = Path(text).expanduser()
-            if not path.is_absolute():
-                path = viewer.panels["export"].folder / path
-            if save:
-                self.session_text = str(session.save(viewer, path))
-                self.session_status = f"saved {self.session_text}"
-            else:
-                session.load(viewer, path)
-                self.session_status = f"loaded {path}"
-        if self.session_status:
-            ui.note(self.session_status)
 
     def remember(self, path: Path) -> None:
         """Put ``path`` first in the recent-files list (at most 8)."""
