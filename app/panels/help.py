@@ -45,6 +45,7 @@ class HelpPanel(NoStructures):
         self.open = None
         if not self.shown:
             return
+        self.session.draw(viewer)  # first: the lecture's prepared view, one click away
         for key, what in SHORTCUTS:
             ui.text(f"{key:>12}  {what}")
         ch, on = ui.checkbox(
@@ -61,7 +62,6 @@ class HelpPanel(NoStructures):
         )
         if ch:
             self.set_scale(viewer, scale)
-        self.session.draw(viewer)
 
     def set_scale(self, viewer: Viewer, scale: float) -> None:
         """UI scale in [0.5, 3] (MeshError for a non-finite value)."""
