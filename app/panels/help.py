@@ -19,7 +19,7 @@ SHORTCUTS = (
     ("R", "reset (smoothing run, or the camera)"),
     ("H", "this help"),
     ("mouse", "left-drag rotate, right-drag pan, wheel zoom; click a vertex for its one-ring"),
-    ("drop", "drop a mesh file on the window to open it"),
+    ("drop", "drop a mesh file (or a session .json) on the window to open it"),
 )
 
 
