@@ -206,7 +206,8 @@ class Viewer:
                 self.reframe = True
 
     def files_dropped(self, paths: list[str]) -> None:
-        """polyscope's drag-and-drop callback: open the first file dropped on the window.
+        """polyscope's drag-and-drop callback: open the first file dropped on the window (a
+        ``.json`` file is loaded as a saved session).
 
         Runs outside the imgui frame, so it draws nothing: a failure is kept for the Mesh panel
         (``mesh.error``, or ``errors["mesh"]`` for an internal error) and never raised.
@@ -214,7 +215,15 @@ class Viewer:
         if not paths:
             return
         try:
-            self.open(Path(paths[0]))
+            if Path(paths[0]).suffix.lower() == ".json":  # a saved session
+                from .session import load
+
+                load(self, paths[0])
+                self.errors.pop("mesh", None)
+            else:
+                self.open(Path(paths[0]))
+        except MeshError as exc:  # a refused session: said in the Mesh panel, nothing changes
+            self.errors["mesh"] = str(exc)
         except Exception as exc:  # a callback from C++ must not raise
             self.errors["mesh"] = self._internal_error("mesh", exc)
 
@@ -436,12 +445,19 @@ def run(
     k: int | None = None,
     backend: str | None = None,
     ui_scale: float = 1.0,
+    session: str | Path | None = None,
 ) -> int:
     """Open the viewer on ``path`` (the bundled default mesh when ``None``).
 
     With ``screenshot`` a single frame is rendered headless (EGL) into that PNG and the
-    function returns.
+    function returns. With ``session`` (a saved session file) its mesh, settings and camera
+    replace ``path``, ``field``, ``panel``, ``vertex``, ``k`` and ``ui_scale``.
     """
+    from .state.session import check_vertex, read_session
+
+    saved = read_session(session) if session is not None else None  # refused before a window
+    if saved is not None:
+        path, panel = saved.mesh, saved.panel
     cwd = Path.cwd()  # before polyscope.init(), which may change it: the export folder
     path = Path(path).resolve() if path is not None else None
     shot = Path(screenshot).resolve() if screenshot is not None else None
@@ -456,6 +472,8 @@ def run(
     mesh = MeshState()
     if not mesh.load(path):
         raise MeshError(mesh.error)
+    if saved is not None:
+        check_vertex(saved, len(mesh.V), session)
     if vertex is not None and not 0 <= vertex < len(mesh.V):
         raise MeshError(
             f"vertex {vertex} is out of range (the mesh has {len(mesh.V)} vertices)", "--vertex"
@@ -471,18 +489,23 @@ def run(
     viewer.sync_mesh()
     if shot is not None:
         ps.set_window_size(1600, 900)
-    if panel == "onering":
+    if saved is not None:
+        from .session import apply
+
+        apply(viewer, saved, session, mesh=mesh)
+    elif panel == "onering":
         viewer.select_vertex(vertex if vertex is not None else 0)
-    if k is None and shot is not None and panel == "spectral":
+    if saved is None and k is None and shot is not None and panel == "spectral":
         k = SCREENSHOT_K  # a spectral screenshot shows a reconstruction, not an empty panel
     if k is not None:
         viewer.panels["spectral"].prepare_screenshot(viewer, k)
-    if panel == "smoothing":
+    if saved is None and panel == "smoothing":
         viewer.panels["smoothing"].prepare_screenshot(viewer)
     ps.set_user_callback(viewer.callback)
     ps.set_files_dropped_callback(viewer.files_dropped)
     if shot is not None:
-        viewer.frame()
+        if saved is None:  # a session brings its own camera
+            viewer.frame()
         ps.frame_tick()
         ps.frame_tick()  # ImPlot fits its axes on the second frame
         scene.save_screenshot(shot)

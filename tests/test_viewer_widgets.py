@@ -495,6 +495,10 @@ def test_every_widget_is_driven(viewer, tmp_path, sphere):
     from test_viewer_inspector import drive_inspector  # the inspector's widgets
 
     drive_inspector(viewer)
+
+    from test_session import drive_session_widgets  # the session widgets (Help and window)
+
+    drive_session_widgets(viewer, tmp_path)
     ui = viewer.ui
     undriven = sorted(set(ui.seen) - ui.driven)
     assert not undriven, f"widgets no test drives: {undriven}"

@@ -19,18 +19,21 @@ SHORTCUTS = (
     ("R", "reset (smoothing run, or the camera)"),
     ("H", "this help"),
     ("mouse", "left-drag rotate, right-drag pan, wheel zoom; click a vertex for its one-ring"),
-    ("drop", "drop a mesh file on the window to open it"),
+    ("drop", "drop a mesh file (or a session .json) on the window to open it"),
 )
 
 
 class HelpPanel(NoStructures):
-    """Shortcut list, a toggle for polyscope's own panels, the UI scale."""
+    """Shortcut list, a toggle for polyscope's own panels, the UI scale, saved sessions."""
 
     def __init__(self, ui_scale: float = 1.0) -> None:
         self.open: bool | None = None  # H toggles: force the header open / closed once
         self.shown = False
         self.polyscope_panels = False
         self.ui_scale = ui_scale
+        from ..session import SessionWidgets
+
+        self.session = SessionWidgets()  # save / load a session (app/session.py)
 
     def toggle(self) -> None:
         self.shown = not self.shown
@@ -42,6 +45,7 @@ class HelpPanel(NoStructures):
         self.open = None
         if not self.shown:
             return
+        self.session.draw(viewer)  # first: the lecture's prepared view, one click away
         for key, what in SHORTCUTS:
             ui.text(f"{key:>12}  {what}")
         ch, on = ui.checkbox(

@@ -48,6 +48,7 @@ class MeshState:
     info: dict[str, Any] = field(default_factory=dict)
     error: str = ""
     version: int = 0  # bumped on every successful load, so panels know to recompute
+    path: Path | None = None  # the file loaded (resolved); None for the generated default
 
     def load(self, path: str | Path | None) -> bool:
         """Load ``path`` (the bundled default when ``None``). Returns success."""
@@ -70,6 +71,8 @@ class MeshState:
             self.error = f"{path}: {exc.strerror or exc}"
             return False
         self.V, self.F, self.name = mesh.V, mesh.F, name
+        source = path if path is not None else default_mesh_path()
+        self.path = Path(source).resolve() if source is not None else None
         self.info = mesh_info(mesh.V, mesh.F, mesh.report, str(path) if path else name)
         self.error = ""
         self.version += 1

@@ -17,20 +17,36 @@ def register(sub: argparse._SubParsersAction) -> None:
         metavar="OUT.png",
         help="render one frame headless (EGL) into OUT.png and exit",
     )
-    p.add_argument("--field", choices=FIELDS, default="cotan", help="curvature field shown first")
-    p.add_argument("--panel", choices=PANELS, default="curvature", help="panel shown first")
+    p.add_argument(
+        "--session",
+        metavar="FILE.json",
+        help="reopen a saved session (mesh, panel settings, camera); replaces MESH and the "
+        "options below",
+    )
+    p.add_argument("--field", choices=FIELDS, help="curvature field shown first (default cotan)")
+    p.add_argument("--panel", choices=PANELS, help="panel shown first (default curvature)")
     p.add_argument("--vertex", type=int, help="one-ring panel: the selected vertex")
     p.add_argument("--k", type=int, help="spectral panel: reconstruct from k eigenvectors")
     p.add_argument(
         "--ui-scale",
         type=float,
-        default=1.0,
         help="size of the panel's text and widgets, 0.5 to 3 (projectors: 1.5-2)",
     )
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.session is not None:
+        given = [("MESH", args.mesh)] + [
+            (f"--{name.replace('_', '-')}", getattr(args, name))
+            for name in ("field", "panel", "vertex", "k", "ui_scale")
+        ]
+        given = [flag for flag, value in given if value is not None]
+        if given:
+            raise MeshError(
+                f"{', '.join(given)} cannot be combined with --session (the session sets them)",
+                "--session",
+            )
     if args.k is not None and args.k < 1:
         raise MeshError(f"must be at least 1, got {args.k}", "--k")
     if args.screenshot is not None:
@@ -41,7 +57,7 @@ def run(args: argparse.Namespace) -> int:
         # complete new one (the viewer writes it atomically)
         check_output_path(
             args.screenshot,
-            overwrite_inputs=[args.mesh] if args.mesh else [],
+            overwrite_inputs=[p for p in (args.mesh, args.session) if p],
             suffixes=(".png",),
         )
     # a bad mesh fails in meshlap_app.viewer.run before any window or EGL context is created
@@ -50,9 +66,10 @@ def run(args: argparse.Namespace) -> int:
     return run_viewer(
         args.mesh,
         screenshot=args.screenshot,
-        field=args.field,
-        panel=args.panel,
+        field=args.field or "cotan",
+        panel=args.panel or "curvature",
         vertex=args.vertex,
         k=args.k,
-        ui_scale=args.ui_scale,
+        ui_scale=1.0 if args.ui_scale is None else args.ui_scale,
+        session=args.session,
     )

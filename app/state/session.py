@@ -1,0 +1,300 @@
+"""Saved sessions: the viewer's settings as a versioned JSON file (no polyscope import).
+
+A session file is one JSON object::
+
+    {"format": "meshlap-session", "version": 1, "meshlap": "0.1.0",
+     "mesh": "bumpy.obj", "panel": "smoothing", "ui_scale": 1.0, "camera": {...},
+     "curvature": {"field": "cotan", "area": "barycentric", "boundary": "pi", "clip": 2.0,
+                   "side_by_side": false, "second_field": "uniform"},
+     "onering": {"vertex": -1, "reverse": false},
+     "spectral": {"computed": false, "k_request": 100, "k": 10, "mode": 1},
+     "smoothing": {"method": "implicit", "laplacian": "uniform", "lam": 0.5,
+                   "noise_alpha": 0.0, "seed": 0, "iterations": 0},
+     "surfaces": {"surface": "helicoid", "res": 48, "u": 0.0, "v": 0.0}}
+
+``camera`` is polyscope's ``get_view_as_json()`` parsed (or ``null``). A relative ``mesh`` is
+resolved against the session file's folder; ``null`` means the bundled default mesh. Missing
+keys take the defaults below; unknown keys, wrong types, values out of range, a newer
+``version`` or a missing mesh are a :class:`MeshError` naming the file and the problem.
+
+This module only maps a :class:`Session` to and from a dict and a file; the viewer
+(:mod:`meshlap_app.session`) captures one from its panels and applies one to them.
+"""
+
+from __future__ import annotations
+
+import copy
+import json
+import math
+import os
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from meshlap_core import __version__
+from meshlap_core.errors import MeshError
+from meshlap_core.io import atomic_write, check_output_path
+from meshlap_core.options import AREA_KINDS, BOUNDARY_RULES, LAPLACIAN_KINDS
+from meshlap_core.surfaces import SURFACES
+
+from .names import FIELDS, PANELS
+from .surface import MAX_RES
+
+FORMAT = "meshlap-session"
+VERSION = 1
+"""The session format this meshlap writes and the newest it reads."""
+
+Check = Callable[[Any], str | None]  # returns what is wrong with a value, or None
+
+
+def _one_of(choices: tuple[str, ...]) -> Check:
+    def check(x: Any) -> str | None:
+        if not isinstance(x, str):
+            return f"must be a string, got {type(x).__name__}"
+        return None if x in choices else f"must be one of {', '.join(choices)}, got {x!r}"
+
+    return check
+
+
+def _boolean(x: Any) -> str | None:
+    return None if isinstance(x, bool) else f"must be true or false, got {json.dumps(x)}"
+
+
+def _integer(lo: int, hi: int | None = None) -> Check:
+    def check(x: Any) -> str | None:
+        if not isinstance(x, int) or isinstance(x, bool):
+            return f"must be an integer, got {json.dumps(x)}"
+        if x < lo or (hi is not None and x > hi):
+            top = f" and <= {hi}" if hi is not None else ""
+            return f"must be >= {lo}{top}, got {x}"
+        return None
+
+    return check
+
+
+def _number(lo: float = -math.inf, hi: float = math.inf, positive: bool = False) -> Check:
+    def check(x: Any) -> str | None:
+        if not isinstance(x, int | float) or isinstance(x, bool) or not math.isfinite(x):
+            return f"must be a finite number, got {json.dumps(x)}"
+        if positive and not x > 0:
+            return f"must be > 0, got {x}"
+        if not lo <= x <= hi:
+            return f"must be between {lo:g} and {hi:g}, got {x}"
+        return None
+
+    return check
+
+
+# section -> key -> (default, check). The defaults are the viewer's own start values.
+SCHEMA: dict[str, dict[str, tuple[Any, Check]]] = {
+    "curvature": {
+        "field": ("cotan", _one_of(FIELDS)),
+        "area": ("barycentric", _one_of(AREA_KINDS)),
+        "boundary": ("pi", _one_of(BOUNDARY_RULES)),
+        "clip": (2.0, _number(0.0, 49.0)),
+        "side_by_side": (False, _boolean),
+        "second_field": ("uniform", _one_of(FIELDS)),
+    },
+    "onering": {"vertex": (-1, _integer(-1)), "reverse": (False, _boolean)},
+    "spectral": {
+        "computed": (False, _boolean),
+        "k_request": (100, _integer(2)),
+        "k": (10, _integer(1)),
+        "mode": (1, _integer(0)),
+    },
+    "smoothing": {
+        "method": ("implicit", _one_of(("explicit", "implicit", "taubin"))),
+        "laplacian": ("uniform", _one_of(LAPLACIAN_KINDS)),
+        "lam": (0.5, _number(positive=True)),
+        "noise_alpha": (0.0, _number(0.0)),
+        "seed": (0, _integer(0)),
+        "iterations": (0, _integer(0, 100_000)),
+    },
+    "surfaces": {
+        "surface": ("helicoid", _one_of(tuple(SURFACES))),
+        "res": (48, _integer(1, MAX_RES)),
+        "u": (0.0, _number()),
+        "v": (0.0, _number()),
+    },
+}
+TOP_LEVEL = ("format", "version", "meshlap", "mesh", "panel", "ui_scale", "camera", *SCHEMA)
+
+
+def default_settings() -> dict[str, dict[str, Any]]:
+    """Every section's settings at the viewer's defaults."""
+    return {sec: {k: d for k, (d, _) in keys.items()} for sec, keys in SCHEMA.items()}
+
+
+@dataclass
+class Session:
+    """What a session file holds, validated.
+
+    ``mesh`` is an absolute path (``None``: the bundled default mesh); ``settings`` maps each
+    section of :data:`SCHEMA` to its values; ``camera`` is polyscope's view JSON as a dict.
+    """
+
+    mesh: Path | None = None
+    panel: str = "curvature"
+    ui_scale: float = 1.0
+    camera: dict[str, Any] | None = None
+    settings: dict[str, dict[str, Any]] = field(default_factory=default_settings)
+
+    def to_dict(self, folder: Path | None = None) -> dict[str, Any]:
+        """The JSON object of this session; the mesh path is written relative to ``folder``
+        when the mesh lies inside it (so a folder of session + mesh can be moved)."""
+        mesh: str | None = None
+        if self.mesh is not None:
+            mesh = str(self.mesh)
+            if folder is not None:
+                try:
+                    mesh = Path(self.mesh).resolve().relative_to(folder.resolve()).as_posix()
+                except ValueError:
+                    pass  # outside the folder: keep the absolute path
+        return {
+            "format": FORMAT,
+            "version": VERSION,
+            "meshlap": __version__,
+            "mesh": mesh,
+            "panel": self.panel,
+            "ui_scale": self.ui_scale,
+            "camera": copy.deepcopy(self.camera),
+            **copy.deepcopy(self.settings),
+        }
+
+
+def from_dict(
+    data: Any, source: str | os.PathLike = "session", folder: Path | None = None
+) -> Session:
+    """Validate a session object and return the :class:`Session`.
+
+    Parameters
+    ----------
+    data : object
+        The parsed JSON.
+    source : str or PathLike
+        Named in every error (the session file).
+    folder : Path, optional
+        A relative mesh path is resolved against it (the session file's folder).
+
+    Raises
+    ------
+    MeshError
+        Not an object, another format, a newer version, an unknown key, a wrong type or value
+        (named as ``section.key``), or a mesh file that does not exist.
+    """
+    if not isinstance(data, dict):
+        raise MeshError(f"a session must be a JSON object, got {type(data).__name__}", source)
+    if data.get("format") != FORMAT:
+        raise MeshError(f'not a meshlap session ("format" must be "{FORMAT}")', source)
+    version = data.get("version")
+    if not isinstance(version, int) or isinstance(version, bool) or version < 1:
+        raise MeshError(f'"version" must be an integer >= 1, got {json.dumps(version)}', source)
+    if version > VERSION:
+        raise MeshError(
+            f"written by a newer meshlap ({data.get('meshlap', '?')}, session version {version}); "
+            f"this meshlap {__version__} reads session version {VERSION}: update meshlap",
+            source,
+        )
+    unknown = sorted(set(data) - set(TOP_LEVEL))
+    if unknown:
+        raise MeshError(f"unknown key(s) {', '.join(map(repr, unknown))}", source)
+    session = Session(mesh=_mesh_path(data.get("mesh"), source, folder))
+    session.panel = _checked(data, "panel", "curvature", _one_of(PANELS), source)
+    session.ui_scale = float(_checked(data, "ui_scale", 1.0, _number(0.5, 3.0), source))
+    camera = data.get("camera")
+    if camera is not None and not isinstance(camera, dict):
+        raise MeshError(f'"camera" must be an object or null, got {json.dumps(camera)}', source)
+    session.camera = camera
+    for sec, keys in SCHEMA.items():
+        values = data.get(sec, {})
+        if not isinstance(values, dict):
+            raise MeshError(f'"{sec}" must be an object, got {json.dumps(values)}', source)
+        unknown = sorted(set(values) - set(keys))
+        if unknown:
+            raise MeshError(f"unknown key(s) in {sec!r}: {', '.join(map(repr, unknown))}", source)
+        for key, (default, check) in keys.items():
+            session.settings[sec][key] = _checked(values, key, default, check, source, sec)
+    return session
+
+
+def _checked(
+    values: dict[str, Any], key: str, default: Any, check: Check, source: Any, sec: str = ""
+) -> Any:
+    value = values.get(key, default)
+    problem = check(value)
+    if problem:
+        raise MeshError(f'"{sec + "." if sec else ""}{key}" {problem}', source)
+    return float(value) if isinstance(default, float) else value
+
+
+def _mesh_path(mesh: Any, source: str | os.PathLike, folder: Path | None) -> Path | None:
+    if mesh is None:
+        return None
+    if not isinstance(mesh, str) or not mesh.strip():
+        raise MeshError(f'"mesh" must be a file name or null, got {json.dumps(mesh)}', source)
+    path = Path(mesh).expanduser()
+    if not path.is_absolute() and folder is not None:
+        path = folder / path
+    if not path.is_file():
+        raise MeshError(f"the mesh {mesh!r} does not exist (looked for {path})", source)
+    return path.resolve()
+
+
+def check_vertex(session: Session, n_vertices: int, source: str | os.PathLike) -> None:
+    """Refuse a one-ring vertex that the session's mesh does not have.
+
+    Raises
+    ------
+    MeshError
+        ``onering.vertex >= n_vertices`` (named with the mesh's vertex count).
+    """
+    vertex = session.settings["onering"]["vertex"]
+    if vertex >= n_vertices:
+        raise MeshError(
+            f'"onering.vertex" {vertex} is out of range (the mesh has {n_vertices} vertices)',
+            source,
+        )
+
+
+def read_session(path: str | os.PathLike) -> Session:
+    """Read and validate a session file.
+
+    Raises
+    ------
+    MeshError
+        The file cannot be read, is not JSON (line and column given), or :func:`from_dict`
+        refuses it; the message starts with the file name.
+    """
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError:
+        raise MeshError("not a session file (not UTF-8 text)", path) from None
+    except OSError as exc:
+        raise MeshError(f"cannot read the session: {exc.strerror or exc}", path) from None
+    try:
+        data = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise MeshError(
+            f"not JSON ({exc.msg} at line {exc.lineno}, column {exc.colno})", path
+        ) from None
+    return from_dict(data, path, path.resolve().parent)
+
+
+def write_session(path: str | os.PathLike, session: Session) -> Path:
+    """Write ``session`` to ``path`` atomically (indented JSON). Returns the resolved path.
+
+    Raises
+    ------
+    MeshError
+        The folder does not exist, the path is a directory, does not end in ``.json``, or is
+        the session's mesh; or a value that :func:`from_dict` would refuse.
+    """
+    inputs = [session.mesh] if session.mesh is not None else []
+    target = check_output_path(path, overwrite_inputs=inputs, suffixes=(".json",)).resolve()
+    from_dict(session.to_dict(), target)  # write only what reads back (no NaN, no bad value)
+    text = json.dumps(session.to_dict(target.parent), indent=2, allow_nan=False)
+    with atomic_write(target, overwrite_inputs=inputs) as f:
+        f.write(text + "\n")
+    return target

@@ -1,0 +1,522 @@
+"""Saved sessions: the state <-> JSON mapping (headless), bad files, the window's *save session* /
+*load session* widgets on polyscope's openGL_mock backend, ``meshlap view --session`` errors, and
+(EGL) the render of a reloaded session against the render taken when it was saved."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import threading
+
+import numpy as np
+import pytest
+from meshlap_app.state.session import (
+    SCHEMA,
+    VERSION,
+    Session,
+    default_settings,
+    from_dict,
+    read_session,
+    write_session,
+)
+
+from meshlap_core import __version__, primitives
+from meshlap_core.cli import main
+from meshlap_core.errors import MeshError
+from meshlap_core.io import save_mesh
+
+
+@pytest.fixture
+def sphere(tmp_path):
+    path = tmp_path / "sphere.obj"
+    save_mesh(path, *primitives.icosphere(2))
+    return path
+
+
+def non_default_session(mesh) -> Session:
+    """A session whose every field differs from the default."""
+    s = Session(mesh=mesh.resolve(), panel="smoothing", ui_scale=1.75)
+    s.camera = {"fov": 40.0, "viewMat": [float(i) for i in range(16)], "upDir": "Y Up"}
+    s.settings = {
+        "curvature": {
+            "field": "gaussian",
+            "area": "voronoi",
+            "boundary": "2pi",
+            "clip": 7.5,
+            "side_by_side": True,
+            "second_field": "k1",
+        },
+        "onering": {"vertex": 17, "reverse": True},
+        "spectral": {"computed": True, "k_request": 24, "k": 9, "mode": 4},
+        "smoothing": {
+            "method": "taubin",
+            "laplacian": "cotan",
+            "lam": 0.25,
+            "noise_alpha": 0.01,
+            "seed": 7,
+            "iterations": 5,
+        },
+        "surfaces": {"surface": "torus", "res": 30, "u": 1.25, "v": -0.5},
+    }
+    return s
+
+
+# ---------------------------------------------------------------- the mapping, headless
+def test_every_field_differs_from_its_default_and_round_trips(tmp_path, sphere):
+    s = non_default_session(sphere)
+    defaults = default_settings()
+    for sec, keys in SCHEMA.items():
+        assert set(s.settings[sec]) == set(keys)  # the test covers every field
+        for key in keys:
+            assert s.settings[sec][key] != defaults[sec][key], f"{sec}.{key}"
+    out = write_session(tmp_path / "lecture.json", s)
+    data = json.loads(out.read_text())
+    assert data["format"] == "meshlap-session" and data["version"] == VERSION == 1
+    assert data["meshlap"] == __version__
+    assert data["mesh"] == "sphere.obj"  # inside the session's folder: written relative
+    back = read_session(out)
+    assert back == s
+    assert from_dict(s.to_dict(), "x") == s  # absolute path without a folder
+
+
+def test_relative_mesh_resolves_against_the_session_folder(tmp_path, sphere, monkeypatch):
+    sub = tmp_path / "slides"
+    sub.mkdir()
+    out = write_session(sub / "s.json", Session(mesh=sphere))
+    assert json.loads(out.read_text())["mesh"] == str(sphere.resolve())  # outside: absolute
+    data = Session().to_dict()
+    data["mesh"] = "../sphere.obj"
+    (sub / "rel.json").write_text(json.dumps(data))
+    monkeypatch.chdir(tmp_path.parent)  # the working directory does not matter
+    assert read_session(sub / "rel.json").mesh == sphere.resolve()
+
+
+def test_missing_keys_take_the_defaults(tmp_path):
+    path = tmp_path / "min.json"
+    path.write_text('{"format": "meshlap-session", "version": 1, "smoothing": {"seed": 3}}')
+    s = read_session(path)
+    assert s.mesh is None and s.panel == "curvature" and s.camera is None
+    expected = default_settings()
+    expected["smoothing"]["seed"] = 3
+    assert s.settings == expected
+
+
+BAD = [
+    ("{not json", "not JSON"),
+    ("[1, 2]", "must be a JSON object"),
+    ('"text"', "must be a JSON object"),
+    ('{"format": "other", "version": 1}', "not a meshlap session"),
+    ('{"format": "meshlap-session"}', '"version" must be an integer'),
+    ('{"format": "meshlap-session", "version": "1"}', '"version" must be an integer'),
+    ('{"format": "meshlap-session", "version": 2, "meshlap": "9.0"}', "newer meshlap (9.0"),
+    ('{"format": "meshlap-session", "version": 1, "colour": 1}', "unknown key(s) 'colour'"),
+    ('{"format": "meshlap-session", "version": 1, "mesh": "gone.obj"}', "does not exist"),
+    ('{"format": "meshlap-session", "version": 1, "mesh": 5}', '"mesh" must be a file name'),
+    ('{"format": "meshlap-session", "version": 1, "panel": "nope"}', '"panel" must be one of'),
+    ('{"format": "meshlap-session", "version": 1, "ui_scale": 9}', '"ui_scale" must be between'),
+    ('{"format": "meshlap-session", "version": 1, "camera": [1]}', '"camera" must be an object'),
+    ('{"format": "meshlap-session", "version": 1, "spectral": 3}', '"spectral" must be an object'),
+    ('{"format": "meshlap-session", "version": 1, "onering": {"x": 1}}', "unknown key(s) in"),
+]
+WRONG_VALUES = [
+    ("curvature", "field", "mean"),
+    ("curvature", "area", 3),
+    ("curvature", "clip", "5"),
+    ("curvature", "clip", 60.0),
+    ("curvature", "side_by_side", 1),
+    ("onering", "vertex", -2),
+    ("onering", "vertex", 1.5),
+    ("spectral", "computed", "yes"),
+    ("spectral", "k_request", 1),
+    ("spectral", "k", True),
+    ("smoothing", "lam", 0),
+    ("smoothing", "lam", -1.0),
+    ("smoothing", "lam", None),
+    ("smoothing", "noise_alpha", -0.1),
+    ("smoothing", "seed", -1),
+    ("smoothing", "iterations", 10**9),
+    ("surfaces", "surface", "klein"),
+    ("surfaces", "res", 0),
+    ("surfaces", "u", "nan"),
+]
+
+
+@pytest.mark.parametrize("text, message", BAD)
+def test_bad_files_are_a_clear_mesh_error(tmp_path, text, message):
+    path = tmp_path / "bad.json"
+    path.write_text(text)
+    with pytest.raises(MeshError) as exc:
+        read_session(path)
+    assert str(exc.value).startswith(str(path)) and message in str(exc.value)
+
+
+@pytest.mark.parametrize("section, key, value", WRONG_VALUES)
+def test_wrong_types_and_values_name_the_field(tmp_path, section, key, value):
+    data = Session().to_dict()
+    data[section][key] = value
+    path = tmp_path / "bad.json"
+    path.write_text(json.dumps(data))
+    with pytest.raises(MeshError, match=rf'bad.json: "{section}.{key}" must'):
+        read_session(path)
+
+
+def test_unreadable_files_and_bad_output_paths(tmp_path, sphere):
+    with pytest.raises(MeshError, match="cannot read the session"):
+        read_session(tmp_path / "missing.json")
+    (tmp_path / "bin.json").write_bytes(b"\xff\xfe\x00")
+    with pytest.raises(MeshError, match="not UTF-8"):
+        read_session(tmp_path / "bin.json")
+    with pytest.raises(MeshError, match="does not exist"):
+        write_session(tmp_path / "no" / "s.json", Session())
+    with pytest.raises(MeshError, match="unsupported output type"):
+        write_session(tmp_path / "s.txt", Session())
+    with pytest.raises(MeshError, match="overwrite an input"):
+        write_session(sphere, Session(mesh=sphere))
+    with pytest.raises(MeshError):
+        write_session(tmp_path / "sphere.json", Session(mesh=sphere, ui_scale=float("nan")))
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bin.json", "sphere.obj"]
+
+
+def test_the_mapping_module_imports_no_polyscope():
+    code = (
+        "import sys, meshlap_app.state.session\n"
+        "assert 'polyscope' not in sys.modules, 'polyscope imported'\n"
+    )
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert res.returncode == 0, res.stderr
+
+
+# ---------------------------------------------------------------- the CLI
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["--session", "{dir}/missing.json"], "cannot read the session"),
+        (["--session", "{dir}/bad.json"], "not JSON"),
+        (["--session", "{dir}/newer.json"], "newer meshlap"),
+        (["--session", "{dir}/nomesh.json"], "does not exist"),
+        (["--session", "{dir}/vertex.json"], '"onering.vertex" 100000 is out of range'),
+        (["{dir}/sphere.obj", "--session", "{dir}/ok.json"], "MESH cannot be combined"),
+        (["--session", "{dir}/ok.json", "--panel", "spectral"], "--panel cannot be combined"),
+    ],
+)
+def test_cli_refuses_bad_sessions_in_one_line(tmp_path, sphere, capsys, args, message):
+    (tmp_path / "bad.json").write_text("{")
+    (tmp_path / "newer.json").write_text('{"format": "meshlap-session", "version": 7}')
+    (tmp_path / "nomesh.json").write_text(
+        '{"format": "meshlap-session", "version": 1, "mesh": "gone.ply"}'
+    )
+    vertex = Session(mesh=sphere)
+    vertex.settings["onering"]["vertex"] = 100_000
+    write_session(tmp_path / "vertex.json", vertex)
+    write_session(tmp_path / "ok.json", Session(mesh=sphere))
+    code = main(["view", *(a.format(dir=tmp_path) for a in args)])
+    err = capsys.readouterr().err
+    assert code == 2
+    assert err.count("\n") == 1 and err.startswith("meshlap: error: ") and message in err
+
+
+# ---------------------------------------------------------------- the window (openGL_mock)
+ps = pytest.importorskip("polyscope")
+
+
+@pytest.fixture(scope="module")
+def mock(tmp_path_factory):
+    old = os.getcwd()
+    os.chdir(tmp_path_factory.mktemp("polyscope"))  # polyscope writes .ini files here
+    ps.set_allow_headless_backends(True)
+    ps.init("openGL_mock")
+    ps.set_max_fps(-1)
+    ps.set_frame_tick_limit_fps_mode("ignore_limits")
+    yield ps
+    ps.clear_user_callback()
+    ps.remove_all_structures()
+    os.chdir(old)
+
+
+def new_viewer(path):
+    from meshlap_app.state import CurvatureState, MeshState
+    from meshlap_app.ui import UI
+    from meshlap_app.viewer import Viewer
+
+    ps.remove_all_structures()
+    mesh = MeshState()
+    assert mesh.load(path)
+    v = Viewer(mesh, CurvatureState(), ui=UI(), export_dir=path.parent)
+    v.sync_mesh()
+    ps.set_user_callback(v.callback)
+    ps.frame_tick()
+    return v
+
+
+def tick(viewer, label=None, value=None):
+    """One frame; ``label`` (a widget of the Help and window section, opened) gets ``value``."""
+    if label is not None:
+        viewer.ui.script(label, value)
+        viewer.ui.script("Help and window (H)", True)
+    ps.frame_tick()
+    assert not viewer.ui.pending()
+    internal = {k: m for k, m in viewer.errors.items() if "internal error" in m}
+    assert not internal, internal
+
+
+def drive_session_widgets(viewer, tmp_path) -> None:
+    """Drive the session widgets (Help and window section) with good and bad values; the
+    every-widget tour of ``test_viewer_widgets.py`` runs this too."""
+    from meshlap_app import session
+
+    tick(viewer)
+    tick(viewer)  # a pending re-frame happens first
+    before = session.capture(viewer)
+    tick(viewer, "session file", str(tmp_path / "no-such-folder" / "s.json"))
+    tick(viewer, "save session", True)
+    assert "does not exist" in viewer.errors["help"]
+    tick(viewer, "session file", "")  # empty: <mesh>.session.json in the export folder
+    tick(viewer, "save session", True)
+    saved = viewer.panels["export"].folder / f"{viewer.mesh.path.stem}.session.json"
+    assert saved.is_file() and viewer.panels["help"].session.text == str(saved.resolve())
+    assert "help" not in viewer.errors
+    for bad in ("{", '{"format": "meshlap-session", "version": 3}', "[]"):
+        (tmp_path / "bad.json").write_text(bad)
+        tick(viewer, "session file", str(tmp_path / "bad.json"))
+        tick(viewer, "load session", True)
+        assert str(tmp_path / "bad.json") in viewer.errors["help"]  # red, in that section
+        assert session.capture(viewer) == before  # nothing changed
+    tick(viewer, "session file", str(saved))
+    tick(viewer, "load session", True)
+    assert "help" not in viewer.errors and session.capture(viewer).settings == before.settings
+
+
+def test_session_widgets_save_and_load(mock, tmp_path, sphere, monkeypatch):
+    monkeypatch.setenv("MESHLAP_CACHE_DIR", str(tmp_path / "cache"))
+    viewer = new_viewer(sphere)
+    drive_session_widgets(viewer, tmp_path)
+    ui = viewer.ui
+    mine = {("help", "session file"), ("help", "save session"), ("help", "load session")}
+    assert mine <= set(ui.seen) and mine <= ui.driven and mine <= set(ui.tooltips)
+
+
+def set_up_everything(viewer) -> None:
+    """Change every panel's settings away from the defaults, as a teacher would."""
+    from meshlap_app.panels.help import HelpPanel
+
+    assert isinstance(viewer.panels["help"], HelpPanel)
+    viewer.panels["help"].set_scale(viewer, 1.25)
+    c = viewer.curv
+    c.field_name, c.area, c.boundary = "k2", "voronoi", "2pi"
+    c.set_percentile(4.5)
+    viewer.panels["curvature"].side_by_side = True
+    viewer.panels["curvature"].second_field = "gaussian"
+    viewer.push_curvature(force=True)
+    viewer.ring.reverse = True
+    viewer.select_vertex(11)
+    viewer.surf.set_surface("torus", 20)
+    viewer.surf.set_uv(0.7, 1.1)
+    spec = viewer.panels["spectral"]
+    spec.state.k_request = 16
+    spec.state.start(viewer.mesh.V, viewer.mesh.F, background=False)
+    spec.state.set_mode(5)
+    spec.state.set_k(7)
+    sm = viewer.panels["smoothing"]
+    sm.state.configure(viewer.mesh.V, viewer.mesh.F, method="explicit", laplacian="cotan")
+    sm.state.configure(viewer.mesh.V, viewer.mesh.F, noise_alpha=0.02, seed=4)
+    sm.state.set_lam(0.001)
+    for _ in range(6):
+        assert sm.state.step()
+    viewer.set_panel("smoothing")
+    tick(viewer)
+    ps.look_at((1.0, 2.0, 3.0), (0.0, 0.0, 0.0))
+    tick(viewer)
+
+
+def test_load_restores_every_setting_the_run_and_the_camera(mock, tmp_path, sphere, monkeypatch):
+    from meshlap_app import session
+
+    monkeypatch.setenv("MESHLAP_CACHE_DIR", str(tmp_path / "cache"))
+    viewer = new_viewer(sphere)
+    set_up_everything(viewer)
+    saved = session.capture(viewer)
+    assert saved.camera is not None and saved.settings["smoothing"]["iterations"] == 6
+    V_run = viewer.panels["smoothing"].state.V.copy()
+    path = session.save(viewer, tmp_path / "lecture.json")
+
+    other = tmp_path / "other.obj"
+    save_mesh(other, *primitives.icosphere(1))
+    fresh = new_viewer(other)  # a new window on another mesh, every setting at its default
+    assert session.capture(fresh) != saved
+    session.load(fresh, path)
+    tick(fresh)
+    tick(fresh)
+    back = session.capture(fresh)
+    assert back.mesh == saved.mesh and back.panel == saved.panel == "smoothing"
+    assert back.settings == saved.settings and back.ui_scale == 1.25
+    np.testing.assert_allclose(back.camera["viewMat"], saved.camera["viewMat"], atol=1e-6)
+    # the run is replayed: same seed, same noise, same six steps, same positions
+    np.testing.assert_array_equal(fresh.panels["smoothing"].state.V, V_run)
+    spec = fresh.panels["spectral"].state
+    assert spec.basis.info.from_cache and (spec.k, spec.mode, spec.basis.k_max) == (7, 5, 16)
+    assert fresh.ring.vertex == 11 and fresh.ring.reverse
+    assert ps.has_surface_mesh("mesh (second estimator)")
+    assert not fresh.reframe  # the saved camera is kept, not re-framed
+
+
+def test_window_size_of_the_camera_and_a_busy_worker(mock, tmp_path, sphere, monkeypatch):
+    from meshlap_app import session
+
+    monkeypatch.setenv("MESHLAP_CACHE_DIR", str(tmp_path / "cache"))
+    viewer = new_viewer(sphere)
+    ps.look_at((2.0, 1.0, 2.0), (0.0, 0.0, 0.0))
+    tick(viewer)
+    saved = session.capture(viewer)
+    saved.camera["windowWidth"], saved.camera["windowHeight"] = 800, 600
+    path = write_session(tmp_path / "s.json", saved)
+    ps.set_window_size(1280, 720)
+    ps.look_at((0.0, 0.0, 5.0), (0.0, 0.0, 0.0))
+    tick(viewer)
+    session.load(viewer, path)  # the window's load button: the window keeps its size
+    tick(viewer)
+    assert tuple(ps.get_window_size()) == (1280, 720)
+    view = session.capture(viewer).camera["viewMat"]
+    np.testing.assert_allclose(view, saved.camera["viewMat"], atol=1e-6)
+    session.load(viewer, path, resize=True)  # `meshlap view --session`: the saved size
+    tick(viewer)
+    assert tuple(ps.get_window_size()) == (800, 600)
+    np.testing.assert_allclose(view, saved.camera["viewMat"], atol=1e-6)
+    ps.set_window_size(1280, 720)
+    # while the eigen worker runs, a session is refused and nothing changes
+    spec = viewer.panels["spectral"].state
+    done = threading.Event()
+    spec._thread = threading.Thread(target=done.wait, args=(60,))
+    spec._thread.start()
+    viewer.busy_frame_s = 0.0
+    tick(viewer)  # the re-frame for the new window size happens first
+    before = session.capture(viewer)
+    tick(viewer, "session file", str(path))
+    tick(viewer, "load session", True)
+    assert "still being computed" in viewer.errors["help"]
+    assert session.capture(viewer) == before
+    done.set()
+    spec._thread.join()
+
+
+def test_dropping_a_session_file_loads_it(mock, tmp_path, sphere, monkeypatch):
+    from meshlap_app import session
+
+    monkeypatch.setenv("MESHLAP_CACHE_DIR", str(tmp_path / "cache"))
+    viewer = new_viewer(sphere)
+    s = Session(mesh=sphere, panel="surfaces")
+    s.settings["surfaces"].update(surface="torus", u=0.5)
+    write_session(tmp_path / "drop.json", s)
+    (tmp_path / "bad.json").write_text("{")
+    viewer.files_dropped([str(tmp_path / "bad.json")])
+    assert "bad.json: not JSON" in viewer.errors["mesh"] and viewer.panel == "curvature"
+    viewer.files_dropped([str(tmp_path / "drop.json")])
+    tick(viewer)
+    assert viewer.panel == "surfaces" and viewer.surf.name == "torus" and viewer.surf.u == 0.5
+    assert session.capture(viewer).settings == s.settings and "mesh" not in viewer.errors
+
+
+# ---------------------------------------------------------------- real pixels (EGL)
+def _egl_available() -> bool:
+    code = "import polyscope as ps; ps.set_allow_headless_backends(True); ps.init('openGL3_egl')"
+    try:
+        with tempfile.TemporaryDirectory() as tmp:  # polyscope writes .ini files into the cwd
+            res = subprocess.run(
+                [sys.executable, "-c", code], capture_output=True, timeout=120, cwd=tmp
+            )
+    except subprocess.TimeoutExpired:
+        return False
+    return res.returncode == 0
+
+
+SAVE_SCRIPT = """
+import sys
+from pathlib import Path
+import polyscope as ps
+from meshlap_app import scene, session
+from meshlap_app.state import CurvatureState, MeshState
+from meshlap_app.viewer import Viewer, init_polyscope
+
+mesh = MeshState(); assert mesh.load(Path(sys.argv[1]))
+init_polyscope("openGL3_egl")
+viewer = Viewer(mesh, CurvatureState(field_name="gaussian"), panel=sys.argv[2])
+ps.set_build_default_gui_panels(False)
+viewer.sync_mesh()
+ps.set_window_size(1600, 900)
+viewer.curv.set_percentile(6.0)
+viewer.panels["curvature"].side_by_side = sys.argv[2] == "curvature"
+sm = viewer.panels["smoothing"].state
+sm.configure(mesh.V, mesh.F, noise_alpha=0.01, seed=3)
+for _ in range(4):
+    sm.step()
+viewer.panels["smoothing"].push(force=True)
+if sys.argv[2] == "spectral":
+    spec = viewer.panels["spectral"]
+    spec.state.k_request = 40
+    spec.state.start(mesh.V, mesh.F, background=False)
+    spec.state.set_mode(6)
+    spec.state.set_k(12)
+    spec.push_mode(viewer, force=True)
+    spec.push_k(viewer, force=True)
+if sys.argv[2] == "onering":
+    viewer.ring.reverse = True
+    viewer.select_vertex(123)
+if sys.argv[2] == "surfaces":
+    viewer.surf.set_surface("torus", 40)
+    viewer.surf.set_uv(1.0, 2.0)
+viewer.push_curvature(force=True)
+viewer.set_panel(sys.argv[2])
+ps.set_user_callback(viewer.callback)
+ps.frame_tick()
+far = 3.0 if sys.argv[2] == "surfaces" else 1.0  # the torus is larger than the mesh
+ps.look_at((0.6 * far, 1.6 * far, 3.2 * far), (0.2, 0.0, 0.0))
+ps.frame_tick()
+ps.frame_tick()
+scene.save_screenshot(Path(sys.argv[3]))
+session.save(viewer, Path(sys.argv[4]))
+"""
+
+
+@pytest.mark.egl
+@pytest.mark.parametrize("panel", ["curvature", "onering", "spectral", "smoothing", "surfaces"])
+def test_render_of_a_loaded_session_equals_the_render_when_saved(tmp_path, panel):
+    if not _egl_available():
+        pytest.skip("polyscope's EGL backend cannot start on this machine (no EGL/Mesa)")
+    import matplotlib.image as mpimg
+    from meshlap_app.state.mesh import default_mesh_path
+
+    env = {**os.environ, "MESHLAP_CACHE_DIR": str(tmp_path / "cache")}
+    saved_png, session_json, loaded_png = (
+        tmp_path / "saved.png",
+        tmp_path / "s.json",
+        tmp_path / "loaded.png",
+    )
+    args = [str(default_mesh_path()), panel, str(saved_png), str(session_json)]
+    res = subprocess.run(
+        [sys.executable, "-c", SAVE_SCRIPT, *args],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        cwd=tmp_path,
+        env=env,
+    )
+    assert res.returncode == 0, res.stderr
+    cmd = [sys.executable, "-m", "meshlap_core.cli", "view", "--session", str(session_json)]
+    res = subprocess.run(
+        [*cmd, "--screenshot", str(loaded_png)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        cwd=tmp_path,
+        env=env,
+    )
+    assert res.returncode == 0, res.stderr
+    a = mpimg.imread(saved_png)[..., :3]
+    b = mpimg.imread(loaded_png)[..., :3]
+    assert a.shape == b.shape
+    scene_part = np.abs(a - a[0, 0]).sum(axis=2) > 0.05
+    assert scene_part.mean() > 0.05  # something is drawn
+    differs = np.abs(a - b).max(axis=2) > 2 / 255  # pixel tolerance: 2 levels of 255
+    assert differs.mean() < 0.002, f"{differs.mean():.4%} of the pixels differ"
