@@ -51,7 +51,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--session",
         metavar="FILE.json",
-        help="animate a saved viewer session (needs `meshlap view --session`; not yet available)",
+        help="a saved viewer session (not available yet: use `meshlap view --session`)",
     )
     p.set_defaults(func=run)
 
@@ -92,9 +92,13 @@ def _check_numbers(args: argparse.Namespace) -> None:
 
 def run(args: argparse.Namespace) -> int:
     if args.session is not None:
-        # hook for saved sessions (issue 15, part 2): a session fixes the mesh, panel, settings
-        # and camera; until `meshlap view --session` exists, say so instead of guessing
-        raise MeshError("animating a saved session is not available yet", "--session")
+        # a session fixes the mesh, panel, settings and camera (meshlap_app.session.apply);
+        # the frame generators do not yet start from a restored viewer, so say so, not guess
+        raise MeshError(
+            "animating a saved session is not available yet; open it with "
+            "`meshlap view --session` and use the record button",
+            "--session",
+        )
     k = parse_range(args.k, "--k", lo=1) if args.k is not None else None
     modes = parse_range(args.modes, "--modes", lo=0) if args.modes is not None else None
     _check_numbers(args)
