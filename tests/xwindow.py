@@ -91,7 +91,7 @@ def write_png(path: Path, rgb: np.ndarray) -> None:
     png = (
         b"\x89PNG\r\n\x1a\n"
         + chunk(b"IHDR", ihdr)
-        + chunk(b"IDAT", zlib.compress(rows.tobytes(), 9))
+        + chunk(b"IDAT", zlib.compress(rows.tobytes(), 6))
         + chunk(b"IEND", b"")
     )
     tmp = path.with_suffix(path.suffix + ".part")
