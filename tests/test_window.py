@@ -160,7 +160,7 @@ class Session:
         def same(img: np.ndarray) -> bool:  # no change over 3 screenshots ~0.2 s apart
             calm[0] = calm[0] + 1 if changed_fraction(prev[0], img, box) < STILL else 0
             prev[0] = img
-            time.sleep(0.1)
+            time.sleep(0.05)
             return calm[0] >= 2
 
         return self.until(same, timeout, "steady picture")
