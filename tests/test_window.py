@@ -1,20 +1,28 @@
 """The viewer in a real window: ``meshlap view`` under Xvfb, driven with xdotool like a user.
 
-A scripted tour (open the mesh list and pick a mesh, every panel, type λ, drag k, click a vertex,
-play/pause, export) runs at 1280×720 and 1920×1080, then a seeded "monkey" clicks, drags and
-types at random. After every step the test takes a screenshot (``xwd``, decoded and written as
-PNG by :mod:`tests.xwindow`) and checks that the process is alive and that its stderr holds
-nothing but polyscope's own ``[polyscope]`` lines.
+One viewer per window size (1280×720 on the default mesh, 1920×1080 on ``assets/torus.obj``)
+serves two tests, in this order:
 
-A step that kills the viewer is recorded with the viewer's stderr, the viewer is started again,
-and the tour goes on, so one run reports every failing step; the test fails at the end with the
-list. Widgets are found on each screenshot by colour and layout (:mod:`tests.imgui_screen`); the
-order of widgets inside each section of meshlap's panel is stated once, in the step functions
-below.
+- ``test_scripted_tour``: pick a mesh from the list, then every panel through its shortcut
+  (1–5) with its widgets (curvature field and side by side, click a vertex and type one, compute
+  the eigenbasis and drag k, type λ and press Enter, space to play and to pause, a surface and
+  its u slider), export what is shown, the Help pane (H). After each step the test checks what
+  a user sees on a screenshot: the subject left of meshlap's panel and not running behind it,
+  the second mesh (side by side, reconstruction, smoothed copy) beside it, λ applied on Enter
+  and not before, the export message, and that the process is alive with nothing on stderr
+  but polyscope's own ``[polyscope]`` lines. A failing step is recorded (the viewer is
+  restarted if it died) and the tour goes on, so one run reports every failing step.
+- ``test_monkey``: seeded random clicks, drags and keys anywhere for ``MESHLAP_MONKEY_SECONDS``
+  (20 s); the viewer survives.
 
-Set ``MESHLAP_WINDOW_SHOTS=<folder>`` to keep the screenshots (the default-size panel pictures
-in ``docs/img/window/`` come from there); ``MESHLAP_MONKEY_SECONDS`` sets the monkey's time per
-size (30 s).
+Widgets are found on each screenshot by colour and layout (:mod:`tests.imgui_screen`); the order
+of widgets inside each panel is stated once, in the step functions below. Every wait is for a
+visible outcome and bounded (a loaded machine draws few frames per second; a timeout fails with
+what was awaited). The mouse rests in the scene's bottom-left corner between actions, so no
+tooltip covers a widget on a screenshot.
+
+Set ``MESHLAP_WINDOW_SHOTS=<folder>`` to keep the screenshots (``docs/img/window/`` holds the
+1280×720 ones).
 """
 
 from __future__ import annotations
@@ -24,19 +32,28 @@ import shutil
 import struct
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import numpy as np
 import pytest
-from imgui_screen import Layout, changed_fraction, parse, popup_lines, subject_point
+from imgui_screen import (
+    Layout,
+    behind_panel,
+    changed_fraction,
+    parse,
+    popup_lines,
+    subject_point,
+    subjects,
+)
 from xwindow import App, XServer, missing_tools, read_png, read_xwd, write_png
 
 ROOT = Path(__file__).resolve().parents[1]
-PANELS = ("curvature", "onering", "spectral", "smoothing", "surfaces")  # the "view" combo
 SIZES = ((1280, 720), (1920, 1080))
 SECOND_MESH = ROOT / "assets" / "torus.obj"
-SETTLE = 0.35  # seconds for the viewer to draw a frame after an input event
+MESH_LIST = ("bumpy.obj", "cube.obj", "grid.obj", "icosphere.obj", "torus.obj")  # assets/, sorted
+TITLE = "meshlap — "  # the window title: meshlap — <file>
+STILL = 3e-5  # fraction of changed pixels that is no change (a blinking text cursor)
 
 
 def meshlap_command() -> list[str]:
@@ -48,16 +65,6 @@ def meshlap_command() -> list[str]:
             pytest.skip("the `meshlap` console script is not installed (pip install -e .)")
         exe = Path(found)
     return [str(exe), "view"]
-
-
-@pytest.fixture(scope="module")
-def x_tools() -> None:
-    missing = missing_tools()
-    if missing:
-        pytest.skip(
-            f"real-window tests need {', '.join(missing)} (apt-get install xvfb xdotool "
-            "x11-apps; .ci/run installs them)"
-        )
 
 
 def foreign_lines(text: str) -> list[str]:
@@ -76,7 +83,7 @@ class Session:
         self.shots.mkdir(parents=True, exist_ok=True)
         self.failures: list[str] = []
         self.n_shot = 0
-        self.img: np.ndarray | None = None
+        self.img = np.zeros((size[1], size[0], 3), dtype=np.uint8)
         self.start()
 
     # -------------------------------------------------------------- process
@@ -84,32 +91,28 @@ class Session:
         home = self.tmp / f"run{len(list(self.tmp.glob('run*')))}"
         home.mkdir()
         argv = meshlap_command() + ([str(self.mesh)] if self.mesh is not None else [])
-        self.app = App(self.x, argv, cwd=home).start()
-        self.panel = "curvature"
+        self.app = App(self.x, argv, cwd=home).start(title="meshlap")
+        self.panel = 1  # the curvature panel
         w, h = self.size
         self.x.xdotool("windowmove", self.app.window, "0", "0")
         self.x.xdotool("windowsize", self.app.window, str(w), str(h))
-        deadline = time.monotonic() + 60
-        while True:  # until the panel is drawn at the new size
-            time.sleep(0.5)
+        self.park()
+
+        def ready(img: np.ndarray) -> bool:  # the panel drawn at the new size, a mesh framed
             try:
-                layout = self.layout()
-                if len(layout.sections) >= 2 and layout.right >= w - 40:
-                    return
+                layout = parse(img)
             except LookupError:
-                pass
-            if time.monotonic() > deadline or not self.app.alive():
-                raise RuntimeError(f"the viewer did not show its panel: {self.app.stderr()}")
+                return False
+            return (
+                layout.right >= w - 40 and len(layout.sections) >= 3 and bool(subjects(img, layout))
+            )
+
+        self.until(ready, 60, "the viewer's panel and mesh at the window's size")
 
     def close(self) -> None:
         if self.app is not None:
             self.app.stop()
         self.x.stop()
-
-    @property
-    def cwd(self) -> Path:
-        assert self.app is not None
-        return self.app.cwd
 
     def problem(self) -> str | None:
         """Why the viewer is not fine (dead, or stderr beyond polyscope's lines), else None."""
@@ -135,72 +138,64 @@ class Session:
     def layout(self) -> Layout:
         return parse(self.screenshot())
 
-    def scene_box(self, layout: Layout) -> tuple[int, int, int, int]:
-        """The part of the window left of meshlap's panel (where the subject is drawn)."""
-        return int(0.25 * self.size[0]), 0, layout.left, self.size[1]
-
-    def hidden(self, before: np.ndarray) -> str:
-        """Say whether a change the scene did not show happened behind meshlap's panel."""
-        img = self.screenshot()
-        layout = parse(img)
-        box = (layout.left, layout.top, layout.right, layout.bottom)
-        panel = changed_fraction(before, img, box)
-        return (
-            f"left of the panel (behind meshlap's panel {100 * panel:.1f}% of its pixels "
-            "changed: the subject is hidden by the panel)"
-            if panel > 0.002
-            else "(nor anywhere in the window)"
-        )
-
-    # -------------------------------------------------------------- input
-    def click(self, xy: tuple[int, int]) -> None:
-        x, y = (str(int(v)) for v in xy)
-        self.x.xdotool("mousemove", x, y)
-        time.sleep(0.12)  # the hover frame first: ImGui acts on a press over a hovered item
-        self.x.xdotool("click", "1")
-        time.sleep(SETTLE)
-
-    def drag(
-        self, a: tuple[int, int], b: tuple[int, int], steps: int = 8, pause: float = 1.5
-    ) -> None:
-        self.x.xdotool("mousemove", str(a[0]), str(a[1]))
-        time.sleep(0.12)
-        self.x.xdotool("mousedown", "1")
-        time.sleep(pause)
-        for t in np.linspace(0, 1, steps + 1)[1:]:
-            x, y = (round(p + t * (q - p)) for p, q in zip(a, b, strict=True))
-            time.sleep(0.1)
-            self.x.xdotool("mousemove", str(x), str(y))
-        # a release in the same frame as the last moves ends the drag before ImGui reads
-        # the new position: let the viewer draw a frame with the button still down
-        time.sleep(pause)
-        self.x.xdotool("mouseup", "1")
-        time.sleep(SETTLE)
-
-    def type_into(self, xy: tuple[int, int], text: str) -> None:
-        """Click a text field, select all, type ``text`` key by key, press Enter."""
-        self.click(xy)
-        time.sleep(1.0)  # the field becomes active on the next frame
-        self.x.xdotool("key", "ctrl+a")
-        time.sleep(0.5)
-        self.x.xdotool("type", "--delay", "150", text)
-        time.sleep(1.0)
-        self.x.xdotool("key", "Return")
-        time.sleep(1.0)
-
-    def until(self, test: Callable[[np.ndarray], bool], timeout: float = 15.0) -> np.ndarray | None:
-        """Screenshots until ``test(img)`` holds; the last one, or None on timeout/death.
-
-        The viewer may draw only a few frames per second on a loaded machine, so every wait
-        is for a visible outcome, not a fixed time."""
+    def until(self, test: Callable[[np.ndarray], bool], timeout: float, what: str) -> np.ndarray:
+        """Screenshots until ``test(img)`` holds (returns that one); AssertionError naming
+        ``what`` after ``timeout`` seconds or when the viewer died."""
         deadline = time.monotonic() + timeout
         while True:
             img = self.screenshot()
             if test(img):
                 return img
-            if time.monotonic() > deadline or (self.app is not None and not self.app.alive()):
-                return None
-            time.sleep(0.2)
+            if self.app is not None and not self.app.alive():
+                raise AssertionError(f"the viewer died while waiting for {what}")
+            if time.monotonic() > deadline:
+                raise AssertionError(f"after {timeout:.0f} s still no {what}")
+            time.sleep(0.1)
+
+    def settled(self, box: tuple[int, int, int, int], timeout: float = 10) -> np.ndarray:
+        """Wait until ``box`` is the same on two screenshots in a row (up to a text cursor's
+        blink: 3e-5 of its pixels)."""
+        prev, calm = [self.screenshot()], [0]
+
+        def same(img: np.ndarray) -> bool:  # no change over 3 screenshots ~0.2 s apart
+            calm[0] = calm[0] + 1 if changed_fraction(prev[0], img, box) < STILL else 0
+            prev[0] = img
+            time.sleep(0.05)
+            return calm[0] >= 2
+
+        return self.until(same, timeout, "steady picture")
+
+    # -------------------------------------------------------------- input
+    def park(self) -> None:
+        """Rest the mouse in the scene's bottom-left corner (no hover, no tooltip)."""
+        self.x.xdotool("mousemove", "3", str(self.size[1] - 3))
+
+    def click(self, xy: tuple[int, int]) -> None:
+        x, y = (str(int(v)) for v in xy)
+        self.x.xdotool("mousemove", x, y)
+        time.sleep(0.1)  # the hover frame first: ImGui acts on a press over a hovered item
+        self.x.xdotool("click", "1")
+        time.sleep(0.1)
+        self.park()
+
+    def key(self, *keys: str) -> None:
+        self.x.xdotool("key", "--delay", "60", *keys)
+
+    def drag(self, a: tuple[int, int], b: tuple[int, int], steps: int = 6, pause=0.3) -> None:
+        self.x.xdotool("mousemove", str(a[0]), str(a[1]))
+        time.sleep(0.1)
+        self.x.xdotool("mousedown", "1")
+        time.sleep(pause)
+        for t in np.linspace(0, 1, steps + 1)[1:]:
+            x, y = (round(p + t * (q - p)) for p, q in zip(a, b, strict=True))
+            self.x.xdotool("mousemove", str(x), str(y))
+            time.sleep(0.05)
+        # a release in the same frame as the last move ends the drag before ImGui reads the
+        # new position: let the viewer draw a frame with the button still down
+        time.sleep(pause)
+        self.x.xdotool("mouseup", "1")
+        time.sleep(0.1)
+        self.park()
 
     def choose(self, section: int, nth: int, entry: int) -> None:
         """Open the ``nth`` combo of a section and pick its ``entry``-th line."""
@@ -214,205 +209,290 @@ class Session:
             seen.append(found)
             return done
 
-        if self.until(opened) is None:
-            raise LookupError(f"the list opened by the combo shows {len(seen[-1])} entries")
-        lines = seen[-1]
-        self.click(lines[entry])
-        if self.until(lambda img: len(popup_lines(img, combo)) < 2) is None:
-            raise AssertionError("the combo's list did not close after a click on an entry")
+        self.until(opened, 10, f"list of at least {entry + 1} entries under the combo")
+        self.click(seen[-1][entry])
+        self.until(lambda img: len(popup_lines(img, combo)) < 2, 10, "closed list after a pick")
 
-    def goto(self, panel: str) -> Layout:
-        """Switch meshlap's panel with the "view" combo (the last combo of the Mesh section);
-        wait until the panel's second section (its own header and widgets) changed."""
+    def goto(self, number: int, header: str) -> Layout:
+        """Press the panel's shortcut (1–5); wait until the panel's section changed."""
         before = self.layout()
-        header = before.sections[1][0] if len(before.sections) > 1 else before.sections[0][0]
-        box = (header.x0, header.y0, header.x1, header.y1)
+        head = before.sections[1][0]
+        box = (head.x0, head.y0, head.x1, head.y1)
         old = self.img
-        self.choose(0, -1, PANELS.index(panel))
-        if self.panel != panel:
-            self.until(lambda img: changed_fraction(old, img, box) > 0.01)
-        self.panel = panel
-        time.sleep(SETTLE)
-        return self.layout()
+        self.key(str(number))
+        if self.panel != number:
+            self.until(lambda img: changed_fraction(old, img, box) > 0.01, 10, f"{header} panel")
+        self.panel = number
+        return parse(self.settled((0, 0, *self.size)))
 
-    def wait_for(self, test: Callable[[Layout], bool], timeout: float) -> Layout:
-        deadline = time.monotonic() + timeout
-        while True:
-            layout = self.layout()
-            if test(layout) or time.monotonic() > deadline:
-                return layout
-            if self.app is not None and not self.app.alive():
-                return layout
-            time.sleep(0.5)
+    def subject_ok(self, layout: Layout, n: int, what: str) -> None:
+        """At least ``n`` objects left of the panel, none running behind it."""
+        found = subjects(self.img, layout)
+        if len(found) < n:
+            raise AssertionError(f"{what}: {len(found)} object(s) left of the panel, want {n}")
+        if behind_panel(self.img, layout):
+            raise AssertionError(f"{what}: the subject runs behind meshlap's panel")
 
     # -------------------------------------------------------------- the tour
     def step(self, name: str, action: Callable[[Session], None]) -> None:
         """Run one step; record an exception, a death or foreign stderr; restart if dead."""
-        err = None
+        err, t0 = None, time.monotonic()
         try:
             action(self)
         except Exception as exc:
             err = f"{type(exc).__name__}: {exc}"
-        time.sleep(SETTLE)
         self.screenshot(name)
+        print(f"{self.size[0]}x{self.size[1]} {name}: {time.monotonic() - t0:.1f} s")
         problem = self.problem()
-        if problem:  # an error message comes before the exit: let the viewer finish
-            time.sleep(1.5)
-            problem = self.problem()
         if problem or err:
             self.failures.append(f"{name}: " + "; ".join(p for p in (err, problem) if p))
         assert self.app is not None
         if not self.app.alive():
+            time.sleep(1.0)  # let the viewer's last words reach stderr before the report
+            self.failures[-1] += f"; stderr: {self.app.stderr().strip()!r}"
             self.start()
 
 
+def scene_box(s: Session, layout: Layout) -> tuple[int, int, int, int]:
+    """The scene left of meshlap's panel."""
+    return 0, 0, layout.left, s.size[1]
+
+
+def pixels(a: np.ndarray, b: np.ndarray, box: tuple[int, int, int, int]) -> int:
+    """How many pixels of ``box`` differ between two screenshots."""
+    x0, y0, x1, y1 = box
+    return round(changed_fraction(a, b, box) * max(x1 - x0, 0) * max(y1 - y0, 0))
+
+
+def panel_box(s: Session, layout: Layout) -> tuple[int, int, int, int]:
+    """meshlap's panel from its second section's header to the window's bottom."""
+    return layout.left, layout.sections[1][0].y0, layout.right, s.size[1]
+
+
+def section_box(layout: Layout, section: int) -> tuple[int, int, int, int]:
+    sec = layout.sections[section]
+    nxt = layout.sections[section + 1][0].y0 if section + 1 < len(layout.sections) else None
+    return layout.left, sec[0].y0, layout.right, nxt or layout.bottom
+
+
 # ------------------------------------------------------------------ steps
+def opened(s: Session) -> None:
+    """The window as it opens: titled after the file, the mesh framed left of the panel."""
+    assert s.app is not None
+    title = s.app.title()
+    if not title.startswith(TITLE):
+        raise AssertionError(f"window title {title!r}, want 'meshlap — <file>'")
+    s.subject_ok(parse(s.img), 1, "on open")
+
+
 def pick_mesh(s: Session) -> None:
-    """Open the mesh list (the first combo of the Mesh section) and pick assets/torus.obj
-    (the list's 5th line: assets/ sorted by name) or, with the torus open, assets/bumpy.obj."""
+    """The mesh list (first combo of the Mesh section): the torus, or with the torus open,
+    bumpy; the Mesh section describes the new mesh and the scene shows it."""
+    entry = 0 if s.mesh == SECOND_MESH else MESH_LIST.index("torus.obj")
     before = s.screenshot()
-    s.choose(0, 0, 0 if s.mesh == SECOND_MESH else 4)
-    layout = s.layout()
-    if changed_fraction(before, s.img, s.scene_box(layout)) < 0.02:
+    mesh_box = section_box(parse(before), 0)
+    s.choose(0, 0, entry)
+    layout = parse(s.settled((0, 0, *s.size)))
+    if changed_fraction(before, s.img, scene_box(s, layout)) < 0.02:
         raise AssertionError("the picked mesh did not replace the shown one")
+    if changed_fraction(before, s.img, mesh_box) < 0.002:
+        raise AssertionError("the Mesh section still describes the previous mesh")
+    s.subject_ok(layout, 1, "the picked mesh")
 
 
-def visit(panel: str) -> Callable[[Session], None]:
-    def action(s: Session) -> None:
-        layout = s.goto(panel)
-        if len(layout.sections) < 3:
-            raise AssertionError(f"{panel}: expected Mesh, {panel} and Export sections")
-
-    return action
-
-
-def kinds(img: np.ndarray, section: int, kind: str) -> int:
-    """How many widgets of ``kind`` a section of the panel on ``img`` holds."""
-    try:
-        layout = parse(img)
-    except LookupError:
-        return 0
-    if not -len(layout.sections) <= section < len(layout.sections):
-        return 0
-    return sum(it.kind == kind for it in layout.sections[section])
-
-
-def curvature_widgets(s: Session) -> None:
-    """field combo → 3rd entry (gaussian); side by side on (a "second field" combo appears);
-    drag clip %."""
-    s.goto("curvature")
+def curvature(s: Session) -> None:
+    """Key 1; field combo → gaussian (3rd entry); side by side on: a second mesh beside the
+    first and a "second field" combo; drag clip %."""
+    s.goto(1, "Curvature")
     s.choose(1, 0, 2)
     layout = s.layout()
-    n = kinds(s.img, 1, "combo")
+    n = sum(it.kind == "combo" for it in layout.sections[1])
     s.click(layout.find(1, "checkbox", 0).center)
-    if s.until(lambda img: kinds(img, 1, "combo") > n) is None:
-        raise AssertionError("side by side: no second-field combo appeared")
-    slider = s.layout().find(1, "slider", 0)
+    s.until(
+        lambda img: (
+            len(subjects(img, parse(img))) >= 2
+            and sum(it.kind == "combo" for it in parse(img).sections[1]) > n
+        ),
+        10,
+        "second mesh and second-field combo after 'side by side'",
+    )
+    layout = parse(s.settled((0, 0, *s.size)))
+    s.subject_ok(layout, 2, "side by side")
+    slider = layout.find(1, "slider", 0)
     y = slider.center[1]
     s.drag((slider.x0 + 10, y), (slider.x0 + (slider.x1 - slider.x0) // 2, y))
+    s.settled((0, 0, *s.size))
 
 
-def click_vertex(s: Session) -> None:
-    """Click the mesh in the scene: the one-ring panel shows the picked vertex."""
-    layout = s.goto("onering")
+def onering(s: Session) -> None:
+    """Key 2; click the mesh: the panel lists the vertex and the camera turns to it; then type
+    12 into the "vertex" field and press Enter."""
+    layout = s.goto(2, "One-ring")
+    s.subject_ok(layout, 1, "one-ring panel")
     point = subject_point(s.img, layout)
     if point is None:
-        raise AssertionError("no mesh visible left of the panel")
+        raise AssertionError("no mesh to click left of the panel")
     before = s.img
     s.click(point)
-    box = (layout.left, layout.top, layout.right, layout.bottom)
-    if s.until(lambda img: changed_fraction(before, img, box) > 0.005, timeout=10) is None:
-        raise AssertionError(f"clicking the mesh at {point} changed nothing in the panel")
-
-
-def type_vertex(s: Session) -> None:
-    """Type a vertex number into the one-ring panel's "vertex" field."""
-    layout = s.goto("onering")
-    s.type_into(layout.find(1, "input", 0).center, "12")
-
-
-def spectral_k(s: Session) -> None:
-    """Compute the eigenbasis, then drag the k slider (the last slider): the
-    reconstruction beside the mesh changes."""
-    layout = s.goto("spectral")
-    button = layout.find(1, "buttons", 0)
-    s.click(((button.buttons[0][0] + button.buttons[0][1]) // 2, button.center[1]))
-    if s.until(lambda img: kinds(img, 1, "slider") >= 2, timeout=90) is None:
-        raise AssertionError("no eigenmode/k sliders after computing the eigenbasis")
-    layout = s.layout()
-    slider = layout.find(1, "slider", -1)
+    panel = panel_box(s, layout)
+    s.until(
+        lambda img: (
+            pixels(before, img, panel) > 200 and pixels(before, img, scene_box(s, layout)) > 200
+        ),
+        10,
+        f"vertex in the panel and its one-ring drawn after a click at {point}",
+    )
+    layout = parse(s.settled((0, 0, *s.size)))
     before = s.img
-    y = slider.center[1]
-    s.drag((slider.x0 + 6, y), (slider.x0 + (slider.x1 - slider.x0) // 3, y))
-    box = s.scene_box(layout)
-    if s.until(lambda img: changed_fraction(before, img, box) > 0.002, timeout=10) is None:
-        raise AssertionError("dragging k changed nothing in the scene " + s.hidden(before))
+    s.click(layout.find(1, "input", 0).center)
+    time.sleep(0.3)
+    s.key("ctrl+a", "1", "2", "Return")
+    panel = panel_box(s, layout)
+    s.until(
+        lambda img: pixels(before, img, panel) > 100,
+        10,
+        "vertex 12 in the panel after typing 12 and Enter",
+    )
+    s.settled((0, 0, *s.size))
 
 
-def type_lambda(s: Session) -> None:
-    """Type λ = 0.25 into the smoothing panel's first input field (λ)."""
-    layout = s.goto("smoothing")
-    s.type_into(layout.find(1, "input", 0).center, "0.25")
-
-
-def play_pause(s: Session) -> None:
-    """play (2nd button of the step/play/reset row): the smoothed copy moves; pause: it stops."""
-    layout = s.goto("smoothing")
+def spectral(s: Session) -> None:
+    """Key 3; "compute eigenbasis": eigenmode and k sliders, the reconstruction beside the
+    mesh; drag k (the last slider): the reconstruction changes."""
+    layout = s.goto(3, "Spectral")
     row = layout.find(1, "buttons", 0)
-    play = ((row.buttons[1][0] + row.buttons[1][1]) // 2, row.center[1])
-    box = s.scene_box(layout)
-    s.click(play)
-    time.sleep(2.0)
-    a = s.screenshot()
-    moving = s.until(lambda img: changed_fraction(a, img, box) > 0.0005, timeout=10)
-    s.click(play)
-    time.sleep(2.0)
-    c = s.screenshot()
-    time.sleep(2.0)
-    still = changed_fraction(c, s.screenshot(), box)
-    if moving is None:
-        raise AssertionError("play: the smoothed copy does not move " + s.hidden(a))
-    if still > 0.0005:
-        raise AssertionError("pause: the smoothed copy still moves")
+    s.click(((row.buttons[0][0] + row.buttons[0][1]) // 2, row.center[1]))
+    s.until(
+        lambda img: sum(it.kind == "slider" for it in parse(img).sections[1]) >= 2,
+        60,
+        "eigenmode and k sliders after 'compute eigenbasis'",
+    )
+    layout = parse(s.settled((0, 0, *s.size)))
+    s.subject_ok(layout, 2, "mesh and reconstruction")
+    slider = layout.find(1, "slider", -1)
+    before, y = s.img, slider.center[1]
+    s.drag((slider.x0 + 6, y), (slider.x0 + (slider.x1 - slider.x0) // 3, y))
+    s.until(
+        lambda img: changed_fraction(before, img, scene_box(s, layout)) > 0.002,
+        10,
+        "change of the reconstruction after dragging k",
+    )
+    s.subject_ok(parse(s.settled((0, 0, *s.size))), 2, "after dragging k")
 
 
-def surfaces_widgets(s: Session) -> None:
-    """surface combo → 2nd entry, then drag u (first slider)."""
-    s.goto("surfaces")
+def smoothing(s: Session) -> None:
+    """Key 4; type λ = 0.25 in the third field: nothing applies until Enter (the keys 2 and 5
+    typed go to the field, not to the panel shortcuts), Enter changes the g(μ) plot; space
+    plays (the smoothed copy moves), space pauses (it stops)."""
+    layout = s.goto(4, "Smoothing")
+    s.subject_ok(layout, 2, "input and smoothed copy")
+    plot = layout.find(1, "plot", 0)
+    plot_box = (plot.x0, plot.y0, plot.x1, plot.y1)
+    before = s.img
+    s.click(layout.find(1, "input", 0).center)
+    time.sleep(0.3)
+    s.key("ctrl+a", "0", "period", "2", "5")
+    typed = s.settled((0, 0, *s.size))
+    scene = scene_box(s, layout)
+    if pixels(before, typed, plot_box) + pixels(before, typed, scene) > 10:
+        raise AssertionError("λ applied before Enter (g(μ) or the caption changed while typing)")
+    if len(parse(typed).sections[1]) != len(layout.sections[1]):
+        raise AssertionError("typing 0.25 into λ changed the panel (a shortcut fired?)")
+    s.key("Return")
+    s.until(lambda img: pixels(typed, img, scene) > 20, 10, "new caption (λ = 0.25) after Enter")
+    box = scene_box(s, layout)
+    a = s.settled(box)
+    s.key("space")
+    s.until(lambda img: changed_fraction(a, img, box) > 0.002, 10, "smoothed copy moving (space)")
+    s.key("space")
+    c = s.settled(box, timeout=10)
+    time.sleep(1.0)
+    if changed_fraction(c, s.screenshot(), box) > STILL:
+        raise AssertionError("space again: the smoothed copy still moves")
+    s.subject_ok(parse(s.img), 2, "after play/pause")
+
+
+def surfaces(s: Session) -> None:
+    """Key 5; surface combo → 2nd entry; drag u (the first slider)."""
+    s.goto(5, "Surfaces")
+    before = s.img
     s.choose(1, 0, 1)
-    time.sleep(SETTLE)
-    slider = s.layout().find(1, "slider", 0)
-    y = slider.center[1]
+    layout = parse(s.settled((0, 0, *s.size)))
+    if changed_fraction(before, s.img, scene_box(s, layout)) < 0.02:
+        raise AssertionError("the chosen surface did not replace the shown one")
+    s.subject_ok(layout, 1, "the surface")
+    slider = layout.find(1, "slider", 0)
+    before, y = s.img, slider.center[1]
     s.drag((slider.x0 + 20, y), (slider.x1 - 30, y))
+    s.until(
+        lambda img: changed_fraction(before, img, section_box(layout, 1)) > 0.002,
+        10,
+        "new (u, v) figures after dragging u",
+    )
+    s.settled((0, 0, *s.size))
 
 
 def export(s: Session) -> None:
-    """Open the Export header, click its last button; a new .ply file appears."""
+    """Open the Export header (the one before Help), click "export what is shown" (its last
+    button): a .ply file appears and the panel says where it wrote."""
     layout = s.layout()
-    s.click(layout.sections[-1][0].center)
-    if s.until(lambda img: kinds(img, -1, "buttons") > 0) is None:
-        raise AssertionError("the Export header shows no buttons")
-    row = s.layout().find(-1, "buttons", 0)
-    before = set(s.tmp.rglob("*.ply"))
+    s.click(layout.sections[-2][0].center)
+    s.settled((0, 0, *s.size))
+    for _ in range(12):  # the panel may now be taller than the window: scroll it
+        if any(it.kind == "buttons" for it in parse(s.img).sections[-2]):
+            break
+        s.x.xdotool("mousemove", str(layout.left + 20), str(s.size[1] // 2))
+        s.x.xdotool("click", "--repeat", "3", "5")
+        s.park()
+        s.settled((0, 0, *s.size))
+    else:
+        raise AssertionError("no buttons under the Export header, even scrolled down")
+    layout = parse(s.settled((0, 0, *s.size)))
+    row = layout.find(-2, "buttons", 0)
+    before_files, before = set(s.tmp.rglob("*.ply")), s.img
+    below = (layout.left, row.y1 + 2, layout.right, min(row.y1 + 60, layout.bottom))
     s.click(((row.buttons[-1][0] + row.buttons[-1][1]) // 2, row.center[1]))
-    deadline = time.monotonic() + 15
-    while not set(s.tmp.rglob("*.ply")) - before:
-        if time.monotonic() > deadline:
-            raise AssertionError("export wrote no .ply file")
-        time.sleep(0.5)
+    s.until(
+        lambda img: (
+            bool(set(s.tmp.rglob("*.ply")) - before_files)
+            and changed_fraction(before, img, below) > 0.005
+        ),
+        15,
+        "new .ply file and the 'wrote ...' message under the buttons",
+    )
+    s.settled((0, 0, *s.size))
+
+
+def help_pane(s: Session) -> None:
+    """Back to the (short) one-ring panel, Export closed; H opens the Help pane (its check box
+    and UI-scale slider appear)."""
+    layout = s.goto(2, "One-ring")
+    if any(it.kind == "buttons" for it in layout.sections[-2]):
+        s.click(layout.sections[-2][0].center)
+        s.until(
+            lambda img: not any(it.kind == "buttons" for it in parse(img).sections[-2]),
+            10,
+            "closed Export section",
+        )
+    s.key("h")
+    s.until(
+        lambda img: any(it.kind in ("checkbox", "slider") for it in parse(img).sections[-1]),
+        10,
+        "the Help pane's widgets after H",
+    )
+    s.settled((0, 0, *s.size))
 
 
 TOUR: list[tuple[str, Callable[[Session], None]]] = [
+    ("window", opened),
     ("pick_mesh", pick_mesh),
-    *[(f"panel_{p}", visit(p)) for p in PANELS],
-    ("curvature_widgets", curvature_widgets),
-    ("click_vertex", click_vertex),
-    ("type_vertex", type_vertex),
-    ("spectral_drag_k", spectral_k),
-    ("type_lambda", type_lambda),
-    ("play_pause", play_pause),
-    ("surfaces_widgets", surfaces_widgets),
+    ("curvature", curvature),
+    ("onering", onering),
+    ("spectral", spectral),
+    ("smoothing", smoothing),
+    ("surfaces", surfaces),
     ("export", export),
+    ("help", help_pane),
 ]
 
 
@@ -424,68 +504,72 @@ def keep_shots(s: Session) -> None:
             shutil.copy2(png, Path(target) / png.name)
 
 
-@pytest.mark.window
-@pytest.mark.parametrize(
-    ("size", "mesh"),
-    [(SIZES[0], None), (SIZES[1], SECOND_MESH)],
+@pytest.fixture(
+    scope="module",
+    params=[(SIZES[0], None), (SIZES[1], SECOND_MESH)],
     ids=["1280x720-default", "1920x1080-torus"],
 )
-def test_scripted_tour(x_tools, tmp_path, size, mesh):
-    s = Session(size, mesh, tmp_path)
+def session(request, tmp_path_factory) -> Iterator[Session]:
+    """One viewer per size, shared by the tour and then the monkey."""
+    missing = missing_tools()
+    if missing:
+        pytest.skip(
+            f"real-window tests need {', '.join(missing)} (apt-get install xvfb xdotool "
+            "x11-apps; .ci/run installs them)"
+        )
+    size, mesh = request.param
+    t0 = time.monotonic()
+    s = Session(size, mesh, tmp_path_factory.mktemp(f"window{size[0]}"))
+    print(f"{size[0]}x{size[1]} start: {time.monotonic() - t0:.1f} s")
     try:
-        assert s.app is not None
-        title = s.app.title()
-        assert title == "Polyscope" or title.startswith("meshlap"), title
-        for name, action in TOUR:
-            s.step(name, action)
+        yield s
     finally:
         keep_shots(s)
         s.close()
-    assert not s.failures, "\n".join(s.failures)
+
+
+@pytest.mark.window
+def test_scripted_tour(session):
+    for name, action in TOUR:
+        session.step(name, action)
+    assert not session.failures, "\n".join(session.failures)
 
 
 KEYS = "space Right Left Up Down 1 2 3 4 5 f h r Tab Return BackSpace 0 period minus a x".split()
 
 
 @pytest.mark.window
-@pytest.mark.parametrize(
-    ("size", "mesh"),
-    [(SIZES[0], None), (SIZES[1], SECOND_MESH)],
-    ids=["1280x720-default", "1920x1080-torus"],
-)
-def test_monkey(x_tools, tmp_path, size, mesh):
+def test_monkey(session):
     """Seeded random clicks, drags and keys anywhere in the window; the viewer survives."""
-    seconds = float(os.environ.get("MESHLAP_MONKEY_SECONDS", "30"))
-    rng = np.random.default_rng(20261124 + size[0])
-    s = Session(size, mesh, tmp_path)
-    w, h = size
+    s = session
+    if s.app is None or not s.app.alive():
+        s.start()
+    seconds = float(os.environ.get("MESHLAP_MONKEY_SECONDS", "20"))
+    rng = np.random.default_rng(20261124 + s.size[0])
+    w, h = s.size
     log: list[str] = []
-    try:
-        end = time.monotonic() + seconds
-        while time.monotonic() < end:
-            r = rng.random()
-            a = (int(rng.integers(0, w)), int(rng.integers(0, h)))
-            if r < 0.6:
-                log.append(f"click {a}")
-                s.x.xdotool("mousemove", str(a[0]), str(a[1]))
-                time.sleep(0.06)
-                s.x.xdotool("click", "1")
-            elif r < 0.8:
-                b = (int(rng.integers(0, w)), int(rng.integers(0, h)))
-                log.append(f"drag {a} -> {b}")
-                s.drag(a, b, steps=4, pause=0.2)
-            else:
-                key = str(rng.choice(KEYS))
-                log.append(f"key {key}")
-                s.x.xdotool("key", key)
-            time.sleep(0.1)
-            if len(log) % 10 == 0 and s.problem():
-                break
-        s.screenshot("monkey_end")
-        problem = s.problem()
-    finally:
-        keep_shots(s)
-        s.close()
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        r = rng.random()
+        a = (int(rng.integers(0, w)), int(rng.integers(0, h)))
+        if r < 0.6:
+            log.append(f"click {a}")
+            s.x.xdotool("mousemove", str(a[0]), str(a[1]))
+            time.sleep(0.06)
+            s.x.xdotool("click", "1")
+        elif r < 0.8:
+            b = (int(rng.integers(0, w)), int(rng.integers(0, h)))
+            log.append(f"drag {a} -> {b}")
+            s.drag(a, b, steps=4, pause=0.15)
+        else:
+            key = str(rng.choice(KEYS))
+            log.append(f"key {key}")
+            s.x.xdotool("key", key)
+        time.sleep(0.1)
+        if len(log) % 10 == 0 and s.problem():
+            break
+    s.screenshot("monkey_end")
+    problem = s.problem()
     assert problem is None, f"{problem}\nlast actions: {log[-8:]}"
 
 

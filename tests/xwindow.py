@@ -57,6 +57,11 @@ def read_xwd(data: bytes) -> np.ndarray:
         raise ValueError(f"unsupported xwd dump (version {version}, format {fmt}, {bpp} bpp)")
     start = header_size + 12 * ncolors
     raw = np.frombuffer(data, dtype=np.uint8, count=bpl * height, offset=start)
+    if bpp == 32 and byte_order == 0 and masks == (0xFF0000, 0x00FF00, 0x0000FF):
+        # Xvfb's usual dump: bytes B, G, R, pad per pixel (a slice, no per-channel shifts)
+        return np.ascontiguousarray(
+            raw.reshape(height, bpl)[:, : 4 * width].reshape(height, width, 4)[..., 2::-1]
+        )
     rows = raw.reshape(height, bpl)[:, : width * (bpp // 8)].reshape(height, width, bpp // 8)
     if bpp == 32:
         pix = rows.view("<u4" if byte_order == 0 else ">u4")[..., 0]
@@ -91,7 +96,7 @@ def write_png(path: Path, rgb: np.ndarray) -> None:
     png = (
         b"\x89PNG\r\n\x1a\n"
         + chunk(b"IHDR", ihdr)
-        + chunk(b"IDAT", zlib.compress(rows.tobytes(), 9))
+        + chunk(b"IDAT", zlib.compress(rows.tobytes(), 6))
         + chunk(b"IEND", b"")
     )
     tmp = path.with_suffix(path.suffix + ".part")

@@ -112,6 +112,7 @@ class OneRingPanel:
         if not viewer.ring.select(viewer.mesh, viewer.curv, i):
             return False
         self.push(viewer)
+        viewer.reframe = True  # the camera turns to the new one-ring (else a speck on the mesh)
         return True
 
     def push(self, viewer: Viewer) -> None:

@@ -36,6 +36,10 @@ class SpectralPanel:
             ps.get_surface_mesh(RECON).set_enabled(panel == "spectral")
         if panel == "spectral" and self.state.basis is not None:
             self.push_mode(viewer, force=True)
+        elif self._shown_mode >= 0 and ps.has_surface_mesh(MESH):
+            # the eigenfunction's colour bar stays on screen while the mesh is hidden
+            ps.get_surface_mesh(MESH).remove_quantity(EIGEN)
+            self._shown_mode = -1
 
     def _offset(self, viewer: Viewer) -> np.ndarray:
         return side_offset(viewer.display.points(viewer.mesh.V))

@@ -26,8 +26,9 @@ class SurfacesPanel:
     def show(self, viewer: Viewer, panel: str) -> None:
         if panel == "surfaces":
             self.push(viewer)
-        if ps.has_surface_mesh(SURFACE):
-            ps.get_surface_mesh(SURFACE).set_enabled(panel == "surfaces")
+        elif ps.has_surface_mesh(SURFACE):  # hidden, its K colour bar would stay on screen
+            ps.remove_surface_mesh(SURFACE)
+            self._version = -1  # registered again when the panel comes back
         if ps.has_point_cloud(SURFACE_POINT):
             ps.get_point_cloud(SURFACE_POINT).set_enabled(panel == "surfaces")
 
