@@ -195,32 +195,9 @@ COLORBAR_STRIP = 0.17
 
 def frame_view(viewer: Viewer, strip: float = COLORBAR_STRIP) -> None:
     """Frame the current panel's structures in the window right of a ``strip`` (fraction of
-    the width) kept for the colour bar (:func:`.scene.frame_scene_left` on the remaining width,
-    then the camera slides left)."""
+    the width) kept for the colour bar (:func:`.scene.frame_scene_left`)."""
     view = scene.OBLIQUE_VIEW if viewer.panel == "surfaces" else viewer_view(viewer)
-    scene.frame_scene_left(viewer_framed(), viewer.structure_points, 0.95 - strip, view)
-    if strip <= 0:
-        return
-    pts = [viewer.structure_points(n) for n in viewer_framed() if _shown(n)]
-    pts = [P for P in pts if P is not None and len(P)]
-    if not pts:
-        return
-    P = np.vstack(pts)
-    c = 0.5 * (P.min(axis=0) + P.max(axis=0))
-    cam = ps.get_view_camera_parameters()
-    pos, look, right = (
-        np.asarray(x, dtype=float)
-        for x in (cam.get_position(), cam.get_look_dir(), cam.get_right_dir())
-    )
-    w, h = ps.get_window_size()
-    tan_h = np.tan(np.radians(cam.get_fov_vertical_deg()) / 2.0) * w / max(h, 1)
-    depth = float(np.dot(c - pos, look))
-    pos = pos - strip * 2.0 * depth * tan_h * right  # the content moves right by the strip
-    ps.look_at(pos, pos + look)
-
-
-def _shown(name: str) -> bool:
-    return ps.has_surface_mesh(name) and ps.get_surface_mesh(name).is_enabled()
+    scene.frame_scene_left(viewer_framed(), viewer.structure_points, 0.95, view, max(strip, 0.0))
 
 
 def viewer_view(viewer: Viewer) -> tuple[float, float, float]:

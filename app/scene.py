@@ -44,6 +44,7 @@ SMOOTH_INPUT = "smoothing input"
 # ---------------------------------------------------------------- colours (RGBA / RGB)
 RED = (1.0, 0.35, 0.35, 1.0)
 COLORBAR_AT = (15.0, 15.0)  # polyscope's on-screen colour bar: top-left, clear of the panel
+COLORBAR_PX = 150.0  # width of the colour bar's box at UI scale 1: the camera frames right of it
 INPUT_COLOR = (0.85, 0.75, 0.6)
 SMOOTHED_COLOR = (0.55, 0.7, 0.9)
 NEGATIVE_COLOR = (0.85, 0.1, 0.85)  # negative cotangent weights: outside the coolwarm map
@@ -134,14 +135,16 @@ def frame_points(
     P: np.ndarray,
     toward_eye: tuple[float, float, float] = DEFAULT_VIEW,
     fraction: float = 0.6,
+    left: float = 0.0,
 ) -> None:
     """Point the camera at the points ``P (k,3)`` (display coordinates) from the direction
-    ``toward_eye`` so that they fill the left ``fraction`` of the window (meshlap's panel covers
-    the rest, on the right), with y up.
+    ``toward_eye`` so that they fill the window between ``left`` and ``fraction`` of its width
+    (meshlap's panel covers the right, the colour bar the left strip), with y up.
 
-    The distance ``d`` fits the bounding box's extent across (``w``) and up (``h``) the view:
-    ``d = max(w / (2 f tan(fov_h/2)), h / (2 · 0.85 tan(fov_v/2))) + depth/2``, and the target
-    moves right by ``(1 − f) d tan(fov_h/2)`` so the box's centre lands at ``f/2`` of the width.
+    With ``s = fraction − left``, the distance ``d`` fits the bounding box's extent across (``w``)
+    and up (``h``) the view: ``d = max(w / (2 s tan(fov_h/2)), h / (2 · 0.85 tan(fov_v/2))) +
+    depth/2``, and the target moves right by ``(1 − left − fraction) d tan(fov_h/2)`` so the
+    box's centre lands at ``(left + fraction)/2`` of the width.
     """
     P = np.asarray(P, dtype=np.float64)
     if len(P) == 0:
@@ -165,8 +168,9 @@ def frame_points(
     fov = np.radians(ps.get_view_camera_parameters().get_fov_vertical_deg())
     tan_v = np.tan(fov / 2.0)
     tan_h = tan_v * width / max(height, 1)
-    d = max(w / (2 * fraction * tan_h), h / (2 * 0.85 * tan_v), 1e-12) + 0.5 * depth
-    target = c + (1.0 - fraction) * d * tan_h * right
+    span = max(fraction - left, 0.05)
+    d = max(w / (2 * span * tan_h), h / (2 * 0.85 * tan_v), 1e-12) + 0.5 * depth
+    target = c + (1.0 - left - fraction) * d * tan_h * right
     ps.look_at(target + d * back, target)
 
 
@@ -175,16 +179,18 @@ def frame_scene_left(
     points: Callable[[str], np.ndarray | None],
     fraction: float = 0.6,
     toward_eye: tuple[float, float, float] = DEFAULT_VIEW,
+    left: float = 0.0,
 ) -> None:
-    """Frame the enabled structures among ``names`` (:func:`frame_points`); ``points(name)``
-    gives a structure's display positions ``(k,3)`` (``None``: unknown)."""
+    """Frame the enabled structures among ``names`` between ``left`` and ``fraction`` of the
+    width (:func:`frame_points`); ``points(name)`` gives a structure's display positions
+    ``(k,3)`` (``None``: unknown)."""
     pts = []
     for name in names:
         if ps.has_surface_mesh(name) and ps.get_surface_mesh(name).is_enabled():
             P = points(name)
             if P is not None:
                 pts.append(P)
-    frame_points(np.vstack(pts) if pts else np.zeros((0, 3)), toward_eye, fraction)
+    frame_points(np.vstack(pts) if pts else np.zeros((0, 3)), toward_eye, fraction, left)
 
 
 def save_screenshot(path: Path) -> None:

@@ -383,7 +383,8 @@ class Viewer:
             view = scene.OBLIQUE_VIEW
         else:
             view = scene.FRONT_VIEWS.get(self.mesh.name, scene.DEFAULT_VIEW)
-        scene.frame_scene_left(FRAMED, self.structure_points, fraction, view)
+        left = scene.COLORBAR_PX * self.ui.scale / max(w, 1)  # keep clear of the colour bar
+        scene.frame_scene_left(FRAMED, self.structure_points, fraction, view, left)
         self._caption_boxes = {}
         for name in FRAMED:
             if ps.has_surface_mesh(name) and ps.get_surface_mesh(name).is_enabled():
