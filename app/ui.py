@@ -380,8 +380,17 @@ class UI:
     def plot_line(self, label: str, x: Any, y: Any) -> None:
         self.ip.PlotLine(label, _f64(x), _f64(y))
 
-    def plot_bars(self, label: str, x: Any, y: Any, width: float) -> None:
-        self.ip.PlotBars(label, _f64(x), _f64(y), float(width))
+    def plot_bars(
+        self, label: str, x: Any, y: Any, width: float, colors: Any | None = None
+    ) -> None:
+        """Bars at ``x`` of heights ``y``; ``colors (k,4)`` gives each bar its own fill (one
+        legend entry, ``label``, for all of them)."""
+        if colors is None:
+            self.ip.PlotBars(label, _f64(x), _f64(y), float(width))
+            return
+        for i, (xi, yi, c) in enumerate(zip(_f64(x), _f64(y), colors, strict=True)):
+            self.ip.SetNextFillStyle(tuple(float(t) for t in c))
+            self.ip.PlotBars(label if i == 0 else f"##{label}{i}", _f64([xi]), _f64([yi]), width)
 
     def plot_vlines(self, label: str, x: Any) -> None:
         self.ip.PlotInfLines(label, _f64(x))

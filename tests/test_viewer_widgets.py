@@ -506,3 +506,17 @@ def test_every_widget_is_driven(viewer, tmp_path, sphere):
     untipped = sorted(set(untipped) - set(ui.tooltips))
     assert not untipped, f"widgets without a tooltip: {untipped}"
     assert len(ui.seen) >= 25
+
+
+def test_histogram_bars_take_the_colour_of_their_value_on_the_mesh():
+    from matplotlib import colormaps
+    from meshlap_app.panels.curvature import _bar_colors
+
+    centers = np.array([-2.0, 0.0, 2.0, 5.0])
+    signed = _bar_colors(centers, -2.0, 2.0, signed=True)
+    cool = colormaps["coolwarm"]
+    np.testing.assert_allclose(signed[0], cool(0.0))  # the low end of the range
+    np.testing.assert_allclose(signed[1], cool(0.5))  # zero: the middle (white) of coolwarm
+    np.testing.assert_allclose(signed[3], cool(1.0))  # clipped like the mesh's colours
+    unsigned = _bar_colors(centers, 0.0, 5.0, signed=False)
+    np.testing.assert_allclose(unsigned[3], colormaps["viridis"](1.0))

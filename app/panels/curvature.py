@@ -140,4 +140,20 @@ class CurvaturePanel:
             "vertices",
         ) as shown:
             if shown:
-                ui.plot_bars("vertices", st["centers"], st["counts"], st["width"])
+                ui.plot_bars(
+                    "vertices",
+                    st["centers"],
+                    st["counts"],
+                    st["width"],
+                    _bar_colors(st["centers"], lo, hi, FIELD_LABELS[c.field_name][1]),
+                )
+
+
+def _bar_colors(centers: np.ndarray, lo: float, hi: float, signed: bool) -> np.ndarray:
+    """Each histogram bar ``(k,4)`` in the colour the mesh shows for its value (the same map,
+    coolwarm or viridis, and the same range ``[lo, hi]``)."""
+    from matplotlib import colormaps
+
+    c = np.asarray(centers, dtype=np.float64)
+    t = (c - lo) / (hi - lo) if hi > lo else np.full(len(c), 0.5)
+    return colormaps["coolwarm" if signed else "viridis"](np.clip(t, 0.0, 1.0))
