@@ -38,12 +38,23 @@ def green(img: np.ndarray) -> np.ndarray:
     return (g - r >= 25) & (g - b >= 8) & (g >= 95) & (g <= 215)
 
 
-def frame(img: np.ndarray) -> np.ndarray:
-    """Pixels of an ImGui frame (grey, drawn translucent over the scene, hence tinted)."""
+def frame(img: np.ndarray, ref: np.ndarray | None = None) -> np.ndarray:
+    """Pixels of an ImGui frame (grey, drawn translucent over the scene, hence tinted).
+
+    Over a light scene a frame is brighter than any panel background can be (mean >= 86).
+    Over a dark scene (a close-up that fills the view) the translucent frame darkens too;
+    ``ref``, the mean level of the panel background next to the pixels (broadcast against
+    them), then tells it apart: a frame is at least 30 levels above the background it is
+    drawn on, text excluded (mean <= 180 as always).
+    """
     r, g, b = _rgb(img)
     lo, hi = _spread(r, g, b)
     total = r + g + b  # 3 x mean
-    return (hi - lo <= 30) & (total >= 3 * 86) & (total <= 3 * 180) & ~green(img)
+    level = total >= 3 * 86
+    if ref is not None:
+        ref = np.asarray(ref, dtype=np.int16)
+        level |= (ref <= 80) & (total >= 3 * (ref + 16))
+    return (hi - lo <= 30) & level & (total <= 3 * 180) & ~green(img)
 
 
 def bright(img: np.ndarray) -> np.ndarray:
@@ -140,7 +151,10 @@ def parse(img: np.ndarray) -> Layout:
     # and buttons may be narrow)
     # (white text and a header's arrow are neutral)
     is_g = ((g | t | f)[:, 10:24].mean(axis=1) > 0.8) & (g[:, 10:24].mean(axis=1) > 0.3)
-    is_f = (f[:, 10:30] | t[:, 10:30]).mean(axis=1) > 0.6
+    # the panel's background in its left margin, row by row: frames over a dark scene
+    margin = sub[:, 3:7].astype(np.int16).mean(axis=(1, 2))
+    probe = f[:, 10:30] | frame(sub[:, 10:30], margin[:, None])
+    is_f = (probe | t[:, 10:30]).mean(axis=1) > 0.6
     width = right - left
     items: list[Item] = []
     for kind, mask in (("g", is_g), ("f", is_f & ~is_g)):
@@ -194,8 +208,11 @@ def _classify(
         spans = runs(f[(y0 + y1) // 2] | t[(y0 + y1) // 2], min_len=20, max_gap=6)
         x0, x1 = spans[0] if spans else (0, width)
         return Item("plot", y0, y1, x0, x1)
-    # the frame's top rows hold no text; the scene seen through it may darken a few pixels
-    spans = runs(f[row, 6:], min_len=h - 6, max_gap=10)
+    # the frame's top rows hold no text; the scene seen through it may darken a few pixels.
+    # Over a dark scene, compare with the panel background in the gap just above the row
+    gap = sub[max(y0 - 3, 0) : max(y0 - 1, 1)].astype(np.int16).mean(axis=2).min(axis=0)
+    f_row = f[row] | frame(sub[row : row + 1], gap[None, :])[0]
+    spans = runs(f_row[6:], min_len=h - 6, max_gap=10)
     if not spans:
         return None
     x0, x1 = spans[0][0] + 6, spans[0][1] + 6

@@ -343,13 +343,17 @@ def onering(s: Session) -> None:
         f"vertex in the panel and its one-ring drawn after a click at {point}",
     )
     layout = parse(s.settled((0, 0, *s.size)))
-    before = s.img
-    s.click(layout.find(1, "input", 0).center)
+    field = layout.find(1, "input", 0)
+    s.click(field.center)
     time.sleep(0.3)
-    s.key("ctrl+a", "1", "2", "Return")
-    panel = panel_box(s, layout)
+    s.key("ctrl+a", "1", "2")
+    typed = s.settled((0, 0, *s.size))
+    s.key("Return")
+    # the lines under the field ("vertex 12: ...", the inspector's tables), not the typed
+    # digits: selecting a vertex may take the viewer a second or more to draw
+    below = (layout.left, field.y1 + 4, layout.right, s.size[1])
     s.until(
-        lambda img: pixels(before, img, panel) > 100,
+        lambda img: pixels(typed, img, below) > 100,
         10,
         "vertex 12 in the panel after typing 12 and Enter",
     )
@@ -372,10 +376,16 @@ def spectral(s: Session) -> None:
     slider = layout.find(1, "slider", -1)
     before, y = s.img, slider.center[1]
     s.drag((slider.x0 + 6, y), (slider.x0 + (slider.x1 - slider.x0) // 3, y))
+    # a new k may take the viewer a second or more to draw (software GL compiles the error
+    # map's shader): a still screen is no proof yet; wait for the mesh and the new
+    # reconstruction (the press at the slider's left end shows k = 1 first: a single point)
     s.until(
-        lambda img: changed_fraction(before, img, scene_box(s, layout)) > 0.002,
+        lambda img: (
+            changed_fraction(before, img, scene_box(s, layout)) > 0.002
+            and len(subjects(img, parse(img))) >= 2
+        ),
         10,
-        "change of the reconstruction after dragging k",
+        "change of the reconstruction after dragging k, the mesh and the reconstruction shown",
     )
     s.subject_ok(parse(s.settled((0, 0, *s.size))), 2, "after dragging k")
 
@@ -401,10 +411,22 @@ def smoothing(s: Session) -> None:
     s.key("Return")
     s.until(lambda img: pixels(typed, img, scene) > 20, 10, "new caption (λ = 0.25) after Enter")
     box = scene_box(s, layout)
+    row = layout.find(1, "buttons", 0)  # step / play / reset: "play" reads "pause" while playing
+    row_box = (row.x0, row.y0, min(row.x1 + 60, layout.right), row.y1)
     a = s.settled(box)
     s.key("space")
     s.until(lambda img: changed_fraction(a, img, box) > 0.002, 10, "smoothed copy moving (space)")
+    playing = s.until(
+        lambda img: changed_fraction(a, img, row_box) > 0.01, 10, "'pause' on the play button"
+    )
     s.key("space")
+    # a playing frame may take longer than a steady-picture check (one smoothing step moves
+    # few pixels): first the button says the pause took effect, then the copy must be still
+    s.until(
+        lambda img: changed_fraction(playing, img, row_box) > 0.01,
+        10,
+        "'play' on the button again after space",
+    )
     c = s.settled(box, timeout=10)
     time.sleep(1.0)
     if changed_fraction(c, s.screenshot(), box) > STILL:
@@ -463,10 +485,36 @@ def export(s: Session) -> None:
     s.settled((0, 0, *s.size))
 
 
+def scroll_to_end(s: Session) -> Layout:
+    """Turn the mouse wheel over meshlap's panel until it scrolls no further (the one-ring
+    panel with the vertex inspector is taller than the window); the last header is then
+    the panel's last section (Help)."""
+    layout = parse(s.settled((0, 0, *s.size)))
+    for _ in range(20):
+        before = s.img
+        s.x.xdotool("mousemove", str(layout.left + 20), str(s.size[1] // 2))
+        s.x.xdotool("click", "--repeat", "3", "5")
+        s.park()
+        # the scroll bar's strip: hover highlights and tooltips over the panel do not count
+        box = (layout.right - 18, layout.top + 30, layout.right + 1, s.size[1])
+
+        def moved(img: np.ndarray, before=before, box=box) -> bool:
+            return changed_fraction(before, img, box) > 0.002
+
+        try:
+            s.until(moved, 1.5, "scroll")
+        except AssertionError:
+            return parse(s.img)  # nothing moved: the end
+        layout = parse(s.settled((0, 0, *s.size)))
+    raise AssertionError("meshlap's panel still scrolls after 20 turns of the wheel")
+
+
 def help_pane(s: Session) -> None:
-    """Back to the (short) one-ring panel, Export closed; H opens the Help pane (its check box
-    and UI-scale slider appear)."""
-    layout = s.goto(2, "One-ring")
+    """Back to the one-ring panel, Export closed; H opens the Help pane at the panel's end
+    (scrolled to: the inspector makes the panel tall): its session file field, save / load
+    buttons, check box and UI-scale slider appear."""
+    s.goto(2, "One-ring")
+    layout = scroll_to_end(s)
     if any(it.kind == "buttons" for it in layout.sections[-2]):
         s.click(layout.sections[-2][0].center)
         s.until(
@@ -474,12 +522,16 @@ def help_pane(s: Session) -> None:
             10,
             "closed Export section",
         )
+    before, box = s.img, (layout.left, 0, layout.right, s.size[1])
     s.key("h")
-    s.until(
-        lambda img: any(it.kind in ("checkbox", "slider") for it in parse(img).sections[-1]),
-        10,
-        "the Help pane's widgets after H",
-    )
+    s.until(lambda img: changed_fraction(before, img, box) > 0.001, 10, "the panel grown after H")
+    scroll_to_end(s)
+
+    def shown(img: np.ndarray) -> bool:
+        kinds = {it.kind for it in parse(img).sections[-1]}
+        return {"input", "buttons"} <= kinds and bool(kinds & {"checkbox", "slider"})
+
+    s.until(shown, 10, "the Help pane's widgets after H (session file, buttons, UI scale)")
     s.settled((0, 0, *s.size))
 
 
