@@ -52,11 +52,7 @@ class NeighbourTerm:
     weight_cotan: float  # w_ij = ½(cot α + cot β)
     weight_uniform: float  # 1/|N(i)|
     contribution: FloatArray  # w_ij (x_j − x_i), (3,)
-
-    @property
-    def negative(self) -> bool:
-        """An obtuse opposite angle made the cotangent weight negative."""
-        return self.weight_cotan < 0
+    negative: bool = False  # obtuse opposite angles made w_ij < 0 (beyond round-off)
 
 
 @dataclass(frozen=True)
@@ -260,9 +256,11 @@ def inspect_vertex(
     ring, fans, manifold = _ring_and_fans(F, n, i, nbr)
     x_i = V[i]
     neighbours = []
-    for j in ring:
-        angles = opp[nbr == j]
-        w = 0.5 * float(np.sum(_cot(angles)))
+    opposite = [opp[nbr == j] for j in ring]
+    weights = [0.5 * float(np.sum(_cot(angles))) for angles in opposite]
+    # a right angle's cotangent is round-off (~1e-17), not a negative weight
+    tiny = 1e-12 * max((abs(w) for w in weights), default=0.0)
+    for j, angles, w in zip(ring, opposite, weights, strict=True):
         neighbours.append(
             NeighbourTerm(
                 index=int(j),
@@ -272,6 +270,7 @@ def inspect_vertex(
                 weight_cotan=w,
                 weight_uniform=1.0 / len(ring),
                 contribution=w * (V[j] - x_i),
+                negative=w < -tiny,
             )
         )
     faces = [

@@ -169,3 +169,15 @@ def test_cli_json_and_errors(tmp_path):
     assert res.returncode == 2 and res.stderr.count("\n") == 1 and "--vertex" in res.stderr
     res = subprocess.run([*run, "--vertex", "1"], capture_output=True, text=True)
     assert res.returncode == 0 and "H_cotan = −½" in res.stdout
+
+
+def test_right_angles_give_zero_weights_not_negative_ones():
+    """Opposite angles of 90° give cot = round-off (±1e-17): listed as 0, never as negative."""
+    V, F = primitives.grid(4, 4)
+    for i in range(len(V)):
+        r = inspect_vertex(V, F, i)
+        scale = max(abs(t.weight_cotan) for t in r.neighbors)
+        zero = [t for t in r.neighbors if abs(t.weight_cotan) < 1e-12 * scale]
+        assert not any(t.negative for t in r.neighbors)
+        if not r.boundary:
+            assert zero  # the squares' diagonals: both opposite angles are right angles

@@ -25,6 +25,7 @@ from ..state.onering import (
     arrow_scales,
     weight_segments,
 )
+from ..ui import sig
 
 if TYPE_CHECKING:
     from ..viewer import Viewer
@@ -387,11 +388,13 @@ class OneRingPanel:
     def draw_neighbours(self, viewer: Viewer, ins: VertexInspection) -> None:
         ui = viewer.ui
         ui.note("j  |x_j - x_i|  alpha  beta  w_ij = 1/2(cot a + cot b)  1/|N|")
-        for t in viewer.ring.rows():
+        rows = viewer.ring.rows()
+        scale = max((abs(t.weight_cotan) for t in rows), default=0.0)
+        for t in rows:
             beta = "-" if t.beta is None else f"{math.degrees(t.beta):.2f}°"
             row = (
                 f"{t.index}:  {t.edge_length:.4g}   {math.degrees(t.alpha):.2f}°  {beta}   "
-                f"w = {t.weight_cotan:.4g}   {t.weight_uniform:.4g}"
+                f"w = {sig(t.weight_cotan, scale)}   {t.weight_uniform:.4g}"
             )
             if t.negative:
                 ui.colored(row + "  < 0 (obtuse)", NEGATIVE_RGBA)
