@@ -375,7 +375,24 @@ def spectral(s: Session) -> None:
     s.subject_ok(layout, 2, "mesh and reconstruction")
     slider = layout.find(1, "slider", -1)
     before, y = s.img, slider.center[1]
-    s.drag((slider.x0 + 6, y), (slider.x0 + (slider.x1 - slider.x0) // 3, y))
+    # the drag waits for the viewer at each stage (a new k may take a second or more to
+    # draw, and a release queued behind a slow frame can lose the motion): press at the
+    # left end (k = 1 shows), move to a third with the button down (k follows), release
+    knob = (slider.x0, slider.y0, slider.x1, slider.y1)
+    s.x.xdotool("mousemove", str(slider.x0 + 6), str(y))
+    time.sleep(0.1)
+    s.x.xdotool("mousedown", "1")
+    try:
+        pressed = s.until(
+            lambda img: changed_fraction(before, img, knob) > 0.01, 10, "k = 1 on the slider"
+        )
+        s.x.xdotool("mousemove", str(slider.x0 + (slider.x1 - slider.x0) // 3), str(y))
+        s.until(
+            lambda img: changed_fraction(pressed, img, knob) > 0.01, 10, "k following the mouse"
+        )
+    finally:
+        s.x.xdotool("mouseup", "1")
+        s.park()
     # a new k may take the viewer a second or more to draw (software GL compiles the error
     # map's shader): a still screen is no proof yet; wait for the mesh and the new
     # reconstruction (the press at the slider's left end shows k = 1 first: a single point)
@@ -415,10 +432,11 @@ def smoothing(s: Session) -> None:
     row_box = (row.x0, row.y0, min(row.x1 + 60, layout.right), row.y1)
     a = s.settled(box)
     s.key("space")
-    s.until(lambda img: changed_fraction(a, img, box) > 0.002, 10, "smoothed copy moving (space)")
     playing = s.until(
         lambda img: changed_fraction(a, img, row_box) > 0.01, 10, "'pause' on the play button"
     )
+    # a loaded machine draws a playing frame (one step) in up to ~2 s: give the copy time
+    s.until(lambda img: changed_fraction(a, img, box) > 0.002, 30, "smoothed copy moving (space)")
     s.key("space")
     # a playing frame may take longer than a steady-picture check (one smoothing step moves
     # few pixels): first the button says the pause took effect, then the copy must be still
