@@ -258,7 +258,7 @@ def test_every_referenced_figure_exists_and_is_a_valid_png(quick):
 def test_screenshots_are_real_unless_egl_is_missing(quick):
     if quick.screenshots_ok == 0:
         reason = quick.screenshot_failures[0] if quick.screenshot_failures else "unknown"
-        if "EGL" in reason or "egl" in reason:
+        if ("EGL" in reason or "egl" in reason) and "re-initializing" not in reason:
             pytest.skip(f"no EGL on this machine: {reason}")
         pytest.fail(f"no viewer screenshot was taken: {reason}")
     assert quick.screenshot_failures == []

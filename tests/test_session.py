@@ -233,6 +233,7 @@ def mock(tmp_path_factory):
     yield ps
     ps.clear_user_callback()
     ps.remove_all_structures()
+    ps.shutdown()  # a later test may start polyscope with another backend (EGL)
     os.chdir(old)
 
 

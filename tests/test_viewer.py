@@ -22,6 +22,7 @@ def mock_backend(tmp_path_factory):
     ps.set_frame_tick_limit_fps_mode("ignore_limits")  # every frame_tick runs the callback
     yield ps
     ps.remove_all_structures()
+    ps.shutdown()  # a later test may start polyscope with another backend (EGL)
     os.chdir(old)
 
 
