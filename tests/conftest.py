@@ -30,6 +30,27 @@ def shared_mesh() -> Callable[[str], Path]:
     return get
 
 
+@pytest.fixture(scope="module")
+def polyscope_mock(tmp_path_factory):
+    """polyscope on its ``openGL_mock`` backend for one test module, every frame running the
+    callback; shut down afterwards so a later module may start another backend (EGL)."""
+    import os
+
+    import polyscope as ps
+
+    old = os.getcwd()
+    os.chdir(tmp_path_factory.mktemp("polyscope"))  # polyscope writes .ini files here
+    ps.set_allow_headless_backends(True)
+    ps.init("openGL_mock")
+    ps.set_max_fps(-1)
+    ps.set_frame_tick_limit_fps_mode("ignore_limits")
+    yield ps
+    ps.clear_user_callback()
+    ps.remove_all_structures()
+    ps.shutdown()
+    os.chdir(old)
+
+
 def pytest_configure(config: pytest.Config) -> None:
     config.addinivalue_line(
         "markers",

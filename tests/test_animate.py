@@ -284,19 +284,8 @@ def test_modes_k_sweep_and_theta_render(tmp_path, sphere):
 
 # ---------------------------------------------------------------- the record button (mock)
 @pytest.fixture(scope="module")
-def mock(tmp_path_factory):
-    ps = pytest.importorskip("polyscope")
-    old = os.getcwd()
-    os.chdir(tmp_path_factory.mktemp("polyscope"))  # polyscope writes .ini files here
-    ps.set_allow_headless_backends(True)
-    ps.init("openGL_mock")
-    ps.set_max_fps(-1)
-    ps.set_frame_tick_limit_fps_mode("ignore_limits")
-    yield ps
-    ps.clear_user_callback()
-    ps.remove_all_structures()
-    ps.shutdown()  # a later test may start polyscope with another backend (EGL)
-    os.chdir(old)
+def mock(polyscope_mock):
+    return polyscope_mock
 
 
 @pytest.fixture

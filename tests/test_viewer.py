@@ -12,18 +12,8 @@ ps = pytest.importorskip("polyscope")
 
 
 @pytest.fixture(scope="module")
-def mock_backend(tmp_path_factory):
-    # polyscope writes .polyscope.ini / imgui.ini into the working directory
-    old = os.getcwd()
-    os.chdir(tmp_path_factory.mktemp("polyscope"))
-    ps.set_allow_headless_backends(True)
-    ps.init("openGL_mock")
-    ps.set_max_fps(-1)
-    ps.set_frame_tick_limit_fps_mode("ignore_limits")  # every frame_tick runs the callback
-    yield ps
-    ps.remove_all_structures()
-    ps.shutdown()  # a later test may start polyscope with another backend (EGL)
-    os.chdir(old)
+def mock_backend(polyscope_mock):
+    return polyscope_mock
 
 
 def test_every_panel_runs_frames_on_mock(mock_backend, tmp_path):

@@ -10,7 +10,6 @@ widget that no test here drives.
 
 from __future__ import annotations
 
-import os
 import time
 
 import numpy as np
@@ -29,18 +28,8 @@ BAD_NUMBERS = ["", "0", "-1", "nan", "1e309", "abc"]
 
 
 @pytest.fixture(scope="module")
-def mock(tmp_path_factory):
-    old = os.getcwd()
-    os.chdir(tmp_path_factory.mktemp("polyscope"))  # polyscope writes .ini files here
-    ps.set_allow_headless_backends(True)
-    ps.init("openGL_mock")
-    ps.set_max_fps(-1)
-    ps.set_frame_tick_limit_fps_mode("ignore_limits")
-    yield ps
-    ps.clear_user_callback()
-    ps.remove_all_structures()
-    ps.shutdown()  # a later test may start polyscope with another backend (EGL)
-    os.chdir(old)
+def mock(polyscope_mock):
+    return polyscope_mock
 
 
 @pytest.fixture
