@@ -10,11 +10,19 @@ MP4 atomically.
 Kinds: ``smoothing`` (one frame per iteration, 0 to ``iters``), ``spectral`` with ``k`` (the
 reconstruction from the first k modes, k = A..B) or ``modes`` (the eigenmodes A..B one by one),
 ``surfaces`` with ``theta`` (the normal section at (u, v) turning through 360°, κₙ(θ)).
+
+With a saved session (``meshlap animate --session``) the viewer is first restored from it
+(:func:`.session.apply`: mesh, settings, replayed smoothing, cached basis, camera) and the
+frame generators start from that viewer: the session's camera is kept (:func:`frame_view` does
+nothing for it) and each frame is cropped to the part of the saved window left of meshlap's
+panel (:func:`session_window`).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import sys
+import weakref
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -66,6 +74,8 @@ class AnimationSpec:
     fps: float | None = None
     size: tuple[int, int] = (960, 540)
     shadow: bool = False
+    session: Any = None  # a meshlap_app.state.session.Session to restore first
+    session_file: Path | None = None  # its file (named in errors; never overwritten)
 
     @property
     def what(self) -> str:
@@ -108,7 +118,18 @@ def check_spec(spec: AnimationSpec, mesh: MeshState | None) -> None:
             raise MeshError(f"must end at {n} or less (the mesh has {n} vertices)", "--k")
         if spec.modes is not None and spec.modes[1] > n - 1:
             raise MeshError(f"must end at {n - 1} or less (the mesh has {n} vertices)", "--modes")
-    check_animation_output(spec.out, [spec.mesh] if spec.mesh else [])
+    if spec.session is not None:
+        window = session_window(spec.session, spec.size, spec.session_file or "--session")
+        if window is not None and window[0][0] > 8192:
+            raise MeshError(f"too wide for this session's view, got {w}x{h}", "--size")
+    if mesh is not None and spec.session is not None:
+        from .state.session import check_vertex
+
+        check_vertex(spec.session, len(mesh.V), spec.session_file or "--session")
+    inputs = [spec.mesh, spec.session_file]
+    if spec.session is not None:
+        inputs.append(spec.session.mesh)
+    check_animation_output(spec.out, [p for p in inputs if p is not None])
 
 
 def load_mesh_state(spec: AnimationSpec) -> MeshState:
@@ -137,11 +158,12 @@ def render(spec: AnimationSpec, mesh: MeshState, progress: bool = True) -> Path:
     colorbar = spec.what != "smoothing"  # polyscope draws its colour bar with imgui
     viewer = Viewer(mesh, CurvatureState(), panel=spec.panel)
     viewer.sync_mesh()
+    keep = restore_session(viewer, spec, mesh) if spec.session is not None else None
     scenes = {"smoothing": smoothing_frames, "k": k_frames, "modes": mode_frames}
     frames = scenes.get(spec.what, theta_frames)(viewer, spec)
     bar = Progress(frame_count(spec)) if progress else None
     try:
-        write_frames(frames, writer, colorbar, bar)
+        write_frames(frames, writer, colorbar, bar, keep)
         return writer.close()
     except BaseException:
         writer.abort()
@@ -151,13 +173,18 @@ def render(spec: AnimationSpec, mesh: MeshState, progress: bool = True) -> Path:
 
 
 def write_frames(
-    frames: Iterator[str], writer: FrameWriter, colorbar: bool, bar: Progress | None
+    frames: Iterator[str],
+    writer: FrameWriter,
+    colorbar: bool,
+    bar: Progress | None,
+    keep: int | None = None,
 ) -> None:
     """Render each frame the generator sets up and hand it to the writer.
 
     The caption and the GIF quantization run in a worker thread while the main thread computes
     the next frame (a smoothing step, a reconstruction: numpy/scipy release the GIL), one frame
-    in flight, so the order is kept.
+    in flight, so the order is kept. ``keep``: only the left ``keep`` window pixels of each
+    frame are kept (a session's view, :func:`session_window`).
     """
     from concurrent.futures import Future, ThreadPoolExecutor
 
@@ -168,6 +195,8 @@ def write_frames(
     with ThreadPoolExecutor(max_workers=1) as pool:
         for i, caption in enumerate(frames):
             buf = ps.screenshot_to_buffer(transparent_bg=False, include_UI=colorbar)
+            if keep is not None:
+                buf = buf[:, : keep * buf.shape[1] // max(ps.get_window_size()[0], 1)]
             if pending is not None:
                 pending.result()  # re-raises a failure of the previous frame
             pending = pool.submit(add, buf, caption)
@@ -189,13 +218,109 @@ def frame_count(spec: AnimationSpec) -> int:
     return spec.frames
 
 
+# ---------------------------------------------------------------- a saved session's view
+_SESSION_CAMERA: weakref.WeakSet[Viewer] = weakref.WeakSet()
+"""Viewers restored from a session with its camera: :func:`frame_view` leaves them alone."""
+
+
+def _saved_window(session: Any, source: Any) -> tuple[int, int] | None:
+    """The window size stored with the session's camera (``None`` without a camera).
+
+    Raises
+    ------
+    MeshError
+        A camera whose ``windowWidth`` / ``windowHeight`` are missing or not 64 to 8192.
+    """
+    if session.camera is None:
+        return None
+    size = []
+    for key in ("windowWidth", "windowHeight"):
+        x = session.camera.get(key)
+        if not isinstance(x, int) or isinstance(x, bool) or not 64 <= x <= 8192:
+            raise MeshError(f'"camera.{key}" must be an integer 64 to 8192, got {x!r}', source)
+        size.append(x)
+    return size[0], size[1]
+
+
+def panel_strip(width: int, ui_scale: float) -> int:
+    """Pixels on the right of a window ``width`` wide that meshlap's panel covered at
+    ``ui_scale`` (the rule of the viewer's framing and of the record button's crop: at most
+    70 % of the window; what is kept has an even width)."""
+    from .viewer import PANEL_PX
+
+    keep = int(width * min(max((width - PANEL_PX * ui_scale) / width, 0.3), 1.0))
+    return width - max(keep // 2 * 2, 2)
+
+
+def session_window(
+    session: Any, size: tuple[int, int] | None = None, source: Any = "--session"
+) -> tuple[tuple[int, int], int] | None:
+    """The window to render and the width kept on its left so that the frames show what the
+    session's window showed left of meshlap's panel (``None``: the session has no camera).
+
+    The saved window ``W_s x H_s`` showed the view left of a strip ``P`` (:func:`panel_strip`).
+    For an output ``size = (W, H)`` (default ``(W_s - P, H_s)``) the window is
+    ``(W + P·H/H_s) x H`` and its left ``W`` pixels are kept: polyscope's field of view is
+    vertical, so the vertical extent is the saved one at any size, and the kept part is centred
+    where the saved view was (an aspect change widens or narrows it symmetrically). The default
+    size gives the saved window and exactly its part left of the panel.
+    """
+    saved = _saved_window(session, source)
+    if saved is None:
+        return None
+    w_s, h_s = saved
+    strip = panel_strip(w_s, session.ui_scale)
+    if size is None:
+        return (w_s, h_s), w_s - strip
+    w, h = size
+    return (w + round(strip * h / h_s), h), w
+
+
+def session_size(session: Any, source: Any = "--session") -> tuple[int, int] | None:
+    """The default frame size of a session's animation: its window's part left of the panel
+    (``None``: the session has no camera)."""
+    window = session_window(session, None, source)
+    return None if window is None else (window[1], window[0][1])
+
+
+def restore_session(viewer: Viewer, spec: AnimationSpec, mesh: MeshState) -> int | None:
+    """Apply ``spec.session`` to ``viewer`` (:func:`.session.apply` with the window size of
+    :func:`session_window`) and return the width of each frame to keep (``None``: all).
+
+    The session's camera is kept (no re-framing) when the animated panel is the session's; on
+    another panel (its camera framed other structures) or without a camera, the window is
+    ``spec.size`` and the frame generators frame the view as without a session.
+    """
+    from .session import apply
+
+    session = spec.session
+    source = spec.session_file or "--session"
+    window = session_window(session, spec.size, source)
+    keep_camera = window is not None and session.panel == spec.panel
+    if session.camera is not None:
+        camera = dict(session.camera)
+        size = window[0] if keep_camera and window is not None else spec.size
+        camera["windowWidth"], camera["windowHeight"] = int(size[0]), int(size[1])
+        session = dataclasses.replace(session, camera=camera)
+    apply(viewer, session, source, resize=True, mesh=mesh)
+    if not keep_camera:
+        ps.set_window_size(*spec.size)
+        viewer.set_panel(spec.panel)
+        return None
+    _SESSION_CAMERA.add(viewer)
+    return window[1] if window is not None else None
+
+
 COLORBAR_STRIP = 0.17
 """Left fraction of a frame kept clear for polyscope's colour bar (top-left, ``COLORBAR_AT``)."""
 
 
 def frame_view(viewer: Viewer, strip: float = COLORBAR_STRIP) -> None:
     """Frame the current panel's structures in the window right of a ``strip`` (fraction of
-    the width) kept for the colour bar (:func:`.scene.frame_scene_left`)."""
+    the width) kept for the colour bar (:func:`.scene.frame_scene_left`); a viewer restored
+    from a session with its camera keeps that camera (nothing happens)."""
+    if viewer in _SESSION_CAMERA:
+        return
     view = scene.OBLIQUE_VIEW if viewer.panel == "surfaces" else viewer_view(viewer)
     scene.frame_scene_left(viewer_framed(), viewer.structure_points, 0.95, view, max(strip, 0.0))
 
@@ -245,6 +370,8 @@ def smoothing_caption(st: Any, iters: int | None = None) -> str:
 def _basis(viewer: Viewer, k: int) -> Any:
     """Compute (or read from the cache) ``k`` eigenpairs synchronously."""
     st = viewer.panels["spectral"].state
+    if st.basis is not None and not st.error and st.basis.k_max >= k:
+        return st  # restored from a session: its basis has enough modes
     st.k_request = k
     sys.stderr.write(f"meshlap: animate: {k} eigenpairs (from the cache after the first run)\n")
     st.start(viewer.mesh.V, viewer.mesh.F, background=False)
