@@ -365,3 +365,271 @@ def test_record_button_spectral_k_drag(viewer, tmp_path):
     assert "4 frames" in viewer.panels["spectral"].recorder.status
     assert Image.open(tmp_path / "k.gif").n_frames == 4
     assert ("spectral", "record file") in viewer.ui.driven
+
+
+# ---------------------------------------------------------------- --session (issue 15)
+def _session_file(tmp_path, mesh, panel="smoothing", name="s.json", **changes):
+    """A session on ``mesh`` saved on ``panel`` with a 1200x700 window (``changes``:
+    ``section=dict`` updates, or top-level fields such as ``ui_scale``)."""
+    from meshlap_app.state.session import Session, write_session
+
+    s = Session(mesh=mesh, panel=panel)
+    s.camera = {"fov": 45.0, "windowWidth": 1200, "windowHeight": 700, "viewMat": [0.0] * 16}
+    s.settings["smoothing"].update(method="explicit", lam=0.25, noise_alpha=0.01, seed=4)
+    s.settings["smoothing"]["iterations"] = 3
+    s.settings["spectral"].update(k=6, mode=4)
+    s.settings["surfaces"].update(surface="torus", res=30, u=1.0, v=2.0)
+    for key, value in changes.items():
+        if key in s.settings:
+            s.settings[key].update(value)
+        else:
+            setattr(s, key, value)
+    path = write_session(tmp_path / f"{name}.json", s)
+    return path.rename(tmp_path / name)  # write_session wants .json; a session may be named .gif
+
+
+@pytest.fixture
+def spec_of(monkeypatch):
+    """Run ``meshlap animate`` with the renderer replaced: returns the spec it was given."""
+    import meshlap_app.animate as anim
+
+    seen = []
+
+    def fake(spec, mesh, progress=True):
+        seen.append(spec)
+        return spec.out
+
+    monkeypatch.setattr(anim, "render", fake)
+
+    def run(*args: str):
+        seen.clear()
+        assert main(["animate", *args]) == 0
+        return seen[0]
+
+    return run
+
+
+def test_session_values_fill_what_was_not_typed(spec_of, sphere, tmp_path):
+    path = _session_file(tmp_path, sphere)
+    out = str(tmp_path / "a.gif")
+    spec = spec_of("--session", str(path), "--out", out)
+    assert spec.panel == "smoothing" and spec.mesh == sphere.resolve()
+    assert (spec.method, spec.laplacian, spec.lam) == ("explicit", "uniform", 0.25)
+    assert (spec.noise, spec.seed, spec.iters) == (0.01, 4, 3)  # iters: the saved iteration
+    assert spec.size == (680, 700)  # the 1200x700 window left of the 520-pixel panel
+    assert spec.session.panel == "smoothing" and spec.session_file == path
+    # typed options win over the session
+    spec = spec_of("--session", str(path), "--out", out, "--lam", "2", "--iters", "7")
+    assert (spec.lam, spec.iters, spec.method, spec.seed) == (2.0, 7, "explicit", 4)
+    spec = spec_of("--session", str(path), "--out", out, "--size", "320x200")
+    assert spec.size == (320, 200)
+    # a session at iteration 0: the built-in 30 iterations; a larger UI scale: a wider panel
+    zero = _session_file(tmp_path, sphere, name="z.json", smoothing={"iterations": 0})
+    assert spec_of("--session", str(zero), "--out", out).iters == 30
+    big = _session_file(tmp_path, sphere, name="big.json", ui_scale=1.5)
+    assert spec_of("--session", str(big), "--out", out).size == (420, 700)  # 1200 - 1.5*520
+    # no camera in the file: the built-in size
+    nocam = _session_file(tmp_path, sphere, name="nocam.json", camera=None)
+    assert spec_of("--session", str(nocam), "--out", out).size == (960, 540)
+
+
+def test_session_spectral_and_surfaces_rules(spec_of, sphere, tmp_path):
+    out = str(tmp_path / "a.gif")
+    sp = _session_file(tmp_path, sphere, panel="spectral", name="sp.json")
+    spec = spec_of("--session", str(sp), "--out", out)
+    assert spec.what == "k" and spec.k == (1, 6)  # the k sweep up to the session's k
+    spec = spec_of("--session", str(sp), "--out", out, "--modes", "2:5")
+    assert spec.what == "modes" and spec.modes == (2, 5) and spec.k is None
+    assert spec_of("--session", str(sp), "--out", out, "--k", "3:4").k == (3, 4)
+    sf = _session_file(tmp_path, sphere, panel="surfaces", name="sf.json")
+    spec = spec_of("--session", str(sf), "--out", out)
+    assert spec.theta and spec.surface == "torus" and spec.uv == (1.0, 2.0)
+    assert spec.frames == 72
+    spec = spec_of("--session", str(sf), "--out", out, "--uv", "0.5,0.25")
+    assert spec.uv == (0.5, 0.25) and spec.surface == "torus"
+    spec = spec_of("--session", str(sf), "--out", out, "--surface", "saddle")
+    assert spec.surface == "saddle" and spec.uv is None  # the torus's point is not the saddle's
+    # a session saved on the curvature panel is animated with --panel
+    cv = _session_file(tmp_path, sphere, panel="curvature", name="cv.json")
+    spec = spec_of("--session", str(cv), "--out", out, "--panel", "smoothing")
+    assert spec.panel == "smoothing" and spec.iters == 3 and spec.lam == 0.25
+
+
+def test_without_a_session_the_defaults_are_unchanged(spec_of, sphere, tmp_path):
+    from meshlap_app.animate import AnimationSpec
+
+    out = tmp_path / "a.gif"
+    for panel, extra in (("smoothing", []), ("spectral", ["--k", "1:5"])):
+        spec = spec_of(str(sphere), "--panel", panel, "--out", str(out), *extra)
+        expected = AnimationSpec(panel=panel, out=out, mesh=sphere, k=spec.k)
+        assert spec == expected
+    spec = spec_of("--panel", "surfaces", "--theta", "--out", str(out))
+    assert spec == AnimationSpec(panel="surfaces", out=out, theta=True)
+
+
+def test_session_window_keeps_the_view_left_of_the_panel():
+    from meshlap_app.animate import panel_strip, session_window
+    from meshlap_app.state.session import Session
+    from meshlap_app.viewer import PANEL_PX
+
+    s = Session(camera={"windowWidth": 1600, "windowHeight": 900})
+    assert panel_strip(1600, 1.0) == PANEL_PX
+    assert session_window(s) == ((1600, 900), 1600 - PANEL_PX)
+    # another size: same vertical extent, the strip scaled with the height, centred the same
+    assert session_window(s, (540, 450)) == ((540 + PANEL_PX // 2, 450), 540)
+    s.ui_scale = 2.0
+    assert session_window(s) == ((1600, 900), 1600 - 2 * PANEL_PX)
+    s.camera = {"windowWidth": 600, "windowHeight": 400}  # the panel at most 70 % of the window
+    assert session_window(s) == ((600, 400), 180)
+    s.camera = None
+    assert session_window(s) is None
+
+
+def _bad_sessions(tmp_path, sphere) -> dict[str, str]:
+    (tmp_path / "notjson.json").write_text("{ not json")
+    (tmp_path / "newer.json").write_text('{"format": "meshlap-session", "version": 9}')
+    (tmp_path / "nomesh.json").write_text(
+        '{"format": "meshlap-session", "version": 1, "mesh": "gone.obj"}'
+    )
+    _session_file(tmp_path, sphere, name="vertex.json", onering={"vertex": 10**6})
+    _session_file(tmp_path, sphere, panel="curvature", name="curv.json")
+    _session_file(tmp_path, sphere, panel="onering", name="ring.json")
+    _session_file(tmp_path, sphere, panel="spectral", name="sp.json")
+    _session_file(tmp_path, sphere, name="ok.json")
+    _session_file(tmp_path, sphere, name="cam.json", camera={"windowWidth": "wide"})
+    _session_file(tmp_path, sphere, name="lecture.gif")  # a session file with a .gif name
+    gifmesh = tmp_path / "mesh.gif"  # a mesh whose name ends in .gif
+    gifmesh.write_bytes(sphere.read_bytes())
+    _session_file(tmp_path, gifmesh, name="gifmesh.json")
+    return {"dir": str(tmp_path), "sphere": str(sphere)}
+
+
+@pytest.mark.parametrize(
+    ("args", "needle"),
+    [
+        (["--session", "{dir}/notjson.json"], "not JSON"),
+        (["--session", "{dir}/newer.json"], "newer meshlap"),
+        (["--session", "{dir}/missing.json"], "cannot read the session"),
+        (["--session", "{dir}/nomesh.json"], "does not exist"),
+        (["--session", "{dir}/vertex.json"], '"onering.vertex" 1000000 is out of range'),
+        (["--session", "{dir}/curv.json"], "curvature panel, which has no animation"),
+        (["--session", "{dir}/ring.json"], "--panel smoothing|spectral|surfaces"),
+        (["--session", "{dir}/sp.json", "--k", "1:3", "--modes", "1:3"], "exactly one"),
+        (["--session", "{dir}/sp.json", "--k", "5:2"], "--k"),
+        (["--session", "{dir}/ok.json", "--lam", "-1"], "--lam"),
+        (["{sphere}", "--session", "{dir}/ok.json"], "MESH cannot be combined"),
+        (["--session", "{dir}/cam.json"], '"camera.windowWidth"'),
+        (["--session", "{dir}/cam.json", "--size", "300x200"], '"camera.windowWidth"'),
+        (["--session", "{dir}/ok.json", "--size", "10x10"], "--size"),
+        (["{sphere}"], "--panel"),
+    ],
+)
+def test_bad_sessions_fail_before_rendering(args, needle, sphere, tmp_path, capsys, no_render):
+    names = _bad_sessions(tmp_path, sphere)
+    before = sorted(p.name for p in tmp_path.iterdir())
+    out = tmp_path / "a.gif"
+    code = main(["animate", *(a.format(**names) for a in args), "--out", str(out)])
+    assert code == 2
+    assert needle in _err(capsys)
+    assert sorted(p.name for p in tmp_path.iterdir()) == before  # nothing written
+
+
+@pytest.mark.parametrize(
+    ("session", "out", "needle"),
+    [
+        ("ok.json", "missing/a.gif", "does not exist"),
+        ("ok.json", "a.png", "unsupported output type"),
+        ("lecture.gif", "lecture.gif", "overwrite an input"),  # the session file itself
+        ("gifmesh.json", "mesh.gif", "overwrite an input"),  # the session's mesh
+    ],
+)
+def test_session_outputs_never_overwrite_an_input(
+    session, out, needle, sphere, tmp_path, capsys, no_render
+):
+    _bad_sessions(tmp_path, sphere)
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir() if p.is_file()}
+    code = main(["animate", "--session", str(tmp_path / session), "--out", str(tmp_path / out)])
+    assert code == 2 and needle in _err(capsys)
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir() if p.is_file()} == before
+
+
+def test_session_unwritable_out(sphere, tmp_path, capsys, no_render, monkeypatch):
+    import meshlap_core.frames as frames
+
+    path = _session_file(tmp_path, sphere)
+    real = os.access
+    locked = tmp_path / "locked"
+    locked.mkdir()
+    monkeypatch.setattr(frames.os, "access", lambda p, m: False if p == locked else real(p, m))
+    code = main(["animate", "--session", str(path), "--out", str(locked / "a.gif")])
+    assert code == 2 and "permission denied" in _err(capsys)
+    assert list(locked.iterdir()) == []
+
+
+def _teacher_session(viewer, tmp_path, panel: str):
+    """Prepare ``viewer`` as a teacher would (noise, λ, 3 steps; a basis with k = 6, mode 4;
+    the torus at (u, v) = (1, 2)), turn the camera and save on ``panel``."""
+    import polyscope as ps
+    from meshlap_app import session
+
+    mesh = viewer.mesh
+    sm = viewer.panels["smoothing"].state
+    sm.configure(mesh.V, mesh.F, noise_alpha=0.02, seed=5)
+    sm.set_lam(2.0)
+    for _ in range(3):
+        assert sm.step()
+    viewer.panels["smoothing"].push(force=True)
+    spec = viewer.panels["spectral"].state
+    spec.k_request = 12
+    spec.start(mesh.V, mesh.F, background=False)
+    spec.set_mode(4)
+    spec.set_k(6)
+    viewer.surf.set_surface("torus", 30)
+    viewer.surf.set_uv(1.0, 2.0)
+    viewer.set_panel(panel)
+    ps.set_window_size(1200, 700)
+    ps.frame_tick()
+    ps.look_at((0.9, 1.1, 2.6), (0.3, 0.0, 0.0))
+    ps.frame_tick()
+    return session.save(viewer, tmp_path / f"{panel}.json")
+
+
+@pytest.mark.parametrize("panel", ["smoothing", "spectral", "surfaces"])
+def test_session_frames_start_from_the_restored_viewer(panel, viewer, spec_of, tmp_path, mock):
+    """openGL_mock: the generators run on the viewer restored from the session, keep its
+    camera (no re-framing) and caption what the session set."""
+    import json
+
+    import meshlap_app.animate as anim
+    from meshlap_app.state import CurvatureState, MeshState
+    from meshlap_app.viewer import Viewer
+
+    path = _teacher_session(viewer, tmp_path, panel)
+    saved = json.loads(path.read_text())["camera"]
+    spec = spec_of("--session", str(path), "--out", str(tmp_path / "a.gif"), "--frames", "4")
+    mock.clear_user_callback()
+    mock.remove_all_structures()
+    mesh = MeshState()
+    assert mesh.load(spec.mesh)
+    fresh = Viewer(mesh, CurvatureState(), panel=spec.panel)
+    fresh.sync_mesh()
+    assert anim.restore_session(fresh, spec, mesh) == 680  # the window left of the panel
+    assert tuple(mock.get_window_size()) == (1200, 700)
+    generator = {"smoothing": anim.smoothing_frames, "spectral": anim.k_frames}
+    captions = list(generator.get(panel, anim.theta_frames)(fresh, spec))
+    assert len(captions) == anim.frame_count(spec)
+    camera = json.loads(mock.get_view_as_json())
+    np.testing.assert_allclose(camera["viewMat"], saved["viewMat"], atol=1e-6)
+    if panel == "smoothing":
+        assert len(captions) == 4  # iterations 0..3: the last is the saved view
+        assert captions[0].startswith("implicit (uniform L), λ = 2, noise α = 0.02")
+        assert "iteration 0/3" in captions[0] and "iteration 3/3" in captions[-1]
+        np.testing.assert_array_equal(
+            fresh.panels["smoothing"].state.V, viewer.panels["smoothing"].state.V
+        )
+    elif panel == "spectral":
+        assert [c.split("   ")[0] for c in captions] == [f"k = {k} modes" for k in range(1, 7)]
+        assert fresh.panels["spectral"].state.basis.info.from_cache  # the session's basis
+    else:
+        assert all(c.startswith("torus at (u, v) = (1, 2)   θ = ") for c in captions)
+        assert (fresh.surf.u, fresh.surf.v, fresh.surf.res) == (1.0, 2.0, 30)
