@@ -633,3 +633,150 @@ def test_session_frames_start_from_the_restored_viewer(panel, viewer, spec_of, t
     else:
         assert all(c.startswith("torus at (u, v) = (1, 2)   θ = ") for c in captions)
         assert (fresh.surf.u, fresh.surf.v, fresh.surf.res) == (1.0, 2.0, 30)
+
+
+EGL_SAVE = """
+import sys
+from pathlib import Path
+import polyscope as ps
+from meshlap_app import session
+from meshlap_app.state import CurvatureState, MeshState
+from meshlap_app.viewer import Viewer, init_polyscope
+
+mesh = MeshState(); assert mesh.load(None)  # the bundled mesh
+init_polyscope("openGL3_egl")
+viewer = Viewer(mesh, CurvatureState())
+ps.set_build_default_gui_panels(False)
+viewer.sync_mesh()
+ps.set_window_size(1200, 700)
+sm = viewer.panels["smoothing"].state
+sm.configure(mesh.V, mesh.F, noise_alpha=0.02, seed=5)
+sm.set_lam(2.0)
+for _ in range(3):
+    sm.step()
+viewer.panels["smoothing"].push(force=True)
+spec = viewer.panels["spectral"]
+spec.state.k_request = 12
+spec.state.start(mesh.V, mesh.F, background=False)
+spec.state.set_mode(4)
+spec.state.set_k(5)
+viewer.surf.set_surface("torus", 30)
+viewer.surf.set_uv(1.0, 2.0)
+ps.set_user_callback(viewer.callback)
+for panel in ("smoothing", "spectral", "surfaces"):
+    viewer.set_panel(panel)
+    ps.frame_tick()
+    ps.frame_tick()
+    if panel != "surfaces":  # the teacher turns the camera (the torus keeps the framing)
+        ps.look_at((0.9, 1.1, 2.6), (0.3, 0.0, 0.0))
+        ps.frame_tick()
+    session.save(viewer, Path(sys.argv[1]) / f"{panel}.json")
+"""
+
+
+def _egl_sessions(tmp_path) -> None:
+    env = dict(os.environ, MESHLAP_CACHE_DIR=str(tmp_path / "cache"))
+    res = subprocess.run(
+        [sys.executable, "-c", EGL_SAVE, str(tmp_path)],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        cwd=tmp_path,
+        env=env,
+    )
+    assert res.returncode == 0, res.stderr
+
+
+def _differing(a: np.ndarray, b: np.ndarray, tol: int = 40) -> float:
+    """Fraction of pixels whose RGB differ by more than ``tol`` in some channel."""
+    return float((np.abs(a - b).max(axis=2) > tol).mean())
+
+
+@pytest.mark.egl
+def test_session_animations_show_the_saved_view(tmp_path):
+    """EGL: a smoothing session (noise, λ = 2, 3 iterations) animates to iterations 0..3 whose
+    LAST frame is the saved view (`meshlap view --session --screenshot`, cropped left of the
+    panel; frame 0 is the noisy start, not the saved view); a spectral session gives the k
+    sweep 1..5, a surfaces session the θ frames; an explicit --size keeps the picture's centre
+    and vertical extent."""
+    _egl_or_skip()
+    _egl_sessions(tmp_path)
+    view_png = tmp_path / "view.png"
+    env = dict(os.environ, MESHLAP_CACHE_DIR=str(tmp_path / "cache"))
+    cmd = [sys.executable, "-m", "meshlap_core.cli", "view", "--session"]
+    res = subprocess.run(
+        [*cmd, str(tmp_path / "smoothing.json"), "--screenshot", str(view_png)],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        cwd=tmp_path,
+        env=env,
+    )
+    assert res.returncode == 0, res.stderr
+    out = tmp_path / "smoothing.gif"
+    res = _run_cli(tmp_path, "--session", "smoothing.json", "--shadow", "--out", str(out))
+    assert res.returncode == 0, res.stderr
+    frames = _read_gif(out)
+    assert len(frames) == 4 and frames[0].shape == (700, 680, 3)  # 1200 - 520 panel pixels
+    view = np.asarray(Image.open(view_png).convert("RGB")).astype(int)
+    assert view.shape == (700, 1200, 3)
+    _, y0, _, _ = caption_box(700, 680)
+    saved = view[:y0, :680]  # the window left of meshlap's panel
+    # the viewer writes its own small captions under the two meshes: < 1 % of the pixels
+    assert _differing(frames[-1][:y0], saved) < 0.01
+    assert _differing(frames[0][:y0], saved) > 0.015  # iteration 0: the noisy copy
+    assert np.abs(frames[-1][:y0] - saved).mean() < 6  # GIF palette round-off only
+
+    # an explicit size: same vertical extent, centred on the saved view's centre
+    for size in ("340x350", "480x350"):
+        res = _run_cli(
+            tmp_path, "--session", "smoothing.json", "--iters", "0", "--size", size,
+            "--out", str(tmp_path / f"{size}.gif"),
+        )  # fmt: skip
+        assert res.returncode == 0, res.stderr
+    narrow, wide = (_read_gif(tmp_path / f"{s}.gif")[0] for s in ("340x350", "480x350"))
+    assert narrow.shape == (350, 340, 3) and wide.shape == (350, 480, 3)
+    _, y1, _, _ = caption_box(350, 480)
+    assert _differing(narrow[:y1], wide[:y1, 70:410]) < 0.01  # the middle 340 columns
+    half = frames[0][::2, ::2][:y1]  # the default size at half scale: the same picture
+    assert _differing(narrow[:y1], half) < 0.05
+
+    res = _run_cli(tmp_path, "--session", "spectral.json", "--out", str(tmp_path / "k.gif"))
+    assert res.returncode == 0, res.stderr
+    k = _read_gif(tmp_path / "k.gif")
+    assert len(k) == 5 and k[0].shape == (700, 680, 3)  # k = 1..5, the session's k
+    assert not np.array_equal(k[1], k[4])
+    res = _run_cli(
+        tmp_path, "--session", "surfaces.json", "--frames", "4", "--out", str(tmp_path / "t.gif")
+    )
+    assert res.returncode == 0, res.stderr
+    theta = _read_gif(tmp_path / "t.gif")
+    assert len(theta) == 4 and theta[0].shape == (700, 680, 3)
+    assert not np.array_equal(theta[0], theta[1])  # the section turns
+
+
+def test_session_on_another_panel_is_framed_as_without_a_session(viewer, spec_of, tmp_path, mock):
+    """--panel other than the session's: its camera framed other structures, so the view is
+    framed as without --session, at the requested (default: the saved view's) size."""
+    import json
+
+    import meshlap_app.animate as anim
+    from meshlap_app.state import CurvatureState, MeshState
+    from meshlap_app.viewer import Viewer
+
+    path = _teacher_session(viewer, tmp_path, "curvature")
+    saved = json.loads(path.read_text())["camera"]
+    spec = spec_of("--session", str(path), "--panel", "smoothing", "--out", str(tmp_path / "a.gif"))
+    assert spec.size == (680, 700) and spec.iters == 3
+    mock.clear_user_callback()
+    mock.remove_all_structures()
+    mesh = MeshState()
+    assert mesh.load(spec.mesh)
+    fresh = Viewer(mesh, CurvatureState(), panel=spec.panel)
+    fresh.sync_mesh()
+    assert anim.restore_session(fresh, spec, mesh) is None  # nothing cropped
+    assert fresh.panel == "smoothing" and tuple(mock.get_window_size()) == (680, 700)
+    captions = list(anim.smoothing_frames(fresh, spec))
+    assert len(captions) == 4 and "iteration 3/3" in captions[-1]
+    camera = json.loads(mock.get_view_as_json())
+    assert not np.allclose(camera["viewMat"], saved["viewMat"], atol=1e-3)  # re-framed
