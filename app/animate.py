@@ -20,6 +20,7 @@ panel (:func:`session_window`).
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import sys
 import weakref
@@ -289,7 +290,10 @@ def restore_session(viewer: Viewer, spec: AnimationSpec, mesh: MeshState) -> int
 
     The session's camera is kept (no re-framing) when the animated panel is the session's; on
     another panel (its camera framed other structures) or without a camera, the window is
-    ``spec.size`` and the frame generators frame the view as without a session.
+    ``spec.size`` and the frame generators frame the view as without a session. What the
+    frames do not show is not restored: the smoothing is not replayed to the saved iteration
+    (the frames run it from iteration 0: the last frame is the saved iteration) and the
+    eigenbasis is read only for the spectral panel.
     """
     from .session import apply
 
@@ -297,6 +301,11 @@ def restore_session(viewer: Viewer, spec: AnimationSpec, mesh: MeshState) -> int
     source = spec.session_file or "--session"
     window = session_window(session, spec.size, source)
     keep_camera = window is not None and session.panel == spec.panel
+    settings = copy.deepcopy(session.settings)
+    settings["smoothing"]["iterations"] = 0  # the frames run the smoothing from iteration 0
+    if spec.panel != "spectral":
+        settings["spectral"]["computed"] = False  # no eigenbasis needed in the frames
+    session = dataclasses.replace(session, settings=settings)
     if session.camera is not None:
         camera = dict(session.camera)
         size = window[0] if keep_camera and window is not None else spec.size
@@ -336,13 +345,21 @@ def viewer_framed() -> tuple[str, ...]:
 
 
 def smoothing_frames(viewer: Viewer, spec: AnimationSpec) -> Iterator[str]:
-    """Iterations 0..iters of the Smoothing panel's stepper (input beside the smoothed copy)."""
+    """Iterations 0..iters of the Smoothing panel's stepper (input beside the smoothed copy).
+
+    A stepper already built with the same options (a restored session) is reset to iteration
+    0 and kept (same noise: same seed); otherwise it is rebuilt with the options of ``spec``.
+    """
     panel = viewer.panels["smoothing"]
     st = panel.state
-    st.method, st.laplacian, st.lam = spec.method, spec.laplacian, spec.lam
-    st.noise_alpha, st.seed = spec.noise, spec.seed
-    if not st.rebuild(viewer.mesh.V, viewer.mesh.F):
-        raise MeshError(st.error)
+    options = (spec.method, spec.laplacian, spec.lam, spec.noise, spec.seed)
+    current = (st.method, st.laplacian, st.lam, st.noise_alpha, st.seed)
+    if st.smoother is not None and current == options:
+        st.reset()
+    else:
+        st.method, st.laplacian, st.lam, st.noise_alpha, st.seed = options
+        if not st.rebuild(viewer.mesh.V, viewer.mesh.F):
+            raise MeshError(st.error)
     panel.push(force=True)
     viewer.show_panel()
     frame_view(viewer, strip=0.0)  # no colour map: no colour bar

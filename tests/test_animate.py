@@ -496,6 +496,7 @@ def _bad_sessions(tmp_path, sphere) -> dict[str, str]:
     _session_file(tmp_path, sphere, panel="onering", name="ring.json")
     _session_file(tmp_path, sphere, panel="spectral", name="sp.json")
     _session_file(tmp_path, sphere, name="ok.json")
+    _session_file(tmp_path, sphere, name="long.json", smoothing={"iterations": 6000})
     _session_file(tmp_path, sphere, name="cam.json", camera={"windowWidth": "wide"})
     _session_file(tmp_path, sphere, name="lecture.gif")  # a session file with a .gif name
     gifmesh = tmp_path / "mesh.gif"  # a mesh whose name ends in .gif
@@ -522,6 +523,7 @@ def _bad_sessions(tmp_path, sphere) -> dict[str, str]:
         (["--session", "{dir}/cam.json", "--size", "300x200"], '"camera.windowWidth"'),
         (["--session", "{dir}/ok.json", "--size", "10x10"], "--size"),
         (["{sphere}"], "--panel"),
+        (["--session", "{dir}/long.json"], "ran 6000 iterations; an animation has at most 5000"),
     ],
 )
 def test_bad_sessions_fail_before_rendering(args, needle, sphere, tmp_path, capsys, no_render):

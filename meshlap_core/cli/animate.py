@@ -180,6 +180,12 @@ def _from_session(args: argparse.Namespace) -> Any:
             )
         args.panel = session.panel
     sm, sp, sf = (session.settings[s] for s in ("smoothing", "spectral", "surfaces"))
+    if args.panel == "smoothing" and args.iters is None and sm["iterations"] > 5000:
+        raise MeshError(
+            f"the session's smoothing ran {sm['iterations']} iterations; an animation has at "
+            "most 5000: give --iters N",
+            args.session,
+        )
     saved = {
         "method": sm["method"],
         "laplacian": sm["laplacian"],
