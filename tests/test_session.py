@@ -678,3 +678,34 @@ def test_cli_refuses_bad_lam_steps_in_one_line(tmp_path, sphere, capsys):
     err = capsys.readouterr().err
     assert code == 2 and err.count("\n") == 1
     assert err.startswith("meshlap: error: ") and '"smoothing.lam_steps" entry 0: lam' in err
+
+
+@pytest.mark.parametrize("method, laplacian", [("implicit", "cotan"), ("taubin", "uniform")])
+def test_every_method_replays_lam_changes_exactly(
+    mock, tmp_path, sphere, monkeypatch, method, laplacian
+):
+    """The implicit system is refactorized per λ and Taubin's ν follows λ: both replay bit for
+    bit, including a λ set before the first step and one set after the last."""
+    from meshlap_app import session
+
+    monkeypatch.setenv("MESHLAP_CACHE_DIR", str(tmp_path / "cache"))
+    viewer = new_viewer(sphere)
+    st = viewer.panels["smoothing"].state
+    V, F = viewer.mesh.V, viewer.mesh.F
+    st.configure(V, F, method=method, laplacian=laplacian, noise_alpha=0.03, seed=2)
+    lams = (0.02, 0.05, 0.02) if laplacian == "cotan" else (0.3, 0.6, 0.3)
+    st.set_lam(lams[0])  # before any step: the run starts at lams[0], not the built 0.5
+    for lam, steps in zip(lams, (2, 3, 1), strict=True):
+        st.set_lam(lam)
+        for _ in range(steps):
+            assert st.step()
+    st.set_lam(lams[1])
+    assert st.lam_steps == [[lams[0], 2], [lams[1], 3], [lams[2], 1]]
+    viewer.set_panel("smoothing")
+    path = session.save(viewer, tmp_path / f"{method}.json")
+    fresh = new_viewer(sphere)
+    session.load(fresh, path)
+    st2 = fresh.panels["smoothing"].state
+    assert st2.smoother.method == method and st2.lam == lams[1]
+    assert np.array_equal(st2.V, st.V)
+    assert st2.lam_steps == st.lam_steps
