@@ -93,9 +93,9 @@ def is_number(cell: str) -> bool:
 
 @dataclass
 class TableRecord:
-    """What :meth:`UI.table` drew on the last frame: ``headers`` (with their ``tips``), every
-    row's ``cells`` (strings, as shown), each row's colour (``None``: the text colour) and the
-    indices of the ``highlighted`` rows."""
+    """What :meth:`UI.table` drew the last time it was drawn: ``headers`` (with their ``tips``),
+    every row's ``cells`` (strings, as shown), each row's colour (``None``: the text colour),
+    the indices of the ``highlighted`` rows, and its measured ``width``."""
 
     headers: list[str]
     tips: list[str] = field(default_factory=list)
@@ -103,7 +103,7 @@ class TableRecord:
     colors: list[tuple[float, float, float, float] | None] = field(default_factory=list)
     highlighted: list[int] = field(default_factory=list)
     width: float = 0.0  # pixels, as drawn (0 when imgui skipped it)
-    avail: float = 0.0  # pixels the panel had left of the table's row
+    avail: float = 0.0  # pixels of panel width available where the table starts
 
     def flagged(self) -> list[list[str]]:
         """The rows drawn in a colour of their own."""
