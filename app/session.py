@@ -18,7 +18,14 @@ import polyscope as ps
 from meshlap_core.errors import MeshError
 
 from .state.mesh import MeshState
-from .state.session import Session, check_vertex, read_session, write_session
+from .state.session import (
+    Session,
+    check_vertex,
+    encode_lam_steps,
+    read_session,
+    replay_steps,
+    write_session,
+)
 
 if TYPE_CHECKING:
     from .viewer import Viewer
@@ -75,6 +82,7 @@ def capture(viewer: Viewer) -> Session:
         noise_alpha=float(sm.noise_alpha),
         seed=int(sm.seed),
         iterations=int(sm.smoother.iteration) if sm.smoother is not None else 0,
+        lam_steps=encode_lam_steps(sm.lam_steps, sm.lam) if sm.smoother is not None else None,
     )
     s.settings["surfaces"].update(surface=surf.name, res=int(surf.res), u=surf.u, v=surf.v)
     return s
@@ -192,19 +200,26 @@ def _apply_spectral(viewer: Viewer, sp: dict[str, Any]) -> None:
 
 
 def _apply_smoothing(viewer: Viewer, sm: dict[str, Any], shown: bool) -> None:
-    """Options; when the run had steps (or its panel is shown), rebuild and replay them."""
+    """Options; when the run had steps (or its panel is shown), rebuild and replay them, each
+    run of steps with the λ it used (``lam_steps``), then set the saved ``lam``."""
     panel = viewer.panels["smoothing"]
     state = panel.state
+    runs = replay_steps(sm)
     state.method, state.laplacian = sm["method"], sm["laplacian"]
-    state.lam, state.noise_alpha, state.seed = sm["lam"], sm["noise_alpha"], sm["seed"]
+    state.lam = runs[0][0] if runs else sm["lam"]  # the stepper is built with the first λ
+    state.noise_alpha, state.seed = sm["noise_alpha"], sm["seed"]
     state.smoother, state.playing = None, False
     if not (shown or sm["iterations"]):
+        state.lam = sm["lam"]
         return
     if not state.rebuild(viewer.mesh.V, viewer.mesh.F):
+        state.lam = sm["lam"]
         return  # said in the Smoothing panel
-    for _ in range(sm["iterations"]):
-        if not state.step():
+    for lam, steps in runs:
+        state.set_lam(lam)
+        if not all(state.step() for _ in range(steps)):
             break  # a diverging run stops where it stopped when it was saved
+    state.set_lam(sm["lam"])
     panel.push(force=True)
 
 

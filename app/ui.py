@@ -11,8 +11,10 @@ Every widget of every panel is drawn through a :class:`UI`. It calls the real im
   (and presses Enter) on one frame and ``0.5`` on the next;
 - **records** the label of every interactive widget it drew (``seen``, per section) and of every
   scripted one (``driven``), so a test fails when a panel has a widget no test drives;
-- keeps imgui's begin/end pairs balanced even when a handler raises (``plot`` and ``choose``
-  close what they opened in a ``finally``).
+- **records the tables** it drew (``tables``, per section and table id: headers, every row's
+  cells, flagged and highlighted rows), so a test reads what a panel listed without pixels;
+- keeps imgui's begin/end pairs balanced even when a handler raises (``plot``, ``table`` and
+  ``choose`` close what they opened in a ``finally``).
 
 Numeric fields apply on Enter only (``ImGuiInputTextFlags_EnterReturnsTrue``): a half-typed
 number (the ``0`` of ``0.5``) is never applied.
@@ -24,12 +26,15 @@ import math
 from collections import deque
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 RED = (1.0, 0.35, 0.35, 1.0)
 GREY = (0.7, 0.7, 0.7, 1.0)
+HIGHLIGHT = (0.95, 0.75, 0.2, 0.35)  # the background of a highlighted table row
+TABLE_ROWS = ((0.11, 0.11, 0.12, 0.94), (0.17, 0.17, 0.19, 0.94))  # opaque: readable over 3D
 
 # the return types the adapter was written for (polyscope 2.6.x; pyproject pins the range)
 EXPECTED: dict[str, tuple[type, ...]] = {
@@ -45,6 +50,7 @@ EXPECTED: dict[str, tuple[type, ...]] = {
     "InputInt": (bool, int),
     "InputText": (bool, str),
     "BeginPlot": (bool,),
+    "BeginTable": (bool,),
 }
 
 
@@ -70,6 +76,43 @@ def sig(x: float, scale: float, digits: int = 4) -> str:
     if abs(x) < 1e-12 * abs(scale) or x == 0:
         return "0"
     return f"{x:.{digits}g}"
+
+
+def is_number(cell: str) -> bool:
+    """Is the table cell a number (``-0.5007``, ``38.07°``, ``1e-05``)? Those are right-aligned;
+    ``-`` (no value) is too, so a column of numbers stays one column."""
+    t = cell.strip().rstrip("°")
+    if t == "-":
+        return True
+    try:
+        float(t)
+    except ValueError:
+        return False
+    return True
+
+
+@dataclass
+class TableRecord:
+    """What :meth:`UI.table` drew the last time it was drawn: ``headers`` (with their ``tips``),
+    every row's ``cells`` (strings, as shown), each row's colour (``None``: the text colour),
+    the indices of the ``highlighted`` rows, and its measured ``width``."""
+
+    headers: list[str]
+    tips: list[str] = field(default_factory=list)
+    rows: list[list[str]] = field(default_factory=list)
+    colors: list[tuple[float, float, float, float] | None] = field(default_factory=list)
+    highlighted: list[int] = field(default_factory=list)
+    width: float = 0.0  # pixels, as drawn (0 when imgui skipped it)
+    avail: float = 0.0  # pixels of panel width available where the table starts
+
+    def flagged(self) -> list[list[str]]:
+        """The rows drawn in a colour of their own."""
+        return [r for r, c in zip(self.rows, self.colors, strict=True) if c is not None]
+
+    def column(self, header: str) -> list[str]:
+        """The cells of the column ``header``, top to bottom."""
+        k = self.headers.index(header)
+        return [r[k] for r in self.rows]
 
 
 class UIApiMismatch(TypeError):
@@ -145,6 +188,9 @@ class UI:
         self.driven: set[tuple[str, str]] = set()
         self.changed = False  # some widget reported a change since begin_section
         self._script: dict[str, deque[Any]] = {}
+        self.tables: dict[tuple[str, str], TableRecord] = {}  # (section, id) -> last drawn
+        self._table: TableRecord | None = None  # the table being drawn
+        self._table_shown = False
 
     # ------------------------------------------------------------------ set-up
     @property
@@ -397,6 +443,90 @@ class UI:
 
     def plot_hlines(self, label: str, y: Any) -> None:
         self.ip.PlotInfLines(label, _f64(y), self.ip.ImPlotInfLinesFlags_Horizontal)
+
+    # ------------------------------------------------------------------ tables
+    @contextmanager
+    def table(
+        self, table_id: str, headers: Sequence[str], tips: Sequence[str] = ()
+    ) -> Iterator[bool]:
+        """``with ui.table(id, headers, tips) as shown:`` then :meth:`row` per row: an ImGui
+        table with borders, alternating (nearly opaque, so the 3D view behind the panel does
+        not show through) row shades, columns as wide as their widest cell, and each header's
+        tooltip from ``tips``. EndTable always runs; the table is recorded in :attr:`tables`
+        (also when imgui skips drawing it, e.g. a collapsed window)."""
+        record = TableRecord(list(headers), list(tips))
+        self.tables[(self.section, table_id)] = record
+        im = self.im
+        flags = (
+            im.ImGuiTableFlags_Borders
+            | im.ImGuiTableFlags_RowBg
+            | im.ImGuiTableFlags_SizingFixedFit
+            | im.ImGuiTableFlags_NoHostExtendX
+        )
+        record.avail = float(im.GetContentRegionAvail()[0])
+        im.PushStyleColor(im.ImGuiCol_TableRowBg, TABLE_ROWS[0])
+        im.PushStyleColor(im.ImGuiCol_TableRowBgAlt, TABLE_ROWS[1])
+        shown = False
+        try:
+            shown = check_return("BeginTable", im.BeginTable(table_id, len(record.headers), flags))
+            self._table, self._table_shown = record, shown
+            if shown:
+                for h in record.headers:
+                    im.TableSetupColumn(h)
+                im.TableNextRow(im.ImGuiTableRowFlags_Headers)
+                for k, h in enumerate(record.headers):
+                    im.TableSetColumnIndex(k)
+                    im.TableHeader(h)
+                    if k < len(record.tips) and record.tips[k]:
+                        im.SetItemTooltip(record.tips[k])
+            yield shown
+        finally:
+            self._table, self._table_shown = None, False
+            if shown:
+                im.EndTable()
+                record.width = float(im.GetItemRectSize()[0])
+            im.PopStyleColor(2)
+
+    def row(
+        self,
+        cells: Sequence[str],
+        rgba: tuple[float, float, float, float] | None = None,
+        highlight: bool = False,
+    ) -> None:
+        """One row of the open :meth:`table`: numbers right-aligned, the whole row in ``rgba``
+        when given (a flagged row), its background lit when ``highlight``.
+
+        Raises
+        ------
+        RuntimeError
+            Outside ``with ui.table(...)``, or with more cells than the table has columns.
+        """
+        record = self._table
+        if record is None:
+            raise RuntimeError("ui.row() outside a ui.table() block")
+        cells = [str(c) for c in cells]
+        if len(cells) > len(record.headers):
+            raise RuntimeError(f"{len(cells)} cells for {len(record.headers)} columns")
+        record.rows.append(cells)
+        record.colors.append(rgba)
+        if highlight:
+            record.highlighted.append(len(record.rows) - 1)
+        if not self._table_shown:
+            return
+        im = self.im
+        im.TableNextRow()
+        if highlight:
+            im.TableSetBgColor(im.ImGuiTableBgTarget_RowBg1, im.GetColorU32(HIGHLIGHT))
+        for k, cell in enumerate(cells):
+            im.TableSetColumnIndex(k)
+            if is_number(cell):
+                free = im.GetContentRegionAvail()[0] - im.CalcTextSize(cell)[0]
+                if free > 0:
+                    im.SetCursorPosX(im.GetCursorPosX() + free)
+            if rgba is None:
+                im.TextUnformatted(cell)
+            else:
+                im.TextColored(rgba, cell)
 
     # ------------------------------------------------------------------ overlay, keys
     def key(self, name: str) -> bool:

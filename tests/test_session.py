@@ -58,6 +58,7 @@ def non_default_session(mesh) -> Session:
             "noise_alpha": 0.01,
             "seed": 7,
             "iterations": 5,
+            "lam_steps": [[0.5, 2], [0.25, 3]],
         },
         "surfaces": {"surface": "torus", "res": 30, "u": 1.25, "v": -0.5},
     }
@@ -511,3 +512,200 @@ def test_render_of_a_loaded_session_equals_the_render_when_saved(tmp_path, panel
     assert scene_part.mean() > 0.05  # something is drawn
     differs = np.abs(a - b).max(axis=2) > 2 / 255  # pixel tolerance: 2 levels of 255
     assert differs.mean() < 0.002, f"{differs.mean():.4%} of the pixels differ"
+
+
+# ---------------------------------------------------------------- λ changed during a run
+def drive_smoothing(viewer, label, *values) -> None:
+    """Give the Smoothing panel's widget ``label`` one value per frame."""
+    viewer.set_panel("smoothing")
+    for value in values:
+        viewer.ui.script(label, value)
+        tick(viewer)
+
+
+def test_lam_changed_mid_run_is_replayed_bit_for_bit(mock, tmp_path, sphere, monkeypatch):
+    from meshlap_app import session
+
+    monkeypatch.setenv("MESHLAP_CACHE_DIR", str(tmp_path / "cache"))
+    viewer = new_viewer(sphere)
+    st = viewer.panels["smoothing"].state
+    drive_smoothing(viewer, "method", "explicit")
+    drive_smoothing(viewer, "noise alpha", 0.02)
+    drive_smoothing(viewer, "step", *[True] * 4)  # 4 steps at the default 0.5
+    drive_smoothing(viewer, "lambda", "0.9")  # typed in the window: the mesh is kept
+    drive_smoothing(viewer, "step", *[True] * 3)
+    drive_smoothing(viewer, "lambda", "0.1")
+    drive_smoothing(viewer, "step", True, True)
+    drive_smoothing(viewer, "lambda", "0.3")  # set, not used yet: the next step's λ
+    assert st.smoother.iteration == 9 and st.lam == 0.3
+    assert st.lam_steps == [[0.5, 4], [0.9, 3], [0.1, 2]]
+    V_run = np.array(st.V)
+    path = session.save(viewer, tmp_path / "run.json")
+    saved = json.loads(path.read_text())["smoothing"]
+    assert saved["lam_steps"] == [[0.5, 4], [0.9, 3], [0.1, 2]] and saved["lam"] == 0.3
+    assert saved["iterations"] == 9
+
+    fresh = new_viewer(sphere)
+    session.load(fresh, path)
+    tick(fresh)
+    st2 = fresh.panels["smoothing"].state
+    assert np.array_equal(st2.V, V_run)  # bit for bit
+    assert st2.smoother.iteration == 9 and st2.lam == st2.smoother.lam == 0.3
+    assert (
+        session.capture(fresh).settings["smoothing"]
+        == session.capture(viewer).settings["smoothing"]
+    )
+    assert st.step() and st2.step()  # the next step uses the λ set last, in both
+    assert np.array_equal(st2.V, st.V) and st2.lam_steps[-1] == [0.3, 1]
+
+    # the same file without lam_steps (version 1 before it): 9 steps at 0.3, another mesh
+    old = dict(saved)
+    del old["lam_steps"]
+    data = json.loads(path.read_text())
+    data["smoothing"] = old
+    (tmp_path / "old.json").write_text(json.dumps(data))
+    other = new_viewer(sphere)
+    session.load(other, tmp_path / "old.json")
+    st3 = other.panels["smoothing"].state
+    assert st3.smoother.iteration == 9 and st3.lam_steps == [[0.3, 9]]
+    assert not np.array_equal(st3.V, V_run)  # so the test above proves the replay
+    assert float(np.abs(st3.V - V_run).max()) > 1e-4
+
+
+def test_lam_steps_written_only_when_lam_changed(mock, tmp_path, sphere, monkeypatch):
+    """A run at one λ is saved as before (no ``lam_steps``: older meshlaps still read it);
+    reset and a rebuild start a new record."""
+    from meshlap_app import session
+
+    monkeypatch.setenv("MESHLAP_CACHE_DIR", str(tmp_path / "cache"))
+    viewer = new_viewer(sphere)
+    st = viewer.panels["smoothing"].state
+    drive_smoothing(viewer, "step", True, True)
+    assert st.lam_steps == [[0.5, 2]]
+    assert session.capture(viewer).settings["smoothing"]["lam_steps"] is None
+    drive_smoothing(viewer, "lambda", "0.7")  # changed after the last step: must be saved
+    assert session.capture(viewer).settings["smoothing"]["lam_steps"] == [[0.5, 2]]
+    drive_smoothing(viewer, "reset", True)
+    assert st.lam_steps == [] and session.capture(viewer).settings["smoothing"]["lam_steps"] is None
+    drive_smoothing(viewer, "step", True)
+    drive_smoothing(viewer, "Laplacian", "cotan")  # a rebuild: iteration 0, a new record
+    assert st.lam_steps == [] and st.smoother.iteration == 0
+    path = session.save(viewer, tmp_path / "plain.json")
+    assert "lam_steps" not in json.loads(path.read_text())["smoothing"] or (
+        json.loads(path.read_text())["smoothing"]["lam_steps"] is None
+    )
+
+
+def test_old_format_file_replays_iterations_at_lam(tmp_path, sphere):
+    from meshlap_app.state.session import replay_steps
+
+    path = tmp_path / "v1.json"
+    path.write_text(
+        json.dumps(
+            {
+                "format": "meshlap-session",
+                "version": 1,
+                "mesh": "sphere.obj",
+                "smoothing": {"method": "explicit", "lam": 0.25, "iterations": 7},
+            }
+        )
+    )
+    s = read_session(path)
+    assert s.settings["smoothing"]["lam_steps"] is None
+    assert replay_steps(s.settings["smoothing"]) == [[0.25, 7]]
+    s.settings["smoothing"]["iterations"] = 0
+    assert replay_steps(s.settings["smoothing"]) == []
+    path.write_text(
+        json.dumps(
+            {
+                "format": "meshlap-session",
+                "version": 1,
+                "smoothing": {"lam": 2, "iterations": 3, "lam_steps": [[1, 1], [0.5, 2]]},
+            }
+        )
+    )
+    sm = read_session(path).settings["smoothing"]
+    assert sm["lam_steps"] == [[1.0, 1], [0.5, 2]] and isinstance(sm["lam_steps"][0][0], float)
+    assert replay_steps(sm) == [[1.0, 1], [0.5, 2]]
+
+
+BAD_LAM_STEPS = [
+    ('"0.5"', "must be a list of [lam, steps] pairs"),
+    ("{}", "must be a list of [lam, steps] pairs"),
+    ("[0.5, 3]", "entry 0 must be a [lam, steps] pair"),
+    ("[[0.5, 3, 1]]", "entry 0 must be a [lam, steps] pair"),
+    ("[[0, 3]]", "entry 0: lam must be > 0"),
+    ("[[0.5, 1], [-1, 2]]", "entry 1: lam must be > 0"),
+    ("[[NaN, 3]]", "entry 0: lam must be a finite number"),
+    ("[[Infinity, 3]]", "entry 0: lam must be a finite number"),
+    ('[["0.5", 3]]', "entry 0: lam must be a finite number"),
+    ("[[true, 3]]", "entry 0: lam must be a finite number"),
+    ("[[0.5, 0], [1.0, 3]]", "entry 0: steps must be >= 1"),
+    ("[[0.5, 1.5]]", "entry 0: steps must be an integer"),
+    ("[[0.5, 2], [1.0, 2]]", 'counts 4 steps but "smoothing.iterations" is 3'),
+    ("[]", '"smoothing.lam_steps" counts 0 steps but "smoothing.iterations" is 3'),
+]
+
+
+@pytest.mark.parametrize("value, message", BAD_LAM_STEPS)
+def test_bad_lam_steps_are_one_clear_error(tmp_path, value, message):
+    path = tmp_path / "bad.json"
+    path.write_text(
+        '{"format": "meshlap-session", "version": 1, '
+        f'"smoothing": {{"iterations": 3, "lam_steps": {value}}}}}'
+    )
+    with pytest.raises(MeshError) as err:
+        read_session(path)
+    text = str(err.value)
+    assert text.startswith(str(path)) and message in text and "\n" not in text
+    if "counts" not in message:
+        assert '"smoothing.lam_steps"' in text
+
+
+def test_cli_refuses_bad_lam_steps_in_one_line(tmp_path, sphere, capsys):
+    path = tmp_path / "bad.json"
+    path.write_text(
+        json.dumps(
+            {
+                "format": "meshlap-session",
+                "version": 1,
+                "mesh": str(sphere),
+                "smoothing": {"iterations": 2, "lam_steps": [[-0.5, 2]]},
+            }
+        )
+    )
+    code = main(["view", "--session", str(path)])
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1
+    assert err.startswith("meshlap: error: ") and '"smoothing.lam_steps" entry 0: lam' in err
+
+
+@pytest.mark.parametrize("method, laplacian", [("implicit", "cotan"), ("taubin", "uniform")])
+def test_every_method_replays_lam_changes_exactly(
+    mock, tmp_path, sphere, monkeypatch, method, laplacian
+):
+    """The implicit system is refactorized per λ and Taubin's ν follows λ: both replay bit for
+    bit, including a λ set before the first step and one set after the last."""
+    from meshlap_app import session
+
+    monkeypatch.setenv("MESHLAP_CACHE_DIR", str(tmp_path / "cache"))
+    viewer = new_viewer(sphere)
+    st = viewer.panels["smoothing"].state
+    V, F = viewer.mesh.V, viewer.mesh.F
+    st.configure(V, F, method=method, laplacian=laplacian, noise_alpha=0.03, seed=2)
+    lams = (0.02, 0.05, 0.02) if laplacian == "cotan" else (0.3, 0.6, 0.3)
+    st.set_lam(lams[0])  # before any step: the run starts at lams[0], not the built 0.5
+    for lam, steps in zip(lams, (2, 3, 1), strict=True):
+        st.set_lam(lam)
+        for _ in range(steps):
+            assert st.step()
+    st.set_lam(lams[1])
+    assert st.lam_steps == [[lams[0], 2], [lams[1], 3], [lams[2], 1]]
+    viewer.set_panel("smoothing")
+    path = session.save(viewer, tmp_path / f"{method}.json")
+    fresh = new_viewer(sphere)
+    session.load(fresh, path)
+    st2 = fresh.panels["smoothing"].state
+    assert st2.smoother.method == method and st2.lam == lams[1]
+    assert np.array_equal(st2.V, st.V)
+    assert st2.lam_steps == st.lam_steps

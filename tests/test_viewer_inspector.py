@@ -296,8 +296,10 @@ def test_negative_weights_drawn_and_listed(viewer, tmp_path):
         del ui.colored, ui.text
     neg = ps.get_curve_network(scene.INSPECT_NEGATIVE)
     assert neg.n_edges() == 2
-    flagged = [t for t, rgba in shown if rgba is not None and "< 0" in t]
-    assert len(flagged) == 2 and all(t.split(":")[0] in ("43", "65") for t in flagged)
+    flagged = ui.tables[("onering", "weights")].flagged()  # the magenta rows of the table
+    assert sorted(r[0] for r in flagged) == ["43", "65"] and all(
+        r[4].startswith("-") for r in flagged
+    )
     assert any(t.startswith("K = deficit / A_i") for t, _ in shown)
     assert any(t.startswith("L_cotan x = (1/A_i)") for t, _ in shown)
     assert any("magenta edges: negative w_ij (2)" in t for t, _ in shown)

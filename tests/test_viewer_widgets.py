@@ -107,6 +107,7 @@ def test_installed_polyscope_returns_what_the_adapter_expects(mock):
         "InputInt": lambda: psim.InputInt("ii", 1),
         "InputText": lambda: psim.InputText("it", "x"),
         "BeginPlot": lambda: psimplot.BeginPlot("p"),
+        "BeginTable": lambda: psim.BeginTable("t", 2),
     }
     assert set(calls) == set(EXPECTED)
     results = {}
@@ -118,6 +119,8 @@ def test_installed_polyscope_returns_what_the_adapter_expects(mock):
                 psim.EndCombo()
             if name == "BeginPlot" and results[name]:
                 psimplot.EndPlot()
+            if name == "BeginTable" and results[name]:
+                psim.EndTable()
 
     ps.set_user_callback(callback)
     ps.frame_tick()

@@ -12,7 +12,7 @@ import numpy as np
 import polyscope as ps
 
 from meshlap_core.errors import MeshError
-from meshlap_core.inspector import VertexInspection, format_inspection
+from meshlap_core.inspector import FaceTerm, NeighbourTerm, VertexInspection, format_inspection
 from meshlap_core.options import AREA_KINDS, BOUNDARY_RULES
 
 from .. import scene
@@ -78,6 +78,7 @@ class OneRingPanel:
         self.clock = clock
         self.throttle = HoverThrottle()
         self.hovered = ""  # the text shown at the cursor ("" over nothing)
+        self.hovered_vertex = -1  # the mesh vertex under the cursor (its table row is lit)
         self.picks = 0  # hover picks done (the throttle keeps this low)
         self.registered = False  # the inspector's structures are in the scene
         self.arrow_text = ""
@@ -286,19 +287,23 @@ class OneRingPanel:
 
     def draw_hover(self, viewer: Viewer) -> None:
         """Pick under the cursor once it rests ``throttle.interval`` seconds at a new position
-        (a moving cursor and an idle frame do no picking); show the answer at the cursor."""
+        (a moving cursor and an idle frame do no picking); show the answer at the cursor, and
+        light the vertex's row in the inspector's tables while it shows."""
         pos = viewer.ui.hover()
         if pos is None:
-            self.hovered = ""
+            self.hovered, self.hovered_vertex = "", -1
             return
         if self.throttle.due(self.clock(), pos):
             self.picks += 1
             self.hovered = self.hover_text(viewer, pos)
         if self.hovered and self.throttle.current(pos):  # nothing stale while moving
             viewer.ui.overlay_text((pos[0] + 16, pos[1] + 12), self.hovered)
+        else:
+            self.hovered_vertex = -1  # a table row is lit only while its label shows
 
     def hover_text(self, viewer: Viewer, pos: tuple[float, float]) -> str:
         """``"vertex i: <field> = value"`` for the mesh vertex under ``pos``, else ``""``."""
+        self.hovered_vertex = -1
         res = ps.pick(screen_coords=pos)
         if not res.is_hit or res.structure_name != MESH:
             return ""
@@ -306,6 +311,7 @@ class OneRingPanel:
         idx = viewer._vertex_of(res.structure_data, res.position, shown, viewer.mesh.F)
         if idx is None:
             return ""
+        self.hovered_vertex = int(idx)
         curv = viewer.curv
         values = curv.fields.get(curv.field_name)
         if values is None:
@@ -386,28 +392,94 @@ class OneRingPanel:
             ui.note(self.arrow_text)
 
     def draw_neighbours(self, viewer: Viewer, ins: VertexInspection) -> None:
+        """Two tables in ring order: the weights (negative rows in magenta), then each
+        neighbour's contribution ``w_ij (x_j − x_i)`` and their sum ``A_i Δx``; the row of the
+        neighbour under the cursor in 3D is lit."""
         ui = viewer.ui
-        ui.note("j  |x_j - x_i|  alpha  beta  w_ij = 1/2(cot a + cot b)  1/|N|")
         rows = viewer.ring.rows()
         scale = max((abs(t.weight_cotan) for t in rows), default=0.0)
-        for t in rows:
-            beta = "-" if t.beta is None else f"{math.degrees(t.beta):.2f}°"
-            row = (
-                f"{t.index}:  {t.edge_length:.4g}   {math.degrees(t.alpha):.2f}°  {beta}   "
-                f"w = {sig(t.weight_cotan, scale)}   {t.weight_uniform:.4g}"
-            )
-            if t.negative:
-                ui.colored(row + "  < 0 (obtuse)", NEGATIVE_RGBA)
-            else:
-                ui.text(row)
+        with ui.table("weights", NEIGHBOUR_HEADERS, NEIGHBOUR_TIPS):
+            for t in rows:
+                ui.row(
+                    neighbour_cells(t, scale),
+                    NEGATIVE_RGBA if t.negative else None,
+                    t.index == self.hovered_vertex,
+                )
+        total = np.sum([t.contribution for t in rows], axis=0) if rows else np.zeros(3)
+        size = max((float(np.abs(t.contribution).max()) for t in rows), default=0.0)
+        ui.note("each neighbour's term w_ij (x_j - x_i); their sum is A_i Lx:")
+        with ui.table("contributions", CONTRIBUTION_HEADERS, CONTRIBUTION_TIPS):
+            for t in rows:
+                ui.row(
+                    [str(t.index), *(sig(float(c), size) for c in t.contribution)],
+                    NEGATIVE_RGBA if t.negative else None,
+                    t.index == self.hovered_vertex,
+                )
+            ui.row(["sum", *(sig(float(c), size) for c in total)])
 
     def draw_faces(self, viewer: Viewer, ins: VertexInspection) -> None:
+        """The incident faces in ring order: corner angle, area, obtuse, both area shares."""
         ui = viewer.ui
-        ui.note("face  theta_f  area  obtuse  A_f/3  Voronoi share (rule)")
-        for f in ins.faces:
-            rule = "A/2" if f.obtuse_at_vertex else ("A/4" if f.obtuse else "cot")
-            ui.text(
-                f"{f.face}:  {math.degrees(f.angle):.2f}°  {f.area:.4g}  "
-                f"{'obtuse' if f.obtuse else 'acute'}  {f.share_barycentric:.4g}  "
-                f"{f.share_voronoi:.4g} ({rule})"
-            )
+        with ui.table("faces", FACE_HEADERS, FACE_TIPS):
+            for f in ins.faces:
+                ui.row(face_cells(f))
+
+
+NEIGHBOUR_HEADERS = ("j", "|x_j - x_i|", "alpha", "beta", "w_ij", "1/|N|")
+NEIGHBOUR_TIPS = (
+    "the neighbour's vertex index, in ring order (the numbers in 3D count along it)",
+    "edge length",
+    "alpha_ij: the angle opposite edge ij in the first face holding it",
+    "beta_ij: the angle opposite edge ij in the second face ('-': a boundary edge)",
+    "cotangent weight w_ij = 1/2 (cot alpha + cot beta); negative (magenta) when the "
+    "opposite angles are obtuse",
+    "uniform weight 1/|N(i)|",
+)
+CONTRIBUTION_HEADERS = ("j", "x", "y", "z")
+CONTRIBUTION_TIPS = (
+    "the neighbour's vertex index, in ring order; 'sum': the sum of the terms, A_i Lx (the "
+    "Lx formula below divides it by A_i)",
+    "w_ij (x_j - x_i), x component",
+    "w_ij (x_j - x_i), y component",
+    "w_ij (x_j - x_i), z component",
+)
+FACE_HEADERS = ("face", "theta_f", "area", "obtuse", "A_f/3", "Voronoi", "rule")
+FACE_TIPS = (
+    "face index, in ring order",
+    "the corner angle of the face at i",
+    "the face's area A_f",
+    "does the face have an angle above 90°? ('at i': at this vertex)",
+    "the face's share of the barycentric area A_i",
+    "the face's share of the mixed Voronoi area A_i (Meyer et al. 2003)",
+    "the Voronoi rule: cot = 1/8 sum l^2 cot (acute face), A/2 (obtuse at i), A/4 (obtuse "
+    "elsewhere)",
+)
+
+
+def neighbour_cells(t: NeighbourTerm, scale: float) -> list[str]:
+    """The weights table's cells of the neighbour ``t`` (``scale``: the largest ``|w|`` of the
+    ring, below which round-off shows as ``0``)."""
+    beta = "-" if t.beta is None else f"{math.degrees(t.beta):.2f}°"
+    return [
+        str(t.index),
+        f"{t.edge_length:.4g}",
+        f"{math.degrees(t.alpha):.2f}°",
+        beta,
+        sig(t.weight_cotan, scale),
+        f"{t.weight_uniform:.4g}",
+    ]
+
+
+def face_cells(f: FaceTerm) -> list[str]:
+    """The faces table's cells of the face ``f``."""
+    obtuse = "at i" if f.obtuse_at_vertex else ("yes" if f.obtuse else "no")
+    rule = "A/2" if f.obtuse_at_vertex else ("A/4" if f.obtuse else "cot")
+    return [
+        str(f.face),
+        f"{math.degrees(f.angle):.2f}°",
+        f"{f.area:.4g}",
+        obtuse,
+        f"{f.share_barycentric:.4g}",
+        f"{f.share_voronoi:.4g}",
+        rule,
+    ]

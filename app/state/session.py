@@ -9,13 +9,30 @@ A session file is one JSON object::
      "onering": {"vertex": -1, "reverse": false},
      "spectral": {"computed": false, "k_request": 100, "k": 10, "mode": 1},
      "smoothing": {"method": "implicit", "laplacian": "uniform", "lam": 0.5,
-                   "noise_alpha": 0.0, "seed": 0, "iterations": 0},
+                   "noise_alpha": 0.0, "seed": 0, "iterations": 15,
+                   "lam_steps": [[0.5, 10], [2.0, 5]]},
      "surfaces": {"surface": "helicoid", "res": 48, "u": 0.0, "v": 0.0}}
 
 ``camera`` is polyscope's ``get_view_as_json()`` parsed (or ``null``). A relative ``mesh`` is
 resolved against the session file's folder; ``null`` means the bundled default mesh. Missing
 keys take the defaults below; unknown keys, wrong types, values out of range, a newer
 ``version`` or a missing mesh are a :class:`MeshError` naming the file and the problem.
+
+**The λ of every smoothing step.** ``smoothing.lam_steps`` lists the λ the run used, run-length
+encoded: ``[[0.5, 10], [2.0, 5]]`` is 10 steps at λ = 0.5, then 5 at 2.0 (the viewer's λ field
+changes λ and keeps the mesh; only λ can change during a run: a new method, Laplacian, noise or
+seed rebuilds the stepper and starts again at iteration 0). The counts sum to ``iterations``;
+``lam`` is the λ set now (the next step's, which may differ from the last run's). Loading
+replays the runs exactly (bit for bit). The key is written only when it says something that
+``lam`` and ``iterations`` do not (λ changed during the run); missing or ``null``, the run is
+``iterations`` steps at ``lam``, as version-1 files have always been read.
+
+**Why the version stays 1.** A file is bumped only when an older reader would *misread* it. A
+reader of this version refuses every unknown key (``unknown key(s) in 'smoothing'``), so an
+older meshlap given a file with ``lam_steps`` refuses it instead of replaying it with the wrong
+λ; and a file without the key (no λ change) means exactly what it meant before, so older
+meshlaps keep opening it. A bump to 2 would make every new file unreadable to them for no
+gain.
 
 This module only maps a :class:`Session` to and from a dict and a file; the viewer
 (:mod:`meshlap_app.session`) captures one from its panels and applies one to them.
@@ -86,6 +103,26 @@ def _number(lo: float = -math.inf, hi: float = math.inf, positive: bool = False)
     return check
 
 
+def _lam_steps(x: Any) -> str | None:
+    """What is wrong with a ``lam_steps`` value (``null`` or a list of ``[λ > 0, count >= 1]``);
+    the counts' sum is checked against ``iterations`` by :func:`_check_lam_steps`."""
+    if x is None:
+        return None
+    if not isinstance(x, list):
+        return f"must be a list of [lam, steps] pairs or null, got {json.dumps(x)}"
+    positive = _number(positive=True)
+    for k, run in enumerate(x):
+        if not isinstance(run, list) or len(run) != 2:
+            return f"entry {k} must be a [lam, steps] pair, got {json.dumps(run)}"
+        problem = positive(run[0])
+        if problem:
+            return f"entry {k}: lam {problem}"
+        problem = _integer(1)(run[1])
+        if problem:
+            return f"entry {k}: steps {problem}"
+    return None
+
+
 # section -> key -> (default, check). The defaults are the viewer's own start values.
 SCHEMA: dict[str, dict[str, tuple[Any, Check]]] = {
     "curvature": {
@@ -110,6 +147,7 @@ SCHEMA: dict[str, dict[str, tuple[Any, Check]]] = {
         "noise_alpha": (0.0, _number(0.0)),
         "seed": (0, _integer(0)),
         "iterations": (0, _integer(0, 100_000)),
+        "lam_steps": (None, _lam_steps),
     },
     "surfaces": {
         "surface": ("helicoid", _one_of(tuple(SURFACES))),
@@ -215,7 +253,40 @@ def from_dict(
             raise MeshError(f"unknown key(s) in {sec!r}: {', '.join(map(repr, unknown))}", source)
         for key, (default, check) in keys.items():
             session.settings[sec][key] = _checked(values, key, default, check, source, sec)
+    _check_lam_steps(session.settings["smoothing"], source)
     return session
+
+
+def _check_lam_steps(sm: dict[str, Any], source: Any) -> None:
+    """Check that ``lam_steps`` counts ``iterations`` steps; λ as floats, counts as ints."""
+    runs = sm["lam_steps"]
+    if runs is None:
+        return
+    total = sum(int(n) for _, n in runs)
+    if total != sm["iterations"]:
+        raise MeshError(
+            f'"smoothing.lam_steps" counts {total} steps but "smoothing.iterations" is '
+            f"{sm['iterations']}",
+            source,
+        )
+    sm["lam_steps"] = [[float(lam), int(n)] for lam, n in runs]
+
+
+def encode_lam_steps(runs: list[list[Any]], lam: float) -> list[list[Any]] | None:
+    """``lam_steps`` to save for a run of ``runs`` (``[[λ, steps], ...]``) with ``lam`` set
+    now: ``None`` when it says nothing that ``lam`` and ``iterations`` do not (no step, or every
+    step at ``lam``), else a copy of ``runs``."""
+    if not runs or (len(runs) == 1 and runs[0][0] == lam):
+        return None
+    return [[float(x), int(n)] for x, n in runs]
+
+
+def replay_steps(sm: dict[str, Any]) -> list[list[Any]]:
+    """The runs ``[[λ, steps], ...]`` that reproduce a saved ``smoothing`` section: its
+    ``lam_steps``, or (missing, as in older files) ``iterations`` steps at ``lam``."""
+    if sm.get("lam_steps") is not None:
+        return [[float(x), int(n)] for x, n in sm["lam_steps"]]
+    return [[float(sm["lam"]), int(sm["iterations"])]] if sm["iterations"] else []
 
 
 def _checked(

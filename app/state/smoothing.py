@@ -4,7 +4,7 @@ noise first, live figures and the amplification curve. No polyscope import.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -21,7 +21,15 @@ _EMPTY_F = np.zeros((0, 3), dtype=np.int64)
 
 @dataclass
 class SmoothingState:
-    """Options, the stepper built from them, and what the panel shows."""
+    """Options, the stepper built from them, and what the panel shows.
+
+    ``lam_steps`` is the ``λ`` of every step the stepper has taken since it was built or reset,
+    run-length encoded: ``[[0.5, 10], [2.0, 5]]`` is 10 steps at 0.5, then 5 at 2.0. Only ``λ``
+    can change during a run (:meth:`set_lam`); a new method, Laplacian, noise α or seed rebuilds
+    the stepper (:meth:`configure`) and starts a new run at iteration 0. A saved session
+    replays these runs (:func:`meshlap_app.session.apply`), so a run whose ``λ`` was changed
+    mid-way comes back bit for bit.
+    """
 
     method: str = "implicit"
     laplacian: str = "uniform"
@@ -32,6 +40,7 @@ class SmoothingState:
     error: str = ""
     smoother: Smoother | None = None
     version: int = 0  # bumped when the stepper is rebuilt (connectivity may need re-upload)
+    lam_steps: list[list[Any]] = field(default_factory=list)  # [[λ, steps], ...] of this run
 
     def rebuild(self, V: FloatArray, F: IntArray) -> bool:
         """Build the stepper for the current options from the clean mesh ``V`` (+ noise).
@@ -58,6 +67,7 @@ class SmoothingState:
         self.smoother = smoother
         self.error = ""
         self.version += 1
+        self.lam_steps = []
         return True
 
     def set_lam(self, lam: float) -> None:
@@ -137,17 +147,28 @@ class SmoothingState:
         if s is None:
             return False
         if not s.diverged:
+            done = s.iteration
             s.step()
+            if s.iteration > done:  # a step taken (a diverging one is discarded)
+                self._count_step(s.lam)
         if s.diverged:
             self.playing = False
             self.error = f"{s.divergence_message()}; press reset"
             return False
         return True
 
+    def _count_step(self, lam: float) -> None:
+        """Add one step at ``lam`` to :attr:`lam_steps`."""
+        if self.lam_steps and self.lam_steps[-1][0] == lam:
+            self.lam_steps[-1][1] += 1
+        else:
+            self.lam_steps.append([lam, 1])
+
     def reset(self) -> None:
         """Back to the noisy input (the noise itself stays)."""
         if self.smoother is not None:
             self.smoother.reset()
+        self.lam_steps = []
         self.playing = False
         self.error = ""
 
