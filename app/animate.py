@@ -75,6 +75,7 @@ class AnimationSpec:
     fps: float | None = None
     size: tuple[int, int] = (960, 540)
     shadow: bool = False
+    lam_steps: list[list[Any]] | None = None  # a session's [[λ, steps], ...]; then ``lam``
     session: Any = None  # a meshlap_app.state.session.Session to restore first
     session_file: Path | None = None  # its file (named in errors; never overwritten)
 
@@ -349,6 +350,8 @@ def smoothing_frames(viewer: Viewer, spec: AnimationSpec) -> Iterator[str]:
 
     A stepper already built with the same options (a restored session) is reset to iteration
     0 and kept (same noise: same seed); otherwise it is rebuilt with the options of ``spec``.
+    Step ``i`` uses the ``i``-th λ of ``spec.lam_steps`` (a session whose λ changed mid-run:
+    the last frame is the saved view), then ``spec.lam``.
     """
     panel = viewer.panels["smoothing"]
     st = panel.state
@@ -363,9 +366,14 @@ def smoothing_frames(viewer: Viewer, spec: AnimationSpec) -> Iterator[str]:
     panel.push(force=True)
     viewer.show_panel()
     frame_view(viewer, strip=0.0)  # no colour map: no colour bar
+    schedule = [float(lam) for lam, n in spec.lam_steps or [] for _ in range(int(n))]
     for it in range(spec.iters + 1):
-        if it > 0 and not st.step():
-            raise MeshError(st.error or "the smoothing stopped", "--lam")
+        if it > 0:
+            lam = schedule[it - 1] if it <= len(schedule) else spec.lam
+            if lam != st.lam:
+                st.set_lam(lam)
+            if not st.step():
+                raise MeshError(st.error or "the smoothing stopped", "--lam")
         panel.push()
         yield smoothing_caption(st, spec.iters)
 

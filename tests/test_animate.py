@@ -637,6 +637,44 @@ def test_session_frames_start_from_the_restored_viewer(panel, viewer, spec_of, t
         assert (fresh.surf.u, fresh.surf.v, fresh.surf.res) == (1.0, 2.0, 30)
 
 
+def test_session_animation_replays_the_lam_of_every_step(viewer, spec_of, tmp_path, mock):
+    """A run whose λ was changed mid-way (0.5 ×2, then 2 ×2): the frames step with the saved
+    λ of each step and end on the saved vertices bit for bit; a typed --lam replaces them."""
+    import meshlap_app.animate as anim
+    from meshlap_app import session
+    from meshlap_app.state import CurvatureState, MeshState
+    from meshlap_app.viewer import Viewer
+
+    mesh = viewer.mesh
+    sm = viewer.panels["smoothing"].state
+    sm.configure(mesh.V, mesh.F, noise_alpha=0.02, seed=5)
+    sm.set_lam(0.5)
+    for lam in (0.5, 0.5, 2.0, 2.0):
+        sm.set_lam(lam)
+        assert sm.step()
+    viewer.set_panel("smoothing")
+    path = session.save(viewer, tmp_path / "lams.json")
+    out = str(tmp_path / "a.gif")
+
+    def frames(*typed: str) -> tuple[list[str], np.ndarray]:
+        spec = spec_of("--session", str(path), "--out", out, *typed)
+        mock.remove_all_structures()
+        m = MeshState()
+        assert m.load(spec.mesh)
+        fresh = Viewer(m, CurvatureState(), panel=spec.panel)
+        fresh.sync_mesh()
+        anim.restore_session(fresh, spec, m)
+        captions = list(anim.smoothing_frames(fresh, spec))
+        return captions, fresh.panels["smoothing"].state.V.copy()
+
+    captions, V = frames()
+    assert [c.split("λ = ")[1].split(",")[0] for c in captions[1:]] == ["0.5", "0.5", "2", "2"]
+    np.testing.assert_array_equal(V, sm.V)
+    captions, V = frames("--lam", "2")  # every step at the typed λ: another result
+    assert all("λ = 2," in c for c in captions)
+    assert np.abs(V - sm.V).max() > 1e-6
+
+
 EGL_SAVE = """
 import sys
 from pathlib import Path

@@ -186,6 +186,8 @@ def _from_session(args: argparse.Namespace) -> Any:
             "most 5000: give --iters N",
             args.session,
         )
+    # the λ of every saved step, unless a λ is typed (then every frame uses that one)
+    args.lam_steps = sm.get("lam_steps") if args.lam is None else None
     saved = {
         "method": sm["method"],
         "laplacian": sm["laplacian"],
@@ -234,6 +236,7 @@ def run(args: argparse.Namespace) -> int:
         method=args.method,
         laplacian=args.laplacian,
         lam=args.lam,
+        lam_steps=getattr(args, "lam_steps", None),
         iters=args.iters,
         noise=args.noise,
         seed=args.seed,
