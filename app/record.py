@@ -131,6 +131,9 @@ class Recorder:
             return
         self._capturing = True
         try:
+            if viewer.reframe:  # a copy appeared this frame: frame it before the picture
+                viewer.reframe = False
+                viewer.frame()
             buf = crop_scene(
                 viewer, ps.screenshot_to_buffer(transparent_bg=False, include_UI=False)
             )

@@ -88,9 +88,12 @@ class SpectralPanel:
         )
 
     def points(self, viewer: Viewer, name: str) -> np.ndarray | None:
-        """Display positions of a structure this panel registered (for camera framing)."""
+        """Display positions of a structure this panel registered (for camera framing): the
+        reconstruction is framed as the mesh it approximates, shifted beside it, so the camera
+        holds still while k changes (x_1 is a single point: framing it would cut the later
+        copies off)."""
         if name == RECON and self.state.basis is not None:
-            return viewer.display.points(self.state.reconstruction) + self._offset(viewer)
+            return viewer.display.points(viewer.mesh.V) + self._offset(viewer)
         return None
 
     def adopt(self, viewer: Viewer) -> None:

@@ -157,18 +157,17 @@ class SurfacesPanel:
             f"k2 = {sig(p.k2, sk)} at {np.degrees(p.theta_min):.1f} deg"
         )
         ui.text("signs: e = p_uu . n with n = p_u x p_v (do Carmo)")
-        _, kn = self.draw_section(viewer)
+        self.draw_section(viewer)
         with ui.plot("normal curvature k_n(theta)", 180, "theta (deg)", "k_n") as shown:
             if shown:
                 ui.plot_line("k_n", np.degrees(s.theta), s.kn)
                 ui.plot_vlines("theta max/min", np.degrees([p.theta_max, p.theta_min]))
-                ui.plot_line("section", np.array([s.section_deg]), np.array([kn]))
                 ui.plot_vlines("section theta", np.array([s.section_deg]))
         key = (s.version, s.u, s.v, s.section_deg)
         draw_record(viewer, self.recorder, key, s.section_caption, "theta")
 
-    def draw_section(self, viewer: Viewer) -> tuple[np.ndarray, float]:
-        """The θ slider, *turn* / *pause turn*, this frame's turn step; returns t(θ), κₙ(θ)."""
+    def draw_section(self, viewer: Viewer) -> None:
+        """The θ slider, *turn* / *pause turn* and this frame's turn step; κₙ at θ."""
         ui, s = viewer.ui, viewer.surf
         ch, deg = ui.slider_float(
             "section theta (deg)",
@@ -190,6 +189,5 @@ class SurfacesPanel:
             s.toggle_turn()
         elif s.tick_turn():
             self.push_section(viewer)
-        t, kn = s.section()
+        _, kn = s.section()
         ui.text(f"section at theta = {s.section_deg:.1f} deg: k_n = {kn:.4g}")
-        return t, kn
