@@ -140,16 +140,30 @@ class Recorder:
             if self.last is None:  # the frame on screen when *record* was pressed
                 self._held = (buf, caption)
             else:
-                if not self.kind:
-                    self.kind = kind
-                    self.writer.fps = DEFAULT_FPS.get(kind, self.writer.fps)
-                if self._held is not None:
-                    self.writer.add(burn_caption(*self._held))
-                    self._held = None
-                self.writer.add(burn_caption(buf, caption))
+                self._add(buf, caption, kind)
             self.last = key
         finally:
             self._capturing = False
+
+    def _add(self, buf: np.ndarray, caption: str, kind: str) -> None:
+        """Write the held first frame (the rate set by this first change) and ``buf``; a
+        frame the writer refuses (the window was resized) ends the recording, nothing written.
+        """
+        writer = self.writer
+        if writer is None:
+            return
+        if not self.kind:
+            self.kind = kind
+            writer.fps = DEFAULT_FPS.get(kind, writer.fps)
+        try:
+            if self._held is not None:
+                writer.add(burn_caption(*self._held))
+                self._held = None
+            writer.add(burn_caption(buf, caption))
+        except MeshError as exc:
+            writer.abort()
+            self.writer, self._held = None, None
+            raise MeshError(f"recording stopped, nothing written: {exc}", "record") from exc
 
 
 def crop_scene(viewer: Viewer, buf: np.ndarray) -> np.ndarray:

@@ -289,6 +289,26 @@ def test_theta_turn_records_one_frame_per_step(viewer, tmp_path):
     assert not [p for p in tmp_path.iterdir() if "tmp" in p.name]  # written atomically
 
 
+def test_a_resized_window_ends_the_recording_without_a_file(viewer, tmp_path, monkeypatch):
+    import meshlap_app.record as record
+
+    viewer.set_panel("surfaces")
+    tick(viewer, "record file", "resized.gif")
+    tick(viewer, "record", True)
+    tick(viewer, "section theta (deg)", 10.0)
+    rec = viewer.panels["surfaces"].recorder
+    assert rec.count == 2
+    real = record.ps.screenshot_to_buffer
+    monkeypatch.setattr(record.ps, "screenshot_to_buffer", lambda **kw: real(**kw)[:-10, :-10])
+    tick(viewer, "section theta (deg)", 20.0)
+    assert not rec.recording and "recording stopped" in viewer.errors["surfaces"]
+    assert not (tmp_path / "resized.gif").exists()
+    assert not [p for p in tmp_path.iterdir() if "tmp" in p.name]
+    monkeypatch.undo()
+    tick(viewer, "section theta (deg)", 30.0)  # the session goes on, the θ applied
+    assert viewer.surf.section_deg == 30.0 and "surfaces" not in viewer.errors
+
+
 def test_cli_theta_frames_draw_with_the_panel(viewer):
     from meshlap_app.animate import AnimationSpec, theta_frames
 
