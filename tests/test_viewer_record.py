@@ -224,16 +224,16 @@ def test_theta_slider_draws_the_section(viewer):
     tick(viewer)
     s = viewer.surf
     assert ps.has_curve_network(NORMAL_SECTION)
-    tick(viewer, "section theta (deg)", 45.0)
+    tick(viewer, "section theta", 45.0)
     assert s.section_deg == 45.0
     t, kn = s.section()
     p = s.point
     assert kn == pytest.approx(normal_curvature(s.name, s.u, s.v, np.radians(45.0)))
     assert abs(np.dot(t, p.n)) < 1e-12 and np.linalg.norm(t) == pytest.approx(1.0)
-    tick(viewer, "section theta (deg)", 400.0)  # Ctrl+click may type any angle: modulo 360
+    tick(viewer, "section theta", 400.0)  # Ctrl+click may type any angle: modulo 360
     assert s.section_deg == pytest.approx(40.0)
     for bad in ("nan", "1e309"):
-        tick(viewer, "section theta (deg)", bad)
+        tick(viewer, "section theta", bad)
         assert s.section_deg == pytest.approx(40.0) and "theta" in viewer.errors["surfaces"]
     assert "θ =  40.0°" in s.section_caption()
     viewer.set_panel("curvature")  # the section is the Surfaces panel's only
@@ -295,17 +295,17 @@ def test_a_resized_window_ends_the_recording_without_a_file(viewer, tmp_path, mo
     viewer.set_panel("surfaces")
     tick(viewer, "record file", "resized.gif")
     tick(viewer, "record", True)
-    tick(viewer, "section theta (deg)", 10.0)
+    tick(viewer, "section theta", 10.0)
     rec = viewer.panels["surfaces"].recorder
     assert rec.count == 2
     real = record.ps.screenshot_to_buffer
     monkeypatch.setattr(record.ps, "screenshot_to_buffer", lambda **kw: real(**kw)[:-10, :-10])
-    tick(viewer, "section theta (deg)", 20.0)
+    tick(viewer, "section theta", 20.0)
     assert not rec.recording and "recording stopped" in viewer.errors["surfaces"]
     assert not (tmp_path / "resized.gif").exists()
     assert not [p for p in tmp_path.iterdir() if "tmp" in p.name]
     monkeypatch.undo()
-    tick(viewer, "section theta (deg)", 30.0)  # the session goes on, the θ applied
+    tick(viewer, "section theta", 30.0)  # the session goes on, the θ applied
     assert viewer.surf.section_deg == 30.0 and "surfaces" not in viewer.errors
 
 
@@ -337,8 +337,8 @@ def drive_record_widgets(viewer, tmp_path) -> None:
     tick(viewer, "play what", "k sweep")
     viewer.set_panel("surfaces")
     tick(viewer)
-    tick(viewer, "section theta (deg)", 30.0)
-    tick(viewer, "section theta (deg)", "nan")
+    tick(viewer, "section theta", 30.0)
+    tick(viewer, "section theta", "nan")
     assert viewer.surf.section_deg == 30.0 and "theta" in viewer.errors["surfaces"]
     tick(viewer, "turn", True)
     tick(viewer, "pause turn", True)
@@ -348,7 +348,7 @@ def drive_record_widgets(viewer, tmp_path) -> None:
     assert ".avi" in viewer.errors["surfaces"]
     tick(viewer, "record file", str(tmp_path / "tour.gif"))
     tick(viewer, "record", True)
-    tick(viewer, "section theta (deg)", 60.0)
+    tick(viewer, "section theta", 60.0)
     tick(viewer, "stop", True)
     assert Image.open(tmp_path / "tour.gif").n_frames == 2
 
@@ -360,7 +360,7 @@ def test_record_widgets_have_tooltips(viewer, tmp_path):
         "play what",
         "play",
         "pause",
-        "section theta (deg)",
+        "section theta",
         "turn",
         "pause turn",
         *RECORD_WIDGETS,
@@ -405,7 +405,7 @@ EGL_SCRIPT = textwrap.dedent(
 
     v.set_panel("surfaces")
     tick(); tick()
-    tick("section theta (deg)", 30.0)
+    tick("section theta", 30.0)
     tick(); tick()
     save_screenshot(out / "surfaces_panel.png")
     tick("record file", "theta.gif")

@@ -167,16 +167,18 @@ class SurfacesPanel:
         draw_record(viewer, self.recorder, key, s.section_caption, "theta")
 
     def draw_section(self, viewer: Viewer) -> None:
-        """The θ slider, *turn* / *pause turn* and this frame's turn step; κₙ at θ."""
+        """The θ slider (showing κₙ(θ)), *turn* / *pause turn* and this frame's turn step."""
         ui, s = viewer.ui, viewer.surf
+        _, kn = s.section()
         ch, deg = ui.slider_float(
-            "section theta (deg)",
+            "section theta",
             s.section_deg,
             0.0,
             360.0,
-            "%.1f",
-            "direction of the normal section (orange) in the tangent plane, from p_u towards "
-            "p_v: its tangent t(theta) and its osculating arc of curvature k_n(theta)",
+            f"%.1f deg: k_n = {kn:.4g}",  # κₙ(θ) shown in the slider (no row of its own)
+            "direction of the normal section (orange) in the tangent plane, in degrees from "
+            "p_u towards p_v: its tangent t(theta) and its osculating arc of curvature "
+            "k_n(theta)",
         )
         if ch:
             self.push_section(viewer, deg)
@@ -189,5 +191,3 @@ class SurfacesPanel:
             s.toggle_turn()
         elif s.tick_turn():
             self.push_section(viewer)
-        _, kn = s.section()
-        ui.text(f"section at theta = {s.section_deg:.1f} deg: k_n = {kn:.4g}")
