@@ -24,7 +24,7 @@ import copy
 import dataclasses
 import sys
 import weakref
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -37,7 +37,7 @@ from meshlap_core.frames import FrameWriter, Progress, burn_caption, check_anima
 from meshlap_core.frames import parse_range as parse_range
 
 from . import scene
-from .scene import COLORBAR_AT, MESH, RECON, SURFACE_POINT, Z_TO_Y
+from .scene import COLORBAR_AT, MESH, RECON
 from .state.mesh import MeshState
 
 if TYPE_CHECKING:
@@ -248,9 +248,7 @@ def panel_strip(width: int, ui_scale: float) -> int:
     """Pixels on the right of a window ``width`` wide that meshlap's panel covered at
     ``ui_scale`` (the rule of the viewer's framing and of the record button's crop: at most
     70 % of the window; what is kept has an even width)."""
-    from .viewer import PANEL_PX
-
-    keep = int(width * min(max((width - PANEL_PX * ui_scale) / width, 0.3), 1.0))
+    keep = int(width * scene.scene_fraction(width, ui_scale, cap=1.0))
     return width - max(keep // 2 * 2, 2)
 
 
@@ -429,10 +427,7 @@ def k_frames(viewer: Viewer, spec: AnimationSpec) -> Iterator[str]:
             onscreen_colorbar_enabled=True,
             onscreen_colorbar_location=COLORBAR_AT,
         )
-        yield (
-            f"k = {k} modes   mean error {e.mean[k]:.3g} "
-            f"({100 * e.relative_mean[k]:.3g}% of the diagonal)   max {e.max[k]:.3g}"
-        )
+        yield st.k_caption()  # shared with the viewer's recording
 
 
 def mode_frames(viewer: Viewer, spec: AnimationSpec) -> Iterator[str]:
@@ -446,27 +441,13 @@ def mode_frames(viewer: Viewer, spec: AnimationSpec) -> Iterator[str]:
     for m in range(a, b + 1):
         st.set_mode(m)
         panel.push_mode(viewer, force=True)
-        _, lam = st.eigenfunction()
-        yield f"eigenmode u_{m}   λ_{m} = {lam:.5g}   (-C u = λ M u)"
-
-
-def section_arc(p: Any, t: np.ndarray, kn: float, length: float, n: int = 80) -> np.ndarray:
-    """Points ``(n,3)`` of the normal section's osculating arc at ``p.p``: the circle of
-    curvature ``kn`` in the plane of the unit tangent ``t`` and the normal ``p.n``
-    (``x(s) = p + t sin(κs)/κ + n (1 − cos(κs))/κ``, at most one full turn)."""
-    half = min(length, np.pi / abs(kn)) if abs(kn) > 1e-12 else length
-    s = np.linspace(-half, half, n)
-    if abs(kn) > 1e-9:
-        along, up = np.sin(kn * s) / kn, (1.0 - np.cos(kn * s)) / kn
-    else:
-        along, up = s, 0.5 * kn * s * s
-    return p.p[None, :] + along[:, None] * t[None, :] + up[:, None] * p.n[None, :]
+        yield st.mode_caption()  # shared with the viewer's recording
 
 
 def theta_frames(viewer: Viewer, spec: AnimationSpec) -> Iterator[str]:
-    """The normal section at (u, v) turning: its tangent t(θ) and osculating arc, κₙ(θ)."""
-    from meshlap_core.surfaces import normal_curvature
-
+    """The normal section at (u, v) turning: its tangent t(θ) and osculating arc, κₙ(θ), drawn
+    by the Surfaces panel's :meth:`~.panels.surfaces.SurfacesPanel.push_section` as in the
+    window."""
     surf = viewer.surf
     if not surf.set_surface(spec.surface):
         raise MeshError(surf.error, "--surface")
@@ -474,126 +455,7 @@ def theta_frames(viewer: Viewer, spec: AnimationSpec) -> Iterator[str]:
         raise MeshError(surf.error, "--uv")
     viewer.show_panel()  # the Surfaces panel registers the surface, K and the point
     frame_view(viewer)
-    p = surf.point
-    size = float(np.ptp(surf.mesh.V, axis=0).max())
-    for theta in np.linspace(0.0, 2 * np.pi, spec.frames, endpoint=False):
-        d = p.p_u * np.cos(theta) + p.p_v * np.sin(theta)
-        t = d / np.linalg.norm(d)
-        kn = float(normal_curvature(surf.name, surf.u, surf.v, np.array([theta]))[0])
-        arc = section_arc(p, t, kn, 0.3 * size)
-        edges = np.column_stack([np.arange(len(arc) - 1), np.arange(1, len(arc))])
-        cn = ps.register_curve_network(NORMAL_SECTION, arc, edges, radius=0.006)
-        cn.set_transform(Z_TO_Y)
-        cn.set_color((0.95, 0.55, 0.05))
-        pc = ps.get_point_cloud(SURFACE_POINT)
-        pc.add_vector_quantity(
-            SECTION_DIRECTION,
-            0.2 * size * t[None, :],
-            vectortype="ambient",
-            enabled=True,
-            color=(0.95, 0.55, 0.05),
-        )
-        yield (
-            f"{surf.name} at (u, v) = ({surf.u:.3g}, {surf.v:.3g})   θ = {np.degrees(theta):5.1f}°"
-            f"   κₙ(θ) = {kn:+.4g}   (κ₁ = {p.k1:.4g}, κ₂ = {p.k2:.4g})"
-        )
-
-
-# ---------------------------------------------------------------- the viewer's record button
-class Recorder:
-    """The *record* / *stop* buttons of a panel: while recording, every change of what the
-    panel plays (a smoothing step, a new k or mode) adds a frame of the 3D view; *stop* writes
-    the GIF/MP4 atomically and says where.
-
-    Parameters
-    ----------
-    stem : str
-        Default file name (without folder), e.g. ``smoothing.gif``.
-    """
-
-    def __init__(self, stem: str) -> None:
-        self.file_text = stem
-        self.writer: FrameWriter | None = None
-        self.status = ""
-        self._last: Any = None
-        self._capturing = False
-
-    @property
-    def recording(self) -> bool:
-        return self.writer is not None
-
-    def draw(self, viewer: Viewer) -> None:
-        """The collapsed *record* header: file name, record / stop, where the last one went."""
-        ui = viewer.ui
-        if not ui.header(RECORD_HEADER, default_open=False):
-            return
-        _, self.file_text = ui.input_text(
-            "record file",
-            self.file_text,
-            "a .gif or .mp4 name (in the Export folder unless a full path)",
-        )
-        if not self.recording:
-            if ui.button("record", "start recording what this panel plays"):
-                self.start(viewer)
-        elif ui.button("stop", "stop and write the file"):
-            self.status = self.stop()
-        if self.recording:
-            ui.text(f"recording: {self.writer.count} frames")  # type: ignore[union-attr]
-        if self.status:
-            ui.text(self.status)
-
-    def start(self, viewer: Viewer) -> None:
-        """Begin a recording into the file named in the field.
-
-        Raises
-        ------
-        MeshError
-            A bad name, extension or folder, or MP4 without the video extra.
-        """
-        path = Path(self.file_text.strip()).expanduser()
-        if not path.is_absolute():
-            path = viewer.panels["export"].folder / path
-        self.writer = FrameWriter(path, DEFAULT_FPS["smoothing"])
-        self._last = None
-        self.status = ""
-
-    def stop(self) -> str:
-        """Write the file; the message says where (or why not)."""
-        writer, self.writer = self.writer, None
-        if writer is None:
-            return ""
-        try:
-            return f"wrote {writer.count} frames to {writer.close()}"
-        except MeshError:
-            writer.abort()
-            raise
-
-    def capture(self, viewer: Viewer, key: Any, caption: str) -> None:
-        """Add a frame when recording and ``key`` (what the panel shows) changed."""
-        if self.writer is None or self._capturing or key == self._last:
-            return
-        self._capturing = True
-        try:
-            buf = ps.screenshot_to_buffer(transparent_bg=False, include_UI=False)
-            self.writer.add(burn_caption(crop_scene(viewer, buf), caption))
-            self._last = key
-        finally:
-            self._capturing = False
-
-
-def crop_scene(viewer: Viewer, buf: np.ndarray) -> np.ndarray:
-    """The part of a window buffer ``(h, w, 4)`` left of meshlap's panel (where the viewer
-    frames the scene)."""
-    from .viewer import PANEL_PX
-
-    w_win = max(ps.get_window_size()[0], 1)
-    w = buf.shape[1]
-    keep = int(w * min(max((w_win - PANEL_PX * viewer.ui.scale) / w_win, 0.3), 1.0))
-    return buf[:, : max(keep // 2 * 2, 2)]
-
-
-def draw_record(viewer: Viewer, recorder: Recorder, key: Any, caption: Callable[[], str]) -> None:
-    """The panels' hook: draw the record header, then capture a frame if recording."""
-    recorder.draw(viewer)
-    if recorder.recording:
-        recorder.capture(viewer, key, caption())
+    panel = viewer.panels["surfaces"]
+    for theta in np.linspace(0.0, 360.0, spec.frames, endpoint=False):
+        panel.push_section(viewer, theta)
+        yield surf.section_caption()

@@ -15,6 +15,18 @@ import polyscope as ps
 from meshlap_core.io import atomic_write
 
 # ---------------------------------------------------------------- structure names
+PANEL_PX = 520
+"""Width of meshlap's panel on the right (pixels at UI scale 1): framing keeps clear of it."""
+
+
+def scene_fraction(window_width: int, ui_scale: float, cap: float = 0.95) -> float:
+    """The fraction of a window ``window_width`` pixels wide left of meshlap's panel at
+    ``ui_scale``: where the viewer frames the scene (``cap`` 0.95 leaves a margin) and what
+    a recording keeps (``cap`` 1); at least 0.3 on a narrow window."""
+    w = max(window_width, 1)
+    return min(max((w - PANEL_PX * ui_scale) / w, 0.3), cap)
+
+
 MESH = "mesh"
 MESH_B = "mesh (second estimator)"
 RING_CURVE = "one-ring order"

@@ -46,8 +46,7 @@ NO_DISPLAY = (
     "`meshlap view MESH --screenshot out.png`"
 )
 
-PANEL_PX = 520
-"""Width of meshlap's panel on the right (pixels at UI scale 1): framing keeps clear of it."""
+PANEL_PX = scene.PANEL_PX
 
 BUSY_FRAME_S = 0.35
 """While the eigen worker runs, each frame waits this long (about 5 frames/s): the render loop
@@ -378,7 +377,7 @@ class Viewer:
             self.focus_ring()
             return
         w, _ = ps.get_window_size()
-        fraction = min(max((w - PANEL_PX * self.ui.scale) / max(w, 1), 0.3), 0.95)
+        fraction = scene.scene_fraction(w, self.ui.scale)
         if self.panel == "surfaces":
             view = scene.OBLIQUE_VIEW
         else:

@@ -492,6 +492,10 @@ def test_every_widget_is_driven(viewer, tmp_path, sphere):
     from test_session import drive_session_widgets  # the session widgets (Help and window)
 
     drive_session_widgets(viewer, tmp_path)
+
+    from test_viewer_record import drive_record_widgets  # play, θ and record widgets
+
+    drive_record_widgets(viewer, tmp_path)
     ui = viewer.ui
     undriven = sorted(set(ui.seen) - ui.driven)
     assert not undriven, f"widgets no test drives: {undriven}"

@@ -3,15 +3,16 @@
 One viewer per window size (1280×720 on the default mesh, 1920×1080 on ``assets/torus.obj``)
 serves two tests, in this order:
 
-- ``test_scripted_tour``: pick a mesh from the list, then every panel through its shortcut
-  (1–5) with its widgets (curvature field and side by side, click a vertex and type one, compute
-  the eigenbasis and drag k, type λ and press Enter, space to play and to pause, a surface and
-  its u slider), export what is shown, the Help pane (H). After each step the test checks what
-  a user sees on a screenshot: the subject left of meshlap's panel and not running behind it,
-  the second mesh (side by side, reconstruction, smoothed copy) beside it, λ applied on Enter
-  and not before, the export message, and that the process is alive with nothing on stderr
-  but polyscope's own ``[polyscope]`` lines. A failing step is recorded (the viewer is
-  restarted if it died) and the tour goes on, so one run reports every failing step.
+- ``test_scripted_tour``: pick a mesh from the list, then every panel through its shortcut (1–5)
+  with its widgets (curvature field and side by side, click a vertex and type one, compute the
+  eigenbasis and drag k, type λ and press Enter, space to play and to pause, a surface and its u
+  slider), export what is shown, the Help pane (H), and at 1280×720 a recording of the normal
+  section turning (record, turn, stop: a GIF of several frames). After each step the test checks
+  what a user sees on a screenshot: the subject left of meshlap's panel and not running behind it,
+  the second mesh (side by side, reconstruction, smoothed copy) beside it, λ applied on Enter and
+  not before, the export message, and that the process is alive with nothing on stderr but
+  polyscope's own ``[polyscope]`` lines. A failing step is recorded (the viewer is restarted if it
+  died) and the tour goes on, so one run reports every failing step.
 - ``test_monkey``: seeded random clicks, drags and keys anywhere for ``MESHLAP_MONKEY_SECONDS``
   (20 s); the viewer survives.
 
@@ -474,8 +475,9 @@ def surfaces(s: Session) -> None:
 
 def export(s: Session) -> None:
     """Open the Export header (the one before Help), click "export what is shown" (its last
-    button): a .ply file appears and the panel says where it wrote."""
-    layout = s.layout()
+    button): a .ply file appears and the panel says where it wrote. The panel is scrolled to
+    its end first (the Surfaces panel with its record header reaches below 720 pixels)."""
+    layout = scroll_to_end(s)
     s.click(layout.sections[-2][0].center)
     s.settled((0, 0, *s.size))
     for _ in range(12):  # the panel may now be taller than the window: scroll it
@@ -553,6 +555,67 @@ def help_pane(s: Session) -> None:
     s.settled((0, 0, *s.size))
 
 
+def surfaces_section(layout: Layout) -> int:
+    """Index of the Surfaces section on screen (the one holding the k_n(θ) plot); the record
+    header follows it."""
+    for i, sec in enumerate(layout.sections):
+        if any(it.kind == "plot" for it in sec):
+            return i
+    raise LookupError("the Surfaces section's plot is not on screen")
+
+
+def record_buttons(img: np.ndarray) -> bool:
+    """The opened record header's button row is on screen."""
+    try:
+        layout = parse(img)
+        return bool(layout.find(surfaces_section(layout) + 1, "buttons", 0))
+    except LookupError:
+        return False
+
+
+def record_turn(s: Session) -> None:
+    """1280x720 only. Key 5, Help closed; open the *record* header (the section after the
+    Surfaces section's plot), press record, press *turn* (right of the θ slider, the Surfaces
+    section's last slider), let θ turn about a second, press stop (record's place): a GIF with
+    more than one frame appears in the viewer's folder."""
+    if s.size != SIZES[0]:
+        return
+    from PIL import Image
+
+    s.goto(5, "Surfaces")
+    layout = scroll_to_end(s)
+    if len(layout.sections[-1]) > 1:  # the Help pane is open: H closes it
+        s.key("h")
+        s.until(lambda img: len(parse(img).sections[-1]) == 1, 10, "Help closed after H")
+        layout = scroll_to_end(s)
+    if not record_buttons(s.img):
+        s.click(layout.sections[surfaces_section(layout) + 1][0].center)
+        s.until(record_buttons, 10, "the record button under the opened record header")
+    layout = parse(s.settled((0, 0, *s.size)))
+    i = surfaces_section(layout)
+    row = layout.find(i + 1, "buttons", 0)
+    button = ((row.buttons[0][0] + row.buttons[0][1]) // 2, row.center[1])
+    row_box = (layout.left, row.y0, layout.right, row.y1)
+    before, gifs = s.img, set(s.tmp.rglob("*.gif"))
+    s.click(button)
+    s.until(lambda img: pixels(before, img, row_box) > 20, 10, "'stop' in record's place")
+    theta = layout.find(i, "slider", -1)
+    if not theta.buttons:
+        raise AssertionError("no turn button right of the θ slider")
+    scene = scene_box(s, layout)
+    before = s.screenshot()
+    s.click(((theta.buttons[0][0] + theta.buttons[0][1]) // 2, theta.center[1]))
+    s.until(lambda img: pixels(before, img, scene) > 50, 15, "the normal section turning")
+    time.sleep(1.0)
+    s.click(button)  # stop
+    s.until(lambda img: bool(set(s.tmp.rglob("*.gif")) - gifs), 20, "the recorded GIF")
+    (gif,) = set(s.tmp.rglob("*.gif")) - gifs
+    frames = Image.open(gif).n_frames
+    if frames < 2:
+        raise AssertionError(f"{gif.name} holds {frames} frame(s), want more than 1")
+    s.settled((0, 0, *s.size))
+
+
 TOUR: list[tuple[str, Callable[[Session], None]]] = [
     ("window", opened),
     ("pick_mesh", pick_mesh),
@@ -563,6 +626,7 @@ TOUR: list[tuple[str, Callable[[Session], None]]] = [
     ("surfaces", surfaces),
     ("export", export),
     ("help", help_pane),
+    ("record", record_turn),
 ]
 
 

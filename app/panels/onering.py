@@ -17,7 +17,7 @@ from meshlap_core.options import AREA_KINDS, BOUNDARY_RULES
 
 from .. import scene
 from ..camera import project_to_screen
-from ..scene import MESH, RING_CENTER, RING_CURVE, RING_POINTS
+from ..scene import MESH, RING_CENTER, RING_CURVE, RING_POINTS, scene_fraction
 from ..state.onering import (
     HoverThrottle,
     angle_arcs,
@@ -243,10 +243,8 @@ class OneRingPanel:
         if np.linalg.norm(np.cross([0.0, 1.0, 0.0], back)) < 1e-6 * np.linalg.norm(back):
             ps.look_at(center + size * back, center)  # frame_points needs a non-vertical view
             return
-        from ..viewer import PANEL_PX  # (imported here: the viewer imports this module)
-
         w, _ = ps.get_window_size()
-        fraction = min(max((w - PANEL_PX * viewer.ui.scale) / max(w, 1), 0.3), 0.95)
+        fraction = scene_fraction(w, viewer.ui.scale)
         # as scene.frame_points does: shift the target right so the vertex lands in the middle
         # of the part of the window left of meshlap's panel
         right = np.cross([0.0, 1.0, 0.0], back)

@@ -10,7 +10,8 @@ import polyscope as ps
 
 from meshlap_core.options import LAPLACIAN_KINDS as LAPLACIANS
 
-from ..animate import Recorder, draw_record, smoothing_caption
+from ..animate import smoothing_caption
+from ..record import Recorder, draw_record
 from ..scene import (
     INPUT_COLOR,
     MESH,

@@ -8,9 +8,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 import polyscope as ps
 
-from ..animate import Recorder, draw_record
+from ..record import Recorder, draw_record
 from ..scene import COLORBAR_AT, EIGEN, MESH, RECON, side_offset
-from ..state.spectral import SpectralState
+from ..state.spectral import PLAY_KINDS, SpectralState
 
 if TYPE_CHECKING:
     from ..viewer import Viewer
@@ -24,10 +24,13 @@ class SpectralPanel:
         self._shown_k = -1
         self._shown_mode = -1
         self.recorder = Recorder("spectral.gif")
+        self._offset_key: tuple[object, ...] = ()
+        self._offset_value = np.zeros(3)
 
     def on_new_mesh(self, viewer: Viewer) -> None:
         self.state.clear()
         self._shown_k = self._shown_mode = -1
+        self._offset_key = ()
         if ps.has_surface_mesh(RECON):
             ps.remove_surface_mesh(RECON)
 
@@ -42,7 +45,14 @@ class SpectralPanel:
             self._shown_mode = -1
 
     def _offset(self, viewer: Viewer) -> np.ndarray:
-        return side_offset(viewer.display.points(viewer.mesh.V))
+        """Where the reconstruction sits beside the mesh: computed from all vertices once per
+        mesh and display fit (not on every k move)."""
+        d = viewer.display
+        key = (id(viewer.mesh), viewer.mesh.version, d.scale, *d.centre.tolist())
+        if key != self._offset_key:
+            self._offset_value = side_offset(d.points(viewer.mesh.V))
+            self._offset_key = key
+        return self._offset_value
 
     def push_mode(self, viewer: Viewer, force: bool = False) -> None:
         st = self.state
@@ -78,9 +88,12 @@ class SpectralPanel:
         )
 
     def points(self, viewer: Viewer, name: str) -> np.ndarray | None:
-        """Display positions of a structure this panel registered (for camera framing)."""
+        """Display positions of a structure this panel registered (for camera framing): the
+        reconstruction is framed as the mesh it approximates, shifted beside it, so the camera
+        holds still while k changes (x_1 is a single point: framing it would cut the later
+        copies off)."""
         if name == RECON and self.state.basis is not None:
-            return viewer.display.points(self.state.reconstruction) + self._offset(viewer)
+            return viewer.display.points(viewer.mesh.V) + self._offset(viewer)
         return None
 
     def adopt(self, viewer: Viewer) -> None:
@@ -157,5 +170,42 @@ class SpectralPanel:
             if ok:
                 ui.plot_line("mean |x - x_k|", e.k[1:], e.mean[1:])
                 ui.plot_vlines("current k", np.array([float(st.k)]))
-        caption = f"k = {st.k}: mean error {e.mean[st.k]:.3g};  eigenmode u_{st.mode}"
-        draw_record(viewer, self.recorder, (st.k, st.mode), lambda: caption)
+        self.draw_play(viewer)
+        draw_record(viewer, self.recorder, (st.k, st.mode), self._record_caption, self._record_kind)
+
+    def draw_play(self, viewer: Viewer) -> None:
+        """What plays (the k sweep or the eigenmodes), play / pause, and this frame's step."""
+        ui, st = viewer.ui, self.state
+        ch, what = ui.combo(
+            "play what",
+            st.play_what,
+            PLAY_KINDS,
+            "k sweep: k = 1, 2, ... one per frame (as meshlap animate --k); modes: the "
+            "eigenmodes 1, 2, ... at 1.5 per second (as --modes); playing stops at the end",
+        )
+        if ch:
+            st.set_play_what(what)
+        ui.same_line()
+        if ui.button(
+            "pause" if st.playing else "play",
+            "play the k sweep or the eigenmodes from the first (or go on after a pause); "
+            "while recording, each k or mode shown adds a frame",
+        ):
+            if st.toggle_play():
+                self.recorder.restart()  # the file starts with the first k (or mode) played
+        elif not st.tick():  # the first k (or mode) of a play shows for a frame of its own
+            return
+        self.push_k(viewer)
+        self.push_mode(viewer)
+
+    def _record_kind(self) -> str:
+        """What changed since the last recorded frame: ``k`` or ``modes`` (the play choice for
+        the first frame)."""
+        last = self.recorder.last
+        if last is None:
+            return "k" if self.state.play_what == "k sweep" else "modes"
+        return "k" if last[0] != self.state.k else "modes"
+
+    def _record_caption(self) -> str:
+        st = self.state
+        return st.k_caption() if self._record_kind() == "k" else st.mode_caption()

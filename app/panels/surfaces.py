@@ -1,4 +1,6 @@
-"""The Surfaces panel: a parametric surface, its exact K, and the geometry at a point (u, v)."""
+"""The Surfaces panel: a parametric surface, its exact K, the geometry at a point (u, v) and the
+normal section at an angle θ (drawn in 3D; ``meshlap animate --theta`` draws it with
+:meth:`SurfacesPanel.push_section` too)."""
 
 from __future__ import annotations
 
@@ -7,7 +9,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 import polyscope as ps
 
+from ..animate import NORMAL_SECTION, SECTION_DIRECTION
+from ..record import Recorder, draw_record
 from ..scene import COLORBAR_AT, SURFACE, SURFACE_POINT, Z_TO_Y
+from ..state.surface import TURN_STEP_DEG, section_arc
 from ..ui import sig
 
 if TYPE_CHECKING:
@@ -15,10 +20,14 @@ if TYPE_CHECKING:
 
 
 class SurfacesPanel:
-    """Surface choice, (u, v) sliders, fundamental forms, principal directions, k_n(θ)."""
+    """Surface choice, (u, v) sliders, fundamental forms, principal directions, k_n(θ), the
+    normal section at θ (slider, *turn*) and its recording."""
+
+    SECTION_COLOR = (0.95, 0.55, 0.05)
 
     def __init__(self) -> None:
         self._version = -1
+        self.recorder = Recorder("surfaces.gif")
 
     def on_new_mesh(self, viewer: Viewer) -> None:
         return None
@@ -31,6 +40,8 @@ class SurfacesPanel:
             self._version = -1  # registered again when the panel comes back
         if ps.has_point_cloud(SURFACE_POINT):
             ps.get_point_cloud(SURFACE_POINT).set_enabled(panel == "surfaces")
+        if ps.has_curve_network(NORMAL_SECTION):
+            ps.get_curve_network(NORMAL_SECTION).set_enabled(panel == "surfaces")
 
     def points(self, viewer: Viewer, name: str) -> np.ndarray | None:
         if name == SURFACE and viewer.surf.mesh is not None:
@@ -86,6 +97,31 @@ class SurfacesPanel:
             enabled=True,
             color=(0.2, 0.7, 0.2),
         )
+        self.push_section(viewer)
+
+    def push_section(self, viewer: Viewer, degrees: float | None = None) -> None:
+        """Draw the normal section at θ (``degrees``, else the state's): its unit tangent
+        t(θ) as an arrow at the point and its osculating arc of curvature κₙ(θ) (orange).
+        The point cloud must be registered (:meth:`push_point`)."""
+        surf = viewer.surf
+        if degrees is not None:
+            surf.set_section(degrees)
+        if surf.point is None or not ps.has_point_cloud(SURFACE_POINT):
+            return
+        size = float(np.ptp(surf.mesh.V, axis=0).max()) if surf.mesh is not None else 1.0
+        t, kn = surf.section()
+        arc = section_arc(surf.point, t, kn, 0.3 * size)
+        edges = np.column_stack([np.arange(len(arc) - 1), np.arange(1, len(arc))])
+        cn = ps.register_curve_network(NORMAL_SECTION, arc, edges, radius=0.006)
+        cn.set_transform(Z_TO_Y)
+        cn.set_color(self.SECTION_COLOR)
+        ps.get_point_cloud(SURFACE_POINT).add_vector_quantity(
+            SECTION_DIRECTION,
+            0.2 * size * t[None, :],
+            vectortype="ambient",
+            enabled=True,
+            color=self.SECTION_COLOR,
+        )
 
     def draw(self, viewer: Viewer) -> None:
         ui = viewer.ui
@@ -121,7 +157,37 @@ class SurfacesPanel:
             f"k2 = {sig(p.k2, sk)} at {np.degrees(p.theta_min):.1f} deg"
         )
         ui.text("signs: e = p_uu . n with n = p_u x p_v (do Carmo)")
+        self.draw_section(viewer)
         with ui.plot("normal curvature k_n(theta)", 180, "theta (deg)", "k_n") as shown:
             if shown:
                 ui.plot_line("k_n", np.degrees(s.theta), s.kn)
                 ui.plot_vlines("theta max/min", np.degrees([p.theta_max, p.theta_min]))
+                ui.plot_vlines("section theta", np.array([s.section_deg]))
+        key = (s.version, s.u, s.v, s.section_deg)
+        draw_record(viewer, self.recorder, key, s.section_caption, "theta")
+
+    def draw_section(self, viewer: Viewer) -> None:
+        """The θ slider (showing κₙ(θ)), *turn* / *pause turn* and this frame's turn step."""
+        ui, s = viewer.ui, viewer.surf
+        _, kn = s.section()
+        ch, deg = ui.slider_float(
+            "section theta",
+            s.section_deg,
+            0.0,
+            360.0,
+            f"%.1f deg: k_n = {kn:.4g}",  # κₙ(θ) shown in the slider (no row of its own)
+            "direction of the normal section (orange) in the tangent plane, in degrees from "
+            "p_u towards p_v: its tangent t(theta) and its osculating arc of curvature "
+            "k_n(theta)",
+        )
+        if ch:
+            self.push_section(viewer, deg)
+        ui.same_line()
+        if ui.button(
+            "pause turn" if s.turning else "turn",
+            f"turn the section once around, {TURN_STEP_DEG:g} deg per frame "
+            "(while recording: a frame per step, as meshlap animate --theta)",
+        ):
+            s.toggle_turn()
+        elif s.tick_turn():
+            self.push_section(viewer)

@@ -9,6 +9,8 @@ the previous k.
 from __future__ import annotations
 
 import threading
+import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -20,6 +22,13 @@ from meshlap_core.types import FloatArray, IntArray
 
 SCREENSHOT_K = 30
 """k of ``meshlap view --panel spectral --screenshot`` without ``--k``."""
+
+PLAY_KINDS = ("k sweep", "modes")
+"""What the Spectral panel plays: k = 1, 2, ... (one per frame) or the eigenmodes 1, 2, ..."""
+
+MODES_PER_SECOND = 1.5
+"""Pace of the eigenmodes played on screen (a mode must be readable); the k sweep is one k
+per frame."""
 
 
 @dataclass
@@ -39,6 +48,11 @@ class SpectralState:
     _thread: threading.Thread | None = None
     _pending: tuple[SpectralBasis, Any] | None = None
     _lock: threading.Lock = field(default_factory=threading.Lock)
+    play_what: str = "k sweep"  # one of PLAY_KINDS
+    playing: bool = False
+    clock: Callable[[], float] = time.monotonic  # seconds (a test gives its own)
+    _due: float = 0.0  # when the next mode is due
+    _paused: bool = False  # paused mid-way: play resumes instead of starting over
 
     @property
     def busy(self) -> bool:
@@ -47,6 +61,7 @@ class SpectralState:
     def clear(self) -> None:
         """Forget the basis (a new mesh was loaded)."""
         self.basis, self.errors, self._pending = None, None, None
+        self.playing = self._paused = False
         self.reconstruction = np.zeros((0, 3))
         self.vertex_error = np.zeros(0)
         self.progress, self.message, self.error = 0.0, "", ""
@@ -119,3 +134,88 @@ class SpectralState:
         self.k = int(np.clip(k, 1, self.basis.k_max))
         self.reconstruction = self.basis.reconstruct(self.k)
         self.vertex_error = np.linalg.norm(self.reconstruction - self.basis.V, axis=1)
+
+    # ------------------------------------------------------------------ captions (CLI and record)
+    def k_caption(self, k: int | None = None) -> str:
+        """``k = 12 modes   mean error 0.0123 (1.2% of the diagonal)   max 0.05``: the caption of
+        a k-sweep frame (``meshlap animate --k`` and the viewer's recording)."""
+        e = self.errors
+        k = self.k if k is None else int(k)
+        return (
+            f"k = {k} modes   mean error {e.mean[k]:.3g} "
+            f"({100 * e.relative_mean[k]:.3g}% of the diagonal)   max {e.max[k]:.3g}"
+        )
+
+    def mode_caption(self, mode: int | None = None) -> str:
+        """``eigenmode u_3   λ_3 = 7.21   (-C u = λ M u)``: the caption of an eigenmode frame."""
+        if self.basis is None:
+            raise MeshError("no eigenbasis computed yet", "spectral")
+        m = self.mode if mode is None else int(mode)
+        lam = float(self.basis.eigenvalues[m])
+        return f"eigenmode u_{m}   λ_{m} = {lam:.5g}   (-C u = λ M u)"
+
+    # ------------------------------------------------------------------ play
+    def set_play_what(self, what: str) -> None:
+        """Choose what *play* plays (stops a sweep that is playing).
+
+        Raises
+        ------
+        MeshError
+            ``what`` is not one of :data:`PLAY_KINDS`.
+        """
+        if what not in PLAY_KINDS:
+            raise MeshError(f"{what!r} is not one of {', '.join(PLAY_KINDS)}", "play")
+        if what != self.play_what:
+            self.play_what, self.playing, self._paused = what, False, False
+
+    def _at_end(self) -> bool:
+        top = self.basis.k_max if self.basis is not None else 0
+        return self.k >= top if self.play_what == "k sweep" else self.mode >= top - 1
+
+    def toggle_play(self) -> bool:
+        """*play* / *pause*: play starts from k = 1 (or mode 1), or resumes where a pause left
+        it; it stops by itself at the last k (or mode). True when a play started over.
+
+        Raises
+        ------
+        MeshError
+            No eigenbasis yet.
+        """
+        if self.playing:
+            self.playing, self._paused = False, True
+            return False
+        if self.basis is None:
+            raise MeshError("compute the eigenbasis first", "play")
+        over = not self._paused or self._at_end()
+        if over and self.play_what == "k sweep":
+            self.set_k(1)
+        elif over:
+            self.set_mode(min(1, self.basis.k_max - 1))
+        self.playing, self._paused = True, False
+        self._due = self.clock() + self.play_interval
+        return over
+
+    @property
+    def play_interval(self) -> float:
+        """Seconds between two steps of what plays (0: one per frame)."""
+        return 1.0 / MODES_PER_SECOND if self.play_what == "modes" else 0.0
+
+    def tick(self) -> bool:
+        """Advance what plays when its next step is due (called every frame); True when k or
+        the mode changed. Playing stops at the end."""
+        if not self.playing:
+            return False
+        if self.basis is None or self._at_end():
+            self.playing = False
+            return False
+        now = self.clock()
+        if now < self._due:
+            return False
+        self._due = now + self.play_interval
+        if self.play_what == "k sweep":
+            self.set_k(self.k + 1)
+        else:
+            self.set_mode(self.mode + 1)
+        if self._at_end():
+            self.playing = False
+        return True

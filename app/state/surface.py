@@ -16,6 +16,25 @@ from meshlap_core.errors import MeshError
 from meshlap_core.types import FloatArray
 
 MAX_RES = 512  # cells per direction the viewer meshes (512² cells: 0.5 M triangles)
+TURN_STEP_DEG = 5.0
+"""θ step of the normal section turning (*turn*): one frame each, 72 frames per turn (as
+``meshlap animate --panel surfaces --theta`` with its default ``--frames 72``)."""
+
+
+def section_arc(
+    p: surfaces.PointGeometry, t: FloatArray, kn: float, length: float, n: int = 80
+) -> FloatArray:
+    """Points ``(n,3)`` of the normal section's osculating arc at ``p.p``: the circle of
+    curvature ``kn`` in the plane of the unit tangent ``t (3,)`` and the normal ``p.n``
+    (``x(s) = p + t sin(κs)/κ + n (1 − cos(κs))/κ``, at most one full turn; a straight
+    segment when ``kn`` is 0)."""
+    half = min(length, np.pi / abs(kn)) if abs(kn) > 1e-12 else length
+    s = np.linspace(-half, half, n)
+    if abs(kn) > 1e-9:
+        along, up = np.sin(kn * s) / kn, (1.0 - np.cos(kn * s)) / kn
+    else:
+        along, up = s, 0.5 * kn * s * s
+    return p.p[None, :] + along[:, None] * t[None, :] + up[:, None] * p.n[None, :]
 
 
 @dataclass
@@ -32,6 +51,9 @@ class SurfaceState:
     theta: FloatArray = field(default_factory=lambda: np.zeros(0))
     kn: FloatArray = field(default_factory=lambda: np.zeros(0))
     version: int = 0  # bumped when the mesh changes (re-register), not when (u, v) moves
+    section_deg: float = 0.0  # θ of the normal section drawn in 3D, degrees in [0, 360)
+    turning: bool = False  # *turn*: θ advances TURN_STEP_DEG per frame
+    _turn_left: int = 0  # steps left in this turn
 
     @property
     def names(self) -> list[str]:
@@ -105,3 +127,65 @@ class SurfaceState:
         if p is None:
             raise MeshError("no point selected on the surface yet", "surface")
         return p.p[None, :], scale * p.dir1[None, :], scale * p.dir2[None, :]
+
+    # ------------------------------------------------------------------ the normal section
+    def set_section(self, degrees: float) -> None:
+        """Turn the normal section to θ = ``degrees`` (taken modulo 360).
+
+        Raises
+        ------
+        MeshError
+            ``degrees`` is not a finite number (θ stays).
+        """
+        d = float(degrees)
+        if not np.isfinite(d):
+            raise MeshError(f"must be a finite angle in degrees, got {degrees!r}", "theta")
+        self.section_deg = d % 360.0
+
+    def section(self) -> tuple[FloatArray, float]:
+        """The unit tangent ``t(θ) (3,)`` (``p_u cos θ + p_v sin θ``, normalized) and the normal
+        curvature ``κₙ(θ)`` of the section at θ = ``section_deg``."""
+        p = self.point
+        if p is None:
+            raise MeshError("no point selected on the surface yet", "surface")
+        theta = np.radians(self.section_deg)
+        c, s = float(np.cos(theta)), float(np.sin(theta))
+        d = p.p_u * c + p.p_v * s
+        # surfaces.normal_curvature's formula on the point's forms (that function evaluates
+        # the surface's derivatives again: ~6 ms, too much for every frame)
+        kn = (p.e * c * c + 2 * p.f * c * s + p.g * s * s) / (
+            p.E * c * c + 2 * p.F * c * s + p.G * s * s
+        )
+        return d / np.linalg.norm(d), float(kn)
+
+    def section_caption(self) -> str:
+        """``saddle at (u, v) = (0.3, 0)   θ =  45.0°   κₙ(θ) = +0.5   (κ₁ = 1, κ₂ = -1)``: the
+        caption of a θ frame (``meshlap animate --theta`` and the viewer's recording)."""
+        p = self.point
+        if p is None:
+            raise MeshError("no point selected on the surface yet", "surface")
+        _, kn = self.section()
+        return (
+            f"{self.name} at (u, v) = ({self.u:.3g}, {self.v:.3g})   θ = {self.section_deg:5.1f}°"
+            f"   κₙ(θ) = {kn:+.4g}   (κ₁ = {p.k1:.4g}, κ₂ = {p.k2:.4g})"
+        )
+
+    def toggle_turn(self) -> None:
+        """*turn* / *pause turn*: one full turn of θ from where it is, ``TURN_STEP_DEG`` per
+        frame (a pause goes on from there); it stops by itself after the turn."""
+        if self.turning:
+            self.turning = False
+            return
+        if self._turn_left <= 0:
+            self._turn_left = round(360.0 / TURN_STEP_DEG) - 1
+        self.turning = self._turn_left > 0
+
+    def tick_turn(self) -> bool:
+        """Advance θ by one step while turning (called every frame); True when θ moved."""
+        if not self.turning or self.point is None:
+            self.turning = False
+            return False
+        self.set_section(self.section_deg + TURN_STEP_DEG)
+        self._turn_left -= 1
+        self.turning = self._turn_left > 0
+        return True

@@ -1,0 +1,191 @@
+"""The viewer's *record* button: what a panel plays, written to the same GIF/MP4 as
+``meshlap animate``.
+
+Each panel that plays something (Smoothing: play; Spectral: the k sweep and the eigenmodes;
+Surfaces: the normal section turning) owns a :class:`Recorder` and calls :func:`draw_record` at
+the end of its ``draw``: the collapsed *record* header (file name, record / stop), then, while
+recording, one frame of the 3D view each time what the panel shows changes, with the caption
+the CLI burns into the same kind of frame (the panels and :mod:`.animate` share the caption
+functions). The file's frame rate follows what was recorded (:data:`.animate.DEFAULT_FPS`:
+smoothing 10, k sweep 15, eigenmodes 1.5, θ turn 15 frames per second).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import polyscope as ps
+
+from meshlap_core.errors import MeshError
+from meshlap_core.frames import FrameWriter, burn_caption
+
+from .animate import DEFAULT_FPS, RECORD_HEADER
+from .scene import scene_fraction
+
+if TYPE_CHECKING:
+    from .viewer import Viewer
+
+
+class Recorder:
+    """The *record* / *stop* buttons of a panel: while recording, every change of what the
+    panel plays (a smoothing step, a new k or mode, a new θ) adds a frame of the 3D view;
+    *stop* writes the GIF/MP4 atomically and says where.
+
+    The frame rate is that of the first change recorded (``kind`` of :meth:`capture`, a key of
+    :data:`.animate.DEFAULT_FPS`): the frame shown when *record* was pressed waits for it, so
+    starting a recording and then playing the eigenmodes gives a 1.5 fps file, dragging k a
+    15 fps one. An MP4 streams from its first frame, so the rate cannot change later.
+
+    Parameters
+    ----------
+    stem : str
+        Default file name (without folder), e.g. ``smoothing.gif``.
+    """
+
+    def __init__(self, stem: str) -> None:
+        self.file_text = stem
+        self.writer: FrameWriter | None = None
+        self.status = ""
+        self.kind = ""  # what set the frame rate ("" until the first change)
+        self.last: Any = None
+        self._held: tuple[np.ndarray, str] | None = None  # the first frame, until a change
+        self._capturing = False
+
+    @property
+    def recording(self) -> bool:
+        return self.writer is not None
+
+    @property
+    def count(self) -> int:
+        """Frames recorded so far."""
+        if self.writer is None:
+            return 0
+        return self.writer.count + (self._held is not None)
+
+    def draw(self, viewer: Viewer) -> None:
+        """The collapsed *record* header: file name, record / stop, where the last one went."""
+        ui = viewer.ui
+        if not ui.header(RECORD_HEADER, default_open=False):
+            return
+        _, self.file_text = ui.input_text(
+            "record file",
+            self.file_text,
+            "a .gif or .mp4 name (in the Export folder unless a full path)",
+        )
+        if not self.recording:
+            if ui.button("record", "start recording what this panel plays (a frame per change)"):
+                self.start(viewer)
+        elif ui.button("stop", "stop and write the file"):
+            self.status = self.stop()
+        if self.recording:
+            ui.text(f"recording: {self.count} frames")
+        if self.status:
+            ui.text(self.status)
+
+    def start(self, viewer: Viewer) -> None:
+        """Begin a recording into the file named in the field.
+
+        Raises
+        ------
+        MeshError
+            Already recording, a bad name, extension or folder, or MP4 without the video extra
+            (nothing changes).
+        """
+        if self.recording:
+            raise MeshError("already recording: stop first", "record")
+        path = Path(self.file_text.strip()).expanduser()
+        if not self.file_text.strip():
+            raise MeshError("the file name is empty", "record file")
+        if not path.is_absolute():
+            path = viewer.panels["export"].folder / path
+        self.writer = FrameWriter(path, DEFAULT_FPS["smoothing"])
+        self.last, self._held, self.kind = None, None, ""
+        self.status = ""
+
+    def stop(self) -> str:
+        """Write the file; the message says where (or why not)."""
+        writer, self.writer = self.writer, None
+        held, self._held = self._held, None
+        if writer is None:
+            return ""
+        try:
+            if held is not None:
+                writer.add(burn_caption(*held))
+            return f"wrote {writer.count} frames ({writer.fps:g} fps) to {writer.close()}"
+        except MeshError:
+            writer.abort()
+            raise
+
+    def restart(self) -> None:
+        """A play starts over right after *record*: drop the frame held from the moment of
+        *record* (the file then starts with the first k or mode played)."""
+        if self.writer is not None and self.writer.count == 0:
+            self._held, self.last = None, None
+
+    def capture(self, viewer: Viewer, key: Any, caption: str, kind: str = "smoothing") -> None:
+        """Add a frame when recording and ``key`` (what the panel shows) changed; ``kind``
+        (``smoothing``, ``k``, ``modes`` or ``theta``) names what changed."""
+        if self.writer is None or self._capturing or key == self.last:
+            return
+        self._capturing = True
+        try:
+            if viewer.reframe:  # a copy appeared this frame: frame it before the picture
+                viewer.reframe = False
+                viewer.frame()
+            buf = crop_scene(
+                viewer, ps.screenshot_to_buffer(transparent_bg=False, include_UI=False)
+            )
+            if self.last is None:  # the frame on screen when *record* was pressed
+                self._held = (buf, caption)
+            else:
+                self._add(buf, caption, kind)
+            self.last = key
+        finally:
+            self._capturing = False
+
+    def _add(self, buf: np.ndarray, caption: str, kind: str) -> None:
+        """Write the held first frame (the rate set by this first change) and ``buf``; a
+        frame the writer refuses (the window was resized) ends the recording, nothing written.
+        """
+        writer = self.writer
+        if writer is None:
+            return
+        if not self.kind:
+            self.kind = kind
+            writer.fps = DEFAULT_FPS.get(kind, writer.fps)
+        try:
+            if self._held is not None:
+                writer.add(burn_caption(*self._held))
+                self._held = None
+            writer.add(burn_caption(buf, caption))
+        except MeshError as exc:
+            writer.abort()
+            self.writer, self._held = None, None
+            raise MeshError(f"recording stopped, nothing written: {exc}", "record") from exc
+
+
+def crop_scene(viewer: Viewer, buf: np.ndarray) -> np.ndarray:
+    """The part of a window buffer ``(h, w, 4)`` left of meshlap's panel (where the viewer
+    frames the scene)."""
+    fraction = scene_fraction(ps.get_window_size()[0], viewer.ui.scale, cap=1.0)
+    keep = int(buf.shape[1] * fraction)
+    return buf[:, : max(keep // 2 * 2, 2)]
+
+
+def draw_record(
+    viewer: Viewer,
+    recorder: Recorder,
+    key: Any,
+    caption: Callable[[], str],
+    kind: str | Callable[[], str] = "smoothing",
+) -> None:
+    """The panels' hook: draw the record header, then capture a frame if recording.
+
+    ``caption`` (and ``kind`` when a function) are called only when a frame is captured.
+    """
+    recorder.draw(viewer)
+    if recorder.recording and key != recorder.last:
+        recorder.capture(viewer, key, caption(), kind() if callable(kind) else kind)
