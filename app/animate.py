@@ -456,6 +456,7 @@ def theta_frames(viewer: Viewer, spec: AnimationSpec) -> Iterator[str]:
     viewer.show_panel()  # the Surfaces panel registers the surface, K and the point
     frame_view(viewer)
     panel = viewer.panels["surfaces"]
-    for theta in np.linspace(0.0, 360.0, spec.frames, endpoint=False):
+    start = surf.section_deg  # 0, or the θ a session saved: one turn from there
+    for theta in np.linspace(start, start + 360.0, spec.frames, endpoint=False):
         panel.push_section(viewer, theta)
         yield surf.section_caption()

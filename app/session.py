@@ -74,6 +74,7 @@ def capture(viewer: Viewer) -> Session:
         k_request=int(spec.basis.k_max if computed else spec.k_request),
         k=int(spec.k),
         mode=int(spec.mode),
+        play=spec.play_what,
     )
     s.settings["smoothing"].update(
         method=sm.method,
@@ -84,7 +85,9 @@ def capture(viewer: Viewer) -> Session:
         iterations=int(sm.smoother.iteration) if sm.smoother is not None else 0,
         lam_steps=encode_lam_steps(sm.lam_steps, sm.lam) if sm.smoother is not None else None,
     )
-    s.settings["surfaces"].update(surface=surf.name, res=int(surf.res), u=surf.u, v=surf.v)
+    s.settings["surfaces"].update(
+        surface=surf.name, res=int(surf.res), u=surf.u, v=surf.v, theta=float(surf.section_deg)
+    )
     return s
 
 
@@ -168,6 +171,7 @@ def apply(
     sf = st["surfaces"]
     if viewer.surf.set_surface(sf["surface"], sf["res"]):
         viewer.surf.set_uv(sf["u"], sf["v"])
+    viewer.surf.set_section(sf["theta"])  # a finite number: checked when the file was read
     _apply_spectral(viewer, st["spectral"])
     _apply_smoothing(viewer, st["smoothing"], session.panel == "smoothing")
     viewer.set_panel(session.panel)
@@ -183,11 +187,12 @@ def apply(
 
 
 def _apply_spectral(viewer: Viewer, sp: dict[str, Any]) -> None:
-    """Basis (from the cache when it was computed before), mode and k."""
+    """What *play* plays; the basis (from the cache when it was computed before), mode, k."""
     panel = viewer.panels["spectral"]
     state = panel.state
     state.k_request = min(sp["k_request"], max(len(viewer.mesh.V), 2))
     state.k, state.mode = sp["k"], sp["mode"]
+    state.set_play_what(sp["play"])
     if not sp["computed"]:
         return
     state.start(viewer.mesh.V, viewer.mesh.F, background=False)  # cache=True by default

@@ -588,6 +588,7 @@ def _teacher_session(viewer, tmp_path, panel: str):
     spec.set_k(6)
     viewer.surf.set_surface("torus", 30)
     viewer.surf.set_uv(1.0, 2.0)
+    viewer.surf.set_section(30.0)
     viewer.set_panel(panel)
     ps.set_window_size(1200, 700)
     ps.frame_tick()
@@ -634,6 +635,8 @@ def test_session_frames_start_from_the_restored_viewer(panel, viewer, spec_of, t
         assert fresh.panels["spectral"].state.basis.info.from_cache  # the session's basis
     else:
         assert all(c.startswith("torus at (u, v) = (1, 2)   θ = ") for c in captions)
+        thetas = [float(c.split("θ = ")[1].split("°")[0]) for c in captions]
+        assert thetas == [30.0, 120.0, 210.0, 300.0]  # one turn from the saved θ
         assert (fresh.surf.u, fresh.surf.v, fresh.surf.res) == (1.0, 2.0, 30)
 
 

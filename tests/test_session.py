@@ -50,7 +50,7 @@ def non_default_session(mesh) -> Session:
             "second_field": "k1",
         },
         "onering": {"vertex": 17, "reverse": True},
-        "spectral": {"computed": True, "k_request": 24, "k": 9, "mode": 4},
+        "spectral": {"computed": True, "k_request": 24, "k": 9, "mode": 4, "play": "modes"},
         "smoothing": {
             "method": "taubin",
             "laplacian": "cotan",
@@ -60,7 +60,7 @@ def non_default_session(mesh) -> Session:
             "iterations": 5,
             "lam_steps": [[0.5, 2], [0.25, 3]],
         },
-        "surfaces": {"surface": "torus", "res": 30, "u": 1.25, "v": -0.5},
+        "surfaces": {"surface": "torus", "res": 30, "u": 1.25, "v": -0.5, "theta": 30.0},
     }
     return s
 
@@ -142,6 +142,8 @@ WRONG_VALUES = [
     ("surfaces", "surface", "klein"),
     ("surfaces", "res", 0),
     ("surfaces", "u", "nan"),
+    ("surfaces", "theta", "30"),
+    ("spectral", "play", "k"),
 ]
 
 
@@ -306,7 +308,9 @@ def set_up_everything(viewer) -> None:
     viewer.select_vertex(11)
     viewer.surf.set_surface("torus", 20)
     viewer.surf.set_uv(0.7, 1.1)
+    viewer.surf.set_section(400.0)  # the normal section at θ = 40°
     spec = viewer.panels["spectral"]
+    spec.state.set_play_what("modes")
     spec.state.k_request = 16
     spec.state.start(viewer.mesh.V, viewer.mesh.F, background=False)
     spec.state.set_mode(5)
@@ -350,6 +354,7 @@ def test_load_restores_every_setting_the_run_and_the_camera(mock, tmp_path, sphe
     spec = fresh.panels["spectral"].state
     assert spec.basis.info.from_cache and (spec.k, spec.mode, spec.basis.k_max) == (7, 5, 16)
     assert fresh.ring.vertex == 11 and fresh.ring.reverse
+    assert fresh.surf.section_deg == 40.0 and spec.play_what == "modes"
     assert ps.has_surface_mesh("mesh (second estimator)")
     assert not fresh.reframe  # the saved camera is kept, not re-framed
 
@@ -591,9 +596,25 @@ def test_lam_steps_written_only_when_lam_changed(mock, tmp_path, sphere, monkeyp
     drive_smoothing(viewer, "Laplacian", "cotan")  # a rebuild: iteration 0, a new record
     assert st.lam_steps == [] and st.smoother.iteration == 0
     path = session.save(viewer, tmp_path / "plain.json")
-    assert "lam_steps" not in json.loads(path.read_text())["smoothing"] or (
-        json.loads(path.read_text())["smoothing"]["lam_steps"] is None
-    )
+    assert "lam_steps" not in json.loads(path.read_text())["smoothing"]
+
+
+def test_added_keys_are_written_only_when_they_say_something(tmp_path, sphere):
+    """A session at the defaults has none of the keys added after the first files (an older
+    meshlap, which refuses unknown keys, still opens it); set, each is written and read back."""
+    from meshlap_app.state.session import ADDED_KEYS
+
+    plain = json.loads(write_session(tmp_path / "plain.json", Session(mesh=sphere)).read_text())
+    for sec, key in ADDED_KEYS:
+        assert key not in plain[sec], f"{sec}.{key}"
+    s = non_default_session(sphere)
+    data = json.loads(write_session(tmp_path / "all.json", s).read_text())
+    assert [data[sec][key] for sec, key in ADDED_KEYS] == [
+        [[0.5, 2], [0.25, 3]],
+        "modes",
+        30.0,
+    ]
+    assert read_session(tmp_path / "all.json") == s
 
 
 def test_old_format_file_replays_iterations_at_lam(tmp_path, sphere):

@@ -21,3 +21,6 @@ FIELD_LABELS: dict[str, tuple[str, bool]] = {
 
 FIELDS: tuple[str, ...] = tuple(FIELD_LABELS)
 """Curvature fields the viewer shows (``meshlap view --field``)."""
+
+PLAY_KINDS: tuple[str, ...] = ("k sweep", "modes")
+"""What the Spectral panel plays: k = 1, 2, ... (one per frame) or the eigenmodes 1, 2, ..."""

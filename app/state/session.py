@@ -7,11 +7,11 @@ A session file is one JSON object::
      "curvature": {"field": "cotan", "area": "barycentric", "boundary": "pi", "clip": 2.0,
                    "side_by_side": false, "second_field": "uniform"},
      "onering": {"vertex": -1, "reverse": false},
-     "spectral": {"computed": false, "k_request": 100, "k": 10, "mode": 1},
+     "spectral": {"computed": false, "k_request": 100, "k": 10, "mode": 1, "play": "modes"},
      "smoothing": {"method": "implicit", "laplacian": "uniform", "lam": 0.5,
                    "noise_alpha": 0.0, "seed": 0, "iterations": 15,
                    "lam_steps": [[0.5, 10], [2.0, 5]]},
-     "surfaces": {"surface": "helicoid", "res": 48, "u": 0.0, "v": 0.0}}
+     "surfaces": {"surface": "helicoid", "res": 48, "u": 0.0, "v": 0.0, "theta": 30.0}}
 
 ``camera`` is polyscope's ``get_view_as_json()`` parsed (or ``null``). A relative ``mesh`` is
 resolved against the session file's folder; ``null`` means the bundled default mesh. Missing
@@ -27,12 +27,16 @@ replays the runs exactly (bit for bit). The key is written only when it says som
 ``lam`` and ``iterations`` do not (λ changed during the run); missing or ``null``, the run is
 ``iterations`` steps at ``lam``, as version-1 files have always been read.
 
+**Keys added after the first files** (:data:`ADDED_KEYS`): ``smoothing.lam_steps``,
+``spectral.play`` (what the Spectral panel's *play* plays: ``k sweep`` or ``modes``) and
+``surfaces.theta`` (the normal section's θ in degrees). Each is written only when it differs
+from its default, and a missing one takes its default.
+
 **Why the version stays 1.** A file is bumped only when an older reader would *misread* it. A
 reader of this version refuses every unknown key (``unknown key(s) in 'smoothing'``), so an
-older meshlap given a file with ``lam_steps`` refuses it instead of replaying it with the wrong
-λ; and a file without the key (no λ change) means exactly what it meant before, so older
-meshlaps keep opening it. A bump to 2 would make every new file unreadable to them for no
-gain.
+older meshlap given a file with an added key refuses it instead of replaying it with the wrong
+λ; and a file without them means exactly what it meant before, so older meshlaps keep opening
+it. A bump to 2 would make every new file unreadable to them for no gain.
 
 This module only maps a :class:`Session` to and from a dict and a file; the viewer
 (:mod:`meshlap_app.session`) captures one from its panels and applies one to them.
@@ -55,7 +59,7 @@ from meshlap_core.io import atomic_write, check_output_path
 from meshlap_core.options import AREA_KINDS, BOUNDARY_RULES, LAPLACIAN_KINDS
 from meshlap_core.surfaces import SURFACES
 
-from .names import FIELDS, PANELS
+from .names import FIELDS, PANELS, PLAY_KINDS
 from .surface import MAX_RES
 
 FORMAT = "meshlap-session"
@@ -139,6 +143,7 @@ SCHEMA: dict[str, dict[str, tuple[Any, Check]]] = {
         "k_request": (100, _integer(2)),
         "k": (10, _integer(1)),
         "mode": (1, _integer(0)),
+        "play": ("k sweep", _one_of(PLAY_KINDS)),
     },
     "smoothing": {
         "method": ("implicit", _one_of(("explicit", "implicit", "taubin"))),
@@ -154,8 +159,11 @@ SCHEMA: dict[str, dict[str, tuple[Any, Check]]] = {
         "res": (48, _integer(1, MAX_RES)),
         "u": (0.0, _number()),
         "v": (0.0, _number()),
+        "theta": (0.0, _number()),
     },
 }
+ADDED_KEYS = (("smoothing", "lam_steps"), ("spectral", "play"), ("surfaces", "theta"))
+"""Keys newer than the first session files: written only when they differ from the default."""
 TOP_LEVEL = ("format", "version", "meshlap", "mesh", "panel", "ui_scale", "camera", *SCHEMA)
 
 
@@ -197,8 +205,17 @@ class Session:
             "panel": self.panel,
             "ui_scale": self.ui_scale,
             "camera": copy.deepcopy(self.camera),
-            **copy.deepcopy(self.settings),
+            **_without_default_added_keys(copy.deepcopy(self.settings)),
         }
+
+
+def _without_default_added_keys(settings: dict[str, dict[str, Any]]) -> dict[str, dict[str, Any]]:
+    """``settings`` without the :data:`ADDED_KEYS` that hold their default (older readers
+    refuse unknown keys: a file that does not need them stays readable there)."""
+    for sec, key in ADDED_KEYS:
+        if sec in settings and settings[sec].get(key, SCHEMA[sec][key][0]) == SCHEMA[sec][key][0]:
+            settings[sec].pop(key, None)
+    return settings
 
 
 def from_dict(

@@ -20,11 +20,11 @@ from meshlap_core.errors import MeshError
 from meshlap_core.spectral import SpectralBasis
 from meshlap_core.types import FloatArray, IntArray
 
+from .names import PLAY_KINDS
+
 SCREENSHOT_K = 30
 """k of ``meshlap view --panel spectral --screenshot`` without ``--k``."""
 
-PLAY_KINDS = ("k sweep", "modes")
-"""What the Spectral panel plays: k = 1, 2, ... (one per frame) or the eigenmodes 1, 2, ..."""
 
 MODES_PER_SECOND = 1.5
 """Pace of the eigenmodes played on screen (a mode must be readable); the k sweep is one k
