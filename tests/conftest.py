@@ -51,6 +51,37 @@ def polyscope_mock(tmp_path_factory):
     os.chdir(old)
 
 
+@pytest.fixture
+def sphere(tmp_path: Path) -> Path:
+    """An icosphere (level 2, 162 vertices) written to ``tmp_path/sphere.obj``."""
+    from meshlap_core import primitives
+    from meshlap_core.io import save_mesh
+
+    path = tmp_path / "sphere.obj"
+    save_mesh(path, *primitives.icosphere(2))
+    return path
+
+
+@pytest.fixture
+def viewer(polyscope_mock, sphere, tmp_path, monkeypatch):
+    """A viewer on ``sphere`` drawing through the scriptable UI adapter on ``openGL_mock``
+    (every ``frame_tick`` runs its callback), exporting to ``tmp_path``, with a private
+    eigenbasis cache."""
+    from meshlap_app.state import CurvatureState, MeshState
+    from meshlap_app.ui import UI
+    from meshlap_app.viewer import Viewer
+
+    monkeypatch.setenv("MESHLAP_CACHE_DIR", str(tmp_path / "cache"))
+    polyscope_mock.remove_all_structures()
+    mesh = MeshState()
+    assert mesh.load(sphere)
+    v = Viewer(mesh, CurvatureState(), ui=UI(), export_dir=tmp_path)
+    v.sync_mesh()
+    polyscope_mock.set_user_callback(v.callback)
+    yield v
+    polyscope_mock.clear_user_callback()
+
+
 def pytest_configure(config: pytest.Config) -> None:
     config.addinivalue_line(
         "markers",

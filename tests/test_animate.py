@@ -12,20 +12,11 @@ import sys
 import numpy as np
 import pytest
 
-from meshlap_core import primitives
 from meshlap_core.cli import main
 from meshlap_core.errors import MeshError
 from meshlap_core.frames import FrameWriter, burn_caption, caption_box, parse_range
-from meshlap_core.io import save_mesh
 
 Image = pytest.importorskip("PIL.Image")
-
-
-@pytest.fixture
-def sphere(tmp_path):
-    path = tmp_path / "ico.obj"
-    save_mesh(path, *primitives.icosphere(2))
-    return path
 
 
 @pytest.fixture
@@ -286,23 +277,6 @@ def test_modes_k_sweep_and_theta_render(tmp_path, sphere):
 @pytest.fixture(scope="module")
 def mock(polyscope_mock):
     return polyscope_mock
-
-
-@pytest.fixture
-def viewer(mock, sphere, tmp_path, monkeypatch):
-    from meshlap_app.state import CurvatureState, MeshState
-    from meshlap_app.ui import UI
-    from meshlap_app.viewer import Viewer
-
-    monkeypatch.setenv("MESHLAP_CACHE_DIR", str(tmp_path / "cache"))
-    mock.remove_all_structures()
-    mesh = MeshState()
-    assert mesh.load(sphere)
-    v = Viewer(mesh, CurvatureState(), ui=UI(), export_dir=tmp_path)
-    v.sync_mesh()
-    mock.set_user_callback(v.callback)
-    yield v
-    mock.clear_user_callback()
 
 
 def _drive(viewer, label, *values) -> None:

@@ -163,7 +163,7 @@ import test_viewer_widgets as widgets  # noqa: E402
 from meshlap_app import scene  # noqa: E402
 
 # the fixtures and helpers of the every-widget tests (same backend, same viewer set-up)
-mock, sphere, viewer = widgets.mock, widgets.sphere, widgets.viewer
+mock = widgets.mock  # `sphere` and `viewer` come from conftest
 drive = widgets.drive
 
 

@@ -35,30 +35,6 @@ def mock(polyscope_mock):
     return polyscope_mock
 
 
-@pytest.fixture
-def sphere(tmp_path):
-    path = tmp_path / "sphere.obj"
-    save_mesh(path, *primitives.icosphere(2))
-    return path
-
-
-@pytest.fixture
-def viewer(mock, sphere, tmp_path, monkeypatch):
-    from meshlap_app.state import CurvatureState, MeshState
-    from meshlap_app.ui import UI
-    from meshlap_app.viewer import Viewer
-
-    monkeypatch.setenv("MESHLAP_CACHE_DIR", str(tmp_path / "cache"))
-    ps.remove_all_structures()
-    mesh = MeshState()
-    assert mesh.load(sphere)
-    v = Viewer(mesh, CurvatureState(), ui=UI(), export_dir=tmp_path)
-    v.sync_mesh()
-    ps.set_user_callback(v.callback)
-    yield v
-    ps.clear_user_callback()
-
-
 def tick(viewer, label: str | None = None, value=None) -> None:
     """One frame; ``label`` gets ``value`` (the record header is opened for its widgets)."""
     if label is not None:

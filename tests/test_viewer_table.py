@@ -32,7 +32,7 @@ from meshlap_app.ui import sig  # noqa: E402
 from test_session import _egl_available  # noqa: E402
 from test_viewer_inspector import FakeClock, perturbed_grid  # noqa: E402
 
-mock, sphere, viewer = widgets.mock, widgets.sphere, widgets.viewer
+mock = widgets.mock  # `sphere` and `viewer` come from conftest
 drive = widgets.drive
 
 VERTEX = 54  # the README's inspector vertex: two negative weights (rows 65 and 43)

@@ -17,12 +17,10 @@ import pytest
 
 ps = pytest.importorskip("polyscope")
 
-from meshlap_app.state import CurvatureState, MeshState  # noqa: E402
-from meshlap_app.ui import EXPECTED, UI, UIApiMismatch, check_return, parse_number  # noqa: E402
+from meshlap_app.ui import EXPECTED, UIApiMismatch, check_return, parse_number  # noqa: E402
 from meshlap_app.viewer import Viewer  # noqa: E402
 
-from meshlap_core import primitives  # noqa: E402
-from meshlap_core.io import load_mesh, save_mesh  # noqa: E402
+from meshlap_core.io import load_mesh  # noqa: E402
 
 BAD_NUMBERS = ["", "0", "-1", "nan", "1e309", "abc"]
 
@@ -30,26 +28,6 @@ BAD_NUMBERS = ["", "0", "-1", "nan", "1e309", "abc"]
 @pytest.fixture(scope="module")
 def mock(polyscope_mock):
     return polyscope_mock
-
-
-@pytest.fixture
-def sphere(tmp_path):
-    path = tmp_path / "sphere.obj"
-    save_mesh(path, *primitives.icosphere(2))
-    return path
-
-
-@pytest.fixture
-def viewer(mock, sphere, tmp_path, monkeypatch):
-    monkeypatch.setenv("MESHLAP_CACHE_DIR", str(tmp_path / "cache"))
-    ps.remove_all_structures()
-    mesh = MeshState()
-    assert mesh.load(sphere)
-    v = Viewer(mesh, CurvatureState(), ui=UI(), export_dir=tmp_path)
-    v.sync_mesh()
-    ps.set_user_callback(v.callback)
-    yield v
-    ps.clear_user_callback()
 
 
 def frames(viewer: Viewer, n: int = 1) -> None:
