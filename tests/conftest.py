@@ -7,6 +7,10 @@ passes the suite.
 
 from __future__ import annotations
 
+import functools
+import subprocess
+import sys
+import tempfile
 from collections.abc import Callable
 from pathlib import Path
 
@@ -80,6 +84,30 @@ def viewer(polyscope_mock, sphere, tmp_path, monkeypatch):
     polyscope_mock.set_user_callback(v.callback)
     yield v
     polyscope_mock.clear_user_callback()
+
+
+EGL_SKIP = "polyscope's EGL backend cannot start on this machine (no EGL/Mesa)"
+
+
+@functools.cache
+def egl_available() -> bool:
+    """Whether polyscope's ``openGL3_egl`` backend starts here (probed once, in a subprocess:
+    a failing backend can abort the interpreter)."""
+    code = "import polyscope as ps; ps.set_allow_headless_backends(True); ps.init('openGL3_egl')"
+    try:
+        with tempfile.TemporaryDirectory() as tmp:  # polyscope writes .ini files into the cwd
+            res = subprocess.run(
+                [sys.executable, "-c", code], capture_output=True, timeout=120, cwd=tmp
+            )
+    except subprocess.TimeoutExpired:
+        return False
+    return res.returncode == 0
+
+
+def pytest_runtest_setup(item: pytest.Item) -> None:
+    """Tests marked ``egl`` skip, saying why, where the EGL backend cannot start."""
+    if item.get_closest_marker("egl") is not None and not egl_available():
+        pytest.skip(EGL_SKIP)
 
 
 def pytest_configure(config: pytest.Config) -> None:

@@ -208,19 +208,8 @@ def _read_gif(path) -> list[np.ndarray]:
     return out
 
 
-def _egl_or_skip() -> None:
-    code = "import polyscope as ps; ps.set_allow_headless_backends(True); ps.init('openGL3_egl')"
-    try:
-        res = subprocess.run([sys.executable, "-c", code], capture_output=True, timeout=120)
-    except subprocess.TimeoutExpired:
-        pytest.skip("polyscope's EGL backend does not start")
-    if res.returncode != 0:
-        pytest.skip("polyscope's EGL backend cannot start on this machine (no EGL/Mesa)")
-
-
 @pytest.mark.egl
 def test_smoothing_gif_of_an_icosphere(tmp_path, sphere):
-    _egl_or_skip()
     out = tmp_path / "smooth.gif"
     res = _run_cli(
         tmp_path,
@@ -254,7 +243,6 @@ def test_smoothing_gif_of_an_icosphere(tmp_path, sphere):
 
 @pytest.mark.egl
 def test_modes_k_sweep_and_theta_render(tmp_path, sphere):
-    _egl_or_skip()
     cases = {
         "modes.gif": ["--panel", "spectral", "--modes", "1:3"],
         "k.gif": ["--panel", "spectral", "--k", "2:4"],
@@ -716,7 +704,6 @@ def test_session_animations_show_the_saved_view(tmp_path):
     panel; frame 0 is the noisy start, not the saved view); a spectral session gives the k
     sweep 1..5, a surfaces session the θ frames; an explicit --size keeps the picture's centre
     and vertical extent."""
-    _egl_or_skip()
     _egl_sessions(tmp_path)
     view_png = tmp_path / "view.png"
     env = dict(os.environ, MESHLAP_CACHE_DIR=str(tmp_path / "cache"))

@@ -29,7 +29,6 @@ from meshlap_app import scene  # noqa: E402
 from meshlap_app.panels.onering import NEGATIVE_RGBA  # noqa: E402
 from meshlap_app.state.onering import HoverThrottle  # noqa: E402
 from meshlap_app.ui import sig  # noqa: E402
-from test_session import _egl_available  # noqa: E402
 from test_viewer_inspector import FakeClock, perturbed_grid  # noqa: E402
 
 mock = widgets.mock  # `sphere` and `viewer` come from conftest
@@ -256,8 +255,6 @@ print(json.dumps(out))
 @pytest.mark.egl
 @pytest.mark.parametrize("scale", [1.0, 2.0])
 def test_tables_fit_the_panel_with_real_fonts(tmp_path, scale):
-    if not _egl_available():
-        pytest.skip("polyscope's EGL backend cannot start on this machine (no EGL/Mesa)")
     mesh = tmp_path / "grid.obj"
     save_mesh(mesh, *perturbed_grid())
     res = subprocess.run(
