@@ -19,6 +19,7 @@ from typing import Any
 from ..errors import MeshError
 from ..frames import parse_range
 from ..options import LAPLACIAN_KINDS
+from ..smoothing.params import check_lam
 
 METHODS = ("explicit", "implicit", "taubin")
 PANELS = ("smoothing", "spectral", "surfaces")
@@ -130,8 +131,7 @@ def _uv(text: str | None) -> tuple[float, float] | None:
 
 def _check_numbers(args: argparse.Namespace) -> None:
     if args.panel == "smoothing":
-        if not (math.isfinite(args.lam) and args.lam > 0):
-            raise MeshError(f"must be a finite number > 0, got {args.lam}", "--lam")
+        check_lam(args.lam, "--lam")
         if not 0 <= args.iters <= 5000:
             raise MeshError(f"must be 0 to 5000, got {args.iters}", "--iters")
         if not (math.isfinite(args.noise) and args.noise >= 0):
