@@ -123,6 +123,17 @@ def read_png(path: Path) -> np.ndarray:
 
 
 # ---------------------------------------------------------------------------- X server
+def terminate(proc: subprocess.Popen | None) -> None:
+    """Stop ``proc`` if it still runs: SIGTERM, then SIGKILL after 10 s."""
+    if proc is not None and proc.poll() is None:
+        proc.terminate()
+        try:
+            proc.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait()
+
+
 def free_display(start: int = 90, stop: int = 190) -> int:
     """A display number with neither a lock file nor a socket (``/tmp/.X<n>-lock``)."""
     for n in range(start, stop):
@@ -183,13 +194,7 @@ class XServer:
         return read_xwd(res.stdout)
 
     def stop(self) -> None:
-        if self.proc is not None and self.proc.poll() is None:
-            self.proc.terminate()
-            try:
-                self.proc.wait(timeout=10)
-            except subprocess.TimeoutExpired:
-                self.proc.kill()
-                self.proc.wait()
+        terminate(self.proc)
 
 
 # ---------------------------------------------------------------------------- the viewer
@@ -243,10 +248,4 @@ class App:
         return self.stderr_path.read_text(errors="replace") if self.stderr_path.exists() else ""
 
     def stop(self) -> None:
-        if self.proc is not None and self.proc.poll() is None:
-            self.proc.terminate()
-            try:
-                self.proc.wait(timeout=10)
-            except subprocess.TimeoutExpired:
-                self.proc.kill()
-                self.proc.wait()
+        terminate(self.proc)
