@@ -8,6 +8,7 @@ passes the suite.
 from __future__ import annotations
 
 import functools
+import os
 import subprocess
 import sys
 import tempfile
@@ -84,6 +85,28 @@ def viewer(polyscope_mock, sphere, tmp_path, monkeypatch):
     polyscope_mock.set_user_callback(v.callback)
     yield v
     polyscope_mock.clear_user_callback()
+
+
+@pytest.fixture
+def python_ok(tmp_path: Path) -> Callable[..., subprocess.CompletedProcess]:
+    """Run ``python ARGS...`` (a ``-c`` script or ``-m meshlap_core.cli ...``) in ``tmp_path``
+    with a private eigenbasis cache, assert it exits 0 (showing its stderr otherwise) and
+    return the completed process (text output)."""
+
+    def run(*args: object, timeout: float = 600) -> subprocess.CompletedProcess:
+        env = dict(os.environ, MESHLAP_CACHE_DIR=str(tmp_path / "cache"))
+        res = subprocess.run(
+            [sys.executable, *map(str, args)],
+            capture_output=True,
+            text=True,
+            timeout=timeout,
+            cwd=tmp_path,
+            env=env,
+        )
+        assert res.returncode == 0, res.stderr
+        return res
+
+    return run
 
 
 EGL_SKIP = "polyscope's EGL backend cannot start on this machine (no EGL/Mesa)"

@@ -679,44 +679,22 @@ for panel in ("smoothing", "spectral", "surfaces"):
 """
 
 
-def _egl_sessions(tmp_path) -> None:
-    env = dict(os.environ, MESHLAP_CACHE_DIR=str(tmp_path / "cache"))
-    res = subprocess.run(
-        [sys.executable, "-c", EGL_SAVE, str(tmp_path)],
-        capture_output=True,
-        text=True,
-        timeout=600,
-        cwd=tmp_path,
-        env=env,
-    )
-    assert res.returncode == 0, res.stderr
-
-
 def _differing(a: np.ndarray, b: np.ndarray, tol: int = 40) -> float:
     """Fraction of pixels whose RGB differ by more than ``tol`` in some channel."""
     return float((np.abs(a - b).max(axis=2) > tol).mean())
 
 
 @pytest.mark.egl
-def test_session_animations_show_the_saved_view(tmp_path):
+def test_session_animations_show_the_saved_view(tmp_path, python_ok):
     """EGL: a smoothing session (noise, λ = 2, 3 iterations) animates to iterations 0..3 whose
     LAST frame is the saved view (`meshlap view --session --screenshot`, cropped left of the
     panel; frame 0 is the noisy start, not the saved view); a spectral session gives the k
     sweep 1..5, a surfaces session the θ frames; an explicit --size keeps the picture's centre
     and vertical extent."""
-    _egl_sessions(tmp_path)
+    python_ok("-c", EGL_SAVE, tmp_path)
     view_png = tmp_path / "view.png"
-    env = dict(os.environ, MESHLAP_CACHE_DIR=str(tmp_path / "cache"))
-    cmd = [sys.executable, "-m", "meshlap_core.cli", "view", "--session"]
-    res = subprocess.run(
-        [*cmd, str(tmp_path / "smoothing.json"), "--screenshot", str(view_png)],
-        capture_output=True,
-        text=True,
-        timeout=600,
-        cwd=tmp_path,
-        env=env,
-    )
-    assert res.returncode == 0, res.stderr
+    cli = ("-m", "meshlap_core.cli", "view", "--session")
+    python_ok(*cli, tmp_path / "smoothing.json", "--screenshot", view_png)
     out = tmp_path / "smoothing.gif"
     res = _run_cli(tmp_path, "--session", "smoothing.json", "--shadow", "--out", str(out))
     assert res.returncode == 0, res.stderr

@@ -5,7 +5,6 @@
 from __future__ import annotations
 
 import json
-import os
 import subprocess
 import sys
 import threading
@@ -465,36 +464,19 @@ session.save(viewer, Path(sys.argv[4]))
 
 @pytest.mark.egl
 @pytest.mark.parametrize("panel", ["curvature", "onering", "spectral", "smoothing", "surfaces"])
-def test_render_of_a_loaded_session_equals_the_render_when_saved(tmp_path, panel):
+def test_render_of_a_loaded_session_equals_the_render_when_saved(tmp_path, panel, python_ok):
     import matplotlib.image as mpimg
     from meshlap_app.state.mesh import default_mesh_path
 
-    env = {**os.environ, "MESHLAP_CACHE_DIR": str(tmp_path / "cache")}
     saved_png, session_json, loaded_png = (
         tmp_path / "saved.png",
         tmp_path / "s.json",
         tmp_path / "loaded.png",
     )
     args = [str(default_mesh_path()), panel, str(saved_png), str(session_json)]
-    res = subprocess.run(
-        [sys.executable, "-c", SAVE_SCRIPT, *args],
-        capture_output=True,
-        text=True,
-        timeout=300,
-        cwd=tmp_path,
-        env=env,
-    )
-    assert res.returncode == 0, res.stderr
-    cmd = [sys.executable, "-m", "meshlap_core.cli", "view", "--session", str(session_json)]
-    res = subprocess.run(
-        [*cmd, "--screenshot", str(loaded_png)],
-        capture_output=True,
-        text=True,
-        timeout=300,
-        cwd=tmp_path,
-        env=env,
-    )
-    assert res.returncode == 0, res.stderr
+    python_ok("-c", SAVE_SCRIPT, *args, timeout=300)
+    cli = ("-m", "meshlap_core.cli", "view", "--session", session_json)
+    python_ok(*cli, "--screenshot", loaded_png, timeout=300)
     a = mpimg.imread(saved_png)[..., :3]
     b = mpimg.imread(loaded_png)[..., :3]
     assert a.shape == b.shape

@@ -126,7 +126,7 @@ def _scene_fraction(png) -> float:
 
 @pytest.mark.egl
 @pytest.mark.parametrize("scale", [1e74, 1e-55])
-def test_screenshot_of_extreme_but_accepted_coordinates_is_not_blank(tmp_path, scale):
+def test_screenshot_of_extreme_but_accepted_coordinates_is_not_blank(tmp_path, scale, python_ok):
     """float32 holds at most 3.4e38: the viewer centres and scales before every upload."""
     from meshlap_core import primitives
     from meshlap_core.io import save_mesh
@@ -136,15 +136,8 @@ def test_screenshot_of_extreme_but_accepted_coordinates_is_not_blank(tmp_path, s
     save_mesh(mesh, V * scale + 3 * scale, F)
     for panel in ("curvature", "smoothing"):
         out = tmp_path / f"{panel}.png"
-        cmd = [sys.executable, "-m", "meshlap_core.cli", "view", str(mesh), "--panel", panel]
-        res = subprocess.run(
-            [*cmd, "--screenshot", str(out)],
-            capture_output=True,
-            text=True,
-            timeout=300,
-            cwd=tmp_path,
-        )
-        assert res.returncode == 0, res.stderr
+        cli = ("-m", "meshlap_core.cli", "view", mesh, "--panel", panel)
+        python_ok(*cli, "--screenshot", out, timeout=300)
         assert _scene_fraction(out) > 0.05  # the mesh is drawn (before the fix: 0.0)
 
 
@@ -175,7 +168,7 @@ print(json.dumps({"hit": hit, "vertex": viewer.ring.vertex, "front": bool(front[
 
 
 @pytest.mark.egl
-def test_picking_a_projected_vertex_selects_its_one_ring(tmp_path):
+def test_picking_a_projected_vertex_selects_its_one_ring(tmp_path, python_ok):
     import json
 
     from meshlap_app.state import MeshState
@@ -187,14 +180,7 @@ def test_picking_a_projected_vertex_selects_its_one_ring(tmp_path):
     # a vertex near the middle, facing the default camera (which looks along +z from -z)
     N = vertex_normals(mesh.V, mesh.F)
     target = int(np.argmin(N[:, 2] + 0.2 * np.abs(mesh.V[:, 1]) + 0.2 * np.abs(mesh.V[:, 0])))
-    res = subprocess.run(
-        [sys.executable, "-c", PICK_SCRIPT, str(target)],
-        capture_output=True,
-        text=True,
-        timeout=300,
-        cwd=tmp_path,
-    )
-    assert res.returncode == 0, res.stderr
+    res = python_ok("-c", PICK_SCRIPT, target, timeout=300)
     out = json.loads(res.stdout.strip().splitlines()[-1])
     assert out["front"] and out["hit"]
     assert out["vertex"] == target

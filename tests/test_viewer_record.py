@@ -7,9 +7,6 @@ pixels come from an EGL subprocess (``test_recordings_with_real_pixels``)."""
 from __future__ import annotations
 
 import itertools
-import os
-import subprocess
-import sys
 import textwrap
 
 import numpy as np
@@ -423,20 +420,11 @@ EGL_SCRIPT = textwrap.dedent(
 
 
 @pytest.mark.egl
-def test_recordings_with_real_pixels(tmp_path, sphere):
+def test_recordings_with_real_pixels(tmp_path, sphere, python_ok):
     """EGL: the θ turn and the k sweep recorded through the widgets change the picture from
     frame to frame (the section turns, the copy grows into the sphere)."""
     pytest.importorskip("polyscope")
-    env = dict(os.environ, MESHLAP_CACHE_DIR=str(tmp_path / "cache"))
-    res = subprocess.run(
-        [sys.executable, "-c", EGL_SCRIPT, str(sphere), str(tmp_path)],
-        capture_output=True,
-        text=True,
-        timeout=600,
-        cwd=tmp_path,
-        env=env,
-    )
-    assert res.returncode == 0, res.stderr
+    python_ok("-c", EGL_SCRIPT, sphere, tmp_path)
     theta, _ = read_gif(tmp_path / "theta.gif")
     k, _ = read_gif(tmp_path / "k.gif")
     modes, _ = read_gif(tmp_path / "modes.gif")

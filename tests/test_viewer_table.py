@@ -12,8 +12,6 @@ from __future__ import annotations
 
 import json
 import math
-import subprocess
-import sys
 
 import numpy as np
 import pytest
@@ -254,17 +252,10 @@ print(json.dumps(out))
 
 @pytest.mark.egl
 @pytest.mark.parametrize("scale", [1.0, 2.0])
-def test_tables_fit_the_panel_with_real_fonts(tmp_path, scale):
+def test_tables_fit_the_panel_with_real_fonts(tmp_path, scale, python_ok):
     mesh = tmp_path / "grid.obj"
     save_mesh(mesh, *perturbed_grid())
-    res = subprocess.run(
-        [sys.executable, "-c", WIDTH_SCRIPT, str(mesh), str(scale), str(VERTEX)],
-        capture_output=True,
-        text=True,
-        timeout=300,
-        cwd=tmp_path,
-    )
-    assert res.returncode == 0, res.stderr
+    res = python_ok("-c", WIDTH_SCRIPT, mesh, scale, VERTEX, timeout=300)
     sizes = json.loads(res.stdout.strip().splitlines()[-1])
     wrap = sizes.pop("wrap")
     assert set(sizes) == {"onering/weights", "onering/contributions", "onering/faces"}
