@@ -23,7 +23,6 @@ from __future__ import annotations
 import copy
 import dataclasses
 import sys
-import weakref
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -85,6 +84,13 @@ class AnimationSpec:
         if self.panel == "spectral":
             return "modes" if self.modes is not None else "k"
         return "theta" if self.panel == "surfaces" else "smoothing"
+
+    @property
+    def keeps_camera(self) -> bool:
+        """The frames keep the session's camera (no re-framing): the session has one and the
+        animated panel is the session's (another panel's camera framed other structures)."""
+        s = self.session
+        return s is not None and s.camera is not None and s.panel == self.panel
 
 
 def check_spec(spec: AnimationSpec, mesh: MeshState | None) -> None:
@@ -221,10 +227,6 @@ def frame_count(spec: AnimationSpec) -> int:
 
 
 # ---------------------------------------------------------------- a saved session's view
-_SESSION_CAMERA: weakref.WeakSet[Viewer] = weakref.WeakSet()
-"""Viewers restored from a session with its camera: :func:`frame_view` leaves them alone."""
-
-
 def _saved_window(session: Any, source: Any) -> tuple[int, int] | None:
     """The window size stored with the session's camera (``None`` without a camera).
 
@@ -298,8 +300,8 @@ def restore_session(viewer: Viewer, spec: AnimationSpec, mesh: MeshState) -> int
 
     session = spec.session
     source = spec.session_file or "--session"
-    window = session_window(session, spec.size, source)
-    keep_camera = window is not None and session.panel == spec.panel
+    window = session_window(session, spec.size, source)  # None: no camera
+    keep_camera = spec.keeps_camera
     settings = copy.deepcopy(session.settings)
     settings["smoothing"]["iterations"] = 0  # the frames run the smoothing from iteration 0
     if spec.panel != "spectral":
@@ -315,7 +317,6 @@ def restore_session(viewer: Viewer, spec: AnimationSpec, mesh: MeshState) -> int
         ps.set_window_size(*spec.size)
         viewer.set_panel(spec.panel)
         return None
-    _SESSION_CAMERA.add(viewer)
     return window[1] if window is not None else None
 
 
@@ -323,11 +324,11 @@ COLORBAR_STRIP = 0.17
 """Left fraction of a frame kept clear for polyscope's colour bar (top-left, ``COLORBAR_AT``)."""
 
 
-def frame_view(viewer: Viewer, strip: float = COLORBAR_STRIP) -> None:
+def frame_view(viewer: Viewer, spec: AnimationSpec, strip: float = COLORBAR_STRIP) -> None:
     """Frame the current panel's structures in the window right of a ``strip`` (fraction of
-    the width) kept for the colour bar (:func:`.scene.frame_scene_left`); a viewer restored
-    from a session with its camera keeps that camera (nothing happens)."""
-    if viewer in _SESSION_CAMERA:
+    the width) kept for the colour bar (:func:`.scene.frame_scene_left`); a session's camera
+    is kept (``spec.keeps_camera``: nothing happens)."""
+    if spec.keeps_camera:
         return
     view = scene.OBLIQUE_VIEW if viewer.panel == "surfaces" else viewer_view(viewer)
     scene.frame_scene_left(viewer_framed(), viewer.structure_points, 0.95, view, max(strip, 0.0))
@@ -363,7 +364,7 @@ def smoothing_frames(viewer: Viewer, spec: AnimationSpec) -> Iterator[str]:
             raise MeshError(st.error)
     panel.push(force=True)
     viewer.show_panel()
-    frame_view(viewer, strip=0.0)  # no colour map: no colour bar
+    frame_view(viewer, spec, strip=0.0)  # no colour map: no colour bar
     schedule = [float(lam) for lam, n in spec.lam_steps or [] for _ in range(int(n))]
     for it in range(spec.iters + 1):
         if it > 0:
@@ -413,7 +414,7 @@ def k_frames(viewer: Viewer, spec: AnimationSpec) -> Iterator[str]:
     st = _basis(viewer, max(b, 2))
     st.set_k(a)
     panel.push_k(viewer, force=True)
-    frame_view(viewer)
+    frame_view(viewer, spec)
     e = st.errors
     for k in range(a, b + 1):
         st.set_k(k)
@@ -437,7 +438,7 @@ def mode_frames(viewer: Viewer, spec: AnimationSpec) -> Iterator[str]:
     panel = viewer.panels["spectral"]
     st = _basis(viewer, max(b + 1, 2))
     scene.remove_structure(RECON)
-    frame_view(viewer)
+    frame_view(viewer, spec)
     for m in range(a, b + 1):
         st.set_mode(m)
         panel.push_mode(viewer, force=True)
@@ -454,7 +455,7 @@ def theta_frames(viewer: Viewer, spec: AnimationSpec) -> Iterator[str]:
     if spec.uv is not None and not surf.set_uv(*spec.uv):
         raise MeshError(surf.error, "--uv")
     viewer.show_panel()  # the Surfaces panel registers the surface, K and the point
-    frame_view(viewer)
+    frame_view(viewer, spec)
     panel = viewer.panels["surfaces"]
     start = surf.section_deg  # 0, or the θ a session saved: one turn from there
     for theta in np.linspace(start, start + 360.0, spec.frames, endpoint=False):
