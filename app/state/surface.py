@@ -151,11 +151,9 @@ class SurfaceState:
         theta = np.radians(self.section_deg)
         c, s = float(np.cos(theta)), float(np.sin(theta))
         d = p.p_u * c + p.p_v * s
-        # surfaces.normal_curvature's formula on the point's forms (that function evaluates
-        # the surface's derivatives again: ~6 ms, too much for every frame)
-        kn = (p.e * c * c + 2 * p.f * c * s + p.g * s * s) / (
-            p.E * c * c + 2 * p.F * c * s + p.G * s * s
-        )
+        # from the point's forms (surfaces.normal_curvature evaluates the surface's
+        # derivatives again: ~6 ms, too much for every frame)
+        kn = surfaces.normal_curvature_from_forms(p, theta)
         return d / np.linalg.norm(d), float(kn)
 
     def section_caption(self) -> str:

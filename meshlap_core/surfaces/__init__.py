@@ -69,6 +69,7 @@ from .geometry import (
     classify,
     normal_curvature,
     normal_curvature_curve,
+    normal_curvature_from_forms,
     point_geometry,
     surface_curvature_fields,
 )
@@ -128,6 +129,7 @@ __all__ = [
     "monkey_saddle",
     "normal_curvature",
     "normal_curvature_curve",
+    "normal_curvature_from_forms",
     "plot_normal_curvature",
     "point_geometry",
     "saddle",

@@ -137,10 +137,22 @@ def normal_curvature(
     uu, vv = check_uv(surface, u, v)
     cf = surface_curvature_fields(surface, uu, vv, method)
     _require_regular(surface, cf, float(uu), float(vv))
+    return normal_curvature_from_forms(cf, theta)
+
+
+def normal_curvature_from_forms(forms: Any, theta: Any) -> FloatArray:
+    """``κₙ(θ) = II(d, d) / I(d, d)`` for ``d = (cos θ, sin θ)`` from fundamental forms already
+    computed: ``forms`` has ``E, F, G, e, f, g`` (a :class:`CurvatureFields` or a
+    :class:`PointGeometry`), broadcast against ``theta``.
+
+    Returns
+    -------
+    kn : float array of the broadcast shape
+    """
     th = np.asarray(theta, dtype=np.float64)
     c, s = np.cos(th), np.sin(th)
-    second = cf.e * c * c + 2 * cf.f * c * s + cf.g * s * s
-    first = cf.E * c * c + 2 * cf.F * c * s + cf.G * s * s
+    second = forms.e * c * c + 2 * forms.f * c * s + forms.g * s * s
+    first = forms.E * c * c + 2 * forms.F * c * s + forms.G * s * s
     return second / first
 
 
