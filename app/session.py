@@ -209,17 +209,16 @@ def _apply_smoothing(viewer: Viewer, sm: dict[str, Any], shown: bool) -> None:
     run of steps with the λ it used (``lam_steps``), then set the saved ``lam``."""
     panel = viewer.panels["smoothing"]
     state = panel.state
-    runs = replay_steps(sm)
     state.method, state.laplacian = sm["method"], sm["laplacian"]
-    state.lam = runs[0][0] if runs else sm["lam"]  # the stepper is built with the first λ
-    state.noise_alpha, state.seed = sm["noise_alpha"], sm["seed"]
+    state.lam, state.noise_alpha, state.seed = sm["lam"], sm["noise_alpha"], sm["seed"]
     state.smoother, state.playing = None, False
     if not (shown or sm["iterations"]):
-        state.lam = sm["lam"]
         return
+    runs = replay_steps(sm)
+    state.lam = runs[0][0] if runs else sm["lam"]  # the stepper is built with the first λ
     if not state.rebuild(viewer.mesh.V, viewer.mesh.F):
-        state.lam = sm["lam"]
-        return  # said in the Smoothing panel
+        state.lam = sm["lam"]  # (set_lam would clear the error the Smoothing panel shows)
+        return
     for lam, steps in runs:
         state.set_lam(lam)
         if not all(state.step() for _ in range(steps)):
