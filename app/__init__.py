@@ -1,11 +1,18 @@
 """The meshlap viewer, installed as ``meshlap_app`` (the folder is ``app/``).
 
-- :mod:`.state` — plain state objects, tested headless; no polyscope import anywhere in it;
-  owns the vocabulary ``PANELS`` / ``FIELDS`` that ``meshlap view`` imports.
-- :mod:`.camera` — pinhole projection (numpy only).
-- :mod:`.scene` — structure names, offsets, colours and camera framing (imports polyscope).
-- :mod:`.panels` — one module per panel (imports polyscope).
-- :mod:`.viewer` — the loop: ``polyscope.init``, the frame callback, ``run`` (imports polyscope).
+- :mod:`.registry` — the list of panels (the only module that names them all).
+- :mod:`.state` — plain state objects, tested headless; no polyscope import anywhere in it:
+  ``AppState`` (the one owner of the viewer's state), ``Watch`` (the one invalidation rule),
+  each panel's state slice, session section and animation declaration.
+- :mod:`.panels` — one module per panel, each following ``panels.base.Panel`` and typed against
+  the narrow ``panels.base.Host`` (imports polyscope).
+- :mod:`.viewer` — the host on polyscope's frame loop, ``run`` (imports polyscope).
+- :mod:`.session` / :mod:`.animate` / :mod:`.record` — saved sessions, ``meshlap animate`` and
+  the record button: loops over the registered panels.
+- :mod:`.commands` — the ``meshlap view`` / ``meshlap animate`` commands, added to the core's
+  command line through the ``meshlap.commands`` entry points; :mod:`.screenshots` the report's.
+- :mod:`.scene`, :mod:`.camera`, :mod:`.ui` — structure names and framing, projection, the
+  imgui adapter.
 
 Importing ``meshlap_app`` or ``meshlap_app.state`` does not import polyscope; ``scene``,
 ``panels`` and ``viewer`` do.

@@ -1,30 +1,26 @@
-"""Animations for slides: ``meshlap animate`` (headless, EGL) and the viewer's *record* button.
+"""Animations for slides: ``meshlap animate`` renders a panel's animation headless (EGL).
 
-Frames come from the viewer's own scene code: a :class:`~.viewer.Viewer` is built on the mesh
-and its panels register and update the structures exactly as in the window (``push``,
-``push_k``, ``push_mode``, the Surfaces panel's ``push``); the camera is framed with
-:func:`.scene.frame_scene_left`; polyscope renders each frame (``screenshot_to_buffer`` with its
-on-screen colour bar) and :mod:`meshlap_core.frames` burns the caption in and writes the GIF or
-MP4 atomically.
+Frames come from the viewer's own scene code: a :class:`~.viewer.Viewer` (a host of the
+panels) is built on the mesh, and the animated panel's ``frames`` sets up each frame exactly
+as the window shows it; polyscope renders each frame (``screenshot_to_buffer`` with its
+on-screen colour bar) and :mod:`meshlap_core.frames` burns the caption in and writes the GIF
+or MP4 atomically.
 
-Kinds: ``smoothing`` (one frame per iteration, 0 to ``iters``), ``spectral`` with ``k`` (the
-reconstruction from the first k modes, k = A..B) or ``modes`` (the eigenmodes A..B one by one),
-``surfaces`` with ``theta`` (the normal section at (u, v) turning through 360°, κₙ(θ)).
+Which panels can be animated, their options and frame rates are declared by each panel's state
+module (``ANIMATION``, :class:`~.state.animation.Animation`); this module never names a panel.
 
 With a saved session (``meshlap animate --session``) the viewer is first restored from it
-(:func:`.session.apply`: mesh, settings, replayed smoothing, cached basis, camera) and the
-frame generators start from that viewer: the session's camera is kept (:func:`frame_view` does
-nothing for it) and each frame is cropped to the part of the saved window left of meshlap's
-panel (:func:`session_window`).
+(:func:`.session.apply`: mesh, settings, cached basis, camera) and the frames start from that
+viewer: the session's camera is kept (``Viewer.keep_camera``) and each frame is cropped to the
+part of the saved window left of meshlap's panel (:func:`session_window`).
 """
 
 from __future__ import annotations
 
 import copy
 import dataclasses
-import sys
 from collections.abc import Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -33,57 +29,45 @@ import polyscope as ps
 
 from meshlap_core.errors import MeshError
 from meshlap_core.frames import FrameWriter, Progress, burn_caption, check_animation_output
-from meshlap_core.frames import parse_range as parse_range
 
 from . import scene
-from .scene import COLORBAR_AT, MESH, RECON
+from .registry import REGISTRY
+from .state.animation import Animation, animations
+from .state.app import AppState
 from .state.mesh import MeshState
+from .state.session import check_session_mesh
 
 if TYPE_CHECKING:
     from .viewer import Viewer
-
-KINDS = ("smoothing", "spectral", "surfaces")
-NORMAL_SECTION = "normal section"
-SECTION_DIRECTION = "normal section direction"
-RECORD_HEADER = "record (GIF / MP4)"
-DEFAULT_FPS = {"smoothing": 10.0, "k": 15.0, "modes": 1.5, "theta": 15.0}
 
 
 @dataclass
 class AnimationSpec:
     """What ``meshlap animate`` renders (validated by :func:`check_spec` before any rendering).
 
-    ``k`` / ``modes`` are inclusive ranges ``(A, B)``; ``size`` is ``(width, height)`` pixels.
+    ``options`` are the animated panel's own (its ``ANIMATION.options``, defaults filled and
+    checked); ``size`` is ``(width, height)`` pixels.
     """
 
     panel: str
     out: Path
     mesh: Path | None = None
-    method: str = "implicit"
-    laplacian: str = "uniform"
-    lam: float = 1.0
-    iters: int = 30
-    noise: float = 0.0
-    seed: int = 0
-    k: tuple[int, int] | None = None
-    modes: tuple[int, int] | None = None
-    theta: bool = False
-    surface: str = "saddle"
-    uv: tuple[float, float] | None = None
-    frames: int = 72
+    options: dict[str, Any] = field(default_factory=dict)
     fps: float | None = None
     size: tuple[int, int] = (960, 540)
     shadow: bool = False
-    lam_steps: list[list[Any]] | None = None  # a session's [[λ, steps], ...]; then ``lam``
     session: Any = None  # a meshlap_app.state.session.Session to restore first
     session_file: Path | None = None  # its file (named in errors; never overwritten)
 
     @property
+    def animation(self) -> Animation:
+        """The animated panel's declaration."""
+        return animations()[self.panel]
+
+    @property
     def what(self) -> str:
-        """``smoothing``, ``k``, ``modes`` or ``theta``."""
-        if self.panel == "spectral":
-            return "modes" if self.modes is not None else "k"
-        return "theta" if self.panel == "surfaces" else "smoothing"
+        """What is animated (the panel's kind: ``smoothing``, ``k``, ``modes``, ``theta``...)."""
+        return self.animation.kind(self.options)
 
     @property
     def keeps_camera(self) -> bool:
@@ -101,39 +85,23 @@ def check_spec(spec: AnimationSpec, mesh: MeshState | None) -> None:
     MeshError
         An inconsistent or out-of-range option, naming it.
     """
-    if spec.panel not in KINDS:
+    kinds = animations()
+    if spec.panel not in kinds:
         raise MeshError(
-            f"unknown panel {spec.panel!r}; choose one of {', '.join(KINDS)}", "--panel"
+            f"unknown panel {spec.panel!r}; choose one of {', '.join(kinds)}", "--panel"
         )
     w, h = spec.size
     if not (64 <= w <= 4096 and 64 <= h <= 4096):
         raise MeshError(f"each side must be 64 to 4096 pixels, got {w}x{h}", "--size")
-    if spec.panel == "spectral" and (spec.k is None) == (spec.modes is None):
-        raise MeshError("give exactly one of --k A:B (reconstruction) or --modes A:B", "--panel")
-    if spec.panel == "surfaces" and not spec.theta:
-        raise MeshError("the surfaces animation is the normal section: add --theta", "--panel")
-    if spec.panel == "surfaces":
-        from meshlap_core import surfaces
-
-        if spec.surface not in surfaces.SURFACES:
-            names = ", ".join(surfaces.SURFACES)
-            raise MeshError(f"unknown surface {spec.surface!r}; choose one of {names}", "--surface")
-    if spec.panel == "surfaces" and not 2 <= spec.frames <= 2000:
-        raise MeshError(f"must be 2 to 2000, got {spec.frames}", "--frames")
-    if mesh is not None and spec.panel == "spectral":
-        n = len(mesh.V)
-        if spec.k is not None and spec.k[1] > n:
-            raise MeshError(f"must end at {n} or less (the mesh has {n} vertices)", "--k")
-        if spec.modes is not None and spec.modes[1] > n - 1:
-            raise MeshError(f"must end at {n - 1} or less (the mesh has {n} vertices)", "--modes")
+    spec.animation.check(spec.options)
+    if mesh is not None:
+        spec.animation.check_mesh(spec.options, mesh)
     if spec.session is not None:
         window = session_window(spec.session, spec.size, spec.session_file or "--session")
         if window is not None and window[0][0] > 8192:
             raise MeshError(f"too wide for this session's view, got {w}x{h}", "--size")
     if mesh is not None and spec.session is not None:
-        from .state.session import check_vertex
-
-        check_vertex(spec.session, len(mesh.V), spec.session_file or "--session")
+        check_session_mesh(spec.session, mesh, spec.session_file or "--session")
     inputs = [spec.mesh, spec.session_file]
     if spec.session is not None:
         inputs.append(spec.session.mesh)
@@ -154,22 +122,21 @@ def render(spec: AnimationSpec, mesh: MeshState, progress: bool = True) -> Path:
     The viewer is built on ``mesh`` without a user callback (no meshlap panel in the frames)
     and polyscope's own panels off: the frames show the 3D view and the colour bar only.
     """
-    from .state.curvature import CurvatureState
     from .viewer import Viewer, init_polyscope
 
-    writer = FrameWriter(spec.out, spec.fps or DEFAULT_FPS[spec.what], [spec.mesh or ""])
+    anim = spec.animation
+    writer = FrameWriter(spec.out, spec.fps or anim.fps[spec.what], [spec.mesh or ""])
     init_polyscope("openGL3_egl")
     ps.set_build_default_gui_panels(False)
     ps.set_window_size(*spec.size)
     if not spec.shadow:  # the ground shadow is a second render pass: about 40 % of a frame
         ps.set_ground_plane_mode("none")
-    colorbar = spec.what != "smoothing"  # polyscope draws its colour bar with imgui
-    viewer = Viewer(mesh, CurvatureState(), panel=spec.panel)
+    viewer = Viewer(AppState(mesh=mesh, panel=spec.panel))
     viewer.sync_mesh()
     keep = restore_session(viewer, spec, mesh) if spec.session is not None else None
-    scenes = {"smoothing": smoothing_frames, "k": k_frames, "modes": mode_frames}
-    frames = scenes.get(spec.what, theta_frames)(viewer, spec)
-    bar = Progress(frame_count(spec)) if progress else None
+    frames = viewer.panels[spec.panel].frames(viewer, spec.options)
+    bar = Progress(anim.frame_count(spec.options)) if progress else None
+    colorbar = anim.colorbar  # polyscope draws its colour bar with imgui
     try:
         write_frames(frames, writer, colorbar, bar, keep)
         return writer.close()
@@ -216,16 +183,6 @@ def write_frames(
         bar.finish()
 
 
-def frame_count(spec: AnimationSpec) -> int:
-    """How many frames ``spec`` renders."""
-    if spec.what == "smoothing":
-        return spec.iters + 1
-    if spec.what in ("k", "modes"):
-        a, b = spec.k if spec.what == "k" else spec.modes  # type: ignore[misc]
-        return b - a + 1
-    return spec.frames
-
-
 # ---------------------------------------------------------------- a saved session's view
 def _saved_window(session: Any, source: Any) -> tuple[int, int] | None:
     """The window size stored with the session's camera (``None`` without a camera).
@@ -248,10 +205,9 @@ def _saved_window(session: Any, source: Any) -> tuple[int, int] | None:
 
 def panel_strip(width: int, ui_scale: float) -> int:
     """Pixels on the right of a window ``width`` wide that meshlap's panel covered at
-    ``ui_scale`` (the rule of the viewer's framing and of the record button's crop: at most
-    70 % of the window; what is kept has an even width)."""
-    keep = int(width * scene.scene_fraction(width, ui_scale, cap=1.0))
-    return width - max(keep // 2 * 2, 2)
+    ``ui_scale`` (the rule of the viewer's framing and of the record button's crop,
+    :func:`.scene.scene_width`)."""
+    return width - scene.scene_width(width, ui_scale)
 
 
 def session_window(
@@ -291,10 +247,11 @@ def restore_session(viewer: Viewer, spec: AnimationSpec, mesh: MeshState) -> int
 
     The session's camera is kept (no re-framing) when the animated panel is the session's; on
     another panel (its camera framed other structures) or without a camera, the window is
-    ``spec.size`` and the frame generators frame the view as without a session. What the
-    frames do not show is not restored: the smoothing is not replayed to the saved iteration
-    (the frames run it from iteration 0: the last frame is the saved iteration) and the
-    eigenbasis is read only for the spectral panel.
+    ``spec.size`` and the panel frames the view as without a session. What the frames do not
+    show is not restored: each panel's ``frames`` starts its own animation from the settings
+    (the smoothing runs from iteration 0, the last frame is the saved iteration) and only the
+    animated panel's section of the session is restored in full (an eigenbasis is read only
+    when it is the one shown).
     """
     from .session import apply
 
@@ -303,9 +260,14 @@ def restore_session(viewer: Viewer, spec: AnimationSpec, mesh: MeshState) -> int
     window = session_window(session, spec.size, source)  # None: no camera
     keep_camera = spec.keeps_camera
     settings = copy.deepcopy(session.settings)
-    settings["smoothing"]["iterations"] = 0  # the frames run the smoothing from iteration 0
-    if spec.panel != "spectral":
-        settings["spectral"]["computed"] = False  # no eigenbasis needed in the frames
+    for e in REGISTRY:  # the frames start their own run: no computation nobody will see
+        if e.name not in settings:
+            continue
+        if e.name == spec.panel:
+            settings[e.name].update(spec.animation.session_overrides)
+        else:
+            module = e.state_module()
+            settings[e.name].update(getattr(module, "QUIET", {}) if module is not None else {})
     session = dataclasses.replace(session, settings=settings)
     if session.camera is not None:
         camera = dict(session.camera)
@@ -313,151 +275,9 @@ def restore_session(viewer: Viewer, spec: AnimationSpec, mesh: MeshState) -> int
         camera["windowWidth"], camera["windowHeight"] = int(size[0]), int(size[1])
         session = dataclasses.replace(session, camera=camera)
     apply(viewer, session, source, resize=True, mesh=mesh)
+    viewer.keep_camera = keep_camera
     if not keep_camera:
         ps.set_window_size(*spec.size)
         viewer.set_panel(spec.panel)
         return None
     return window[1] if window is not None else None
-
-
-COLORBAR_STRIP = 0.17
-"""Left fraction of a frame kept clear for polyscope's colour bar (top-left, ``COLORBAR_AT``)."""
-
-
-def frame_view(viewer: Viewer, spec: AnimationSpec, strip: float = COLORBAR_STRIP) -> None:
-    """Frame the current panel's structures in the window right of a ``strip`` (fraction of
-    the width) kept for the colour bar (:func:`.scene.frame_scene_left`); a session's camera
-    is kept (``spec.keeps_camera``: nothing happens)."""
-    if spec.keeps_camera:
-        return
-    view = scene.OBLIQUE_VIEW if viewer.panel == "surfaces" else viewer_view(viewer)
-    scene.frame_scene_left(viewer_framed(), viewer.structure_points, 0.95, view, max(strip, 0.0))
-
-
-def viewer_view(viewer: Viewer) -> tuple[float, float, float]:
-    return scene.FRONT_VIEWS.get(viewer.mesh.name, scene.DEFAULT_VIEW)
-
-
-def viewer_framed() -> tuple[str, ...]:
-    from .viewer import FRAMED
-
-    return FRAMED
-
-
-def smoothing_frames(viewer: Viewer, spec: AnimationSpec) -> Iterator[str]:
-    """Iterations 0..iters of the Smoothing panel's stepper (input beside the smoothed copy).
-
-    A stepper already built with the same options (a restored session) is reset to iteration
-    0 and kept (same noise: same seed); otherwise it is rebuilt with the options of ``spec``.
-    Step ``i`` uses the ``i``-th λ of ``spec.lam_steps`` (a session whose λ changed mid-run:
-    the last frame is the saved view), then ``spec.lam``.
-    """
-    panel = viewer.panels["smoothing"]
-    st = panel.state
-    options = (spec.method, spec.laplacian, spec.lam, spec.noise, spec.seed)
-    current = (st.method, st.laplacian, st.lam, st.noise_alpha, st.seed)
-    if st.smoother is not None and current == options:
-        st.reset()
-    else:
-        st.method, st.laplacian, st.lam, st.noise_alpha, st.seed = options
-        if not st.rebuild(viewer.mesh.V, viewer.mesh.F):
-            raise MeshError(st.error)
-    panel.push(force=True)
-    viewer.show_panel()
-    frame_view(viewer, spec, strip=0.0)  # no colour map: no colour bar
-    schedule = [float(lam) for lam, n in spec.lam_steps or [] for _ in range(int(n))]
-    for it in range(spec.iters + 1):
-        if it > 0:
-            lam = schedule[it - 1] if it <= len(schedule) else spec.lam
-            if lam != st.lam:
-                st.set_lam(lam)
-            if not st.step():
-                raise MeshError(st.error or "the smoothing stopped", "--lam")
-        panel.push()
-        yield smoothing_caption(st, spec.iters)
-
-
-def smoothing_caption(st: Any, iters: int | None = None) -> str:
-    """``implicit (uniform L), λ = 1   iteration 3/30   RMSE 0.0012`` for a smoothing state
-    (read from the stepper's history: never the lazy stability estimate, an eigensolve)."""
-    s = st.smoother
-    last = s.history[-1] if s is not None and s.history else {}
-    rmse = last.get("rmse")
-    it = s.iteration if s is not None else 0
-    of = f"/{iters}" if iters is not None else ""
-    noise = f", noise α = {st.noise_alpha:g}" if st.noise_alpha else ""
-    return f"{st.method} ({st.laplacian} L), λ = {st.lam:g}{noise}   iteration {it}{of}" + (
-        f"   RMSE {rmse:.4g}" if rmse is not None else ""
-    )
-
-
-def _basis(viewer: Viewer, k: int) -> Any:
-    """Compute (or read from the cache) ``k`` eigenpairs synchronously."""
-    st = viewer.panels["spectral"].state
-    if st.basis is not None and not st.error and st.basis.k_max >= k:
-        return st  # restored from a session: its basis has enough modes
-    st.k_request = k
-    sys.stderr.write(f"meshlap: animate: {k} eigenpairs (from the cache after the first run)\n")
-    st.start(viewer.mesh.V, viewer.mesh.F, background=False)
-    if st.error or st.basis is None:
-        raise MeshError(st.error or "the eigenbasis could not be computed", "spectral")
-    return st
-
-
-def k_frames(viewer: Viewer, spec: AnimationSpec) -> Iterator[str]:
-    """The reconstruction from the first k modes beside the mesh, k = A..B, coloured by the
-    error |x - x_k| on each k's own scale (the colour bar; the numbers are in the caption)."""
-    a, b = spec.k  # type: ignore[misc]
-    viewer.show_panel()  # before the basis exists: no eigenfunction on the mesh
-    ps.get_surface_mesh(MESH).remove_all_quantities()  # the original plain beside x_k
-    panel = viewer.panels["spectral"]
-    st = _basis(viewer, max(b, 2))
-    st.set_k(a)
-    panel.push_k(viewer, force=True)
-    frame_view(viewer, spec)
-    e = st.errors
-    for k in range(a, b + 1):
-        st.set_k(k)
-        panel.push_k(viewer)
-        ps.get_surface_mesh(RECON).add_scalar_quantity(
-            "error |x - x_k|",
-            st.vertex_error,
-            cmap="reds",
-            vminmax=(0.0, float(e.max[k]) or 1.0),  # as the viewer: this k's largest error
-            enabled=True,
-            onscreen_colorbar_enabled=True,
-            onscreen_colorbar_location=COLORBAR_AT,
-        )
-        yield st.k_caption()  # shared with the viewer's recording
-
-
-def mode_frames(viewer: Viewer, spec: AnimationSpec) -> Iterator[str]:
-    """The eigenfunctions u_A..u_B as colour maps on the mesh, one per frame."""
-    a, b = spec.modes  # type: ignore[misc]
-    viewer.show_panel()
-    panel = viewer.panels["spectral"]
-    st = _basis(viewer, max(b + 1, 2))
-    scene.remove_structure(RECON)
-    frame_view(viewer, spec)
-    for m in range(a, b + 1):
-        st.set_mode(m)
-        panel.push_mode(viewer, force=True)
-        yield st.mode_caption()  # shared with the viewer's recording
-
-
-def theta_frames(viewer: Viewer, spec: AnimationSpec) -> Iterator[str]:
-    """The normal section at (u, v) turning: its tangent t(θ) and osculating arc, κₙ(θ), drawn
-    by the Surfaces panel's :meth:`~.panels.surfaces.SurfacesPanel.push_section` as in the
-    window."""
-    surf = viewer.surf
-    if not surf.set_surface(spec.surface):
-        raise MeshError(surf.error, "--surface")
-    if spec.uv is not None and not surf.set_uv(*spec.uv):
-        raise MeshError(surf.error, "--uv")
-    viewer.show_panel()  # the Surfaces panel registers the surface, K and the point
-    frame_view(viewer, spec)
-    panel = viewer.panels["surfaces"]
-    start = surf.section_deg  # 0, or the θ a session saved: one turn from there
-    for theta in np.linspace(start, start + 360.0, spec.frames, endpoint=False):
-        panel.push_section(viewer, theta)
-        yield surf.section_caption()

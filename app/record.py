@@ -5,15 +5,15 @@ Each panel that plays something (Smoothing: play; Spectral: the k sweep and the 
 Surfaces: the normal section turning) owns a :class:`Recorder` and calls :func:`draw_record` at
 the end of its ``draw``: the collapsed *record* header (file name, record / stop), then, while
 recording, one frame of the 3D view each time what the panel shows changes, with the caption
-the CLI burns into the same kind of frame (the panels and :mod:`.animate` share the caption
-functions). The file's frame rate follows what was recorded (:data:`.animate.DEFAULT_FPS`:
-smoothing 10, k sweep 15, eigenmodes 1.5, θ turn 15 frames per second).
+the CLI burns into the same kind of frame (the panel's state module has the caption function
+its animation uses too). The file's frame rate follows what was recorded: the rate the panel's
+animation declares for it (smoothing 10, k sweep 15, eigenmodes 1.5, θ turn 15 frames per
+second).
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
-from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -22,11 +22,14 @@ import polyscope as ps
 from meshlap_core.errors import MeshError
 from meshlap_core.frames import FrameWriter, burn_caption
 
-from .animate import DEFAULT_FPS, RECORD_HEADER
-from .scene import scene_fraction
+from .scene import scene_width
 
 if TYPE_CHECKING:
-    from .viewer import Viewer
+    from .panels.base import Host
+
+RECORD_HEADER = "record (GIF / MP4)"
+FIRST_FPS = 10.0
+"""The frame rate a recording opens with, until its first change sets the panel's own."""
 
 
 class Recorder:
@@ -34,10 +37,10 @@ class Recorder:
     panel plays (a smoothing step, a new k or mode, a new θ) adds a frame of the 3D view;
     *stop* writes the GIF/MP4 atomically and says where.
 
-    The frame rate is that of the first change recorded (``kind`` of :meth:`capture`, a key of
-    :data:`.animate.DEFAULT_FPS`): the frame shown when *record* was pressed waits for it, so
-    starting a recording and then playing the eigenmodes gives a 1.5 fps file, dragging k a
-    15 fps one. An MP4 streams from its first frame, so the rate cannot change later.
+    The frame rate is that of the first change recorded (``fps`` of :meth:`capture`): the
+    frame shown when *record* was pressed waits for it, so starting a recording and then
+    playing the eigenmodes gives a 1.5 fps file, dragging k a 15 fps one. An MP4 streams from
+    its first frame, so the rate cannot change later.
 
     Parameters
     ----------
@@ -49,7 +52,7 @@ class Recorder:
         self.file_text = stem
         self.writer: FrameWriter | None = None
         self.status = ""
-        self.kind = ""  # what set the frame rate ("" until the first change)
+        self.rate_set = False  # the first change has set the frame rate
         self.last: Any = None
         self._held: tuple[np.ndarray, str] | None = None  # the first frame, until a change
         self._capturing = False
@@ -65,9 +68,9 @@ class Recorder:
             return 0
         return self.writer.count + (self._held is not None)
 
-    def draw(self, viewer: Viewer) -> None:
+    def draw(self, host: Host) -> None:
         """The collapsed *record* header: file name, record / stop, where the last one went."""
-        ui = viewer.ui
+        ui = host.ui
         if not ui.header(RECORD_HEADER, default_open=False):
             return
         _, self.file_text = ui.input_text(
@@ -77,7 +80,7 @@ class Recorder:
         )
         if not self.recording:
             if ui.button("record", "start recording what this panel plays (a frame per change)"):
-                self.start(viewer)
+                self.start(host)
         elif ui.button("stop", "stop and write the file"):
             self.status = self.stop()
         if self.recording:
@@ -85,7 +88,7 @@ class Recorder:
         if self.status:
             ui.text(self.status)
 
-    def start(self, viewer: Viewer) -> None:
+    def start(self, host: Host) -> None:
         """Begin a recording into the file named in the field.
 
         Raises
@@ -96,13 +99,10 @@ class Recorder:
         """
         if self.recording:
             raise MeshError("already recording: stop first", "record")
-        path = Path(self.file_text.strip()).expanduser()
         if not self.file_text.strip():
             raise MeshError("the file name is empty", "record file")
-        if not path.is_absolute():
-            path = viewer.panels["export"].folder / path
-        self.writer = FrameWriter(path, DEFAULT_FPS["smoothing"])
-        self.last, self._held, self.kind = None, None, ""
+        self.writer = FrameWriter(host.state.in_folder(self.file_text), FIRST_FPS)
+        self.last, self._held, self.rate_set = None, None, False
         self.status = ""
 
     def stop(self) -> str:
@@ -125,37 +125,33 @@ class Recorder:
         if self.writer is not None and self.writer.count == 0:
             self._held, self.last = None, None
 
-    def capture(self, viewer: Viewer, key: Any, caption: str, kind: str = "smoothing") -> None:
-        """Add a frame when recording and ``key`` (what the panel shows) changed; ``kind``
-        (``smoothing``, ``k``, ``modes`` or ``theta``) names what changed."""
+    def capture(self, host: Host, key: Any, caption: str, fps: float) -> None:
+        """Add a frame when recording and ``key`` (what the panel shows) changed; ``fps`` is
+        the frame rate of what changed (taken by the file at its first change)."""
         if self.writer is None or self._capturing or key == self.last:
             return
         self._capturing = True
         try:
-            if viewer.reframe:  # a copy appeared this frame: frame it before the picture
-                viewer.reframe = False
-                viewer.frame()
-            buf = crop_scene(
-                viewer, ps.screenshot_to_buffer(transparent_bg=False, include_UI=False)
-            )
+            host.flush_frame()  # a copy appeared this frame: frame it before the picture
+            buf = crop_scene(host, ps.screenshot_to_buffer(transparent_bg=False, include_UI=False))
             if self.last is None:  # the frame on screen when *record* was pressed
                 self._held = (buf, caption)
             else:
-                self._add(buf, caption, kind)
+                self._add(buf, caption, fps)
             self.last = key
         finally:
             self._capturing = False
 
-    def _add(self, buf: np.ndarray, caption: str, kind: str) -> None:
+    def _add(self, buf: np.ndarray, caption: str, fps: float) -> None:
         """Write the held first frame (the rate set by this first change) and ``buf``; a
         frame the writer refuses (the window was resized) ends the recording, nothing written.
         """
         writer = self.writer
         if writer is None:
             return
-        if not self.kind:
-            self.kind = kind
-            writer.fps = DEFAULT_FPS.get(kind, writer.fps)
+        if not self.rate_set:
+            self.rate_set = True
+            writer.fps = fps
         try:
             if self._held is not None:
                 writer.add(burn_caption(*self._held))
@@ -167,25 +163,25 @@ class Recorder:
             raise MeshError(f"recording stopped, nothing written: {exc}", "record") from exc
 
 
-def crop_scene(viewer: Viewer, buf: np.ndarray) -> np.ndarray:
+def crop_scene(host: Host, buf: np.ndarray) -> np.ndarray:
     """The part of a window buffer ``(h, w, 4)`` left of meshlap's panel (where the viewer
-    frames the scene)."""
-    fraction = scene_fraction(ps.get_window_size()[0], viewer.ui.scale, cap=1.0)
-    keep = int(buf.shape[1] * fraction)
+    frames the scene; :func:`.scene.scene_width`)."""
+    width = ps.get_window_size()[0]
+    keep = scene_width(width, host.state.ui_scale) * buf.shape[1] // max(width, 1)
     return buf[:, : max(keep // 2 * 2, 2)]
 
 
 def draw_record(
-    viewer: Viewer,
+    host: Host,
     recorder: Recorder,
     key: Any,
     caption: Callable[[], str],
-    kind: str | Callable[[], str] = "smoothing",
+    fps: float | Callable[[], float],
 ) -> None:
     """The panels' hook: draw the record header, then capture a frame if recording.
 
-    ``caption`` (and ``kind`` when a function) are called only when a frame is captured.
+    ``caption`` (and ``fps`` when a function) are called only when a frame is captured.
     """
-    recorder.draw(viewer)
+    recorder.draw(host)
     if recorder.recording and key != recorder.last:
-        recorder.capture(viewer, key, caption(), kind() if callable(kind) else kind)
+        recorder.capture(host, key, caption(), fps() if callable(fps) else fps)

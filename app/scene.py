@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterable
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import polyscope as ps
@@ -25,6 +26,14 @@ def scene_fraction(window_width: int, ui_scale: float, cap: float = 0.95) -> flo
     a recording keeps (``cap`` 1); at least 0.3 on a narrow window."""
     w = max(window_width, 1)
     return min(max((w - PANEL_PX * ui_scale) / w, 0.3), cap)
+
+
+def scene_width(window_width: int, ui_scale: float) -> int:
+    """Pixels of a window ``window_width`` wide left of meshlap's panel at ``ui_scale``, even
+    (a video encoder's need): what a recording keeps of each frame, and what an animation of
+    a saved view keeps of its window."""
+    keep = int(window_width * scene_fraction(window_width, ui_scale, cap=1.0))
+    return max(keep // 2 * 2, 2)
 
 
 MESH = "mesh"
@@ -48,6 +57,8 @@ INSPECTOR = (
 )
 SURFACE = "surface"
 SURFACE_POINT = "surface point"
+NORMAL_SECTION = "normal section"
+SECTION_DIRECTION = "normal section direction"
 RECON = "reconstruction"
 EIGEN = "eigenfunction"
 SMOOTHED = "smoothed"
@@ -56,6 +67,8 @@ SMOOTH_INPUT = "smoothing input"
 # ---------------------------------------------------------------- colours (RGBA / RGB)
 RED = (1.0, 0.35, 0.35, 1.0)
 COLORBAR_AT = (15.0, 15.0)  # polyscope's on-screen colour bar: top-left, clear of the panel
+COLORBAR_STRIP = 0.17
+"""Left fraction of an animation frame kept clear for polyscope's colour bar (``COLORBAR_AT``)."""
 COLORBAR_PX = 150.0  # width of the colour bar's box at UI scale 1: the camera frames right of it
 INPUT_COLOR = (0.85, 0.75, 0.6)
 SMOOTHED_COLOR = (0.55, 0.7, 0.9)
@@ -68,41 +81,6 @@ LAPLACIAN_COLOR = (0.0, 0.6, 0.6)
 # parametric surfaces are written z-up; the viewer is y-up: display them rotated (x, y, z) ->
 # (x, z, -y) with a polyscope transform, so the data (and the numbers in the panel) are unchanged
 Z_TO_Y = np.array([[1.0, 0, 0, 0], [0, 0, 1, 0], [0, -1, 0, 0], [0, 0, 0, 1]])
-
-
-class Display:
-    """World → display coordinates ``x_d = (x − c) · s`` for everything uploaded from the mesh.
-
-    polyscope stores positions as float32 (largest 3.4e38, smallest normal 1.2e-38), while the
-    loader accepts coordinates up to ``MAX_COORDINATE`` = 1e75 and extents down to 1e-60: a mesh
-    near 1e74 would upload as ``inf`` and render a blank frame. Centring on the bounding box and
-    scaling by a power of two (exact in float64) to a diagonal near 1 makes every accepted mesh
-    representable. The panels' numbers stay in world units; only uploads go through this.
-    """
-
-    def __init__(self) -> None:
-        self.centre = np.zeros(3)
-        self.scale = 1.0
-
-    def fit(self, V: np.ndarray) -> None:
-        """Fit to the positions ``V (n,3)`` (bounding-box centre; diagonal → about 1)."""
-        V = np.asarray(V, dtype=np.float64)
-        if len(V) == 0:
-            self.centre, self.scale = np.zeros(3), 1.0
-            return
-        lo, hi = V.min(axis=0), V.max(axis=0)
-        self.centre = 0.5 * lo + 0.5 * hi  # no overflow of lo + hi near the float64 limit
-        half = 0.5 * hi - 0.5 * lo
-        diag = 2.0 * float(np.linalg.norm(half))
-        self.scale = float(2.0 ** -np.round(np.log2(diag))) if diag > 0 else 1.0
-
-    def points(self, P: np.ndarray) -> np.ndarray:
-        """Display positions of world points ``P (k,3)``."""
-        return (np.asarray(P, dtype=np.float64) - self.centre) * self.scale
-
-    def vectors(self, D: np.ndarray) -> np.ndarray:
-        """Display vectors of world displacements ``D (k,3)`` (scaled, not shifted)."""
-        return np.asarray(D, dtype=np.float64) * self.scale
 
 
 def scalar_for_upload(
@@ -121,6 +99,20 @@ def scalar_for_upload(
 def side_offset(V: np.ndarray) -> np.ndarray:
     """Offset of a copy shown beside a mesh: to its right as seen from the default camera."""
     return np.array([-1.15 * float(np.ptp(V[:, 0])) - 1e-9, 0.0, 0.0])
+
+
+def picked_vertex(hit: Any, V: np.ndarray, F: np.ndarray) -> int | None:
+    """The vertex of ``V (n,3)`` that polyscope's pick result ``hit`` points at: the picked
+    vertex, or the nearest corner of a picked face of ``F (m,3)`` (``V`` in the coordinates
+    of ``hit.position``); ``None`` for another kind of element."""
+    data = hit.structure_data
+    kind = data.get("element_type")
+    if kind == "vertex":
+        return int(data["index"])
+    if kind == "face":
+        f = F[int(data["index"])]
+        return int(f[np.argmin(np.linalg.norm(V[f] - np.asarray(hit.position), axis=1))])
+    return None
 
 
 def remove_structure(name: str) -> None:

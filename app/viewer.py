@@ -1,12 +1,13 @@
-"""The viewer's loop: opens polyscope, owns the state objects and the panels, runs the frame.
+"""The viewer: a host for the registered panels (:mod:`.registry`) on polyscope's frame loop.
 
 ``run`` opens a window (or, with ``screenshot``, renders one frame with the EGL backend and
 exits). Paths are resolved before ``polyscope.init()``, which may change the working directory.
 
-Each panel (``app/panels/``) reads its widgets, calls its state object's methods and, only when
-something changed, pushes arrays to polyscope (position updates where the connectivity is
-unchanged, never re-registration per frame). Structure names, offsets and framing live in
-:mod:`.scene`.
+The :class:`Viewer` owns the one :class:`~.state.app.AppState`, the UI adapter and the main
+mesh structure; everything else belongs to a panel. Each frame it draws the sections and the
+active view, lets every panel bring its uploads up to date (``sync``: cheap when nothing
+changed), hands clicks and keys to the panels, and frames the scene when asked. It implements
+:class:`~.panels.base.Host`, the narrow interface panels are given; it never names a panel.
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ import os
 import sys
 import time
 import traceback
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -24,21 +26,11 @@ import polyscope as ps
 from meshlap_core.errors import MeshError
 
 from . import scene
-from .panels.curvature import CurvaturePanel
-from .panels.export import ExportPanel
-from .panels.help import HelpPanel
-from .panels.mesh import MeshPanel
-from .panels.onering import OneRingPanel
-from .panels.smoothing import SmoothingPanel
-from .panels.spectral import SpectralPanel
-from .panels.surfaces import SurfacesPanel
-from .scene import MESH, SURFACE, Z_TO_Y
-from .state.curvature import CurvatureState
-from .state.mesh import MeshState
-from .state.names import FIELD_LABELS, PANELS
-from .state.onering import OneRingState
-from .state.spectral import SCREENSHOT_K
-from .state.surface import SurfaceState
+from .panels.base import Panel
+from .registry import REGISTRY, VIEWS
+from .scene import MESH
+from .state.app import AppState
+from .state.watch import Watch
 from .ui import UI
 
 NO_DISPLAY = (
@@ -46,20 +38,10 @@ NO_DISPLAY = (
     "`meshlap view MESH --screenshot out.png`"
 )
 
-PANEL_PX = scene.PANEL_PX
-
 BUSY_FRAME_S = 0.35
-"""While the eigen worker runs, each frame waits this long (about 5 frames/s): the render loop
-then leaves the cores to the solver, so the basis takes about as long as ``meshlap spectral``."""
-
-FRAMED = (
-    scene.MESH,
-    scene.MESH_B,
-    scene.SURFACE,
-    scene.RECON,
-    scene.SMOOTHED,
-    scene.SMOOTH_INPUT,
-)
+"""While a panel's background job runs, each frame waits this long (about 5 frames/s): the
+render loop then leaves the cores to the worker, so an eigenbasis takes about as long as
+``meshlap spectral``."""
 
 
 def init_polyscope(backend: str) -> None:
@@ -91,244 +73,222 @@ def init_polyscope(backend: str) -> None:
     ps.set_open_imgui_window_for_user_callback(True)
 
 
-class Viewer:
-    """The state objects (one per concern) and the panels that show them."""
+def make_panels(state: AppState) -> dict[str, Panel]:
+    """One instance of every registered panel, each given its slice of ``state``."""
+    return {e.name: e.panel_module().PANEL(e.name, state.slices.get(e.name)) for e in REGISTRY}
 
-    def __init__(
-        self,
-        mesh: MeshState,
-        curv: CurvatureState | None = None,
-        panel: str = "curvature",
-        ui: UI | None = None,
-        export_dir: Path | None = None,
-    ) -> None:
+
+class Viewer:
+    """The host of the panels: state, UI adapter, the main mesh, framing and captions.
+
+    Parameters
+    ----------
+    state : AppState
+        The mesh (loaded), settings and every panel's state slice.
+    ui : UI, optional
+        The imgui adapter (a test passes a scripted one).
+    """
+
+    def __init__(self, state: AppState, ui: UI | None = None) -> None:
+        self.state = state
         self.ui = ui or UI()
-        self.display = scene.Display()  # world -> display coordinates (float32-safe uploads)
+        self.ui.scale = state.ui_scale
+        self.panels = make_panels(state)
         self.busy_frame_s = BUSY_FRAME_S
-        self.errors: dict[str, str] = {}  # section -> the message shown in red there
-        self._logged: set[tuple[str, str]] = set()
-        self.mesh = mesh
-        self.curv = curv or CurvatureState()
-        self.ring = OneRingState()
-        self.surf = SurfaceState()
-        self.panels: dict[str, Any] = {
-            "mesh": MeshPanel(),
-            "curvature": CurvaturePanel(),
-            "onering": OneRingPanel(),
-            "spectral": SpectralPanel(),
-            "smoothing": SmoothingPanel(),
-            "surfaces": SurfacesPanel(),
-            "export": ExportPanel(export_dir),
-            "help": HelpPanel(),
-        }
-        self.panel = panel
-        self._mesh_version = -1
         self.reframe = True  # frame the visible structures at the end of the next frame
-        self._window_size: tuple[int, int] = (0, 0)
+        self.keep_camera = False  # an animation of a saved view: never re-frame
+        self.window_size: tuple[int, int] = (0, 0)
+        self.watch = Watch()
+        self._logged: set[tuple[str, str]] = set()
         self._caption_boxes: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+
+    # ------------------------------------------------------------------ Host
+    def active(self) -> Panel:
+        return self.panels[self.state.panel]
+
+    def request_frame(self) -> None:
+        self.reframe = True
+
+    def set_ui_scale(self, scale: float) -> None:
+        """UI scale in [0.5, 3] for the state, polyscope and the adapter (``MeshError`` for a
+        non-finite value; nothing changes)."""
+        value = self.state.set_ui_scale(scale)
+        ps.set_ui_scale(value)
+        self.ui.scale = value
+        self.reframe = True
+
+    def mesh_points(self) -> np.ndarray:
+        d, mesh = self.state.display, self.state.mesh
+        key = (mesh.version, id(mesh.V), d.scale, *d.centre.tolist())
+        return self.watch.cached("mesh points", key, lambda: d.points(mesh.V))
+
+    @property
+    def sections(self) -> list[Panel]:
+        """The panels drawn on every frame (not views)."""
+        return [self.panels[e.name] for e in REGISTRY if not e.view]
 
     # ------------------------------------------------------------------ registration
     def sync_mesh(self) -> None:
-        """Register the mesh when it changed (a new file), then the visible panel."""
-        if self._mesh_version != self.mesh.version:
-            self._mesh_version = self.mesh.version
-            for name in (
-                MESH,
-                scene.MESH_B,
-                scene.RING_CURVE,
-                scene.RING_POINTS,
-                scene.RING_CENTER,
-            ):
-                scene.remove_structure(name)
-            self.display.fit(self.mesh.V)
-            shown = self.display.points(self.mesh.V)
-            ps.register_surface_mesh(MESH, shown, self.mesh.F, smooth_shade=True)
-            self.ring = OneRingState(reverse=self.ring.reverse)
+        """Register the mesh when it changed (a new file), bring every panel up to date and
+        show the active view."""
+        mesh = self.state.mesh
+        if self.watch.changed("mesh", mesh.version, id(mesh)):
+            scene.remove_structure(MESH)
+            self.state.display.fit(mesh.V)
+            ps.register_surface_mesh(MESH, self.mesh_points(), mesh.F, smooth_shade=True)
             for p in self.panels.values():
                 p.on_new_mesh(self)
-        self.push_curvature()
-        self.show_panel()
+        for p in self.panels.values():
+            p.sync(self)
+        self.refresh()
 
-    def push_curvature(self, force: bool = False) -> None:
-        """Add the selected curvature field(s) as colour maps (only when they changed)."""
-        self.panels["curvature"].push(self, force)
-
-    def show_panel(self) -> None:
-        """Show the structures of the current panel and hide the others."""
-        on_mesh = self.panel in ("curvature", "onering", "spectral", "smoothing")
+    def refresh(self) -> None:
+        """Show the structures of the active view and hide the others."""
+        active = self.active()
         if ps.has_surface_mesh(MESH):
-            ps.get_surface_mesh(MESH).set_enabled(on_mesh)
-        for name in ("curvature", "onering", "surfaces", "spectral", "smoothing"):
-            self.panels[name].show(self, self.panel)
+            ps.get_surface_mesh(MESH).set_enabled(active.shows_mesh)
+        for p in self.panels.values():
+            p.show(self, active)
 
-    # ------------------------------------------------------------------ one-ring
-    def select_vertex(self, i: int) -> bool:
-        """Select vertex ``i`` and draw its ordered one-ring."""
-        return self.panels["onering"].select(self, i)
+    def set_panel(self, name: str) -> None:
+        """Switch to the view ``name``, show its structures and frame them."""
+        self.state.panel = self.state.check_panel(name)
+        self.refresh()
+        self.reframe = True
 
-    def focus_ring(self) -> None:
-        """Point the camera at the selected vertex, along its normal, framing the one-ring."""
-        self.panels["onering"].focus(self)
-
-    # ------------------------------------------------------------------ picking
+    # ------------------------------------------------------------------ input
     def handle_click(self) -> None:
         xy = self.ui.scene_click()
         if xy is not None:
             self.pick_at(xy)
 
+    def pick_at(self, screen_xy: tuple[float, float]) -> bool:
+        """Pick at window coordinates; the active view first, then the others, may use it."""
+        res = ps.pick(screen_coords=screen_xy)
+        if not res.is_hit:
+            return False
+        active = self.active()
+        others = [p for p in self.panels.values() if p is not active]
+        return any(p.pick(self, res, active) for p in (active, *others))
+
     def handle_keys(self) -> None:
-        """The shortcuts (listed in the Help panel)."""
+        """The shortcuts: a number selects a view; other keys go to the active view, then to
+        the sections, then to the host's own (F frames, R re-frames)."""
         ui = self.ui
-        for i, name in enumerate(PANELS):
+        for i, name in enumerate(VIEWS):
             if ui.key(str(i + 1)):
                 self.set_panel(name)
-        smoothing, spectral = self.panels["smoothing"], self.panels["spectral"]
-        if ui.key("space") and self.panel == "smoothing":
-            smoothing.state.playing = not smoothing.state.playing
-        for key, dk in (("right", 1), ("left", -1)):
-            if not ui.key(key):
-                continue
-            if self.panel == "smoothing" and dk > 0:
-                smoothing.state.step()
-            elif self.panel == "spectral" and spectral.state.basis is not None:
-                spectral.state.set_k(spectral.state.k + dk)
-                spectral.push_k(self)
-        if ui.key("f"):
-            self.reframe = True
-        if ui.key("h"):
-            self.panels["help"].toggle()
-        if ui.key("r"):
-            if self.panel == "smoothing":
-                smoothing.state.reset()
-                smoothing.push(force=True)
-            else:
-                self.reframe = True
+        panels = [self.active(), *self.sections]
+        keys = dict.fromkeys([*(k for p in self.panels.values() for k in p.keys), "f", "r"])
+        for key in keys:
+            if ui.key(key) and not any(p.on_key(self, key) for p in panels):
+                if key in ("f", "r"):  # nobody used it: frame (R: the camera's reset)
+                    self.reframe = True
 
     def files_dropped(self, paths: list[str]) -> None:
         """polyscope's drag-and-drop callback: open the first file dropped on the window (a
         ``.json`` file is loaded as a saved session).
 
-        Runs outside the imgui frame, so it draws nothing: a failure is kept for the Mesh panel
-        (``mesh.error``, or ``errors["mesh"]`` for an internal error) and never raised.
+        Runs outside the imgui frame, so it draws nothing: a failure is kept for the Mesh
+        section (``mesh.error``, or ``errors["mesh"]`` for an internal error), never raised.
         """
         if not paths:
             return
+        section = REGISTRY[0].name  # the first section: the mesh's
         try:
             if Path(paths[0]).suffix.lower() == ".json":  # a saved session
                 from .session import load
 
                 load(self, paths[0])
-                self.errors.pop("mesh", None)
+                self.state.errors.pop(section, None)
             else:
                 self.open(Path(paths[0]))
-        except MeshError as exc:  # a refused session: said in the Mesh panel, nothing changes
-            self.errors["mesh"] = str(exc)
+        except MeshError as exc:  # a refused session: said in the Mesh section, nothing changes
+            self.state.errors[section] = str(exc)
         except Exception as exc:  # a callback from C++ must not raise
-            self.errors["mesh"] = self._internal_error("mesh", exc)
-
-    def pick_at(self, screen_xy: tuple[float, float]) -> bool:
-        """Pick at window coordinates; a vertex of the mesh selects its one-ring (or a point
-        on the parametric surface). Uses the structure's own element index."""
-        res = ps.pick(screen_coords=screen_xy)
-        if not res.is_hit:
-            return False
-        data = res.structure_data
-        if res.structure_name == MESH and self.panel in ("onering", "curvature"):
-            shown = self.display.points(self.mesh.V)  # picked positions are display positions
-            idx = self._vertex_of(data, res.position, shown, self.mesh.F)
-            if idx is not None:
-                self.panel = "onering"
-                return self.select_vertex(idx)
-        if res.structure_name == SURFACE and self.surf.mesh is not None:
-            shown = self.surf.mesh.V @ Z_TO_Y[:3, :3].T  # picked positions are in world space
-            idx = self._vertex_of(data, res.position, shown, self.surf.mesh.F)
-            if idx is not None and self.surf.pick_vertex(idx):
-                self.panels["surfaces"].push_point(self)
-                return True
-        return False
-
-    @staticmethod
-    def _vertex_of(data: dict, position: Any, V: np.ndarray, F: np.ndarray) -> int | None:
-        kind = data.get("element_type")
-        if kind == "vertex":
-            return int(data["index"])
-        if kind == "face":  # nearest corner of the clicked face
-            f = F[int(data["index"])]
-            return int(f[np.argmin(np.linalg.norm(V[f] - np.asarray(position), axis=1))])
-        return None
+            self.state.errors[section] = self._internal_error(section, exc)
 
     # ------------------------------------------------------------------ the frame
     def callback(self) -> None:
-        """The per-frame user callback: draw the panels, react to changes only.
+        """The per-frame user callback: draw the sections and the active view, let each panel
+        sync, react to clicks and keys, frame and caption.
 
-        Every section runs guarded (:meth:`draw_guarded`): no exception of a widget handler
+        Every step runs guarded (:meth:`draw_guarded`): no exception of a widget handler
         leaves this function, so none ends the session.
         """
         ui = self.ui
-        if self.panels["spectral"].state.busy and self.busy_frame_s > 0:
+        if self.busy_frame_s > 0 and any(p.busy() for p in self.panels.values()):
             time.sleep(self.busy_frame_s)  # releases the GIL too
         ui.push_width(200)
         try:
-            self.draw_guarded("mesh", self.panels["mesh"].draw)
-            self.draw_guarded("view", self.draw_view_combo)
-            self.draw_guarded(self.panel, self.panels[self.panel].draw)
-            self.draw_guarded("export", self.panels["export"].draw)
-            self.draw_guarded("help", self.panels["help"].draw)
+            viewed = False
+            for e in REGISTRY:
+                if not e.view:
+                    self.draw_guarded(e.name, self.panels[e.name].draw)
+                elif not viewed:  # where the views start: the combo, then the active one
+                    viewed = True
+                    self.draw_guarded("view", lambda host: host.draw_view_combo())
+                    self.draw_guarded(self.state.panel, self.active().draw)
         finally:
             ui.pop_width()
-        self.draw_guarded("picking", lambda viewer: viewer.handle_click())
-        self.draw_guarded("keys", lambda viewer: viewer.handle_keys())
-        if self.panel == "onering":
-            self.draw_guarded("labels", self.panels["onering"].draw_labels)
-        self.draw_guarded("layout", lambda viewer: viewer.layout())
+        for name, p in self.panels.items():
+            self.draw_guarded(name, p.sync, show=False)
+        self.draw_guarded("picking", lambda host: host.handle_click())
+        self.draw_guarded("keys", lambda host: host.handle_keys())
+        self.draw_guarded("labels", self.active().overlay)
+        self.draw_guarded("layout", lambda host: host.layout())
 
     def layout(self) -> None:
         """Re-frame after a change of what is shown or of the window size; draw captions."""
         size = tuple(ps.get_window_size())
-        if self.reframe or size != self._window_size:
-            self._window_size = size
+        if self.reframe or size != self.window_size:
+            self.window_size = size
             self.reframe = False
             self.frame()
         self.draw_captions()
 
-    def draw_view_combo(self, viewer: Viewer) -> None:
+    def keep_view(self) -> None:
+        """Keep the camera as it is now: no pending re-frame, the window size taken as seen."""
+        self.reframe = False
+        self.window_size = tuple(ps.get_window_size())
+
+    def flush_frame(self) -> None:
+        """Frame now if a re-frame was requested (before a recorded picture)."""
+        if self.reframe:
+            self.reframe = False
+            self.frame()
+
+    def draw_view_combo(self) -> None:
         changed, panel = self.ui.combo(
-            "view", self.panel, PANELS, "which panel: curvature, one-ring, spectral, ..."
+            "view", self.state.panel, VIEWS, "which panel: curvature, one-ring, spectral, ..."
         )
         if changed:
             self.set_panel(panel)
 
-    def set_panel(self, panel: str) -> None:
-        """Switch to ``panel``, show its structures and frame them."""
-        if panel not in PANELS:
-            raise MeshError(f"unknown panel {panel!r}; choose one of {', '.join(PANELS)}", "view")
-        self.panel = panel
-        self.show_panel()
-        self.reframe = True
-
-    def draw_guarded(self, section: str, draw: Any) -> None:
+    def draw_guarded(self, section: str, draw: Callable[[Any], None], show: bool = True) -> None:
         """Run ``draw(self)``; an exception is shown in red in that section, never raised.
 
         A ``MeshError``/``ValueError`` (bad widget input) shows its message and the state keeps
         its last good values (the state objects validate before they change). Anything else is
         an internal error: shown with a "details" line and logged once on stderr (with the
         traceback when ``MESHLAP_DEBUG=1``). The message stays until a widget of the section
-        changes something without an error.
+        changes something without an error. ``show=False``: the message is only kept (drawn
+        with the section's widgets).
         """
-        ui = self.ui
+        ui, errors = self.ui, self.state.errors
         outer = (ui.section, ui.changed)  # a screenshot re-runs the callback from inside one
         ui.begin_section(section)
         try:
             draw(self)
         except ValueError as exc:  # MeshError is a ValueError: bad input, said in its message
-            self.errors[section] = str(exc)
+            errors[section] = str(exc)
         except Exception as exc:  # a bug or an API change: keep the session, say what failed
-            self.errors[section] = self._internal_error(section, exc)
+            errors[section] = self._internal_error(section, exc)
         else:
             if ui.changed:
-                self.errors.pop(section, None)
-        message = self.errors.get(section)
-        if message:
+                errors.pop(section, None)
+        message = errors.get(section)
+        if message and show:
             ui.error(message)
         ui.section, ui.changed = outer[0], outer[1] or ui.changed
 
@@ -348,66 +308,62 @@ class Viewer:
         )
 
     def open(self, path: Path | None) -> bool:
-        """Load ``path``; on failure the error is shown in the Mesh panel, the mesh stays."""
-        if self.mesh.load(path):
-            if path is not None:
-                self.panels["mesh"].remember(Path(path))
+        """Load ``path``; on failure the error is shown in the Mesh section, the mesh stays."""
+        if self.state.mesh.load(path):
             self.sync_mesh()
             self.reframe = True
             return True
         return False
 
-    def export(self, folder: Path) -> str:
-        """Write the current mesh (PLY with the shown field) and the field (CSV) into folder."""
-        return self.panels["export"].export(self, folder)
+    # ------------------------------------------------------------------ framing, captions
+    def framed_names(self) -> tuple[str, ...]:
+        """The surface meshes framing fits in view: the mesh and every panel's copies."""
+        return (MESH, *(n for p in self.panels.values() for n in p.framed))
 
     def structure_points(self, name: str) -> np.ndarray | None:
-        """Display positions of a structure some panel registered (for camera framing)."""
+        """Display positions of a structure the host or a panel registered (for framing)."""
+        if name == MESH:
+            return self.mesh_points()
         for p in self.panels.values():
             P = p.points(self, name)
             if P is not None:
                 return P
         return None
 
-    def frame(self) -> None:
-        """Frame what the current panel shows in the part of the window left of meshlap's panel
-        (the one-ring: its selected vertex; the surfaces: obliquely from above; a mesh: from its
-        front, see ``scene.FRONT_VIEWS``). The same code serves the window and screenshots."""
-        if self.panel == "onering" and self.ring.valence:
-            self.focus_ring()
+    def view_direction(self) -> tuple[float, float, float]:
+        """Where the camera looks from: the active view's own direction, else the mesh's
+        front (:data:`.scene.FRONT_VIEWS`)."""
+        own = getattr(self.active(), "view_direction", None)
+        return own or scene.FRONT_VIEWS.get(self.state.mesh.name, scene.DEFAULT_VIEW)
+
+    def frame(self, strip: float | None = None) -> None:
+        """Frame what the active view shows in the part of the window left of meshlap's panel
+        (a view may frame its own way: the one-ring its selected vertex). ``strip``: an
+        animation frame (no panel), keeping that left fraction of the width clear for the
+        colour bar; nothing happens when the animation keeps a saved camera."""
+        if strip is not None:
+            if not self.keep_camera:
+                scene.frame_scene_left(
+                    self.framed_names(), self.structure_points, 0.95, self.view_direction(), strip
+                )
+            return
+        if self.active().focus(self):
             return
         w, _ = ps.get_window_size()
-        fraction = scene.scene_fraction(w, self.ui.scale)
-        if self.panel == "surfaces":
-            view = scene.OBLIQUE_VIEW
-        else:
-            view = scene.FRONT_VIEWS.get(self.mesh.name, scene.DEFAULT_VIEW)
-        left = scene.COLORBAR_PX * self.ui.scale / max(w, 1)  # keep clear of the colour bar
-        scene.frame_scene_left(FRAMED, self.structure_points, fraction, view, left)
+        fraction = scene.scene_fraction(w, self.state.ui_scale)
+        left = scene.COLORBAR_PX * self.state.ui_scale / max(w, 1)  # clear of the colour bar
+        names = self.framed_names()
+        scene.frame_scene_left(names, self.structure_points, fraction, self.view_direction(), left)
         self._caption_boxes = {}
-        for name in FRAMED:
+        for name in names:
             if ps.has_surface_mesh(name) and ps.get_surface_mesh(name).is_enabled():
                 P = self.structure_points(name)
                 if P is not None and len(P):
                     self._caption_boxes[name] = (P.min(axis=0), P.max(axis=0))
 
     def captions(self) -> dict[str, str]:
-        """Caption of each structure shown side by side in the current panel."""
-        out: dict[str, str] = {}
-        curv = self.panels["curvature"]
-        if self.panel == "curvature" and curv.side_by_side:
-            out[MESH] = FIELD_LABELS[self.curv.field_name][0]
-            out[scene.MESH_B] = FIELD_LABELS[curv.second_field][0]
-        spec = self.panels["spectral"].state
-        if self.panel == "spectral" and spec.basis is not None:
-            out[MESH] = f"eigenfunction u_{spec.mode}"
-            out[scene.RECON] = f"k = {spec.k} of {spec.basis.k_max} modes"
-        sm = self.panels["smoothing"].state
-        if self.panel == "smoothing" and sm.smoother is not None:
-            noisy = f"noisy alpha = {sm.noise_alpha:g}" if sm.noise_alpha else "no noise"
-            out[scene.SMOOTH_INPUT] = f"input, {noisy}"
-            out[scene.SMOOTHED] = f"{sm.method}, lambda = {sm.lam:g}, {sm.smoother.iteration} steps"
-        return out
+        """Caption of each structure the active view shows side by side."""
+        return self.active().captions(self)
 
     def draw_captions(self) -> None:
         """Write each caption under its structure (the bottom of its bounding box on screen)."""
@@ -436,24 +392,34 @@ class Viewer:
             self.ui.overlay_text((x, y), text)
 
 
+def check_options(options: dict[str, Any], state: AppState) -> None:
+    """Each panel's state module checks the ``meshlap view`` options it knows
+    (``check_view_options``) against the loaded mesh, before any window opens."""
+    for e in REGISTRY:
+        module = e.state_module()
+        check = getattr(module, "check_view_options", None) if module is not None else None
+        if check is not None:
+            check(options, state)
+
+
 def run(
     path: str | Path | None = None,
     screenshot: str | Path | None = None,
-    field: str = "cotan",
-    panel: str = "curvature",
-    vertex: int | None = None,
-    k: int | None = None,
+    panel: str | None = None,
     backend: str | None = None,
     ui_scale: float = 1.0,
     session: str | Path | None = None,
+    **options: Any,
 ) -> int:
     """Open the viewer on ``path`` (the bundled default mesh when ``None``).
 
     With ``screenshot`` a single frame is rendered headless (EGL) into that PNG and the
     function returns. With ``session`` (a saved session file) its mesh, settings and camera
-    replace ``path``, ``field``, ``panel``, ``vertex``, ``k`` and ``ui_scale``.
+    replace ``path``, ``panel``, ``options`` and ``ui_scale``. ``options`` are the panels'
+    start options (``field``, ``vertex``, ``k``: ``None`` when not given), each checked by its
+    panel's state module before the window opens.
     """
-    from .state.session import check_vertex, read_session
+    from .state.session import check_session_mesh, read_session
 
     saved = read_session(session) if session is not None else None  # refused before a window
     if saved is not None:
@@ -463,44 +429,31 @@ def run(
     shot = Path(screenshot).resolve() if screenshot is not None else None
     if shot is not None and not shot.parent.is_dir():
         raise MeshError(f"output directory {shot.parent} does not exist", shot)
-    if field not in FIELD_LABELS:
-        raise MeshError(
-            f"unknown field {field!r}; choose one of {', '.join(FIELD_LABELS)}", "--field"
-        )
-    if panel not in PANELS:
-        raise MeshError(f"unknown panel {panel!r}; choose one of {', '.join(PANELS)}", "--panel")
-    mesh = MeshState()
-    if not mesh.load(path):
-        raise MeshError(mesh.error)
+    state = AppState(folder=cwd)
+    state.panel = state.check_panel(panel or VIEWS[0], "--panel")
+    if not state.mesh.load(path):
+        raise MeshError(state.mesh.error)
     if saved is not None:
-        check_vertex(saved, len(mesh.V), session)
-    if vertex is not None and not 0 <= vertex < len(mesh.V):
-        raise MeshError(
-            f"vertex {vertex} is out of range (the mesh has {len(mesh.V)} vertices)", "--vertex"
-        )
+        check_session_mesh(saved, state.mesh, session)
+    check_options(options, state)
     if not 0.5 <= ui_scale <= 3.0:  # also refuses NaN
         raise MeshError(f"must be between 0.5 and 3, got {ui_scale}", "--ui-scale")
-    ps.set_program_name(f"meshlap — {mesh.name}")  # the window title (set before init)
+    ps.set_program_name(f"meshlap — {state.mesh.name}")  # the window title (set before init)
     init_polyscope(backend or ("openGL3_egl" if shot else "auto"))
-    viewer = Viewer(mesh, CurvatureState(field_name=field), panel=panel, export_dir=cwd)
+    viewer = Viewer(state)
     ps.set_build_default_gui_panels(False)  # polyscope's own panels: a toggle in Help
     if ui_scale != 1.0:
-        viewer.panels["help"].set_scale(viewer, ui_scale)
+        viewer.set_ui_scale(ui_scale)
     viewer.sync_mesh()
     if shot is not None:
         ps.set_window_size(1600, 900)
     if saved is not None:
         from .session import apply
 
-        apply(viewer, saved, session, mesh=mesh)
-    elif panel == "onering":
-        viewer.select_vertex(vertex if vertex is not None else 0)
-    if saved is None and k is None and shot is not None and panel == "spectral":
-        k = SCREENSHOT_K  # a spectral screenshot shows a reconstruction, not an empty panel
-    if k is not None:
-        viewer.panels["spectral"].prepare_screenshot(viewer, k)
-    if saved is None and panel == "smoothing":
-        viewer.panels["smoothing"].prepare_screenshot(viewer)
+        apply(viewer, saved, session, mesh=state.mesh)
+    else:
+        for name, p in viewer.panels.items():
+            p.start(viewer, options, name == state.panel, shot is not None)
     ps.set_user_callback(viewer.callback)
     ps.set_files_dropped_callback(viewer.files_dropped)
     if shot is not None:

@@ -72,7 +72,7 @@ def viewer(polyscope_mock, sphere, tmp_path, monkeypatch):
     """A viewer on ``sphere`` drawing through the scriptable UI adapter on ``openGL_mock``
     (every ``frame_tick`` runs its callback), exporting to ``tmp_path``, with a private
     eigenbasis cache."""
-    from meshlap_app.state import CurvatureState, MeshState
+    from meshlap_app.state import AppState, MeshState
     from meshlap_app.ui import UI
     from meshlap_app.viewer import Viewer
 
@@ -80,7 +80,7 @@ def viewer(polyscope_mock, sphere, tmp_path, monkeypatch):
     polyscope_mock.remove_all_structures()
     mesh = MeshState()
     assert mesh.load(sphere)
-    v = Viewer(mesh, CurvatureState(), ui=UI(), export_dir=tmp_path)
+    v = Viewer(AppState(mesh=mesh, folder=tmp_path), ui=UI())
     v.sync_mesh()
     polyscope_mock.set_user_callback(v.callback)
     yield v

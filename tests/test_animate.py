@@ -270,14 +270,14 @@ def mock(polyscope_mock):
 def _drive(viewer, label, *values) -> None:
     """One value per frame for widget ``label`` inside the (collapsed) record header."""
     import polyscope as ps
-    from meshlap_app.animate import RECORD_HEADER
+    from meshlap_app.record import RECORD_HEADER
 
     for value in values:
         viewer.ui.script(label, value)
         viewer.ui.script(RECORD_HEADER, True)
         ps.frame_tick()
         assert not viewer.ui.pending(), f"widget {label!r} was not drawn"
-    internal = {k: m for k, m in viewer.errors.items() if "internal error" in m}
+    internal = {k: m for k, m in viewer.state.errors.items() if "internal error" in m}
     assert not internal, internal
 
 
@@ -289,11 +289,11 @@ def test_record_button_smoothing_play(viewer, tmp_path):
     st = viewer.panels["smoothing"].state
     _drive(viewer, "record file", "nowhere/x.gif")
     _drive(viewer, "record", True)  # a missing folder: said in red, nothing recorded
-    assert "does not exist" in viewer.errors["smoothing"]
+    assert "does not exist" in viewer.state.errors["smoothing"]
     assert not viewer.panels["smoothing"].recorder.recording
     _drive(viewer, "record file", "play.avi")
     _drive(viewer, "record", True)
-    assert ".avi" in viewer.errors["smoothing"]
+    assert ".avi" in viewer.state.errors["smoothing"]
     _drive(viewer, "record file", "play.gif")
     _drive(viewer, "record", True)
     assert viewer.panels["smoothing"].recorder.recording
@@ -316,7 +316,7 @@ def test_record_button_spectral_k_drag(viewer, tmp_path):
     viewer.set_panel("spectral")
     st = viewer.panels["spectral"].state
     st.k_request = 12
-    st.start(viewer.mesh.V, viewer.mesh.F, background=False)
+    st.start(viewer.state.mesh.V, viewer.state.mesh.F, background=False)
     ps.frame_tick()
     _drive(viewer, "record file", "k.gif")
     _drive(viewer, "record", True)
@@ -376,18 +376,31 @@ def test_session_values_fill_what_was_not_typed(spec_of, sphere, tmp_path):
     out = str(tmp_path / "a.gif")
     spec = spec_of("--session", str(path), "--out", out)
     assert spec.panel == "smoothing" and spec.mesh == sphere.resolve()
-    assert (spec.method, spec.laplacian, spec.lam) == ("explicit", "uniform", 0.25)
-    assert (spec.noise, spec.seed, spec.iters) == (0.01, 4, 3)  # iters: the saved iteration
+    assert (spec.options["method"], spec.options["laplacian"], spec.options["lam"]) == (
+        "explicit",
+        "uniform",
+        0.25,
+    )
+    assert (spec.options["noise"], spec.options["seed"], spec.options["iters"]) == (
+        0.01,
+        4,
+        3,
+    )  # iters: the saved iteration
     assert spec.size == (680, 700)  # the 1200x700 window left of the 520-pixel panel
     assert spec.session.panel == "smoothing" and spec.session_file == path
     # typed options win over the session
     spec = spec_of("--session", str(path), "--out", out, "--lam", "2", "--iters", "7")
-    assert (spec.lam, spec.iters, spec.method, spec.seed) == (2.0, 7, "explicit", 4)
+    assert (
+        spec.options["lam"],
+        spec.options["iters"],
+        spec.options["method"],
+        spec.options["seed"],
+    ) == (2.0, 7, "explicit", 4)
     spec = spec_of("--session", str(path), "--out", out, "--size", "320x200")
     assert spec.size == (320, 200)
     # a session at iteration 0: the built-in 30 iterations; a larger UI scale: a wider panel
     zero = _session_file(tmp_path, sphere, name="z.json", smoothing={"iterations": 0})
-    assert spec_of("--session", str(zero), "--out", out).iters == 30
+    assert spec_of("--session", str(zero), "--out", out).options["iters"] == 30
     big = _session_file(tmp_path, sphere, name="big.json", ui_scale=1.5)
     assert spec_of("--session", str(big), "--out", out).size == (420, 700)  # 1200 - 1.5*520
     # no camera in the file: the built-in size
@@ -399,40 +412,50 @@ def test_session_spectral_and_surfaces_rules(spec_of, sphere, tmp_path):
     out = str(tmp_path / "a.gif")
     sp = _session_file(tmp_path, sphere, panel="spectral", name="sp.json")
     spec = spec_of("--session", str(sp), "--out", out)
-    assert spec.what == "k" and spec.k == (1, 6)  # the k sweep up to the session's k
+    assert spec.what == "k" and spec.options["k"] == (1, 6)  # the k sweep up to the session's k
     spec = spec_of("--session", str(sp), "--out", out, "--modes", "2:5")
-    assert spec.what == "modes" and spec.modes == (2, 5) and spec.k is None
-    assert spec_of("--session", str(sp), "--out", out, "--k", "3:4").k == (3, 4)
+    assert spec.what == "modes" and spec.options["modes"] == (2, 5) and spec.options["k"] is None
+    assert spec_of("--session", str(sp), "--out", out, "--k", "3:4").options["k"] == (3, 4)
     sf = _session_file(tmp_path, sphere, panel="surfaces", name="sf.json")
     spec = spec_of("--session", str(sf), "--out", out)
-    assert spec.theta and spec.surface == "torus" and spec.uv == (1.0, 2.0)
-    assert spec.frames == 72
+    assert (
+        spec.options["theta"]
+        and spec.options["surface"] == "torus"
+        and spec.options["uv"] == (1.0, 2.0)
+    )
+    assert spec.options["frames"] == 72
     spec = spec_of("--session", str(sf), "--out", out, "--uv", "0.5,0.25")
-    assert spec.uv == (0.5, 0.25) and spec.surface == "torus"
+    assert spec.options["uv"] == (0.5, 0.25) and spec.options["surface"] == "torus"
     spec = spec_of("--session", str(sf), "--out", out, "--surface", "saddle")
-    assert spec.surface == "saddle" and spec.uv is None  # the torus's point is not the saddle's
+    assert (
+        spec.options["surface"] == "saddle" and spec.options["uv"] is None
+    )  # the torus's point is not the saddle's
     # a session saved on the curvature panel is animated with --panel
     cv = _session_file(tmp_path, sphere, panel="curvature", name="cv.json")
     spec = spec_of("--session", str(cv), "--out", out, "--panel", "smoothing")
-    assert spec.panel == "smoothing" and spec.iters == 3 and spec.lam == 0.25
+    assert spec.panel == "smoothing" and spec.options["iters"] == 3 and spec.options["lam"] == 0.25
 
 
 def test_without_a_session_the_defaults_are_unchanged(spec_of, sphere, tmp_path):
     from meshlap_app.animate import AnimationSpec
 
     out = tmp_path / "a.gif"
-    for panel, extra in (("smoothing", []), ("spectral", ["--k", "1:5"])):
-        spec = spec_of(str(sphere), "--panel", panel, "--out", str(out), *extra)
-        expected = AnimationSpec(panel=panel, out=out, mesh=sphere, k=spec.k)
-        assert spec == expected
+    spec = spec_of(str(sphere), "--panel", "smoothing", "--out", str(out))
+    smoothing = {"method": "implicit", "laplacian": "uniform", "lam": 1.0, "iters": 30}
+    smoothing |= {"noise": 0.0, "seed": 0}
+    assert spec == AnimationSpec(panel="smoothing", out=out, mesh=sphere, options=smoothing)
+    spec = spec_of(str(sphere), "--panel", "spectral", "--out", str(out), "--k", "1:5")
+    spectral = {"k": (1, 5), "modes": None}
+    assert spec == AnimationSpec(panel="spectral", out=out, mesh=sphere, options=spectral)
     spec = spec_of("--panel", "surfaces", "--theta", "--out", str(out))
-    assert spec == AnimationSpec(panel="surfaces", out=out, theta=True)
+    surfaces = {"theta": True, "surface": "saddle", "uv": None, "frames": 72}
+    assert spec == AnimationSpec(panel="surfaces", out=out, options=surfaces)
 
 
 def test_session_window_keeps_the_view_left_of_the_panel():
     from meshlap_app.animate import panel_strip, session_window
+    from meshlap_app.scene import PANEL_PX
     from meshlap_app.state.session import Session
-    from meshlap_app.viewer import PANEL_PX
 
     s = Session(camera={"windowWidth": 1600, "windowHeight": 900})
     assert panel_strip(1600, 1.0) == PANEL_PX
@@ -476,7 +499,7 @@ def _bad_sessions(tmp_path, sphere) -> dict[str, str]:
         (["--session", "{dir}/nomesh.json"], "does not exist"),
         (["--session", "{dir}/vertex.json"], '"onering.vertex" 1000000 is out of range'),
         (["--session", "{dir}/curv.json"], "curvature panel, which has no animation"),
-        (["--session", "{dir}/ring.json"], "--panel smoothing|spectral|surfaces"),
+        (["--session", "{dir}/ring.json"], "--panel spectral|smoothing|surfaces"),
         (["--session", "{dir}/sp.json", "--k", "1:3", "--modes", "1:3"], "exactly one"),
         (["--session", "{dir}/sp.json", "--k", "5:2"], "--k"),
         (["--session", "{dir}/ok.json", "--lam", "-1"], "--lam"),
@@ -536,21 +559,21 @@ def _teacher_session(viewer, tmp_path, panel: str):
     import polyscope as ps
     from meshlap_app import session
 
-    mesh = viewer.mesh
+    mesh = viewer.state.mesh
     sm = viewer.panels["smoothing"].state
     sm.configure(mesh.V, mesh.F, noise_alpha=0.02, seed=5)
     sm.set_lam(2.0)
     for _ in range(3):
         assert sm.step()
-    viewer.panels["smoothing"].push(force=True)
+    viewer.panels["smoothing"].push(viewer, force=True)
     spec = viewer.panels["spectral"].state
     spec.k_request = 12
     spec.start(mesh.V, mesh.F, background=False)
     spec.set_mode(4)
     spec.set_k(6)
-    viewer.surf.set_surface("torus", 30)
-    viewer.surf.set_uv(1.0, 2.0)
-    viewer.surf.set_section(30.0)
+    viewer.panels["surfaces"].state.set_surface("torus", 30)
+    viewer.panels["surfaces"].state.set_uv(1.0, 2.0)
+    viewer.panels["surfaces"].state.set_section(30.0)
     viewer.set_panel(panel)
     ps.set_window_size(1200, 700)
     ps.frame_tick()
@@ -566,7 +589,7 @@ def test_session_frames_start_from_the_restored_viewer(panel, viewer, spec_of, t
     import json
 
     import meshlap_app.animate as anim
-    from meshlap_app.state import CurvatureState, MeshState
+    from meshlap_app.state import AppState, MeshState
     from meshlap_app.viewer import Viewer
 
     path = _teacher_session(viewer, tmp_path, panel)
@@ -576,13 +599,12 @@ def test_session_frames_start_from_the_restored_viewer(panel, viewer, spec_of, t
     mock.remove_all_structures()
     mesh = MeshState()
     assert mesh.load(spec.mesh)
-    fresh = Viewer(mesh, CurvatureState(), panel=spec.panel)
+    fresh = Viewer(AppState(mesh=mesh, panel=spec.panel))
     fresh.sync_mesh()
     assert anim.restore_session(fresh, spec, mesh) == 680  # the window left of the panel
     assert tuple(mock.get_window_size()) == (1200, 700)
-    generator = {"smoothing": anim.smoothing_frames, "spectral": anim.k_frames}
-    captions = list(generator.get(panel, anim.theta_frames)(fresh, spec))
-    assert len(captions) == anim.frame_count(spec)
+    captions = list(fresh.panels[panel].frames(fresh, spec.options))
+    assert len(captions) == spec.animation.frame_count(spec.options)
     camera = json.loads(mock.get_view_as_json())
     np.testing.assert_allclose(camera["viewMat"], saved["viewMat"], atol=1e-6)
     if panel == "smoothing":
@@ -599,7 +621,11 @@ def test_session_frames_start_from_the_restored_viewer(panel, viewer, spec_of, t
         assert all(c.startswith("torus at (u, v) = (1, 2)   θ = ") for c in captions)
         thetas = [float(c.split("θ = ")[1].split("°")[0]) for c in captions]
         assert thetas == [30.0, 120.0, 210.0, 300.0]  # one turn from the saved θ
-        assert (fresh.surf.u, fresh.surf.v, fresh.surf.res) == (1.0, 2.0, 30)
+        assert (
+            fresh.panels["surfaces"].state.u,
+            fresh.panels["surfaces"].state.v,
+            fresh.panels["surfaces"].state.res,
+        ) == (1.0, 2.0, 30)
 
 
 def test_session_animation_replays_the_lam_of_every_step(viewer, spec_of, tmp_path, mock):
@@ -607,10 +633,10 @@ def test_session_animation_replays_the_lam_of_every_step(viewer, spec_of, tmp_pa
     λ of each step and end on the saved vertices bit for bit; a typed --lam replaces them."""
     import meshlap_app.animate as anim
     from meshlap_app import session
-    from meshlap_app.state import CurvatureState, MeshState
+    from meshlap_app.state import AppState, MeshState
     from meshlap_app.viewer import Viewer
 
-    mesh = viewer.mesh
+    mesh = viewer.state.mesh
     sm = viewer.panels["smoothing"].state
     sm.configure(mesh.V, mesh.F, noise_alpha=0.02, seed=5)
     sm.set_lam(0.5)
@@ -626,10 +652,10 @@ def test_session_animation_replays_the_lam_of_every_step(viewer, spec_of, tmp_pa
         mock.remove_all_structures()
         m = MeshState()
         assert m.load(spec.mesh)
-        fresh = Viewer(m, CurvatureState(), panel=spec.panel)
+        fresh = Viewer(AppState(mesh=m, panel=spec.panel))
         fresh.sync_mesh()
         anim.restore_session(fresh, spec, m)
-        captions = list(anim.smoothing_frames(fresh, spec))
+        captions = list(fresh.panels["smoothing"].frames(fresh, spec.options))
         return captions, fresh.panels["smoothing"].state.V.copy()
 
     captions, V = frames()
@@ -645,12 +671,12 @@ import sys
 from pathlib import Path
 import polyscope as ps
 from meshlap_app import session
-from meshlap_app.state import CurvatureState, MeshState
+from meshlap_app.state import AppState, CurvatureState, MeshState
 from meshlap_app.viewer import Viewer, init_polyscope
 
 mesh = MeshState(); assert mesh.load(None)  # the bundled mesh
 init_polyscope("openGL3_egl")
-viewer = Viewer(mesh, CurvatureState())
+viewer = Viewer(AppState(mesh=mesh))
 ps.set_build_default_gui_panels(False)
 viewer.sync_mesh()
 ps.set_window_size(1200, 700)
@@ -659,14 +685,14 @@ sm.configure(mesh.V, mesh.F, noise_alpha=0.02, seed=5)
 sm.set_lam(2.0)
 for _ in range(3):
     sm.step()
-viewer.panels["smoothing"].push(force=True)
+viewer.panels["smoothing"].push(viewer, force=True)
 spec = viewer.panels["spectral"]
 spec.state.k_request = 12
 spec.state.start(mesh.V, mesh.F, background=False)
 spec.state.set_mode(4)
 spec.state.set_k(5)
-viewer.surf.set_surface("torus", 30)
-viewer.surf.set_uv(1.0, 2.0)
+viewer.panels["surfaces"].state.set_surface("torus", 30)
+viewer.panels["surfaces"].state.set_uv(1.0, 2.0)
 ps.set_user_callback(viewer.callback)
 for panel in ("smoothing", "spectral", "surfaces"):
     viewer.set_panel(panel)
@@ -743,22 +769,22 @@ def test_session_on_another_panel_is_framed_as_without_a_session(viewer, spec_of
     import json
 
     import meshlap_app.animate as anim
-    from meshlap_app.state import CurvatureState, MeshState
+    from meshlap_app.state import AppState, MeshState
     from meshlap_app.viewer import Viewer
 
     path = _teacher_session(viewer, tmp_path, "curvature")
     saved = json.loads(path.read_text())["camera"]
     spec = spec_of("--session", str(path), "--panel", "smoothing", "--out", str(tmp_path / "a.gif"))
-    assert spec.size == (680, 700) and spec.iters == 3
+    assert spec.size == (680, 700) and spec.options["iters"] == 3
     mock.clear_user_callback()
     mock.remove_all_structures()
     mesh = MeshState()
     assert mesh.load(spec.mesh)
-    fresh = Viewer(mesh, CurvatureState(), panel=spec.panel)
+    fresh = Viewer(AppState(mesh=mesh, panel=spec.panel))
     fresh.sync_mesh()
     assert anim.restore_session(fresh, spec, mesh) is None  # nothing cropped
-    assert fresh.panel == "smoothing" and tuple(mock.get_window_size()) == (680, 700)
-    captions = list(anim.smoothing_frames(fresh, spec))
+    assert fresh.state.panel == "smoothing" and tuple(mock.get_window_size()) == (680, 700)
+    captions = list(fresh.panels["smoothing"].frames(fresh, spec.options))
     assert len(captions) == 4 and "iteration 3/3" in captions[-1]
     camera = json.loads(mock.get_view_as_json())
     assert not np.allclose(camera["viewMat"], saved["viewMat"], atol=1e-3)  # re-framed

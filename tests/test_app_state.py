@@ -55,7 +55,7 @@ def test_robust_range_ignores_one_spike():
 
 
 def test_one_ring_state_draws_the_ordered_ring():
-    from meshlap_app.state import OneRingState
+    from meshlap_app.state.onering import OneRingState
 
     from meshlap_core.topology import one_ring
 
@@ -76,7 +76,7 @@ def test_one_ring_state_draws_the_ordered_ring():
 
 
 def test_one_ring_state_open_fan(tmp_path):
-    from meshlap_app.state import OneRingState
+    from meshlap_app.state.onering import OneRingState
 
     path = tmp_path / "grid.obj"
     save_mesh(path, *primitives.grid(4, 4))

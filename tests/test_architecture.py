@@ -1,10 +1,13 @@
 """The shape of the code: an acyclic import graph pointing one way, small modules, short functions.
 
-- ``meshlap_core`` never imports the viewer (``meshlap_app`` / ``app``) nor polyscope; only the
-  CLI (the top layer) reads the viewer's pure-data names (``meshlap_app.state``) and imports the
-  viewer lazily, inside the commands that open or render it;
+- ``meshlap_core`` never imports the viewer (``meshlap_app`` / ``app``) nor polyscope, not even
+  inside a function: the viewer adds its commands and the report's screenshots through entry
+  points the core's CLI reads;
 - ``meshlap_core.linalg`` is mesh-free: it imports only itself and ``meshlap_core.errors``;
-- the module import graph (module-level imports) has no cycle;
+- the module import graph has no cycle, counting imports inside functions (a package's
+  ``__init__`` re-exporting its submodules excepted);
+- the viewer wing: panels never import the viewer (they type against the host protocol), and
+  no module of ``app/`` but a panel's own two files and the registry names a panel in a string;
 - no module is longer than ``MAX_MODULE_LINES`` and no function longer than
   ``MAX_FUNCTION_LINES`` (docstring excluded) unless its docstring says why (``Long because``).
 """
@@ -85,11 +88,60 @@ def test_the_sources_were_found():
 def test_core_never_imports_the_viewer(module):
     imported = _imports(module, top_level_only=False)
     bad = {n for n in imported if n.split(".")[0] in {"polyscope", "meshlap_app", "app"}}
-    if module.startswith("meshlap_core.cli"):
-        # the CLI is the top layer: it may read the viewer's pure-data names (panels, fields)
-        # at import time and import the viewer itself lazily, inside the command that runs it
-        bad &= _imports(module, top_level_only=True)
-        bad = {n for n in bad if not n.startswith("meshlap_app.state")}
+    assert not bad, f"{module} imports {sorted(bad)}"
+
+
+def test_the_core_has_no_viewer_import_at_all():
+    """Not even in a string: no ``import meshlap_app`` / ``from meshlap_app`` anywhere."""
+    found = [
+        m
+        for m, p in SOURCES.items()
+        if m.startswith("meshlap_core")
+        and any(s in p.read_text() for s in ("import meshlap_app", "from meshlap_app"))
+    ]
+    assert not found
+
+
+def _panel_names() -> set[str]:
+    from meshlap_app.registry import REGISTRY
+
+    return {e.name for e in REGISTRY}
+
+
+def _strings(tree: ast.AST) -> list[tuple[int, str]]:
+    """String constants of a module that are not docstrings, with their line."""
+    docs = set()
+    for node in ast.walk(tree):
+        if isinstance(node, (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef)):
+            body = node.body
+            if body and isinstance(body[0], ast.Expr) and isinstance(body[0].value, ast.Constant):
+                docs.add(id(body[0].value))
+    out = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Constant) and isinstance(node.value, str) and id(node) not in docs:
+            out.append((node.lineno, node.value))
+    return out
+
+
+@pytest.mark.parametrize("module", [m for m in SOURCES if m.startswith("meshlap_app")])
+def test_only_a_panels_own_files_name_it(module):
+    """Adding a panel touches its own files and one registry line: no other module of the
+    viewer wing names a panel (in a string: a key, a comparison, a default)."""
+    names = _panel_names()
+    parts = module.split(".")
+    own = {parts[-1]} if parts[1:2] in (["panels"], ["state"]) else set()
+    if module == "meshlap_app.registry":
+        return
+    tree = ast.parse(SOURCES[module].read_text())
+    bad = [(line, s) for line, s in _strings(tree) if s in names - own]
+    assert not bad, f"{module} names panels: {bad}"
+
+
+@pytest.mark.parametrize("module", [m for m in SOURCES if m.startswith("meshlap_app.panels")])
+def test_panels_never_import_the_viewer(module):
+    """Not even for type hints: a panel types against ``panels.base.Host``."""
+    imported = _imports(module, top_level_only=False)
+    bad = {n for n in imported if n.startswith(("meshlap_app.viewer", "meshlap_app.animate"))}
     assert not bad, f"{module} imports {sorted(bad)}"
 
 
@@ -105,7 +157,8 @@ def test_linalg_is_mesh_free(module):
 
 
 def test_import_graph_has_no_cycle():
-    graph = {m: _internal(_imports(m, top_level_only=True)) - {m} for m in SOURCES}
+    """Counting the imports inside functions (a lazy import is still a dependency)."""
+    graph = {m: _internal(_imports(m, top_level_only=False)) - {m} for m in SOURCES}
     # a package's __init__ re-exporting its submodules is not a cycle with them
     for m, deps in graph.items():
         graph[m] = {

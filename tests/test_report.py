@@ -13,9 +13,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from meshlap_app.screenshots import ViewerScreenshots
 
 from meshlap_core.cli import main
-from meshlap_core.cli.report import ViewerScreenshots
 from meshlap_core.errors import MeshError
 from meshlap_core.study import SECTIONS, build_report, parse_sections
 

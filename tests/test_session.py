@@ -12,12 +12,13 @@ import threading
 import numpy as np
 import pytest
 from meshlap_app.state.session import (
-    SCHEMA,
     VERSION,
     Session,
+    added_keys,
     default_settings,
     from_dict,
     read_session,
+    schema,
     write_session,
 )
 
@@ -67,7 +68,7 @@ def non_default_session(mesh) -> Session:
 def test_every_field_differs_from_its_default_and_round_trips(tmp_path, sphere):
     s = non_default_session(sphere)
     defaults = default_settings()
-    for sec, keys in SCHEMA.items():
+    for sec, keys in schema().items():
         assert set(s.settings[sec]) == set(keys)  # the test covers every field
         for key in keys:
             assert s.settings[sec][key] != defaults[sec][key], f"{sec}.{key}"
@@ -229,14 +230,14 @@ def mock(polyscope_mock):
 
 
 def new_viewer(path):
-    from meshlap_app.state import CurvatureState, MeshState
+    from meshlap_app.state import AppState, MeshState
     from meshlap_app.ui import UI
     from meshlap_app.viewer import Viewer
 
     ps.remove_all_structures()
     mesh = MeshState()
     assert mesh.load(path)
-    v = Viewer(mesh, CurvatureState(), ui=UI(), export_dir=path.parent)
+    v = Viewer(AppState(mesh=mesh, folder=path.parent), ui=UI())
     v.sync_mesh()
     ps.set_user_callback(v.callback)
     ps.frame_tick()
@@ -250,7 +251,7 @@ def tick(viewer, label=None, value=None):
         viewer.ui.script("Help and window (H)", True)
     ps.frame_tick()
     assert not viewer.ui.pending()
-    internal = {k: m for k, m in viewer.errors.items() if "internal error" in m}
+    internal = {k: m for k, m in viewer.state.errors.items() if "internal error" in m}
     assert not internal, internal
 
 
@@ -264,21 +265,21 @@ def drive_session_widgets(viewer, tmp_path) -> None:
     before = session.capture(viewer)
     tick(viewer, "session file", str(tmp_path / "no-such-folder" / "s.json"))
     tick(viewer, "save session", True)
-    assert "does not exist" in viewer.errors["help"]
+    assert "does not exist" in viewer.state.errors["help"]
     tick(viewer, "session file", "")  # empty: <mesh>.session.json in the export folder
     tick(viewer, "save session", True)
-    saved = viewer.panels["export"].folder / f"{viewer.mesh.path.stem}.session.json"
+    saved = viewer.state.folder / f"{viewer.state.mesh.path.stem}.session.json"
     assert saved.is_file() and viewer.panels["help"].session.text == str(saved.resolve())
-    assert "help" not in viewer.errors
+    assert "help" not in viewer.state.errors
     for bad in ("{", '{"format": "meshlap-session", "version": 3}', "[]"):
         (tmp_path / "bad.json").write_text(bad)
         tick(viewer, "session file", str(tmp_path / "bad.json"))
         tick(viewer, "load session", True)
-        assert str(tmp_path / "bad.json") in viewer.errors["help"]  # red, in that section
+        assert str(tmp_path / "bad.json") in viewer.state.errors["help"]  # red, in that section
         assert session.capture(viewer) == before  # nothing changed
     tick(viewer, "session file", str(saved))
     tick(viewer, "load session", True)
-    assert "help" not in viewer.errors and session.capture(viewer).settings == before.settings
+    assert "help" not in viewer.state.errors and session.capture(viewer).settings == before.settings
 
 
 def test_session_widgets_save_and_load(mock, tmp_path, sphere, monkeypatch):
@@ -295,27 +296,29 @@ def set_up_everything(viewer) -> None:
     from meshlap_app.panels.help import HelpPanel
 
     assert isinstance(viewer.panels["help"], HelpPanel)
-    viewer.panels["help"].set_scale(viewer, 1.25)
-    c = viewer.curv
+    viewer.set_ui_scale(1.25)
+    c = viewer.state.curv
     c.field_name, c.area, c.boundary = "k2", "voronoi", "2pi"
     c.set_percentile(4.5)
-    viewer.panels["curvature"].side_by_side = True
-    viewer.panels["curvature"].second_field = "gaussian"
-    viewer.push_curvature(force=True)
-    viewer.ring.reverse = True
-    viewer.select_vertex(11)
-    viewer.surf.set_surface("torus", 20)
-    viewer.surf.set_uv(0.7, 1.1)
-    viewer.surf.set_section(400.0)  # the normal section at θ = 40°
+    viewer.state.curv.side_by_side = True
+    viewer.state.curv.second_field = "gaussian"
+    viewer.panels["curvature"].sync(viewer)
+    viewer.panels["onering"].state.reverse = True
+    viewer.panels["onering"].select(viewer, 11)
+    viewer.panels["surfaces"].state.set_surface("torus", 20)
+    viewer.panels["surfaces"].state.set_uv(0.7, 1.1)
+    viewer.panels["surfaces"].state.set_section(400.0)  # the normal section at θ = 40°
     spec = viewer.panels["spectral"]
     spec.state.set_play_what("modes")
     spec.state.k_request = 16
-    spec.state.start(viewer.mesh.V, viewer.mesh.F, background=False)
+    spec.state.start(viewer.state.mesh.V, viewer.state.mesh.F, background=False)
     spec.state.set_mode(5)
     spec.state.set_k(7)
     sm = viewer.panels["smoothing"]
-    sm.state.configure(viewer.mesh.V, viewer.mesh.F, method="explicit", laplacian="cotan")
-    sm.state.configure(viewer.mesh.V, viewer.mesh.F, noise_alpha=0.02, seed=4)
+    sm.state.configure(
+        viewer.state.mesh.V, viewer.state.mesh.F, method="explicit", laplacian="cotan"
+    )
+    sm.state.configure(viewer.state.mesh.V, viewer.state.mesh.F, noise_alpha=0.02, seed=4)
     sm.state.set_lam(0.001)
     for _ in range(6):
         assert sm.state.step()
@@ -351,8 +354,8 @@ def test_load_restores_every_setting_the_run_and_the_camera(mock, tmp_path, sphe
     np.testing.assert_array_equal(fresh.panels["smoothing"].state.V, V_run)
     spec = fresh.panels["spectral"].state
     assert spec.basis.info.from_cache and (spec.k, spec.mode, spec.basis.k_max) == (7, 5, 16)
-    assert fresh.ring.vertex == 11 and fresh.ring.reverse
-    assert fresh.surf.section_deg == 40.0 and spec.play_what == "modes"
+    assert fresh.panels["onering"].state.vertex == 11 and fresh.panels["onering"].state.reverse
+    assert fresh.panels["surfaces"].state.section_deg == 40.0 and spec.play_what == "modes"
     assert ps.has_surface_mesh("mesh (second estimator)")
     assert not fresh.reframe  # the saved camera is kept, not re-framed
 
@@ -390,7 +393,7 @@ def test_window_size_of_the_camera_and_a_busy_worker(mock, tmp_path, sphere, mon
     before = session.capture(viewer)
     tick(viewer, "session file", str(path))
     tick(viewer, "load session", True)
-    assert "still being computed" in viewer.errors["help"]
+    assert "still being computed" in viewer.state.errors["help"]
     assert session.capture(viewer) == before
     done.set()
     spec._thread.join()
@@ -406,11 +409,16 @@ def test_dropping_a_session_file_loads_it(mock, tmp_path, sphere, monkeypatch):
     write_session(tmp_path / "drop.json", s)
     (tmp_path / "bad.json").write_text("{")
     viewer.files_dropped([str(tmp_path / "bad.json")])
-    assert "bad.json: not JSON" in viewer.errors["mesh"] and viewer.panel == "curvature"
+    assert "bad.json: not JSON" in viewer.state.errors["mesh_info"]
+    assert viewer.state.panel == "curvature"
     viewer.files_dropped([str(tmp_path / "drop.json")])
     tick(viewer)
-    assert viewer.panel == "surfaces" and viewer.surf.name == "torus" and viewer.surf.u == 0.5
-    assert session.capture(viewer).settings == s.settings and "mesh" not in viewer.errors
+    assert (
+        viewer.state.panel == "surfaces"
+        and viewer.panels["surfaces"].state.name == "torus"
+        and viewer.panels["surfaces"].state.u == 0.5
+    )
+    assert session.capture(viewer).settings == s.settings and "mesh" not in viewer.state.errors
 
 
 # ---------------------------------------------------------------- real pixels (EGL)
@@ -419,22 +427,22 @@ import sys
 from pathlib import Path
 import polyscope as ps
 from meshlap_app import scene, session
-from meshlap_app.state import CurvatureState, MeshState
+from meshlap_app.state import AppState, CurvatureState, MeshState
 from meshlap_app.viewer import Viewer, init_polyscope
 
 mesh = MeshState(); assert mesh.load(Path(sys.argv[1]))
 init_polyscope("openGL3_egl")
-viewer = Viewer(mesh, CurvatureState(field_name="gaussian"), panel=sys.argv[2])
+viewer = Viewer(AppState(mesh=mesh, curv=CurvatureState(field_name="gaussian"), panel=sys.argv[2]))
 ps.set_build_default_gui_panels(False)
 viewer.sync_mesh()
 ps.set_window_size(1600, 900)
-viewer.curv.set_percentile(6.0)
-viewer.panels["curvature"].side_by_side = sys.argv[2] == "curvature"
+viewer.state.curv.set_percentile(6.0)
+viewer.state.curv.side_by_side = sys.argv[2] == "curvature"
 sm = viewer.panels["smoothing"].state
 sm.configure(mesh.V, mesh.F, noise_alpha=0.01, seed=3)
 for _ in range(4):
     sm.step()
-viewer.panels["smoothing"].push(force=True)
+viewer.panels["smoothing"].push(viewer, force=True)
 if sys.argv[2] == "spectral":
     spec = viewer.panels["spectral"]
     spec.state.k_request = 40
@@ -444,12 +452,12 @@ if sys.argv[2] == "spectral":
     spec.push_mode(viewer, force=True)
     spec.push_k(viewer, force=True)
 if sys.argv[2] == "onering":
-    viewer.ring.reverse = True
-    viewer.select_vertex(123)
+    viewer.panels["onering"].state.reverse = True
+    viewer.panels["onering"].select(viewer, 123)
 if sys.argv[2] == "surfaces":
-    viewer.surf.set_surface("torus", 40)
-    viewer.surf.set_uv(1.0, 2.0)
-viewer.push_curvature(force=True)
+    viewer.panels["surfaces"].state.set_surface("torus", 40)
+    viewer.panels["surfaces"].state.set_uv(1.0, 2.0)
+viewer.panels["curvature"].sync(viewer)
 viewer.set_panel(sys.argv[2])
 ps.set_user_callback(viewer.callback)
 ps.frame_tick()
@@ -569,23 +577,23 @@ def test_lam_steps_written_only_when_lam_changed(mock, tmp_path, sphere, monkeyp
 def test_added_keys_are_written_only_when_they_say_something(tmp_path, sphere):
     """A session at the defaults has none of the keys added after the first files (an older
     meshlap, which refuses unknown keys, still opens it); set, each is written and read back."""
-    from meshlap_app.state.session import ADDED_KEYS
+    ADDED_KEYS = added_keys()
 
     plain = json.loads(write_session(tmp_path / "plain.json", Session(mesh=sphere)).read_text())
     for sec, key in ADDED_KEYS:
         assert key not in plain[sec], f"{sec}.{key}"
     s = non_default_session(sphere)
     data = json.loads(write_session(tmp_path / "all.json", s).read_text())
-    assert [data[sec][key] for sec, key in ADDED_KEYS] == [
-        [[0.5, 2], [0.25, 3]],
-        "modes",
-        30.0,
-    ]
+    assert {(sec, key): data[sec][key] for sec, key in ADDED_KEYS} == {
+        ("smoothing", "lam_steps"): [[0.5, 2], [0.25, 3]],
+        ("spectral", "play"): "modes",
+        ("surfaces", "theta"): 30.0,
+    }
     assert read_session(tmp_path / "all.json") == s
 
 
 def test_old_format_file_replays_iterations_at_lam(tmp_path, sphere):
-    from meshlap_app.state.session import replay_steps
+    from meshlap_app.state.smoothing import replay_steps
 
     path = tmp_path / "v1.json"
     path.write_text(
@@ -679,7 +687,7 @@ def test_every_method_replays_lam_changes_exactly(
     monkeypatch.setenv("MESHLAP_CACHE_DIR", str(tmp_path / "cache"))
     viewer = new_viewer(sphere)
     st = viewer.panels["smoothing"].state
-    V, F = viewer.mesh.V, viewer.mesh.F
+    V, F = viewer.state.mesh.V, viewer.state.mesh.F
     st.configure(V, F, method=method, laplacian=laplacian, noise_alpha=0.03, seed=2)
     lams = (0.02, 0.05, 0.02) if laplacian == "cotan" else (0.3, 0.6, 0.3)
     st.set_lam(lams[0])  # before any step: the run starts at lams[0], not the built 0.5

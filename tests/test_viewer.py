@@ -16,36 +16,39 @@ def mock_backend(polyscope_mock):
 
 
 def test_every_panel_runs_frames_on_mock(mock_backend, tmp_path):
-    from meshlap_app.state import PANELS, CurvatureState, MeshState
+    from meshlap_app.registry import VIEWS as PANELS
+    from meshlap_app.state import AppState, MeshState
     from meshlap_app.viewer import Viewer
 
     mesh = MeshState()
     assert mesh.load(None)
-    viewer = Viewer(mesh, CurvatureState())
+    viewer = Viewer(AppState(mesh=mesh))
     viewer.sync_mesh()
     ps.set_user_callback(viewer.callback)
     for panel in PANELS:
-        viewer.panel = panel
-        viewer.show_panel()
+        viewer.state.panel = panel
+        viewer.refresh()
         for _ in range(3):
             ps.frame_tick()
     assert ps.get_surface_mesh("mesh").n_vertices() == len(mesh.V)
     # the one-ring panel draws the ring of a selected vertex, numbered in order
-    viewer.panel = "onering"
-    assert viewer.select_vertex(7)
+    viewer.state.panel = "onering"
+    assert viewer.panels["onering"].select(viewer, 7)
     ps.frame_tick()
     assert ps.has_curve_network("one-ring order")
-    assert viewer.ring.valence == len(viewer.ring.neighbors) > 2
+    assert (
+        viewer.panels["onering"].state.valence == len(viewer.panels["onering"].state.neighbors) > 2
+    )
     # side-by-side curvature registers a second copy of the mesh
-    viewer.panel = "curvature"
-    viewer.panels["curvature"].side_by_side = True
-    viewer.push_curvature()
+    viewer.state.panel = "curvature"
+    viewer.state.curv.side_by_side = True
+    viewer.panels["curvature"].sync(viewer)
     ps.frame_tick()
     assert ps.has_surface_mesh("mesh (second estimator)")
     # the surfaces panel moves its point with (u, v)
-    viewer.panel = "surfaces"
-    viewer.show_panel()
-    assert viewer.surf.set_uv(0.5, 1.0)
+    viewer.state.panel = "surfaces"
+    viewer.refresh()
+    assert viewer.panels["surfaces"].state.set_uv(0.5, 1.0)
     viewer.panels["surfaces"].push_point(viewer)
     ps.frame_tick()
     assert ps.has_point_cloud("surface point")
@@ -53,12 +56,12 @@ def test_every_panel_runs_frames_on_mock(mock_backend, tmp_path):
 
 
 def test_bad_file_in_mesh_panel_keeps_mesh(mock_backend, tmp_path):
-    from meshlap_app.state import CurvatureState, MeshState
+    from meshlap_app.state import AppState, MeshState
     from meshlap_app.viewer import Viewer
 
     mesh = MeshState()
     assert mesh.load(None)
-    viewer = Viewer(mesh, CurvatureState())
+    viewer = Viewer(AppState(mesh=mesh))
     viewer.sync_mesh()
     n = ps.get_surface_mesh("mesh").n_vertices()
     bad = tmp_path / "broken.off"
@@ -72,21 +75,21 @@ def test_bad_file_in_mesh_panel_keeps_mesh(mock_backend, tmp_path):
 
 
 def test_export_writes_mesh_and_field(mock_backend, tmp_path):
-    from meshlap_app.state import CurvatureState, MeshState
+    from meshlap_app.state import AppState, CurvatureState, MeshState
     from meshlap_app.viewer import Viewer
 
     from meshlap_core.io import load_mesh
 
     mesh = MeshState()
     assert mesh.load(None)
-    viewer = Viewer(mesh, CurvatureState(field_name="gaussian"))
+    viewer = Viewer(AppState(mesh=mesh, curv=CurvatureState(field_name="gaussian")))
     viewer.sync_mesh()
-    msg = viewer.export(tmp_path)
+    msg = viewer.panels["export"].export(viewer, tmp_path)
     assert "wrote" in msg
     back = load_mesh(tmp_path / "bumpy_gaussian.ply")
     assert back.n_vertices == len(mesh.V)
     values = np.loadtxt(tmp_path / "bumpy_gaussian.csv", skiprows=1)
-    np.testing.assert_allclose(values, viewer.curv.fields["gaussian"], rtol=1e-9)
+    np.testing.assert_allclose(values, viewer.state.curv.fields["gaussian"], rtol=1e-9)
 
 
 @pytest.mark.egl
@@ -146,12 +149,12 @@ import json, sys
 import numpy as np
 import polyscope as ps
 from meshlap_app.camera import project_to_screen
-from meshlap_app.state import CurvatureState, MeshState
+from meshlap_app.state import AppState, CurvatureState, MeshState
 from meshlap_app.viewer import Viewer, init_polyscope
 
 mesh = MeshState(); mesh.load(None)
 init_polyscope("openGL3_egl")
-viewer = Viewer(mesh, CurvatureState(), panel="onering")
+viewer = Viewer(AppState(mesh=mesh, panel="onering"))
 viewer.sync_mesh()
 ps.set_user_callback(viewer.callback)
 ps.reset_camera_to_home_view()
@@ -159,11 +162,12 @@ ps.frame_tick()
 target = int(sys.argv[1])
 params = ps.get_view_camera_parameters()
 w, h = ps.get_window_size()
-xy, front = project_to_screen(viewer.display.points(mesh.V[[target]]), params.get_view_mat(),
+xy, front = project_to_screen(viewer.state.display.points(mesh.V[[target]]), params.get_view_mat(),
                               params.get_fov_vertical_deg(), w, h)
 hit = viewer.pick_at((float(xy[0, 0]), float(xy[0, 1])))
-print(json.dumps({"hit": hit, "vertex": viewer.ring.vertex, "front": bool(front[0]),
-                  "dist": float(np.linalg.norm(mesh.V[viewer.ring.vertex] - mesh.V[target]))}))
+picked = viewer.panels["onering"].state.vertex
+print(json.dumps({"hit": hit, "vertex": picked, "front": bool(front[0]),
+                  "dist": float(np.linalg.norm(mesh.V[picked] - mesh.V[target]))}))
 """
 
 
@@ -204,10 +208,10 @@ def test_no_display_is_one_clear_error(tmp_path):
 
 
 def test_cli_uses_the_viewers_single_definition_of_panels_and_fields():
-    """`meshlap view` imports its choices from meshlap_app.state (pure data, no polyscope)."""
-    from meshlap_app import state
+    """`meshlap view` takes its choices from the registry and the field names (pure data, no
+    polyscope)."""
+    from meshlap_app import registry, state
+    from meshlap_app.commands import view
 
-    from meshlap_core.cli import view
-
-    assert view.PANELS is state.PANELS
+    assert view.VIEWS is registry.VIEWS
     assert view.FIELDS is state.FIELDS == tuple(state.FIELD_LABELS)

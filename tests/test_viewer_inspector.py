@@ -14,9 +14,10 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
-from meshlap_app.state import CurvatureState, MeshState, OneRingState
+from meshlap_app.state import CurvatureState, MeshState
 from meshlap_app.state.onering import (
     HoverThrottle,
+    OneRingState,
     angle_arcs,
     area_cell,
     arrow_scales,
@@ -187,24 +188,36 @@ def drive_inspector(viewer) -> None:
     """Every inspector widget with good and bad values (also run by the every-widget tour)."""
     viewer.set_panel("onering")
     drive(viewer, "vertex", 7)
-    ins = viewer.ring.inspection
+    ins = viewer.panels["onering"].state.inspection
     assert ins is not None and ins.vertex == 7
     assert {scene.INSPECT_WEIGHTS, scene.INSPECT_ARCS, scene.INSPECT_CELL} <= inspector_names()
     drive(viewer, "area kind", "voronoi")
-    assert viewer.curv.area == "voronoi" and viewer.ring.inspection.area_kind == "voronoi"
+    assert (
+        viewer.state.curv.area == "voronoi"
+        and viewer.panels["onering"].state.inspection.area_kind == "voronoi"
+    )
     cell = ps.get_surface_mesh(scene.INSPECT_CELL)
     assert cell.n_faces() >= 2 * len(ins.faces)  # circumcentre paths on the acute sphere
     for bad in ("", "nonsense", "VORONOI"):
         drive(viewer, "area kind", bad)
-        assert viewer.curv.area == "voronoi" and "area kind" in viewer.errors["onering"]
+        assert viewer.state.curv.area == "voronoi" and "area kind" in viewer.state.errors["onering"]
     drive(viewer, "area kind", "barycentric")
-    assert viewer.ring.inspection.area_kind == "barycentric" and "onering" not in viewer.errors
+    assert (
+        viewer.panels["onering"].state.inspection.area_kind == "barycentric"
+        and "onering" not in viewer.state.errors
+    )
     for rule in ("zero", "2pi", "pi"):
         drive(viewer, "boundary rule", rule)
-        assert viewer.curv.boundary == rule == viewer.ring.inspection.boundary_rule
+        assert (
+            viewer.state.curv.boundary
+            == rule
+            == viewer.panels["onering"].state.inspection.boundary_rule
+        )
     for bad in ("", "4pi", "-1"):
         drive(viewer, "boundary rule", bad)
-        assert viewer.curv.boundary == "pi" and "boundary rule" in viewer.errors["onering"]
+        assert (
+            viewer.state.curv.boundary == "pi" and "boundary rule" in viewer.state.errors["onering"]
+        )
     drive_hover(viewer)
 
 
@@ -224,7 +237,7 @@ def drive_hover(viewer) -> None:
     clock.t += 0.1
     drive(viewer, "hover", (-1e9, 1e9))
     assert panel.picks == picks0 + 2 and panel.hovered == ""
-    assert "labels" not in viewer.errors
+    assert "labels" not in viewer.state.errors
 
 
 def test_inspector_widgets(viewer):
@@ -252,9 +265,9 @@ def test_hover_shows_index_and_field_value(viewer, monkeypatch):
     drive(viewer, "hover", (100.0, 80.0))
     clock.t = 0.1
     drive(viewer, "hover", (100.0, 80.0))
-    assert "labels" not in viewer.errors, viewer.errors
-    value = viewer.curv.fields[viewer.curv.field_name][11]
-    assert panel.hovered == f"vertex 11: {viewer.curv.field_name} = {value:.4g}"
+    assert "labels" not in viewer.state.errors, viewer.state.errors
+    value = viewer.state.curv.fields[viewer.state.curv.field_name][11]
+    assert panel.hovered == f"vertex 11: {viewer.state.curv.field_name} = {value:.4g}"
     drive(viewer, "hover", *[(100.0, 80.0)] * 5)  # idle frames: the answer stays, no picking
     assert len(calls) == 1 and panel.hovered.startswith("vertex 11")
     hit.structure_data = {"element_type": "face", "index": 0}
@@ -263,16 +276,19 @@ def test_hover_shows_index_and_field_value(viewer, monkeypatch):
     clock.t = 1.0
     drive(viewer, "hover", (101.0, 80.0))
     assert len(calls) == 2 and panel.hovered.startswith("vertex ")
-    assert int(panel.hovered.split()[1].rstrip(":")) in viewer.mesh.F[0]
+    assert int(panel.hovered.split()[1].rstrip(":")) in viewer.state.mesh.F[0]
 
 
 def test_inspector_structures_follow_the_panel(viewer):
     viewer.set_panel("onering")
     drive(viewer, "vertex", 5)
     nodes = ps.get_curve_network(scene.INSPECT_WEIGHTS).n_nodes()
-    assert nodes == 1 + viewer.ring.valence
+    assert nodes == 1 + viewer.panels["onering"].state.valence
     drive(viewer, "vertex", 0)  # a selection change updates the drawings
-    assert ps.get_curve_network(scene.INSPECT_WEIGHTS).n_nodes() == 1 + viewer.ring.valence
+    assert (
+        ps.get_curve_network(scene.INSPECT_WEIGHTS).n_nodes()
+        == 1 + viewer.panels["onering"].state.valence
+    )
     viewer.set_panel("curvature")
     assert not inspector_names()  # removed when leaving the panel
     viewer.set_panel("onering")
@@ -303,7 +319,7 @@ def test_negative_weights_drawn_and_listed(viewer, tmp_path):
     assert any(t.startswith("K = deficit / A_i") for t, _ in shown)
     assert any(t.startswith("L_cotan x = (1/A_i)") for t, _ in shown)
     assert any("magenta edges: negative w_ij (2)" in t for t, _ in shown)
-    assert math.isfinite(viewer.ring.inspection.H_cotan)
+    assert math.isfinite(viewer.panels["onering"].state.inspection.H_cotan)
 
 
 def test_non_manifold_vertex_lists_its_fans(viewer, tmp_path):
@@ -318,5 +334,8 @@ def test_non_manifold_vertex_lists_its_fans(viewer, tmp_path):
         drive(viewer, "vertex", 0)
     finally:
         del viewer.ui.error
-    assert viewer.ring.inspection is not None and not viewer.ring.inspection.manifold
+    assert (
+        viewer.panels["onering"].state.inspection is not None
+        and not viewer.panels["onering"].state.inspection.manifold
+    )
     assert any("non-manifold vertex: 2 fans" in t for t in shown)

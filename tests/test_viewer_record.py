@@ -15,8 +15,12 @@ import pytest
 ps = pytest.importorskip("polyscope")
 Image = pytest.importorskip("PIL.Image")
 
-from meshlap_app.animate import DEFAULT_FPS, NORMAL_SECTION, RECORD_HEADER  # noqa: E402
-from meshlap_app.state.surface import TURN_STEP_DEG, section_arc  # noqa: E402
+from meshlap_app.record import RECORD_HEADER  # noqa: E402
+from meshlap_app.scene import NORMAL_SECTION  # noqa: E402
+from meshlap_app.state.animation import animations  # noqa: E402
+
+DEFAULT_FPS = {kind: fps for a in animations().values() for kind, fps in a.fps.items()}
+from meshlap_app.state.surfaces import TURN_STEP_DEG, section_arc  # noqa: E402
 
 from meshlap_core import primitives  # noqa: E402
 from meshlap_core.errors import MeshError  # noqa: E402
@@ -40,14 +44,14 @@ def tick(viewer, label: str | None = None, value=None) -> None:
             viewer.ui.script(RECORD_HEADER, True)
     ps.frame_tick()
     assert not viewer.ui.pending(), f"widget {label!r} was not drawn"
-    internal = {k: m for k, m in viewer.errors.items() if "internal error" in m}
+    internal = {k: m for k, m in viewer.state.errors.items() if "internal error" in m}
     assert not internal, internal
 
 
 def basis(viewer, k: int) -> None:
     st = viewer.panels["spectral"].state
     st.k_request = k
-    st.start(viewer.mesh.V, viewer.mesh.F, background=False)
+    st.start(viewer.state.mesh.V, viewer.state.mesh.F, background=False)
     tick(viewer)
 
 
@@ -156,9 +160,9 @@ def test_pause_resumes_and_the_kind_choice_is_checked(viewer):
     tick(viewer)
     assert st.k == k + 1
     tick(viewer, "play what", "nonsense")
-    assert "nonsense" in viewer.errors["spectral"] and st.play_what == "k sweep"
+    assert "nonsense" in viewer.state.errors["spectral"] and st.play_what == "k sweep"
     tick(viewer, "play what", "modes")  # a new choice stops the sweep
-    assert st.play_what == "modes" and not st.playing and "spectral" not in viewer.errors
+    assert st.play_what == "modes" and not st.playing and "spectral" not in viewer.state.errors
 
 
 def test_spectral_copy_offset_is_cached_per_mesh(viewer, tmp_path, monkeypatch):
@@ -187,7 +191,7 @@ def test_spectral_copy_offset_is_cached_per_mesh(viewer, tmp_path, monkeypatch):
     tick(viewer, "k (reconstruct)", 3)
     assert len(calls) == 2 and calls[-1] == len(V)  # a new mesh: recomputed
     after = panel._offset(viewer)
-    np.testing.assert_allclose(after, real(viewer.display.points(viewer.mesh.V)))
+    np.testing.assert_allclose(after, real(viewer.state.display.points(viewer.state.mesh.V)))
     assert not np.allclose(after, before)
 
 
@@ -195,7 +199,7 @@ def test_spectral_copy_offset_is_cached_per_mesh(viewer, tmp_path, monkeypatch):
 def test_theta_slider_draws_the_section(viewer):
     viewer.set_panel("surfaces")
     tick(viewer)
-    s = viewer.surf
+    s = viewer.panels["surfaces"].state
     assert ps.has_curve_network(NORMAL_SECTION)
     tick(viewer, "section theta", 45.0)
     assert s.section_deg == 45.0
@@ -207,7 +211,7 @@ def test_theta_slider_draws_the_section(viewer):
     assert s.section_deg == pytest.approx(40.0)
     for bad in ("nan", "1e309"):
         tick(viewer, "section theta", bad)
-        assert s.section_deg == pytest.approx(40.0) and "theta" in viewer.errors["surfaces"]
+        assert s.section_deg == pytest.approx(40.0) and "theta" in viewer.state.errors["surfaces"]
     assert "θ =  40.0°" in s.section_caption()
     viewer.set_panel("curvature")  # the section is the Surfaces panel's only
     assert not ps.get_curve_network(NORMAL_SECTION).is_enabled()
@@ -230,15 +234,15 @@ def test_section_arc_is_the_osculating_circle():
 def test_theta_turn_records_one_frame_per_step(viewer, tmp_path):
     viewer.set_panel("surfaces")
     tick(viewer, "surface", "saddle")
-    s = viewer.surf
+    s = viewer.panels["surfaces"].state
     rec = viewer.panels["surfaces"].recorder
     for bad, needle in (("", "empty"), ("x.avi", ".avi"), ("nowhere/x.gif", "does not exist")):
         tick(viewer, "record file", bad)
         tick(viewer, "record", True)
-        assert needle in viewer.errors["surfaces"] and not rec.recording  # said in red
+        assert needle in viewer.state.errors["surfaces"] and not rec.recording  # said in red
     tick(viewer, "record file", "turn.gif")
     tick(viewer, "record", True)
-    assert rec.recording and "surfaces" not in viewer.errors
+    assert rec.recording and "surfaces" not in viewer.state.errors
     viewer.ui.script("record", True)  # a second recording: the button is "stop" now
     viewer.ui.script(RECORD_HEADER, True)
     ps.frame_tick()
@@ -274,23 +278,23 @@ def test_a_resized_window_ends_the_recording_without_a_file(viewer, tmp_path, mo
     real = record.ps.screenshot_to_buffer
     monkeypatch.setattr(record.ps, "screenshot_to_buffer", lambda **kw: real(**kw)[:-10, :-10])
     tick(viewer, "section theta", 20.0)
-    assert not rec.recording and "recording stopped" in viewer.errors["surfaces"]
+    assert not rec.recording and "recording stopped" in viewer.state.errors["surfaces"]
     assert not (tmp_path / "resized.gif").exists()
     assert not [p for p in tmp_path.iterdir() if "tmp" in p.name]
     monkeypatch.undo()
     tick(viewer, "section theta", 30.0)  # the session goes on, the θ applied
-    assert viewer.surf.section_deg == 30.0 and "surfaces" not in viewer.errors
+    assert (
+        viewer.panels["surfaces"].state.section_deg == 30.0
+        and "surfaces" not in viewer.state.errors
+    )
 
 
 def test_cli_theta_frames_draw_with_the_panel(viewer):
-    from meshlap_app.animate import AnimationSpec, theta_frames
-
-    spec = AnimationSpec(panel="surfaces", out=viewer.panels["export"].folder / "t.gif")
-    spec.theta, spec.frames, spec.surface = True, 4, "saddle"
+    options = {"theta": True, "frames": 4, "surface": "saddle", "uv": None}
     viewer.set_panel("surfaces")
-    for i, caption in enumerate(theta_frames(viewer, spec)):
-        assert viewer.surf.section_deg == pytest.approx(90.0 * i)
-        assert caption == viewer.surf.section_caption()
+    for i, caption in enumerate(viewer.panels["surfaces"].frames(viewer, options)):
+        assert viewer.panels["surfaces"].state.section_deg == pytest.approx(90.0 * i)
+        assert caption == viewer.panels["surfaces"].state.section_caption()
         assert ps.has_curve_network(NORMAL_SECTION)
 
 
@@ -302,7 +306,7 @@ def drive_record_widgets(viewer, tmp_path) -> None:
     basis(viewer, 8)
     st = viewer.panels["spectral"].state
     tick(viewer, "play what", "nonsense")
-    assert "nonsense" in viewer.errors["spectral"]
+    assert "nonsense" in viewer.state.errors["spectral"]
     tick(viewer, "play what", "modes")
     st.clock = Clock()
     tick(viewer, "play", True)
@@ -312,13 +316,16 @@ def drive_record_widgets(viewer, tmp_path) -> None:
     tick(viewer)
     tick(viewer, "section theta", 30.0)
     tick(viewer, "section theta", "nan")
-    assert viewer.surf.section_deg == 30.0 and "theta" in viewer.errors["surfaces"]
+    assert (
+        viewer.panels["surfaces"].state.section_deg == 30.0
+        and "theta" in viewer.state.errors["surfaces"]
+    )
     tick(viewer, "turn", True)
     tick(viewer, "pause turn", True)
-    assert not viewer.surf.turning
+    assert not viewer.panels["surfaces"].state.turning
     tick(viewer, "record file", "bad.avi")
     tick(viewer, "record", True)
-    assert ".avi" in viewer.errors["surfaces"]
+    assert ".avi" in viewer.state.errors["surfaces"]
     tick(viewer, "record file", str(tmp_path / "tour.gif"))
     tick(viewer, "record", True)
     tick(viewer, "section theta", 60.0)
@@ -351,9 +358,9 @@ EGL_SCRIPT = textwrap.dedent(
     from pathlib import Path
     import polyscope as ps
     from meshlap_app.record import crop_scene
-    from meshlap_app.animate import RECORD_HEADER
+    from meshlap_app.record import RECORD_HEADER
     from meshlap_app.scene import save_screenshot
-    from meshlap_app.state import CurvatureState, MeshState
+    from meshlap_app.state import AppState, CurvatureState, MeshState
     from meshlap_app.ui import UI
     from meshlap_app.viewer import Viewer, init_polyscope
 
@@ -363,7 +370,7 @@ EGL_SCRIPT = textwrap.dedent(
     ps.set_window_size(1280, 720)
     mesh = MeshState()
     assert mesh.load(mesh_path)
-    v = Viewer(mesh, CurvatureState(), ui=UI(), export_dir=out)
+    v = Viewer(AppState(mesh=mesh, folder=out), ui=UI())
     v.sync_mesh()
     ps.set_user_callback(v.callback)
 
@@ -374,7 +381,7 @@ EGL_SCRIPT = textwrap.dedent(
                 v.ui.script(RECORD_HEADER, True)
         ps.frame_tick()
         assert not v.ui.pending(), label
-        assert not v.errors, v.errors
+        assert not v.state.errors, v.state.errors
 
     v.set_panel("surfaces")
     tick(); tick()

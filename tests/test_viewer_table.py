@@ -227,19 +227,19 @@ import json, sys
 from pathlib import Path
 import polyscope as ps
 from meshlap_app import scene
-from meshlap_app.state import CurvatureState, MeshState
+from meshlap_app.state import AppState, CurvatureState, MeshState
 from meshlap_app.viewer import Viewer, init_polyscope
 
 mesh = MeshState(); assert mesh.load(Path(sys.argv[1]))
 init_polyscope("openGL3_egl")
 ps.set_window_size(1280, 720)
-viewer = Viewer(mesh, CurvatureState(), panel="onering")
+viewer = Viewer(AppState(mesh=mesh, panel="onering"))
 ps.set_build_default_gui_panels(False)
 scale = float(sys.argv[2])
 if scale != 1.0:
-    viewer.panels["help"].set_scale(viewer, scale)
+    viewer.set_ui_scale(scale)
 viewer.sync_mesh()
-viewer.select_vertex(int(sys.argv[3]))
+viewer.panels["onering"].select(viewer, int(sys.argv[3]))
 ps.set_user_callback(viewer.callback)
 viewer.ui.script("incident faces", *[True] * 3)
 for _ in range(3):

@@ -34,7 +34,7 @@ def frames(viewer: Viewer, n: int = 1) -> None:
     """Run ``n`` frames; no exception may end the session and nothing may be an internal error."""
     for _ in range(n):
         ps.frame_tick()
-    internal = {k: m for k, m in viewer.errors.items() if "internal error" in m}
+    internal = {k: m for k, m in viewer.state.errors.items() if "internal error" in m}
     assert not internal, internal
 
 
@@ -122,38 +122,38 @@ def test_parse_number_reads_like_imgui():
 # ---------------------------------------------------------------- the Mesh panel and view
 def test_mesh_panel_list_path_and_bad_files(viewer, tmp_path, sphere):
     drive(viewer, "bundled / shared", "assets/bumpy.obj")
-    assert viewer.mesh.name == "bumpy.obj"
-    assert ps.get_surface_mesh("mesh").n_vertices() == len(viewer.mesh.V)
-    n = len(viewer.mesh.V)
+    assert viewer.state.mesh.name == "bumpy.obj"
+    assert ps.get_surface_mesh("mesh").n_vertices() == len(viewer.state.mesh.V)
+    n = len(viewer.state.mesh.V)
     bad = tmp_path / "broken.off"
     bad.write_text("OFF\n10 5 0\n0 0 0\n")
     for text in ("", str(tmp_path / "missing.obj"), str(bad), str(tmp_path)):
-        viewer.panels["mesh"].path_text = text
+        viewer.panels["mesh_info"].path_text = text
         drive(viewer, "Open", True)
-        assert len(viewer.mesh.V) == n  # the last good mesh stays
-    assert viewer.mesh.error  # said in the Mesh panel
+        assert len(viewer.state.mesh.V) == n  # the last good mesh stays
+    assert viewer.state.mesh.error  # said in the Mesh panel
     drive(viewer, "path", str(sphere))  # Enter in the path field opens it
-    assert viewer.mesh.name == "sphere.obj" and not viewer.mesh.error
+    assert viewer.state.mesh.name == "sphere.obj" and not viewer.state.mesh.error
     # the recent-files entry appears in the list and opens the file again
     drive(viewer, "bundled / shared", "assets/bumpy.obj", "recent: sphere.obj")
-    assert viewer.mesh.name == "sphere.obj"
+    assert viewer.state.mesh.name == "sphere.obj"
     viewer.ui.script("bundled / shared", "no such mesh")
     ps.frame_tick()
-    assert "not in the list" in viewer.errors["mesh"]
+    assert "not in the list" in viewer.state.errors["mesh_info"]
 
 
 def test_view_combo_switches_every_panel(viewer):
     for panel in ("onering", "spectral", "smoothing", "surfaces", "curvature"):
         drive(viewer, "view", panel)
-        assert viewer.panel == panel
+        assert viewer.state.panel == panel
     viewer.ui.script("view", "nonsense")
     ps.frame_tick()
-    assert viewer.panel == "curvature" and "nonsense" in viewer.errors["view"]
+    assert viewer.state.panel == "curvature" and "nonsense" in viewer.state.errors["view"]
 
 
 # ---------------------------------------------------------------- Curvature
 def test_curvature_widgets(viewer):
-    c = viewer.curv
+    c = viewer.state.curv
     drive(viewer, "field", "gaussian")
     assert c.field_name == "gaussian"
     drive(viewer, "area", "voronoi")
@@ -165,11 +165,11 @@ def test_curvature_widgets(viewer):
     drive(viewer, "clip %", 80.0, -3.0)  # out of range (Ctrl+click types any value): clamped
     assert c.percentile == 0.0
     drive(viewer, "clip %", "nan", "1e309")
-    assert c.percentile == 0.0 and "clip %" in viewer.errors["curvature"]
+    assert c.percentile == 0.0 and "clip %" in viewer.state.errors["curvature"]
     drive(viewer, "side by side", True)
     assert ps.has_surface_mesh("mesh (second estimator)")
     drive(viewer, "second field", "k1")
-    assert viewer.panels["curvature"].second_field == "k1"
+    assert viewer.state.curv.second_field == "k1"
     drive(viewer, "side by side", False)
     assert not ps.has_surface_mesh("mesh (second estimator)")
     lo, hi = c.color_range("gaussian")
@@ -180,16 +180,20 @@ def test_curvature_widgets(viewer):
 def test_onering_widgets(viewer):
     viewer.set_panel("onering")
     drive(viewer, "vertex", 7)
-    assert viewer.ring.vertex == 7 and viewer.ring.valence >= 5
-    before = list(viewer.ring.neighbors)
-    for bad in ["", "-1", "nan", "1e309", "abc", str(len(viewer.mesh.V)), 10**9]:
+    assert (
+        viewer.panels["onering"].state.vertex == 7 and viewer.panels["onering"].state.valence >= 5
+    )
+    before = list(viewer.panels["onering"].state.neighbors)
+    for bad in ["", "-1", "nan", "1e309", "abc", str(len(viewer.state.mesh.V)), 10**9]:
         drive(viewer, "vertex", bad)
-        assert viewer.ring.vertex == 7  # the selection stays
-        assert "vertex" in viewer.errors["onering"]
+        assert viewer.panels["onering"].state.vertex == 7  # the selection stays
+        assert "vertex" in viewer.state.errors["onering"]
     drive(viewer, "clockwise (reverse)", True)
-    assert viewer.ring.neighbors == before[::-1]
+    assert viewer.panels["onering"].state.neighbors == before[::-1]
     drive(viewer, "clockwise (reverse)", False)
-    assert viewer.ring.neighbors == before and "onering" not in viewer.errors
+    assert (
+        viewer.panels["onering"].state.neighbors == before and "onering" not in viewer.state.errors
+    )
 
 
 # ---------------------------------------------------------------- Spectral
@@ -205,7 +209,7 @@ def wait_for_basis(viewer: Viewer) -> None:
 def test_spectral_widgets(viewer):
     viewer.set_panel("spectral")
     st = viewer.panels["spectral"].state
-    n = len(viewer.mesh.V)
+    n = len(viewer.state.mesh.V)
     drive(viewer, "modes to compute", 30)
     assert st.k_request == 30
     for bad in ("", "nan", "1e309", "abc"):
@@ -227,7 +231,7 @@ def test_spectral_widgets(viewer):
     assert st.k == 12
     np.testing.assert_allclose(st.reconstruction, st.basis.reconstruct(12))
     drive(viewer, "k (reconstruct)", 0, 10**6, "nan")
-    assert st.k == 30 and "k (reconstruct)" in viewer.errors["spectral"]
+    assert st.k == 30 and "k (reconstruct)" in viewer.state.errors["spectral"]
 
 
 # ---------------------------------------------------------------- Smoothing
@@ -242,9 +246,9 @@ def test_smoothing_lambda_typed_keeps_the_mesh(viewer):
     assert smoother.iteration == 3
     for bad in BAD_NUMBERS:
         drive(viewer, "lambda", bad)
-        assert st.lam == 0.5 and "lambda" in viewer.errors["smoothing"]
+        assert st.lam == 0.5 and "lambda" in viewer.state.errors["smoothing"]
     drive(viewer, "lambda", "0.25")
-    assert st.lam == 0.25 and "smoothing" not in viewer.errors
+    assert st.lam == 0.25 and "smoothing" not in viewer.state.errors
     # a λ edit keeps the current mesh, its noise and the iteration count (set_lam only)
     assert st.smoother is smoother and smoother.lam == 0.25 and smoother.iteration == 3
     np.testing.assert_array_equal(st.V, V)
@@ -264,7 +268,7 @@ def test_smoothing_widgets(viewer):
     start = np.array(st.V_start)
     for bad in ("nan", "1e309", -0.5):
         drive(viewer, "noise alpha", bad)
-        assert st.noise_alpha == 0.02 and "alpha" in viewer.errors["smoothing"]
+        assert st.noise_alpha == 0.02 and "alpha" in viewer.state.errors["smoothing"]
         np.testing.assert_array_equal(st.V_start, start)
     drive(viewer, "noise seed", 3)
     assert st.seed == 3
@@ -300,7 +304,7 @@ def test_diverging_explicit_run_stops_with_the_stable_lambda(viewer):
 # ---------------------------------------------------------------- Surfaces
 def test_surfaces_widgets(viewer):
     viewer.set_panel("surfaces")
-    s = viewer.surf
+    s = viewer.panels["surfaces"].state
     frames(viewer)
     drive(viewer, "surface", "torus")
     assert s.name == "torus" and ps.has_surface_mesh("surface")
@@ -308,7 +312,7 @@ def test_surfaces_widgets(viewer):
     assert s.res == 24 and s.mesh is not None
     for bad in (0, -3, 2, 10**6, "", "nan", "1e309"):
         drive(viewer, "resolution", bad)
-        assert s.res == 24 and viewer.errors["surfaces"]
+        assert s.res == 24 and viewer.state.errors["surfaces"]
     drive(viewer, "u", 1.0)
     drive(viewer, "v", 0.5)
     assert (s.u, s.v) == (1.0, 0.5)
@@ -325,9 +329,9 @@ def test_export_writes_what_is_on_screen(viewer, tmp_path):
     out = tmp_path / "out"
     out.mkdir()
     drive(viewer, "folder", str(tmp_path / "does-not-exist"))
-    assert "export folder" in viewer.errors["export"]
+    assert "export folder" in viewer.state.errors["export"]
     drive(viewer, "folder", str(out))
-    assert viewer.panels["export"].folder == out.resolve()
+    assert viewer.state.folder == out.resolve()
     # smoothing: the smoothed mesh as it is now, not the original vertices
     viewer.set_panel("smoothing")
     frames(viewer)
@@ -340,7 +344,7 @@ def test_export_writes_what_is_on_screen(viewer, tmp_path):
     assert status == f"wrote {name} in {out.resolve()}"
     back = load_mesh(out / name)
     np.testing.assert_allclose(back.V, st.V, atol=1e-6)
-    assert not np.allclose(back.V, viewer.mesh.V, atol=1e-6)
+    assert not np.allclose(back.V, viewer.state.mesh.V, atol=1e-6)
     drive(viewer, "screenshot", True)
     assert (out / "sphere_smoothing.png").is_file()
 
@@ -349,17 +353,17 @@ def test_internal_error_is_shown_and_logged_once(viewer, capsys, monkeypatch):
     def broken(*args, **kwargs):
         raise RuntimeError("boom")
 
-    monkeypatch.setattr(viewer.panels["curvature"], "push", broken)
+    monkeypatch.setattr(viewer.panels["curvature"], "sync", broken)
     for _ in range(3):
         viewer.ui.script("field", "k2")
         ps.frame_tick()  # the session goes on
-    message = viewer.errors["curvature"]
+    message = viewer.state.errors["curvature"]
     assert "internal error: RuntimeError: boom" in message and "details" in message
     err = capsys.readouterr().err
     assert err.count("RuntimeError: boom") == 1
     monkeypatch.undo()
     drive(viewer, "field", "cotan")
-    assert "curvature" not in viewer.errors  # a good change clears the message
+    assert "curvature" not in viewer.state.errors  # a good change clears the message
 
 
 # ---------------------------------------------------------------- Help, shortcuts, mouse, drop
@@ -374,12 +378,12 @@ def test_help_widgets(viewer):
     assert help_panel.polyscope_panels
     drive(viewer, "polyscope's own panels", False)
     drive(viewer, "UI scale", 1.5)
-    assert help_panel.ui_scale == 1.5 and viewer.ui.scale == 1.5
+    assert viewer.state.ui_scale == 1.5 and viewer.ui.scale == 1.5
     drive(viewer, "UI scale", 10.0)
-    assert help_panel.ui_scale == 3.0  # clamped
+    assert viewer.state.ui_scale == 3.0  # clamped
     for bad in ("nan", -1.0, "1e309"):
         drive(viewer, "UI scale", bad)
-        assert help_panel.ui_scale == 3.0 and "UI scale" in viewer.errors["help"]
+        assert viewer.state.ui_scale == 3.0 and "UI scale" in viewer.state.errors["help"]
     drive(viewer, "UI scale", 1.0)
     drive(viewer, "key h", True)
     frames(viewer)
@@ -387,11 +391,11 @@ def test_help_widgets(viewer):
 
 
 def test_shortcuts(viewer):
-    from meshlap_app.state import PANELS
+    from meshlap_app.registry import VIEWS as PANELS
 
     for i, panel in enumerate(PANELS):
         drive(viewer, f"key {i + 1}", True)
-        assert viewer.panel == panel
+        assert viewer.state.panel == panel
     drive(viewer, "key 4", True)  # smoothing
     st = viewer.panels["smoothing"].state
     it0 = st.smoother.iteration
@@ -406,7 +410,7 @@ def test_shortcuts(viewer):
     drive(viewer, "key 3", True)  # spectral: arrows move k once a basis exists
     spec = viewer.panels["spectral"].state
     spec.k_request = 12
-    spec.start(viewer.mesh.V, viewer.mesh.F, background=False)
+    spec.start(viewer.state.mesh.V, viewer.state.mesh.F, background=False)
     frames(viewer)
     spec.set_k(5)
     drive(viewer, "key right", True)
@@ -420,19 +424,19 @@ def test_shortcuts(viewer):
 
 
 def test_click_and_drop(viewer, tmp_path, sphere):
-    before = viewer.ring.vertex
+    before = viewer.panels["onering"].state.vertex
     drive(viewer, "click", (10.0, 10.0), (-5.0, 1e9))  # nothing there: nothing happens
-    assert viewer.ring.vertex == before
+    assert viewer.panels["onering"].state.vertex == before
     bad = tmp_path / "bad.obj"
     bad.write_text("v 0 0 0\nf 1 2 3\n")
-    n = len(viewer.mesh.V)
+    n = len(viewer.state.mesh.V)
     viewer.files_dropped([str(bad)])
-    assert "bad.obj" in viewer.mesh.error and len(viewer.mesh.V) == n
+    assert "bad.obj" in viewer.state.mesh.error and len(viewer.state.mesh.V) == n
     viewer.files_dropped([])
     viewer.files_dropped([str(tmp_path / "assets_missing.ply")])
     frames(viewer)
     viewer.files_dropped([str(sphere)])
-    assert viewer.mesh.name == "sphere.obj" and not viewer.mesh.error
+    assert viewer.state.mesh.name == "sphere.obj" and not viewer.state.mesh.error
 
 
 def test_captions_name_what_is_side_by_side(viewer):

@@ -1,42 +1,202 @@
-"""The one protocol every panel of the viewer follows."""
+"""The protocol every panel follows, and the narrow host it is given.
+
+A panel owns one feature end to end: its widgets (:meth:`Panel.draw`), the structures it
+registers (shown, hidden, framed), the captions under them, what *export* writes, its slice of a
+saved session, its shortcut keys and what *play* / *record* / ``meshlap animate`` advance. The
+viewer (:mod:`meshlap_app.viewer`) and the headless animator (:mod:`meshlap_app.animate`) are
+*hosts*: they loop over the registered panels (:mod:`meshlap_app.registry`) and never name one.
+A panel never imports the viewer; it types against :class:`Host`.
+"""
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Protocol
+from collections.abc import Iterator
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, ClassVar, Protocol
 
 import numpy as np
 
+from ..state.watch import Watch
+
 if TYPE_CHECKING:
-    from ..viewer import Viewer
+    from ..state.app import AppState
+    from ..ui import UI
+
+ExportItem = tuple[str, "np.ndarray | None", "np.ndarray | None", "np.ndarray | None"]
+"""(file name, V or ``None``, F or ``None``, per-vertex scalars or ``None``): a mesh (PLY with
+the scalars) when V is given, else the scalars alone (CSV)."""
 
 
-class Panel(Protocol):
-    """A section of meshlap's window: its widgets and the structures it registers.
+HOST_SHORTCUTS: tuple[tuple[str, str], ...] = (
+    ("F", "frame what the view shows"),
+    ("R", "reset the camera (a view may use R for its own reset)"),
+    ("mouse", "left-drag rotate, right-drag pan, wheel zoom; click a vertex for its one-ring"),
+    ("drop", "drop a mesh file (or a session .json) on the window to open it"),
+)
+"""The keys and gestures every host answers itself (each panel lists its own ``shortcuts``)."""
 
-    ``draw`` runs every frame while the panel is shown (it reads widgets, calls its state's
-    methods and pushes arrays only when something changed); ``on_new_mesh`` forgets what
-    belonged to the previous mesh; ``show`` enables this panel's structures when ``panel`` is the
-    current panel and disables them otherwise; ``points`` gives the display positions of a
-    structure this panel registered (for camera framing), ``None`` for other names.
+
+class Host(Protocol):
+    """What a panel may use of the program that shows it (the window or the animator)."""
+
+    state: AppState
+    ui: UI
+    panels: dict[str, Panel]  # every registered panel, in the registry's order
+
+    def open(self, path: Path | None) -> bool:
+        """Load the mesh file ``path`` (``None``: the bundled default); on failure the mesh's
+        error is set and the mesh on screen stays."""
+        ...
+
+    def active(self) -> Panel:
+        """The panel of the active view."""
+        ...
+
+    def set_panel(self, name: str) -> None:
+        """Switch the active view (its structures shown, the others hidden, re-framed)."""
+        ...
+
+    def sync_mesh(self) -> None:
+        """Register the mesh if it changed (each panel's ``on_new_mesh``), sync every panel
+        and show the active view."""
+        ...
+
+    def keep_view(self) -> None:
+        """Keep the camera as it is now: no pending re-frame, the window size taken as seen."""
+        ...
+
+    def refresh(self) -> None:
+        """Show the active view's structures and hide the others (after registering some)."""
+        ...
+
+    def request_frame(self) -> None:
+        """Frame what is shown again at the end of this frame."""
+        ...
+
+    def frame(self, strip: float | None = None) -> None:
+        """Frame what is shown now (``strip``: an animation frame, that left fraction of the
+        width kept for the colour bar; a kept camera is not moved)."""
+        ...
+
+    def flush_frame(self) -> None:
+        """Frame now if a re-frame was requested (before a recorded picture)."""
+        ...
+
+    def set_ui_scale(self, scale: float) -> None:
+        """Set the UI scale (text, widgets, the panel's width) everywhere it applies."""
+        ...
+
+    def mesh_points(self) -> np.ndarray:
+        """Display positions ``(n,3)`` of the mesh's vertices (as uploaded)."""
+        ...
+
+
+class Panel:
+    """Defaults for every hook of the protocol; a panel overrides what it does.
+
+    Class attributes a panel sets:
+
+    ``title``
+        Its header in meshlap's panel.
+    ``shows_mesh``
+        The main mesh is visible while this view is active.
+    ``shows_curvature``
+        The main mesh shows the curvature field (with its colour bar) while this view is
+        active.
+    ``pick_through``
+        A click on the mesh in this view may select a vertex for another panel (the
+        curvature view hands its clicks to the one-ring).
+    ``framed``
+        Names of the surface meshes it registers that framing fits in view.
+    ``shortcuts``
+        ``(key, what it does)`` rows for the help window and the README.
+    ``keys``
+        The key names (:meth:`meshlap_app.ui.UI.key`) :meth:`on_key` is offered while this
+        view is active (a section: always).
+    ``view_direction``
+        Where the camera looks from when it frames this view (``None``: the mesh's front).
     """
 
-    def draw(self, viewer: Viewer) -> None: ...
+    title: ClassVar[str] = ""
+    shows_mesh: ClassVar[bool] = True
+    shows_curvature: ClassVar[bool] = False
+    pick_through: ClassVar[bool] = False
+    framed: ClassVar[tuple[str, ...]] = ()
+    shortcuts: ClassVar[tuple[tuple[str, str], ...]] = ()
+    keys: ClassVar[tuple[str, ...]] = ()
+    view_direction: ClassVar[tuple[float, float, float] | None] = None
 
-    def on_new_mesh(self, viewer: Viewer) -> None: ...
+    def __init__(self, name: str, state: Any = None) -> None:
+        self.name = name
+        self.state = state  # this panel's slice of the AppState (None: it has none)
+        self.watch = Watch()  # what was uploaded, and from which inputs
 
-    def show(self, viewer: Viewer, panel: str) -> None: ...
+    # -------------------------------------------------------------- every frame
+    def draw(self, host: Host) -> None:
+        """Its widgets (while its view is active, or always for a section)."""
 
-    def points(self, viewer: Viewer, name: str) -> np.ndarray | None: ...
+    def sync(self, host: Host) -> None:
+        """Bring what it uploaded up to date with the state (every frame, every panel: cheap
+        when nothing changed, see :class:`~meshlap_app.state.watch.Watch`)."""
 
+    def overlay(self, host: Host) -> None:
+        """Text drawn over the 3D view while its view is active (labels, hover)."""
 
-class NoStructures:
-    """Defaults for a panel that registers nothing of its own."""
+    # -------------------------------------------------------------- the scene
+    def on_new_mesh(self, host: Host) -> None:
+        """Forget what belonged to the previous mesh."""
 
-    def on_new_mesh(self, viewer: Viewer) -> None:
+    def show(self, host: Host, active: Panel) -> None:
+        """Enable its structures when ``active`` is this panel, disable them otherwise."""
+
+    def points(self, host: Host, name: str) -> np.ndarray | None:
+        """Display positions of the structure ``name`` it registered (framing), or ``None``."""
         return None
 
-    def show(self, viewer: Viewer, panel: str) -> None:
-        return None
+    def focus(self, host: Host) -> bool:
+        """Frame the camera its own way (True), or leave it to the host (False)."""
+        return False
 
-    def points(self, viewer: Viewer, name: str) -> np.ndarray | None:
-        return None
+    def pick(self, host: Host, hit: Any, active: Panel) -> bool:
+        """Handle a click on the 3D view (``hit``: polyscope's pick result); True if used."""
+        return False
+
+    def captions(self, host: Host) -> dict[str, str]:
+        """Caption of each structure it shows side by side (its view active)."""
+        return {}
+
+    # -------------------------------------------------------------- files
+    def export_items(self, host: Host) -> list[ExportItem]:
+        """What *export what is shown* writes for this view (``[]``: the default export)."""
+        return []
+
+    def capture(self, host: Host) -> dict[str, Any]:
+        """Its settings for a saved session (its section, ``SESSION`` of its state module)."""
+        return {}
+
+    def configure(self, host: Host, values: dict[str, Any]) -> None:
+        """Restore settings of a session before the mesh is registered (no computation)."""
+
+    def restore(self, host: Host, values: dict[str, Any], active: bool) -> None:
+        """Restore the rest of a session once the mesh is registered (``active``: the session's
+        view is this panel)."""
+
+    def start(self, host: Host, options: dict[str, Any], shown: bool, screenshot: bool) -> None:
+        """Apply ``meshlap view`` options it understands (``--vertex``, ``--k``, ...) when the
+        window opens; ``shown``: it is the first view; ``screenshot``: a headless picture
+        follows."""
+
+    def busy(self) -> str:
+        """What background job of this panel is running (``""``: none); while one runs the
+        frame yields the CPU and a session is not loaded."""
+        return ""
+
+    # -------------------------------------------------------------- keys, play
+    def on_key(self, host: Host, key: str) -> bool:
+        """React to a shortcut key; True when it was used."""
+        return False
+
+    def frames(self, host: Host, options: dict[str, Any]) -> Iterator[str]:
+        """``meshlap animate``: set up each frame of its animation, yield the frame's caption
+        (only panels whose state module declares ``ANIMATION``)."""
+        raise NotImplementedError(f"the {self.name} panel has no animation")

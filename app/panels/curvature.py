@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 import polyscope as ps
@@ -12,10 +12,7 @@ from meshlap_core.options import BOUNDARY_RULES
 
 from ..scene import COLORBAR_AT, MESH, MESH_B, scalar_for_upload, side_offset
 from ..state.names import FIELD_LABELS
-
-if TYPE_CHECKING:
-    from ..viewer import Viewer
-
+from .base import Host, Panel
 
 FIELD_HELP = (
     "H = |Lx|/2 with the uniform or cotangent Laplacian (signed by the normal); "
@@ -23,60 +20,96 @@ FIELD_HELP = (
 )
 
 
-class CurvaturePanel:
-    """Field, area, boundary rule, clip percentage, side-by-side second estimator, histogram."""
+class CurvaturePanel(Panel):
+    """Field, area, boundary rule, clip percentage, side-by-side second estimator, histogram.
 
-    def __init__(self) -> None:
-        self.side_by_side = False
-        self.second_field = "uniform"
-        self.shown: Any = ""
-        self.colorbar = True  # the main field's colour bar: on in this panel and the one-ring's
+    Its state is the :class:`~meshlap_app.state.app.AppState`'s curvature fields (the One-ring
+    view and the export read them too); this panel shows them on the mesh whenever the active
+    view ``shows_curvature``.
+    """
 
-    def on_new_mesh(self, viewer: Viewer) -> None:
-        self.shown = ""
+    title = "Curvature"
+    shows_curvature = True
+    pick_through = True  # a click on the mesh selects a vertex (the one-ring view takes it)
+    framed = (MESH_B,)
 
-    def show(self, viewer: Viewer, panel: str) -> None:
-        want = panel in ("curvature", "onering")
-        if want != self.colorbar and ps.has_surface_mesh(MESH):
-            self.colorbar = want
-            self.push(viewer, force=True)
+    def on_new_mesh(self, host: Host) -> None:
+        self.watch.forget()
+
+    def show(self, host: Host, active: Panel) -> None:
+        self.sync(host)
         if ps.has_surface_mesh(MESH_B):
-            ps.get_surface_mesh(MESH_B).set_enabled(panel == "curvature")
+            ps.get_surface_mesh(MESH_B).set_enabled(active is self)
 
-    def points(self, viewer: Viewer, name: str) -> np.ndarray | None:
-        shown = viewer.display.points(viewer.mesh.V)
-        if name == MESH:
-            return shown
+    def points(self, host: Host, name: str) -> np.ndarray | None:
         if name == MESH_B:
+            shown = host.mesh_points()
             return shown + side_offset(shown)
         return None
 
-    def push(self, viewer: Viewer, force: bool = False) -> None:
-        """Add the selected curvature field(s) as colour maps (only when they changed)."""
-        curv = viewer.curv
-        changed = curv.update(viewer.mesh) or force
-        key = (curv.field_name, curv.percentile, self.side_by_side, self.second_field)
-        if not changed and key == self.shown:
+    def captions(self, host: Host) -> dict[str, str]:
+        c = host.state.curv
+        if not c.side_by_side:
+            return {}
+        return {MESH: FIELD_LABELS[c.field_name][0], MESH_B: FIELD_LABELS[c.second_field][0]}
+
+    def capture(self, host: Host) -> dict[str, Any]:
+        c = host.state.curv
+        return {
+            "field": c.field_name,
+            "area": c.area,
+            "boundary": c.boundary,
+            "clip": float(c.percentile),
+            "side_by_side": bool(c.side_by_side),
+            "second_field": c.second_field,
+        }
+
+    def configure(self, host: Host, values: dict[str, Any]) -> None:
+        c = host.state.curv
+        c.field_name, c.area, c.boundary = values["field"], values["area"], values["boundary"]
+        c.set_percentile(values["clip"])
+        c.side_by_side, c.second_field = values["side_by_side"], values["second_field"]
+
+    def start(self, host: Host, options: dict[str, Any], shown: bool, screenshot: bool) -> None:
+        if options.get("field") is not None:
+            host.state.curv.field_name = options["field"]
+
+    def sync(self, host: Host) -> None:
+        """Upload the selected curvature field(s) as colour maps when the mesh, the fields'
+        options or the display options changed (the field's colour bar is on while the active
+        view ``shows_curvature``)."""
+        curv, mesh = host.state.curv, host.state.mesh
+        colorbar = host.active().shows_curvature
+        if not ps.has_surface_mesh(MESH):
             return
-        self.shown = key
-        self._add_field(viewer, ps.get_surface_mesh(MESH), curv.field_name, self.colorbar)
-        if self.side_by_side:
+        curv.update(mesh)
+        key = (
+            mesh.version,
+            curv.area,
+            curv.boundary,
+            curv.field_name,
+            curv.percentile,
+            curv.side_by_side,
+            curv.second_field,
+            colorbar,
+        )
+        if not self.watch.changed("uploaded", *key):
+            return
+        self._add_field(host, ps.get_surface_mesh(MESH), curv.field_name, colorbar)
+        if curv.side_by_side:
             if not ps.has_surface_mesh(MESH_B):
-                V = viewer.display.points(viewer.mesh.V)
-                ps.register_surface_mesh(
-                    MESH_B, V + side_offset(V), viewer.mesh.F, smooth_shade=True
-                )
-            self._add_field(viewer, ps.get_surface_mesh(MESH_B), self.second_field)
+                V = host.mesh_points()
+                ps.register_surface_mesh(MESH_B, V + side_offset(V), mesh.F, smooth_shade=True)
+            self._add_field(host, ps.get_surface_mesh(MESH_B), curv.second_field)
         elif ps.has_surface_mesh(MESH_B):
             ps.remove_surface_mesh(MESH_B)
 
     @staticmethod
-    def _add_field(viewer: Viewer, sm: Any, name: str, colorbar: bool = False) -> None:
+    def _add_field(host: Host, sm: Any, name: str, colorbar: bool = False) -> None:
+        curv = host.state.curv
         label, signed = FIELD_LABELS[name]
         label += " [1/length^2]" if name == "gaussian" else " [1/length]"
-        values, (lo, hi), factor = scalar_for_upload(
-            viewer.curv.fields[name], viewer.curv.color_range(name)
-        )
+        values, (lo, hi), factor = scalar_for_upload(curv.fields[name], curv.color_range(name))
         sm.add_scalar_quantity(
             label + factor,
             values,
@@ -88,11 +121,11 @@ class CurvaturePanel:
             onscreen_colorbar_location=COLORBAR_AT,
         )
 
-    def draw(self, viewer: Viewer) -> None:
-        ui = viewer.ui
-        if not ui.header("Curvature"):
+    def draw(self, host: Host) -> None:
+        ui = host.ui
+        if not ui.header(self.title):
             return
-        c = viewer.curv
+        c = host.state.curv
         names = tuple(FIELD_LABELS)
         ch1, c.field_name = ui.combo("field", c.field_name, names, FIELD_HELP)
         ch2, c.area = ui.combo(
@@ -115,18 +148,18 @@ class CurvaturePanel:
         )
         if ch4:
             c.set_percentile(pct)
-        ch5, self.side_by_side = ui.checkbox(
-            "side by side", self.side_by_side, "show a second field on a copy beside the mesh"
+        ch5, c.side_by_side = ui.checkbox(
+            "side by side", c.side_by_side, "show a second field on a copy beside the mesh"
         )
-        ch6 = False
-        if self.side_by_side:
-            ch6, self.second_field = ui.combo(
-                "second field", self.second_field, names, "the field on the copy"
+        if c.side_by_side:
+            _, c.second_field = ui.combo(
+                "second field", c.second_field, names, "the field on the copy"
             )
-        if ch1 or ch2 or ch3 or ch4 or ch5 or ch6:
-            self.push(viewer, force=ch2 or ch3)
-            viewer.show_panel()
-            viewer.reframe = viewer.reframe or ch5
+        if ch1 or ch2 or ch3 or ch4 or ch5:
+            self.sync(host)
+            host.refresh()
+        if ch5:
+            host.request_frame()
         if c.field_name not in c.fields:
             return
         st = c.summary()
@@ -157,3 +190,6 @@ def _bar_colors(centers: np.ndarray, lo: float, hi: float, signed: bool) -> np.n
     c = np.asarray(centers, dtype=np.float64)
     t = (c - lo) / (hi - lo) if hi > lo else np.full(len(c), 0.5)
     return colormaps["coolwarm" if signed else "viridis"](np.clip(t, 0.0, 1.0))
+
+
+PANEL = CurvaturePanel

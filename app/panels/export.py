@@ -1,50 +1,52 @@
-"""The Export panel: a screenshot, or what is on screen written to files in a chosen folder."""
+"""The Export section: a screenshot, or what is on screen written to files in a chosen folder."""
 
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING
-
-import numpy as np
 
 from meshlap_core.errors import MeshError
 from meshlap_core.io import save_mesh, save_scalars
 
 from ..scene import save_screenshot
-from .base import NoStructures
-
-if TYPE_CHECKING:
-    from ..viewer import Viewer
+from .base import ExportItem, Host, Panel
 
 
-class ExportPanel(NoStructures):
-    """Export folder, screenshot and export buttons, and where the last export wrote."""
+class ExportPanel(Panel):
+    """Export folder, screenshot and export buttons, and where the last export wrote.
 
-    def __init__(self, folder: Path | None = None) -> None:
-        self.folder = Path(folder) if folder is not None else Path.cwd()
-        self.folder_text = str(self.folder)
+    The folder is the app state's (``AppState.folder``): recordings and relative session
+    files go there too.
+    """
+
+    title = "Export"
+
+    def __init__(self, name: str, state: object = None) -> None:
+        super().__init__(name, state)
+        self.folder_text = ""
         self.status = ""
 
-    def draw(self, viewer: Viewer) -> None:
-        ui = viewer.ui
-        if not ui.header("Export", default_open=False):
+    def draw(self, host: Host) -> None:
+        ui = host.ui
+        if not ui.header(self.title, default_open=False):
             return
+        if not self.folder_text:
+            self.folder_text = str(host.state.folder)
         entered, self.folder_text = ui.input_text(
             "folder",
             self.folder_text,
             "where screenshots and exports are written (press Enter to set)",
         )
         if entered:
-            self.set_folder(self.folder_text)
+            self.set_folder(host, self.folder_text)
         if ui.button("screenshot", "save the window as a PNG in the folder"):
-            self.status = self.screenshot(viewer)
+            self.status = self.screenshot(host)
         ui.same_line()
         if ui.button("export what is shown", "write the shown mesh / field to the folder"):
-            self.status = self.export(viewer, self.folder)
+            self.status = self.export(host, host.state.folder)
         if self.status:
             ui.text(self.status)
 
-    def set_folder(self, text: str) -> None:
+    def set_folder(self, host: Host, text: str) -> None:
         """Use ``text`` as the export folder.
 
         Raises
@@ -52,16 +54,14 @@ class ExportPanel(NoStructures):
         MeshError
             The folder does not exist (the previous folder stays).
         """
-        folder = Path(text.strip()).expanduser()
-        if not folder.is_dir():
-            self.folder_text = str(self.folder)
-            raise MeshError(f"{text!r} is not an existing folder", "export folder")
-        self.folder = folder.resolve()
-        self.folder_text = str(self.folder)
+        try:
+            self.folder_text = str(host.state.set_folder(text))
+        except MeshError:
+            self.folder_text = str(host.state.folder)
+            raise
 
-    def screenshot(self, viewer: Viewer) -> str:
-        stem = Path(viewer.mesh.name).stem or "mesh"
-        path = self.folder / f"{stem}_{viewer.panel}.png"
+    def screenshot(self, host: Host) -> str:
+        path = host.state.folder / f"{host.state.mesh.stem}_{host.state.panel}.png"
         try:
             save_screenshot(path)
         except (MeshError, OSError) as exc:
@@ -69,17 +69,16 @@ class ExportPanel(NoStructures):
         return f"wrote {path}"
 
     @staticmethod
-    def export(viewer: Viewer, folder: Path) -> str:
-        """Write what the current panel shows into ``folder``; returns where it wrote.
+    def export(host: Host, folder: Path) -> str:
+        """Write what the active view shows into ``folder``; returns where it wrote.
 
-        curvature / one-ring: the mesh as PLY with the shown field, and the field as CSV;
-        spectral: the k-reconstruction (PLY with the per-vertex error) and the shown
-        eigenfunction (CSV); smoothing: the smoothed mesh as it is now (PLY); surfaces: the
-        parametric surface's mesh (PLY with the exact Gaussian curvature).
+        The view's own files (:meth:`~.base.Panel.export_items`: the k-reconstruction, the
+        smoothed mesh, the parametric surface...), or by default the mesh as PLY with the shown
+        curvature field and the field as CSV.
         """
         files = []
         try:
-            for name, V, F, scalars in _shown(viewer):
+            for name, V, F, scalars in host.active().export_items(host) or field_items(host):
                 path = Path(folder) / name
                 if V is None:
                     save_scalars(path, scalars)
@@ -91,30 +90,16 @@ class ExportPanel(NoStructures):
         return f"wrote {', '.join(files)} in {Path(folder).resolve()}"
 
 
-def _shown(viewer: Viewer) -> list[tuple[str, np.ndarray | None, np.ndarray | None, np.ndarray]]:
-    """(file name, V or None, F, scalars) for what the current panel shows."""
-    stem = Path(viewer.mesh.name).stem or "mesh"
-    mesh, curv = viewer.mesh, viewer.curv
-    if viewer.panel == "spectral":
-        st = viewer.panels["spectral"].state
-        if st.basis is not None:
-            f, _ = st.eigenfunction()
-            return [
-                (f"{stem}_k{st.k}.ply", st.reconstruction, mesh.F, st.vertex_error),
-                (f"{stem}_mode{st.mode}.csv", None, None, f),
-            ]
-    if viewer.panel == "smoothing":
-        st = viewer.panels["smoothing"].state
-        if st.smoother is not None:
-            name = f"{stem}_{st.method}_{st.laplacian}_it{st.smoother.iteration}.ply"
-            return [(name, np.array(st.V), st.F, None)]
-    if viewer.panel == "surfaces":
-        s = viewer.surf
-        if s.mesh is not None:
-            return [(f"{s.name}_res{s.res}.ply", s.mesh.V, s.mesh.F, None)]
+def field_items(host: Host) -> list[ExportItem]:
+    """The default export: the mesh (PLY with the shown curvature field) and the field (CSV)."""
+    mesh, curv = host.state.mesh, host.state.curv
     curv.update(mesh)
     field = curv.fields.get(curv.field_name)
+    stem = mesh.stem
     return [
         (f"{stem}_{curv.field_name}.ply", mesh.V, mesh.F, field),
         (f"{stem}_{curv.field_name}.csv", None, None, field),
     ]
+
+
+PANEL = ExportPanel

@@ -1,52 +1,55 @@
-"""The Help panel: shortcuts, mouse use, polyscope's own panels and the UI scale."""
+"""The Help section: shortcuts, mouse use, polyscope's own panels, the UI scale and sessions."""
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 import polyscope as ps
 
-from .base import NoStructures
-
-if TYPE_CHECKING:
-    from ..viewer import Viewer
-
-SHORTCUTS = (
-    ("1-5", "panels: curvature, one-ring, spectral, smoothing, surfaces"),
-    ("space", "play / pause smoothing"),
-    ("right / left", "smoothing: one step; spectral: k + 1 / k - 1"),
-    ("F", "frame what the panel shows"),
-    ("R", "reset (smoothing run, or the camera)"),
-    ("H", "this help"),
-    ("mouse", "left-drag rotate, right-drag pan, wheel zoom; click a vertex for its one-ring"),
-    ("drop", "drop a mesh file (or a session .json) on the window to open it"),
-)
+from ..registry import VIEWS
+from ..session import SessionWidgets
+from .base import HOST_SHORTCUTS, Host, Panel
 
 
-class HelpPanel(NoStructures):
+def shortcut_rows(host: Host) -> list[tuple[str, str]]:
+    """Every key the window answers: the views' numbers and the host's own keys, then each
+    panel's (registry order)."""
+    rows = [(f"1-{len(VIEWS)}", f"views: {', '.join(VIEWS)}"), *HOST_SHORTCUTS]
+    for p in host.panels.values():
+        rows += list(p.shortcuts)
+    return rows
+
+
+class HelpPanel(Panel):
     """Shortcut list, a toggle for polyscope's own panels, the UI scale, saved sessions."""
 
-    def __init__(self, ui_scale: float = 1.0) -> None:
+    title = "Help and window (H)"
+    keys = ("h",)
+    shortcuts = (("H", "this help"),)
+
+    def __init__(self, name: str, state: object = None) -> None:
+        super().__init__(name, state)
         self.open: bool | None = None  # H toggles: force the header open / closed once
         self.shown = False
         self.polyscope_panels = False
-        self.ui_scale = ui_scale
-        from ..session import SessionWidgets
-
         self.session = SessionWidgets()  # save / load a session (app/session.py)
+
+    def on_key(self, host: Host, key: str) -> bool:
+        if key != "h":
+            return False
+        self.toggle()
+        return True
 
     def toggle(self) -> None:
         self.shown = not self.shown
         self.open = self.shown
 
-    def draw(self, viewer: Viewer) -> None:
-        ui = viewer.ui
-        self.shown = ui.header("Help and window (H)", default_open=False, force=self.open)
+    def draw(self, host: Host) -> None:
+        ui = host.ui
+        self.shown = ui.header(self.title, default_open=False, force=self.open)
         self.open = None
         if not self.shown:
             return
-        self.session.draw(viewer)  # first: the lecture's prepared view, one click away
-        for key, what in SHORTCUTS:
+        self.session.draw(host)  # first: the lecture's prepared view, one click away
+        for key, what in shortcut_rows(host):
             ui.text(f"{key:>12}  {what}")
         ch, on = ui.checkbox(
             "polyscope's own panels",
@@ -56,20 +59,17 @@ class HelpPanel(NoStructures):
         if ch:
             self.polyscope_panels = on
             ps.set_build_default_gui_panels(on)
-            viewer.reframe = True
+            host.request_frame()
         ch, scale = ui.slider_float(
-            "UI scale", self.ui_scale, 0.5, 3.0, "%.2f", "size of text and widgets (projectors)"
+            "UI scale",
+            host.state.ui_scale,
+            0.5,
+            3.0,
+            "%.2f",
+            "size of text and widgets (projectors)",
         )
         if ch:
-            self.set_scale(viewer, scale)
+            host.set_ui_scale(scale)
 
-    def set_scale(self, viewer: Viewer, scale: float) -> None:
-        """UI scale in [0.5, 3] (MeshError for a non-finite value)."""
-        from meshlap_core.errors import MeshError
 
-        if not 0 < scale < float("inf"):
-            raise MeshError(f"must be a number between 0.5 and 3, got {scale!r}", "UI scale")
-        self.ui_scale = min(max(float(scale), 0.5), 3.0)
-        ps.set_ui_scale(self.ui_scale)
-        viewer.ui.scale = self.ui_scale
-        viewer.reframe = True
+PANEL = HelpPanel

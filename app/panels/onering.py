@@ -6,7 +6,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable
-from typing import TYPE_CHECKING
+from typing import Any
 
 import numpy as np
 import polyscope as ps
@@ -17,19 +17,17 @@ from meshlap_core.options import AREA_KINDS, BOUNDARY_RULES
 
 from .. import scene
 from ..camera import project_to_screen
-from ..scene import MESH, RING_CENTER, RING_CURVE, RING_POINTS, scene_fraction
+from ..scene import MESH, RING_CENTER, RING_CURVE, RING_POINTS, picked_vertex, scene_fraction
 from ..state.onering import (
     HoverThrottle,
+    OneRingState,
     angle_arcs,
     area_cell,
     arrow_scales,
     weight_segments,
 )
 from ..ui import sig
-
-if TYPE_CHECKING:
-    from ..viewer import Viewer
-
+from .base import Host, Panel
 
 NEGATIVE_RGBA = (*scene.NEGATIVE_COLOR, 1.0)
 WEIGHTS_COLORBAR_AT = (15.0, 300.0)  # below the mesh field's colour bar (scene.COLORBAR_AT)
@@ -62,18 +60,29 @@ BOUNDARY_HELP = (
 )
 
 
-class OneRingPanel:
+class OneRingPanel(Panel):
     """Vertex field, clockwise toggle, the ring drawn as numbered points and arrows, and the
     inspector: its tables in the panel and its drawings in 3D (ring edges coloured by ``w_ij``,
     corner-angle arcs, the area cell, ``n`` and ``Δx`` at the vertex).
 
     Parameters
     ----------
+    name : str
+        Its registry name.
+    state : OneRingState
+        Its slice of the app state (the selection).
     clock : callable
         Seconds (monotonic) for the hover throttle; a test passes a fake clock.
     """
 
-    def __init__(self, clock: Callable[[], float] = time.monotonic) -> None:
+    title = "One-ring"
+    shows_curvature = True  # the mesh keeps the curvature field and its colour bar
+
+    def __init__(
+        self, name: str, state: OneRingState, clock: Callable[[], float] = time.monotonic
+    ) -> None:
+        super().__init__(name, state)
+        self.state: OneRingState = state
         self.labels: list[tuple[tuple[float, float], str]] = []  # the one-ring numbers drawn
         self.clock = clock
         self.throttle = HoverThrottle()
@@ -83,22 +92,26 @@ class OneRingPanel:
         self.registered = False  # the inspector's structures are in the scene
         self.arrow_text = ""
 
-    def on_new_mesh(self, viewer: Viewer) -> None:
+    def on_new_mesh(self, host: Host) -> None:
+        self.state.clear()
+        for name in (RING_CURVE, RING_POINTS, RING_CENTER):
+            scene.remove_structure(name)
         self.labels = []
         self.hovered = ""
         self.throttle = HoverThrottle(self.throttle.interval)
         self.remove_inspector()
 
-    def show(self, viewer: Viewer, panel: str) -> None:
+    def show(self, host: Host, active: Panel) -> None:
+        mine = active is self
         if ps.has_curve_network(RING_CURVE):
-            ps.get_curve_network(RING_CURVE).set_enabled(panel == "onering")
+            ps.get_curve_network(RING_CURVE).set_enabled(mine)
         for name in (RING_POINTS, RING_CENTER):
             if ps.has_point_cloud(name):
-                ps.get_point_cloud(name).set_enabled(panel == "onering")
-        if panel != "onering":
+                ps.get_point_cloud(name).set_enabled(mine)
+        if not mine:
             self.remove_inspector()  # registered again when the panel comes back
-        elif not self.registered and viewer.ring.inspection is not None:
-            self.push_inspector(viewer)
+        elif not self.registered and self.state.inspection is not None:
+            self.push_inspector(host)
 
     def remove_inspector(self) -> None:
         """Remove the inspector's structures from the scene."""
@@ -106,23 +119,47 @@ class OneRingPanel:
             scene.remove_structure(name)
         self.registered = False
 
-    def points(self, viewer: Viewer, name: str) -> np.ndarray | None:
-        return None
-
-    def select(self, viewer: Viewer, i: int) -> bool:
+    def select(self, host: Host, i: int) -> bool:
         """Select vertex ``i`` and draw its ordered one-ring."""
-        if not viewer.ring.select(viewer.mesh, viewer.curv, i):
+        if not self.state.select(host.state.mesh, host.state.curv, i):
             return False
-        self.push(viewer)
-        viewer.reframe = True  # the camera turns to the new one-ring (else a speck on the mesh)
+        self.push(host)
+        host.request_frame()  # the camera turns to the new one-ring (else a speck on the mesh)
         return True
 
-    def push(self, viewer: Viewer) -> None:
-        r = viewer.ring
+    def pick(self, host: Host, hit: Any, active: Panel) -> bool:
+        """A click on the mesh (in this view, or in one that hands its clicks through)
+        selects the vertex and shows this view."""
+        if hit.structure_name != MESH or not (active is self or active.pick_through):
+            return False
+        idx = picked_vertex(hit, host.mesh_points(), host.state.mesh.F)
+        if idx is None:
+            return False
+        host.state.panel = self.name
+        return self.select(host, idx)
+
+    def capture(self, host: Host) -> dict[str, Any]:
+        return {"vertex": int(self.state.vertex), "reverse": bool(self.state.reverse)}
+
+    def configure(self, host: Host, values: dict[str, Any]) -> None:
+        self.state.reverse = values["reverse"]
+
+    def restore(self, host: Host, values: dict[str, Any], active: bool) -> None:
+        self.state.reverse = values["reverse"]
+        if values["vertex"] >= 0:
+            self.select(host, values["vertex"])
+
+    def start(self, host: Host, options: dict[str, Any], shown: bool, screenshot: bool) -> None:
+        if shown:
+            vertex = options.get("vertex")
+            self.select(host, vertex if vertex is not None else 0)
+
+    def push(self, host: Host) -> None:
+        r = self.state
         if r.valence == 0:
             return
-        d = viewer.display
-        center, ring = d.points(viewer.mesh.V[[r.vertex]]), d.points(r.polyline)
+        d = host.state.display
+        center, ring = d.points(host.state.mesh.V[[r.vertex]]), d.points(r.polyline)
         # sizes follow the ring's own edge length, so any mesh and zoom level looks the same
         scale = 0.08 * float(np.linalg.norm(ring - center, axis=1).mean())
         cn = ps.register_curve_network(RING_CURVE, ring, r.edges, radius=0.5 * scale)
@@ -141,20 +178,20 @@ class OneRingPanel:
         c = ps.register_point_cloud(RING_CENTER, center, radius=2.0 * scale)
         c.set_radius(2.0 * scale, relative=False)
         c.set_color((1.0, 0.1, 0.1))
-        self.push_inspector(viewer)
-        viewer.show_panel()
+        self.push_inspector(host)
+        host.refresh()
 
-    def push_inspector(self, viewer: Viewer) -> None:
+    def push_inspector(self, host: Host) -> None:
         """Register the inspector's drawings for the selected vertex (on a selection change)."""
-        ins = viewer.ring.inspection
+        ins = self.state.inspection
         self.remove_inspector()
         if ins is None or not ins.neighbors:
             return
-        d, V, F = viewer.display, viewer.mesh.V, viewer.mesh.F
+        d, V, F = host.state.display, host.state.mesh.V, host.state.mesh.F
         lengths = np.array([t.edge_length for t in ins.neighbors])
         mean = float(lengths.mean())
         r = 0.08 * mean * d.scale  # display radius unit, as the ring's
-        self._push_weights(viewer, ins, r)
+        self._push_weights(host, ins, r)
         lift = 0.02 * mean * ins.normal  # just above the surface (no z-fighting)
         nodes, edges, theta = angle_arcs(ins, V, F, 0.4 * float(lengths.min()))
         if len(edges):
@@ -171,14 +208,14 @@ class OneRingPanel:
         cn = ps.register_curve_network(scene.INSPECT_CELL_EDGE, d.points(lifted), outline)
         cn.set_radius(0.15 * r, relative=False)
         cn.set_color((0.1, 0.5, 0.1))
-        self._push_arrows(viewer, ins, 1.5 * mean, r)
+        self._push_arrows(host, ins, 1.5 * mean, r)
         self.registered = True
 
-    def _push_weights(self, viewer: Viewer, ins: VertexInspection, r: float) -> None:
+    def _push_weights(self, host: Host, ins: VertexInspection, r: float) -> None:
         """The ring edges ``i–j`` coloured by ``w_ij`` (coolwarm, symmetric around 0), the
         negative ones drawn over in their own colour."""
-        d = viewer.display
-        nodes, edges, w = weight_segments(ins, viewer.mesh.V)
+        d = host.state.display
+        nodes, edges, w = weight_segments(ins, host.state.mesh.V)
         m = float(np.abs(w).max()) or 1.0
         cn = ps.register_curve_network(scene.INSPECT_WEIGHTS, d.points(nodes), edges)
         cn.set_radius(0.35 * r, relative=False)
@@ -198,10 +235,10 @@ class OneRingPanel:
             nc.set_radius(0.45 * r, relative=False)
             nc.set_color(scene.NEGATIVE_COLOR)
 
-    def _push_arrows(self, viewer: Viewer, ins: VertexInspection, length: float, r: float) -> None:
+    def _push_arrows(self, host: Host, ins: VertexInspection, length: float, r: float) -> None:
         """``n`` (``length`` long, world units) and ``Δ_cotan x`` (scaled to ``0.7 length``, so
         both show when they are parallel, as ``Δx = −2Hn`` makes them) as arrows at ``x_i``."""
-        d = viewer.display
+        d = host.state.display
         s_n, _ = arrow_scales(ins, length)
         _, s_lap = arrow_scales(ins, 0.7 * length)
         pc = ps.register_point_cloud(scene.INSPECT_ARROWS, d.points(ins.position[None, :]))
@@ -223,13 +260,14 @@ class OneRingPanel:
             f"(|Lx| = {float(np.linalg.norm(ins.laplacian_cotan)):.4g}; world units)"
         )
 
-    def focus(self, viewer: Viewer) -> None:
-        """Point the camera at the selected vertex, along its normal, framing the one-ring."""
-        r = viewer.ring
+    def focus(self, host: Host) -> bool:
+        """Point the camera at the selected vertex, along its normal, framing the one-ring
+        (nothing selected: the host frames the mesh)."""
+        r = self.state
         if r.valence == 0:
-            return
-        center = viewer.display.points(viewer.mesh.V[[r.vertex]])[0]
-        ring = viewer.display.points(r.polyline)
+            return False
+        center = host.state.display.points(host.state.mesh.V[[r.vertex]])[0]
+        ring = host.state.display.points(r.polyline)
         size = float(np.linalg.norm(ring - center, axis=1).max()) or 1.0
         normal = r.normal if np.linalg.norm(r.normal) > 0 else np.array([0.0, 0.0, 1.0])
         # tilt a little towards the up axis inside the tangent plane: looking straight along
@@ -242,9 +280,9 @@ class OneRingPanel:
         back = 2.4 * normal + 2.0 * tilt
         if np.linalg.norm(np.cross([0.0, 1.0, 0.0], back)) < 1e-6 * np.linalg.norm(back):
             ps.look_at(center + size * back, center)  # frame_points needs a non-vertical view
-            return
+            return True
         w, _ = ps.get_window_size()
-        fraction = scene_fraction(w, viewer.ui.scale)
+        fraction = scene_fraction(w, host.state.ui_scale)
         # as scene.frame_points does: shift the target right so the vertex lands in the middle
         # of the part of the window left of meshlap's panel
         right = np.cross([0.0, 1.0, 0.0], back)
@@ -254,16 +292,17 @@ class OneRingPanel:
         d = size * float(np.linalg.norm(back))
         target = center + (1.0 - fraction) * d * tan_h * right
         ps.look_at(target + size * back, target)
+        return True
 
-    def ring_labels(self, viewer: Viewer) -> list[tuple[tuple[float, float], str]]:
+    def ring_labels(self, host: Host) -> list[tuple[tuple[float, float], str]]:
         """Screen positions and texts of the order numbers ("0", "1", ...) of the one-ring."""
-        r = viewer.ring
+        r = self.state
         if r.valence == 0:
             return []
         params = ps.get_view_camera_parameters()
         w, h = ps.get_window_size()
         xy, front = project_to_screen(
-            viewer.display.points(r.polyline),
+            host.state.display.points(r.polyline),
             params.get_view_mat(),
             params.get_fov_vertical_deg(),
             w,
@@ -275,74 +314,72 @@ class OneRingPanel:
             if f
         ]
 
-    def draw_labels(self, viewer: Viewer) -> None:
+    def overlay(self, host: Host) -> None:
         """Write the order numbers next to the neighbours (over the 3D view), and the hovered
         vertex's index and field value at the cursor."""
-        self.labels = self.ring_labels(viewer)
+        self.labels = self.ring_labels(host)
         for pos, text in self.labels:
-            viewer.ui.overlay_text(pos, text)
-        self.draw_hover(viewer)
+            host.ui.overlay_text(pos, text)
+        self.draw_hover(host)
 
-    def draw_hover(self, viewer: Viewer) -> None:
+    def draw_hover(self, host: Host) -> None:
         """Pick under the cursor once it rests ``throttle.interval`` seconds at a new position
         (a moving cursor and an idle frame do no picking); show the answer at the cursor, and
         light the vertex's row in the inspector's tables while it shows."""
-        pos = viewer.ui.hover()
+        pos = host.ui.hover()
         if pos is None:
             self.hovered, self.hovered_vertex = "", -1
             return
         if self.throttle.due(self.clock(), pos):
             self.picks += 1
-            self.hovered = self.hover_text(viewer, pos)
+            self.hovered = self.hover_text(host, pos)
         if self.hovered and self.throttle.current(pos):  # nothing stale while moving
-            viewer.ui.overlay_text((pos[0] + 16, pos[1] + 12), self.hovered)
+            host.ui.overlay_text((pos[0] + 16, pos[1] + 12), self.hovered)
         else:
             self.hovered_vertex = -1  # a table row is lit only while its label shows
 
-    def hover_text(self, viewer: Viewer, pos: tuple[float, float]) -> str:
+    def hover_text(self, host: Host, pos: tuple[float, float]) -> str:
         """``"vertex i: <field> = value"`` for the mesh vertex under ``pos``, else ``""``."""
         self.hovered_vertex = -1
         res = ps.pick(screen_coords=pos)
         if not res.is_hit or res.structure_name != MESH:
             return ""
-        shown = viewer.display.points(viewer.mesh.V)
-        idx = viewer._vertex_of(res.structure_data, res.position, shown, viewer.mesh.F)
+        idx = picked_vertex(res, host.mesh_points(), host.state.mesh.F)
         if idx is None:
             return ""
         self.hovered_vertex = int(idx)
-        curv = viewer.curv
+        curv = host.state.curv
         values = curv.fields.get(curv.field_name)
         if values is None:
             return f"vertex {idx}"
         return f"vertex {idx}: {curv.field_name} = {float(values[idx]):.4g}"
 
-    def draw(self, viewer: Viewer) -> None:
-        ui = viewer.ui
-        if not ui.header("One-ring"):
+    def draw(self, host: Host) -> None:
+        ui = host.ui
+        if not ui.header(self.title):
             return
         ui.text("click a vertex of the mesh")
-        n = len(viewer.mesh.V)
-        r = viewer.ring
+        n = len(host.state.mesh.V)
+        r = self.state
         ch, v = ui.input_int(
             "vertex", max(r.vertex, 0), f"vertex index, 0 to {n - 1}; Enter or -/+ selects it"
         )
         if ch:
             if not 0 <= v < n:
                 raise MeshError(f"{v} is out of range (the mesh has {n} vertices)", "vertex")
-            self.select(viewer, v)
+            self.select(host, v)
         ch, _ = ui.checkbox(
             "clockwise (reverse)", r.reverse, "list the neighbours clockwise instead"
         )
         if ch:
-            r.toggle_reverse(viewer.mesh, viewer.curv)
-            self.push(viewer)
-        c = viewer.curv
+            r.toggle_reverse(host.state.mesh, host.state.curv)
+            self.push(host)
+        c = host.state.curv
         ch1, area = ui.combo("area kind", c.area, AREA_KINDS, AREA_HELP)
         ch2, rule = ui.combo("boundary rule", c.boundary, BOUNDARY_RULES, BOUNDARY_HELP)
         if ch1 or ch2:
-            r.set_rules(viewer.mesh, c, area, rule)
-            viewer.push_curvature(force=True)
-            self.push(viewer)
+            r.set_rules(host.state.mesh, c, area, rule)  # the mesh's colours follow (sync)
+            self.push(host)
         if r.vertex < 0:
             return
         kind = "boundary vertex (open fan)" if r.boundary else "interior vertex (closed cycle)"
@@ -355,28 +392,28 @@ class OneRingPanel:
             if r.inspection_error:
                 ui.error(r.inspection_error)
             return
-        self.draw_inspection(viewer, r.inspection)
+        self.draw_inspection(host, r.inspection)
 
-    def draw_inspection(self, viewer: Viewer, ins: VertexInspection) -> None:
+    def draw_inspection(self, host: Host, ins: VertexInspection) -> None:
         """The inspector's tables and formulas, and the legend of its 3D drawings."""
-        ui = viewer.ui
+        ui = host.ui
         if not ins.manifold:
             ui.error(f"non-manifold vertex: {len(ins.fans)} fans (faces of each, ring per fan)")
             for k, fan in enumerate(ins.fans):
                 ui.text(f"  fan {k}: faces {', '.join(str(f) for f in fan)}")
-        self.draw_legend(viewer, ins)
+        self.draw_legend(host, ins)
         if ui.header("weights per neighbour (ring order)"):
-            self.draw_neighbours(viewer, ins)
+            self.draw_neighbours(host, ins)
         if ui.header("incident faces", default_open=False):
-            self.draw_faces(viewer, ins)
+            self.draw_faces(host, ins)
         if ui.header("the vertex: formulas with numbers"):
             lines = format_inspection(ins).splitlines()
             start = next(k for k, line in enumerate(lines) if line.startswith("A_i"))
             for line in lines[start:]:
                 ui.text(line.translate(ASCII_MATH))
 
-    def draw_legend(self, viewer: Viewer, ins: VertexInspection) -> None:
-        ui = viewer.ui
+    def draw_legend(self, host: Host, ins: VertexInspection) -> None:
+        ui = host.ui
         w = np.array([t.weight_cotan for t in ins.neighbors])
         m = float(np.abs(w).max()) if len(w) else 0.0
         ui.note(
@@ -389,12 +426,12 @@ class OneRingPanel:
         if self.arrow_text:
             ui.note(self.arrow_text)
 
-    def draw_neighbours(self, viewer: Viewer, ins: VertexInspection) -> None:
+    def draw_neighbours(self, host: Host, ins: VertexInspection) -> None:
         """Two tables in ring order: the weights (negative rows in magenta), then each
         neighbour's contribution ``w_ij (x_j − x_i)`` and their sum ``A_i Δx``; the row of the
         neighbour under the cursor in 3D is lit."""
-        ui = viewer.ui
-        rows = viewer.ring.rows()
+        ui = host.ui
+        rows = self.state.rows()
         scale = max((abs(t.weight_cotan) for t in rows), default=0.0)
         with ui.table("weights", NEIGHBOUR_HEADERS, NEIGHBOUR_TIPS):
             for t in rows:
@@ -415,9 +452,9 @@ class OneRingPanel:
                 )
             ui.row(["sum", *(sig(float(c), size) for c in total)])
 
-    def draw_faces(self, viewer: Viewer, ins: VertexInspection) -> None:
+    def draw_faces(self, host: Host, ins: VertexInspection) -> None:
         """The incident faces in ring order: corner angle, area, obtuse, both area shares."""
-        ui = viewer.ui
+        ui = host.ui
         with ui.table("faces", FACE_HEADERS, FACE_TIPS):
             for f in ins.faces:
                 ui.row(face_cells(f))
@@ -481,3 +518,6 @@ def face_cells(f: FaceTerm) -> list[str]:
         f"{f.share_voronoi:.4g}",
         rule,
     ]
+
+
+PANEL = OneRingPanel

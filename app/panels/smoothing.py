@@ -1,113 +1,197 @@
 """The Smoothing panel: a smoother stepped live beside its input (state in
-:mod:`..state.smoothing`)."""
+:mod:`..state.smoothing`), its play / record, and ``meshlap animate --panel smoothing``."""
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from collections.abc import Iterator
+from typing import Any
 
 import numpy as np
 import polyscope as ps
 
+from meshlap_core.errors import MeshError
 from meshlap_core.options import LAPLACIAN_KINDS as LAPLACIANS
 
-from ..animate import smoothing_caption
+from .. import scene
 from ..record import Recorder, draw_record
-from ..scene import (
-    INPUT_COLOR,
-    MESH,
-    SMOOTH_INPUT,
-    SMOOTHED,
-    SMOOTHED_COLOR,
-    Display,
-    side_offset,
+from ..scene import INPUT_COLOR, SMOOTH_INPUT, SMOOTHED, SMOOTHED_COLOR, side_offset
+from ..state.smoothing import (
+    ANIMATION,
+    METHODS,
+    SmoothingState,
+    caption,
+    encode_lam_steps,
+    replay_steps,
 )
-from ..state.smoothing import METHODS, SmoothingState
-
-if TYPE_CHECKING:
-    from ..ui import UI
-    from ..viewer import Viewer
+from ..ui import UI
+from .base import ExportItem, Host, Panel
 
 
-class SmoothingPanel:
+class SmoothingPanel(Panel):
     """Method, Laplacian, λ, noise; step / play / pause / reset; live figures; g(μ)."""
 
-    def __init__(self) -> None:
-        self.state = SmoothingState()
-        self._registered = -1
-        self._shown_iteration = -1
-        self._shift = np.zeros(3)
-        self.new_copy = False
-        self.display = Display()  # the viewer's, set in on_new_mesh
-        self.recorder = Recorder("smoothing.gif")
+    title = "Smoothing"
+    shows_mesh = False  # the input and the smoothed copy replace it
+    framed = (SMOOTHED, SMOOTH_INPUT)
+    keys = ("space", "right", "r")
+    shortcuts = (
+        ("space", "smoothing: play / pause"),
+        ("right", "smoothing: one step"),
+        ("R", "smoothing: back to the input"),
+    )
 
-    def on_new_mesh(self, viewer: Viewer) -> None:
-        self.display = viewer.display
+    def __init__(self, name: str, state: SmoothingState) -> None:
+        super().__init__(name, state)
+        self.state: SmoothingState = state
+        self.recorder = Recorder(f"{name}.gif")
+
+    def on_new_mesh(self, host: Host) -> None:
         self.state.smoother = None
         self.state.playing = False
         for name in (SMOOTHED, SMOOTH_INPUT):
-            if ps.has_surface_mesh(name):
-                ps.remove_surface_mesh(name)
-        self._registered = -1
+            scene.remove_structure(name)
+        self.watch.forget()
 
-    def show(self, viewer: Viewer, panel: str) -> None:
-        if panel == "smoothing" and self.state.smoother is None:
-            self.rebuild(viewer)
+    def show(self, host: Host, active: Panel) -> None:
+        if active is self and self.state.smoother is None:
+            self.rebuild(host)
         for name in (SMOOTHED, SMOOTH_INPUT):
             if ps.has_surface_mesh(name):
-                ps.get_surface_mesh(name).set_enabled(panel == "smoothing")
-        if ps.has_surface_mesh(MESH) and panel == "smoothing":
-            ps.get_surface_mesh(MESH).set_enabled(False)
+                ps.get_surface_mesh(name).set_enabled(active is self)
 
-    def rebuild(self, viewer: Viewer) -> None:
-        if self.state.rebuild(viewer.mesh.V, viewer.mesh.F):
-            self.push(force=True)
+    def rebuild(self, host: Host) -> None:
+        if self.state.rebuild(host.state.mesh.V, host.state.mesh.F):
+            self.push(host, force=True)
 
-    def push(self, force: bool = False) -> None:
+    def _shift(self, host: Host) -> np.ndarray:
+        st, d = self.state, host.state.display
+        key = (st.version, d.scale, *d.centre.tolist())
+        return self.watch.cached("shift", key, lambda: side_offset(d.points(st.V_start)))
+
+    def push(self, host: Host, force: bool = False) -> None:
         """Upload the current positions (position update; re-register only on a rebuild)."""
         st = self.state
         if st.smoother is None:
             return
-        d = self.display
-        if self._registered != st.version:
-            start = d.points(st.V_start)
-            self._shift = side_offset(start)
+        d = host.state.display
+        if self.watch.changed("registered", st.version, id(st.smoother)):
             # the input (with its noise) stays put; the smoothed copy moves beside it
-            inp = ps.register_surface_mesh(SMOOTH_INPUT, start, st.F, smooth_shade=True)
+            inp = ps.register_surface_mesh(
+                SMOOTH_INPUT, d.points(st.V_start), st.F, smooth_shade=True
+            )
             inp.set_color(INPUT_COLOR)
             sm = ps.register_surface_mesh(
-                SMOOTHED, d.points(st.V) + self._shift, st.F, smooth_shade=True
+                SMOOTHED, d.points(st.V) + self._shift(host), st.F, smooth_shade=True
             )
             sm.set_color(SMOOTHED_COLOR)
-            self._registered = st.version
-            self.new_copy = True  # the viewer re-frames
-        elif force or st.smoother.iteration != self._shown_iteration:
-            ps.get_surface_mesh(SMOOTHED).update_vertex_positions(d.points(st.V) + self._shift)
-        self._shown_iteration = st.smoother.iteration
+            self.watch.changed("iteration", st.smoother.iteration)
+            host.request_frame()  # a new copy: frame it
+        elif self.watch.changed("iteration", st.smoother.iteration) or force:
+            ps.get_surface_mesh(SMOOTHED).update_vertex_positions(
+                d.points(st.V) + self._shift(host)
+            )
 
-    def points(self, viewer: Viewer, name: str) -> np.ndarray | None:
+    def points(self, host: Host, name: str) -> np.ndarray | None:
         """Display positions of a structure this panel registered (for camera framing)."""
-        if self.state.smoother is None:
+        st = self.state
+        if st.smoother is None:
             return None
         if name == SMOOTHED:
-            return self.display.points(self.state.V) + self._shift
-        return self.display.points(self.state.V_start) if name == SMOOTH_INPUT else None
+            return host.state.display.points(st.V) + self._shift(host)
+        return host.state.display.points(st.V_start) if name == SMOOTH_INPUT else None
 
-    def prepare_screenshot(self, viewer: Viewer, iterations: int = 10) -> None:
+    def captions(self, host: Host) -> dict[str, str]:
+        sm = self.state
+        if sm.smoother is None:
+            return {}
+        noisy = f"noisy alpha = {sm.noise_alpha:g}" if sm.noise_alpha else "no noise"
+        return {
+            SMOOTH_INPUT: f"input, {noisy}",
+            SMOOTHED: f"{sm.method}, lambda = {sm.lam:g}, {sm.smoother.iteration} steps",
+        }
+
+    def export_items(self, host: Host) -> list[ExportItem]:
+        """The smoothed mesh as it is now (PLY)."""
+        st = self.state
+        if st.smoother is None:
+            return []
+        name = f"{host.state.mesh.stem}_{st.method}_{st.laplacian}_it{st.smoother.iteration}.ply"
+        return [(name, np.array(st.V), st.F, None)]
+
+    def on_key(self, host: Host, key: str) -> bool:
+        st = self.state
+        if key == "space":
+            st.playing = not st.playing
+        elif key == "right":
+            st.step()
+        elif key == "r":
+            st.reset()
+            self.push(host, force=True)
+        else:
+            return False
+        return True
+
+    # ------------------------------------------------------------------ sessions, start
+    def capture(self, host: Host) -> dict[str, Any]:
+        sm = self.state
+        return {
+            "method": sm.method,
+            "laplacian": sm.laplacian,
+            "lam": float(sm.lam),
+            "noise_alpha": float(sm.noise_alpha),
+            "seed": int(sm.seed),
+            "iterations": int(sm.smoother.iteration) if sm.smoother is not None else 0,
+            "lam_steps": (
+                encode_lam_steps(sm.lam_steps, sm.lam) if sm.smoother is not None else None
+            ),
+        }
+
+    def configure(self, host: Host, values: dict[str, Any]) -> None:
+        st = self.state
+        st.method, st.laplacian = values["method"], values["laplacian"]
+        st.lam, st.noise_alpha, st.seed = values["lam"], values["noise_alpha"], values["seed"]
+        st.smoother, st.playing = None, False
+
+    def restore(self, host: Host, values: dict[str, Any], active: bool) -> None:
+        """When the run had steps (or this view is shown), rebuild and replay them, each run of
+        steps with the λ it used (``lam_steps``), then set the saved ``lam``."""
+        self.configure(host, values)
+        if not (active or values["iterations"]):
+            return
+        st = self.state
+        runs = replay_steps(values)
+        st.lam = runs[0][0] if runs else values["lam"]  # the stepper is built with the first λ
+        if not st.rebuild(host.state.mesh.V, host.state.mesh.F):
+            st.lam = values["lam"]  # (set_lam would clear the error the panel shows)
+            return
+        for lam, steps in runs:
+            st.set_lam(lam)
+            if not all(st.step() for _ in range(steps)):
+                break  # a diverging run stops where it stopped when it was saved
+        st.set_lam(values["lam"])
+        self.push(host, force=True)
+
+    def start(self, host: Host, options: dict[str, Any], shown: bool, screenshot: bool) -> None:
+        if shown:
+            self.prepare_screenshot(host)
+
+    def prepare_screenshot(self, host: Host, iterations: int = 10) -> None:
         """Add a little noise, smooth a few steps and show the result (headless render)."""
         st = self.state
         st.noise_alpha = 0.004
-        self.rebuild(viewer)
+        self.rebuild(host)
         for _ in range(iterations):
             st.step()
-        self.push(force=True)
-        viewer.show_panel()
+        self.push(host, force=True)
+        host.refresh()
 
-    def draw(self, viewer: Viewer) -> None:
-        ui = viewer.ui
-        if not ui.header("Smoothing"):
+    # ------------------------------------------------------------------ widgets
+    def draw(self, host: Host) -> None:
+        ui = host.ui
+        if not ui.header(self.title):
             return
         st = self.state
-        V, F = viewer.mesh.V, viewer.mesh.F
+        V, F = host.state.mesh.V, host.state.mesh.F
         ch, method = ui.combo(
             "method",
             st.method,
@@ -117,7 +201,7 @@ class SmoothingPanel:
         )
         if ch:
             st.configure(V, F, method=method)
-            self.push(force=True)
+            self.push(host, force=True)
         ch, lap = ui.combo(
             "Laplacian",
             st.laplacian,
@@ -126,7 +210,7 @@ class SmoothingPanel:
         )
         if ch:
             st.configure(V, F, laplacian=lap)
-            self.push(force=True)
+            self.push(host, force=True)
         ch, lam = ui.input_float(
             "lambda",
             st.lam,
@@ -146,11 +230,11 @@ class SmoothingPanel:
         )
         if ch:
             st.configure(V, F, noise_alpha=alpha)
-            self.push(force=True)
+            self.push(host, force=True)
         ch, seed = ui.input_int("noise seed", st.seed, "seed of the noise (an integer >= 0)")
         if ch:
             st.configure(V, F, seed=seed)
-            self.push(force=True)
+            self.push(host, force=True)
         if ui.button("step", "one iteration"):
             st.step()
         ui.same_line()
@@ -159,17 +243,16 @@ class SmoothingPanel:
         ui.same_line()
         if ui.button("reset", "back to the (noisy) input, iteration 0"):
             st.reset()
-            self.push(force=True)
+            self.push(host, force=True)
         if st.playing:
             st.step()
-        self.push()
-        if self.new_copy:
-            viewer.reframe, self.new_copy = True, False
+        self.push(host)
         if st.error:
             ui.error(st.error)
         self.draw_figures(ui)
         it = st.smoother.iteration if st.smoother is not None else None
-        draw_record(viewer, self.recorder, (st.version, it), lambda: smoothing_caption(st))
+        fps = ANIMATION.fps[ANIMATION.kind({})]
+        draw_record(host, self.recorder, (st.version, it), lambda: caption(st), fps)
 
     def draw_figures(self, ui: UI) -> None:
         """Iteration, RMSE, volume change, the stable limit and the amplification plot."""
@@ -200,3 +283,55 @@ class SmoothingPanel:
                 ui.plot_y_limits(lo, hi)
                 ui.plot_line("g", mu, g)
                 ui.plot_hlines("|g| = 1", np.array([-1.0, 1.0]))
+
+    # ------------------------------------------------------------------ meshlap animate
+    def frames(self, host: Host, options: dict[str, Any]) -> Iterator[str]:
+        """Iterations 0..iters of the stepper (input beside the smoothed copy).
+
+        A stepper already built with the same options (a restored session) is reset to
+        iteration 0 and kept (same noise: same seed); otherwise it is rebuilt with
+        ``options``. Step ``i`` uses the ``i``-th λ of ``options["lam_steps"]`` (a session whose
+        λ changed mid-run: the last frame is the saved view), then ``options["lam"]``.
+        """
+        st = self.state
+        wanted = (
+            options["method"],
+            options["laplacian"],
+            options["lam"],
+            options["noise"],
+            options["seed"],
+        )
+        if (
+            st.smoother is not None
+            and (
+                st.method,
+                st.laplacian,
+                st.lam,
+                st.noise_alpha,
+                st.seed,
+            )
+            == wanted
+        ):
+            st.reset()
+        else:
+            st.method, st.laplacian, st.lam, st.noise_alpha, st.seed = wanted
+            if not st.rebuild(host.state.mesh.V, host.state.mesh.F):
+                raise MeshError(st.error)
+        self.push(host, force=True)
+        host.refresh()
+        host.frame(0.0)  # no colour map: no colour bar
+        steps = options.get("lam_steps")
+        schedule = [float(lam) for lam, n in steps or [] for _ in range(int(n))]
+        iters = int(options["iters"])
+        for it in range(iters + 1):
+            if it > 0:
+                lam = schedule[it - 1] if it <= len(schedule) else options["lam"]
+                if lam != st.lam:
+                    st.set_lam(lam)
+                if not st.step():
+                    raise MeshError(st.error or "the smoothing stopped", "--lam")
+            self.push(host)
+            yield caption(st, iters)
+
+
+PANEL = SmoothingPanel

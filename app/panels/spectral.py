@@ -1,64 +1,73 @@
 """The Spectral panel: eigenmodes and the k-reconstruction beside the mesh (state in
-:mod:`..state.spectral`)."""
+:mod:`..state.spectral`), its play / record, and ``meshlap animate --panel spectral``."""
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+import sys
+from collections.abc import Iterator
+from typing import Any
 
 import numpy as np
 import polyscope as ps
 
+from meshlap_core.errors import MeshError
+
+from .. import scene
 from ..record import Recorder, draw_record
 from ..scene import COLORBAR_AT, EIGEN, MESH, RECON, side_offset
-from ..state.spectral import PLAY_KINDS, SpectralState
-
-if TYPE_CHECKING:
-    from ..viewer import Viewer
+from ..state.spectral import ANIMATION, PLAY_KINDS, SCREENSHOT_K, SpectralState
+from .base import ExportItem, Host, Panel
 
 
-class SpectralPanel:
+class SpectralPanel(Panel):
     """Eigenmode browser and k slider; the reconstruction sits beside the original."""
 
-    def __init__(self) -> None:
-        self.state = SpectralState()
-        self._shown_k = -1
-        self._shown_mode = -1
-        self.recorder = Recorder("spectral.gif")
-        self._offset_key: tuple[object, ...] = ()
-        self._offset_value = np.zeros(3)
+    title = "Spectral"
+    framed = (RECON,)
+    keys = ("right", "left")
+    shortcuts = (("right / left", "spectral: k + 1 / k - 1"),)
 
-    def on_new_mesh(self, viewer: Viewer) -> None:
+    def __init__(self, name: str, state: SpectralState) -> None:
+        super().__init__(name, state)
+        self.state: SpectralState = state
+        self.recorder = Recorder(f"{name}.gif")
+
+    def busy(self) -> str:
+        return "the eigenbasis is still being computed" if self.state.busy else ""
+
+    def on_new_mesh(self, host: Host) -> None:
         self.state.clear()
-        self._shown_k = self._shown_mode = -1
-        self._offset_key = ()
-        if ps.has_surface_mesh(RECON):
-            ps.remove_surface_mesh(RECON)
+        self.watch.forget()
+        scene.remove_structure(RECON)
 
-    def show(self, viewer: Viewer, panel: str) -> None:
+    def show(self, host: Host, active: Panel) -> None:
         if ps.has_surface_mesh(RECON):
-            ps.get_surface_mesh(RECON).set_enabled(panel == "spectral")
-        if panel == "spectral" and self.state.basis is not None:
-            self.push_mode(viewer, force=True)
-        elif self._shown_mode >= 0 and ps.has_surface_mesh(MESH):
+            ps.get_surface_mesh(RECON).set_enabled(active is self)
+        if active is self and self.state.basis is not None:
+            self.push_mode(host, force=True)
+        elif self.watch.seen("mode") is not None and ps.has_surface_mesh(MESH):
             # the eigenfunction's colour bar stays on screen while the mesh is hidden
             ps.get_surface_mesh(MESH).remove_quantity(EIGEN)
-            self._shown_mode = -1
+            self.watch.forget("mode")
 
-    def _offset(self, viewer: Viewer) -> np.ndarray:
+    def sync(self, host: Host) -> None:
+        """Adopt a basis the worker finished, once this view is shown."""
+        if host.active() is self:
+            self.adopt(host)
+
+    def _offset(self, host: Host) -> np.ndarray:
         """Where the reconstruction sits beside the mesh: computed from all vertices once per
         mesh and display fit (not on every k move)."""
-        d = viewer.display
-        key = (id(viewer.mesh), viewer.mesh.version, d.scale, *d.centre.tolist())
-        if key != self._offset_key:
-            self._offset_value = side_offset(d.points(viewer.mesh.V))
-            self._offset_key = key
-        return self._offset_value
+        d, mesh = host.state.display, host.state.mesh
+        key = (id(mesh), mesh.version, d.scale, *d.centre.tolist())
+        return self.watch.cached("offset", key, lambda: side_offset(host.mesh_points()))
 
-    def push_mode(self, viewer: Viewer, force: bool = False) -> None:
+    def push_mode(self, host: Host, force: bool = False) -> None:
         st = self.state
-        if st.basis is None or (st.mode == self._shown_mode and not force):
+        if st.basis is None:
             return
-        self._shown_mode = st.mode
+        if not self.watch.changed("mode", st.mode, id(st.basis)) and not force:
+            return
         f, _ = st.eigenfunction()
         r = float(np.abs(f).max()) or 1.0
         ps.get_surface_mesh(MESH).add_scalar_quantity(
@@ -71,15 +80,16 @@ class SpectralPanel:
             onscreen_colorbar_location=COLORBAR_AT,
         )
 
-    def push_k(self, viewer: Viewer, force: bool = False) -> None:
+    def push_k(self, host: Host, force: bool = False) -> None:
         st = self.state
-        if st.basis is None or (st.k == self._shown_k and not force):
+        if st.basis is None:
             return
-        self._shown_k = st.k
-        X = viewer.display.points(st.reconstruction) + self._offset(viewer)
+        if not self.watch.changed("k", st.k, id(st.basis)) and not force:
+            return
+        X = host.state.display.points(st.reconstruction) + self._offset(host)
         if not ps.has_surface_mesh(RECON):
-            ps.register_surface_mesh(RECON, X, viewer.mesh.F, smooth_shade=True)
-            viewer.reframe = True  # a new copy beside the mesh
+            ps.register_surface_mesh(RECON, X, host.state.mesh.F, smooth_shade=True)
+            host.request_frame()  # a new copy beside the mesh
         else:
             ps.get_surface_mesh(RECON).update_vertex_positions(X)
         hi = float(st.errors.max[st.k]) or 1.0  # precomputed for every k
@@ -87,40 +97,107 @@ class SpectralPanel:
             "error |x - x_k|", st.vertex_error, cmap="reds", vminmax=(0.0, hi), enabled=True
         )
 
-    def points(self, viewer: Viewer, name: str) -> np.ndarray | None:
+    def points(self, host: Host, name: str) -> np.ndarray | None:
         """Display positions of a structure this panel registered (for camera framing): the
         reconstruction is framed as the mesh it approximates, shifted beside it, so the camera
         holds still while k changes (x_1 is a single point: framing it would cut the later
         copies off)."""
         if name == RECON and self.state.basis is not None:
-            return viewer.display.points(viewer.mesh.V) + self._offset(viewer)
+            return host.mesh_points() + self._offset(host)
         return None
 
-    def adopt(self, viewer: Viewer) -> None:
+    def captions(self, host: Host) -> dict[str, str]:
+        st = self.state
+        if st.basis is None:
+            return {}
+        return {MESH: f"eigenfunction u_{st.mode}", RECON: f"k = {st.k} of {st.basis.k_max} modes"}
+
+    def export_items(self, host: Host) -> list[ExportItem]:
+        """The k-reconstruction (PLY with the per-vertex error) and the shown eigenfunction
+        (CSV)."""
+        st = self.state
+        if st.basis is None:
+            return []
+        stem = host.state.mesh.stem
+        f, _ = st.eigenfunction()
+        return [
+            (f"{stem}_k{st.k}.ply", st.reconstruction, host.state.mesh.F, st.vertex_error),
+            (f"{stem}_mode{st.mode}.csv", None, None, f),
+        ]
+
+    def on_key(self, host: Host, key: str) -> bool:
+        st = self.state
+        if key not in ("right", "left") or st.basis is None:
+            return False
+        st.set_k(st.k + (1 if key == "right" else -1))
+        self.push_k(host)
+        return True
+
+    # ------------------------------------------------------------------ sessions, start
+    def capture(self, host: Host) -> dict[str, Any]:
+        st = self.state
+        computed = st.basis is not None
+        return {
+            "computed": computed,
+            "k_request": int(st.basis.k_max if computed else st.k_request),
+            "k": int(st.k),
+            "mode": int(st.mode),
+            "play": st.play_what,
+        }
+
+    def configure(self, host: Host, values: dict[str, Any]) -> None:
+        st = self.state
+        st.k_request = min(values["k_request"], max(len(host.state.mesh.V), 2))
+        st.k, st.mode = values["k"], values["mode"]
+        st.set_play_what(values["play"])
+
+    def restore(self, host: Host, values: dict[str, Any], active: bool) -> None:
+        """The basis (from the cache when it was computed before), mode and k."""
+        self.configure(host, values)  # the new mesh cleared them
+        if not values["computed"]:
+            return
+        st = self.state
+        st.start(host.state.mesh.V, host.state.mesh.F, background=False)  # cache=True by default
+        if st.basis is None:
+            return  # the error is shown in the Spectral panel
+        st.set_mode(values["mode"])
+        st.set_k(values["k"])
+        self.push_mode(host, force=True)
+        self.push_k(host, force=True)
+
+    def start(self, host: Host, options: dict[str, Any], shown: bool, screenshot: bool) -> None:
+        k = options.get("k")
+        if k is None and shown and screenshot:
+            k = SCREENSHOT_K  # a spectral screenshot shows a reconstruction, not an empty panel
+        if k is not None:
+            self.prepare_screenshot(host, k)
+
+    def adopt(self, host: Host) -> None:
         """Show a basis that just finished."""
         if self.state.poll():
-            self.push_mode(viewer, force=True)
-            self.push_k(viewer, force=True)
+            self.push_mode(host, force=True)
+            self.push_k(host, force=True)
 
-    def prepare_screenshot(self, viewer: Viewer, k: int) -> None:
+    def prepare_screenshot(self, host: Host, k: int) -> None:
         """Compute synchronously (headless render) and show the reconstruction from k modes."""
         st = self.state
         st.k_request = max(k, 10)
         st.k = k
-        st.start(viewer.mesh.V, viewer.mesh.F, background=False)
+        st.start(host.state.mesh.V, host.state.mesh.F, background=False)
         if st.error:
             return
-        self.push_mode(viewer, force=True)
-        self.push_k(viewer, force=True)
-        viewer.show_panel()
+        self.push_mode(host, force=True)
+        self.push_k(host, force=True)
+        host.refresh()
 
-    def draw(self, viewer: Viewer) -> None:
-        ui = viewer.ui
-        if not ui.header("Spectral"):
+    # ------------------------------------------------------------------ widgets
+    def draw(self, host: Host) -> None:
+        ui = host.ui
+        if not ui.header(self.title):
             return
         st = self.state
-        self.adopt(viewer)
-        n = len(viewer.mesh.V)
+        self.adopt(host)
+        n = len(host.state.mesh.V)
         ch, k_request = ui.input_int(
             "modes to compute",
             st.k_request,
@@ -131,7 +208,7 @@ class SpectralPanel:
         if st.busy:
             ui.progress(st.progress, st.message or "working")
         elif ui.button("compute eigenbasis", "solve for the modes in the background"):
-            st.start(viewer.mesh.V, viewer.mesh.F)
+            st.start(host.state.mesh.V, host.state.mesh.F)
         if st.error:
             ui.error(st.error)
         if st.basis is None:
@@ -148,7 +225,7 @@ class SpectralPanel:
         )
         if ch:
             st.set_mode(mode)
-            self.push_mode(viewer)
+            self.push_mode(host)
         _, lam = st.eigenfunction()
         ui.text(f"lambda_{st.mode} = {lam:.6g}  (frequency of -Laplacian, >= 0)")
         ch, k = ui.slider_int(
@@ -160,7 +237,7 @@ class SpectralPanel:
         )
         if ch:
             st.set_k(k)
-            self.push_k(viewer)
+            self.push_k(host)
         e = st.errors
         ui.text(
             f"k = {st.k}: mean error {e.mean[st.k]:.4g}, max {e.max[st.k]:.4g} "
@@ -170,12 +247,12 @@ class SpectralPanel:
             if ok:
                 ui.plot_line("mean |x - x_k|", e.k[1:], e.mean[1:])
                 ui.plot_vlines("current k", np.array([float(st.k)]))
-        self.draw_play(viewer)
-        draw_record(viewer, self.recorder, (st.k, st.mode), self._record_caption, self._record_kind)
+        self.draw_play(host)
+        draw_record(host, self.recorder, (st.k, st.mode), self._record_caption, self._record_fps)
 
-    def draw_play(self, viewer: Viewer) -> None:
+    def draw_play(self, host: Host) -> None:
         """What plays (the k sweep or the eigenmodes), play / pause, and this frame's step."""
-        ui, st = viewer.ui, self.state
+        ui, st = host.ui, self.state
         ch, what = ui.combo(
             "play what",
             st.play_what,
@@ -195,17 +272,79 @@ class SpectralPanel:
                 self.recorder.restart()  # the file starts with the first k (or mode) played
         elif not st.tick():  # the first k (or mode) of a play shows for a frame of its own
             return
-        self.push_k(viewer)
-        self.push_mode(viewer)
+        self.push_k(host)
+        self.push_mode(host)
 
     def _record_kind(self) -> str:
         """What changed since the last recorded frame: ``k`` or ``modes`` (the play choice for
         the first frame)."""
         last = self.recorder.last
         if last is None:
-            return "k" if self.state.play_what == "k sweep" else "modes"
+            return "k" if self.state.play_what == PLAY_KINDS[0] else "modes"
         return "k" if last[0] != self.state.k else "modes"
+
+    def _record_fps(self) -> float:
+        return ANIMATION.fps[self._record_kind()]
 
     def _record_caption(self) -> str:
         st = self.state
         return st.k_caption() if self._record_kind() == "k" else st.mode_caption()
+
+    # ------------------------------------------------------------------ meshlap animate
+    def _basis(self, host: Host, k: int) -> SpectralState:
+        """Compute (or read from the cache) ``k`` eigenpairs synchronously."""
+        st = self.state
+        if st.basis is not None and not st.error and st.basis.k_max >= k:
+            return st  # restored from a session: its basis has enough modes
+        st.k_request = k
+        sys.stderr.write(f"meshlap: animate: {k} eigenpairs (from the cache after the first run)\n")
+        st.start(host.state.mesh.V, host.state.mesh.F, background=False)
+        if st.error or st.basis is None:
+            raise MeshError(st.error or "the eigenbasis could not be computed", self.name)
+        return st
+
+    def frames(self, host: Host, options: dict[str, Any]) -> Iterator[str]:
+        """The k sweep (``options["k"] = (A, B)``: the reconstruction from the first k modes
+        beside the mesh, coloured by the error |x - x_k| on each k's own scale) or the
+        eigenmodes (``options["modes"]``: u_A..u_B as colour maps on the mesh)."""
+        if options.get("modes") is not None:
+            yield from self._mode_frames(host, options["modes"])
+        else:
+            yield from self._k_frames(host, options["k"])
+
+    def _k_frames(self, host: Host, k_range: tuple[int, int]) -> Iterator[str]:
+        a, b = k_range
+        host.refresh()  # before the basis exists: no eigenfunction on the mesh
+        ps.get_surface_mesh(MESH).remove_all_quantities()  # the original plain beside x_k
+        st = self._basis(host, max(b, 2))
+        st.set_k(a)
+        self.push_k(host, force=True)
+        host.frame(scene.COLORBAR_STRIP)
+        e = st.errors
+        for k in range(a, b + 1):
+            st.set_k(k)
+            self.push_k(host)
+            ps.get_surface_mesh(RECON).add_scalar_quantity(
+                "error |x - x_k|",
+                st.vertex_error,
+                cmap="reds",
+                vminmax=(0.0, float(e.max[k]) or 1.0),  # as the viewer: this k's largest error
+                enabled=True,
+                onscreen_colorbar_enabled=True,
+                onscreen_colorbar_location=COLORBAR_AT,
+            )
+            yield st.k_caption()  # shared with the viewer's recording
+
+    def _mode_frames(self, host: Host, mode_range: tuple[int, int]) -> Iterator[str]:
+        a, b = mode_range
+        host.refresh()
+        st = self._basis(host, max(b + 1, 2))
+        scene.remove_structure(RECON)
+        host.frame(scene.COLORBAR_STRIP)
+        for m in range(a, b + 1):
+            st.set_mode(m)
+            self.push_mode(host, force=True)
+            yield st.mode_caption()  # shared with the viewer's recording
+
+
+PANEL = SpectralPanel

@@ -4,59 +4,98 @@ normal section at an angle θ (drawn in 3D; ``meshlap animate --theta`` draws it
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from collections.abc import Iterator
+from typing import Any
 
 import numpy as np
 import polyscope as ps
 
-from ..animate import NORMAL_SECTION, SECTION_DIRECTION
+from meshlap_core.errors import MeshError
+
+from .. import scene
 from ..record import Recorder, draw_record
-from ..scene import COLORBAR_AT, SURFACE, SURFACE_POINT, Z_TO_Y
-from ..state.surface import TURN_STEP_DEG, section_arc
+from ..scene import (
+    COLORBAR_AT,
+    NORMAL_SECTION,
+    SECTION_DIRECTION,
+    SURFACE,
+    SURFACE_POINT,
+    Z_TO_Y,
+    picked_vertex,
+)
+from ..state.surfaces import ANIMATION, TURN_STEP_DEG, SurfaceState, section_arc
 from ..ui import sig
-
-if TYPE_CHECKING:
-    from ..viewer import Viewer
+from .base import ExportItem, Host, Panel
 
 
-class SurfacesPanel:
+class SurfacesPanel(Panel):
     """Surface choice, (u, v) sliders, fundamental forms, principal directions, k_n(θ), the
     normal section at θ (slider, *turn*) and its recording."""
 
+    title = "Surfaces"
+    shows_mesh = False  # a parametric surface instead of the mesh
+    framed = (SURFACE,)
+    view_direction = scene.OBLIQUE_VIEW
     SECTION_COLOR = (0.95, 0.55, 0.05)
 
-    def __init__(self) -> None:
-        self._version = -1
-        self.recorder = Recorder("surfaces.gif")
+    def __init__(self, name: str, state: SurfaceState) -> None:
+        super().__init__(name, state)
+        self.state: SurfaceState = state
+        self.recorder = Recorder(f"{name}.gif")
 
-    def on_new_mesh(self, viewer: Viewer) -> None:
-        return None
-
-    def show(self, viewer: Viewer, panel: str) -> None:
-        if panel == "surfaces":
-            self.push(viewer)
+    def show(self, host: Host, active: Panel) -> None:
+        if active is self:
+            self.push(host)
         elif ps.has_surface_mesh(SURFACE):  # hidden, its K colour bar would stay on screen
             ps.remove_surface_mesh(SURFACE)
-            self._version = -1  # registered again when the panel comes back
+            self.watch.forget("surface")  # registered again when the panel comes back
         if ps.has_point_cloud(SURFACE_POINT):
-            ps.get_point_cloud(SURFACE_POINT).set_enabled(panel == "surfaces")
+            ps.get_point_cloud(SURFACE_POINT).set_enabled(active is self)
         if ps.has_curve_network(NORMAL_SECTION):
-            ps.get_curve_network(NORMAL_SECTION).set_enabled(panel == "surfaces")
+            ps.get_curve_network(NORMAL_SECTION).set_enabled(active is self)
 
-    def points(self, viewer: Viewer, name: str) -> np.ndarray | None:
-        if name == SURFACE and viewer.surf.mesh is not None:
-            return viewer.surf.mesh.V @ Z_TO_Y[:3, :3].T
+    def points(self, host: Host, name: str) -> np.ndarray | None:
+        if name == SURFACE and self.state.mesh is not None:
+            return self.state.mesh.V @ Z_TO_Y[:3, :3].T
         return None
 
-    def push(self, viewer: Viewer) -> None:
-        surf = viewer.surf
+    def pick(self, host: Host, hit: Any, active: Panel) -> bool:
+        """A click on the surface moves the point there."""
+        surf = self.state
+        if hit.structure_name != SURFACE or surf.mesh is None:
+            return False
+        shown = surf.mesh.V @ Z_TO_Y[:3, :3].T  # picked positions are in world space
+        idx = picked_vertex(hit, shown, surf.mesh.F)
+        if idx is not None and surf.pick_vertex(idx):
+            self.push_point(host)
+            return True
+        return False
+
+    def export_items(self, host: Host) -> list[ExportItem]:
+        """The parametric surface's mesh (PLY)."""
+        s = self.state
+        if s.mesh is None:
+            return []
+        return [(f"{s.name}_res{s.res}.ply", s.mesh.V, s.mesh.F, None)]
+
+    def capture(self, host: Host) -> dict[str, Any]:
+        s = self.state
+        return {"surface": s.name, "res": int(s.res), "u": s.u, "v": s.v, "theta": s.section_deg}
+
+    def restore(self, host: Host, values: dict[str, Any], active: bool) -> None:
+        s = self.state
+        if s.set_surface(values["surface"], values["res"]):
+            s.set_uv(values["u"], values["v"])
+        s.set_section(values["theta"])  # a finite number: checked when the file was read
+
+    def push(self, host: Host) -> None:
+        surf = self.state
         if surf.mesh is None:
             surf.set_surface(surf.name)
         sm = surf.mesh
         if sm is None:
             return
-        if self._version != surf.version:
-            self._version = surf.version
+        if self.watch.changed("surface", surf.version):
             s = ps.register_surface_mesh(SURFACE, sm.V, sm.F, smooth_shade=True)
             s.set_transform(Z_TO_Y)
             from meshlap_core.surfaces import curvature_fields as surface_curvature
@@ -73,10 +112,10 @@ class SurfacesPanel:
                 onscreen_colorbar_enabled=True,
                 onscreen_colorbar_location=COLORBAR_AT,
             )
-        self.push_point(viewer)
+        self.push_point(host)
 
-    def push_point(self, viewer: Viewer) -> None:
-        surf = viewer.surf
+    def push_point(self, host: Host) -> None:
+        surf = self.state
         if surf.point is None:
             return
         size = float(np.ptp(surf.mesh.V, axis=0).max()) if surf.mesh is not None else 1.0
@@ -97,13 +136,13 @@ class SurfacesPanel:
             enabled=True,
             color=(0.2, 0.7, 0.2),
         )
-        self.push_section(viewer)
+        self.push_section(host)
 
-    def push_section(self, viewer: Viewer, degrees: float | None = None) -> None:
+    def push_section(self, host: Host, degrees: float | None = None) -> None:
         """Draw the normal section at θ (``degrees``, else the state's): its unit tangent
         t(θ) as an arrow at the point and its osculating arc of curvature κₙ(θ) (orange).
         The point cloud must be registered (:meth:`push_point`)."""
-        surf = viewer.surf
+        surf = self.state
         if degrees is not None:
             surf.set_section(degrees)
         if surf.point is None or not ps.has_point_cloud(SURFACE_POINT):
@@ -123,24 +162,24 @@ class SurfacesPanel:
             color=self.SECTION_COLOR,
         )
 
-    def draw(self, viewer: Viewer) -> None:
-        ui = viewer.ui
-        if not ui.header("Surfaces"):
+    def draw(self, host: Host) -> None:
+        ui = host.ui
+        if not ui.header(self.title):
             return
-        s = viewer.surf
+        s = self.state
         ch, name = ui.combo("surface", s.name, s.names, "a parametric surface p(u, v)")
         if ch and s.set_surface(name):
-            self.push(viewer)
-            viewer.reframe = True
+            self.push(host)
+            host.request_frame()
         ch, res = ui.input_int("resolution", s.res, "cells per parameter direction; Enter applies")
         if ch:
             s.set_resolution(res)
-            self.push(viewer)
+            self.push(host)
         u0, u1, v0, v1 = s.domain
         ch1, u = ui.slider_float("u", s.u, u0, u1, "%.3f", "first parameter of the point")
         ch2, v = ui.slider_float("v", s.v, v0, v1, "%.3f", "second parameter of the point")
         if (ch1 or ch2) and s.set_uv(u, v):
-            self.push_point(viewer)
+            self.push_point(host)
         if s.error:
             ui.error(s.error)
         p = s.point
@@ -157,18 +196,18 @@ class SurfacesPanel:
             f"k2 = {sig(p.k2, sk)} at {np.degrees(p.theta_min):.1f} deg"
         )
         ui.text("signs: e = p_uu . n with n = p_u x p_v (do Carmo)")
-        self.draw_section(viewer)
+        self.draw_section(host)
         with ui.plot("normal curvature k_n(theta)", 180, "theta (deg)", "k_n") as shown:
             if shown:
                 ui.plot_line("k_n", np.degrees(s.theta), s.kn)
                 ui.plot_vlines("theta max/min", np.degrees([p.theta_max, p.theta_min]))
                 ui.plot_vlines("section theta", np.array([s.section_deg]))
         key = (s.version, s.u, s.v, s.section_deg)
-        draw_record(viewer, self.recorder, key, s.section_caption, "theta")
+        draw_record(host, self.recorder, key, s.section_caption, ANIMATION.fps["theta"])
 
-    def draw_section(self, viewer: Viewer) -> None:
+    def draw_section(self, host: Host) -> None:
         """The θ slider (showing κₙ(θ)), *turn* / *pause turn* and this frame's turn step."""
-        ui, s = viewer.ui, viewer.surf
+        ui, s = host.ui, self.state
         _, kn = s.section()
         ch, deg = ui.slider_float(
             "section theta",
@@ -181,7 +220,7 @@ class SurfacesPanel:
             "k_n(theta)",
         )
         if ch:
-            self.push_section(viewer, deg)
+            self.push_section(host, deg)
         ui.same_line()
         if ui.button(
             "pause turn" if s.turning else "turn",
@@ -190,4 +229,23 @@ class SurfacesPanel:
         ):
             s.toggle_turn()
         elif s.tick_turn():
-            self.push_section(viewer)
+            self.push_section(host)
+
+    # ------------------------------------------------------------------ meshlap animate
+    def frames(self, host: Host, options: dict[str, Any]) -> Iterator[str]:
+        """The normal section at (u, v) turning once around from its θ: its tangent t(θ) and
+        osculating arc, κₙ(θ), drawn by :meth:`push_section` as in the window."""
+        surf = self.state
+        if not surf.set_surface(options["surface"]):
+            raise MeshError(surf.error, "--surface")
+        if options.get("uv") is not None and not surf.set_uv(*options["uv"]):
+            raise MeshError(surf.error, "--uv")
+        host.refresh()  # registers the surface, K and the point
+        host.frame(scene.COLORBAR_STRIP)
+        start = surf.section_deg  # 0, or the θ a session saved: one turn from there
+        for theta in np.linspace(start, start + 360.0, int(options["frames"]), endpoint=False):
+            self.push_section(host, theta)
+            yield surf.section_caption()
+
+
+PANEL = SurfacesPanel

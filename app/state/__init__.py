@@ -1,38 +1,44 @@
 """Viewer state as plain objects, tested headless (no polyscope import anywhere in this package).
 
-One module per concern: :mod:`.names` (``PANELS``, ``FIELDS``, ``FIELD_LABELS``: the single
-definition the CLI imports), :mod:`.mesh` (``MeshState``, the mesh list), :mod:`.curvature`
-(``CurvatureState``, ``robust_range``), :mod:`.onering` (``OneRingState``), :mod:`.spectral`,
-:mod:`.smoothing` and :mod:`.surface`. The classes are re-exported here lazily, so importing the
-names for the CLI's argument parser does not import numpy, scipy or libigl.
+One module per concern: :mod:`.app` (``AppState``, the one owner of every state object and
+setting), :mod:`.watch` (``Watch``, the one invalidation rule), :mod:`.display`,
+:mod:`.names` (``FIELDS``, ``FIELD_LABELS``), :mod:`.mesh` (``MeshState``, the mesh list),
+:mod:`.curvature` (``CurvatureState``, ``robust_range``), and one module per panel that has a
+state (named as the panel in :mod:`meshlap_app.registry`: :mod:`.onering`, :mod:`.spectral`,
+:mod:`.smoothing`, :mod:`.surfaces`), which also declares the panel's section of a saved session
+(:mod:`.session`) and its animation (:mod:`.animation`). The classes are re-exported here
+lazily, so importing the names for the CLI's argument parser does not import numpy, scipy or
+libigl.
 """
 
 from __future__ import annotations
 
-import importlib
 from typing import Any
 
-from .names import FIELD_LABELS, FIELDS, PANELS
+from .names import FIELD_LABELS, FIELDS
 
-_LAZY = {
-    "MeshState": "mesh",
-    "list_meshes": "mesh",
-    "default_mesh_path": "mesh",
-    "ASSETS_DIR": "mesh",
-    "CurvatureState": "curvature",
-    "robust_range": "curvature",
-    "OneRingState": "onering",
-    "SpectralState": "spectral",
-    "SmoothingState": "smoothing",
-    "METHODS": "smoothing",
-    "SurfaceState": "surface",
-}
-
-__all__ = ["FIELDS", "FIELD_LABELS", "PANELS", *_LAZY]
+__all__ = [
+    "ASSETS_DIR",
+    "FIELDS",
+    "FIELD_LABELS",
+    "AppState",
+    "CurvatureState",
+    "MeshState",
+    "default_mesh_path",
+    "list_meshes",
+    "robust_range",
+]
 
 
 def __getattr__(name: str) -> Any:
-    module = _LAZY.get(name)
-    if module is None:
+    """The shared state classes, imported on first use (a panel's own state class is imported
+    from its module, ``meshlap_app.state.<panel>``)."""
+    if name == "AppState":
+        from . import app as module
+    elif name in ("CurvatureState", "robust_range"):
+        from . import curvature as module
+    elif name in ("MeshState", "list_meshes", "default_mesh_path", "ASSETS_DIR"):
+        from . import mesh as module
+    else:
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    return getattr(importlib.import_module(f".{module}", __name__), name)
+    return getattr(module, name)

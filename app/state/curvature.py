@@ -9,10 +9,37 @@ import numpy as np
 
 from meshlap_core.curvature import curvature_fields
 from meshlap_core.errors import MeshError
+from meshlap_core.options import AREA_KINDS, BOUNDARY_RULES
 from meshlap_core.types import FloatArray
 
+from .checks import Schema, boolean, number, one_of
 from .mesh import MeshState
-from .names import FIELD_LABELS
+from .names import FIELD_LABELS, FIELDS
+
+SESSION: Schema = {
+    "field": ("cotan", one_of(FIELDS)),
+    "area": ("barycentric", one_of(AREA_KINDS)),
+    "boundary": ("pi", one_of(BOUNDARY_RULES)),
+    "clip": (2.0, number(0.0, 49.0)),
+    "side_by_side": (False, boolean),
+    "second_field": ("uniform", one_of(FIELDS)),
+}
+"""The Curvature panel's section of a saved session (:mod:`.session`)."""
+
+
+def check_view_options(options: dict[str, Any], state: Any) -> None:
+    """``meshlap view --field``: a known field.
+
+    Raises
+    ------
+    MeshError
+        An unknown field, naming the choices.
+    """
+    name = options.get("field")
+    if name is not None and name not in FIELD_LABELS:
+        raise MeshError(
+            f"unknown field {name!r}; choose one of {', '.join(FIELD_LABELS)}", "--field"
+        )
 
 
 def robust_range(values: FloatArray, signed: bool, percentile: float = 2.0) -> tuple[float, float]:
@@ -48,12 +75,15 @@ def robust_range(values: FloatArray, signed: bool, percentile: float = 2.0) -> t
 
 @dataclass
 class CurvatureState:
-    """Curvature fields of the current mesh for the chosen area and boundary rule."""
+    """Curvature fields of the current mesh for the chosen area and boundary rule, and how
+    they are shown (the field, its clip percentage, a second field side by side)."""
 
     area: str = "barycentric"
     boundary: str = "pi"
     field_name: str = "cotan"
     percentile: float = 2.0
+    side_by_side: bool = False
+    second_field: str = "uniform"
     _key: tuple[Any, ...] = ()
     fields: dict[str, FloatArray] = field(default_factory=dict)
     _summaries: dict[tuple[Any, ...], dict[str, Any]] = field(default_factory=dict)

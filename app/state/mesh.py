@@ -50,6 +50,11 @@ class MeshState:
     version: int = 0  # bumped on every successful load, so panels know to recompute
     path: Path | None = None  # the file loaded (resolved); None for the generated default
 
+    @property
+    def stem(self) -> str:
+        """The mesh's name without its extension (for output file names)."""
+        return Path(self.name).stem or "mesh"
+
     def load(self, path: str | Path | None) -> bool:
         """Load ``path`` (the bundled default when ``None``). Returns success."""
         try:

@@ -1,13 +1,10 @@
-"""The viewer's vocabulary, defined once: its panels and curvature fields.
+"""The viewer's curvature fields and their labels.
 
 Pure data (no numpy, no polyscope), so ``meshlap view``'s argument parser imports it at start-up
 without loading the viewer.
 """
 
 from __future__ import annotations
-
-PANELS: tuple[str, ...] = ("curvature", "onering", "spectral", "smoothing", "surfaces")
-"""Panels of the viewer, in the order of the ``view`` combo and of the 1–5 shortcuts."""
 
 # field name -> (label shown to users, signed?)
 FIELD_LABELS: dict[str, tuple[str, bool]] = {
@@ -21,6 +18,3 @@ FIELD_LABELS: dict[str, tuple[str, bool]] = {
 
 FIELDS: tuple[str, ...] = tuple(FIELD_LABELS)
 """Curvature fields the viewer shows (``meshlap view --field``)."""
-
-PLAY_KINDS: tuple[str, ...] = ("k sweep", "modes")
-"""What the Spectral panel plays: k = 1, 2, ... (one per frame) or the eigenmodes 1, 2, ..."""

@@ -14,8 +14,49 @@ from meshlap_core.inspector import VertexInspection, inspect_vertex
 from meshlap_core.options import AREA_KINDS, BOUNDARY_RULES
 from meshlap_core.types import FloatArray, IntArray
 
+from .checks import Schema, boolean, integer
 from .curvature import CurvatureState
 from .mesh import MeshState
+
+SESSION: Schema = {"vertex": (-1, integer(-1)), "reverse": (False, boolean)}
+"""The One-ring panel's section of a saved session (:mod:`.session`)."""
+
+
+def make_state() -> OneRingState:
+    """The One-ring panel's slice of the :class:`~.app.AppState`."""
+    return OneRingState()
+
+
+def check_view_options(options: dict[str, Any], state: Any) -> None:
+    """``meshlap view --vertex``: a vertex of the mesh.
+
+    Raises
+    ------
+    MeshError
+        Out of range, naming the mesh's vertex count.
+    """
+    vertex = options.get("vertex")
+    if vertex is not None and not 0 <= vertex < len(state.mesh.V):
+        raise MeshError(
+            f"vertex {vertex} is out of range (the mesh has {len(state.mesh.V)} vertices)",
+            "--vertex",
+        )
+
+
+def check_session(values: dict[str, Any], mesh: MeshState, source: Any) -> None:
+    """A saved one-ring vertex the session's mesh has (``-1``: none selected).
+
+    Raises
+    ------
+    MeshError
+        ``onering.vertex`` beyond the mesh's vertices.
+    """
+    vertex = values["vertex"]
+    if vertex >= len(mesh.V):
+        raise MeshError(
+            f'"onering.vertex" {vertex} is out of range (the mesh has {len(mesh.V)} vertices)',
+            source,
+        )
 
 
 @dataclass
@@ -52,6 +93,12 @@ class OneRingState:
     @property
     def valence(self) -> int:
         return len(self.neighbors)
+
+    def clear(self) -> None:
+        """Forget the selection and the ring of the previous mesh (the order stays)."""
+        reverse = self.reverse
+        self.__init__()  # type: ignore[misc]  # the dataclass defaults, in place
+        self.reverse = reverse
 
     def select(self, mesh: MeshState, curv: CurvatureState, vertex: int) -> bool:
         """Select ``vertex``; returns False (and keeps the old selection) when out of range."""

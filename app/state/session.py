@@ -13,6 +13,9 @@ A session file is one JSON object::
                    "lam_steps": [[0.5, 10], [2.0, 5]]},
      "surfaces": {"surface": "helicoid", "res": 48, "u": 0.0, "v": 0.0, "theta": 30.0}}
 
+Each section after ``camera`` is one registered panel's settings (:mod:`meshlap_app.registry`):
+its keys, defaults and checks are declared beside the panel's state (``SESSION`` in
+``app/state/<panel>.py``; :func:`schema` collects them), so a new panel brings its own section.
 ``camera`` is polyscope's ``get_view_as_json()`` parsed (or ``null``). A relative ``mesh`` is
 resolved against the session file's folder; ``null`` means the bundled default mesh. Missing
 keys take the defaults below; unknown keys, wrong types, values out of range, a newer
@@ -27,10 +30,10 @@ replays the runs exactly (bit for bit). The key is written only when it says som
 ``lam`` and ``iterations`` do not (λ changed during the run); missing or ``null``, the run is
 ``iterations`` steps at ``lam``, as version-1 files have always been read.
 
-**Keys added after the first files** (:data:`ADDED_KEYS`): ``smoothing.lam_steps``,
-``spectral.play`` (what the Spectral panel's *play* plays: ``k sweep`` or ``modes``) and
-``surfaces.theta`` (the normal section's θ in degrees). Each is written only when it differs
-from its default, and a missing one takes its default.
+**Keys added after the first files** (``SESSION_ADDED`` of a state module, :func:`added_keys`):
+``smoothing.lam_steps``, ``spectral.play`` (what the Spectral panel's *play* plays: ``k sweep``
+or ``modes``) and ``surfaces.theta`` (the normal section's θ in degrees). Each is written only
+when it differs from its default, and a missing one takes its default.
 
 **Why the version stays 1.** A file is bumped only when an older reader would *misread* it. A
 reader of this version refuses every unknown key (``unknown key(s) in 'smoothing'``), so an
@@ -45,10 +48,9 @@ This module only maps a :class:`Session` to and from a dict and a file; the view
 from __future__ import annotations
 
 import copy
+import functools
 import json
-import math
 import os
-from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -56,120 +58,50 @@ from typing import Any
 from meshlap_core import __version__
 from meshlap_core.errors import MeshError
 from meshlap_core.io import atomic_write, check_output_path
-from meshlap_core.options import AREA_KINDS, BOUNDARY_RULES, LAPLACIAN_KINDS
-from meshlap_core.surfaces import SURFACES
 
-from .names import FIELDS, PANELS, PLAY_KINDS
-from .surface import MAX_RES
+from ..registry import REGISTRY, VIEWS
+from .checks import Check, Schema, number, one_of
+from .mesh import MeshState
 
 FORMAT = "meshlap-session"
 VERSION = 1
 """The session format this meshlap writes and the newest it reads."""
 
-Check = Callable[[Any], str | None]  # returns what is wrong with a value, or None
+
+@functools.cache
+def schema() -> dict[str, Schema]:
+    """Section -> key -> (default, check): each registered panel's ``SESSION`` (declared in
+    ``app/state/<panel>.py``), in the registry's order. The defaults are the viewer's own start
+    values."""
+    out: dict[str, Schema] = {}
+    for e in REGISTRY:
+        module = e.state_module()
+        section = getattr(module, "SESSION", None) if module is not None else None
+        if section:
+            out[e.name] = section
+    return out
 
 
-def _one_of(choices: tuple[str, ...]) -> Check:
-    def check(x: Any) -> str | None:
-        if not isinstance(x, str):
-            return f"must be a string, got {type(x).__name__}"
-        return None if x in choices else f"must be one of {', '.join(choices)}, got {x!r}"
-
-    return check
-
-
-def _boolean(x: Any) -> str | None:
-    return None if isinstance(x, bool) else f"must be true or false, got {json.dumps(x)}"
-
-
-def _integer(lo: int, hi: int | None = None) -> Check:
-    def check(x: Any) -> str | None:
-        if not isinstance(x, int) or isinstance(x, bool):
-            return f"must be an integer, got {json.dumps(x)}"
-        if x < lo or (hi is not None and x > hi):
-            top = f" and <= {hi}" if hi is not None else ""
-            return f"must be >= {lo}{top}, got {x}"
-        return None
-
-    return check
+@functools.cache
+def added_keys() -> tuple[tuple[str, str], ...]:
+    """Keys newer than the first session files (each state module's ``SESSION_ADDED``):
+    written only when they differ from the default."""
+    return tuple(
+        (e.name, key)
+        for e in REGISTRY
+        if (m := e.state_module()) is not None
+        for key in getattr(m, "SESSION_ADDED", ())
+    )
 
 
-def _number(lo: float = -math.inf, hi: float = math.inf, positive: bool = False) -> Check:
-    def check(x: Any) -> str | None:
-        if not isinstance(x, int | float) or isinstance(x, bool) or not math.isfinite(x):
-            return f"must be a finite number, got {json.dumps(x)}"
-        if positive and not x > 0:
-            return f"must be > 0, got {x}"
-        if not lo <= x <= hi:
-            return f"must be between {lo:g} and {hi:g}, got {x}"
-        return None
-
-    return check
-
-
-def _lam_steps(x: Any) -> str | None:
-    """What is wrong with a ``lam_steps`` value (``null`` or a list of ``[λ > 0, count >= 1]``);
-    the counts' sum is checked against ``iterations`` by :func:`_check_lam_steps`."""
-    if x is None:
-        return None
-    if not isinstance(x, list):
-        return f"must be a list of [lam, steps] pairs or null, got {json.dumps(x)}"
-    positive = _number(positive=True)
-    for k, run in enumerate(x):
-        if not isinstance(run, list) or len(run) != 2:
-            return f"entry {k} must be a [lam, steps] pair, got {json.dumps(run)}"
-        problem = positive(run[0])
-        if problem:
-            return f"entry {k}: lam {problem}"
-        problem = _integer(1)(run[1])
-        if problem:
-            return f"entry {k}: steps {problem}"
-    return None
-
-
-# section -> key -> (default, check). The defaults are the viewer's own start values.
-SCHEMA: dict[str, dict[str, tuple[Any, Check]]] = {
-    "curvature": {
-        "field": ("cotan", _one_of(FIELDS)),
-        "area": ("barycentric", _one_of(AREA_KINDS)),
-        "boundary": ("pi", _one_of(BOUNDARY_RULES)),
-        "clip": (2.0, _number(0.0, 49.0)),
-        "side_by_side": (False, _boolean),
-        "second_field": ("uniform", _one_of(FIELDS)),
-    },
-    "onering": {"vertex": (-1, _integer(-1)), "reverse": (False, _boolean)},
-    "spectral": {
-        "computed": (False, _boolean),
-        "k_request": (100, _integer(2)),
-        "k": (10, _integer(1)),
-        "mode": (1, _integer(0)),
-        "play": ("k sweep", _one_of(PLAY_KINDS)),
-    },
-    "smoothing": {
-        "method": ("implicit", _one_of(("explicit", "implicit", "taubin"))),
-        "laplacian": ("uniform", _one_of(LAPLACIAN_KINDS)),
-        "lam": (0.5, _number(positive=True)),
-        "noise_alpha": (0.0, _number(0.0)),
-        "seed": (0, _integer(0)),
-        "iterations": (0, _integer(0, 100_000)),
-        "lam_steps": (None, _lam_steps),
-    },
-    "surfaces": {
-        "surface": ("helicoid", _one_of(tuple(SURFACES))),
-        "res": (48, _integer(1, MAX_RES)),
-        "u": (0.0, _number()),
-        "v": (0.0, _number()),
-        "theta": (0.0, _number()),
-    },
-}
-ADDED_KEYS = (("smoothing", "lam_steps"), ("spectral", "play"), ("surfaces", "theta"))
-"""Keys newer than the first session files: written only when they differ from the default."""
-TOP_LEVEL = ("format", "version", "meshlap", "mesh", "panel", "ui_scale", "camera", *SCHEMA)
+def top_level() -> tuple[str, ...]:
+    """The keys a session object may have."""
+    return ("format", "version", "meshlap", "mesh", "panel", "ui_scale", "camera", *schema())
 
 
 def default_settings() -> dict[str, dict[str, Any]]:
     """Every section's settings at the viewer's defaults."""
-    return {sec: {k: d for k, (d, _) in keys.items()} for sec, keys in SCHEMA.items()}
+    return {sec: {k: d for k, (d, _) in keys.items()} for sec, keys in schema().items()}
 
 
 @dataclass
@@ -177,11 +109,11 @@ class Session:
     """What a session file holds, validated.
 
     ``mesh`` is an absolute path (``None``: the bundled default mesh); ``settings`` maps each
-    section of :data:`SCHEMA` to its values; ``camera`` is polyscope's view JSON as a dict.
+    section of :func:`schema` to its values; ``camera`` is polyscope's view JSON as a dict.
     """
 
     mesh: Path | None = None
-    panel: str = "curvature"
+    panel: str = VIEWS[0]
     ui_scale: float = 1.0
     camera: dict[str, Any] | None = None
     settings: dict[str, dict[str, Any]] = field(default_factory=default_settings)
@@ -210,10 +142,12 @@ class Session:
 
 
 def _without_default_added_keys(settings: dict[str, dict[str, Any]]) -> dict[str, dict[str, Any]]:
-    """``settings`` without the :data:`ADDED_KEYS` that hold their default (older readers
+    """``settings`` without the :func:`added_keys` that hold their default (older readers
     refuse unknown keys: a file that does not need them stays readable there)."""
-    for sec, key in ADDED_KEYS:
-        if sec in settings and settings[sec].get(key, SCHEMA[sec][key][0]) == SCHEMA[sec][key][0]:
+    sections = schema()
+    for sec, key in added_keys():
+        default = sections[sec][key][0]
+        if sec in settings and settings[sec].get(key, default) == default:
             settings[sec].pop(key, None)
     return settings
 
@@ -251,17 +185,17 @@ def from_dict(
             f"this meshlap {__version__} reads session version {VERSION}: update meshlap",
             source,
         )
-    unknown = sorted(set(data) - set(TOP_LEVEL))
+    unknown = sorted(set(data) - set(top_level()))
     if unknown:
         raise MeshError(f"unknown key(s) {', '.join(map(repr, unknown))}", source)
     session = Session(mesh=_mesh_path(data.get("mesh"), source, folder))
-    session.panel = _checked(data, "panel", "curvature", _one_of(PANELS), source)
-    session.ui_scale = float(_checked(data, "ui_scale", 1.0, _number(0.5, 3.0), source))
+    session.panel = _checked(data, "panel", VIEWS[0], one_of(VIEWS), source)
+    session.ui_scale = float(_checked(data, "ui_scale", 1.0, number(0.5, 3.0), source))
     camera = data.get("camera")
     if camera is not None and not isinstance(camera, dict):
         raise MeshError(f'"camera" must be an object or null, got {json.dumps(camera)}', source)
     session.camera = camera
-    for sec, keys in SCHEMA.items():
+    for sec, keys in schema().items():
         values = data.get(sec, {})
         if not isinstance(values, dict):
             raise MeshError(f'"{sec}" must be an object, got {json.dumps(values)}', source)
@@ -270,40 +204,12 @@ def from_dict(
             raise MeshError(f"unknown key(s) in {sec!r}: {', '.join(map(repr, unknown))}", source)
         for key, (default, check) in keys.items():
             session.settings[sec][key] = _checked(values, key, default, check, source, sec)
-    _check_lam_steps(session.settings["smoothing"], source)
+    for e in REGISTRY:  # checks across the keys of a section (e.g. a run's step counts)
+        module = e.state_module()
+        whole = getattr(module, "check_section", None) if module is not None else None
+        if whole is not None:
+            whole(session.settings[e.name], source)
     return session
-
-
-def _check_lam_steps(sm: dict[str, Any], source: Any) -> None:
-    """Check that ``lam_steps`` counts ``iterations`` steps; λ as floats, counts as ints."""
-    runs = sm["lam_steps"]
-    if runs is None:
-        return
-    total = sum(int(n) for _, n in runs)
-    if total != sm["iterations"]:
-        raise MeshError(
-            f'"smoothing.lam_steps" counts {total} steps but "smoothing.iterations" is '
-            f"{sm['iterations']}",
-            source,
-        )
-    sm["lam_steps"] = [[float(lam), int(n)] for lam, n in runs]
-
-
-def encode_lam_steps(runs: list[list[Any]], lam: float) -> list[list[Any]] | None:
-    """``lam_steps`` to save for a run of ``runs`` (``[[λ, steps], ...]``) with ``lam`` set
-    now: ``None`` when it says nothing that ``lam`` and ``iterations`` do not (no step, or every
-    step at ``lam``), else a copy of ``runs``."""
-    if not runs or (len(runs) == 1 and runs[0][0] == lam):
-        return None
-    return [[float(x), int(n)] for x, n in runs]
-
-
-def replay_steps(sm: dict[str, Any]) -> list[list[Any]]:
-    """The runs ``[[λ, steps], ...]`` that reproduce a saved ``smoothing`` section: its
-    ``lam_steps``, or (missing, as in older files) ``iterations`` steps at ``lam``."""
-    if sm.get("lam_steps") is not None:
-        return [[float(x), int(n)] for x, n in sm["lam_steps"]]
-    return [[float(sm["lam"]), int(sm["iterations"])]] if sm["iterations"] else []
 
 
 def _checked(
@@ -329,20 +235,20 @@ def _mesh_path(mesh: Any, source: str | os.PathLike, folder: Path | None) -> Pat
     return path.resolve()
 
 
-def check_vertex(session: Session, n_vertices: int, source: str | os.PathLike) -> None:
-    """Refuse a one-ring vertex that the session's mesh does not have.
+def check_session_mesh(session: Session, mesh: MeshState, source: str | os.PathLike) -> None:
+    """Refuse a session whose settings do not fit its mesh (each state module's
+    ``check_session(values, mesh, source)``, e.g. a one-ring vertex the mesh does not have).
 
     Raises
     ------
     MeshError
-        ``onering.vertex >= n_vertices`` (named with the mesh's vertex count).
+        Naming the setting and the mesh's size.
     """
-    vertex = session.settings["onering"]["vertex"]
-    if vertex >= n_vertices:
-        raise MeshError(
-            f'"onering.vertex" {vertex} is out of range (the mesh has {n_vertices} vertices)',
-            source,
-        )
+    for e in REGISTRY:
+        module = e.state_module()
+        check = getattr(module, "check_session", None) if module is not None else None
+        if check is not None and e.name in session.settings:
+            check(session.settings[e.name], mesh, source)
 
 
 def read_session(path: str | os.PathLike) -> Session:

@@ -4,6 +4,8 @@ noise first, live figures and the amplification curve. No polyscope import.
 
 from __future__ import annotations
 
+import json
+import math
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -11,10 +13,15 @@ import numpy as np
 
 from meshlap_core.errors import MeshError
 from meshlap_core.noise import add_noise
-from meshlap_core.smoothing import Smoother, amplification_curve, check_lam
+from meshlap_core.options import LAPLACIAN_KINDS
+from meshlap_core.smoothing import METHODS, Smoother, amplification_curve, check_lam
 from meshlap_core.types import FloatArray, IntArray
 
-METHODS = ("explicit", "implicit", "taubin")
+from .animation import Animation, Option
+from .checks import Schema, integer, number, one_of
+
+MAX_FRAMES_ITERS = 5000
+"""Most smoothing iterations an animation renders (one frame each)."""
 _EMPTY_V = np.zeros((0, 3))
 _EMPTY_F = np.zeros((0, 3), dtype=np.int64)
 
@@ -199,3 +206,158 @@ class SmoothingState:
             return mu, amplification_curve(self.method, self.lam, mu)
         mu = np.linspace(s.stability.mu_min, 0.0, n)
         return mu, amplification_curve(self.method, self.lam, mu, k_pb=s.k_pb)
+
+
+def make_state() -> SmoothingState:
+    """The Smoothing panel's slice of the :class:`~.app.AppState`."""
+    return SmoothingState()
+
+
+def caption(st: SmoothingState, iters: int | None = None) -> str:
+    """``implicit (uniform L), λ = 1   iteration 3/30   RMSE 0.0012`` for a smoothing state
+    (read from the stepper's history: never the lazy stability estimate, an eigensolve); the
+    caption of ``meshlap animate``'s frames and of the window's recording."""
+    s = st.smoother
+    last = s.history[-1] if s is not None and s.history else {}
+    rmse = last.get("rmse")
+    it = s.iteration if s is not None else 0
+    of = f"/{iters}" if iters is not None else ""
+    noise = f", noise α = {st.noise_alpha:g}" if st.noise_alpha else ""
+    return f"{st.method} ({st.laplacian} L), λ = {st.lam:g}{noise}   iteration {it}{of}" + (
+        f"   RMSE {rmse:.4g}" if rmse is not None else ""
+    )
+
+
+# ---------------------------------------------------------------- saved sessions
+def _lam_steps(x: Any) -> str | None:
+    """What is wrong with a ``lam_steps`` value (``null`` or a list of ``[λ > 0, count >= 1]``);
+    the counts' sum is checked against ``iterations`` by :func:`check_section`."""
+    if x is None:
+        return None
+    if not isinstance(x, list):
+        return f"must be a list of [lam, steps] pairs or null, got {json.dumps(x)}"
+    positive = number(positive=True)
+    for k, run in enumerate(x):
+        if not isinstance(run, list) or len(run) != 2:
+            return f"entry {k} must be a [lam, steps] pair, got {json.dumps(run)}"
+        problem = positive(run[0])
+        if problem:
+            return f"entry {k}: lam {problem}"
+        problem = integer(1)(run[1])
+        if problem:
+            return f"entry {k}: steps {problem}"
+    return None
+
+
+SESSION: Schema = {
+    "method": ("implicit", one_of(METHODS)),
+    "laplacian": ("uniform", one_of(LAPLACIAN_KINDS)),
+    "lam": (0.5, number(positive=True)),
+    "noise_alpha": (0.0, number(0.0)),
+    "seed": (0, integer(0)),
+    "iterations": (0, integer(0, 100_000)),
+    "lam_steps": (None, _lam_steps),
+}
+"""The Smoothing panel's section of a saved session (:mod:`.session`)."""
+SESSION_ADDED = ("lam_steps",)
+QUIET: dict[str, Any] = {"iterations": 0}
+"""Restored for another panel's animation: no run replayed."""
+
+
+def check_section(sm: dict[str, Any], source: Any) -> None:
+    """Check that ``lam_steps`` counts ``iterations`` steps; λ as floats, counts as ints.
+
+    Raises
+    ------
+    MeshError
+        The counts do not sum to ``iterations``.
+    """
+    runs = sm["lam_steps"]
+    if runs is None:
+        return
+    total = sum(int(n) for _, n in runs)
+    if total != sm["iterations"]:
+        raise MeshError(
+            f'"smoothing.lam_steps" counts {total} steps but "smoothing.iterations" is '
+            f"{sm['iterations']}",
+            source,
+        )
+    sm["lam_steps"] = [[float(lam), int(n)] for lam, n in runs]
+
+
+def encode_lam_steps(runs: list[list[Any]], lam: float) -> list[list[Any]] | None:
+    """``lam_steps`` to save for a run of ``runs`` (``[[λ, steps], ...]``) with ``lam`` set
+    now: ``None`` when it says nothing that ``lam`` and ``iterations`` do not (no step, or every
+    step at ``lam``), else a copy of ``runs``."""
+    if not runs or (len(runs) == 1 and runs[0][0] == lam):
+        return None
+    return [[float(x), int(n)] for x, n in runs]
+
+
+def replay_steps(sm: dict[str, Any]) -> list[list[Any]]:
+    """The runs ``[[λ, steps], ...]`` that reproduce a saved ``smoothing`` section: its
+    ``lam_steps``, or (missing, as in older files) ``iterations`` steps at ``lam``."""
+    if sm.get("lam_steps") is not None:
+        return [[float(x), int(n)] for x, n in sm["lam_steps"]]
+    return [[float(sm["lam"]), int(sm["iterations"])]] if sm["iterations"] else []
+
+
+# ---------------------------------------------------------------- meshlap animate
+def _animation_from_session(opts: dict[str, Any], sm: dict[str, Any], source: Any) -> None:
+    """Fill the options not typed from the saved section: method, Laplacian, λ (and the λ of
+    every saved step unless ``--lam`` is typed), noise, seed, and the iterations (the last
+    frame is then the saved view)."""
+    if opts.get("iters") is None and sm["iterations"] > MAX_FRAMES_ITERS:
+        raise MeshError(
+            f"the session's smoothing ran {sm['iterations']} iterations; an animation has at "
+            f"most {MAX_FRAMES_ITERS}: give --iters N",
+            source,
+        )
+    opts["lam_steps"] = sm.get("lam_steps") if opts.get("lam") is None else None
+    saved = {
+        "method": sm["method"],
+        "laplacian": sm["laplacian"],
+        "lam": sm["lam"],
+        "noise": sm["noise_alpha"],
+        "seed": sm["seed"],
+        "iters": sm["iterations"] or None,  # 0: the built-in default
+    }
+    for name, value in saved.items():
+        if opts.get(name) is None:
+            opts[name] = value
+
+
+def _animation_check(opts: dict[str, Any]) -> None:
+    check_lam(opts["lam"], "--lam")
+    if not 0 <= opts["iters"] <= MAX_FRAMES_ITERS:
+        raise MeshError(f"must be 0 to {MAX_FRAMES_ITERS}, got {opts['iters']}", "--iters")
+    if not (math.isfinite(opts["noise"]) and opts["noise"] >= 0):
+        raise MeshError(f"must be a finite number >= 0, got {opts['noise']}", "--noise")
+    if opts["seed"] < 0:
+        raise MeshError(f"must be >= 0, got {opts['seed']}", "--seed")
+
+
+ANIMATION = Animation(
+    summary="smoothing: one frame per iteration, the input beside the smoothed copy",
+    options=(
+        Option("--method", "smoothing method (default implicit)", "implicit", choices=METHODS),
+        Option("--laplacian", "default uniform", "uniform", choices=LAPLACIAN_KINDS),
+        Option("--lam", "smoothing step λ > 0 (default 1)", 1.0, float),
+        Option("--iters", "smoothing iterations (frames: iters+1; default 30)", 30, int),
+        Option("--noise", "noise α before smoothing (default 0)", 0.0, float),
+        Option("--seed", "noise seed (default 0)", 0, int),
+    ),
+    session_help=(
+        "smoothing  method, laplacian, lambda, noise alpha and seed from the session; --iters\n"
+        "           defaults to the session's iteration count when it is > 0 (else 30): the\n"
+        "           frames are iterations 0..iters, so the last frame is the saved view"
+    ),
+    check=_animation_check,
+    kind=lambda opts: "smoothing",
+    fps={"smoothing": 10.0},
+    frame_count=lambda opts: int(opts["iters"]) + 1,
+    from_session=_animation_from_session,
+    session_overrides={"iterations": 0},  # the frames run the smoothing from iteration 0
+    colorbar=False,  # no colour map: the input and its smoothed copy
+)
+"""``meshlap animate --panel smoothing``."""

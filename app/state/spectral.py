@@ -17,10 +17,15 @@ from typing import Any
 import numpy as np
 
 from meshlap_core.errors import MeshError
+from meshlap_core.frames import parse_range
 from meshlap_core.spectral import SpectralBasis
 from meshlap_core.types import FloatArray, IntArray
 
-from .names import PLAY_KINDS
+from .animation import Animation, Option
+from .checks import Schema, boolean, integer, one_of
+
+PLAY_KINDS: tuple[str, ...] = ("k sweep", "modes")
+"""What the Spectral panel plays: k = 1, 2, ... (one per frame) or the eigenmodes 1, 2, ..."""
 
 SCREENSHOT_K = 30
 """k of ``meshlap view --panel spectral --screenshot`` without ``--k``."""
@@ -219,3 +224,84 @@ class SpectralState:
         if self._at_end():
             self.playing = False
         return True
+
+
+def make_state() -> SpectralState:
+    """The Spectral panel's slice of the :class:`~.app.AppState`."""
+    return SpectralState()
+
+
+def check_view_options(options: dict[str, Any], state: Any) -> None:
+    """``meshlap view --k``: at least 1.
+
+    Raises
+    ------
+    MeshError
+        ``k < 1``.
+    """
+    k = options.get("k")
+    if k is not None and k < 1:
+        raise MeshError(f"must be at least 1, got {k}", "--k")
+
+
+SESSION: Schema = {
+    "computed": (False, boolean),
+    "k_request": (100, integer(2)),
+    "k": (10, integer(1)),
+    "mode": (1, integer(0)),
+    "play": ("k sweep", one_of(PLAY_KINDS)),
+}
+"""The Spectral panel's section of a saved session (:mod:`.session`)."""
+SESSION_ADDED = ("play",)
+QUIET: dict[str, Any] = {"computed": False}
+"""Restored for another panel's animation: no eigenbasis read."""
+
+
+# ---------------------------------------------------------------- meshlap animate
+def _animation_from_session(opts: dict[str, Any], sp: dict[str, Any], source: Any) -> None:
+    """Without ``--k``/``--modes``: the k sweep up to the session's k."""
+    if opts.get("k") is None and opts.get("modes") is None:
+        opts["k"] = f"1:{sp['k']}"
+
+
+def _animation_check(opts: dict[str, Any]) -> None:
+    if (opts.get("k") is None) == (opts.get("modes") is None):
+        raise MeshError("give exactly one of --k A:B (reconstruction) or --modes A:B", "--panel")
+    if isinstance(opts.get("k"), str):
+        opts["k"] = parse_range(opts["k"], "--k", lo=1)
+    if isinstance(opts.get("modes"), str):
+        opts["modes"] = parse_range(opts["modes"], "--modes", lo=0)
+
+
+def _animation_check_mesh(opts: dict[str, Any], mesh: Any) -> None:
+    n = len(mesh.V)
+    if opts.get("k") is not None and opts["k"][1] > n:
+        raise MeshError(f"must end at {n} or less (the mesh has {n} vertices)", "--k")
+    if opts.get("modes") is not None and opts["modes"][1] > n - 1:
+        raise MeshError(f"must end at {n - 1} or less (the mesh has {n} vertices)", "--modes")
+
+
+def _frames(opts: dict[str, Any]) -> int:
+    a, b = opts["k"] if opts.get("k") is not None else opts["modes"]
+    return b - a + 1
+
+
+ANIMATION = Animation(
+    summary="the spectral k sweep (--k A:B) or the eigenmodes one by one (--modes A:B)",
+    options=(
+        Option("--k", "spectral: reconstruct from k = A..B modes", metavar="A:B"),
+        Option("--modes", "spectral: show eigenmodes A..B one by one", metavar="A:B"),
+    ),
+    session_help=(
+        "spectral   without --k/--modes: the k sweep 1:k up to the session's k (also when the\n"
+        "           session showed an eigenmode: the modes are animated only with --modes); the\n"
+        "           basis comes from the cache as in `meshlap view --session`"
+    ),
+    check=_animation_check,
+    kind=lambda opts: "modes" if opts.get("modes") is not None else "k",
+    fps={"k": 15.0, "modes": MODES_PER_SECOND},
+    frame_count=_frames,
+    from_session=_animation_from_session,
+    check_mesh=_animation_check_mesh,
+)
+"""``meshlap animate --panel spectral``."""

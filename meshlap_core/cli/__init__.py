@@ -39,20 +39,22 @@ from collections.abc import Sequence  # noqa: E402
 from .._version import __version__  # noqa: E402
 from ..errors import MeshError, MeshWarning  # noqa: E402
 
-# subcommand modules, in the order ``meshlap --help`` lists them
+# subcommand modules of the core, in the order ``meshlap --help`` lists them; the commands
+# that open or render the viewer come from the ``meshlap.commands`` entry-point group
 COMMANDS: tuple[str, ...] = (
     "info",
     "curvature",
     "onering",
     "inspect",
-    "view",
     "surface",
     "smooth",
     "denoise_eval",
     "report",
     "spectral",
-    "animate",
 )
+COMMAND_GROUP = "meshlap.commands"
+"""Entry points of this group name modules with ``register(sub)``: other packages (the viewer)
+add their commands through it."""
 
 
 class _Parser(argparse.ArgumentParser):
@@ -71,6 +73,10 @@ def build_parser() -> argparse.ArgumentParser:
     sub.required = True
     for name in COMMANDS:
         importlib.import_module(f"{__name__}.{name}").register(sub)
+    from importlib.metadata import entry_points
+
+    for ep in sorted(entry_points(group=COMMAND_GROUP), key=lambda e: e.name):
+        ep.load().register(sub)
     return parser
 
 

@@ -111,7 +111,8 @@ def build_report(
         Where the progress bar goes (the CLI passes stderr); ``None``: silent.
     screenshot : Screenshot, optional
         The function that renders a viewer frame (:class:`~meshlap_core.study.shots.Screenshot`;
-        the ``meshlap report`` command passes :class:`meshlap_core.cli.report.ViewerScreenshots`).
+        the ``meshlap report`` command passes the viewer's, from the ``meshlap.screenshots``
+        entry point).
         The study never imports the viewer itself.
     max_screenshots : int, optional
         Take at most this many viewer screenshots; the later pictures are drawn with

@@ -2,8 +2,9 @@
 
 The study is part of the headless core, which never imports polyscope nor the viewer package.
 :func:`~meshlap_core.study.build.build_report` therefore takes the screenshot function as an
-argument: the ``meshlap report`` command (the top layer, which may import the viewer lazily)
-passes :class:`meshlap_core.cli.report.ViewerScreenshots`; tests pass fakes.
+argument: the ``meshlap report`` command (the top layer, which never imports the viewer either)
+passes the viewer's (``meshlap_app.screenshots.ViewerScreenshots``, found through the
+``meshlap.screenshots`` entry point); tests pass fakes.
 """
 
 from __future__ import annotations

@@ -1,31 +1,37 @@
-"""The Mesh panel: what the mesh is, a path field and the list of bundled / shared meshes."""
+"""The Mesh section (``mesh_info``): the mesh on screen, a path field, bundled / shared meshes."""
 
 from __future__ import annotations
 
 import time
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 from ..state.mesh import list_meshes
-from .base import NoStructures
-
-if TYPE_CHECKING:
-    from ..viewer import Viewer
+from .base import Host, Panel
 
 
-class MeshPanel(NoStructures):
+class MeshPanel(Panel):
     """Counts and topology of the current mesh; open a file by path or from the list."""
 
-    def __init__(self) -> None:
+    title = "Mesh"
+
+    def __init__(self, name: str, state: object = None) -> None:
+        super().__init__(name, state)
         self.path_text = ""
         self.recent: list[Path] = []  # the last meshes opened, newest first
         self._listed: tuple[float, list[tuple[str, Path]]] = (-1e9, [])
 
-    def draw(self, viewer: Viewer) -> None:
-        ui = viewer.ui
-        if not ui.header("Mesh"):
+    def on_new_mesh(self, host: Host) -> None:
+        """A mesh opened after the first one goes to the top of the recent list."""
+        opened_before = self.watch.seen("mesh") is not None
+        self.watch.changed("mesh", host.state.mesh.version)
+        if opened_before and host.state.mesh.path is not None:
+            self.remember(host.state.mesh.path)
+
+    def draw(self, host: Host) -> None:
+        ui = host.ui
+        if not ui.header(self.title):
             return
-        mesh = viewer.mesh
+        mesh = host.state.mesh
         info = mesh.info
         ui.text(
             f"{mesh.name}: {info.get('n_vertices', 0)} vertices, "
@@ -45,7 +51,7 @@ class MeshPanel(NoStructures):
         if (ui.button("Open", "load the file named in the path field") or entered) and (
             self.path_text.strip()
         ):
-            viewer.open(Path(self.path_text.strip()).expanduser())
+            host.open(Path(self.path_text.strip()).expanduser())
         now = time.monotonic()
         if now - self._listed[0] > 2.0:  # the folders are listed at most every 2 s, not per frame
             self._listed = (now, list_meshes())
@@ -59,7 +65,7 @@ class MeshPanel(NoStructures):
             "the bundled assets, ../shared/meshes and recently opened files",
         )
         if picked:
-            viewer.open(choices[picked])
+            host.open(choices[picked])
         if mesh.error:
             ui.error(mesh.error)
 
@@ -67,3 +73,6 @@ class MeshPanel(NoStructures):
         """Put ``path`` first in the recent-files list (at most 8)."""
         path = Path(path).resolve()
         self.recent = [path, *(p for p in self.recent if p != path)][:8]
+
+
+PANEL = MeshPanel

@@ -7,13 +7,18 @@ the panel says so next to the numbers.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
 from meshlap_core import surfaces
 from meshlap_core.errors import MeshError
 from meshlap_core.types import FloatArray
+
+from .animation import Animation, Option
+from .checks import Schema, integer, number, one_of
 
 MAX_RES = 512  # cells per direction the viewer meshes (512² cells: 0.5 M triangles)
 TURN_STEP_DEG = 5.0
@@ -187,3 +192,82 @@ class SurfaceState:
         self._turn_left -= 1
         self.turning = self._turn_left > 0
         return True
+
+
+def make_state() -> SurfaceState:
+    """The Surfaces panel's slice of the :class:`~.app.AppState`."""
+    return SurfaceState()
+
+
+SESSION: Schema = {
+    "surface": ("helicoid", one_of(tuple(surfaces.SURFACES))),
+    "res": (48, integer(1, MAX_RES)),
+    "u": (0.0, number()),
+    "v": (0.0, number()),
+    "theta": (0.0, number()),
+}
+"""The Surfaces panel's section of a saved session (:mod:`.session`)."""
+SESSION_ADDED = ("theta",)
+
+
+# ---------------------------------------------------------------- meshlap animate
+def parse_uv(text: str | None) -> tuple[float, float] | None:
+    """``"U,V"`` as two finite numbers (``None`` stays ``None``).
+
+    Raises
+    ------
+    MeshError
+        Not two finite numbers separated by a comma (``--uv``).
+    """
+    if text is None:
+        return None
+    try:
+        u, v = (float(t) for t in text.split(","))
+    except ValueError:
+        raise MeshError(f"expected U,V such as 0.5,1.0, got {text!r}", "--uv") from None
+    if not (math.isfinite(u) and math.isfinite(v)):
+        raise MeshError(f"must be finite, got {text!r}", "--uv")
+    return u, v
+
+
+def _animation_from_session(opts: dict[str, Any], sf: dict[str, Any], source: Any) -> None:
+    """The session's surface and (u, v) (unless another surface or a point is typed)."""
+    opts["theta"] = True
+    if opts.get("surface") is None:
+        opts["surface"] = sf["surface"]
+    if opts.get("uv") is None and opts["surface"] == sf["surface"]:
+        opts["uv"] = f"{sf['u']!r},{sf['v']!r}"
+
+
+def _animation_check(opts: dict[str, Any]) -> None:
+    if not opts.get("theta"):
+        raise MeshError("the surfaces animation is the normal section: add --theta", "--panel")
+    if opts["surface"] not in surfaces.SURFACES:
+        names = ", ".join(surfaces.SURFACES)
+        raise MeshError(f"unknown surface {opts['surface']!r}; choose one of {names}", "--surface")
+    if not 2 <= opts["frames"] <= 2000:
+        raise MeshError(f"must be 2 to 2000, got {opts['frames']}", "--frames")
+    if isinstance(opts.get("uv"), str):
+        opts["uv"] = parse_uv(opts["uv"])
+
+
+ANIMATION = Animation(
+    summary="a turning normal section of a parametric surface (--theta)",
+    options=(
+        Option("--theta", "surfaces: turn the normal section", store_true=True),
+        Option("--surface", "surfaces: the parametric surface (default saddle)", "saddle"),
+        Option("--uv", "surfaces: the point (default: the surface's)", metavar="U,V"),
+        Option("--frames", "surfaces: frames per turn (default 72)", 72, int),
+    ),
+    session_help=(
+        "surfaces   the session's surface, resolution and (u, v); --theta is implied (--uv or\n"
+        "           another --surface replace the point)"
+    ),
+    check=_animation_check,
+    kind=lambda opts: "theta",
+    fps={"theta": 15.0},
+    frame_count=lambda opts: int(opts["frames"]),
+    from_session=_animation_from_session,
+    uses_mesh=False,
+)
+"""``meshlap animate --panel surfaces --theta``."""

@@ -1,12 +1,21 @@
-"""``meshlap view [MESH] [--screenshot OUT.png]``: the polyscope viewer (``meshlap_app.viewer``)."""
+"""``meshlap view [MESH] [--screenshot OUT.png]``: the polyscope viewer (:mod:`..viewer`).
+
+Registered with the core's command line through the ``meshlap.commands`` entry point; the
+parser reads only pure data (the registry's views, the field names), so ``meshlap --help``
+does not import polyscope.
+"""
 
 from __future__ import annotations
 
 import argparse
 
-from meshlap_app.state.names import FIELDS, PANELS  # pure data: no polyscope, no numpy
+from meshlap_core.errors import MeshError
 
-from ..errors import MeshError
+from ..registry import VIEWS
+from ..state.names import FIELDS
+
+START_OPTIONS = ("field", "vertex", "k")
+"""The options handed to the panels when the window opens (each checks its own)."""
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -24,7 +33,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "options below",
     )
     p.add_argument("--field", choices=FIELDS, help="curvature field shown first (default cotan)")
-    p.add_argument("--panel", choices=PANELS, help="panel shown first (default curvature)")
+    p.add_argument("--panel", choices=VIEWS, help=f"panel shown first (default {VIEWS[0]})")
     p.add_argument("--vertex", type=int, help="one-ring panel: the selected vertex")
     p.add_argument("--k", type=int, help="spectral panel: reconstruct from k eigenvectors")
     p.add_argument(
@@ -39,7 +48,7 @@ def run(args: argparse.Namespace) -> int:
     if args.session is not None:
         given = [("MESH", args.mesh)] + [
             (f"--{name.replace('_', '-')}", getattr(args, name))
-            for name in ("field", "panel", "vertex", "k", "ui_scale")
+            for name in (*START_OPTIONS, "panel", "ui_scale")
         ]
         given = [flag for flag, value in given if value is not None]
         if given:
@@ -47,10 +56,8 @@ def run(args: argparse.Namespace) -> int:
                 f"{', '.join(given)} cannot be combined with --session (the session sets them)",
                 "--session",
             )
-    if args.k is not None and args.k < 1:
-        raise MeshError(f"must be at least 1, got {args.k}", "--k")
     if args.screenshot is not None:
-        from ..io import check_output_path
+        from meshlap_core.io import check_output_path
 
         # before the viewer starts: a missing folder, a directory, a non-PNG name or the input
         # mesh itself as the target fail at once, and an existing PNG is replaced only by a
@@ -60,16 +67,14 @@ def run(args: argparse.Namespace) -> int:
             overwrite_inputs=[p for p in (args.mesh, args.session) if p],
             suffixes=(".png",),
         )
-    # a bad mesh fails in meshlap_app.viewer.run before any window or EGL context is created
-    from meshlap_app.viewer import run as run_viewer  # the CLI imports the GUI only here
+    # a bad mesh or option fails in viewer.run before any window or EGL context is created
+    from ..viewer import run as run_viewer  # polyscope is imported only when a view runs
 
     return run_viewer(
         args.mesh,
         screenshot=args.screenshot,
-        field=args.field or "cotan",
-        panel=args.panel or "curvature",
-        vertex=args.vertex,
-        k=args.k,
+        panel=args.panel,
         ui_scale=1.0 if args.ui_scale is None else args.ui_scale,
         session=args.session,
+        **{name: getattr(args, name) for name in START_OPTIONS},
     )

@@ -1,0 +1,166 @@
+"""``meshlap animate MESH --panel P ... --out OUT.gif|.mp4``: an animation for slides,
+rendered headless (EGL) with the viewer's scene code (:mod:`..animate`). ``--session
+FILE.json`` animates a view prepared in the window: its mesh, settings and camera (an option
+typed on the command line wins over the session's value, which wins over the built-in default).
+
+The animatable panels and their options come from the panels' state modules (``ANIMATION``);
+this module names none of them. Every argument, the session, the mesh and the output path are
+checked before the renderer starts: a bad one is one line ``meshlap: error: ...`` and exit 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from pathlib import Path
+from typing import Any
+
+from meshlap_core.errors import MeshError
+
+from ..state.animation import Animation, animations
+
+DEFAULT_SIZE = "960x540"
+
+SESSION_HELP = """\
+--session FILE.json animates a view saved in the window (save session): its mesh (MESH is
+then an error), its settings and its camera. An option typed here wins over the session's
+value, which wins over the built-in default.
+  panel      the session's panel; a session saved on a panel without an animation needs
+             --panel
+{sections}
+  camera     the session's camera, not re-framed; the default --size is the part of the
+             saved window left of meshlap's panel, and the frames show exactly that part. An
+             explicit --size keeps the camera's view matrix and vertical field of view and
+             widens or narrows the picture symmetrically about that part's centre. With
+             --panel naming another panel than the session's (whose camera framed other
+             structures) or a session without a camera, the view is framed as without
+             --session.
+"""
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    kinds = animations()
+    p = sub.add_parser(
+        "animate",
+        help="render an animation (GIF/MP4): " + "; ".join(a.summary for a in kinds.values()),
+        epilog=SESSION_HELP.format(
+            sections="\n".join("  " + a.session_help for a in kinds.values() if a.session_help)
+        ),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument("mesh", nargs="?", help="mesh file (default: assets/bumpy.obj)")
+    p.add_argument(
+        "--panel",
+        choices=tuple(kinds),
+        help="what to animate (required without --session; default: the session's panel)",
+    )
+    p.add_argument("--out", required=True, metavar="OUT.gif|OUT.mp4", help="the animation file")
+    seen: set[str] = set()
+    for anim in kinds.values():
+        for opt in anim.options:
+            if opt.flag in seen:
+                continue
+            seen.add(opt.flag)
+            if opt.store_true:
+                p.add_argument(opt.flag, action="store_true", default=None, help=opt.help)
+            else:
+                p.add_argument(
+                    opt.flag, type=opt.type, choices=opt.choices, metavar=opt.metavar, help=opt.help
+                )
+    p.add_argument("--fps", type=float, help="frames per second (default depends on the kind)")
+    p.add_argument(
+        "--size",
+        metavar="WxH",
+        help=f"frame size in pixels (default {DEFAULT_SIZE}; with --session: the saved window's "
+        "view)",
+    )
+    p.add_argument(
+        "--shadow",
+        action="store_true",
+        help="draw the ground shadow as the viewer does (slower: a second render pass)",
+    )
+    p.add_argument(
+        "--session",
+        metavar="FILE.json",
+        help="animate a saved viewer session: its mesh, settings and camera (see below)",
+    )
+    p.set_defaults(func=run)
+
+
+def _size(text: str) -> tuple[int, int]:
+    try:
+        w, h = (int(t) for t in text.lower().split("x"))
+    except ValueError:
+        raise MeshError(f"expected WxH such as 960x540, got {text!r}", "--size") from None
+    return w, h
+
+
+def _choose(args: argparse.Namespace, session: Any) -> tuple[str, Animation]:
+    """The animated panel (typed, else the session's) and its animation."""
+    kinds = animations()
+    if args.panel is None and session is not None:
+        if session.panel not in kinds:
+            raise MeshError(
+                f"the session was saved on the {session.panel} panel, which has no animation; "
+                f"add --panel {'|'.join(kinds)}",
+                args.session,
+            )
+        args.panel = session.panel
+    if args.panel is None:
+        raise MeshError(
+            f"choose what to animate: --panel {'|'.join(kinds)} (or give --session FILE.json)",
+            "--panel",
+        )
+    return args.panel, kinds[args.panel]
+
+
+def _read_session(args: argparse.Namespace) -> Any:
+    """The session file, refused with MESH beside it."""
+    if args.mesh is not None:
+        raise MeshError(
+            "MESH cannot be combined with --session (the session names its mesh)", "--session"
+        )
+    from ..state.session import read_session  # no polyscope: pure data
+
+    return read_session(args.session)
+
+
+def run(args: argparse.Namespace) -> int:
+    session = _read_session(args) if args.session is not None else None
+    panel, anim = _choose(args, session)
+    options = {opt.dest: getattr(args, opt.dest) for opt in anim.options}
+    if session is not None:
+        anim.from_session(options, session.settings[panel], args.session)
+        if args.size is None:
+            from ..animate import session_size
+
+            size = session_size(session, args.session)
+            args.size = f"{size[0]}x{size[1]}" if size is not None else None
+    anim.fill_defaults(options)
+    if args.fps is not None and not (math.isfinite(args.fps) and 0.1 <= args.fps <= 120):
+        raise MeshError(f"must be between 0.1 and 120, got {args.fps}", "--fps")
+    from ..animate import AnimationSpec, check_spec, load_mesh_state, render
+
+    spec = AnimationSpec(
+        panel=panel,
+        out=Path(args.out),
+        mesh=session.mesh if session is not None else Path(args.mesh) if args.mesh else None,
+        options=options,
+        fps=args.fps,
+        size=_size(args.size or DEFAULT_SIZE),
+        shadow=args.shadow,
+        session=session,
+        session_file=Path(args.session) if session is not None else None,
+    )
+    check_spec(spec, None)  # options and output path first: a doomed run fails in a second
+    mesh = load_mesh_state(spec) if anim.uses_mesh or session is not None else None
+    check_spec(spec, mesh)
+    if mesh is None:
+        from ..state.mesh import MeshState
+
+        mesh = MeshState()
+        mesh.load(None)  # the frames do not show it; the viewer needs one
+    out = render(spec, mesh, progress=True)
+    sys.stdout.write(f"wrote {out}\n")
+    return 0

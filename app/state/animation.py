@@ -1,0 +1,111 @@
+"""What a panel declares to be animated by ``meshlap animate --panel NAME`` (no polyscope).
+
+A panel's state module that defines ``ANIMATION`` (an :class:`Animation`) is animatable: the
+animate command adds its options to the command line, fills the ones not typed from a saved
+session's section, checks them before the renderer starts, and the panel's ``frames`` sets up
+each frame. Nothing outside the panel's files names its options.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+from ..registry import REGISTRY
+
+
+@dataclass(frozen=True)
+class Option:
+    """One command-line option of an animation (argparse's default is ``None`` so that a typed
+    value can be told apart from a session's; ``default`` is the built-in one)."""
+
+    flag: str
+    help: str
+    default: Any = None
+    type: Callable[[str], Any] | None = None
+    choices: tuple[str, ...] | None = None
+    metavar: str | None = None
+    store_true: bool = False
+
+    @property
+    def dest(self) -> str:
+        """The option's key in the options dict (``--lam`` → ``lam``)."""
+        return self.flag.lstrip("-").replace("-", "_")
+
+
+def _no_session(options: dict[str, Any], values: dict[str, Any], source: Any) -> None:
+    return None
+
+
+def _nothing(options: dict[str, Any], mesh: Any) -> None:
+    return None
+
+
+@dataclass(frozen=True)
+class Animation:
+    """A panel's animation: its options and the functions the animate command calls.
+
+    Attributes
+    ----------
+    summary : str
+        One line for ``meshlap animate --help`` (what the frames show).
+    options : tuple of Option
+        Its command-line options.
+    session_help : str
+        How a saved session's section fills the options (``--help`` epilog).
+    check : callable
+        ``check(options)`` after the defaults are filled: validates and converts in place
+        (ranges parsed, numbers bounded); raises ``MeshError`` naming the option.
+    kind : callable
+        ``kind(options)``: what is animated (``smoothing``, ``k``, ``modes``, ``theta``...),
+        the key of ``fps``.
+    fps : dict
+        Default frames per second of each kind.
+    frame_count : callable
+        ``frame_count(options)``.
+    from_session : callable
+        ``from_session(options, section, source)`` fills the options not typed (``None``)
+        from the panel's saved section.
+    check_mesh : callable
+        ``check_mesh(options, mesh)`` once the mesh is loaded (e.g. k ≤ vertices).
+    uses_mesh : bool
+        ``False``: the frames do not show the mesh (it is not loaded without a session).
+    colorbar : bool
+        The frames show a colour map, whose on-screen colour bar is kept (polyscope draws it
+        with imgui).
+    session_overrides : dict
+        Settings of the panel's section replaced when a session is restored before its
+        animation (e.g. the smoothing restarts at iteration 0: the frames run it). Other
+        panels' sections take their state module's ``QUIET`` (nothing computed).
+    """
+
+    summary: str
+    options: tuple[Option, ...]
+    check: Callable[[dict[str, Any]], None]
+    kind: Callable[[dict[str, Any]], str]
+    fps: dict[str, float]
+    frame_count: Callable[[dict[str, Any]], int]
+    session_help: str = ""
+    from_session: Callable[[dict[str, Any], dict[str, Any], Any], None] = _no_session
+    check_mesh: Callable[[dict[str, Any], Any], None] = _nothing
+    uses_mesh: bool = True
+    colorbar: bool = True
+    session_overrides: dict[str, Any] = field(default_factory=dict)
+
+    def fill_defaults(self, options: dict[str, Any]) -> None:
+        """Every option not typed (``None``) takes its built-in default."""
+        for opt in self.options:
+            if options.get(opt.dest) is None and opt.default is not None:
+                options[opt.dest] = opt.default
+
+
+def animations() -> dict[str, Animation]:
+    """Each animatable panel's :class:`Animation`, by panel name (registry order)."""
+    out = {}
+    for e in REGISTRY:
+        module = e.state_module()
+        anim = getattr(module, "ANIMATION", None) if module is not None else None
+        if anim is not None:
+            out[e.name] = anim
+    return out

@@ -1,0 +1,95 @@
+"""``AppState``: every state object and setting of the viewer, in one owner (no polyscope).
+
+The viewer (and the headless animator) hold one :class:`AppState`; panels read and change it
+through their host. What belongs to one panel lives in that panel's *slice*
+(``slices[name]``, made by ``app/state/<name>.py``'s ``make_state()``); what several panels read
+lives here: the mesh, its curvature fields, the display transform, the active view, the UI
+scale and the export folder.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from meshlap_core.errors import MeshError
+
+from ..registry import REGISTRY, VIEWS
+from .curvature import CurvatureState
+from .display import Display
+from .mesh import MeshState
+
+UI_SCALES = (0.5, 3.0)
+"""The UI scale's range (text and widgets; projectors use 1.5 to 2)."""
+
+
+def make_slices() -> dict[str, Any]:
+    """A fresh state slice for every registered panel that has one (``make_state()`` of
+    ``app/state/<name>.py``)."""
+    out: dict[str, Any] = {}
+    for entry in REGISTRY:
+        module = entry.state_module()
+        make = getattr(module, "make_state", None) if module is not None else None
+        if make is not None:
+            out[entry.name] = make()
+    return out
+
+
+@dataclass
+class AppState:
+    """The mesh on screen and everything derived from it or set by the user.
+
+    ``panel`` is the active view (one of :data:`~meshlap_app.registry.VIEWS`); ``folder`` is
+    where exports, recordings and relative session files go; ``errors`` maps a section to the
+    message shown in red there.
+    """
+
+    mesh: MeshState = field(default_factory=MeshState)
+    curv: CurvatureState = field(default_factory=CurvatureState)
+    display: Display = field(default_factory=Display)
+    panel: str = VIEWS[0]
+    ui_scale: float = 1.0
+    folder: Path = field(default_factory=Path.cwd)
+    slices: dict[str, Any] = field(default_factory=make_slices)
+    errors: dict[str, str] = field(default_factory=dict)
+
+    def check_panel(self, name: str, flag: str = "view") -> str:
+        """``name`` if it is a view, else a :class:`MeshError` naming the views."""
+        if name not in VIEWS:
+            raise MeshError(f"unknown panel {name!r}; choose one of {', '.join(VIEWS)}", flag)
+        return name
+
+    def set_ui_scale(self, scale: float) -> float:
+        """Set the UI scale, clamped to :data:`UI_SCALES`; returns it.
+
+        Raises
+        ------
+        MeshError
+            ``scale`` is not a finite positive number (the previous scale stays).
+        """
+        lo, hi = UI_SCALES
+        if not 0 < float(scale) < float("inf"):
+            message = f"must be a number between {lo:g} and {hi:g}, got {scale!r}"
+            raise MeshError(message, "UI scale")
+        self.ui_scale = min(max(float(scale), lo), hi)
+        return self.ui_scale
+
+    def set_folder(self, text: str) -> Path:
+        """Use the existing folder ``text`` for exports; returns it resolved.
+
+        Raises
+        ------
+        MeshError
+            The folder does not exist (the previous folder stays).
+        """
+        folder = Path(text.strip()).expanduser()
+        if not folder.is_dir():
+            raise MeshError(f"{text!r} is not an existing folder", "export folder")
+        self.folder = folder.resolve()
+        return self.folder
+
+    def in_folder(self, text: str) -> Path:
+        """The path ``text`` names: as typed when absolute, else in the export folder."""
+        path = Path(text.strip()).expanduser()
+        return path if path.is_absolute() else self.folder / path
