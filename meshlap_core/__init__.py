@@ -37,7 +37,7 @@ _PUBLIC: dict[str, str | tuple[str, str]] = {
     "inspect_vertex": "inspector",
     # generated meshes
     "icosphere": "primitives",
-    "torus_mesh": ("primitives", "torus"),  # the triangle mesh; surfaces.torus is the surface
+    "torus_mesh": "primitives",  # the triangle mesh; get_surface("torus") is the surface
     "grid": "primitives",
     "cube": "primitives",
     # topology
@@ -53,18 +53,17 @@ _PUBLIC: dict[str, str | tuple[str, str]] = {
     "laplace_beltrami": "laplacian",
     # curvature
     "curvature_field": "curvature",
-    "curvature_fields": "curvature",
+    "all_curvature_fields": "curvature",
     "vertex_normals": "curvature",
     # spectral
     "SpectralBasis": "spectral",
-    "compute_basis": "spectral",
     # smoothing
     "Smoother": "smoothing",
     "smooth": "smoothing",
     "add_noise": "noise",
     "rmse": "metrics",
     # parametric surfaces
-    "surface": "surfaces",
+    "get_surface": "surfaces",
     "mesh_surface": "surfaces",
     "point_geometry": "surfaces",
 }

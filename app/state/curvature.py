@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from meshlap_core.curvature import curvature_fields
+from meshlap_core.curvature import all_curvature_fields
 from meshlap_core.errors import MeshError
 from meshlap_core.types import FloatArray
 
@@ -63,7 +63,7 @@ class CurvatureState:
         key = (mesh.version, self.area, self.boundary)
         if key == self._key:
             return False
-        self.fields = curvature_fields(mesh.V, mesh.F, self.area, self.boundary)
+        self.fields = all_curvature_fields(mesh.V, mesh.F, self.area, self.boundary)
         self._key = key
         return True
 

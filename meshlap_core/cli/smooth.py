@@ -19,17 +19,21 @@ from pathlib import Path
 from typing import Any, TextIO
 
 from ..errors import MeshError, MeshWarning
-from ..options import AREA_KINDS
+from ..options import (
+    AREA_KINDS,
+    DEFAULT_MASS_UPDATE,
+    DEFAULT_SMOOTHING_METHOD,
+    LAPLACIAN_KINDS,
+    MASS_UPDATES,
+    SMOOTHING_METHODS,
+)
 from ..smoothing import (
-    LAPLACIANS,
-    MASS_MODES,
     MAX_ITERS,
-    METHODS,
     Smoother,
     check_iters,
     check_lam,
 )
-from ._common import add_json_flag, emit_json, summary_stats
+from ._common import add_json_flag, add_renamed_flag, emit_json, summary_stats
 
 HISTORY_SAMPLES = 2000
 """At most this many per-iteration entries in the output (about 1 MB of JSON)."""
@@ -47,8 +51,15 @@ def register(sub: argparse._SubParsersAction) -> None:
         ),
     )
     p.add_argument("mesh", help="mesh file")
-    p.add_argument("--method", choices=METHODS, default="explicit", help="default: explicit")
-    p.add_argument("--laplacian", choices=LAPLACIANS, default="uniform", help="default: uniform")
+    p.add_argument(
+        "--method",
+        choices=SMOOTHING_METHODS,
+        default=DEFAULT_SMOOTHING_METHOD,
+        help=f"default: {DEFAULT_SMOOTHING_METHOD}",
+    )
+    p.add_argument(
+        "--laplacian", choices=LAPLACIAN_KINDS, default="uniform", help="default: uniform"
+    )
     p.add_argument("--lam", default="0.5", help="step lambda > 0 (default 0.5)")
     p.add_argument(
         "--iters",
@@ -70,10 +81,16 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="rescale to keep the enclosed volume (closed meshes)",
     )
     p.add_argument(
+        "--mass-update",
+        choices=MASS_UPDATES,
+        default=DEFAULT_MASS_UPDATE,
+        help="cotan mass matrix frozen (factorize once) or recomputed each step "
+        f"(default {DEFAULT_MASS_UPDATE})",
+    )
+    add_renamed_flag(
+        p,
         "--mass",
-        choices=MASS_MODES,
-        default="frozen",
-        help="cotan mass matrix frozen (factorize once) or recomputed each step (default frozen)",
+        "--mass-update (frozen|recompute); the area kind is --area (barycentric|voronoi)",
     )
     p.add_argument(
         "--area", choices=AREA_KINDS, default="voronoi", help="cotan lumped area (default voronoi)"
@@ -159,7 +176,7 @@ def run(args: argparse.Namespace) -> int:
         "iters": s.iteration,
         "fix_boundary": bool(args.fix_boundary),
         "preserve_volume": bool(args.preserve_volume),
-        "mass": args.mass,
+        "mass": args.mass_update,
         "area": args.area,
         "closed": s.closed,
         "volume_change_pct": last["volume_change_pct"],
@@ -208,7 +225,7 @@ def _make_smoother(
                 pass_band=pass_band,
                 fix_boundary=args.fix_boundary,
                 preserve_volume=args.preserve_volume,
-                mass=args.mass,
+                mass=args.mass_update,
                 area=args.area,
                 history_samples=HISTORY_SAMPLES,
             )

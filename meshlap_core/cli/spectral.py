@@ -14,9 +14,9 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import MeshError
-from ..options import AREA_KINDS, LAPLACIAN_KINDS
+from ..options import AREA_KINDS, LAPLACIAN_KINDS, MASS_AREA
 from ..spectral import SpectralBasis
-from ._common import add_json_flag, emit_json, parse_list
+from ._common import add_json_flag, add_renamed_flag, emit_json, parse_list
 
 _DEFAULT_RECONSTRUCT = (5, 15, 50, 100, 300, 1000)
 
@@ -34,11 +34,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("mesh", help="mesh file (OBJ, OFF, PLY, STL)")
     p.add_argument("--k", required=True, help="number of eigenmodes (1 <= K <= vertices)")
     p.add_argument(
-        "--mass",
+        "--area",
         choices=AREA_KINDS,
-        default="voronoi",
-        help="lumped mass for the cotan Laplacian (default voronoi)",
+        default=MASS_AREA,
+        help=f"vertex area of the lumped mass M of the cotan Laplacian (default {MASS_AREA})",
     )
+    add_renamed_flag(p, "--mass", "--area (the area kind of the mass matrix, barycentric|voronoi)")
     p.add_argument(
         "--laplacian",
         choices=LAPLACIAN_KINDS,
@@ -127,7 +128,7 @@ def _compute(args: argparse.Namespace, V: Any, F: Any, k: int) -> SpectralBasis:
             F,
             k,
             laplacian=args.laplacian,
-            area=args.mass,
+            area=args.area,
             cache=not args.no_cache,
             progress=_Progress(),
         )

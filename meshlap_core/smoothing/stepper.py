@@ -21,17 +21,22 @@ from ..laplacian import vertex_areas
 from ..linalg.spd import SPDSolver
 from ..metrics import _signed_volume_unchecked, n_boundary_edges, percent_volume_change
 from ..noise import bbox_diagonal
-from ..options import AREA_KINDS, MASS_AREA, AreaKind, LaplacianKind
+from ..options import (
+    AREA_KINDS,
+    LAPLACIAN_KINDS,
+    MASS_AREA,
+    MASS_UPDATES,
+    SMOOTHING_METHODS,
+    AreaKind,
+    LaplacianKind,
+    MassUpdate,
+    SmoothingMethod,
+    check_choice,
+)
 from ..topology import boundary_vertex_mask
 from ..types import FloatArray, IntArray, as_mesh, as_vertices
 from .params import (
     DEFAULT_PASS_BAND,
-    LAPLACIANS,
-    MASS_MODES,
-    METHODS,
-    MassMode,
-    Method,
-    _check_choice,
     _resolve_nu,
     check_iters,
     check_lam,
@@ -156,7 +161,7 @@ class Smoother:
         self,
         V: FloatArray,
         F: IntArray,
-        method: Method = "explicit",
+        method: SmoothingMethod = "explicit",
         laplacian: LaplacianKind = "uniform",
         lam: float = 0.5,
         *,
@@ -164,7 +169,7 @@ class Smoother:
         pass_band: float = DEFAULT_PASS_BAND,
         fix_boundary: bool = False,
         preserve_volume: bool = False,
-        mass: MassMode = "frozen",
+        mass: MassUpdate = "frozen",
         area: AreaKind = MASS_AREA,
         reference: FloatArray | None = None,
         track_history: bool = True,
@@ -175,10 +180,10 @@ class Smoother:
         self.V0, self.F = as_mesh(V, F)
         self._init_history(history_limit, history_samples)
         self.n = len(self.V0)
-        self.method = _check_choice(method, METHODS, "method")
-        self.laplacian = _check_choice(laplacian, LAPLACIANS, "laplacian")
-        self.mass = _check_choice(mass, MASS_MODES, "mass")
-        self.area = _check_choice(area, AREA_KINDS, "area")
+        self.method = check_choice(method, SMOOTHING_METHODS, "method")
+        self.laplacian = check_choice(laplacian, LAPLACIAN_KINDS, "laplacian")
+        self.mass = check_choice(mass, MASS_UPDATES, "mass")
+        self.area = check_choice(area, AREA_KINDS, "area")
         self.pass_band = check_lam(pass_band, "pass_band")
         self.lam = check_lam(lam)
         self._nu_given = taubin_nu
@@ -553,7 +558,7 @@ class Smoother:
 def smooth(
     V: FloatArray,
     F: IntArray,
-    method: Method = "explicit",
+    method: SmoothingMethod = "explicit",
     laplacian: LaplacianKind = "uniform",
     lam: float = 0.5,
     iters: int = 10,

@@ -114,7 +114,7 @@ def _load_asset(file: str) -> tuple[FloatArray, IntArray, Path | None]:
     gen = {
         "bumpy.obj": lambda: primitives.bumpy_sphere(4),
         "icosphere.obj": lambda: primitives.icosphere(3),
-        "torus.obj": lambda: primitives.torus(48, 24),
+        "torus.obj": lambda: primitives.torus_mesh(48, 24),
         "grid.obj": lambda: primitives.grid(20, 20),
         "cube.obj": lambda: primitives.cube(0),
     }[file]
@@ -319,7 +319,7 @@ class Context:
             V, F = mesh.V, mesh.F
         assert V is not None and F is not None
         if values is None:
-            values = curvature.curvature_fields(V, F)[field]
+            values = curvature.all_curvature_fields(V, F)[field]
         f = new_figure(6.4, 4.8)
         ax = f.add_axes((0.0, 0.0, 0.84, 1.0))
         sm = draw_mesh(ax, V, F, values, cmap=cmap, symmetric=symmetric)
