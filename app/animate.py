@@ -32,8 +32,9 @@ import numpy as np
 import polyscope as ps
 
 from meshlap_core.errors import MeshError
-from meshlap_core.frames import FrameWriter, Progress, burn_caption, check_animation_output
+from meshlap_core.frames import FrameWriter, burn_caption, check_animation_output, frame_progress
 from meshlap_core.frames import parse_range as parse_range
+from meshlap_core.progress import Progress
 
 from . import scene
 from .scene import COLORBAR_AT, MESH, RECON
@@ -169,7 +170,7 @@ def render(spec: AnimationSpec, mesh: MeshState, progress: bool = True) -> Path:
     keep = restore_session(viewer, spec, mesh) if spec.session is not None else None
     scenes = {"smoothing": smoothing_frames, "k": k_frames, "modes": mode_frames}
     frames = scenes.get(spec.what, theta_frames)(viewer, spec)
-    bar = Progress(frame_count(spec)) if progress else None
+    bar = frame_progress(frame_count(spec)) if progress else None
     try:
         write_frames(frames, writer, colorbar, bar, keep)
         return writer.close()
@@ -213,7 +214,7 @@ def write_frames(
         if pending is not None:
             pending.result()
     if bar is not None:
-        bar.finish()
+        bar.close()
 
 
 def frame_count(spec: AnimationSpec) -> int:

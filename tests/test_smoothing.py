@@ -764,11 +764,11 @@ class _Stream:
 
 
 def _run_progress(tty, seconds_per_step, steps=100):
-    from meshlap_core.cli.smooth import Progress
+    from meshlap_core.cli.smooth import iteration_progress
 
     now = [0.0]
     stream = _Stream(tty)
-    p = Progress(stream, steps, clock=lambda: now[0])
+    p = iteration_progress(steps, stream, clock=lambda: now[0])
     for k in range(1, steps + 1):
         now[0] += seconds_per_step
         p.update(k)

@@ -27,6 +27,7 @@ from ..options import (
     MASS_UPDATES,
     SMOOTHING_METHODS,
 )
+from ..progress import Progress
 from ..smoothing import (
     MAX_ITERS,
     Smoother,
@@ -236,7 +237,7 @@ def _make_smoother(
 
 def _iterate(s: Smoother, iters: int) -> None:
     """Step ``iters`` times (progress on stderr for long runs), stopping if the run diverges."""
-    progress = Progress(sys.stderr, iters)
+    progress = iteration_progress(iters)
     for k in range(iters):
         s.step()
         if s.diverged:
@@ -255,64 +256,36 @@ def _history_note(s: Smoother) -> str | None:
     )
 
 
-class Progress:
-    """Progress of a long loop on stderr, never in the way of a short run's output.
+def iteration_progress(
+    total: int, stream: TextIO | str | None = "stderr", clock: Callable[[], float] = time.monotonic
+) -> Progress:
+    """Progress of a long smoothing run on stderr, never in the way of a short run's output.
 
-    On a terminal: one line redrawn in place (``\\r``) at most every ``redraw_s`` seconds once
-    ``start_s`` seconds have passed, erased by :meth:`close`. Otherwise (a pipe, a log, a test
-    capturing stderr): nothing for the first ``long_s`` seconds, then one full line every
-    ``every_s`` seconds; a run shorter than ``long_s`` prints nothing.
-
-    Parameters
-    ----------
-    stream : text stream
-    total : int
-        Iterations planned.
-    clock : callable, optional
-        Seconds (``time.monotonic`` by default; tests pass a fake clock).
+    On a terminal: one line redrawn in place once a second has passed, at most every 0.5 s,
+    erased at the end. Otherwise (a pipe, a log, a test capturing stderr): nothing for the first
+    10 s, then one full line every 30 s; a run shorter than 10 s prints nothing.
+    ``smooth: 10/100 iterations (10.0 %), 10 s elapsed, about 90 s left``.
     """
+    return Progress(
+        total,
+        _iterations_line,
+        "smooth",
+        stream=stream,  # type: ignore[arg-type]
+        erase=True,
+        after_s=10.0,
+        every_s=30.0,
+        tty_after_s=1.0,
+        tty_every_s=0.5,
+        clock=clock,
+    )
 
-    def __init__(
-        self,
-        stream: TextIO,
-        total: int,
-        *,
-        clock: Callable[[], float] = time.monotonic,
-        start_s: float = 1.0,
-        redraw_s: float = 0.5,
-        long_s: float = 10.0,
-        every_s: float = 30.0,
-    ) -> None:
-        self.stream, self.total, self.clock = stream, total, clock
-        try:
-            self.tty = bool(stream.isatty())
-        except (AttributeError, ValueError):
-            self.tty = False
-        self.t0 = clock()
-        self.next_s = start_s if self.tty else long_s
-        self.gap_s = redraw_s if self.tty else every_s
-        self.drawn = False
 
-    def update(self, done: int) -> None:
-        """Record that ``done`` of ``total`` iterations are finished (one clock read: ~50 ns)."""
-        now = self.clock() - self.t0
-        if now < self.next_s:
-            return
-        self.next_s = now + self.gap_s
-        left = now * (self.total - done) / done if done else float("nan")
-        text = (
-            f"smooth: {done}/{self.total} iterations ({100.0 * done / self.total:.1f} %), "
-            f"{now:.0f} s elapsed, about {left:.0f} s left"
-        )
-        self.stream.write(f"\r{text}\x1b[K" if self.tty else text + "\n")
-        self.stream.flush()
-        self.drawn = True
-
-    def close(self) -> None:
-        """Erase the terminal line (a later error or report starts on a clean line)."""
-        if self.tty and self.drawn:
-            self.stream.write("\r\x1b[K")
-            self.stream.flush()
+def _iterations_line(p: Progress) -> str:
+    left = p.elapsed * (p.total - p.done) / p.done if p.done else float("nan")
+    return (
+        f"{p.label}: {p.done}/{p.total} iterations ({100.0 * p.done / p.total:.1f} %), "
+        f"{p.elapsed:.0f} s elapsed, about {left:.0f} s left"
+    )
 
 
 def _cli_error(exc: MeshError, mesh: str) -> MeshError:
