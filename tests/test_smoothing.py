@@ -255,11 +255,11 @@ def test_mass_recompute_refactorizes_frozen_reuses():
     frozen.set_lam(0.02)
     frozen.run(2)
     assert frozen.n_factorizations == 2
-    moving = S.Smoother(V, F, "implicit", "cotan", 0.01, mass="recompute")
+    moving = S.Smoother(V, F, "implicit", "cotan", 0.01, mass_update="recompute")
     moving.run(4)
     assert moving.n_factorizations == 4
     # first step identical (same M), later steps differ
-    one = S.Smoother(V, F, "implicit", "cotan", 0.01, mass="recompute").step()
+    one = S.Smoother(V, F, "implicit", "cotan", 0.01, mass_update="recompute").step()
     np.testing.assert_allclose(one, S.smooth(V, F, "implicit", "cotan", 0.01, 1), atol=1e-14)
     assert not np.allclose(moving.V, S.smooth(V, F, "implicit", "cotan", 0.01, 4), atol=1e-9)
 
@@ -272,7 +272,7 @@ def test_mass_recompute_matches_the_kazhdan_update():
     for _ in range(3):
         Mt = lap.mass_matrix(X, F, "voronoi")
         X = sla.spsolve((Mt - lam * C).tocsc(), Mt @ X)
-    got = S.smooth(V, F, "implicit", "cotan", lam, 3, mass="recompute")
+    got = S.smooth(V, F, "implicit", "cotan", lam, 3, mass_update="recompute")
     np.testing.assert_allclose(got, X, atol=1e-10)
 
 
@@ -559,7 +559,7 @@ def test_explicit_with_mass_recompute_uses_the_current_areas():
     X = V.copy()
     for _ in range(3):  # x ← x + λ M(x)⁻¹ C₀ x, stiffness frozen
         X = X + lam * (C @ X) / lap.vertex_areas(X, F, "voronoi")[:, None]
-    got = S.smooth(V, F, "explicit", "cotan", lam, 3, mass="recompute")
+    got = S.smooth(V, F, "explicit", "cotan", lam, 3, mass_update="recompute")
     np.testing.assert_allclose(got, X, atol=1e-12)
 
 

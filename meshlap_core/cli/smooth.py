@@ -226,7 +226,7 @@ def _make_smoother(
                 pass_band=pass_band,
                 fix_boundary=args.fix_boundary,
                 preserve_volume=args.preserve_volume,
-                mass=args.mass_update,
+                mass_update=args.mass_update,
                 area=args.area,
                 history_samples=HISTORY_SAMPLES,
             )

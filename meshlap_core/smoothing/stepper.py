@@ -23,6 +23,7 @@ from ..metrics import _signed_volume_unchecked, n_boundary_edges, percent_volume
 from ..noise import bbox_diagonal
 from ..options import (
     AREA_KINDS,
+    DEFAULT_MASS_UPDATE,
     LAPLACIAN_KINDS,
     MASS_AREA,
     MASS_UPDATES,
@@ -88,7 +89,7 @@ class Smoother:
     preserve_volume : bool
         After each step, scale about the vertex centroid so the enclosed volume stays that of the
         input (closed meshes only).
-    mass : {"frozen", "recompute"}
+    mass_update : {"frozen", "recompute"}
         ``frozen``: ``W`` and ``K`` from the input mesh, the implicit system factorized once.
         ``recompute``: ``W`` (the areas) recomputed from the current positions every step with
         ``K`` frozen (Kazhdan et al. 2012); the implicit system is then refactorized every step.
@@ -169,7 +170,7 @@ class Smoother:
         pass_band: float = DEFAULT_PASS_BAND,
         fix_boundary: bool = False,
         preserve_volume: bool = False,
-        mass: MassUpdate = "frozen",
+        mass_update: MassUpdate = DEFAULT_MASS_UPDATE,
         area: AreaKind = MASS_AREA,
         reference: FloatArray | None = None,
         track_history: bool = True,
@@ -182,7 +183,7 @@ class Smoother:
         self.n = len(self.V0)
         self.method = check_choice(method, SMOOTHING_METHODS, "method")
         self.laplacian = check_choice(laplacian, LAPLACIAN_KINDS, "laplacian")
-        self.mass = check_choice(mass, MASS_UPDATES, "mass")
+        self.mass_update = check_choice(mass_update, MASS_UPDATES, "mass_update")
         self.area = check_choice(area, AREA_KINDS, "area")
         self.pass_band = check_lam(pass_band, "pass_band")
         self.lam = check_lam(lam)
@@ -257,7 +258,7 @@ class Smoother:
         self._K_free_rows = K[self._free].tocsr()  # rows of free vertices, all columns
         self._K_ff = self._K_free_rows[:, self._free].tocsr()
         self._K_fp = self._K_free_rows[:, self._fixed].tocsr()
-        self._recompute_mass = self.mass == "recompute" and self.laplacian == "cotan"
+        self._recompute_mass = self.mass_update == "recompute" and self.laplacian == "cotan"
         self._stability: Stability | None = None
         self.n_factorizations = 0
         self._solver: SPDSolver | None = None
@@ -578,7 +579,8 @@ def smooth(
     iters : int
         ``>= 0``.
     **options
-        Keyword options of :class:`Smoother` (``fix_boundary``, ``preserve_volume``, ``mass``, ...).
+        Keyword options of :class:`Smoother` (``fix_boundary``, ``preserve_volume``,
+        ``mass_update``, ...).
 
     Returns
     -------
