@@ -16,7 +16,7 @@ import time
 import warnings
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any, TextIO
+from typing import Any, Literal, TextIO
 
 from ..errors import MeshError, MeshWarning
 from ..options import (
@@ -257,7 +257,9 @@ def _history_note(s: Smoother) -> str | None:
 
 
 def iteration_progress(
-    total: int, stream: TextIO | str | None = "stderr", clock: Callable[[], float] = time.monotonic
+    total: int,
+    stream: TextIO | Literal["stderr"] | None = "stderr",
+    clock: Callable[[], float] = time.monotonic,
 ) -> Progress:
     """Progress of a long smoothing run on stderr, never in the way of a short run's output.
 
@@ -270,7 +272,7 @@ def iteration_progress(
         total,
         _iterations_line,
         "smooth",
-        stream=stream,  # type: ignore[arg-type]
+        stream=stream,
         erase=True,
         after_s=10.0,
         every_s=30.0,
