@@ -28,7 +28,9 @@ import numpy as np
 import polyscope as ps
 
 from meshlap_core.errors import MeshError
-from meshlap_core.frames import FrameWriter, Progress, burn_caption, check_animation_output
+from meshlap_core.frames import FrameWriter, burn_caption, check_animation_output, frame_progress
+from meshlap_core.options import check_choice
+from meshlap_core.progress import Progress
 
 from . import scene
 from .registry import REGISTRY
@@ -86,10 +88,7 @@ def check_spec(spec: AnimationSpec, mesh: MeshState | None) -> None:
         An inconsistent or out-of-range option, naming it.
     """
     kinds = animations()
-    if spec.panel not in kinds:
-        raise MeshError(
-            f"unknown panel {spec.panel!r}; choose one of {', '.join(kinds)}", "--panel"
-        )
+    check_choice(spec.panel, tuple(kinds), "panel", "--panel")
     w, h = spec.size
     if not (64 <= w <= 4096 and 64 <= h <= 4096):
         raise MeshError(f"each side must be 64 to 4096 pixels, got {w}x{h}", "--size")
@@ -135,7 +134,7 @@ def render(spec: AnimationSpec, mesh: MeshState, progress: bool = True) -> Path:
     viewer.sync_mesh()
     keep = restore_session(viewer, spec, mesh) if spec.session is not None else None
     frames = viewer.panels[spec.panel].frames(viewer, spec.options)
-    bar = Progress(anim.frame_count(spec.options)) if progress else None
+    bar = frame_progress(anim.frame_count(spec.options)) if progress else None
     colorbar = anim.colorbar  # polyscope draws its colour bar with imgui
     try:
         write_frames(frames, writer, colorbar, bar, keep)
@@ -180,7 +179,7 @@ def write_frames(
         if pending is not None:
             pending.result()
     if bar is not None:
-        bar.finish()
+        bar.close()
 
 
 # ---------------------------------------------------------------- a saved session's view

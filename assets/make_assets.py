@@ -16,7 +16,7 @@ HERE = Path(__file__).resolve().parent
 ASSETS = {
     "bumpy.obj": lambda: primitives.bumpy_sphere(4),  # the viewer's default mesh
     "icosphere.obj": lambda: primitives.icosphere(3),
-    "torus.obj": lambda: primitives.torus(48, 24),
+    "torus.obj": lambda: primitives.torus_mesh(48, 24),
     "grid.obj": lambda: primitives.grid(20, 20),
     "cube.obj": lambda: primitives.cube(0),
 }

@@ -21,7 +21,7 @@ import igl
 import numpy as np
 from _util import best_of, print_table, shared_mesh
 
-from meshlap_core.curvature import curvature_fields, principal_curvature_quadric
+from meshlap_core.curvature import all_curvature_fields, principal_curvature_quadric
 from meshlap_core.io import load_mesh
 from meshlap_core.laplacian import cotan_stiffness, mass_matrix, uniform_laplacian
 from meshlap_core.topology import boundary_vertex_mask
@@ -81,7 +81,7 @@ def main() -> None:
             t_load_i, _ = best_of(lambda p=path: igl.read_triangle_mesh(str(p)), args.repeat)
         t_ops_o, _ = best_of(partial(ours_operators, V, F), args.repeat)
         t_ops_i, _ = best_of(partial(igl_operators, V, F), args.repeat)
-        t_cur_o, fo = best_of(partial(curvature_fields, V, F), args.repeat)
+        t_cur_o, fo = best_of(partial(all_curvature_fields, V, F), args.repeat)
         t_cur_i, fi = best_of(partial(igl_curvatures, V, F), args.repeat)
         # boundary vertices differ on purpose (we use pi - sum, libigl 2pi - sum): compare inside
         inside = ~boundary_vertex_mask(F, len(V))

@@ -3,14 +3,20 @@
 Pure numpy / scipy / libigl; this package never imports polyscope (the viewer is the separate
 ``meshlap_app`` package). The public API below is what scripts and notebooks use; every name is
 importable from ``meshlap_core`` directly and is loaded on first use, so ``import meshlap_core``
-stays cheap::
+stays cheap. On a file, start with ``mesh = load_mesh("bunny.obj")`` and use ``mesh.V, mesh.F``;
+here a generated unit sphere (``tests/test_doc_examples.py`` runs this example):
 
-    from meshlap_core import load_mesh, curvature_field, SpectralBasis, Smoother
-
-    mesh = load_mesh("bunny.obj")
-    H = curvature_field(mesh.V, mesh.F, "cotan")
-    basis = SpectralBasis(mesh.V, mesh.F, k=50)
-    X = basis.reconstruct(20)
+>>> from meshlap_core import Smoother, SpectralBasis, curvature_field, icosphere
+>>> V, F = icosphere(2)
+>>> H = curvature_field(V, F, "cotan", area="voronoi")  # Δx = −2Hn: H ≈ 1 on the unit sphere
+>>> round(float(H.mean()), 2)
+1.0
+>>> basis = SpectralBasis.compute(V, F, 50, cache=False)  # −C u = λ M u, UᵀMU = I
+>>> basis.reconstruct(20).shape  # U₂₀ U₂₀ᵀ M X
+(162, 3)
+>>> smoother = Smoother(V, F, method="implicit", lam=0.5)
+>>> smoother.step().shape
+(162, 3)
 
 Sign convention: every Laplacian is negative semidefinite (``Δx = −2Hn``); eigenvalues shown
 to users are the non-negative frequencies of ``−Δ``.
@@ -37,7 +43,7 @@ _PUBLIC: dict[str, str | tuple[str, str]] = {
     "inspect_vertex": "inspector",
     # generated meshes
     "icosphere": "primitives",
-    "torus_mesh": ("primitives", "torus"),  # the triangle mesh; surfaces.torus is the surface
+    "torus_mesh": "primitives",  # the triangle mesh; get_surface("torus") is the surface
     "grid": "primitives",
     "cube": "primitives",
     # topology
@@ -53,18 +59,17 @@ _PUBLIC: dict[str, str | tuple[str, str]] = {
     "laplace_beltrami": "laplacian",
     # curvature
     "curvature_field": "curvature",
-    "curvature_fields": "curvature",
+    "all_curvature_fields": "curvature",
     "vertex_normals": "curvature",
     # spectral
     "SpectralBasis": "spectral",
-    "compute_basis": "spectral",
     # smoothing
     "Smoother": "smoothing",
     "smooth": "smoothing",
     "add_noise": "noise",
     "rmse": "metrics",
     # parametric surfaces
-    "surface": "surfaces",
+    "get_surface": "surfaces",
     "mesh_surface": "surfaces",
     "point_geometry": "surfaces",
 }

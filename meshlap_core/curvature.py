@@ -25,25 +25,24 @@ import igl
 import numpy as np
 
 from .errors import MeshError
-from .laplacian import (
-    _check_area,
-    cotan_stiffness,
-    uniform_laplacian,
-    vertex_areas,
+from .laplacian import cotan_stiffness, uniform_laplacian, vertex_areas
+from .options import (
+    AREA_KINDS,
+    BOUNDARY_RULES,
+    CURVATURE_FIELDS,
+    DEFAULT_AREA,
+    DEFAULT_BOUNDARY,
+    AreaKind,
+    BoundaryRule,
+    CurvatureField,
+    check_choice,
 )
-from .options import BOUNDARY_RULES, DEFAULT_AREA, DEFAULT_BOUNDARY, AreaKind, BoundaryRule
 from .topology import boundary_vertex_mask
 from .types import FloatArray, IntArray, as_mesh
 
-METHODS: tuple[str, ...] = ("uniform", "cotan", "gaussian", "k1", "k2")
-
 
 def _check_boundary(boundary: str) -> None:
-    if boundary not in BOUNDARY_RULES:
-        raise MeshError(
-            f"unknown boundary rule {boundary!r}; choose one of {', '.join(BOUNDARY_RULES)}",
-            "boundary",
-        )
+    check_choice(boundary, BOUNDARY_RULES, "boundary rule", "boundary")
 
 
 def _face_geometry(V: FloatArray, F: IntArray) -> tuple[FloatArray, FloatArray]:
@@ -158,7 +157,7 @@ def mean_curvature_cotan(V: FloatArray, F: IntArray, area: AreaKind = DEFAULT_AR
     -------
     H : (n,) float
     """
-    _check_area(area)
+    check_choice(area, AREA_KINDS, "area")
     V, F = as_mesh(V, F)
     return _cotan_H(V, F, vertex_areas(V, F, area), vertex_normals(V, F))
 
@@ -202,7 +201,7 @@ def gaussian_curvature(
     K : (n,) float
         Zero where ``A_i = 0``.
     """
-    _check_area(area)
+    check_choice(area, AREA_KINDS, "area")
     V, F = as_mesh(V, F)
     d = angle_deficit(V, F, boundary)
     A = vertex_areas(V, F, area)
@@ -228,7 +227,7 @@ def principal_curvatures(
     k1, k2 : (n,) float
         ``κ₁ = H + √max(H² − K, 0) ≥ κ₂ = H − √max(H² − K, 0)``.
     """
-    f = curvature_fields(V, F, area=area, boundary=boundary)
+    f = all_curvature_fields(V, F, area=area, boundary=boundary)
     return f["k1"], f["k2"]
 
 
@@ -266,7 +265,7 @@ def principal_curvature_quadric(
     return clean(k1), clean(k2), clean(d1), clean(d2)
 
 
-def curvature_fields(
+def all_curvature_fields(
     V: FloatArray,
     F: IntArray,
     area: AreaKind = DEFAULT_AREA,
@@ -281,7 +280,7 @@ def curvature_fields(
         (angle deficit / area), ``k1``, ``k2`` (from cotan H and K) and ``difference``
         (uniform − cotan).
     """
-    _check_area(area)
+    check_choice(area, AREA_KINDS, "area")
     _check_boundary(boundary)
     V, F = as_mesh(V, F)
     n = len(V)
@@ -306,18 +305,17 @@ def curvature_fields(
 def curvature_field(
     V: FloatArray,
     F: IntArray,
-    method: str,
+    method: CurvatureField,
     area: AreaKind = DEFAULT_AREA,
     boundary: BoundaryRule = DEFAULT_BOUNDARY,
 ) -> FloatArray:
-    """One named field of :func:`curvature_fields` (``method`` in uniform, cotan, gaussian, k1,
+    """One named field of :func:`all_curvature_fields` (``method`` in uniform, cotan, gaussian, k1,
     k2, difference)."""
-    if method not in (*METHODS, "difference"):
-        raise MeshError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}", "method")
+    check_choice(method, CURVATURE_FIELDS, "method")
     if method == "uniform":
         return mean_curvature_uniform(V, F)
     if method == "cotan":
         return mean_curvature_cotan(V, F, area)
     if method == "gaussian":
         return gaussian_curvature(V, F, area, boundary)
-    return curvature_fields(V, F, area, boundary)[method]
+    return all_curvature_fields(V, F, area, boundary)[method]

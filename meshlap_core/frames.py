@@ -12,7 +12,6 @@ import contextlib
 import importlib
 import os
 import secrets
-import sys
 from pathlib import Path
 from typing import IO, Any
 
@@ -20,6 +19,7 @@ import numpy as np
 
 from .errors import MeshError
 from .io import atomic_write, check_output_path
+from .progress import Progress, bar
 
 SUFFIXES = (".gif", ".mp4")
 VIDEO_EXTRA = "pip install 'meshlap[video]'"
@@ -242,23 +242,12 @@ class FrameWriter:
             self._tmp = None
 
 
-class Progress:
-    """A one-line progress bar on stderr: ``meshlap: animate [#####.....] 12/60 frames``."""
+def frame_progress(total: int, label: str = "animate", stream: Any = "stderr") -> Progress:
+    """The frame counter of an animation on stderr, redrawn in place on any stream:
+    ``meshlap: animate [#####.....] 12/60 frames``; :meth:`Progress.close` ends the line."""
+    return Progress(max(int(total), 1), _frames_line, label, stream=stream, in_place=True)
 
-    def __init__(self, total: int, label: str = "animate", stream: Any = None) -> None:
-        self.total = max(int(total), 1)
-        self.label = label
-        self.stream = stream if stream is not None else sys.stderr
-        self.done = 0
 
-    def update(self, done: int) -> None:
-        self.done = done
-        width = 30
-        filled = int(width * done / self.total)
-        bar = "#" * filled + "." * (width - filled)
-        self.stream.write(f"\rmeshlap: {self.label} [{bar}] {done}/{self.total} frames")
-        self.stream.flush()
-
-    def finish(self) -> None:
-        self.stream.write("\n")
-        self.stream.flush()
+def _frames_line(p: Progress) -> str:
+    width = 30
+    return f"meshlap: {p.label} [{bar(int(width * p.fraction), width)}] {p.done}/{p.total} frames"

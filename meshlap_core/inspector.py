@@ -35,6 +35,7 @@ from .options import (
     DEFAULT_BOUNDARY,
     AreaKind,
     BoundaryRule,
+    check_choice,
 )
 from .topology import one_ring
 from .topology.rings import Fan
@@ -202,11 +203,6 @@ def _voronoi_shares(
     return share, obtuse, at_i
 
 
-def _check_choice(value: str, choices: tuple[str, ...], name: str) -> None:
-    if value not in choices:
-        raise MeshError(f"unknown {name} {value!r}; choose one of {', '.join(choices)}", name)
-
-
 def inspect_vertex(
     V: FloatArray,
     F: IntArray,
@@ -233,8 +229,8 @@ def inspect_vertex(
         Neighbours in ring order (counter-clockwise seen from the side the normals point to;
         each fan of a non-manifold vertex in turn), incident faces, and the vertex quantities.
     """
-    _check_choice(area, AREA_KINDS, "area")
-    _check_choice(boundary, BOUNDARY_RULES, "boundary")
+    check_choice(area, AREA_KINDS, "area")
+    check_choice(boundary, BOUNDARY_RULES, "boundary")
     V, F = as_mesh(V, F)
     n = len(V)
     if isinstance(vertex, bool) or not isinstance(vertex, (int, np.integer)):

@@ -20,18 +20,12 @@ import igl
 import numpy as np
 import scipy.sparse as sp
 
-from .errors import MeshError
-from .options import AREA_KINDS, DEFAULT_AREA, DEGENERATE_REL, MASS_AREA, AreaKind
+from .options import AREA_KINDS, DEFAULT_AREA, DEGENERATE_REL, MASS_AREA, AreaKind, check_choice
 from .types import FloatArray, IntArray, as_faces, as_mesh
 
 # A face with 16 A² ≤ (2·DEGENERATE_REL)² (Σ l²)² is degenerate (see options.DEGENERATE_REL):
 # its cotangent weights are set to zero instead of ±inf.
 _DEGENERATE_REL16 = (2.0 * DEGENERATE_REL) ** 2
-
-
-def _check_area(area: str) -> None:
-    if area not in AREA_KINDS:
-        raise MeshError(f"unknown area {area!r}; choose one of {', '.join(AREA_KINDS)}", "area")
 
 
 def squared_edge_lengths(V: FloatArray, F: IntArray) -> FloatArray:
@@ -177,7 +171,7 @@ def vertex_areas(V: FloatArray, F: IntArray, area: AreaKind = DEFAULT_AREA) -> F
     a : (n,) float
         Zero for unreferenced vertices.
     """
-    _check_area(area)
+    check_choice(area, AREA_KINDS, "area")
     V, F = as_mesh(V, F)
     n = len(V)
     if len(F) == 0:

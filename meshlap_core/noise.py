@@ -12,16 +12,13 @@ not enter).
 from __future__ import annotations
 
 import math
-from typing import Literal
 
 import numpy as np
 
 from .curvature import vertex_normals
 from .errors import MeshError
+from .options import NOISE_MODES, NoiseMode, check_choice
 from .types import FloatArray, IntArray, as_faces, as_vertices
-
-NoiseMode = Literal["isotropic", "normal"]
-NOISE_MODES: tuple[str, ...] = ("isotropic", "normal")
 
 
 def bbox_diagonal(V: FloatArray) -> float:
@@ -100,9 +97,7 @@ def add_noise(
     """
     V = as_vertices(V)
     sigma = noise_sigma(V, alpha)
-    if mode not in NOISE_MODES:
-        choices = ", ".join(NOISE_MODES)
-        raise MeshError(f"unknown noise mode {mode!r}; choose one of {choices}", "mode")
+    check_choice(mode, NOISE_MODES, "noise mode", "mode")
     if seed is not None and (not isinstance(seed, int | np.integer) or seed < 0):
         raise MeshError(f"must be a non-negative integer, got {seed!r}", "seed")
     rng = np.random.default_rng(seed)

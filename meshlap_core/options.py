@@ -19,11 +19,37 @@ BoundaryRule
     The angle a boundary vertex's angle sum is compared with in the angle-deficit Gaussian
     curvature ``K = (θ₀ − Σθ)/A``: ``"pi"`` (θ₀ = π, a flat boundary has K = 0), ``"2pi"``
     (θ₀ = 2π, as if the vertex were interior) or ``"zero"`` (K = 0 on the boundary).
+CurvatureMethod, CurvatureField
+    The per-vertex curvature estimators (``meshlap curvature --method``): ``"uniform"`` and
+    ``"cotan"`` (mean curvature H from that Laplacian), ``"gaussian"`` (angle deficit K),
+    ``"k1"``, ``"k2"`` (principal curvatures from cotan H and K). The fields add
+    ``"difference"`` (H uniform − H cotan); :data:`CURVATURE_FIELD_LABELS` gives each field's
+    label shown to users and whether it is signed.
+SmoothingMethod
+    ``"explicit"`` (``x′ = x + λLx``), ``"implicit"`` (``(I − λL)x′ = x``) or ``"taubin"``
+    (a λ step and a ν step).
+MassUpdate
+    How a cotangent smoother treats the mass matrix between steps: ``"frozen"`` (computed once,
+    the system factorized once) or ``"recompute"`` (recomputed from the current positions).
+NoiseMode
+    Direction of the synthetic noise: ``"isotropic"`` (every coordinate) or ``"normal"`` (along
+    the vertex normal).
+DerivativeMethod
+    How a parametric surface's derivatives are obtained: ``"auto"`` (exact when the surface
+    has them, else complex step), ``"exact"``, ``"complex-step"`` or ``"central"``.
+Mesher
+    How a convergence study meshes a parametric surface: ``"grid"`` (the (u, v) grid) or
+    ``"icosphere"`` (the sphere only).
+
+Every choice is checked by :func:`check_choice`, which raises the one standard message
+``unknown <what> <value>; choose one of a, b, c``.
 """
 
 from __future__ import annotations
 
 from typing import Literal, get_args
+
+from .errors import MeshError
 
 AreaKind = Literal["barycentric", "voronoi"]
 AREA_KINDS: tuple[str, ...] = get_args(AreaKind)
@@ -39,6 +65,80 @@ LAPLACIAN_KINDS: tuple[str, ...] = get_args(LaplacianKind)
 BoundaryRule = Literal["pi", "2pi", "zero"]
 BOUNDARY_RULES: tuple[str, ...] = get_args(BoundaryRule)
 DEFAULT_BOUNDARY: BoundaryRule = "pi"
+
+CurvatureMethod = Literal["uniform", "cotan", "gaussian", "k1", "k2"]
+CURVATURE_METHODS: tuple[str, ...] = get_args(CurvatureMethod)
+CurvatureField = Literal[CurvatureMethod, "difference"]
+CURVATURE_FIELDS: tuple[str, ...] = get_args(CurvatureField)
+DEFAULT_CURVATURE_FIELD: CurvatureField = "cotan"
+CURVATURE_FIELD_LABELS: dict[str, tuple[str, bool]] = {
+    "uniform": ("mean curvature H (uniform Laplacian)", True),
+    "cotan": ("mean curvature H (cotangent Laplace-Beltrami)", True),
+    "gaussian": ("Gaussian curvature K (angle deficit)", True),
+    "k1": ("principal curvature k1", True),
+    "k2": ("principal curvature k2", True),
+    "difference": ("H uniform - H cotangent", True),
+}
+"""Curvature field -> (the label shown to users, whether the field is signed)."""
+
+SmoothingMethod = Literal["explicit", "implicit", "taubin"]
+SMOOTHING_METHODS: tuple[str, ...] = get_args(SmoothingMethod)
+DEFAULT_SMOOTHING_METHOD: SmoothingMethod = "explicit"
+EULER_METHODS: tuple[SmoothingMethod, ...] = ("explicit", "implicit")
+"""The forward and backward Euler steps of the heat flow (no Taubin ν step): the methods a
+denoising sweep tries by default and the course's report compares."""
+
+MassUpdate = Literal["frozen", "recompute"]
+MASS_UPDATES: tuple[str, ...] = get_args(MassUpdate)
+DEFAULT_MASS_UPDATE: MassUpdate = "frozen"
+
+NoiseMode = Literal["isotropic", "normal"]
+NOISE_MODES: tuple[str, ...] = get_args(NoiseMode)
+DEFAULT_NOISE_MODE: NoiseMode = "isotropic"
+
+DerivativeMethod = Literal["auto", "exact", "complex-step", "central"]
+DERIVATIVE_METHODS: tuple[str, ...] = get_args(DerivativeMethod)
+
+Mesher = Literal["grid", "icosphere"]
+MESHERS: tuple[str, ...] = get_args(Mesher)
+
+
+def check_choice(value: str, choices: tuple[str, ...], what: str, where: str | None = None) -> str:
+    """Return ``value`` if it is one of ``choices``, else raise the one standard error.
+
+    Parameters
+    ----------
+    value : str
+        What the caller (or user) gave.
+    choices : tuple of str
+        The allowed values, e.g. :data:`AREA_KINDS`.
+    what : str
+        What the value is, in words: ``"area"``, ``"boundary rule"``, ``"Laplacian"``.
+    where : str, optional
+        The argument the error is attributed to (its :attr:`MeshError.source`); ``what`` when
+        not given.
+
+    Raises
+    ------
+    MeshError
+        ``<where>: unknown <what> <value!r>; choose one of a, b, c``.
+
+    Examples
+    --------
+    >>> check_choice("voronoi", AREA_KINDS, "area")
+    'voronoi'
+    >>> check_choice("mixed", AREA_KINDS, "area")
+    Traceback (most recent call last):
+    ...
+    meshlap_core.errors.MeshError: area: unknown area 'mixed'; choose one of barycentric, voronoi
+    """
+    if value not in choices:
+        raise MeshError(
+            f"unknown {what} {value!r}; choose one of {', '.join(choices)}",
+            what if where is None else where,
+        )
+    return value
+
 
 # ------------------------------------------------------------------------------ tolerances
 

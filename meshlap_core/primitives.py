@@ -51,7 +51,7 @@ def grid(nx: int = 10, ny: int = 10, size: float = 1.0) -> tuple[FloatArray, Int
     return V, _grid_faces(nx, ny, False, False)
 
 
-def torus(
+def torus_mesh(
     n_major: int = 32, n_minor: int = 16, R: float = 3.0, r: float = 1.0
 ) -> tuple[FloatArray, IntArray]:
     """Triangle mesh ``(V, F)`` of the torus around the z axis,
@@ -133,7 +133,7 @@ def bumpy_sphere(
 
 PRIMITIVES = {
     "icosphere": icosphere,
-    "torus": torus,
+    "torus": torus_mesh,
     "grid": grid,
     "cube": cube,
     "bumpy": bumpy_sphere,

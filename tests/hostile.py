@@ -377,7 +377,7 @@ def _caps() -> str:
 
 def _near_zero_area() -> str:
     """A torus where one vertex is moved so that two faces have area ~1e-11 of their size."""
-    V, F = primitives.torus(12, 6)
+    V, F = primitives.torus_mesh(12, 6)
     V = V.copy()
     a, b, c = F[0]
     V[c] = V[a] + (V[b] - V[a]) * 0.5 + 1e-11 * np.cross(V[b] - V[a], [0, 0, 1.0])
@@ -1124,7 +1124,7 @@ def tetrahedra_sharing_vertex(k: int) -> tuple[np.ndarray, np.ndarray]:
 
 def glued_torus() -> tuple[np.ndarray, np.ndarray]:
     """An 8 x 6 torus with two far-apart vertices glued (two closed fans at one vertex)."""
-    V, F = primitives.torus(8, 6)
+    V, F = primitives.torus_mesh(8, 6)
     far = int(np.argmax(np.linalg.norm(V - V[0], axis=1)))
     V, F = glue(V, F, 0, far)
     return first_face_at(V, F, 0)

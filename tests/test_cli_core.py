@@ -37,7 +37,7 @@ def grid_obj(tmp_path):
 
 def test_info_json(capsys, tmp_path):
     path = tmp_path / "torus.obj"
-    save_mesh(path, *primitives.torus(16, 8))
+    save_mesh(path, *primitives.torus_mesh(16, 8))
     code, out, _ = run_cli(capsys, "info", path, "--json")
     assert code == 0
     info = json.loads(out)

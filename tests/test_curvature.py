@@ -55,7 +55,7 @@ def test_single_triangle_boundary_rules():
     "make",
     [
         lambda: primitives.icosphere(3),
-        primitives.torus,
+        primitives.torus_mesh,
         lambda: primitives.grid(7, 9),
         primitives.bumpy_sphere,
         lambda: primitives.cube(2),
@@ -138,10 +138,10 @@ def test_agreement_with_libigl():
 def test_degenerate_faces_never_give_nan():
     V = np.array([[0.0, 0, 0], [1, 0, 0], [2, 0, 0], [0, 1, 0], [1, 1, 0.5]])
     F = np.array([[0, 1, 2], [0, 1, 3], [1, 4, 3], [1, 2, 4]])  # face 0 has zero area
-    for name, values in curv.curvature_fields(V, F).items():
+    for name, values in curv.all_curvature_fields(V, F).items():
         assert np.isfinite(values).all(), name
     for area in ("barycentric", "voronoi"):
-        assert np.isfinite(curv.curvature_fields(V, F, area)["gaussian"]).all()
+        assert np.isfinite(curv.all_curvature_fields(V, F, area)["gaussian"]).all()
     assert np.isfinite(curv.vertex_normals(V, F)).all()
 
 
@@ -150,7 +150,7 @@ import numpy as np
 from meshlap_core import curvature, laplacian, primitives
 from meshlap_core.errors import MeshError
 V, F = primitives.icosphere(2)
-for fn in (curvature.principal_curvature_quadric, curvature.curvature_fields,
+for fn in (curvature.principal_curvature_quadric, curvature.all_curvature_fields,
            laplacian.cotan_stiffness, laplacian.mass_matrix):
     try:
         fn(V * {scale}, F)

@@ -27,7 +27,7 @@ def _meshes():
     V, F = primitives.grid(5, 4)
     V = V + rng.normal(scale=0.06, size=V.shape)  # open, curved, obtuse
     yield "open grid", V, F
-    V, F = primitives.torus(12, 8)
+    V, F = primitives.torus_mesh(12, 8)
     yield "torus", V, F
 
 

@@ -125,7 +125,7 @@ def test_obj_slash_forms_and_negative_indices(tmp_path):
 
 
 def test_obj_fast_and_general_paths_agree(tmp_path):
-    V, F = primitives.torus(10, 7)
+    V, F = primitives.torus_mesh(10, 7)
     body = "".join(f"v {x!r} {y!r} {z!r}\n" for x, y, z in V.tolist())
     faces = "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in F.tolist())
     fast = load_mesh(write(tmp_path / "fast.obj", body + faces))
@@ -500,7 +500,7 @@ def test_stl_bad_files(tmp_path, data, needle):
 @pytest.mark.parametrize("prim", ["torus", "bumpy", "grid"])
 def test_round_trip_exact(tmp_path, ext, prim):
     V, F = {
-        "torus": primitives.torus(9, 5),
+        "torus": primitives.torus_mesh(9, 5),
         "bumpy": primitives.bumpy_sphere(2),
         "grid": primitives.grid(5, 4),
     }[prim]

@@ -42,7 +42,7 @@ def test_uniform_laplacian_by_hand_on_octahedron():
 
 
 @pytest.mark.parametrize(
-    "make", [lambda: primitives.icosphere(2), primitives.torus, primitives.grid, random_mesh]
+    "make", [lambda: primitives.icosphere(2), primitives.torus_mesh, primitives.grid, random_mesh]
 )
 def test_invariants(make):
     V, F = make()

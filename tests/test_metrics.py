@@ -8,7 +8,7 @@ from scipy.spatial import ConvexHull
 
 from meshlap_core import metrics as M
 from meshlap_core.errors import MeshError
-from meshlap_core.primitives import bumpy_sphere, cube, grid, icosphere, torus
+from meshlap_core.primitives import bumpy_sphere, cube, grid, icosphere, torus_mesh
 
 # ----------------------------------------------------------------------------- hand-computed
 
@@ -95,7 +95,7 @@ def test_rmse_of_a_translation_is_its_length():
 
 
 def test_volume_is_translation_invariant_on_closed_meshes():
-    V, F = torus()
+    V, F = torus_mesh()
     v0 = M.signed_volume(V, F)
     assert M.signed_volume(V + np.array([5.0, -3.0, 2.0]), F) == pytest.approx(v0, rel=1e-12)
 

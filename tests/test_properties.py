@@ -60,7 +60,7 @@ def test_operators_finite_symmetric_rows_sum_to_zero(mesh):
         a = laplacian.vertex_areas(V, F, area)
         assert np.isfinite(a).all() and (a >= 0).all()
         np.testing.assert_allclose(a.sum(), laplacian.face_areas(V, F).sum(), rtol=1e-10)
-    for values in curvature.curvature_fields(V, F).values():
+    for values in curvature.all_curvature_fields(V, F).values():
         assert np.isfinite(values).all()
 
 
@@ -174,7 +174,7 @@ def perturbed(base, seed):
 bases = st.sampled_from(
     [
         primitives.icosphere(1),
-        primitives.torus(8, 6),
+        primitives.torus_mesh(8, 6),
         primitives.grid(5, 4),
         primitives.cube(1),
     ]

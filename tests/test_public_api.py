@@ -23,7 +23,7 @@ def test_unknown_names_raise_attribute_error():
 def test_torus_mesh_is_the_triangle_mesh_and_surface_the_parametric_one():
     V, F = meshlap_core.torus_mesh(8, 6)
     assert V.shape == (48, 3) and F.shape == (96, 3)
-    assert meshlap_core.surface("torus").name == "torus"
+    assert meshlap_core.get_surface("torus").name == "torus"
 
 
 def test_import_loads_no_numerics_until_a_name_is_used():

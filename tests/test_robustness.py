@@ -307,7 +307,7 @@ def test_denoise_eval_rows_are_finite_or_flagged(capsys, loaded, case):
 @pytest.fixture
 def torus_obj(tmp_path):
     path = tmp_path / "torus.obj"
-    save_mesh(path, *primitives.torus(12, 6))
+    save_mesh(path, *primitives.torus_mesh(12, 6))
     return path
 
 
@@ -375,9 +375,9 @@ def test_bad_arguments_one_error_line(capsys, tmp_path, torus_obj, argv, names):
 
 def test_denoise_eval_mismatched_meshes(capsys, tmp_path, torus_obj):
     other = tmp_path / "other.obj"
-    save_mesh(other, *primitives.torus(12, 7))  # more vertices
+    save_mesh(other, *primitives.torus_mesh(12, 7))  # more vertices
     flipped = tmp_path / "flipped.obj"
-    V, F = primitives.torus(12, 6)
+    V, F = primitives.torus_mesh(12, 6)
     save_mesh(flipped, V, F[:, ::-1])  # same vertices, different faces
     csv = tmp_path / "t.csv"
     csv.write_bytes(SENTINEL)
@@ -578,7 +578,7 @@ DEGENERATE_SCRIPT = r"""
 import json, sys, warnings
 import numpy as np
 from meshlap_core import primitives
-from meshlap_core.curvature import curvature_fields, principal_curvature_quadric, vertex_normals
+from meshlap_core.curvature import all_curvature_fields, principal_curvature_quadric, vertex_normals
 from meshlap_core.errors import MeshError
 from meshlap_core.laplacian import (cotan_stiffness, face_areas, laplace_beltrami,
                                     mass_matrix, uniform_laplacian)
@@ -612,9 +612,9 @@ FUNCS = {
     "uniform_laplacian": lambda V, F: uniform_laplacian(F, len(V)).data,
     "face_areas": face_areas,
     "vertex_normals": lambda V, F: vertex_normals(V, F).ravel(),
-    "curvature_voronoi": lambda V, F: np.concatenate(list(curvature_fields(V, F, "voronoi")
+    "curvature_voronoi": lambda V, F: np.concatenate(list(all_curvature_fields(V, F, "voronoi")
                                                            .values())),
-    "curvature_barycentric": lambda V, F: np.concatenate(list(curvature_fields(V, F).values())),
+    "curvature_barycentric": lambda V, F: np.concatenate(list(all_curvature_fields(V, F).values())),
     "quadric_fit": lambda V, F: np.concatenate([np.ravel(x)
                                                 for x in principal_curvature_quadric(V, F)]),
     "smooth_explicit_uniform": lambda V, F: Smoother(V, F, "explicit", "uniform", 0.5,

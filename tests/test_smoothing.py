@@ -19,9 +19,10 @@ from meshlap_core import smoothing as S
 from meshlap_core.errors import MeshError, MeshWarning
 from meshlap_core.metrics import signed_volume
 from meshlap_core.noise import add_noise
-from meshlap_core.primitives import bumpy_sphere, grid, icosphere, torus
+from meshlap_core.options import LAPLACIAN_KINDS, SMOOTHING_METHODS
+from meshlap_core.primitives import bumpy_sphere, grid, icosphere, torus_mesh
 
-ALL = [(m, lp) for m in S.METHODS for lp in S.LAPLACIANS]
+ALL = [(m, lp) for m in SMOOTHING_METHODS for lp in LAPLACIAN_KINDS]
 # a stable step for each Laplacian on the test meshes below (cotan λ has units of length²)
 LAM = {"uniform": 0.5, "cotan": 1e-3}
 
@@ -53,7 +54,7 @@ def test_linear_positions_on_a_regular_flat_grid_are_fixed(method, laplacian):
     np.testing.assert_allclose(s.V, V, atol=1e-12)
 
 
-@pytest.mark.parametrize("method", S.METHODS)
+@pytest.mark.parametrize("method", SMOOTHING_METHODS)
 def test_cotan_keeps_linear_positions_on_an_irregular_flat_grid(method):
     V, F = _tilted_grid(jitter=0.05)
     s = S.Smoother(V, F, method, "cotan", LAM["cotan"], fix_boundary=True)
@@ -81,7 +82,7 @@ def test_constants_are_in_the_kernel_translation_commutes(method, laplacian):
 # ----------------------------------------------------------------------------- references
 
 
-@pytest.mark.parametrize("laplacian", S.LAPLACIANS)
+@pytest.mark.parametrize("laplacian", LAPLACIAN_KINDS)
 def test_explicit_step_is_x_plus_lam_L_x(laplacian):
     V, F = bumpy_sphere(2)
     lam = LAM[laplacian]
@@ -94,7 +95,7 @@ def test_explicit_step_is_x_plus_lam_L_x(laplacian):
     np.testing.assert_allclose(got, V + lam * (L @ V), atol=1e-12)
 
 
-@pytest.mark.parametrize("laplacian", S.LAPLACIANS)
+@pytest.mark.parametrize("laplacian", LAPLACIAN_KINDS)
 def test_implicit_step_matches_spsolve_on_the_course_system(laplacian):
     V, F = bumpy_sphere(2)
     lam = 2.0 if laplacian == "uniform" else 0.05
@@ -118,7 +119,7 @@ def test_amplification_per_eigenmode_matches_g():
     for k in (5, n // 2, n - 1):
         X = V.copy()
         X[:, 0] = vec[:, k]  # the uniform operator depends on connectivity only
-        for method in S.METHODS:
+        for method in SMOOTHING_METHODS:
             lam = 0.4
             g = S.amplification_curve(method, lam, mu[k])
             out = S.Smoother(X, F, method, "uniform", lam, warn=False).step()
@@ -140,7 +141,7 @@ def test_amplification_curve_hand_values():
         S.amplification_curve("explicit", 0.5, [0.5])
 
 
-@pytest.mark.parametrize("laplacian", S.LAPLACIANS)
+@pytest.mark.parametrize("laplacian", LAPLACIAN_KINDS)
 def test_reported_mu_min_matches_dense_generalized_eigensolver(laplacian):
     V, F = bumpy_sphere(3)  # 642 vertices: the sparse Lanczos path
     W, K = S.operator_parts(V, F, laplacian)
@@ -154,7 +155,7 @@ def test_reported_mu_min_matches_dense_generalized_eigensolver(laplacian):
 # ----------------------------------------------------------------------------- invariants
 
 
-@pytest.mark.parametrize("laplacian", S.LAPLACIANS)
+@pytest.mark.parametrize("laplacian", LAPLACIAN_KINDS)
 @pytest.mark.parametrize("lam", [1e-4, 1e-2, 1.0, 100.0, 1e4])
 def test_implicit_never_increases_dirichlet_energy(laplacian, lam):
     V, F = bumpy_sphere(2)
@@ -168,7 +169,7 @@ def test_implicit_never_increases_dirichlet_energy(laplacian, lam):
     assert energies[-1] < energies[0]
 
 
-@pytest.mark.parametrize("laplacian", S.LAPLACIANS)
+@pytest.mark.parametrize("laplacian", LAPLACIAN_KINDS)
 def test_implicit_with_fixed_boundary_never_increases_energy(laplacian):
     V, F = grid(8, 8)
     V[:, 2] = 0.05 * np.random.default_rng(0).standard_normal(len(V))
@@ -178,7 +179,7 @@ def test_implicit_with_fixed_boundary_never_increases_energy(laplacian):
     assert np.all(np.diff(e) <= 1e-12 * e[0])
 
 
-@pytest.mark.parametrize("laplacian", S.LAPLACIANS)
+@pytest.mark.parametrize("laplacian", LAPLACIAN_KINDS)
 def test_explicit_blows_up_above_the_reported_limit_and_not_below(laplacian):
     V, F = icosphere(2)
     V = add_noise(V, F, 0.01, seed=1)
@@ -201,7 +202,7 @@ def test_explicit_blows_up_above_the_reported_limit_and_not_below(laplacian):
         S.smooth(V, F, "explicit", laplacian, 1.1 * limit, 400, warn=False)
 
 
-@pytest.mark.parametrize("laplacian", S.LAPLACIANS)
+@pytest.mark.parametrize("laplacian", LAPLACIAN_KINDS)
 def test_taubin_shrinks_a_sphere_far_less_than_explicit(laplacian):
     V, F = icosphere(3)
     v0 = signed_volume(V, F)
@@ -254,11 +255,11 @@ def test_mass_recompute_refactorizes_frozen_reuses():
     frozen.set_lam(0.02)
     frozen.run(2)
     assert frozen.n_factorizations == 2
-    moving = S.Smoother(V, F, "implicit", "cotan", 0.01, mass="recompute")
+    moving = S.Smoother(V, F, "implicit", "cotan", 0.01, mass_update="recompute")
     moving.run(4)
     assert moving.n_factorizations == 4
     # first step identical (same M), later steps differ
-    one = S.Smoother(V, F, "implicit", "cotan", 0.01, mass="recompute").step()
+    one = S.Smoother(V, F, "implicit", "cotan", 0.01, mass_update="recompute").step()
     np.testing.assert_allclose(one, S.smooth(V, F, "implicit", "cotan", 0.01, 1), atol=1e-14)
     assert not np.allclose(moving.V, S.smooth(V, F, "implicit", "cotan", 0.01, 4), atol=1e-9)
 
@@ -271,7 +272,7 @@ def test_mass_recompute_matches_the_kazhdan_update():
     for _ in range(3):
         Mt = lap.mass_matrix(X, F, "voronoi")
         X = sla.spsolve((Mt - lam * C).tocsc(), Mt @ X)
-    got = S.smooth(V, F, "implicit", "cotan", lam, 3, mass="recompute")
+    got = S.smooth(V, F, "implicit", "cotan", lam, 3, mass_update="recompute")
     np.testing.assert_allclose(got, X, atol=1e-10)
 
 
@@ -279,7 +280,7 @@ def test_mass_recompute_matches_the_kazhdan_update():
 
 
 def test_stepper_state_history_and_reset():
-    V, F = torus()
+    V, F = torus_mesh()
     s = S.Smoother(V, F, "explicit", "uniform", 0.5)
     assert s.iteration == 0 and len(s.history) == 1 and s.history[0]["iteration"] == 0
     s.run(4)
@@ -354,7 +355,7 @@ def test_zero_iterations_return_the_input():
 def test_unreferenced_vertices_stay_put():
     V, F = icosphere(1)
     V = np.vstack([V, [[5.0, 5.0, 5.0]]])
-    for method in S.METHODS:
+    for method in SMOOTHING_METHODS:
         X = S.smooth(V, F, method, "cotan", 1e-3, 2)
         assert np.array_equal(X[-1], V[-1])
 
@@ -558,7 +559,7 @@ def test_explicit_with_mass_recompute_uses_the_current_areas():
     X = V.copy()
     for _ in range(3):  # x ← x + λ M(x)⁻¹ C₀ x, stiffness frozen
         X = X + lam * (C @ X) / lap.vertex_areas(X, F, "voronoi")[:, None]
-    got = S.smooth(V, F, "explicit", "cotan", lam, 3, mass="recompute")
+    got = S.smooth(V, F, "explicit", "cotan", lam, 3, mass_update="recompute")
     np.testing.assert_allclose(got, X, atol=1e-12)
 
 
@@ -680,10 +681,10 @@ def test_divergence_stops_at_the_first_step_farther_than_the_bounding_box_diagon
     assert S.Smoother(V, F, "explicit", "uniform", 0.5).divergence_message() is None
 
 
-@pytest.mark.parametrize("laplacian", S.LAPLACIANS)
+@pytest.mark.parametrize("laplacian", LAPLACIAN_KINDS)
 def test_stable_runs_never_trip_the_divergence_check(laplacian):
     V, F = icosphere(2)
-    for method in S.METHODS:
+    for method in SMOOTHING_METHODS:
         lam = LAM[laplacian] if method != "implicit" else 1e4  # implicit: collapse to a point
         s = S.Smoother(V, F, method, laplacian, lam, warn=False)
         s.run(300)
@@ -763,11 +764,11 @@ class _Stream:
 
 
 def _run_progress(tty, seconds_per_step, steps=100):
-    from meshlap_core.cli.smooth import Progress
+    from meshlap_core.cli.smooth import iteration_progress
 
     now = [0.0]
     stream = _Stream(tty)
-    p = Progress(stream, steps, clock=lambda: now[0])
+    p = iteration_progress(steps, stream, clock=lambda: now[0])
     for k in range(1, steps + 1):
         now[0] += seconds_per_step
         p.update(k)

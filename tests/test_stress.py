@@ -65,7 +65,7 @@ def test_mesh_panel_keeps_the_previous_mesh_on_every_bad_file(tmp_path):
     from meshlap_app.state import MeshState
 
     good = tmp_path / "good.obj"
-    save_mesh(good, *primitives.torus(12, 6))
+    save_mesh(good, *primitives.torus_mesh(12, 6))
     state = MeshState()
     assert state.load(good)
     V, F, version, info = state.V, state.F, state.version, state.info

@@ -3,7 +3,7 @@
 Tier 1: closed-form values (helicoid, sphere, torus, cylinder, saddles, catenoid) worked out by
 hand from p(u, v). Tier 2: invariants (Euler's theorem, extremes of κₙ, k1 + k2 = 2H,
 watertight welded meshes). Tier 3: independent references (exact vs numeric derivatives,
-primitives.torus, the core's discrete estimators converging to the analytic values).
+primitives.torus_mesh, the core's discrete estimators converging to the analytic values).
 """
 
 from __future__ import annotations
@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 from scipy.optimize import minimize_scalar
 
+import meshlap_core
 from meshlap_core import primitives, surfaces
 from meshlap_core.curvature import vertex_normals
 from meshlap_core.errors import MeshError
@@ -352,7 +353,7 @@ def test_open_surfaces_have_their_boundary(name: str, loops: int) -> None:
 
 
 def test_torus_mesh_equals_primitives_torus() -> None:
-    V, F = primitives.torus(32, 16)
+    V, F = primitives.torus_mesh(32, 16)
     m = mesh_surface("torus", (32, 16))
     np.testing.assert_allclose(m.V, V, atol=1e-14)
     np.testing.assert_array_equal(m.F, F)
@@ -734,11 +735,13 @@ def test_cli_convergence_refuses_a_bad_level_with_one_line(capsys) -> None:
     assert err.count("\n") == 1 and "--res" in err and "level 1" in err
 
 
-def test_public_aliases() -> None:
-    # meshlap_core.surface (the public API) and the viewer's former name stay importable
-    assert surfaces.surface("torus", R=2.0).params == {"R": 2.0, "r": 1.0}
-    assert surfaces.curvature_fields is surface_curvature_fields
+def test_one_name_per_thing() -> None:
+    # get_surface is the one name of the catalogue look-up (the public API's too); the exact
+    # fields at (u, v) are surface_curvature_fields (no aliases left)
+    assert get_surface("torus", R=2.0).params == {"R": 2.0, "r": 1.0}
+    assert meshlap_core.get_surface is get_surface
+    assert not hasattr(surfaces, "surface") and not hasattr(surfaces, "curvature_fields")
     # the parametric torus and the triangle mesh of primitives: the same points
     s = surfaces.torus(R=2.0, r=0.5)
-    V, _ = primitives.torus(8, 6, R=2.0, r=0.5)
+    V, _ = primitives.torus_mesh(8, 6, R=2.0, r=0.5)
     np.testing.assert_allclose(mesh_surface(s, (8, 6)).V, V, atol=1e-14)

@@ -33,7 +33,7 @@ def rot(t):
     "make, chi, genus, loops",
     [
         (lambda: primitives.icosphere(2), 2, 0, 0),
-        (primitives.torus, 0, 1, 0),
+        (primitives.torus_mesh, 0, 1, 0),
         (primitives.grid, 1, 0, 1),
         (primitives.cube, 2, 0, 0),
     ],
@@ -74,7 +74,7 @@ def test_two_components_and_isolated_vertex():
     "make",
     [
         lambda: primitives.icosphere(2),
-        primitives.torus,
+        primitives.torus_mesh,
         lambda: primitives.grid(6, 7),
         lambda: primitives.cube(1),
     ],

@@ -294,7 +294,7 @@ def test_flipped_face_on_cube_is_inconsistent():
     ("name", "mesh", "chi", "n_boundary"),
     [
         ("icosphere", primitives.icosphere(2), 2, 0),
-        ("torus", primitives.torus(12, 8), 0, 0),
+        ("torus", primitives.torus_mesh(12, 8), 0, 0),
         ("grid", primitives.grid(6, 4), 1, 2 * 5 + 2 * 3),
         ("cube", primitives.cube(1), 2, 0),
     ],
@@ -312,7 +312,7 @@ def test_primitives_invariants(name, mesh, chi, n_boundary):
 
 def test_components_count():
     V1, F1 = primitives.icosphere(1)
-    V2, F2 = primitives.torus(8, 6)
+    V2, F2 = primitives.torus_mesh(8, 6)
     V = np.vstack([V1, V2 + 10])
     F = np.vstack([F1, F2 + len(V1)])
     r = validate_mesh(V, F).report

@@ -10,9 +10,9 @@ from __future__ import annotations
 import argparse
 
 from meshlap_core.errors import MeshError
+from meshlap_core.options import CURVATURE_FIELDS
 
 from ..registry import VIEWS
-from ..state.names import FIELDS
 
 START_OPTIONS = ("field", "vertex", "k")
 """The options handed to the panels when the window opens (each checks its own)."""
@@ -32,7 +32,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="reopen a saved session (mesh, panel settings, camera); replaces MESH and the "
         "options below",
     )
-    p.add_argument("--field", choices=FIELDS, help="curvature field shown first (default cotan)")
+    p.add_argument(
+        "--field", choices=CURVATURE_FIELDS, help="curvature field shown first (default cotan)"
+    )
     p.add_argument("--panel", choices=VIEWS, help=f"panel shown first (default {VIEWS[0]})")
     p.add_argument("--vertex", type=int, help="one-ring panel: the selected vertex")
     p.add_argument("--k", type=int, help="spectral panel: reconstruct from k eigenvectors")

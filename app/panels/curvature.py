@@ -8,10 +8,9 @@ import numpy as np
 import polyscope as ps
 
 from meshlap_core.options import AREA_KINDS as AREAS
-from meshlap_core.options import BOUNDARY_RULES
+from meshlap_core.options import BOUNDARY_RULES, CURVATURE_FIELD_LABELS
 
 from ..scene import COLORBAR_AT, MESH, MESH_B, scalar_for_upload, side_offset
-from ..state.names import FIELD_LABELS
 from .base import Host, Panel
 
 FIELD_HELP = (
@@ -51,7 +50,10 @@ class CurvaturePanel(Panel):
         c = host.state.curv
         if not c.side_by_side:
             return {}
-        return {MESH: FIELD_LABELS[c.field_name][0], MESH_B: FIELD_LABELS[c.second_field][0]}
+        return {
+            MESH: CURVATURE_FIELD_LABELS[c.field_name][0],
+            MESH_B: CURVATURE_FIELD_LABELS[c.second_field][0],
+        }
 
     def capture(self, host: Host) -> dict[str, Any]:
         c = host.state.curv
@@ -107,7 +109,7 @@ class CurvaturePanel(Panel):
     @staticmethod
     def _add_field(host: Host, sm: Any, name: str, colorbar: bool = False) -> None:
         curv = host.state.curv
-        label, signed = FIELD_LABELS[name]
+        label, signed = CURVATURE_FIELD_LABELS[name]
         label += " [1/length^2]" if name == "gaussian" else " [1/length]"
         values, (lo, hi), factor = scalar_for_upload(curv.fields[name], curv.color_range(name))
         sm.add_scalar_quantity(
@@ -126,7 +128,7 @@ class CurvaturePanel(Panel):
         if not ui.header(self.title):
             return
         c = host.state.curv
-        names = tuple(FIELD_LABELS)
+        names = tuple(CURVATURE_FIELD_LABELS)
         ch1, c.field_name = ui.combo("field", c.field_name, names, FIELD_HELP)
         ch2, c.area = ui.combo(
             "area", c.area, AREAS, "vertex area A_i: barycentric (1/3 of each face) or Voronoi"
@@ -165,11 +167,11 @@ class CurvaturePanel(Panel):
         st = c.summary()
         lo, hi = st["range"]
         ui.text(f"min {st['min']:.4g}  max {st['max']:.4g}  colour range [{lo:.4g}, {hi:.4g}]")
-        ui.text(FIELD_LABELS[c.field_name][0])
+        ui.text(CURVATURE_FIELD_LABELS[c.field_name][0])
         with ui.plot(
             "histogram (clipped to the colour range)",
             160,
-            FIELD_LABELS[c.field_name][0],
+            CURVATURE_FIELD_LABELS[c.field_name][0],
             "vertices",
         ) as shown:
             if shown:
@@ -178,7 +180,7 @@ class CurvaturePanel(Panel):
                     st["centers"],
                     st["counts"],
                     st["width"],
-                    _bar_colors(st["centers"], lo, hi, FIELD_LABELS[c.field_name][1]),
+                    _bar_colors(st["centers"], lo, hi, CURVATURE_FIELD_LABELS[c.field_name][1]),
                 )
 
 

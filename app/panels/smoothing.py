@@ -10,14 +10,13 @@ import numpy as np
 import polyscope as ps
 
 from meshlap_core.errors import MeshError
-from meshlap_core.options import LAPLACIAN_KINDS as LAPLACIANS
+from meshlap_core.options import LAPLACIAN_KINDS, SMOOTHING_METHODS
 
 from .. import scene
 from ..record import Recorder, draw_record
 from ..scene import INPUT_COLOR, SMOOTH_INPUT, SMOOTHED, SMOOTHED_COLOR, side_offset
 from ..state.smoothing import (
     ANIMATION,
-    METHODS,
     SmoothingState,
     caption,
     encode_lam_steps,
@@ -195,7 +194,7 @@ class SmoothingPanel(Panel):
         ch, method = ui.combo(
             "method",
             st.method,
-            METHODS,
+            SMOOTHING_METHODS,
             "explicit: x <- x + lam L x;  implicit: (I - lam L) x' = x (backward Euler);  "
             "taubin: lam step, then a negative nu step (no shrinkage)",
         )
@@ -205,7 +204,7 @@ class SmoothingPanel(Panel):
         ch, lap = ui.combo(
             "Laplacian",
             st.laplacian,
-            LAPLACIANS,
+            LAPLACIAN_KINDS,
             "uniform: L = D^-1 A - I (lam dimensionless);  cotan: L = M^-1 C (lam in length^2)",
         )
         if ch:

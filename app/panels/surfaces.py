@@ -98,7 +98,7 @@ class SurfacesPanel(Panel):
         if self.watch.changed("surface", surf.version):
             s = ps.register_surface_mesh(SURFACE, sm.V, sm.F, smooth_shade=True)
             s.set_transform(Z_TO_Y)
-            from meshlap_core.surfaces import curvature_fields as surface_curvature
+            from meshlap_core.surfaces import surface_curvature_fields as surface_curvature
 
             cf = surface_curvature(surf.name, sm.uv[:, 0], sm.uv[:, 1])
             K = np.nan_to_num(np.asarray(cf.K, dtype=float))

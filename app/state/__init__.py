@@ -2,7 +2,7 @@
 
 One module per concern: :mod:`.app` (``AppState``, the one owner of every state object and
 setting), :mod:`.watch` (``Watch``, the one invalidation rule), :mod:`.display`,
-:mod:`.names` (``FIELDS``, ``FIELD_LABELS``), :mod:`.mesh` (``MeshState``, the mesh list),
+:mod:`.mesh` (``MeshState``, the mesh list),
 :mod:`.curvature` (``CurvatureState``, ``robust_range``), and one module per panel that has a
 state (named as the panel in :mod:`meshlap_app.registry`: :mod:`.onering`, :mod:`.spectral`,
 :mod:`.smoothing`, :mod:`.surfaces`), which also declares the panel's section of a saved session
@@ -15,12 +15,8 @@ from __future__ import annotations
 
 from typing import Any
 
-from .names import FIELD_LABELS, FIELDS
-
 __all__ = [
     "ASSETS_DIR",
-    "FIELDS",
-    "FIELD_LABELS",
     "AppState",
     "CurvatureState",
     "MeshState",

@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import Any
 
 from meshlap_core.errors import MeshError
+from meshlap_core.options import check_choice
 
 from ..registry import REGISTRY, VIEWS
 from .curvature import CurvatureState
@@ -56,9 +57,7 @@ class AppState:
 
     def check_panel(self, name: str, flag: str = "view") -> str:
         """``name`` if it is a view, else a :class:`MeshError` naming the views."""
-        if name not in VIEWS:
-            raise MeshError(f"unknown panel {name!r}; choose one of {', '.join(VIEWS)}", flag)
-        return name
+        return check_choice(name, VIEWS, "panel", flag)
 
     def set_ui_scale(self, scale: float) -> float:
         """Set the UI scale, clamped to :data:`UI_SCALES`; returns it.

@@ -7,22 +7,27 @@ from typing import Any
 
 import numpy as np
 
-from meshlap_core.curvature import curvature_fields
+from meshlap_core.curvature import all_curvature_fields
 from meshlap_core.errors import MeshError
-from meshlap_core.options import AREA_KINDS, BOUNDARY_RULES
+from meshlap_core.options import (
+    AREA_KINDS,
+    BOUNDARY_RULES,
+    CURVATURE_FIELD_LABELS,
+    CURVATURE_FIELDS,
+    check_choice,
+)
 from meshlap_core.types import FloatArray
 
 from .checks import Schema, boolean, number, one_of
 from .mesh import MeshState
-from .names import FIELD_LABELS, FIELDS
 
 SESSION: Schema = {
-    "field": ("cotan", one_of(FIELDS)),
+    "field": ("cotan", one_of(CURVATURE_FIELDS)),
     "area": ("barycentric", one_of(AREA_KINDS)),
     "boundary": ("pi", one_of(BOUNDARY_RULES)),
     "clip": (2.0, number(0.0, 49.0)),
     "side_by_side": (False, boolean),
-    "second_field": ("uniform", one_of(FIELDS)),
+    "second_field": ("uniform", one_of(CURVATURE_FIELDS)),
 }
 """The Curvature panel's section of a saved session (:mod:`.session`)."""
 
@@ -35,11 +40,8 @@ def check_view_options(options: dict[str, Any], state: Any) -> None:
     MeshError
         An unknown field, naming the choices.
     """
-    name = options.get("field")
-    if name is not None and name not in FIELD_LABELS:
-        raise MeshError(
-            f"unknown field {name!r}; choose one of {', '.join(FIELD_LABELS)}", "--field"
-        )
+    if options.get("field") is not None:
+        check_choice(options["field"], CURVATURE_FIELDS, "field", "--field")
 
 
 def robust_range(values: FloatArray, signed: bool, percentile: float = 2.0) -> tuple[float, float]:
@@ -93,7 +95,7 @@ class CurvatureState:
         key = (mesh.version, self.area, self.boundary)
         if key == self._key:
             return False
-        self.fields = curvature_fields(mesh.V, mesh.F, self.area, self.boundary)
+        self.fields = all_curvature_fields(mesh.V, mesh.F, self.area, self.boundary)
         self._key = key
         return True
 
@@ -122,7 +124,7 @@ class CurvatureState:
         cached = self._summaries.get(key)
         if cached is None:
             values = self.fields[name]
-            lo, hi = robust_range(values, FIELD_LABELS[name][1], self.percentile)
+            lo, hi = robust_range(values, CURVATURE_FIELD_LABELS[name][1], self.percentile)
             counts, edges = np.histogram(np.clip(values, lo, hi), bins=bins, range=(lo, hi))
             cached = {
                 "range": (lo, hi),

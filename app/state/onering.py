@@ -11,7 +11,7 @@ import numpy as np
 
 from meshlap_core.errors import MeshError
 from meshlap_core.inspector import VertexInspection, inspect_vertex
-from meshlap_core.options import AREA_KINDS, BOUNDARY_RULES
+from meshlap_core.options import AREA_KINDS, BOUNDARY_RULES, check_choice
 from meshlap_core.types import FloatArray, IntArray
 
 from .checks import Schema, boolean, integer
@@ -151,13 +151,8 @@ class OneRingState:
         MeshError
             For an unknown area kind or boundary rule (nothing changes).
         """
-        if area not in AREA_KINDS:
-            raise MeshError(f"unknown area {area!r}; choose one of {', '.join(AREA_KINDS)}", "area")
-        if boundary not in BOUNDARY_RULES:
-            raise MeshError(
-                f"unknown boundary rule {boundary!r}; choose one of {', '.join(BOUNDARY_RULES)}",
-                "boundary rule",
-            )
+        check_choice(area, AREA_KINDS, "area")
+        check_choice(boundary, BOUNDARY_RULES, "boundary rule")
         curv.area, curv.boundary = area, boundary
         if self.vertex >= 0:
             self.select(mesh, curv, self.vertex)

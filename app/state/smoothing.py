@@ -13,8 +13,8 @@ import numpy as np
 
 from meshlap_core.errors import MeshError
 from meshlap_core.noise import add_noise
-from meshlap_core.options import LAPLACIAN_KINDS
-from meshlap_core.smoothing import METHODS, Smoother, amplification_curve, check_lam
+from meshlap_core.options import LAPLACIAN_KINDS, SMOOTHING_METHODS
+from meshlap_core.smoothing import Smoother, amplification_curve, check_lam
 from meshlap_core.types import FloatArray, IntArray
 
 from .animation import Animation, Option
@@ -250,7 +250,7 @@ def _lam_steps(x: Any) -> str | None:
 
 
 SESSION: Schema = {
-    "method": ("implicit", one_of(METHODS)),
+    "method": ("implicit", one_of(SMOOTHING_METHODS)),
     "laplacian": ("uniform", one_of(LAPLACIAN_KINDS)),
     "lam": (0.5, number(positive=True)),
     "noise_alpha": (0.0, number(0.0)),
@@ -340,7 +340,9 @@ def _animation_check(opts: dict[str, Any]) -> None:
 ANIMATION = Animation(
     summary="smoothing: one frame per iteration, the input beside the smoothed copy",
     options=(
-        Option("--method", "smoothing method (default implicit)", "implicit", choices=METHODS),
+        Option(
+            "--method", "smoothing method (default implicit)", "implicit", choices=SMOOTHING_METHODS
+        ),
         Option("--laplacian", "default uniform", "uniform", choices=LAPLACIAN_KINDS),
         Option("--lam", "smoothing step λ > 0 (default 1)", 1.0, float),
         Option("--iters", "smoothing iterations (frames: iters+1; default 30)", 30, int),

@@ -84,3 +84,32 @@ def print_report(source: Any, report: Any) -> None:
         sys.stderr.write(f"meshlap: {source}: repaired: {r}\n")
     for w in getattr(report, "warnings", []):
         sys.stderr.write(f"meshlap: {source}: warning: {w}\n")
+
+
+class _RenamedFlag(argparse.Action):
+    """A flag's old spelling: using it (with or without a value) exits 2 naming the new flag."""
+
+    def __init__(self, option_strings: list[str], dest: str, *, new: str, **kwargs: Any) -> None:
+        self.new = new
+        super().__init__(option_strings, dest, nargs="?", default=argparse.SUPPRESS, **kwargs)
+
+    def __call__(
+        self,
+        parser: argparse.ArgumentParser,
+        namespace: argparse.Namespace,
+        values: Any,
+        option_string: str | None = None,
+    ) -> None:
+        parser.error(f"{option_string}: renamed; use {self.new}")
+
+
+def add_renamed_flag(p: argparse.ArgumentParser, old: str, new: str) -> None:
+    """Keep ``old``, a flag renamed to ``new``, for one release as a clear error.
+
+    ``meshlap CMD OLD ...`` prints ``meshlap: error: OLD: renamed; use NEW`` and exits 2;
+    ``new`` is the replacement as users should read it, e.g. ``"--area (the area kind,
+    barycentric|voronoi)"``. The old flag is hidden from ``--help``.
+    """
+    p.add_argument(
+        old, action=_RenamedFlag, new=new, dest=f"renamed_{old.lstrip('-')}", help=argparse.SUPPRESS
+    )

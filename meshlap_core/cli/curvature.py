@@ -7,10 +7,17 @@ from pathlib import Path
 
 import numpy as np
 
-from ..curvature import METHODS, curvature_field
+from ..curvature import curvature_field
 from ..errors import MeshError
 from ..io import check_output_path, load_mesh, save_mesh, save_scalars
-from ..options import AREA_KINDS, BOUNDARY_RULES
+from ..options import (
+    AREA_KINDS,
+    BOUNDARY_RULES,
+    CURVATURE_METHODS,
+    DEFAULT_AREA,
+    DEFAULT_BOUNDARY,
+    DEFAULT_CURVATURE_FIELD,
+)
 from ._common import add_json_flag, emit_json, print_report, summary_stats
 
 OUT_SUFFIXES = (".csv", ".npy", ".ply")
@@ -21,20 +28,20 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("mesh", help="mesh file (OBJ, OFF, PLY, STL)")
     p.add_argument(
         "--method",
-        choices=METHODS,
-        default="cotan",
+        choices=CURVATURE_METHODS,
+        default=DEFAULT_CURVATURE_FIELD,
         help="uniform H, cotangent H, angle-deficit K, or principal k1/k2 (default cotan)",
     )
     p.add_argument(
         "--area",
         choices=AREA_KINDS,
-        default="barycentric",
+        default=DEFAULT_AREA,
         help="vertex area (default barycentric, as in the course; voronoi converges)",
     )
     p.add_argument(
         "--boundary",
         choices=BOUNDARY_RULES,
-        default="pi",
+        default=DEFAULT_BOUNDARY,
         help="angle deficit at boundary vertices: pi - sum (default), 2pi - sum, or zero",
     )
     p.add_argument(

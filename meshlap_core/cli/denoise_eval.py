@@ -17,12 +17,17 @@ from typing import Any
 import numpy as np
 
 from ..errors import MeshError
-from ..noise import NOISE_MODES
-from ..options import AREA_KINDS
+from ..options import (
+    AREA_KINDS,
+    DEFAULT_NOISE_MODE,
+    EULER_METHODS,
+    LAPLACIAN_KINDS,
+    NOISE_MODES,
+    SMOOTHING_METHODS,
+    check_choice,
+)
 from ..smoothing import (
-    LAPLACIANS,
     MAX_ITERS,
-    METHODS,
     best_rows,
     check_iters,
     check_lam,
@@ -68,8 +73,14 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--noisy", default=None, help="noisy version of CLEAN (same faces, same vertex order)"
     )
     p.add_argument("--noise", default=None, help=f"noise levels alpha (default {DEFAULT_NOISE})")
-    p.add_argument("--noise-mode", choices=NOISE_MODES, default="isotropic", help="noise direction")
-    p.add_argument("--methods", default="explicit,implicit", help="from explicit,implicit,taubin")
+    p.add_argument(
+        "--noise-mode", choices=NOISE_MODES, default=DEFAULT_NOISE_MODE, help="noise direction"
+    )
+    p.add_argument(
+        "--methods",
+        default=",".join(EULER_METHODS),
+        help=f"from {','.join(SMOOTHING_METHODS)}",
+    )
     p.add_argument("--laplacian", default="uniform", help="uniform and/or cotan (default uniform)")
     p.add_argument("--lam", default="0.1,0.5,1.0", help="step sizes (default 0.1,0.5,1.0)")
     p.add_argument(
@@ -87,8 +98,7 @@ def _names(text: str, allowed: tuple[str, ...], flag: str) -> list[str]:
     if not values:
         raise MeshError("the list is empty", flag)
     for v in values:
-        if v not in allowed:
-            raise MeshError(f"unknown value {v!r}; choose from {', '.join(allowed)}", flag)
+        check_choice(v, allowed, "value", flag)
     return list(dict.fromkeys(values))
 
 
@@ -123,8 +133,8 @@ def _check_csv(args: argparse.Namespace) -> None:
 def run(args: argparse.Namespace) -> int:
     from ..io import load_mesh  # imported here so --help never loads the mesh readers
 
-    methods = _names(args.methods, METHODS, "--methods")
-    laplacians = _names(args.laplacian, LAPLACIANS, "--laplacian")
+    methods = _names(args.methods, SMOOTHING_METHODS, "--methods")
+    laplacians = _names(args.laplacian, LAPLACIAN_KINDS, "--laplacian")
     lams = [check_lam(v, "--lam") for v in parse_list(args.lam, float, "--lam")]
     iters = [check_iters(v, "--iters") for v in parse_list(args.iters, int, "--iters")]
     seed, noise = _seed_and_noise(args)

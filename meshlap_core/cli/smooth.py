@@ -16,20 +16,25 @@ import time
 import warnings
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any, TextIO
+from typing import Any, Literal, TextIO
 
 from ..errors import MeshError, MeshWarning
-from ..options import AREA_KINDS
+from ..options import (
+    AREA_KINDS,
+    DEFAULT_MASS_UPDATE,
+    DEFAULT_SMOOTHING_METHOD,
+    LAPLACIAN_KINDS,
+    MASS_UPDATES,
+    SMOOTHING_METHODS,
+)
+from ..progress import Progress
 from ..smoothing import (
-    LAPLACIANS,
-    MASS_MODES,
     MAX_ITERS,
-    METHODS,
     Smoother,
     check_iters,
     check_lam,
 )
-from ._common import add_json_flag, emit_json, summary_stats
+from ._common import add_json_flag, add_renamed_flag, emit_json, summary_stats
 
 HISTORY_SAMPLES = 2000
 """At most this many per-iteration entries in the output (about 1 MB of JSON)."""
@@ -47,8 +52,15 @@ def register(sub: argparse._SubParsersAction) -> None:
         ),
     )
     p.add_argument("mesh", help="mesh file")
-    p.add_argument("--method", choices=METHODS, default="explicit", help="default: explicit")
-    p.add_argument("--laplacian", choices=LAPLACIANS, default="uniform", help="default: uniform")
+    p.add_argument(
+        "--method",
+        choices=SMOOTHING_METHODS,
+        default=DEFAULT_SMOOTHING_METHOD,
+        help=f"default: {DEFAULT_SMOOTHING_METHOD}",
+    )
+    p.add_argument(
+        "--laplacian", choices=LAPLACIAN_KINDS, default="uniform", help="default: uniform"
+    )
     p.add_argument("--lam", default="0.5", help="step lambda > 0 (default 0.5)")
     p.add_argument(
         "--iters",
@@ -70,10 +82,16 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="rescale to keep the enclosed volume (closed meshes)",
     )
     p.add_argument(
+        "--mass-update",
+        choices=MASS_UPDATES,
+        default=DEFAULT_MASS_UPDATE,
+        help="cotan mass matrix frozen (factorize once) or recomputed each step "
+        f"(default {DEFAULT_MASS_UPDATE})",
+    )
+    add_renamed_flag(
+        p,
         "--mass",
-        choices=MASS_MODES,
-        default="frozen",
-        help="cotan mass matrix frozen (factorize once) or recomputed each step (default frozen)",
+        "--mass-update (frozen|recompute); the area kind is --area (barycentric|voronoi)",
     )
     p.add_argument(
         "--area", choices=AREA_KINDS, default="voronoi", help="cotan lumped area (default voronoi)"
@@ -159,7 +177,7 @@ def run(args: argparse.Namespace) -> int:
         "iters": s.iteration,
         "fix_boundary": bool(args.fix_boundary),
         "preserve_volume": bool(args.preserve_volume),
-        "mass": args.mass,
+        "mass": args.mass_update,
         "area": args.area,
         "closed": s.closed,
         "volume_change_pct": last["volume_change_pct"],
@@ -208,7 +226,7 @@ def _make_smoother(
                 pass_band=pass_band,
                 fix_boundary=args.fix_boundary,
                 preserve_volume=args.preserve_volume,
-                mass=args.mass,
+                mass_update=args.mass_update,
                 area=args.area,
                 history_samples=HISTORY_SAMPLES,
             )
@@ -219,7 +237,7 @@ def _make_smoother(
 
 def _iterate(s: Smoother, iters: int) -> None:
     """Step ``iters`` times (progress on stderr for long runs), stopping if the run diverges."""
-    progress = Progress(sys.stderr, iters)
+    progress = iteration_progress(iters)
     for k in range(iters):
         s.step()
         if s.diverged:
@@ -238,64 +256,38 @@ def _history_note(s: Smoother) -> str | None:
     )
 
 
-class Progress:
-    """Progress of a long loop on stderr, never in the way of a short run's output.
+def iteration_progress(
+    total: int,
+    stream: TextIO | Literal["stderr"] | None = "stderr",
+    clock: Callable[[], float] = time.monotonic,
+) -> Progress:
+    """Progress of a long smoothing run on stderr, never in the way of a short run's output.
 
-    On a terminal: one line redrawn in place (``\\r``) at most every ``redraw_s`` seconds once
-    ``start_s`` seconds have passed, erased by :meth:`close`. Otherwise (a pipe, a log, a test
-    capturing stderr): nothing for the first ``long_s`` seconds, then one full line every
-    ``every_s`` seconds; a run shorter than ``long_s`` prints nothing.
-
-    Parameters
-    ----------
-    stream : text stream
-    total : int
-        Iterations planned.
-    clock : callable, optional
-        Seconds (``time.monotonic`` by default; tests pass a fake clock).
+    On a terminal: one line redrawn in place once a second has passed, at most every 0.5 s,
+    erased at the end. Otherwise (a pipe, a log, a test capturing stderr): nothing for the first
+    10 s, then one full line every 30 s; a run shorter than 10 s prints nothing.
+    ``smooth: 10/100 iterations (10.0 %), 10 s elapsed, about 90 s left``.
     """
+    return Progress(
+        total,
+        _iterations_line,
+        "smooth",
+        stream=stream,
+        erase=True,
+        after_s=10.0,
+        every_s=30.0,
+        tty_after_s=1.0,
+        tty_every_s=0.5,
+        clock=clock,
+    )
 
-    def __init__(
-        self,
-        stream: TextIO,
-        total: int,
-        *,
-        clock: Callable[[], float] = time.monotonic,
-        start_s: float = 1.0,
-        redraw_s: float = 0.5,
-        long_s: float = 10.0,
-        every_s: float = 30.0,
-    ) -> None:
-        self.stream, self.total, self.clock = stream, total, clock
-        try:
-            self.tty = bool(stream.isatty())
-        except (AttributeError, ValueError):
-            self.tty = False
-        self.t0 = clock()
-        self.next_s = start_s if self.tty else long_s
-        self.gap_s = redraw_s if self.tty else every_s
-        self.drawn = False
 
-    def update(self, done: int) -> None:
-        """Record that ``done`` of ``total`` iterations are finished (one clock read: ~50 ns)."""
-        now = self.clock() - self.t0
-        if now < self.next_s:
-            return
-        self.next_s = now + self.gap_s
-        left = now * (self.total - done) / done if done else float("nan")
-        text = (
-            f"smooth: {done}/{self.total} iterations ({100.0 * done / self.total:.1f} %), "
-            f"{now:.0f} s elapsed, about {left:.0f} s left"
-        )
-        self.stream.write(f"\r{text}\x1b[K" if self.tty else text + "\n")
-        self.stream.flush()
-        self.drawn = True
-
-    def close(self) -> None:
-        """Erase the terminal line (a later error or report starts on a clean line)."""
-        if self.tty and self.drawn:
-            self.stream.write("\r\x1b[K")
-            self.stream.flush()
+def _iterations_line(p: Progress) -> str:
+    left = p.elapsed * (p.total - p.done) / p.done if p.done else float("nan")
+    return (
+        f"{p.label}: {p.done}/{p.total} iterations ({100.0 * p.done / p.total:.1f} %), "
+        f"{p.elapsed:.0f} s elapsed, about {left:.0f} s left"
+    )
 
 
 def _cli_error(exc: MeshError, mesh: str) -> MeshError:

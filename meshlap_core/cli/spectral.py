@@ -14,9 +14,10 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import MeshError
-from ..options import AREA_KINDS, LAPLACIAN_KINDS
+from ..options import AREA_KINDS, LAPLACIAN_KINDS, MASS_AREA
+from ..progress import Progress
 from ..spectral import SpectralBasis
-from ._common import add_json_flag, emit_json, parse_list
+from ._common import add_json_flag, add_renamed_flag, emit_json, parse_list
 
 _DEFAULT_RECONSTRUCT = (5, 15, 50, 100, 300, 1000)
 
@@ -34,11 +35,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("mesh", help="mesh file (OBJ, OFF, PLY, STL)")
     p.add_argument("--k", required=True, help="number of eigenmodes (1 <= K <= vertices)")
     p.add_argument(
-        "--mass",
+        "--area",
         choices=AREA_KINDS,
-        default="voronoi",
-        help="lumped mass for the cotan Laplacian (default voronoi)",
+        default=MASS_AREA,
+        help=f"vertex area of the lumped mass M of the cotan Laplacian (default {MASS_AREA})",
     )
+    add_renamed_flag(p, "--mass", "--area (the area kind of the mass matrix, barycentric|voronoi)")
     p.add_argument(
         "--laplacian",
         choices=LAPLACIAN_KINDS,
@@ -68,20 +70,15 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
-class _Progress:
-    """Progress lines on stderr: at most one per second, and only for solves that take a while."""
+def _solve_progress() -> Progress:
+    """Lines on stderr for a solve that takes a while: the first after a second, then at most
+    one a second (``meshlap spectral:  40% message``); ``update(fraction, message)`` is the
+    solver's progress callback."""
+    return Progress(1.0, _solve_line, in_place=False, after_s=1.0, every_s=1.0)
 
-    def __init__(self) -> None:
-        self.start = time.perf_counter()
-        self.last = 0.0
 
-    def __call__(self, fraction: float, message: str) -> None:
-        now = time.perf_counter()
-        if now - self.start < 1.0 or now - self.last < 1.0:
-            return
-        self.last = now
-        sys.stderr.write(f"meshlap spectral: {100 * fraction:3.0f}% {message}\n")
-        sys.stderr.flush()
+def _solve_line(p: Progress) -> str:
+    return f"meshlap spectral: {100 * p.done:3.0f}% {p.message}"
 
 
 def _parse_k(text: str) -> int:
@@ -127,9 +124,9 @@ def _compute(args: argparse.Namespace, V: Any, F: Any, k: int) -> SpectralBasis:
             F,
             k,
             laplacian=args.laplacian,
-            area=args.mass,
+            area=args.area,
             cache=not args.no_cache,
-            progress=_Progress(),
+            progress=_solve_progress().update,
         )
     except MeshError as exc:
         if exc.source in ("k", "--k"):

@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import MeshError
+from ..options import MESHERS
 from ..surfaces import (
     SURFACES,
     ParametricSurface,
@@ -73,7 +74,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument(
         "--mesher",
-        choices=("grid", "icosphere"),
+        choices=MESHERS,
         default="grid",
         help="--convergence meshes: the (u,v) grid (default) or icospheres (sphere only)",
     )

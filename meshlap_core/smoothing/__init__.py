@@ -30,7 +30,8 @@ the stability numbers, :func:`denoise_sweep` the evaluation table.
 Modules
 -------
 ``params``
-    Names (:data:`METHODS`, :data:`LAPLACIANS`, :data:`MASS_MODES`) and argument checks.
+    Argument checks (the method, Laplacian and mass-update names are in
+    :mod:`meshlap_core.options`).
 ``stability``
     ``W`` and ``K``, the most negative eigenvalue, amplification curves, stable ``λ``.
 ``stepper``
@@ -53,12 +54,7 @@ from ..linalg.quiet import quiet_c_stdout
 from .denoise import best_rows, denoise_sweep
 from .params import (
     DEFAULT_PASS_BAND,
-    LAPLACIANS,
-    MASS_MODES,
     MAX_ITERS,
-    METHODS,
-    MassMode,
-    Method,
     check_iters,
     check_lam,
     taubin_mu,
@@ -75,13 +71,8 @@ from .stepper import ILL_CONDITIONED, DivergenceError, Smoother, smooth
 __all__ = [
     "DEFAULT_PASS_BAND",
     "ILL_CONDITIONED",
-    "LAPLACIANS",
-    "MASS_MODES",
     "MAX_ITERS",
-    "METHODS",
     "DivergenceError",
-    "MassMode",
-    "Method",
     "Smoother",
     "Stability",
     "amplification_curve",

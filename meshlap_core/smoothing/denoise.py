@@ -16,10 +16,18 @@ import numpy as np
 
 from ..errors import MeshError, MeshWarning
 from ..metrics import Reference
-from ..noise import NOISE_MODES, add_noise, bbox_diagonal
-from ..options import MASS_AREA, AreaKind
+from ..noise import add_noise, bbox_diagonal
+from ..options import (
+    EULER_METHODS,
+    LAPLACIAN_KINDS,
+    MASS_AREA,
+    NOISE_MODES,
+    SMOOTHING_METHODS,
+    AreaKind,
+    check_choice,
+)
 from ..types import FloatArray, IntArray, as_mesh, as_vertices
-from .params import LAPLACIANS, METHODS, _check_choice, check_iters, check_lam
+from .params import check_iters, check_lam
 from .stepper import Smoother
 
 
@@ -29,7 +37,7 @@ def denoise_sweep(
     *,
     V_noisy: FloatArray | None = None,
     noise_levels: Sequence[float] = (0.005, 0.02, 0.05),
-    methods: Sequence[str] = ("explicit", "implicit"),
+    methods: Sequence[str] = EULER_METHODS,
     laplacians: Sequence[str] = ("uniform",),
     lams: Sequence[float] = (0.1, 0.5, 1.0),
     iters: Sequence[int] = (10,),
@@ -77,10 +85,10 @@ def denoise_sweep(
     """
     V_clean, F = as_mesh(V_clean, F)
     for m in methods:
-        _check_choice(m, METHODS, "method")
+        check_choice(m, SMOOTHING_METHODS, "method")
     for lap in laplacians:
-        _check_choice(lap, LAPLACIANS, "laplacian")
-    _check_choice(noise_mode, NOISE_MODES, "noise_mode")
+        check_choice(lap, LAPLACIAN_KINDS, "laplacian")
+    check_choice(noise_mode, NOISE_MODES, "noise_mode")
     lam_list = [check_lam(v) for v in lams]
     iter_list = sorted({check_iters(v) for v in iters})
     if not lam_list or not iter_list or not methods or not laplacians:

@@ -1,5 +1,5 @@
-"""Smoothing's names and argument checks: methods, mass modes, ``λ``, iteration counts,
-Taubin's ``ν``.
+"""Smoothing's argument checks: ``λ``, iteration counts, Taubin's ``ν`` (the methods and mass
+updates are named in :mod:`meshlap_core.options`).
 
 Sign convention: every Laplacian is negative semidefinite (``L = W⁻¹K``, see
 :mod:`meshlap_core.smoothing`).
@@ -8,18 +8,11 @@ Sign convention: every Laplacian is negative semidefinite (``L = W⁻¹K``, see
 from __future__ import annotations
 
 import math
-from typing import Any, Literal
+from typing import Any
 
 import numpy as np
 
 from ..errors import MeshError
-from ..options import LAPLACIAN_KINDS
-
-Method = Literal["explicit", "implicit", "taubin"]
-MassMode = Literal["frozen", "recompute"]
-METHODS: tuple[str, ...] = ("explicit", "implicit", "taubin")
-LAPLACIANS = LAPLACIAN_KINDS  # the name this module's callers use
-MASS_MODES: tuple[str, ...] = ("frozen", "recompute")
 
 DEFAULT_PASS_BAND = 0.1  # Taubin's k_PB, in the units of the Laplacian's eigenvalues
 
@@ -70,12 +63,6 @@ def _show_int(value: int) -> str:
     if abs(value) < 10**40:
         return str(int(value))
     return f"a number of about {int(math.log10(abs(value))) + 1} digits"
-
-
-def _check_choice(value: str, choices: tuple[str, ...], name: str) -> str:
-    if value not in choices:
-        raise MeshError(f"unknown {name} {value!r}; choose one of {', '.join(choices)}", name)
-    return value
 
 
 def taubin_mu(lam: float, k_pb: float = DEFAULT_PASS_BAND) -> float:

@@ -18,14 +18,19 @@ import scipy.sparse.linalg as sla
 from ..errors import MeshError
 from ..laplacian import adjacency_matrix, cotan_stiffness, vertex_areas
 from ..linalg.blas import blas_threads
-from ..options import AREA_KINDS, MASS_AREA, AreaKind, LaplacianKind
+from ..options import (
+    AREA_KINDS,
+    LAPLACIAN_KINDS,
+    MASS_AREA,
+    SMOOTHING_METHODS,
+    AreaKind,
+    LaplacianKind,
+    SmoothingMethod,
+    check_choice,
+)
 from ..types import FloatArray, IntArray, as_mesh
 from .params import (
     DEFAULT_PASS_BAND,
-    LAPLACIANS,
-    METHODS,
-    Method,
-    _check_choice,
     _resolve_nu,
     check_lam,
     taubin_mu,
@@ -55,8 +60,8 @@ def operator_parts(
         Symmetric, negative semidefinite, rows summing to 0.
     """
     V, F = as_mesh(V, F)
-    _check_choice(laplacian, LAPLACIANS, "laplacian")
-    _check_choice(area, AREA_KINDS, "area")
+    check_choice(laplacian, LAPLACIAN_KINDS, "laplacian")
+    check_choice(area, AREA_KINDS, "area")
     n = len(V)
     if laplacian == "uniform":
         A = adjacency_matrix(F, n)
@@ -148,7 +153,7 @@ class _OverBudget(Exception):
 
 
 def amplification_curve(
-    method: Method,
+    method: SmoothingMethod,
     lam: float,
     mu: Any,
     *,
@@ -175,7 +180,7 @@ def amplification_curve(
         explicit ``1 + λμ``; implicit ``1 / (1 − λμ)``; taubin ``(1 + λμ)(1 + νμ)``. A mode is
         amplified when ``|g| > 1`` and changes sign each step when ``g < 0``.
     """
-    _check_choice(method, METHODS, "method")
+    check_choice(method, SMOOTHING_METHODS, "method")
     lam = check_lam(lam)
     m = np.asarray(mu, dtype=np.float64)
     if not np.isfinite(m).all():
@@ -331,7 +336,7 @@ def _taubin_max_lam(k: float, kpb: float) -> float | None:
 def stability(
     V: FloatArray,
     F: IntArray,
-    method: Method = "explicit",
+    method: SmoothingMethod = "explicit",
     laplacian: LaplacianKind = "uniform",
     lam: float = 0.5,
     *,
@@ -367,7 +372,7 @@ def stability(
     ``[μ_min, 0]`` too (Cauchy interlacing), so the figures here are on the safe side.
     """
     V, F = as_mesh(V, F)
-    _check_choice(method, METHODS, "method")
+    check_choice(method, SMOOTHING_METHODS, "method")
     lam = check_lam(lam)
     W, K = operator_parts(V, F, laplacian, area)
     k_pb = check_lam(pass_band, "pass_band") * _diagonal_scale(W, K)

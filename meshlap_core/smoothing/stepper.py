@@ -21,17 +21,23 @@ from ..laplacian import vertex_areas
 from ..linalg.spd import SPDSolver
 from ..metrics import _signed_volume_unchecked, n_boundary_edges, percent_volume_change
 from ..noise import bbox_diagonal
-from ..options import AREA_KINDS, MASS_AREA, AreaKind, LaplacianKind
+from ..options import (
+    AREA_KINDS,
+    DEFAULT_MASS_UPDATE,
+    LAPLACIAN_KINDS,
+    MASS_AREA,
+    MASS_UPDATES,
+    SMOOTHING_METHODS,
+    AreaKind,
+    LaplacianKind,
+    MassUpdate,
+    SmoothingMethod,
+    check_choice,
+)
 from ..topology import boundary_vertex_mask
 from ..types import FloatArray, IntArray, as_mesh, as_vertices
 from .params import (
     DEFAULT_PASS_BAND,
-    LAPLACIANS,
-    MASS_MODES,
-    METHODS,
-    MassMode,
-    Method,
-    _check_choice,
     _resolve_nu,
     check_iters,
     check_lam,
@@ -83,7 +89,7 @@ class Smoother:
     preserve_volume : bool
         After each step, scale about the vertex centroid so the enclosed volume stays that of the
         input (closed meshes only).
-    mass : {"frozen", "recompute"}
+    mass_update : {"frozen", "recompute"}
         ``frozen``: ``W`` and ``K`` from the input mesh, the implicit system factorized once.
         ``recompute``: ``W`` (the areas) recomputed from the current positions every step with
         ``K`` frozen (Kazhdan et al. 2012); the implicit system is then refactorized every step.
@@ -156,7 +162,7 @@ class Smoother:
         self,
         V: FloatArray,
         F: IntArray,
-        method: Method = "explicit",
+        method: SmoothingMethod = "explicit",
         laplacian: LaplacianKind = "uniform",
         lam: float = 0.5,
         *,
@@ -164,7 +170,7 @@ class Smoother:
         pass_band: float = DEFAULT_PASS_BAND,
         fix_boundary: bool = False,
         preserve_volume: bool = False,
-        mass: MassMode = "frozen",
+        mass_update: MassUpdate = DEFAULT_MASS_UPDATE,
         area: AreaKind = MASS_AREA,
         reference: FloatArray | None = None,
         track_history: bool = True,
@@ -175,10 +181,10 @@ class Smoother:
         self.V0, self.F = as_mesh(V, F)
         self._init_history(history_limit, history_samples)
         self.n = len(self.V0)
-        self.method = _check_choice(method, METHODS, "method")
-        self.laplacian = _check_choice(laplacian, LAPLACIANS, "laplacian")
-        self.mass = _check_choice(mass, MASS_MODES, "mass")
-        self.area = _check_choice(area, AREA_KINDS, "area")
+        self.method = check_choice(method, SMOOTHING_METHODS, "method")
+        self.laplacian = check_choice(laplacian, LAPLACIAN_KINDS, "laplacian")
+        self.mass_update = check_choice(mass_update, MASS_UPDATES, "mass_update")
+        self.area = check_choice(area, AREA_KINDS, "area")
         self.pass_band = check_lam(pass_band, "pass_band")
         self.lam = check_lam(lam)
         self._nu_given = taubin_nu
@@ -252,7 +258,7 @@ class Smoother:
         self._K_free_rows = K[self._free].tocsr()  # rows of free vertices, all columns
         self._K_ff = self._K_free_rows[:, self._free].tocsr()
         self._K_fp = self._K_free_rows[:, self._fixed].tocsr()
-        self._recompute_mass = self.mass == "recompute" and self.laplacian == "cotan"
+        self._recompute_mass = self.mass_update == "recompute" and self.laplacian == "cotan"
         self._stability: Stability | None = None
         self.n_factorizations = 0
         self._solver: SPDSolver | None = None
@@ -553,7 +559,7 @@ class Smoother:
 def smooth(
     V: FloatArray,
     F: IntArray,
-    method: Method = "explicit",
+    method: SmoothingMethod = "explicit",
     laplacian: LaplacianKind = "uniform",
     lam: float = 0.5,
     iters: int = 10,
@@ -573,7 +579,8 @@ def smooth(
     iters : int
         ``>= 0``.
     **options
-        Keyword options of :class:`Smoother` (``fix_boundary``, ``preserve_volume``, ``mass``, ...).
+        Keyword options of :class:`Smoother` (``fix_boundary``, ``preserve_volume``,
+        ``mass_update``, ...).
 
     Returns
     -------

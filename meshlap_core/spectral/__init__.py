@@ -40,21 +40,16 @@ from __future__ import annotations
 
 from ..linalg.common import ProgressCallback, SolveInfo
 from ..linalg.eigsolve import pencil_eigenpairs
-from ..options import AREA_KINDS
-from .basis import ReconstructionErrors, SpectralBasis, compute_basis, reconstruct
+from .basis import ReconstructionErrors, SpectralBasis, reconstruct
 from .cache import CACHE_FORMAT, default_cache_dir, mesh_key
 from .operators import laplacian_eigenpairs, problem_options, spectral_operators
 
-MASS_KINDS = AREA_KINDS  # the lumped mass of the pencil is a vertex area (the CLI's --mass)
-
 __all__ = [
     "CACHE_FORMAT",
-    "MASS_KINDS",
     "ProgressCallback",
     "ReconstructionErrors",
     "SolveInfo",
     "SpectralBasis",
-    "compute_basis",
     "default_cache_dir",
     "laplacian_eigenpairs",
     "mesh_key",

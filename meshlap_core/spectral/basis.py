@@ -82,9 +82,9 @@ class ReconstructionErrors:
 class SpectralBasis:
     """A computed Laplace–Beltrami eigenbasis of a mesh: compute once, reconstruct fast.
 
-    Build it with :meth:`compute` (or :func:`compute_basis`). Attributes are read-only by
-    convention; the methods are thread-safe (one lock), so a viewer may extend the basis in a
-    worker thread while the UI thread reconstructs.
+    Build it with :meth:`compute`. Attributes are read-only by convention; the methods are
+    thread-safe (one lock), so a viewer may extend the basis in a worker thread while the UI
+    thread reconstructs.
 
     Attributes
     ----------
@@ -504,30 +504,6 @@ class SpectralBasis:
             np.maximum(mx, e.max(axis=0), out=mx)
 
 
-def compute_basis(
-    V: FloatArray,
-    F: IntArray,
-    k: int,
-    *,
-    laplacian: LaplacianKind = "cotan",
-    area: AreaKind = MASS_AREA,
-    cache: bool = True,
-    cache_dir: str | os.PathLike | None = None,
-    progress: ProgressCallback | None = None,
-) -> SpectralBasis:
-    """One-shot wrapper of :meth:`SpectralBasis.compute`."""
-    return SpectralBasis.compute(
-        V,
-        F,
-        k,
-        laplacian=laplacian,
-        area=area,
-        cache=cache,
-        cache_dir=cache_dir,
-        progress=progress,
-    )
-
-
 def reconstruct(
     V: FloatArray,
     F: IntArray,
@@ -538,4 +514,5 @@ def reconstruct(
     cache: bool = False,
 ) -> FloatArray:
     """Spectral reconstruction of the vertices from their ``k`` lowest modes, ``(n,3)``."""
-    return compute_basis(V, F, k, laplacian=laplacian, area=area, cache=cache).reconstruct(k)
+    basis = SpectralBasis.compute(V, F, k, laplacian=laplacian, area=area, cache=cache)
+    return basis.reconstruct(k)

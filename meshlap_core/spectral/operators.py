@@ -17,19 +17,21 @@ from .. import laplacian as _lap
 from ..errors import MeshError
 from ..linalg.common import ProgressCallback, SolveInfo
 from ..linalg.eigsolve import check_k, pencil_eigenpairs
-from ..options import AREA_KINDS, LAPLACIAN_KINDS, MASS_AREA, AreaKind, LaplacianKind
+from ..options import (
+    AREA_KINDS,
+    LAPLACIAN_KINDS,
+    MASS_AREA,
+    AreaKind,
+    LaplacianKind,
+    check_choice,
+)
 from ..types import FloatArray, IntArray, as_mesh
 
 
 def check_options(laplacian: str, area: str) -> None:
     """Raise :class:`MeshError` naming the argument for an unknown Laplacian or area kind."""
-    if laplacian not in LAPLACIAN_KINDS:
-        raise MeshError(
-            f"unknown Laplacian {laplacian!r}; choose one of {', '.join(LAPLACIAN_KINDS)}",
-            "laplacian",
-        )
-    if area not in AREA_KINDS:
-        raise MeshError(f"unknown area {area!r}; choose one of {', '.join(AREA_KINDS)}", "area")
+    check_choice(laplacian, LAPLACIAN_KINDS, "Laplacian", "laplacian")
+    check_choice(area, AREA_KINDS, "area")
 
 
 def problem_options(laplacian: str, area: str) -> dict[str, str]:

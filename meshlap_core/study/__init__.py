@@ -41,7 +41,7 @@ screenshot interface), :mod:`.context` (meshes, files, screenshots, progress bar
 from __future__ import annotations
 
 from .build import build_report, parse_sections
-from .context import ASSETS_DIR, PACKAGE_ROOT, Progress, default_meshes_dir
+from .context import ASSETS_DIR, PACKAGE_ROOT, default_meshes_dir
 from .document import ReportResult
 from .sections import COURSE_EIGEN_SECONDS, SECTION_TITLES, SECTIONS
 from .shots import MeshSource, Screenshot
@@ -53,7 +53,6 @@ __all__ = [
     "SECTIONS",
     "SECTION_TITLES",
     "MeshSource",
-    "Progress",
     "ReportResult",
     "Screenshot",
     "build_report",

@@ -6,14 +6,14 @@ from __future__ import annotations
 
 import csv
 import io
-import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import IO, Any
+from typing import Any
 
 from .. import curvature, noise
 from ..io import atomic_write, load_mesh
+from ..progress import Progress
 from ..types import FloatArray, IntArray
 from .document import Fig, Table, csv_cell
 from .figures import autocrop, draw_mesh, new_figure
@@ -41,56 +41,6 @@ STAND_INS: dict[str, tuple[str, float | None]] = {
 NOISE_SEED = 7
 
 
-class Progress:
-    """A text progress bar per section, with elapsed seconds, on a stream (stderr).
-
-    On a terminal the bar is redrawn in place (carriage return); otherwise each update is one
-    line, so logs stay readable.
-    """
-
-    def __init__(self, stream: IO[str] | None, n_sections: int, width: int = 24) -> None:
-        self.stream = stream
-        self.n_sections = n_sections
-        self.width = width
-        self.tty = bool(stream is not None and getattr(stream, "isatty", lambda: False)())
-        self.index = 0
-        self.title = ""
-        self.steps = 1
-        self.done_steps = 0
-        self.t0 = time.perf_counter()
-
-    def begin(self, index: int, title: str, steps: int) -> None:
-        self.index, self.title = index, title
-        self.steps, self.done_steps = max(1, steps), 0
-        self.t0 = time.perf_counter()
-        self._draw("starting")
-
-    def step(self, message: str) -> None:
-        self.done_steps = min(self.done_steps + 1, self.steps)
-        self._draw(message)
-
-    def end(self, seconds: float, status: str = "done") -> None:
-        self.done_steps = self.steps
-        self._draw(f"{status} in {seconds:.1f} s", final=True)
-
-    def _draw(self, message: str, final: bool = False) -> None:
-        if self.stream is None:
-            return
-        frac = self.done_steps / self.steps
-        filled = round(frac * self.width)
-        bar = "#" * filled + "-" * (self.width - filled)
-        elapsed = time.perf_counter() - self.t0
-        line = (
-            f"report [{bar}] section {self.index}/{self.n_sections} {self.title}: {message} "
-            f"({elapsed:.1f} s)"
-        )
-        if self.tty:
-            self.stream.write("\r" + line[:160].ljust(160) + ("\n" if final else ""))
-        else:
-            self.stream.write(line + "\n")
-        self.stream.flush()
-
-
 @dataclass
 class StudyMesh:
     """A course mesh as the report uses it: the file, or the bundled stand-in and why."""
@@ -114,7 +64,7 @@ def _load_asset(file: str) -> tuple[FloatArray, IntArray, Path | None]:
     gen = {
         "bumpy.obj": lambda: primitives.bumpy_sphere(4),
         "icosphere.obj": lambda: primitives.icosphere(3),
-        "torus.obj": lambda: primitives.torus(48, 24),
+        "torus.obj": lambda: primitives.torus_mesh(48, 24),
         "grid.obj": lambda: primitives.grid(20, 20),
         "cube.obj": lambda: primitives.cube(0),
     }[file]
@@ -319,7 +269,7 @@ class Context:
             V, F = mesh.V, mesh.F
         assert V is not None and F is not None
         if values is None:
-            values = curvature.curvature_fields(V, F)[field]
+            values = curvature.all_curvature_fields(V, F)[field]
         f = new_figure(6.4, 4.8)
         ax = f.add_axes((0.0, 0.0, 0.84, 1.0))
         sm = draw_mesh(ax, V, F, values, cmap=cmap, symmetric=symmetric)

@@ -61,7 +61,7 @@ from .catalogue import (
     torus,
 )
 from .convergence import ESTIMATORS, ConvergenceStudy, convergence_study, exact_curvature_at
-from .derivatives import DERIVATIVE_METHODS, DerivativeMethod, Derivatives, surface_derivatives
+from .derivatives import Derivatives, surface_derivatives
 from .geometry import (
     CLASSIFICATIONS,
     CurvatureFields,
@@ -86,16 +86,8 @@ from .meshing import (
 from .plot import plot_normal_curvature
 from .singular import SINGULAR_REL, is_singular, surface_scale
 
-surface = get_surface
-"""``surface(name, **params)``: the catalogue surface by name, the name
-``meshlap_core.surface`` (the public API) resolves to; same as :func:`get_surface`."""
-curvature_fields = surface_curvature_fields
-"""Former name of :func:`surface_curvature_fields`, kept for ``app/viewer.py``; not to be
-confused with :func:`meshlap_core.curvature.curvature_fields` (discrete, on a mesh)."""
-
 __all__ = [
     "CLASSIFICATIONS",
-    "DERIVATIVE_METHODS",
     "EDGES",
     "ESTIMATORS",
     "MAX_CELLS",
@@ -107,7 +99,6 @@ __all__ = [
     "ConvergenceStudy",
     "CurvatureFields",
     "DerivativeMap",
-    "DerivativeMethod",
     "Derivatives",
     "ParametricSurface",
     "PointGeometry",
@@ -118,7 +109,6 @@ __all__ = [
     "check_uv",
     "classify",
     "convergence_study",
-    "curvature_fields",
     "cylinder",
     "estimate_mesh_bytes",
     "exact_curvature_at",
@@ -134,7 +124,6 @@ __all__ = [
     "point_geometry",
     "saddle",
     "sphere",
-    "surface",
     "surface_curvature_fields",
     "surface_derivatives",
     "surface_scale",

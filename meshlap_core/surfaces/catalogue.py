@@ -1,8 +1,8 @@
 """The catalogue of parametric surfaces: :class:`ParametricSurface` and the seven shipped ones.
 
 ``meshlap_core.surfaces.torus`` here is the *parametric* torus (a :class:`ParametricSurface`,
-exact geometry at any ``(u, v)``); :func:`meshlap_core.primitives.torus` is the *triangle mesh*
-``(V, F)`` of the same parameterization (equal to ``mesh_surface(torus(), (nu, nv))``).
+exact geometry at any ``(u, v)``); :func:`meshlap_core.primitives.torus_mesh` is the *triangle
+mesh* ``(V, F)`` of the same parameterization (equal to ``mesh_surface(torus(), (nu, nv))``).
 """
 
 from __future__ import annotations
@@ -189,8 +189,8 @@ def torus(R: float = 3.0, r: float = 1.0) -> ParametricSurface:
     """Parametric torus ``p(u,v) = ((R + r cos v) cos u, (R + r cos v) sin u, r sin v)`` on
     ``[0,2π]²`` (a :class:`ParametricSurface`, not a mesh).
 
-    The parameterization of :func:`meshlap_core.primitives.torus`, which returns the triangle mesh
-    ``(V, F)`` (same defaults, outward ``n``).
+    The parameterization of :func:`meshlap_core.primitives.torus_mesh`, which returns the
+    triangle mesh ``(V, F)`` (same defaults, outward ``n``).
     ``K = cos v / (r (R + r cos v))``: elliptic outside (``cos v > 0``), hyperbolic inside,
     parabolic on the top and bottom circles ``v = ±π/2``.
     """

@@ -8,12 +8,13 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Any, Literal
+from typing import Any
 
 import numpy as np
 
 from ..curvature import gaussian_curvature, mean_curvature_cotan, mean_curvature_uniform
 from ..errors import MeshError
+from ..options import MESHERS, Mesher, check_choice
 from ..primitives import icosphere
 from ..topology import edges
 from ..types import BoolArray, FloatArray, IntArray
@@ -224,7 +225,7 @@ def exact_curvature_at(
 def convergence_study(
     surface: ParametricSurface | str,
     resolutions: Sequence[int] = (8, 16, 32, 64, 128),
-    mesher: Literal["grid", "icosphere"] = "grid",
+    mesher: Mesher = "grid",
     exclude_poles: bool = False,
     progress: Callable[[str], None] | None = None,
 ) -> ConvergenceStudy:
@@ -288,8 +289,7 @@ def _check_levels(
     """The levels as ints, every one checked before the first (slow) one is meshed: its
     resolution, its memory (the levels kept plus the largest one's estimators, against
     :data:`~meshlap_core.surfaces.meshing.MAX_MESH_BYTES`) and that it has a vertex to compare."""
-    if mesher not in ("grid", "icosphere"):
-        raise MeshError(f"unknown mesher {mesher!r}; choose grid or icosphere", "mesher")
+    check_choice(mesher, MESHERS, "mesher")
     try:
         levels = [int(r) for r in resolutions]
     except (TypeError, ValueError):

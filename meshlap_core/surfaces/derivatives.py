@@ -12,16 +12,14 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, Literal
+from typing import Any
 
 import numpy as np
 
 from ..errors import MeshError
+from ..options import DERIVATIVE_METHODS, DerivativeMethod, check_choice
 from ..types import FloatArray
 from .catalogue import ParametricSurface, _evaluate, get_surface
-
-DerivativeMethod = Literal["auto", "exact", "complex-step", "central"]
-DERIVATIVE_METHODS: tuple[str, ...] = ("auto", "exact", "complex-step", "central")
 
 
 @dataclass(frozen=True)
@@ -96,15 +94,12 @@ def surface_derivatives(
     ``5·10⁻³`` times the width for first and second derivatives, error ~1e-11).
     """
     surface = get_surface(surface)
-    if method not in DERIVATIVE_METHODS:
-        raise MeshError(
-            f"unknown method {method!r}; choose one of {', '.join(DERIVATIVE_METHODS)}", "method"
-        )
+    check_choice(method, DERIVATIVE_METHODS, "method")
     u, v = np.broadcast_arrays(np.asarray(u, dtype=np.float64), np.asarray(v, dtype=np.float64))
     P = np.real(_evaluate(surface, u, v)).astype(np.float64)
     if method == "exact" and surface.derivatives is None:
         raise MeshError(f"the {surface.name} has no exact derivatives", "method")
-    if method in ("auto", "exact") and surface.derivatives is not None:
+    if method == "exact" or (method == "auto" and surface.derivatives is not None):
         parts = surface.derivatives(u, v)
         shape = (*u.shape, 3)
         out = [np.broadcast_to(np.asarray(x, dtype=np.float64), shape).copy() for x in parts]

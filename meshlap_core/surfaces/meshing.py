@@ -1,7 +1,8 @@
 """Triangle meshes of parametric surfaces: the ``(u, v)`` grid, welded seams, collapsed poles.
 
 :func:`mesh_surface` returns a :class:`SurfaceMesh` (``V, F`` plus the parameters of every vertex);
-:func:`meshlap_core.primitives.torus` is the same grid for the torus, without the surface object.
+:func:`meshlap_core.primitives.torus_mesh` is the same grid for the torus, without the surface
+object.
 """
 
 from __future__ import annotations

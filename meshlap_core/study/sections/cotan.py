@@ -30,7 +30,7 @@ def run(ctx: Context, sec: Section) -> None:
     rows, fields = [], {}
     for name in names:
         m = ctx.mesh(name)
-        f = curvature.curvature_fields(m.V, m.F)
+        f = curvature.all_curvature_fields(m.V, m.F)
         fields[name] = f
         bnd = topology.boundary_vertex_mask(m.F, len(m.V))
         for key, label in (
@@ -74,7 +74,7 @@ def _scaling(
     """Median |value| before and after scaling the mesh by 2, as a table and a sentence."""
     # scaling: a curvature scales like 1/length; the uniform H scales like length
     s = 2.0
-    f2 = curvature.curvature_fields(m.V * s, m.F)
+    f2 = curvature.all_curvature_fields(m.V * s, m.F)
     scale_rows = []
     for key, label in (("cotan", "H cotan"), ("uniform", "H uniform"), ("gaussian", "K")):
         a = float(np.median(np.abs(f[key][inner])))

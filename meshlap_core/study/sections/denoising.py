@@ -13,6 +13,7 @@ import numpy as np
 
 from ... import metrics, noise, smoothing
 from ...errors import MeshError, MeshWarning
+from ...options import EULER_METHODS, LAPLACIAN_KINDS, SMOOTHING_METHODS
 from ...types import FloatArray, IntArray
 from ..context import Context, StudyMesh
 from ..document import Section, num, pct
@@ -74,7 +75,7 @@ def run(ctx: Context, sec: Section) -> None:
         )
     alphas = (0.002, 0.005) if ctx.quick else (0.001, 0.002, 0.005, 0.01)
     iters = (1, 5, 10, 20) if ctx.quick else (1, 2, 5, 10, 20, 50, 100)
-    methods = ("explicit", "implicit") if ctx.quick else ("explicit", "implicit", "taubin")
+    methods = EULER_METHODS if ctx.quick else SMOOTHING_METHODS
     sec.p(
         f"Clean reference: {clean.label}; noisy input: {noisy.label}, plus the clean mesh with "
         "seeded isotropic Gaussian noise of σ = α × bbox diagonal for α in "
@@ -91,7 +92,7 @@ def run(ctx: Context, sec: Section) -> None:
     sweep_tab = _sweep_table(ctx, rows)
     by_case = {label: [r for r in rows if r["case"] == label] for label, _ in cases}
     level = {label: rs[0]["noise"] for label, rs in by_case.items()}
-    combos = [(lap, m) for lap in ("uniform", "cotan") for m in methods]
+    combos = [(lap, m) for lap in LAPLACIAN_KINDS for m in methods]
     d = _Study(clean, noisy, combos, by_case, level)
     rec_rows, rec_tab = _recommendation(ctx, d)
     wins, pm_tab = _best_per_method(ctx, d)
@@ -119,7 +120,7 @@ def _sweep(
     """Every case × Laplacian × method × λ × iteration count (:func:`smoothing.denoise_sweep`)."""
     rows: list[dict[str, Any]] = []
     for label, Vn in cases:
-        for lap in ("uniform", "cotan"):
+        for lap in LAPLACIAN_KINDS:
             W, K = smoothing.operator_parts(Vn, F, lap)
             mu_min, _ = smoothing.most_negative_eigenvalue(W, K)
             limit = 2.0 / abs(mu_min)

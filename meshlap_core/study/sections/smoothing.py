@@ -15,6 +15,7 @@ import numpy as np
 
 from ... import metrics, smoothing
 from ...errors import MeshWarning
+from ...options import EULER_METHODS, LAPLACIAN_KINDS
 from ...types import FloatArray
 from ..context import Context, StudyMesh
 from ..document import Section, num
@@ -87,7 +88,7 @@ def _run_all(ctx: Context, sec: Section, iters: int) -> _Runs:
     for name in ("plane_ns", "fandisk_ns"):
         m = ctx.mesh(name)
         sec.p(f"Mesh `{name}`: {m.label}.")
-        for lap in ("uniform", "cotan"):
+        for lap in LAPLACIAN_KINDS:
             # μ_min once per mesh and Laplacian; the gains of every λ follow from it
             W, K = smoothing.operator_parts(m.V, m.F, lap)
             mu_min, _exact = smoothing.most_negative_eigenvalue(W, K)
@@ -95,7 +96,7 @@ def _run_all(ctx: Context, sec: Section, iters: int) -> _Runs:
             limit = 2.0 / abs(mu_min) if mu_min < 0 else math.inf
             runs.limits[(name, lap)] = limit
             mu_grid = np.linspace(mu_min, 0.0, 257)
-            for method in ("explicit", "implicit"):
+            for method in EULER_METHODS:
                 for lam in _lam_grid(ctx, lap, method, limit):
                     row, history, shot = _one_run(
                         m, lap, method, lam, mu_min, mu_grid, limit, iters
@@ -234,7 +235,7 @@ def _history_figs(ctx: Context, sec: Section, runs: _Runs) -> None:
         if closed:
             panels.append(("volume_change_pct", "volume change %", False))
         fig = new_figure(4.3 * len(panels), 6.4)
-        for i, lap in enumerate(("uniform", "cotan")):
+        for i, lap in enumerate(LAPLACIAN_KINDS):
             hist = {k: h for k, h in runs.hist.items() if k[0] == name and k[1] == lap}
             for j, (key, label, logy) in enumerate(panels):
                 ax = fig.add_subplot(2, len(panels), i * len(panels) + j + 1)
@@ -356,8 +357,8 @@ def _pictures(ctx: Context, sec: Section, shots: list[_Shot], iters: int) -> Non
         mesh = ctx.mesh(name)
         if not ctx.quick:
             figs.append(ctx.shot_or_render(f"smoothing_{name}_input", f"{name}: input", mesh))
-        for lap in ("uniform", "cotan") if not ctx.quick else ("uniform",):
-            for meth in ("explicit", "implicit"):
+        for lap in LAPLACIAN_KINDS if not ctx.quick else ("uniform",):
+            for meth in EULER_METHODS:
                 c = sorted(
                     (s for s in shots if s[0] == name and s[1] == lap and s[2] == meth and s[5]),
                     key=lambda s: s[4],

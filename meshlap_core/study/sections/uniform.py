@@ -38,7 +38,7 @@ def run(ctx: Context, sec: Section) -> None:
     rows, gb_rows, fields = [], [], {}
     for name in names:
         m = ctx.mesh(name)
-        f = curvature.curvature_fields(m.V, m.F)
+        f = curvature.all_curvature_fields(m.V, m.F)
         fields[name] = f
         bnd = topology.boundary_vertex_mask(m.F, len(m.V))
         for key, label in (("uniform", "H uniform"), ("gaussian", "K angle deficit")):
