@@ -25,6 +25,7 @@ from .cache import (
     CACHE_FORMAT,
     cache_file,
     default_cache_dir,
+    load_entry,
     mesh_key,
     read_cache,
     validate_arrays,
@@ -218,7 +219,7 @@ class SpectralBasis:
             return
         try:
             path.parent.mkdir(parents=True, exist_ok=True)
-            self.save(path)
+            write_npz(path, self._arrays(), keep_mode=False)  # a fresh, readable entry
             self.info.cache_path = str(path)
         except (OSError, MeshError) as exc:
             self.info.messages.append(f"could not write the cache file {path}: {exc}")
@@ -226,19 +227,19 @@ class SpectralBasis:
     def save(self, path: str | os.PathLike, *, overwrite_inputs: Any = ()) -> None:
         """Write the basis as ``.npz`` (atomically: temporary file and ``os.replace``), in the
         cache format; :meth:`load` reads it back for the same mesh and options."""
-        write_npz(
-            Path(path),
-            {
-                "format": np.array(CACHE_FORMAT),
-                "key": np.array(mesh_key(self.V, self.F, self.options)),
-                "options": np.array(json.dumps(self.options, sort_keys=True)),
-                "eigenvalues": self.eigenvalues,
-                "vectors": self.vectors,
-                "mass": self.mass,
-                "n_faces": np.array(len(self.F)),
-            },
-            overwrite_inputs,
-        )
+        write_npz(Path(path), self._arrays(), overwrite_inputs)
+
+    def _arrays(self) -> dict[str, Any]:
+        """The members of the basis file (the cache format)."""
+        return {
+            "format": np.array(CACHE_FORMAT),
+            "key": np.array(mesh_key(self.V, self.F, self.options)),
+            "options": np.array(json.dumps(self.options, sort_keys=True)),
+            "eigenvalues": self.eigenvalues,
+            "vectors": self.vectors,
+            "mass": self.mass,
+            "n_faces": np.array(len(self.F)),
+        }
 
     @classmethod
     def load(
@@ -256,8 +257,8 @@ class SpectralBasis:
         opts = problem_options(laplacian, area)
         K, m = spectral_operators(V, F, laplacian, area)
         try:
-            with np.load(path, allow_pickle=False) as data:
-                lam, U, orth = validate_arrays(data, mesh_key(V, F, opts), opts, K, m)
+            data = load_entry(path, len(V))  # headers checked before any data is loaded
+            lam, U, orth = validate_arrays(data, mesh_key(V, F, opts), opts, K, m)
         except MeshError:
             raise
         except Exception as exc:
