@@ -18,6 +18,7 @@ from typing import Any
 
 from ..errors import MeshError
 from ..frames import parse_range
+from ..noise import check_noise, check_seed
 from ..options import LAPLACIAN_KINDS
 from ..smoothing.params import check_lam
 
@@ -136,8 +137,7 @@ def _check_numbers(args: argparse.Namespace) -> None:
             raise MeshError(f"must be 0 to 5000, got {args.iters}", "--iters")
         if not (math.isfinite(args.noise) and args.noise >= 0):
             raise MeshError(f"must be a finite number >= 0, got {args.noise}", "--noise")
-        if args.seed < 0:
-            raise MeshError(f"must be >= 0, got {args.seed}", "--seed")
+        check_seed(args.seed, "--seed")
     if args.fps is not None and not (math.isfinite(args.fps) and 0.1 <= args.fps <= 120):
         raise MeshError(f"must be between 0.1 and 120, got {args.fps}", "--fps")
 
@@ -255,6 +255,8 @@ def run(args: argparse.Namespace) -> int:
     check_spec(spec, None)  # options and output path first: a doomed run fails in a second
     mesh = load_mesh_state(spec) if spec.panel != "surfaces" or session is not None else None
     check_spec(spec, mesh)
+    if mesh is not None and spec.panel == "smoothing" and args.noise:
+        check_noise(mesh.V, args.noise, "--noise")  # before the renderer: it names --noise
     if mesh is None:
         from meshlap_app.state.mesh import MeshState
 
