@@ -21,6 +21,7 @@ from ..linalg.components import components
 from ..linalg.eigsolve import check_k
 from ..options import MASS_AREA, AreaKind, LaplacianKind
 from ..types import FloatArray, IntArray, as_mesh
+from .budget import check_basis_memory
 from .cache import (
     CACHE_FORMAT,
     cache_file,
@@ -169,6 +170,7 @@ class SpectralBasis:
         V, F = as_mesh(V, F)
         opts = problem_options(laplacian, area)
         k = check_k(k, len(V), "k")
+        check_basis_memory(len(V), k, "k")  # before the solver: a k that cannot fit, named
         t0 = time.perf_counter()
         K, m = spectral_operators(V, F, laplacian, area)
         known = None
@@ -326,6 +328,7 @@ class SpectralBasis:
         k = check_k(k, self.n_vertices, "k")
         if k <= self.k_max:
             return
+        check_basis_memory(self.n_vertices, k, "k")
         with self._extend_lock:
             if k <= self.k_max:
                 return
