@@ -195,7 +195,7 @@ def atomic_write(
         fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0), 0o666)
     except OSError as exc:
         raise MeshError(
-            f"cannot write in this directory: {os_cause(exc)}", os.fspath(parent)
+            f"cannot create a file in {os.fspath(parent)!r}: {os_cause(exc)}", os.fspath(target)
         ) from None
     if keep_mode and target.exists():  # keep the permissions of the file being replaced
         with contextlib.suppress(OSError):
