@@ -28,6 +28,7 @@ SIZE_LIMITS: dict[str, int] = {
     "session file": 16 * 2**20,  # 16 MiB: a saved session is a few kB
     "cache file": 8 * 2**30,  # 8 GiB: a basis of 1000 modes on 1 M vertices
     "JSON file": 16 * 2**20,
+    "image file": 256 * 2**20,  # a screenshot the report cropped (its own output)
 }
 MESH_SIZE_LIMIT = SIZE_LIMITS["mesh file"]
 JSON_SIZE_LIMIT = SIZE_LIMITS["session file"]
