@@ -154,8 +154,7 @@ class _Parser(argparse.ArgumentParser):
     """argparse that exits 2 with one ``meshlap: error:`` line (no usage dump)."""
 
     def error(self, message: str) -> None:  # type: ignore[override]
-        sys.stderr.write(f"meshlap: error: {message}\n")
-        raise SystemExit(2)
+        raise SystemExit(_fail(message))
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -232,7 +231,7 @@ def _run(args: argparse.Namespace) -> int:
     seen: set[str] = set()
     for w in caught:
         kind = "" if issubclass(w.category, MeshWarning) else f"{w.category.__name__}: "
-        line = f"meshlap: warning: {kind}{w.message}"
+        line = f"meshlap: warning: {kind}{printable(' '.join(str(w.message).split()))}"
         if line not in seen:
             seen.add(line)
             sys.stderr.write(line + "\n")
