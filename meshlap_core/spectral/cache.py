@@ -171,9 +171,17 @@ def _read_member(archive: zipfile.ZipFile, info: zipfile.ZipInfo, name: str, n: 
                 f"member {name!r} declares {nbytes:,} bytes of data but holds "
                 f"{info.file_size - mf.tell():,}"
             )
-        data = mf.read(nbytes)
-    arr = np.frombuffer(data, dtype=dtype).reshape(shape, order="F" if fortran else "C")
-    return arr.copy() if arr.ndim else arr[()]
+        flat = np.empty(math.prod(shape), dtype=dtype)
+        raw = flat.view(np.uint8)
+        done = 0
+        while done < nbytes:  # straight into the array, 16 MiB at a time: no second copy
+            chunk = mf.read(min(nbytes - done, 16 * 2**20))
+            if not chunk:
+                raise ValueError(f"member {name!r} ends early")
+            raw[done : done + len(chunk)] = np.frombuffer(chunk, dtype=np.uint8)
+            done += len(chunk)
+    arr = flat.reshape(shape, order="F" if fortran else "C")
+    return arr if arr.ndim else arr[()]
 
 
 def validate_arrays(
