@@ -184,7 +184,10 @@ def test_an_oversize_mesh_is_refused_by_every_command_at_once(tmp_path):
     for argv in (["info"], ["curvature", "--method", "cotan"], ["spectral", "--k", "2"]):
         res = subprocess.run(
             [sys.executable, "-m", "meshlap_core.cli", argv[0], str(path), *argv[1:]],
-            capture_output=True, text=True, timeout=60, cwd=tmp_path,
+            capture_output=True,
+            text=True,
+            timeout=60,
+            cwd=tmp_path,
         )
         assert res.returncode == 2 and res.stdout == ""
         assert res.stderr.count("\n") == 1 and "may be at most 8 GiB" in res.stderr

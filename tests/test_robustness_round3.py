@@ -46,8 +46,14 @@ def mesh(tmp_path: Path) -> Path:
 
 
 # ---------------------------------------------------------------- output streams
-@pytest.mark.parametrize("env", [{"PYTHONIOENCODING": "ascii"}, {"PYTHONIOENCODING": "latin-1"},
-                                 {"LC_ALL": "C", "PYTHONUTF8": "0", "PYTHONCOERCECLOCALE": "0"}])
+@pytest.mark.parametrize(
+    "env",
+    [
+        {"PYTHONIOENCODING": "ascii"},
+        {"PYTHONIOENCODING": "latin-1"},
+        {"LC_ALL": "C", "PYTHONUTF8": "0", "PYTHONCOERCECLOCALE": "0"},
+    ],
+)
 def test_a_stream_that_cannot_encode_greek_gets_ascii_spellings(mesh, tmp_path, env):
     res = _sh(f"meshlap info {mesh}", tmp_path, **env)
     assert res.returncode == 0, res.stderr
@@ -82,8 +88,9 @@ def test_closed_stdout_on_bad_input_is_still_2(tmp_path):
 
 
 # ---------------------------------------------------------------- file names in messages
-@pytest.mark.parametrize("name", ["a\x1b[31mred\x1b[0m.obj", "bell\x07.obj", "rtl\u202e.obj",
-                                  "cr\rline.obj"])
+@pytest.mark.parametrize(
+    "name", ["a\x1b[31mred\x1b[0m.obj", "bell\x07.obj", "rtl\u202e.obj", "cr\rline.obj"]
+)
 def test_control_characters_in_a_file_name_are_escaped(name, capsys, tmp_path):
     code = main(["info", str(tmp_path / name)])
     err = capsys.readouterr().err

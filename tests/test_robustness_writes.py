@@ -34,19 +34,57 @@ COMMANDS: dict[str, list[str]] = {
     "curvature": ["curvature", "{mesh}", "--method", "k1", "--out", "{out}/k.csv"],
     "onering": ["onering", "{mesh}", "--vertex", "3", "--json"],
     "inspect": ["inspect", "{mesh}", "--vertex", "3", "--area", "voronoi"],
-    "surface": ["surface", "saddle", "--plot", "{out}/kn.png", "--mesh", "{out}/s.obj",
-                "--res", "8"],
+    "surface": [
+        "surface",
+        "saddle",
+        "--plot",
+        "{out}/kn.png",
+        "--mesh",
+        "{out}/s.obj",
+        "--res",
+        "8",
+    ],
     "surface-convergence": ["surface", "sphere", "--convergence", "--res", "4,8"],
-    "spectral": ["spectral", "{mesh}", "--k", "6", "--reconstruct", "2,6", "--out",
-                 "{out}/b.npz", "--save-reconstruction", "{out}/rec"],
-    "smooth": ["smooth", "{mesh}", "--method", "implicit", "--lam", "0.5", "--iters", "3",
-               "--out", "{out}/s.obj"],
+    "spectral": [
+        "spectral",
+        "{mesh}",
+        "--k",
+        "6",
+        "--reconstruct",
+        "2,6",
+        "--out",
+        "{out}/b.npz",
+        "--save-reconstruction",
+        "{out}/rec",
+    ],
+    "smooth": [
+        "smooth",
+        "{mesh}",
+        "--method",
+        "implicit",
+        "--lam",
+        "0.5",
+        "--iters",
+        "3",
+        "--out",
+        "{out}/s.obj",
+    ],
     "denoise-eval": ["denoise-eval", "{mesh}", "--iters", "1", "--csv", "{out}/d.csv"],
 }
 EGL_COMMANDS: dict[str, list[str]] = {
     "view-screenshot": ["view", "{mesh}", "--screenshot", "{out}/v.png"],
-    "animate": ["animate", "{mesh}", "--panel", "smoothing", "--iters", "2", "--size",
-                "128x96", "--out", "{out}/a.gif"],
+    "animate": [
+        "animate",
+        "{mesh}",
+        "--panel",
+        "smoothing",
+        "--iters",
+        "2",
+        "--size",
+        "128x96",
+        "--out",
+        "{out}/a.gif",
+    ],
 }
 EXIT = {"info-missing": 2}
 
@@ -87,11 +125,14 @@ def _run(argv: list[str], places: dict[str, Path]) -> subprocess.CompletedProces
     prefix: list[str] = []
     if AS_NOBODY:
         user = pwd.getpwnam("nobody")
-        prefix = ["setpriv", f"--reuid={user.pw_uid}", f"--regid={user.pw_gid}",
-                  "--clear-groups"]
+        prefix = ["setpriv", f"--reuid={user.pw_uid}", f"--regid={user.pw_gid}", "--clear-groups"]
     return subprocess.run(
         [*prefix, sys.executable, "-m", "meshlap_core.cli", *args],
-        capture_output=True, text=True, timeout=180, cwd=places["cwd"], env=env,
+        capture_output=True,
+        text=True,
+        timeout=180,
+        cwd=places["cwd"],
+        env=env,
     )
 
 

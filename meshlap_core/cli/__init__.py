@@ -134,6 +134,7 @@ def prepare_streams() -> None:
                 with contextlib.suppress(Exception):
                     stream.reconfigure(errors="meshlap-ascii")
 
+
 # subcommand modules, in the order ``meshlap --help`` lists them
 COMMANDS: tuple[str, ...] = (
     "info",
