@@ -7,6 +7,7 @@ from typing import Any
 import numpy as np
 
 from . import topology
+from .errors import MeshError
 from .laplacian import face_areas
 from .types import FloatArray, IntArray, as_mesh
 
@@ -33,6 +34,8 @@ def mesh_info(
     """
     V, F = as_mesh(V, F)
     n, m = len(V), len(F)
+    if n == 0:
+        raise MeshError("the mesh has no vertices", source or "V")
     lo, hi = V.min(axis=0), V.max(axis=0)
     summary = topology.surface_summary(F, n)
     info: dict[str, Any] = {

@@ -9,6 +9,44 @@ from __future__ import annotations
 
 import os
 
+#: the short escapes of :func:`printable` (the other non-printable characters get ``\\xNN``)
+_ESCAPES = {"\n": "\\n", "\r": "\\r", "\t": "\\t"}
+
+
+def printable(text: str) -> str:
+    """``text`` with every non-printable character escaped, for a message on a terminal.
+
+    A file name may hold a NUL byte, ANSI escape sequences (which would recolour or clear the
+    user's terminal), bidirectional overrides or bytes that are not valid in the file-system
+    encoding (surrogates after :func:`os.fsdecode`, which no stream can encode): each becomes
+    ``\\n``, ``\\t``, ``\\xNN``, ``\\uNNNN`` as in Python's ``repr``; everything else
+    (letters of any script, ``χ``, spaces) is kept.
+
+    Parameters
+    ----------
+    text : str
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> printable("a\x1b[31mb.obj")
+    'a\\x1b[31mb.obj'
+    """
+    if text.isprintable():
+        return text
+    out = []
+    for ch in text:
+        if ch.isprintable():
+            out.append(ch)
+        elif ch in _ESCAPES:
+            out.append(_ESCAPES[ch])
+        else:
+            out.append(repr(ch)[1:-1])  # \\x00, \\x1b, \\u202e, \\udcff
+    return "".join(out)
+
 
 class MeshError(ValueError):
     """A mesh (or an argument) that meshlap cannot work with.
@@ -18,13 +56,15 @@ class MeshError(ValueError):
     problem : str
         What is wrong, in words a user understands.
     source : str or os.PathLike, optional
-        The file or argument the problem is in; prefixed to the message.
+        The file or argument the problem is in; prefixed to the message with its non-printable
+        characters escaped (:func:`printable`); :attr:`source` keeps it as given.
     """
 
     def __init__(self, problem: str, source: str | os.PathLike | None = None) -> None:
         self.problem = problem
         self.source = None if source is None else os.fspath(source)
-        super().__init__(f"{self.source}: {problem}" if self.source else problem)
+        shown = None if self.source is None else printable(os.fsdecode(self.source))
+        super().__init__(f"{shown}: {problem}" if shown else problem)
 
     def with_source(self, source: str | os.PathLike) -> MeshError:
         """Return the same error attributed to ``source`` (keeps an existing source)."""

@@ -9,9 +9,11 @@ draws captions (:func:`burn_caption`) and writes the file atomically (:class:`Fr
 from __future__ import annotations
 
 import contextlib
+import errno
 import importlib
 import os
 import secrets
+import sys
 from pathlib import Path
 from typing import IO, Any
 
@@ -19,6 +21,7 @@ import numpy as np
 
 from .errors import MeshError
 from .io import atomic_write, check_output_path
+from .io.atomic import os_cause, unwritable_cause
 from .progress import Progress, bar
 
 SUFFIXES = (".gif", ".mp4")
@@ -80,7 +83,9 @@ def check_animation_output(path: str | os.PathLike, overwrite_inputs: Any = ()) 
     target = check_output_path(path, overwrite_inputs, suffixes=SUFFIXES)
     parent = target.parent if str(target.parent) else Path(".")
     if not os.access(parent, os.W_OK | os.X_OK):
-        raise MeshError("cannot write in this directory: permission denied", os.fspath(parent))
+        raise MeshError(
+            f"cannot write in this directory: {unwritable_cause(parent)}", os.fspath(parent)
+        )
     if target.exists() and not os.access(target, os.W_OK):
         raise MeshError("the output file is not writable", os.fspath(target))
     if target.suffix.lower() == ".mp4":
@@ -138,8 +143,54 @@ def burn_caption(frame: np.ndarray, text: str) -> np.ndarray:
     return np.asarray(img)
 
 
+class _Aborted(Exception):
+    """Thrown into the GIF's :func:`atomic_write` to drop the temporary file."""
+
+
+#: the ``strerror`` texts that ffmpeg prints when its output fails (its error reaches Python
+#: as a broken pipe, with the ffmpeg command line appended)
+_FFMPEG_CAUSES = (
+    "No space left on device",
+    "Disk quota exceeded",
+    "Read-only file system",
+    "Permission denied",
+    "File too large",
+)
+
+
+def video_cause(exc: BaseException, folder: str | os.PathLike) -> str:
+    """Why writing a video failed, in a few words: ffmpeg's own reason when its output names
+    one, ``"no space left on device"`` when the folder has no space left (a full disk ends
+    ffmpeg, which Python sees as a broken pipe), else the first line of the error (never the
+    ffmpeg command line).
+
+    Parameters
+    ----------
+    exc : BaseException
+        What the video writer raised.
+    folder : path
+        The folder the video is written in.
+
+    Returns
+    -------
+    str
+    """
+    text = str(exc)
+    for cause in _FFMPEG_CAUSES:
+        if cause in text:
+            return cause.lower()
+    if isinstance(exc, OSError) and exc.errno not in (None, errno.EPIPE):
+        return os_cause(exc)
+    with contextlib.suppress(OSError):
+        st = os.statvfs(folder)
+        if st.f_bavail * st.f_frsize < 2**20:
+            return "no space left on device"
+    first = text.strip().splitlines()[0] if text.strip() else type(exc).__name__
+    return first.split("FFMPEG COMMAND")[0].strip() or type(exc).__name__
+
+
 class FrameWriter:
-    """Collect frames and write them atomically as GIF (Pillow) or MP4 (imageio-ffmpeg).
+    """Write frames as they arrive, atomically, as GIF (Pillow) or MP4 (imageio-ffmpeg).
 
     Parameters
     ----------
@@ -152,11 +203,14 @@ class FrameWriter:
 
     Notes
     -----
-    GIF frames are quantized as they arrive (a frame costs ``w·h`` bytes while collecting) to
-    one 256-colour palette taken from the first frame (median cut; the colour bar, when shown,
-    brings its whole colour map into it), with Floyd-Steinberg dithering against banding;
-    MP4 frames are streamed to a temporary file beside the target.
+    GIF frames are quantized as they arrive to one 256-colour palette taken from the first
+    frame (median cut; the colour bar, when shown, brings its whole colour map into it), with
+    Floyd-Steinberg dithering against banding, and each is encoded into a temporary file beside
+    the target at once: memory holds one frame, whatever the number of frames and their size.
+    MP4 frames are streamed to a temporary file beside the target by ffmpeg.
     Nothing appears at ``path`` until :meth:`close` succeeds; :meth:`abort` removes the rest.
+    A failed write (a full disk, a read-only file system) is a :class:`MeshError` naming
+    ``path`` and the cause.
     """
 
     def __init__(self, path: str | os.PathLike, fps: float, overwrite_inputs: Any = ()) -> None:
@@ -167,8 +221,9 @@ class FrameWriter:
         self.kind = self.path.suffix.lower()
         self.count = 0
         self.size: tuple[int, int] | None = None  # (width, height)
-        self._gif: list[Any] = []
         self._palette: Any = None
+        self._gif: contextlib.ExitStack | None = None  # the open atomic_write of the GIF
+        self._fh: IO[bytes] | None = None
         self._tmp: Path | None = None
         self._video: Any = None
 
@@ -181,57 +236,79 @@ class FrameWriter:
         elif size != self.size:
             raise MeshError(f"frame {self.count} is {size}, the first was {self.size}", "frames")
         if self.kind == ".gif":
-            from PIL import Image
-
-            img = Image.fromarray(rgb)
-            if self._palette is None:  # one palette for all frames: no flicker between frames
-                self._palette = img.quantize(colors=256, method=Image.Quantize.MEDIANCUT)
-            self._gif.append(
-                img.quantize(palette=self._palette, dither=Image.Dither.FLOYDSTEINBERG)
-            )
+            self._add_gif(rgb)
         else:
-            if self._video is None:
-                iio = require_video()
-                parent = self.path.parent
-                self._tmp = parent / f".{self.path.stem}.{secrets.token_hex(6)}.tmp.mp4"
-                self._video = iio.get_writer(
-                    self._tmp, fps=self.fps, codec="libx264", macro_block_size=2, quality=7
-                )
-            self._video.append_data(rgb[: rgb.shape[0] // 2 * 2, : rgb.shape[1] // 2 * 2])
+            try:
+                if self._video is None:
+                    iio = require_video()
+                    parent = self.path.parent
+                    self._tmp = parent / f".{self.path.stem}.{secrets.token_hex(6)}.tmp.mp4"
+                    self._video = iio.get_writer(
+                        self._tmp, fps=self.fps, codec="libx264", macro_block_size=2, quality=7
+                    )
+                self._video.append_data(rgb[: rgb.shape[0] // 2 * 2, : rgb.shape[1] // 2 * 2])
+            except (OSError, RuntimeError) as exc:
+                self._video_failed(exc)
         self.count += 1
 
+    def _add_gif(self, rgb: np.ndarray) -> None:
+        from PIL import GifImagePlugin, Image
+
+        img = Image.fromarray(rgb)
+        if self._palette is None:  # one palette for all frames: no flicker between frames
+            self._palette = img.quantize(colors=256, method=Image.Quantize.MEDIANCUT)
+        frame = img.quantize(palette=self._palette, dither=Image.Dither.FLOYDSTEINBERG)
+        duration = round(1000.0 / self.fps)
+        if self._gif is None:
+            stack = contextlib.ExitStack()
+            self._fh = stack.enter_context(atomic_write(self.path, mode="wb"))
+            self._gif = stack
+            header, _ = GifImagePlugin.getheader(frame, info={"loop": 0, "duration": duration})
+            self._write(b"".join(header))
+        self._write(b"".join(GifImagePlugin.getdata(frame, duration=duration)))
+
+    def _write(self, data: bytes) -> None:
+        assert self._fh is not None
+        try:
+            self._fh.write(data)
+        except OSError as exc:
+            self.abort()
+            raise MeshError(f"cannot write the file: {os_cause(exc)}", self.path) from exc
+
+    def _video_failed(self, exc: BaseException) -> None:
+        cause = video_cause(exc, self.path.parent)
+        self.abort()
+        raise MeshError(f"cannot write the video: {cause}", os.fspath(self.path)) from exc
+
     def close(self) -> Path:
-        """Write the file (atomically) and return its path."""
+        """Finish the file (atomically) and return its path."""
         if self.count == 0:
             raise MeshError("no frames were rendered", os.fspath(self.path))
         if self.kind == ".gif":
-            first, rest = self._gif[0], self._gif[1:]
-            with atomic_write(self.path, mode="wb") as fh:
-                self._save_gif(fh, first, rest)
-            self._gif = []
+            assert self._gif is not None
+            self._write(b";")  # the GIF trailer
+            stack, self._gif, self._fh = self._gif, None, None
+            stack.close()  # flush, fsync, rename (a failure: MeshError naming the file)
         else:
-            self._video.close()
-            self._video = None
             if self._tmp is None:  # pragma: no cover - set with the video writer
                 raise MeshError("the video was not started", os.fspath(self.path))
-            os.replace(self._tmp, self.path)
+            try:
+                self._video.close()
+                self._video = None
+                os.replace(self._tmp, self.path)
+            except (OSError, RuntimeError) as exc:
+                self._video_failed(exc)
             self._tmp = None
         return self.path
 
-    def _save_gif(self, fh: IO[bytes], first: Any, rest: list[Any]) -> None:
-        first.save(
-            fh,
-            format="GIF",
-            save_all=True,
-            append_images=rest,
-            duration=round(1000.0 / self.fps),
-            loop=0,
-            optimize=False,
-        )
-
     def abort(self) -> None:
-        """Drop what was collected; remove a partial temporary file."""
-        self._gif = []
+        """Drop what was written; remove a partial temporary file."""
+        if self._gif is not None:
+            stack, self._gif, self._fh = self._gif, None, None
+            try:
+                raise _Aborted
+            except _Aborted:
+                stack.__exit__(*sys.exc_info())  # atomic_write removes its temporary file
         if self._video is not None:
             with contextlib.suppress(Exception):
                 self._video.close()

@@ -12,13 +12,91 @@ not enter).
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 
 from .curvature import vertex_normals
 from .errors import MeshError
-from .options import NOISE_MODES, NoiseMode, check_choice
+from .options import MAX_COORDINATE, NOISE_MODES, NoiseMode, check_choice
 from .types import FloatArray, IntArray, as_faces, as_vertices
+
+MAX_SEED = 2**31 - 1
+"""The largest noise seed: what every place a seed is typed can hold (the viewer's integer
+field is a C ``int``; a session or ``--seed`` beyond it would pass here and break there)."""
+
+NOISE_TAIL = 10.0
+"""No standard normal sample numpy draws in practice exceeds this many σ (the largest of 10¹²
+draws is about 7σ): the bound :func:`check_noise` uses for the largest displacement."""
+
+
+def check_seed(seed: Any, name: str = "seed") -> int:
+    """Return ``seed`` as an int, or raise :class:`MeshError` naming ``name`` unless it is an
+    integer in ``0..MAX_SEED`` (booleans and integral floats are refused too: a seed is typed
+    as an integer).
+
+    Parameters
+    ----------
+    seed : Any
+    name : str
+        The option, e.g. ``"--seed"`` or ``'"smoothing.seed"'``.
+
+    Returns
+    -------
+    int
+    """
+    if isinstance(seed, bool) or not isinstance(seed, int | np.integer):
+        raise MeshError(f"must be an integer 0 to {MAX_SEED}, got {seed!r}", name)
+    if not 0 <= seed <= MAX_SEED:
+        digits = int(int(seed).bit_length() * math.log10(2)) + 1
+        shown = str(int(seed)) if abs(seed) < 10**40 else f"a number of about {digits} digits"
+        raise MeshError(f"must be an integer 0 to {MAX_SEED}, got {shown}", name)
+    return int(seed)
+
+
+def check_noise(V: Any, alpha: Any, name: str = "alpha") -> float:
+    """Return ``σ = alpha × bbox_diagonal(V)`` after checking that noise of that size keeps
+    every coordinate finite and within ``±MAX_COORDINATE`` (1e75, the limit the loader and
+    every entry point enforce): ``max|x| + NOISE_TAIL·σ ≤ MAX_COORDINATE``.
+
+    Without this check, ``alpha = 1e308`` would make the noisy coordinates infinite and the
+    next function would blame the mesh ("vertex 0 has a NaN or infinite coordinate").
+
+    Parameters
+    ----------
+    V : (n,3) float
+    alpha : float
+        The relative noise level, ``>= 0``.
+    name : str
+        The option named in messages (``"--noise"``, ``'"smoothing.noise_alpha"'``).
+
+    Returns
+    -------
+    sigma : float
+
+    Raises
+    ------
+    MeshError
+        ``alpha`` negative, NaN or infinite, or so large that the noise would push
+        coordinates beyond ``±MAX_COORDINATE`` (the message gives the largest usable alpha).
+    """
+    V = as_vertices(V)
+    try:
+        a = _check_alpha(alpha)
+    except MeshError as exc:
+        raise MeshError(exc.problem, name) from None
+    diag = bbox_diagonal(V)
+    with np.errstate(over="ignore"):
+        sigma = a * diag
+    reach = float(np.abs(V).max()) if len(V) else 0.0
+    if not math.isfinite(sigma) or reach + NOISE_TAIL * sigma > MAX_COORDINATE:
+        largest = (MAX_COORDINATE - reach) / (NOISE_TAIL * diag) if diag > 0 else math.inf
+        raise MeshError(
+            f"noise alpha {a:.3g} would move vertices by up to {NOISE_TAIL * sigma:.3g}, beyond "
+            f"the coordinate limit ±{MAX_COORDINATE:.0e}; use alpha <= {largest:.3g}",
+            name,
+        )
+    return sigma
 
 
 def bbox_diagonal(V: FloatArray) -> float:
@@ -88,18 +166,24 @@ def add_noise(
         per vertex and ``n_i`` the unit angle-weighted vertex normal of
         :func:`meshlap_core.curvature.vertex_normals` (unreferenced vertices do not move).
     seed : int or None
-        Seed of ``numpy.random.default_rng``; the same seed gives the same noise. ``None`` draws
-        fresh entropy.
+        Seed of ``numpy.random.default_rng``, 0 to :data:`MAX_SEED`; the same seed gives the
+        same noise. ``None`` draws fresh entropy.
+
+    Raises
+    ------
+    MeshError
+        A bad mesh; ``alpha`` negative or so large that coordinates would leave
+        ``±MAX_COORDINATE`` (:func:`check_noise`); a bad seed (:func:`check_seed`).
 
     Returns
     -------
     V_noisy : (n,3) float
     """
     V = as_vertices(V)
-    sigma = noise_sigma(V, alpha)
+    sigma = check_noise(V, alpha)
     check_choice(mode, NOISE_MODES, "noise mode", "mode")
-    if seed is not None and (not isinstance(seed, int | np.integer) or seed < 0):
-        raise MeshError(f"must be a non-negative integer, got {seed!r}", "seed")
+    if seed is not None:
+        check_seed(seed)
     rng = np.random.default_rng(seed)
     if mode == "isotropic":
         return V + sigma * rng.standard_normal(V.shape)

@@ -32,7 +32,7 @@ from .mesh import count_phrase as _count
 from .options import DEGENERATE_REL, MAX_COORDINATE, MIN_EXTENT, SLIVER_ANGLE
 from .topology import sort_with_order as _sort_with_order
 from .topology import topology_report
-from .types import BoolArray, FloatArray, IntArray
+from .types import BoolArray, FloatArray, IntArray, exact_indices, real_array
 
 __all__ = [
     "SLIVER_ANGLE",
@@ -90,8 +90,9 @@ def require_manifold(mesh_or_F: Mesh | Any, operation: str, source: str | None =
 
 
 def _coerce_vertices(V: Any, label: str, vertex_map: IntArray) -> FloatArray:
+    raw = real_array(V, label, "vertex coordinates")  # no bool, complex or string cast
     try:
-        arr = np.array(V, dtype=np.float64, copy=True, order="C")
+        arr = np.array(raw, dtype=np.float64, copy=True, order="C")
     except (TypeError, ValueError) as exc:
         raise MeshError(f"vertex coordinates are not numbers ({exc})", label) from None
     if arr.size == 0:
@@ -138,14 +139,12 @@ def _coerce_faces(F: Any, label: str) -> tuple[IntArray, IntArray | None]:
             return np.zeros((0, 3), dtype=np.int64), None
         if raw.ndim != 2:
             raise MeshError(f"faces should have shape (m,k); shape is {raw.shape}", label)
-        if raw.dtype.kind not in "iuf":
-            raise MeshError(f"face indices must be integers, got dtype {raw.dtype}", label)
         if raw.dtype.kind == "f":
             ok = np.isfinite(raw) & (np.mod(raw, 1) == 0)
             if not ok.all():
                 f = int(np.flatnonzero(~ok.all(axis=1))[0])
                 raise MeshError(f"face {f} has a non-integer index {raw[f].tolist()}", label)
-        arr = np.ascontiguousarray(raw, dtype=np.int64)
+        arr = exact_indices(raw, label)  # checked before the cast: no wrap, no truncation
         if arr.shape[1] == 3:
             return arr.copy(), None
         return arr.ravel().copy(), np.full(len(arr), arr.shape[1], dtype=np.int64)
@@ -160,9 +159,7 @@ def _coerce_faces(F: Any, label: str) -> tuple[IntArray, IntArray | None]:
         raise MeshError(f"faces are not integer index lists ({exc})", label) from None
     if flat.dtype.kind == "f" and not np.all(np.mod(flat, 1) == 0):
         raise MeshError("face indices must be integers", label)
-    if flat.dtype.kind not in "iuf" and flat.size:
-        raise MeshError(f"face indices must be integers, got dtype {flat.dtype}", label)
-    return flat.astype(np.int64), sizes
+    return exact_indices(flat, label), sizes
 
 
 def _is_ragged(F: Sequence) -> bool:

@@ -414,6 +414,17 @@ def _directory(folder: Path) -> Path:
     return path
 
 
+def _oversize(folder: Path) -> Path:
+    """A sparse mesh file one byte over the mesh-file limit (no disk space used)."""
+    from meshlap_core.io.reader import MESH_SIZE_LIMIT
+
+    path = folder / "oversize.obj"
+    with open(path, "wb") as f:
+        f.write(b"v 0 0 0\n")
+        f.truncate(MESH_SIZE_LIMIT + 1)
+    return path
+
+
 def _cube_ply_binary() -> bytes:
     return ply_binary(*primitives.cube())
 
@@ -1044,6 +1055,7 @@ LOADABLE: list[Hostile] = [h for h in CORPUS if h.expect == "ok"]
 SPECIAL: list[Hostile] = [
     Hostile("fifo.obj", _fifo, "error", ("not a regular file",)),
     Hostile("devzero.obj", _dev_zero, "error", ("not a regular file",)),
+    Hostile("oversize.obj", _oversize, "error", ("may be at most",)),
 ]
 
 
@@ -1154,3 +1166,58 @@ def _two_scales(small: float, big: float) -> str:
     pencil whose components differ in scale by many orders)."""
     V, F = primitives.icosphere(1)
     return obj_text(np.vstack([V * small, V * big + [3.0 * big, 0, 0]]), np.vstack([F, F + len(V)]))
+
+
+# ------------------------------------------------------------------------------ round 3
+# JSON documents that break a naive json.loads, sparse files over the size limits, and spectral
+# cache entries built to exhaust memory or print numpy's pickle advice (generated, never stored)
+
+
+def deep_json(folder: Path, depth: int = 100_000) -> Path:
+    """``[[[[...]]]]`` nested ``depth`` deep (json.loads raises RecursionError)."""
+    path = folder / "deep.json"
+    path.write_text("[" * depth + "]" * depth)
+    return path
+
+
+def long_int_json(folder: Path, digits: int = 5000) -> Path:
+    """A session-like object with an integer of ``digits`` digits (beyond Python's limit)."""
+    path = folder / "longint.json"
+    path.write_text('{"version": 1, "seed": ' + "7" * digits + "}")
+    return path
+
+
+def sparse_file(folder: Path, name: str, size: int) -> Path:
+    """A file reporting ``size`` bytes that takes no disk space (``truncate``)."""
+    path = folder / name
+    with open(path, "wb") as f:
+        f.truncate(size)
+    return path
+
+
+def _npy_header(shape: tuple[int, ...], dtype: str = "<f8") -> bytes:
+    """A version-1.0 ``.npy`` header declaring ``shape`` (the data is not included)."""
+    import io
+
+    buf = io.BytesIO()
+    header = {"descr": dtype, "fortran_order": False, "shape": shape}
+    np.lib.format.write_array_header_1_0(buf, header)
+    return buf.getvalue()
+
+
+def npz_bomb(path: Path, n: int, declared_bytes: int = 8 * 2**30, sent: int = 9 * 2**20) -> Path:
+    """A cache entry whose ``vectors`` member declares ``declared_bytes`` of float64 (shape
+    ``(n, declared_bytes // 8 // n)``) but holds ``sent`` bytes of zeros, deflated: a file of a
+    few kB that a loader trusting the header would answer with an 8 GB allocation."""
+    import zipfile
+
+    cols = declared_bytes // 8 // n
+    with zipfile.ZipFile(path, "w", compression=zipfile.ZIP_DEFLATED) as z:
+        z.writestr("vectors.npy", _npy_header((n, cols)) + bytes(sent))
+    return path
+
+
+def random_entry(path: Path, size: int = 4096, seed: int = 3) -> Path:
+    """Random bytes where a cache entry should be (numpy would suggest allow_pickle)."""
+    path.write_bytes(np.random.default_rng(seed).bytes(size))
+    return path

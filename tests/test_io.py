@@ -611,7 +611,7 @@ def test_atomic_write_failure_in_writer_keeps_old_mesh(tmp_path, monkeypatch):
         raise OSError(28, "No space left on device")
 
     monkeypatch.setattr("meshlap_core.io.write._write_ply", broken)
-    with pytest.raises(OSError, match="No space left"):
+    with pytest.raises(MeshError, match=r"m\.ply: cannot write the file: no space left on device"):
         save_mesh(target, V * 2, F)
     assert target.read_bytes() == before
     assert [p.name for p in tmp_path.iterdir()] == ["m.ply"]

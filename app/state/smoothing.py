@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 
 from meshlap_core.errors import MeshError
-from meshlap_core.noise import add_noise
+from meshlap_core.noise import add_noise, check_noise, check_seed
 from meshlap_core.options import LAPLACIAN_KINDS, SMOOTHING_METHODS
 from meshlap_core.smoothing import Smoother, amplification_curve, check_lam
 from meshlap_core.types import FloatArray, IntArray
@@ -333,8 +333,12 @@ def _animation_check(opts: dict[str, Any]) -> None:
         raise MeshError(f"must be 0 to {MAX_FRAMES_ITERS}, got {opts['iters']}", "--iters")
     if not (math.isfinite(opts["noise"]) and opts["noise"] >= 0):
         raise MeshError(f"must be a finite number >= 0, got {opts['noise']}", "--noise")
-    if opts["seed"] < 0:
-        raise MeshError(f"must be >= 0, got {opts['seed']}", "--seed")
+    check_seed(opts["seed"], "--seed")
+
+
+def _animation_check_mesh(opts: dict[str, Any], mesh: Any) -> None:
+    if opts["noise"]:
+        check_noise(mesh.V, opts["noise"], "--noise")  # before the renderer: it names --noise
 
 
 ANIMATION = Animation(
@@ -359,6 +363,7 @@ ANIMATION = Animation(
     fps={"smoothing": 10.0},
     frame_count=lambda opts: int(opts["iters"]) + 1,
     from_session=_animation_from_session,
+    check_mesh=_animation_check_mesh,
     session_overrides={"iterations": 0},  # the frames run the smoothing from iteration 0
     colorbar=False,  # no colour map: the input and its smoothed copy
 )

@@ -8,6 +8,7 @@ files) into one line ``meshlap: error: <file>: <problem>`` on stderr and exit co
 
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
 import sys
@@ -32,12 +33,107 @@ if (
     signal.signal(signal.SIGINT, _quiet_interrupt)
 
 import argparse  # noqa: E402
+import codecs  # noqa: E402
 import importlib  # noqa: E402
+import io  # noqa: E402
 import warnings  # noqa: E402
 from collections.abc import Sequence  # noqa: E402
 
 from .._version import __version__  # noqa: E402
-from ..errors import MeshError, MeshWarning  # noqa: E402
+from ..errors import MeshError, MeshWarning, printable  # noqa: E402
+
+#: ASCII spellings of the symbols meshlap prints, for a stream that cannot encode them
+#: (``PYTHONIOENCODING=ascii``, ``LC_ALL=C`` with an older Python, a latin-1 terminal)
+ASCII_SPELLINGS: dict[str, str] = {
+    "χ": "chi",
+    "λ": "lambda",
+    "κ": "kappa",
+    "ν": "nu",
+    "μ": "mu",
+    "α": "alpha",
+    "β": "beta",
+    "θ": "theta",
+    "σ": "sigma",
+    "Δ": "Delta",
+    "π": "pi",
+    "≤": "<=",
+    "≥": ">=",
+    "≠": "!=",
+    "≈": "~",
+    "±": "+-",
+    "×": "x",
+    "·": "*",
+    "−": "-",
+    "–": "-",
+    "—": "--",
+    "→": "->",
+    "←": "<-",
+    "…": "...",
+    "²": "^2",
+    "³": "^3",
+    "⁻": "^-",
+    "¹": "^1",
+    "₁": "1",
+    "₂": "2",
+    "ᵀ": "^T",
+    "√": "sqrt",
+    "∞": "inf",
+    "°": " deg",
+    "‖": "||",
+}
+
+
+def _ascii_fallback(exc: UnicodeError) -> tuple[str, int]:
+    """Codec error handler ``meshlap-ascii``: the ASCII spelling of each character the stream
+    cannot encode (``χ`` → ``chi``), ``?`` for one without a spelling."""
+    if not isinstance(exc, UnicodeEncodeError):
+        raise exc
+    bad = exc.object[exc.start : exc.end]
+    return "".join(ASCII_SPELLINGS.get(ch, "?") for ch in bad), exc.end
+
+
+codecs.register_error("meshlap-ascii", _ascii_fallback)
+
+
+class _ClosedStream(io.TextIOBase):
+    """Stands in for a standard stream that was closed when meshlap started (``>&-``,
+    ``2>&-``: Python then sets ``sys.stdout``/``sys.stderr`` to None); records whether anything
+    was written, so that lost output is an error rather than a silent success."""
+
+    def __init__(self, name: str) -> None:
+        super().__init__()
+        self.name = name
+        self.lost = False
+
+    def writable(self) -> bool:
+        return True
+
+    def write(self, text: str) -> int:
+        self.lost = self.lost or bool(text)
+        return len(text)
+
+    def fileno(self) -> int:
+        raise OSError(9, "Bad file descriptor")
+
+
+def prepare_streams() -> None:
+    """Make the standard streams safe to print on before a command runs: a closed stdout or
+    stderr becomes a :class:`_ClosedStream`, and a stream whose encoding cannot spell ``χ``
+    or ``λ`` writes their ASCII spellings (:data:`ASCII_SPELLINGS`) instead of raising
+    ``UnicodeEncodeError``."""
+    for name in ("stdout", "stderr"):
+        stream = getattr(sys, name)
+        if stream is None:
+            setattr(sys, name, _ClosedStream(f"<{name}>"))
+            continue
+        encoding = getattr(stream, "encoding", None) or "ascii"
+        try:
+            "χλκ≤−".encode(encoding)
+        except (UnicodeEncodeError, LookupError):
+            if hasattr(stream, "reconfigure"):
+                with contextlib.suppress(Exception):
+                    stream.reconfigure(errors="meshlap-ascii")
+
 
 # subcommand modules of the core, in the order ``meshlap --help`` lists them; the commands
 # that open or render the viewer come from the ``meshlap.commands`` entry-point group
@@ -61,8 +157,7 @@ class _Parser(argparse.ArgumentParser):
     """argparse that exits 2 with one ``meshlap: error:`` line (no usage dump)."""
 
     def error(self, message: str) -> None:  # type: ignore[override]
-        sys.stderr.write(f"meshlap: error: {message}\n")
-        raise SystemExit(2)
+        raise SystemExit(_fail(message))
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -88,12 +183,22 @@ def main(argv: Sequence[str] | None = None) -> int:
     traceback); 130 interrupted. Warnings raised while a command runs are printed after it
     succeeds, one line ``meshlap: warning: ...`` each, and dropped when it fails.
     """
+    prepare_streams()
     try:
         parser = build_parser()  # imports numpy, scipy and libigl: the slow part of start-up
     except KeyboardInterrupt:
         sys.stderr.write("meshlap: interrupted\n")
         return 130
     args = parser.parse_args(argv)
+    code = _run(args)
+    out = sys.stdout
+    if code == 0 and isinstance(out, _ClosedStream) and out.lost:
+        return _fail("<stdout>: standard output is closed; the output was not written")
+    return code
+
+
+def _run(args: argparse.Namespace) -> int:
+    """Run the parsed command; its exit code (see :func:`main`)."""
     if signal.getsignal(signal.SIGINT) is _quiet_interrupt:  # the command handles it from here
         signal.signal(signal.SIGINT, signal.default_int_handler)
     with warnings.catch_warnings(record=True) as caught:
@@ -105,16 +210,18 @@ def main(argv: Sequence[str] | None = None) -> int:
         except MemoryError:
             src = getattr(args, "mesh", None) or getattr(args, "clean", None)
             return _fail(
-                f"{src + ': ' if src else ''}out of memory (the input is too large "
-                "for this machine)"
+                f"{src + ': ' if src else ''}out of memory (this input with these options "
+                "needs more memory than this machine gives)"
             )
         except BrokenPipeError:  # `meshlap ... | head`: the reader went away
             _silence_stdout()
             return 141
         except OSError as exc:
+            from ..io.atomic import os_cause
+
             name = getattr(exc, "filename", None)
-            what = exc.strerror or str(exc) or type(exc).__name__
-            return _fail(f"{name}: {what}" if name else what)
+            what = os_cause(exc)
+            return _fail(f"{os.fsdecode(name)}: {what}" if name else what)
         except KeyboardInterrupt:
             sys.stderr.write("meshlap: interrupted\n")
             return 130
@@ -131,7 +238,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     seen: set[str] = set()
     for w in caught:
         kind = "" if issubclass(w.category, MeshWarning) else f"{w.category.__name__}: "
-        line = f"meshlap: warning: {kind}{w.message}"
+        line = f"meshlap: warning: {kind}{printable(' '.join(str(w.message).split()))}"
         if line not in seen:
             seen.add(line)
             sys.stderr.write(line + "\n")
@@ -139,7 +246,11 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 def _fail(message: str) -> int:
-    sys.stderr.write(f"meshlap: error: {' '.join(message.split())}\n")
+    """Print ``meshlap: error: <message>`` (on one line, non-printable characters escaped)
+    on stderr; return 2."""
+    text = printable(" ".join(message.split()))
+    with contextlib.suppress(OSError, ValueError):
+        sys.stderr.write(f"meshlap: error: {text}\n")
     return 2
 
 

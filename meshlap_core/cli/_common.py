@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import MeshError
+from ..errors import MeshError, printable
 
 
 def parse_list(text: str, kind: type, name: str) -> list[Any]:
@@ -80,10 +80,11 @@ def print_report(source: Any, report: Any) -> None:
     ``meshlap: <file>: repaired: ...`` and ``meshlap: <file>: warning: ...``. Commands call it
     once their work has succeeded, so that a failing run prints its error line alone.
     """
+    shown = printable(str(source))
     for r in getattr(report, "repairs", []):
-        sys.stderr.write(f"meshlap: {source}: repaired: {r}\n")
+        sys.stderr.write(f"meshlap: {shown}: repaired: {r}\n")
     for w in getattr(report, "warnings", []):
-        sys.stderr.write(f"meshlap: {source}: warning: {w}\n")
+        sys.stderr.write(f"meshlap: {shown}: warning: {w}\n")
 
 
 class _RenamedFlag(argparse.Action):

@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import MeshError
+from ..noise import check_noise, check_seed
 from ..options import (
     AREA_KINDS,
     DEFAULT_NOISE_MODE,
@@ -108,8 +109,7 @@ def _seed_and_noise(args: argparse.Namespace) -> tuple[int, list[float]]:
         seed = int(args.seed)
     except ValueError:
         raise MeshError(f"must be an integer >= 0, got {args.seed!r}", "--seed") from None
-    if seed < 0:
-        raise MeshError(f"must be an integer >= 0, got {args.seed!r}", "--seed")
+    seed = check_seed(seed, "--seed")
     if args.noisy is not None and args.noise is not None:
         raise MeshError("cannot be combined with --noisy (that file fixes the noise)", "--noise")
     noise_text = args.noise or DEFAULT_NOISE
@@ -155,6 +155,8 @@ def run(args: argparse.Namespace) -> int:
                 args.noisy,
             )
         Vn = noisy.V
+    for a in noise:  # before any work: an amplitude that would overflow names --noise
+        check_noise(clean.V, a, "--noise")
 
     def progress(line: str) -> None:
         sys.stderr.write(f"denoise-eval: {line}\n")

@@ -14,8 +14,9 @@ extra properties) takes a slower per-line path that gives the same result.
 One tokenizer contract for every format (:mod:`._scan`): lines end at ``\\n``, ``\\r\\n`` or
 ``\\r`` only; numbers are ASCII decimal/exponent literals (``nan``/``inf`` reach the validator,
 which refuses them); anything else in a numeric field is an error naming the line. Headers
-are checked against bodies, never guessed; reads are bounded in size and time
-(:func:`~meshlap_core.io.load.read_bounded`).
+are checked against bodies, never guessed; every file is read through
+:mod:`.reader` (regular files only, a size limit per kind, bounded in size and time), which
+also reads JSON (:func:`~meshlap_core.io.reader.read_json`).
 
 Writing: :func:`save_mesh` (``.obj``, ``.off``, ``.ply``; PLY can carry a per-vertex
 ``quality`` scalar), :func:`save_scalars` (``.csv``, ``.npy``, ``.ply``) and the
@@ -25,7 +26,8 @@ Writing: :func:`save_mesh` (``.obj``, ``.off``, ``.ply``; PLY can carry a per-ve
 Modules: :mod:`.load` (``load_mesh``, ``load_vertex_scalars``: read, dispatch by extension,
 validate), :mod:`.obj`, :mod:`.off`, :mod:`.ply`, :mod:`.stl` (one parser each),
 :mod:`._scan` (the byte-level scanner they share), :mod:`.write` (``save_mesh``,
-``save_scalars``), :mod:`.atomic` (``atomic_write``, ``check_output_path``).
+``save_scalars``), :mod:`.atomic` (``atomic_write``, ``check_output_path``), :mod:`.reader`
+(``read_input``, ``open_input``, ``check_input``, ``read_json``: the one reader).
 """
 
 from __future__ import annotations

@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
 import secrets
 import stat
@@ -14,6 +15,65 @@ from typing import IO, Any
 from ..errors import MeshError
 
 PathLike = str | os.PathLike
+
+_CAUSES = {
+    errno.ENOSPC: "no space left on device",
+    errno.EDQUOT: "disk quota exceeded",
+    errno.EROFS: "read-only file system",
+    errno.EACCES: "permission denied",
+    errno.EPERM: "operation not permitted",
+    errno.EPIPE: "broken pipe",
+    errno.EIO: "input/output error",
+    errno.EFBIG: "file too large",
+}
+
+
+def os_cause(exc: BaseException) -> str:
+    """The cause of an :class:`OSError` in a few words (``"no space left on device"``,
+    ``"read-only file system"``, ...): never a raw ``[Errno N]`` prefix, nor a second line (an
+    ffmpeg command) that some libraries append.
+
+    Parameters
+    ----------
+    exc : BaseException
+
+    Returns
+    -------
+    str
+    """
+    code = getattr(exc, "errno", None)
+    if code in _CAUSES:
+        return _CAUSES[code]
+    text = getattr(exc, "strerror", None) or str(exc) or type(exc).__name__
+    return text.strip().splitlines()[0] if text.strip() else type(exc).__name__
+
+
+def unwritable_cause(folder: PathLike) -> str:
+    """Why this process cannot write in ``folder``: ``"read-only file system"`` when it is on
+    one, else ``"permission denied"``.
+
+    Parameters
+    ----------
+    folder : str or PathLike
+
+    Returns
+    -------
+    str
+    """
+    with contextlib.suppress(OSError, AttributeError):
+        if os.statvfs(folder).f_flag & os.ST_RDONLY:
+            return "read-only file system"
+    return "permission denied"
+
+
+def _discard(f: IO[Any], tmp: Path) -> None:
+    """Close ``f`` and remove ``tmp`` whatever happens: the close may flush and fail again
+    (a full disk: ENOSPC a second time), yet the descriptor is closed by then (``io`` closes the
+    raw file even when the flush raises), and the unlink must run regardless."""
+    with contextlib.suppress(Exception):
+        f.close()
+    with contextlib.suppress(OSError):
+        os.unlink(tmp)
 
 
 def _resolved(path: PathLike) -> Path:
@@ -85,12 +145,15 @@ def atomic_write(
     *,
     overwrite_inputs: Iterable[PathLike] = (),
     encoding: str = "utf-8",
+    keep_mode: bool = True,
 ) -> Iterator[IO[Any]]:
     """Write a file atomically: the target appears complete or not at all.
 
     A temporary file is created in the target's directory, written through the yielded file
     object, flushed, fsync'ed and renamed over the target with ``os.replace``. If the ``with``
-    body raises, the temporary file is removed and an existing target is left untouched.
+    body, the flush, the fsync or the rename raises, the temporary file is closed without
+    depending on a flush (a full disk fails the flush again) and removed, and an existing
+    target is left untouched.
 
     Parameters
     ----------
@@ -101,6 +164,10 @@ def atomic_write(
     overwrite_inputs : iterable of path
         Paths that must not be written (e.g. the command's input mesh); compared after
         resolving symlinks.
+    keep_mode : bool
+        Give the new file the permissions of the file it replaces (default); ``False`` creates
+        it with the default permissions (the cache does, so that an entry someone made
+        unreadable is replaced by a readable one).
 
     Yields
     ------
@@ -110,7 +177,9 @@ def atomic_write(
     ------
     MeshError
         The directory does not exist (named), the target is a directory or one of
-        ``overwrite_inputs``, or the directory is not writable.
+        ``overwrite_inputs``, the directory is not writable, or the file cannot be written
+        (an :class:`OSError` of the write, flush, fsync or rename: the message names the target
+        and the cause, e.g. "no space left on device", "read-only file system").
 
     Examples
     --------
@@ -124,30 +193,36 @@ def atomic_write(
     tmp = parent / f".{target.name}.{secrets.token_hex(6)}.tmp"
     try:
         fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0), 0o666)
-    except PermissionError:
-        raise MeshError(
-            "cannot write in this directory: permission denied", os.fspath(parent)
-        ) from None
     except OSError as exc:
         raise MeshError(
-            f"cannot create a file here: {exc.strerror or exc}", os.fspath(parent)
+            f"cannot create a file in {os.fspath(parent)!r}: {os_cause(exc)}", os.fspath(target)
         ) from None
-    if target.exists():  # keep the permissions of the file being replaced
+    if keep_mode and target.exists():  # keep the permissions of the file being replaced
         with contextlib.suppress(OSError):
             os.chmod(tmp, stat.S_IMODE(target.stat().st_mode))
-    f: IO[Any] = (
-        os.fdopen(fd, "wb") if mode == "wb" else os.fdopen(fd, "w", encoding=encoding, newline="\n")
-    )
+    try:
+        f: IO[Any] = (
+            os.fdopen(fd, "wb")
+            if mode == "wb"
+            else os.fdopen(fd, "w", encoding=encoding, newline="\n")
+        )
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.close(fd)
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        raise
     try:
         yield f
         f.flush()
         os.fsync(f.fileno())
         f.close()
         os.replace(tmp, target)
+    except OSError as exc:
+        _discard(f, tmp)
+        raise MeshError(f"cannot write the file: {os_cause(exc)}", os.fspath(target)) from exc
     except BaseException:
-        f.close()
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
+        _discard(f, tmp)
         raise
     with contextlib.suppress(OSError):  # make the rename itself durable (best effort)
         dfd = os.open(parent, os.O_RDONLY)

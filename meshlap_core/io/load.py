@@ -2,11 +2,7 @@
 
 from __future__ import annotations
 
-import os
-import stat
-import time
 from pathlib import Path
-from typing import Any
 
 from ..errors import MeshError
 from ..types import FloatArray
@@ -16,13 +12,18 @@ from .atomic import PathLike
 from .obj import parse_obj
 from .off import _parse_off
 from .ply import _parse_ply
+from .reader import READ_TIME_LIMIT, UNSIZED_READ_LIMIT, check_input, read_input
 from .stl import _parse_stl
 
 MESH_FORMATS: tuple[str, ...] = (".obj", ".off", ".ply", ".stl")
-#: bytes read at most from a file that reports size 0 (procfs-like files that stream)
-UNSIZED_READ_LIMIT = 64 * 2**20
-#: seconds a read may take (checked between reads of a file; local disks read GBs in that)
-READ_TIME_LIMIT = 300.0
+__all__ = [
+    "MESH_FORMATS",
+    "READ_TIME_LIMIT",
+    "UNSIZED_READ_LIMIT",
+    "load_mesh",
+    "load_vertex_scalars",
+    "read_bounded",
+]
 
 
 def load_mesh(path: PathLike, *, repair: bool = True) -> Mesh:
@@ -104,26 +105,13 @@ def load_vertex_scalars(path: PathLike, name: str = "quality") -> FloatArray:
 
 
 def _read_input(path: PathLike) -> tuple[Path, str, bytes]:
-    try:
-        src = os.fspath(path)
-    except TypeError:
-        raise MeshError(f"expected a file path, got {type(path).__name__}", "path") from None
+    src = check_input(path, what="mesh file")  # a directory, device or oversize file: refused
     p = Path(src)
-    if not p.exists():
-        raise MeshError("no such file", src)
-    if p.is_dir():
-        raise MeshError("is a directory, not a mesh file", src)
     ext = p.suffix.lower()
     if ext not in MESH_FORMATS:
         what = f"unknown mesh format {p.suffix!r}" if ext else "the file name has no extension"
         raise MeshError(f"{what}; supported formats: {', '.join(MESH_FORMATS)}", src)
-    try:
-        mode = p.stat().st_mode
-    except OSError as exc:
-        raise MeshError(f"cannot read the file: {exc.strerror or exc}", src) from None
-    if not stat.S_ISREG(mode):  # a FIFO would block forever, /dev/zero would never end
-        raise MeshError(f"not a regular file ({_kind(mode)}); meshlap reads mesh files only", src)
-    data = read_bounded(p, src)
+    data = read_input(src, what="mesh file")
     if not data or data.isspace():
         raise MeshError(
             "the file is empty" if not data else "the file contains only whitespace", src
@@ -141,72 +129,17 @@ def _parse(ext: str, data: bytes, src: str) -> Parsed:
     return _parse_stl(data, src)
 
 
-def _kind(mode: int) -> str:
-    if stat.S_ISFIFO(mode):
-        return "a named pipe (FIFO)"
-    if stat.S_ISCHR(mode) or stat.S_ISBLK(mode):
-        return "a device"
-    return "a socket" if stat.S_ISSOCK(mode) else "a special file"
-
-
 def read_bounded(path: PathLike, src: str) -> bytes:
-    """The bytes of a regular file, read with bounds on size and time.
-
-    A file is read up to the size it reports (one byte more is the evidence that it lied);
-    one that reports size 0 (procfs and sysfs files do) up to :data:`UNSIZED_READ_LIMIT`.
-    The file is opened non-blocking, so a kernel stream with no data ready (``/proc/kmsg``)
-    answers at once instead of hanging, and reading stops after :data:`READ_TIME_LIMIT`
-    seconds (checked between reads).
+    """The bytes of a regular file, read by :func:`meshlap_core.io.reader.read_input` (the
+    mesh-file size limit; bounds on size and time); ``src`` names the file in messages.
 
     Raises
     ------
     MeshError
-        Unreadable, not a regular file, more data than reported, a stream with no data
-        ready, or too slow; the message names ``src``.
+        Unreadable, not a regular file, more data than reported, a stream with no data ready,
+        or too slow; the message names ``src``.
     """
-    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_NOCTTY", 0)
     try:
-        fd = os.open(path, flags | getattr(os, "O_BINARY", 0))
-    except PermissionError:
-        raise MeshError("cannot read the file: permission denied", src) from None
-    except OSError as exc:
-        raise MeshError(f"cannot read the file: {exc.strerror or exc}", src) from None
-    with os.fdopen(fd, "rb", buffering=0) as f:
-        st = os.fstat(fd)
-        if not stat.S_ISREG(st.st_mode):  # replaced since it was checked
-            raise MeshError(
-                f"not a regular file ({_kind(st.st_mode)}); meshlap reads mesh files only", src
-            )
-        return _read_chunks(f, st.st_size, src)
-
-
-def _read_chunks(f: Any, size: int, src: str) -> bytes:
-    limit = size if size > 0 else UNSIZED_READ_LIMIT
-    chunks: list[bytes] = []
-    got = 0
-    t0 = time.monotonic()
-    while True:
-        try:
-            # one read of the whole reported size; an unsized file in 1 MB reads (procfs files
-            # such as pagemap only accept multiples of 8 bytes)
-            chunk = f.read(size + 1 - got if size else 1 << 20)
-        except OSError as exc:
-            raise MeshError(f"cannot read the file: {exc.strerror or exc}", src) from None
-        if chunk is None:
-            raise MeshError(
-                "the file has no data ready: a kernel or device stream, not a mesh file", src
-            )
-        if not chunk:
-            break
-        chunks.append(chunk)
-        got += len(chunk)
-        if got > limit:
-            more = (
-                f"{size:,} bytes (still being written?)"
-                if size
-                else f"{UNSIZED_READ_LIMIT // 2**20} MB (a kernel or device file, not a mesh file)"
-            )
-            raise MeshError(f"the file reports size {size:,} but streams more than {more}", src)
-        if time.monotonic() - t0 > READ_TIME_LIMIT:
-            raise MeshError(f"reading took over {READ_TIME_LIMIT:.0f} s; stopped", src)
-    return chunks[0] if len(chunks) == 1 else b"".join(chunks)
+        return read_input(path, what="mesh file")
+    except MeshError as exc:
+        raise MeshError(exc.problem, src) from None

@@ -21,10 +21,12 @@ from ..linalg.components import components
 from ..linalg.eigsolve import check_k
 from ..options import MASS_AREA, AreaKind, LaplacianKind
 from ..types import FloatArray, IntArray, as_mesh
+from .budget import check_basis_memory
 from .cache import (
     CACHE_FORMAT,
     cache_file,
     default_cache_dir,
+    load_entry,
     mesh_key,
     read_cache,
     validate_arrays,
@@ -168,6 +170,7 @@ class SpectralBasis:
         V, F = as_mesh(V, F)
         opts = problem_options(laplacian, area)
         k = check_k(k, len(V), "k")
+        check_basis_memory(len(V), k, "k")  # before the solver: a k that cannot fit, named
         t0 = time.perf_counter()
         K, m = spectral_operators(V, F, laplacian, area)
         known = None
@@ -218,7 +221,7 @@ class SpectralBasis:
             return
         try:
             path.parent.mkdir(parents=True, exist_ok=True)
-            self.save(path)
+            write_npz(path, self._arrays(), keep_mode=False)  # a fresh, readable entry
             self.info.cache_path = str(path)
         except (OSError, MeshError) as exc:
             self.info.messages.append(f"could not write the cache file {path}: {exc}")
@@ -226,19 +229,19 @@ class SpectralBasis:
     def save(self, path: str | os.PathLike, *, overwrite_inputs: Any = ()) -> None:
         """Write the basis as ``.npz`` (atomically: temporary file and ``os.replace``), in the
         cache format; :meth:`load` reads it back for the same mesh and options."""
-        write_npz(
-            Path(path),
-            {
-                "format": np.array(CACHE_FORMAT),
-                "key": np.array(mesh_key(self.V, self.F, self.options)),
-                "options": np.array(json.dumps(self.options, sort_keys=True)),
-                "eigenvalues": self.eigenvalues,
-                "vectors": self.vectors,
-                "mass": self.mass,
-                "n_faces": np.array(len(self.F)),
-            },
-            overwrite_inputs,
-        )
+        write_npz(Path(path), self._arrays(), overwrite_inputs)
+
+    def _arrays(self) -> dict[str, Any]:
+        """The members of the basis file (the cache format)."""
+        return {
+            "format": np.array(CACHE_FORMAT),
+            "key": np.array(mesh_key(self.V, self.F, self.options)),
+            "options": np.array(json.dumps(self.options, sort_keys=True)),
+            "eigenvalues": self.eigenvalues,
+            "vectors": self.vectors,
+            "mass": self.mass,
+            "n_faces": np.array(len(self.F)),
+        }
 
     @classmethod
     def load(
@@ -256,8 +259,8 @@ class SpectralBasis:
         opts = problem_options(laplacian, area)
         K, m = spectral_operators(V, F, laplacian, area)
         try:
-            with np.load(path, allow_pickle=False) as data:
-                lam, U, orth = validate_arrays(data, mesh_key(V, F, opts), opts, K, m)
+            data = load_entry(path, len(V))  # headers checked before any data is loaded
+            lam, U, orth = validate_arrays(data, mesh_key(V, F, opts), opts, K, m)
         except MeshError:
             raise
         except Exception as exc:
@@ -325,6 +328,7 @@ class SpectralBasis:
         k = check_k(k, self.n_vertices, "k")
         if k <= self.k_max:
             return
+        check_basis_memory(self.n_vertices, k, "k")
         with self._extend_lock:
             if k <= self.k_max:
                 return

@@ -156,9 +156,13 @@ def _bbox(mask: np.ndarray) -> tuple[int, int, int, int] | None:
 def autocrop(path: Path, margin: int = 12) -> bool:
     """Compact a viewer screenshot: the mesh cut out of the empty background, with the viewer's
     panel (top right) placed beside it. ``False`` if the image is blank."""
+    import io
+
     import matplotlib.image as mpimg
 
-    img = mpimg.imread(path)
+    from ..io.reader import read_input
+
+    img = mpimg.imread(io.BytesIO(read_input(path, what="image file")), format="png")
     if img.ndim != 3 or img.shape[0] < 2 or img.shape[1] < 2:
         return False
     if img.shape[2] == 3:
