@@ -230,13 +230,13 @@ def mock(polyscope_mock):
 
 def new_viewer(path):
     from meshlap_app.state import CurvatureState, MeshState
-    from meshlap_app.ui import UI
     from meshlap_app.viewer import Viewer
+    from scripted_ui import ScriptedUI
 
     ps.remove_all_structures()
     mesh = MeshState()
     assert mesh.load(path)
-    v = Viewer(mesh, CurvatureState(), ui=UI(), export_dir=path.parent)
+    v = Viewer(mesh, CurvatureState(), ui=ScriptedUI(), export_dir=path.parent)
     v.sync_mesh()
     ps.set_user_callback(v.callback)
     ps.frame_tick()

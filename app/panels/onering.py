@@ -25,7 +25,7 @@ from ..state.onering import (
     arrow_scales,
     weight_segments,
 )
-from ..ui import sig
+from ..text_numbers import sig
 
 if TYPE_CHECKING:
     from ..viewer import Viewer

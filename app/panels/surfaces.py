@@ -13,7 +13,7 @@ from ..animate import NORMAL_SECTION, SECTION_DIRECTION
 from ..record import Recorder, draw_record
 from ..scene import COLORBAR_AT, SURFACE, SURFACE_POINT, Z_TO_Y
 from ..state.surface import TURN_STEP_DEG, section_arc
-from ..ui import sig
+from ..text_numbers import sig
 
 if TYPE_CHECKING:
     from ..viewer import Viewer
