@@ -6,35 +6,40 @@ Every widget of every panel is drawn through a :class:`UI`. It calls the real im
 - **pins the polyscope API**: each call's return value is checked against the type this module
   was written for (``EXPECTED``); a difference raises :class:`UIApiMismatch` (shown in the panel
   and failing the widget tests) instead of a ``TypeError`` deep in a handler;
-- **can be scripted** by a test: ``ui.script("field", "gaussian")`` makes the next frame's
-  combo ``field`` return ``(True, "gaussian")``; ``ui.script("lambda", "0", "0.5")`` types ``0``
-  (and presses Enter) on one frame and ``0.5`` on the next;
-- **records** the label of every interactive widget it drew (``seen``, per section) and of every
-  scripted one (``driven``), so a test fails when a panel has a widget no test drives;
-- **records the tables** it drew (``tables``, per section and table id: headers, every row's
-  cells, flagged and highlighted rows), so a test reads what a panel listed without pixels;
 - keeps imgui's begin/end pairs balanced even when a handler raises (``plot``, ``table`` and
-  ``choose`` close what they opened in a ``finally``).
+  ``choose`` close what they opened in a ``finally``);
+- tracks the panel section being drawn (:meth:`UI.begin_section`, ``section``) and whether a
+  widget of it reported a change (``changed``), for the viewer's per-panel error handling;
+- names shortcut keys the way a user does (:meth:`UI.key`: ``"space"``, ``"left"``, any letter
+  or digit).
 
 Numeric fields apply on Enter only (``ImGuiInputTextFlags_EnterReturnsTrue``): a half-typed
 number (the ``0`` of ``0.5``) is never applied.
+
+**Hooks.** The adapter knows nothing of tests. Each interactive widget, shortcut key, scene click
+and hover calls :meth:`UI._record` once per frame after imgui drew it; its return value, when not
+``None``, replaces what the user did on that frame. Tables call :meth:`UI._record_table`,
+:meth:`UI._record_row` and :meth:`UI._record_table_end`. Here the hooks do nothing; the tests'
+``ScriptedUI`` (``tests/scripted_ui.py``) overrides them to script widgets ("this frame, combo
+``field`` returns ``gaussian``") and to record every widget and table drawn.
 """
 
 from __future__ import annotations
 
-import math
-from collections import deque
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
-from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+
+from .text_numbers import is_number
 
 RED = (1.0, 0.35, 0.35, 1.0)
 GREY = (0.7, 0.7, 0.7, 1.0)
 HIGHLIGHT = (0.95, 0.75, 0.2, 0.35)  # the background of a highlighted table row
 TABLE_ROWS = ((0.11, 0.11, 0.12, 0.94), (0.17, 0.17, 0.19, 0.94))  # opaque: readable over 3D
+
+RGBA = tuple[float, float, float, float]
 
 # the return types the adapter was written for (polyscope 2.6.x; pyproject pins the range)
 EXPECTED: dict[str, tuple[type, ...]] = {
@@ -58,61 +63,54 @@ KEYS = {
     "space": "ImGuiKey_Space",
     "left": "ImGuiKey_LeftArrow",
     "right": "ImGuiKey_RightArrow",
-    "1": "ImGuiKey_1",
-    "2": "ImGuiKey_2",
-    "3": "ImGuiKey_3",
-    "4": "ImGuiKey_4",
-    "5": "ImGuiKey_5",
-    "f": "ImGuiKey_F",
-    "h": "ImGuiKey_H",
-    "r": "ImGuiKey_R",
+    "up": "ImGuiKey_UpArrow",
+    "down": "ImGuiKey_DownArrow",
+    "escape": "ImGuiKey_Escape",
+    "enter": "ImGuiKey_Enter",
+    "tab": "ImGuiKey_Tab",
+    "backspace": "ImGuiKey_Backspace",
+    "delete": "ImGuiKey_Delete",
+    "home": "ImGuiKey_Home",
+    "end": "ImGuiKey_End",
+    "pageup": "ImGuiKey_PageUp",
+    "pagedown": "ImGuiKey_PageDown",
 }
-"""The viewer's shortcut keys and their imgui names."""
+"""The named shortcut keys and their imgui names; any single letter or digit needs no entry
+(see :func:`imgui_key`)."""
 
 
-def sig(x: float, scale: float, digits: int = 4) -> str:
-    """``x`` to ``digits`` significant digits, or ``0`` when ``|x| < 1e-12 · scale`` (round-off
-    of a quantity whose size is ``scale``, e.g. ``F = -3.5e-18`` beside ``E = 1``)."""
-    if abs(x) < 1e-12 * abs(scale) or x == 0:
-        return "0"
-    return f"{x:.{digits}g}"
+def imgui_key(name: str) -> str:
+    """The imgui name of the shortcut key ``name``.
 
+    Parameters
+    ----------
+    name : str
+        A key of :data:`KEYS` (``"space"``, ``"left"``, ...) or one letter or digit, in either
+        case (``"f"`` and ``"F"`` are the same key).
 
-def is_number(cell: str) -> bool:
-    """Is the table cell a number (``-0.5007``, ``38.07°``, ``1e-05``)? Those are right-aligned;
-    ``-`` (no value) is too, so a column of numbers stays one column."""
-    t = cell.strip().rstrip("°")
-    if t == "-":
-        return True
-    try:
-        float(t)
-    except ValueError:
-        return False
-    return True
+    Returns
+    -------
+    str
+        The attribute of ``polyscope.imgui`` holding the key's code.
 
+    Raises
+    ------
+    ValueError
+        For any other name (a typo in a panel's shortcut fails at once, also in tests).
 
-@dataclass
-class TableRecord:
-    """What :meth:`UI.table` drew the last time it was drawn: ``headers`` (with their ``tips``),
-    every row's ``cells`` (strings, as shown), each row's colour (``None``: the text colour),
-    the indices of the ``highlighted`` rows, and its measured ``width``."""
-
-    headers: list[str]
-    tips: list[str] = field(default_factory=list)
-    rows: list[list[str]] = field(default_factory=list)
-    colors: list[tuple[float, float, float, float] | None] = field(default_factory=list)
-    highlighted: list[int] = field(default_factory=list)
-    width: float = 0.0  # pixels, as drawn (0 when imgui skipped it)
-    avail: float = 0.0  # pixels of panel width available where the table starts
-
-    def flagged(self) -> list[list[str]]:
-        """The rows drawn in a colour of their own."""
-        return [r for r, c in zip(self.rows, self.colors, strict=True) if c is not None]
-
-    def column(self, header: str) -> list[str]:
-        """The cells of the column ``header``, top to bottom."""
-        k = self.headers.index(header)
-        return [r[k] for r in self.rows]
+    Examples
+    --------
+    >>> imgui_key("space"), imgui_key("f"), imgui_key("7")
+    ('ImGuiKey_Space', 'ImGuiKey_F', 'ImGuiKey_7')
+    """
+    low = name.lower()
+    if low in KEYS:
+        return KEYS[low]
+    if len(name) == 1 and name.isascii() and name.isalnum():
+        return f"ImGuiKey_{name.upper()}"
+    raise ValueError(
+        f"unknown shortcut key {name!r}: use one letter or digit, or one of {', '.join(KEYS)}"
+    )
 
 
 class UIApiMismatch(TypeError):
@@ -143,31 +141,8 @@ def check_return(name: str, result: Any) -> Any:
     return result
 
 
-def parse_number(text: str, label: str, integer: bool = False) -> float:
-    """What imgui reads from a typed numeric field: an int or float literal (``nan``, ``inf``
-    and overflowing literals such as ``1e309`` included, as C's ``strtod`` reads them).
-
-    Raises
-    ------
-    ValueError
-        For an empty field or text that is not a number, naming the field.
-    """
-    t = text.strip()
-    if not t:
-        raise ValueError(f"{label}: the field is empty; type a number and press Enter")
-    try:
-        value = float(t)
-    except ValueError:
-        raise ValueError(f"{label}: {text!r} is not a number") from None
-    if integer:
-        if not math.isfinite(value) or value != int(value):
-            raise ValueError(f"{label}: {text!r} is not a whole number")
-        return int(value)
-    return value
-
-
 class UI:
-    """imgui/implot for the panels, scriptable and recording (see the module docstring).
+    """imgui/implot for the panels (see the module docstring).
 
     Parameters
     ----------
@@ -183,14 +158,8 @@ class UI:
         self.wrap_width = wrap_width
         self.scale = 1.0
         self.section = ""
-        self.seen: dict[tuple[str, str], str] = {}  # (section, label) -> widget kind
-        self.tooltips: dict[tuple[str, str], str] = {}
-        self.driven: set[tuple[str, str]] = set()
         self.changed = False  # some widget reported a change since begin_section
-        self._script: dict[str, deque[Any]] = {}
-        self.tables: dict[tuple[str, str], TableRecord] = {}  # (section, id) -> last drawn
-        self._table: TableRecord | None = None  # the table being drawn
-        self._table_shown = False
+        self._table: tuple[int, bool] | None = None  # the open table: (columns, shown)
 
     # ------------------------------------------------------------------ set-up
     @property
@@ -209,29 +178,70 @@ class UI:
             self._ip = psimplot
         return self._ip
 
-    def script(self, label: str, *values: Any) -> None:
-        """Queue values for the widget ``label``: one value is consumed per frame it is drawn."""
-        self._script.setdefault(label, deque()).extend(values)
-
-    def pending(self) -> dict[str, list[Any]]:
-        """Scripted values not consumed yet (a widget that was never drawn)."""
-        return {k: list(v) for k, v in self._script.items() if v}
-
     def begin_section(self, name: str) -> None:
+        """The widgets drawn from now on belong to the panel section ``name``; ``changed``
+        starts again from ``False``."""
         self.section = name
         self.changed = False
 
-    def _record(self, label: str, kind: str, tooltip: str) -> tuple[bool, Any]:
-        key = (self.section, label)
-        self.seen[key] = kind
+    # ------------------------------------------------------------------ hooks
+    def _record(
+        self,
+        label: str,
+        kind: str,
+        tooltip: str,
+        current: Any = None,
+        choices: Sequence[str] | None = None,
+    ) -> Any:
+        """Hook called once per frame by each interactive widget after imgui drew it.
+
+        Parameters
+        ----------
+        label : str
+            The widget's label (``"key <name>"`` for a shortcut key, ``"click"`` / ``"hover"``
+            for the scene).
+        kind : str
+            ``button``, ``checkbox``, ``combo``, ``choose``, ``slider``, ``input``, ``header``,
+            ``key``, ``click`` or ``hover``.
+        tooltip : str
+            The widget's tooltip (already shown by the adapter; ``""`` for none).
+        current : optional
+            The value the widget was drawn with (its type is the type of the answer:
+            ``bool``, ``int``, ``float`` or ``str``; ``None`` for keys, clicks and hovers).
+        choices : sequence of str, optional
+            The items of a combo or drop-down list.
+
+        Returns
+        -------
+        None or value
+            ``None``: what the user did this frame stands (here, always). Otherwise a value
+            that replaces it: for a button, header or key whether it was pressed; for a
+            checkbox, combo, drop-down, slider or field the new value; for a click or hover the
+            window position ``(x, y)``.
+        """
+        return None
+
+    def _record_table(self, table_id: str, headers: list[str], tips: list[str]) -> None:
+        """Hook called when :meth:`table` starts a table, before imgui's ``BeginTable``."""
+
+    def _record_row(self, cells: list[str], rgba: RGBA | None, highlight: bool) -> None:
+        """Hook called for each row of the open table (also when imgui does not draw it)."""
+
+    def _record_table_end(self, shown: bool) -> None:
+        """Hook called when the table ends, right after imgui's ``EndTable`` when ``shown``."""
+
+    def _widget(
+        self,
+        label: str,
+        kind: str,
+        tooltip: str,
+        current: Any = None,
+        choices: Sequence[str] | None = None,
+    ) -> Any:
+        """Show ``tooltip`` on the widget just drawn and ask :meth:`_record`."""
         if tooltip:
-            self.tooltips[key] = tooltip
             self.im.SetItemTooltip(tooltip)
-        queue = self._script.get(label)
-        if queue:
-            self.driven.add(key)
-            return True, queue.popleft()
-        return False, None
+        return self._record(label, kind, tooltip, current, choices)
 
     def _changed(self, changed: bool) -> bool:
         self.changed = self.changed or bool(changed)
@@ -279,26 +289,23 @@ class UI:
 
     # ------------------------------------------------------------------ widgets
     def header(self, label: str, default_open: bool = True, force: bool | None = None) -> bool:
-        """A collapsing header (``force``: open or close it now); scripting ``label`` with a
-        bool opens/closes it for one frame."""
+        """A collapsing header (``force``: open or close it now): is it open this frame?"""
         flags = self.im.ImGuiTreeNodeFlags_DefaultOpen if default_open else 0
         if force is not None:
             self.im.SetNextItemOpen(bool(force))
         result = check_return("CollapsingHeader", self.im.CollapsingHeader(label, flags))
-        queue = self._script.get(label)
-        if queue:
-            return bool(queue.popleft())
-        return result
+        v = self._record(label, "header", "", result)
+        return result if v is None else bool(v)
 
     def button(self, label: str, tooltip: str = "") -> bool:
         result = check_return("Button", self.im.Button(label))
-        scripted, value = self._record(label, "button", tooltip)
-        return self._changed(bool(value) if scripted else result)
+        v = self._widget(label, "button", tooltip, False)
+        return self._changed(result if v is None else bool(v))
 
     def checkbox(self, label: str, value: bool, tooltip: str = "") -> tuple[bool, bool]:
         changed, new = check_return("Checkbox", self.im.Checkbox(label, bool(value)))
-        scripted, v = self._record(label, "checkbox", tooltip)
-        if scripted:
+        v = self._widget(label, "checkbox", tooltip, bool(value))
+        if v is not None:
             changed, new = bool(v) != bool(value), bool(v)
         return self._changed(changed), new
 
@@ -309,16 +316,15 @@ class UI:
         items = list(items)
         idx = items.index(current) if current in items else 0
         changed, idx = check_return("Combo", self.im.Combo(label, idx, items))
-        scripted, v = self._record(label, "combo", tooltip)
-        if scripted:
-            if v not in items:
-                raise ValueError(f"{label}: {v!r} is not one of {', '.join(items)}")
+        v = self._widget(label, "combo", tooltip, current, items)
+        if v is not None:
             return self._changed(v != current), v
         return self._changed(changed), items[idx]
 
     def choose(self, label: str, preview: str, items: Sequence[str], tooltip: str = "") -> str:
         """A drop-down list of ``items`` (BeginCombo + Selectable): the item picked this frame,
         or ``""``."""
+        items = list(items)
         opened = check_return("BeginCombo", self.im.BeginCombo(label, preview))
         picked = ""
         try:
@@ -329,10 +335,8 @@ class UI:
         finally:
             if opened:
                 self.im.EndCombo()
-        scripted, v = self._record(label, "choose", tooltip)
-        if scripted:
-            if v not in items:
-                raise ValueError(f"{label}: {v!r} is not in the list")
+        v = self._widget(label, "choose", tooltip, preview, items)
+        if v is not None:
             picked = v
         self._changed(bool(picked))
         return picked
@@ -350,18 +354,18 @@ class UI:
         changed, new = check_return(
             "SliderFloat", self.im.SliderFloat(label, float(value), float(lo), float(hi), fmt)
         )
-        scripted, v = self._record(label, "slider", tooltip)
-        if scripted:
-            changed, new = True, parse_number(v, label) if isinstance(v, str) else float(v)
+        v = self._widget(label, "slider", tooltip, float(value))
+        if v is not None:
+            changed, new = True, v
         return self._changed(changed), new
 
     def slider_int(
         self, label: str, value: int, lo: int, hi: int, tooltip: str = ""
     ) -> tuple[bool, int]:
         changed, new = check_return("SliderInt", self.im.SliderInt(label, int(value), lo, hi))
-        scripted, v = self._record(label, "slider", tooltip)
-        if scripted:
-            changed, new = True, parse_number(v, label, True) if isinstance(v, str) else v
+        v = self._widget(label, "slider", tooltip, int(value))
+        if v is not None:
+            changed, new = True, v
         return self._changed(changed), new
 
     def input_float(
@@ -372,27 +376,27 @@ class UI:
         changed, new = check_return(
             "InputFloat", self.im.InputFloat(label, float(value), 0.0, 0.0, fmt, flags)
         )
-        scripted, v = self._record(label, "input", tooltip)
-        if scripted:
-            changed, new = True, parse_number(v, label) if isinstance(v, str) else float(v)
+        v = self._widget(label, "input", tooltip, float(value))
+        if v is not None:
+            changed, new = True, v
         return self._changed(changed), new
 
     def input_int(self, label: str, value: int, tooltip: str = "") -> tuple[bool, int]:
         """A typed integer with -/+ buttons, applied on Enter or a button: ``(changed, value)``."""
         flags = self.im.ImGuiInputTextFlags_EnterReturnsTrue
         changed, new = check_return("InputInt", self.im.InputInt(label, int(value), 1, 100, flags))
-        scripted, v = self._record(label, "input", tooltip)
-        if scripted:
-            changed, new = True, parse_number(v, label, True) if isinstance(v, str) else v
+        v = self._widget(label, "input", tooltip, int(value))
+        if v is not None:
+            changed, new = True, v
         return self._changed(changed), new
 
     def input_text(self, label: str, text: str, tooltip: str = "") -> tuple[bool, str]:
         """A text field: ``(Enter pressed, current text)`` (the text is kept while typing)."""
         flags = self.im.ImGuiInputTextFlags_EnterReturnsTrue
         entered, new = check_return("InputText", self.im.InputText(label, text, flags))
-        scripted, v = self._record(label, "input", tooltip)
-        if scripted:
-            entered, new = True, str(v)
+        v = self._widget(label, "input", tooltip, str(text))
+        if v is not None:
+            entered, new = True, v
         return self._changed(entered), new
 
     # ------------------------------------------------------------------ plots
@@ -452,10 +456,10 @@ class UI:
         """``with ui.table(id, headers, tips) as shown:`` then :meth:`row` per row: an ImGui
         table with borders, alternating (nearly opaque, so the 3D view behind the panel does
         not show through) row shades, columns as wide as their widest cell, and each header's
-        tooltip from ``tips``. EndTable always runs; the table is recorded in :attr:`tables`
-        (also when imgui skips drawing it, e.g. a collapsed window)."""
-        record = TableRecord(list(headers), list(tips))
-        self.tables[(self.section, table_id)] = record
+        tooltip from ``tips``. EndTable always runs; the hooks see the table also when imgui
+        skips drawing it (e.g. a collapsed window)."""
+        headers, tips = [str(h) for h in headers], [str(t) for t in tips]
+        self._record_table(table_id, headers, tips)
         im = self.im
         flags = (
             im.ImGuiTableFlags_Borders
@@ -463,34 +467,35 @@ class UI:
             | im.ImGuiTableFlags_SizingFixedFit
             | im.ImGuiTableFlags_NoHostExtendX
         )
-        record.avail = float(im.GetContentRegionAvail()[0])
         im.PushStyleColor(im.ImGuiCol_TableRowBg, TABLE_ROWS[0])
         im.PushStyleColor(im.ImGuiCol_TableRowBgAlt, TABLE_ROWS[1])
         shown = False
         try:
-            shown = check_return("BeginTable", im.BeginTable(table_id, len(record.headers), flags))
-            self._table, self._table_shown = record, shown
+            shown = check_return("BeginTable", im.BeginTable(table_id, len(headers), flags))
+            self._table = (len(headers), shown)
             if shown:
-                for h in record.headers:
+                for h in headers:
                     im.TableSetupColumn(h)
                 im.TableNextRow(im.ImGuiTableRowFlags_Headers)
-                for k, h in enumerate(record.headers):
+                for k, h in enumerate(headers):
                     im.TableSetColumnIndex(k)
                     im.TableHeader(h)
-                    if k < len(record.tips) and record.tips[k]:
-                        im.SetItemTooltip(record.tips[k])
+                    if k < len(tips) and tips[k]:
+                        im.SetItemTooltip(tips[k])
             yield shown
         finally:
-            self._table, self._table_shown = None, False
-            if shown:
-                im.EndTable()
-                record.width = float(im.GetItemRectSize()[0])
-            im.PopStyleColor(2)
+            self._table = None
+            try:
+                if shown:
+                    im.EndTable()
+                self._record_table_end(shown)
+            finally:
+                im.PopStyleColor(2)
 
     def row(
         self,
         cells: Sequence[str],
-        rgba: tuple[float, float, float, float] | None = None,
+        rgba: RGBA | None = None,
         highlight: bool = False,
     ) -> None:
         """One row of the open :meth:`table`: numbers right-aligned, the whole row in ``rgba``
@@ -501,17 +506,14 @@ class UI:
         RuntimeError
             Outside ``with ui.table(...)``, or with more cells than the table has columns.
         """
-        record = self._table
-        if record is None:
+        if self._table is None:
             raise RuntimeError("ui.row() outside a ui.table() block")
+        columns, shown = self._table
         cells = [str(c) for c in cells]
-        if len(cells) > len(record.headers):
-            raise RuntimeError(f"{len(cells)} cells for {len(record.headers)} columns")
-        record.rows.append(cells)
-        record.colors.append(rgba)
-        if highlight:
-            record.highlighted.append(len(record.rows) - 1)
-        if not self._table_shown:
+        if len(cells) > columns:
+            raise RuntimeError(f"{len(cells)} cells for {columns} columns")
+        self._record_row(cells, rgba, highlight)
+        if not shown:
             return
         im = self.im
         im.TableNextRow()
@@ -530,26 +532,26 @@ class UI:
 
     # ------------------------------------------------------------------ overlay, keys
     def key(self, name: str) -> bool:
-        """Was the shortcut key ``name`` (see :data:`KEYS`) pressed this frame, outside a text
-        field? Scripted as the label ``"key <name>"``."""
-        label = f"key {name}"
-        self.seen[("keys", label)] = "key"
-        queue = self._script.get(label)
-        if queue:
-            self.driven.add(("keys", label))
-            return bool(queue.popleft())
+        """Was the shortcut key ``name`` pressed this frame, outside a text field?
+
+        ``name`` is one letter or digit, or a named key of :data:`KEYS` (``"space"``,
+        ``"left"``, ...): see :func:`imgui_key`. The hook sees it as the label
+        ``"key <name>"``.
+        """
+        code = imgui_key(name)
+        v = self._record(f"key {name}", "key", "")
+        if v is not None:
+            return bool(v)
         if self.im.GetIO().WantCaptureKeyboard:
             return False
-        return bool(self.im.IsKeyPressed(getattr(self.im, KEYS[name]), False))
+        return bool(self.im.IsKeyPressed(getattr(self.im, code), False))
 
     def scene_click(self) -> tuple[float, float] | None:
         """Window position of a left click on the 3D view this frame (not on a panel), or
-        ``None``. Scripted as the label ``"click"`` with an ``(x, y)``."""
-        self.seen[("scene", "click")] = "click"
-        queue = self._script.get("click")
-        if queue:
-            self.driven.add(("scene", "click"))
-            return tuple(queue.popleft())
+        ``None``. The hook sees it as the label ``"click"``."""
+        v = self._record("click", "click", "")
+        if v is not None:
+            return tuple(v)
         io = self.im.GetIO()
         if io.WantCaptureMouse or not self.im.IsMouseClicked(0):
             return None
@@ -557,12 +559,10 @@ class UI:
 
     def hover(self) -> tuple[float, float] | None:
         """Window position of the mouse over the 3D view this frame (``None`` over a panel).
-        Scripted as the label ``"hover"`` with an ``(x, y)``."""
-        self.seen[("scene", "hover")] = "hover"
-        queue = self._script.get("hover")
-        if queue:
-            self.driven.add(("scene", "hover"))
-            return tuple(queue.popleft())
+        The hook sees it as the label ``"hover"``."""
+        v = self._record("hover", "hover", "")
+        if v is not None:
+            return tuple(v)
         io = self.im.GetIO()
         if io.WantCaptureMouse:
             return None

@@ -17,6 +17,8 @@ from pathlib import Path
 
 import pytest
 
+TESTS = Path(__file__).resolve().parent  # the test helpers' folder (imported as modules)
+
 SHARED_MESHES = Path(__file__).resolve().parents[1].parent / "shared" / "meshes"
 
 
@@ -73,14 +75,14 @@ def viewer(polyscope_mock, sphere, tmp_path, monkeypatch):
     (every ``frame_tick`` runs its callback), exporting to ``tmp_path``, with a private
     eigenbasis cache."""
     from meshlap_app.state import AppState, MeshState
-    from meshlap_app.ui import UI
     from meshlap_app.viewer import Viewer
+    from scripted_ui import ScriptedUI
 
     monkeypatch.setenv("MESHLAP_CACHE_DIR", str(tmp_path / "cache"))
     polyscope_mock.remove_all_structures()
     mesh = MeshState()
     assert mesh.load(sphere)
-    v = Viewer(AppState(mesh=mesh, folder=tmp_path), ui=UI())
+    v = Viewer(AppState(mesh=mesh, folder=tmp_path), ui=ScriptedUI())
     v.sync_mesh()
     polyscope_mock.set_user_callback(v.callback)
     yield v
@@ -91,10 +93,13 @@ def viewer(polyscope_mock, sphere, tmp_path, monkeypatch):
 def python_ok(tmp_path: Path) -> Callable[..., subprocess.CompletedProcess]:
     """Run ``python ARGS...`` (a ``-c`` script or ``-m meshlap_core.cli ...``) in ``tmp_path``
     with a private eigenbasis cache, assert it exits 0 (showing its stderr otherwise) and
-    return the completed process (text output)."""
+    return the completed process (text output). The child imports the test helpers
+    (``scripted_ui``, ...) as the tests do: ``tests/`` is on its ``PYTHONPATH``, as pytest
+    puts it on the tests' path."""
+    helpers = os.pathsep.join(p for p in (str(TESTS), os.environ.get("PYTHONPATH")) if p)
 
     def run(*args: object, timeout: float = 600) -> subprocess.CompletedProcess:
-        env = dict(os.environ, MESHLAP_CACHE_DIR=str(tmp_path / "cache"))
+        env = dict(os.environ, MESHLAP_CACHE_DIR=str(tmp_path / "cache"), PYTHONPATH=helpers)
         res = subprocess.run(
             [sys.executable, *map(str, args)],
             capture_output=True,

@@ -231,13 +231,13 @@ def mock(polyscope_mock):
 
 def new_viewer(path):
     from meshlap_app.state import AppState, MeshState
-    from meshlap_app.ui import UI
     from meshlap_app.viewer import Viewer
+    from scripted_ui import ScriptedUI
 
     ps.remove_all_structures()
     mesh = MeshState()
     assert mesh.load(path)
-    v = Viewer(AppState(mesh=mesh, folder=path.parent), ui=UI())
+    v = Viewer(AppState(mesh=mesh, folder=path.parent), ui=ScriptedUI())
     v.sync_mesh()
     ps.set_user_callback(v.callback)
     ps.frame_tick()

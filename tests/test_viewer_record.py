@@ -361,8 +361,8 @@ EGL_SCRIPT = textwrap.dedent(
     from meshlap_app.record import RECORD_HEADER
     from meshlap_app.scene import save_screenshot
     from meshlap_app.state import AppState, CurvatureState, MeshState
-    from meshlap_app.ui import UI
     from meshlap_app.viewer import Viewer, init_polyscope
+    from scripted_ui import ScriptedUI
 
     mesh_path, out = Path(sys.argv[1]), Path(sys.argv[2])
     init_polyscope("openGL3_egl")
@@ -370,7 +370,7 @@ EGL_SCRIPT = textwrap.dedent(
     ps.set_window_size(1280, 720)
     mesh = MeshState()
     assert mesh.load(mesh_path)
-    v = Viewer(AppState(mesh=mesh, folder=out), ui=UI())
+    v = Viewer(AppState(mesh=mesh, folder=out), ui=ScriptedUI())
     v.sync_mesh()
     ps.set_user_callback(v.callback)
 

@@ -15,7 +15,7 @@ import math
 
 import numpy as np
 import pytest
-from meshlap_app.ui import UI, TableRecord, is_number
+from meshlap_app.text_numbers import is_number
 
 from meshlap_core.inspector import inspect_vertex
 from meshlap_core.io import save_mesh
@@ -26,7 +26,8 @@ import test_viewer_widgets as widgets  # noqa: E402
 from meshlap_app import scene  # noqa: E402
 from meshlap_app.panels.onering import NEGATIVE_RGBA  # noqa: E402
 from meshlap_app.state.onering import HoverThrottle  # noqa: E402
-from meshlap_app.ui import sig  # noqa: E402
+from meshlap_app.text_numbers import sig  # noqa: E402
+from scripted_ui import ScriptedUI, TableRecord  # noqa: E402
 from test_viewer_inspector import FakeClock, perturbed_grid  # noqa: E402
 
 mock = widgets.mock  # `sphere` and `viewer` come from conftest
@@ -48,7 +49,7 @@ def test_is_number():
 
 
 def test_table_records_what_it_draws_and_stays_balanced(mock):
-    ui = UI()
+    ui = ScriptedUI()
     ui.begin_section("test")
     errors: list[Exception] = []
 
@@ -229,11 +230,12 @@ import polyscope as ps
 from meshlap_app import scene
 from meshlap_app.state import AppState, CurvatureState, MeshState
 from meshlap_app.viewer import Viewer, init_polyscope
+from scripted_ui import ScriptedUI
 
 mesh = MeshState(); assert mesh.load(Path(sys.argv[1]))
 init_polyscope("openGL3_egl")
 ps.set_window_size(1280, 720)
-viewer = Viewer(AppState(mesh=mesh, panel="onering"))
+viewer = Viewer(AppState(mesh=mesh, panel="onering"), ui=ScriptedUI())
 ps.set_build_default_gui_panels(False)
 scale = float(sys.argv[2])
 if scale != 1.0:

@@ -1,11 +1,11 @@
 """Every widget of every panel, driven through the UI adapter on polyscope's openGL_mock backend.
 
-The adapter (``meshlap_app.ui.UI``) calls the real ``polyscope.imgui`` each frame and lets a test
-say what a widget returns on that frame ("combo ``field`` returns ``gaussian``", "field
-``lambda`` receives ``0``, then ``0.5``"). Each widget gets good values and bad ones (empty, 0,
-negative, NaN, 1e309, out of range): the session never ends, bad input is shown in red in its
-panel and the last good state stays. ``test_every_widget_is_driven`` fails when a panel draws a
-widget that no test here drives.
+The adapter (``meshlap_app.ui.UI``, as the tests' ``ScriptedUI`` in ``tests/scripted_ui.py``)
+calls the real ``polyscope.imgui`` each frame and lets a test say what a widget returns on that
+frame ("combo ``field`` returns ``gaussian``", "field ``lambda`` receives ``0``, then ``0.5``").
+Each widget gets good values and bad ones (empty, 0, negative, NaN, 1e309, out of range): the
+session never ends, bad input is shown in red in its panel and the last good state stays.
+``test_every_widget_is_driven`` fails when a panel draws a widget that no test here drives.
 """
 
 from __future__ import annotations
@@ -17,8 +17,9 @@ import pytest
 
 ps = pytest.importorskip("polyscope")
 
-from meshlap_app.ui import EXPECTED, UIApiMismatch, check_return, parse_number  # noqa: E402
+from meshlap_app.ui import EXPECTED, UIApiMismatch, check_return  # noqa: E402
 from meshlap_app.viewer import Viewer  # noqa: E402
+from scripted_ui import parse_number  # noqa: E402
 
 from meshlap_core.io import load_mesh  # noqa: E402
 
@@ -105,6 +106,31 @@ def test_installed_polyscope_returns_what_the_adapter_expects(mock):
     ps.clear_user_callback()
     for name, result in results.items():
         check_return(name, result)  # raises UIApiMismatch when polyscope changed
+
+
+def test_shortcut_keys_are_any_letter_or_digit_or_a_named_key(mock):
+    """A new panel declares a new shortcut (``ui.key("g")``) without editing ``ui.py``; the
+    production adapter, unscripted, asks imgui and records nothing."""
+    import polyscope.imgui as psim
+    from meshlap_app.ui import KEYS, UI, imgui_key
+
+    assert imgui_key("space") == "ImGuiKey_Space" and imgui_key("left") == "ImGuiKey_LeftArrow"
+    assert imgui_key("g") == imgui_key("G") == "ImGuiKey_G" and imgui_key("0") == "ImGuiKey_0"
+    for name in [*KEYS, *"abcdefghijklmnopqrstuvwxyz0123456789"]:
+        assert isinstance(getattr(psim, imgui_key(name)), int), name  # a key imgui knows
+    for bad in ("", "ctrl", "é", "f1x", "+"):
+        with pytest.raises(ValueError, match="shortcut key"):
+            imgui_key(bad)
+    ui, pressed = UI(), {}
+
+    def callback():
+        pressed.update({name: ui.key(name) for name in ("g", "7", "escape", "space")})
+
+    ps.set_user_callback(callback)
+    ps.frame_tick()
+    ps.clear_user_callback()
+    assert pressed == {"g": False, "7": False, "escape": False, "space": False}
+    assert not hasattr(ui, "script") and not hasattr(ui, "seen")  # no test harness inside
 
 
 def test_parse_number_reads_like_imgui():

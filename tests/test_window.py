@@ -13,14 +13,16 @@ serves two tests, in this order:
   not before, the export message, and that the process is alive with nothing on stderr but
   polyscope's own ``[polyscope]`` lines. A failing step is recorded (the viewer is restarted if it
   died) and the tour goes on, so one run reports every failing step.
-- ``test_monkey``: seeded random clicks, drags and keys anywhere for ``MESHLAP_MONKEY_SECONDS``
-  (20 s); the viewer survives.
+- ``test_monkey``: ``MESHLAP_MONKEY_ACTIONS`` (default 120, about 20 s) random clicks, drags
+  and keys anywhere, drawn from ``MESHLAP_MONKEY_SEED``; the viewer survives. A failure names the
+  seed and the action's index, and the command that replays exactly those actions.
 
 Widgets are found on each screenshot by colour and layout (:mod:`tests.imgui_screen`); the order
 of widgets inside each panel is stated once, in the step functions below. Every wait is for a
-visible outcome and bounded (a loaded machine draws few frames per second; a timeout fails with
-what was awaited). The mouse rests in the scene's bottom-left corner between actions, so no
-tooltip covers a widget on a screenshot.
+visible outcome or for frames the viewer drew after an input event (:meth:`xwindow.App.drawn`,
+counted with X DAMAGE), and bounded (a loaded machine draws few frames per second; a timeout
+fails with what was awaited): no step sleeps a guessed time. The mouse rests in the scene's
+bottom-left corner between actions, so no tooltip covers a widget on a screenshot.
 
 Set ``MESHLAP_WINDOW_SHOTS=<folder>`` to keep the screenshots (``docs/img/window/`` holds the
 1280×720 ones).
@@ -55,6 +57,7 @@ SECOND_MESH = ROOT / "assets" / "torus.obj"
 MESH_LIST = ("bumpy.obj", "cube.obj", "grid.obj", "icosphere.obj", "torus.obj")  # assets/, sorted
 TITLE = "meshlap — "  # the window title: meshlap — <file>
 STILL = 3e-5  # fraction of changed pixels that is no change (a blinking text cursor)
+FRAME_TIMEOUT = 30.0  # seconds the viewer may take to draw the frames after one input event
 
 
 def meshlap_command() -> list[str]:
@@ -158,44 +161,58 @@ class Session:
         blink: 3e-5 of its pixels)."""
         prev, calm = [self.screenshot()], [0]
 
-        def same(img: np.ndarray) -> bool:  # no change over 3 screenshots ~0.2 s apart
+        def same(img: np.ndarray) -> bool:  # no change over 3 screenshots, frames between
             calm[0] = calm[0] + 1 if changed_fraction(prev[0], img, box) < STILL else 0
             prev[0] = img
-            time.sleep(0.05)
+            self.drawn(2)  # at least one whole frame before the next screenshot
             return calm[0] >= 2
 
         return self.until(same, timeout, "steady picture")
 
     # -------------------------------------------------------------- input
+    def drawn(self, n: int = 2) -> None:
+        """Wait until the viewer drew ``n`` frames after the input event just sent (it read
+        the event and drew its outcome); AssertionError when it died or hangs."""
+        assert self.app is not None
+        self.app.drawn(n, FRAME_TIMEOUT)
+
     def park(self) -> None:
         """Rest the mouse in the scene's bottom-left corner (no hover, no tooltip)."""
         self.x.xdotool("mousemove", "3", str(self.size[1] - 3))
 
     def click(self, xy: tuple[int, int]) -> None:
+        """Move to ``xy``, click, park; returns once the viewer read the click (a field
+        clicked has the keyboard, a button clicked has acted)."""
         x, y = (str(int(v)) for v in xy)
         self.x.xdotool("mousemove", x, y)
-        time.sleep(0.1)  # the hover frame first: ImGui acts on a press over a hovered item
+        self.drawn()  # the hover frame first: ImGui acts on a press over a hovered item
         self.x.xdotool("click", "1")
-        time.sleep(0.1)
+        self.drawn()  # the press and release read at ``xy``, before the mouse parks
         self.park()
 
     def key(self, *keys: str) -> None:
-        self.x.xdotool("key", "--delay", "60", *keys)
+        """Press the ``keys`` one after the other, each once the viewer read the one before
+        (typed text arrives in order; a shortcut acts before the next key)."""
+        for k in keys:
+            self.x.xdotool("key", k)
+            self.drawn()
 
-    def drag(self, a: tuple[int, int], b: tuple[int, int], steps: int = 6, pause=0.3) -> None:
+    def drag(self, a: tuple[int, int], b: tuple[int, int], steps: int = 6) -> None:
+        """Press at ``a``, move to ``b`` in ``steps`` moves, release, park; the viewer draws
+        frames after each event (ImGui reads a press over a hovered item, follows each move
+        with the button down, and releases where the last move went)."""
         self.x.xdotool("mousemove", str(a[0]), str(a[1]))
-        time.sleep(0.1)
+        self.drawn()
         self.x.xdotool("mousedown", "1")
-        time.sleep(pause)
+        self.drawn()
         for t in np.linspace(0, 1, steps + 1)[1:]:
             x, y = (round(p + t * (q - p)) for p, q in zip(a, b, strict=True))
             self.x.xdotool("mousemove", str(x), str(y))
-            time.sleep(0.05)
-        # a release in the same frame as the last move ends the drag before ImGui reads the
-        # new position: let the viewer draw a frame with the button still down
-        time.sleep(pause)
+            # also the last move: a release in the same frame as the last move ends the drag
+            # before ImGui reads the new position
+            self.drawn()
         self.x.xdotool("mouseup", "1")
-        time.sleep(0.1)
+        self.drawn()
         self.park()
 
     def choose(self, section: int, nth: int, entry: int) -> None:
@@ -248,8 +265,7 @@ class Session:
         if problem or err:
             self.failures.append(f"{name}: " + "; ".join(p for p in (err, problem) if p))
         assert self.app is not None
-        if not self.app.alive():
-            time.sleep(1.0)  # let the viewer's last words reach stderr before the report
+        if not self.app.alive():  # exited: its last words are all in the stderr file
             self.failures[-1] += f"; stderr: {self.app.stderr().strip()!r}"
             self.start()
 
@@ -345,8 +361,7 @@ def onering(s: Session) -> None:
     )
     layout = parse(s.settled((0, 0, *s.size)))
     field = layout.find(1, "input", 0)
-    s.click(field.center)
-    time.sleep(0.3)
+    s.click(field.center)  # returns once the viewer read the click: the field has the keys
     s.key("ctrl+a", "1", "2")
     typed = s.settled((0, 0, *s.size))
     s.key("Return")
@@ -381,7 +396,7 @@ def spectral(s: Session) -> None:
     # left end (k = 1 shows), move to a third with the button down (k follows), release
     knob = (slider.x0, slider.y0, slider.x1, slider.y1)
     s.x.xdotool("mousemove", str(slider.x0 + 6), str(y))
-    time.sleep(0.1)
+    s.drawn()  # hovered before the press
     s.x.xdotool("mousedown", "1")
     try:
         pressed = s.until(
@@ -417,8 +432,7 @@ def smoothing(s: Session) -> None:
     plot = layout.find(1, "plot", 0)
     plot_box = (plot.x0, plot.y0, plot.x1, plot.y1)
     before = s.img
-    s.click(layout.find(1, "input", 0).center)
-    time.sleep(0.3)
+    s.click(layout.find(1, "input", 0).center)  # the field has the keys once this returns
     s.key("ctrl+a", "0", "period", "2", "5")
     typed = s.settled((0, 0, *s.size))
     scene = scene_box(s, layout)
@@ -447,7 +461,7 @@ def smoothing(s: Session) -> None:
         "'play' on the button again after space",
     )
     c = s.settled(box, timeout=10)
-    time.sleep(1.0)
+    s.drawn(6)  # playing, each of these frames would step the copy
     if changed_fraction(c, s.screenshot(), box) > STILL:
         raise AssertionError("space again: the smoothed copy still moves")
     s.subject_ok(parse(s.img), 2, "after play/pause")
@@ -515,15 +529,10 @@ def scroll_to_end(s: Session) -> Layout:
         s.x.xdotool("mousemove", str(layout.left + 20), str(s.size[1] // 2))
         s.x.xdotool("click", "--repeat", "3", "5")
         s.park()
+        s.drawn()  # the viewer read the wheel and drew the panel scrolled (or not)
         # the scroll bar's strip: hover highlights and tooltips over the panel do not count
         box = (layout.right - 18, layout.top + 30, layout.right + 1, s.size[1])
-
-        def moved(img: np.ndarray, before=before, box=box) -> bool:
-            return changed_fraction(before, img, box) > 0.002
-
-        try:
-            s.until(moved, 1.5, "scroll")
-        except AssertionError:
+        if changed_fraction(before, s.screenshot(), box) <= 0.002:
             return parse(s.img)  # nothing moved: the end
         layout = parse(s.settled((0, 0, *s.size)))
     raise AssertionError("meshlap's panel still scrolls after 20 turns of the wheel")
@@ -606,14 +615,16 @@ def record_turn(s: Session) -> None:
     before = s.screenshot()
     s.click(((theta.buttons[0][0] + theta.buttons[0][1]) // 2, theta.center[1]))
     s.until(lambda img: pixels(before, img, scene) > 50, 15, "the normal section turning")
-    time.sleep(1.0)
+    # θ turns on each frame, and each frame with a new θ is recorded (slowly: a loaded
+    # machine may take seconds per recorded frame): two more frames after the first turn seen
+    s.drawn(2)
     s.click(button)  # stop
     s.until(lambda img: bool(set(s.tmp.rglob("*.gif")) - gifs), 20, "the recorded GIF")
     (gif,) = set(s.tmp.rglob("*.gif")) - gifs
     frames = Image.open(gif).n_frames
     if frames < 2:
         raise AssertionError(f"{gif.name} holds {frames} frame(s), want more than 1")
-    s.settled((0, 0, *s.size))
+    s.drawn()  # the section goes on turning after stop: no steady picture to wait for
 
 
 TOUR: list[tuple[str, Callable[[Session], None]]] = [
@@ -670,41 +681,96 @@ def test_scripted_tour(session):
 
 
 KEYS = "space Right Left Up Down 1 2 3 4 5 f h r Tab Return BackSpace 0 period minus a x".split()
+MONKEY_ACTIONS = 120  # about 20 s when the viewer draws ~25 frames per second (env overrides)
+MONKEY_SEED = 20261124  # + the window's width (MESHLAP_MONKEY_SEED overrides, as printed)
+
+Action = tuple[str, tuple[int, int], tuple[int, int], str]  # kind, a, b, key
 
 
-@pytest.mark.window
-def test_monkey(session):
-    """Seeded random clicks, drags and keys anywhere in the window; the viewer survives."""
-    s = session
-    if s.app is None or not s.app.alive():
-        s.start()
-    seconds = float(os.environ.get("MESHLAP_MONKEY_SECONDS", "20"))
-    rng = np.random.default_rng(20261124 + s.size[0])
-    w, h = s.size
-    log: list[str] = []
-    end = time.monotonic() + seconds
-    while time.monotonic() < end:
+def monkey_actions(seed: int, n: int, size: tuple[int, int]) -> list[Action]:
+    """``n`` random actions in a ``size`` window, a function of ``seed`` alone: 60 % clicks at
+    ``a``, 20 % drags from ``a`` to ``b``, 20 % key presses (a key of :data:`KEYS`)."""
+    rng = np.random.default_rng(seed)
+    w, h = size
+    actions: list[Action] = []
+    for _ in range(n):
         r = rng.random()
         a = (int(rng.integers(0, w)), int(rng.integers(0, h)))
         if r < 0.6:
-            log.append(f"click {a}")
-            s.x.xdotool("mousemove", str(a[0]), str(a[1]))
-            time.sleep(0.06)
-            s.x.xdotool("click", "1")
+            actions.append(("click", a, a, ""))
         elif r < 0.8:
             b = (int(rng.integers(0, w)), int(rng.integers(0, h)))
-            log.append(f"drag {a} -> {b}")
-            s.drag(a, b, steps=4, pause=0.15)
+            actions.append(("drag", a, b, ""))
         else:
-            key = str(rng.choice(KEYS))
-            log.append(f"key {key}")
-            s.x.xdotool("key", key)
-        time.sleep(0.1)
-        if len(log) % 10 == 0 and s.problem():
-            break
+            actions.append(("key", a, a, str(rng.choice(KEYS))))
+    return actions
+
+
+def act(s: Session, action: Action) -> None:
+    """Do one monkey action and return once the viewer drew the frames after it.
+
+    The events of a click (move, press, release) go in one ``xdotool`` call: ImGui's input
+    queue spreads a move and a press that arrive together over two frames, so nothing between
+    them needs a wait. A drag waits once with the button down (the moves read), then after
+    the release.
+    """
+    kind, a, b, key = action
+    x = s.x.xdotool
+    if kind == "click":
+        x("mousemove", str(a[0]), str(a[1]), "click", "1")
+    elif kind == "drag":
+        moves: list[str] = []
+        for t in (0.25, 0.5, 0.75, 1.0):
+            moves += [
+                "mousemove",
+                *(str(round(p + t * (q - p))) for p, q in zip(a, b, strict=True)),
+            ]
+        x("mousemove", str(a[0]), str(a[1]), "mousedown", "1", *moves)
+        s.drawn()
+        x("mouseup", "1")
+    else:
+        x("key", key)
+    s.drawn()
+
+
+def test_monkey_actions_replay_from_the_seed():
+    one, two = monkey_actions(7, 50, (640, 480)), monkey_actions(7, 80, (640, 480))
+    assert one == two[:50] and one != monkey_actions(8, 50, (640, 480))
+    assert {kind for kind, *_ in two} == {"click", "drag", "key"}
+    assert all(0 <= a[0] < 640 and 0 <= b[1] < 480 for _, a, b, _ in two)
+
+
+@pytest.mark.window
+def test_monkey(session, request):
+    """Seeded random clicks, drags and keys anywhere in the window; the viewer survives each
+    (it draws the frames after every action and writes nothing but polyscope's lines)."""
+    s = session
+    if s.app is None or not s.app.alive():
+        s.start()
+    w, h = s.size
+    n = int(os.environ.get("MESHLAP_MONKEY_ACTIONS", str(MONKEY_ACTIONS)))
+    seed = int(os.environ.get("MESHLAP_MONKEY_SEED", str(MONKEY_SEED + w)))
+    actions = monkey_actions(seed, n, s.size)
+    t0 = time.monotonic()
+    for i, action in enumerate(actions):
+        try:
+            act(s, action)
+            problem = s.problem()
+        except AssertionError as exc:
+            problem = s.problem() or str(exc)
+        if problem:
+            s.screenshot("monkey_fail")
+            replay = (
+                f"MESHLAP_MONKEY_SEED={seed} MESHLAP_MONKEY_ACTIONS={i + 1} "
+                f"pytest tests/test_window.py -k '{request.node.callspec.id}'"
+            )
+            pytest.fail(
+                f"monkey action {i} of {n} (seed {seed}, {w}x{h}): {action}: {problem}\n"
+                f"the actions before it: {actions[max(0, i - 8) : i]}\nreplay: {replay}"
+            )
+    print(f"{w}x{h} monkey: {n} actions (seed {seed}) in {time.monotonic() - t0:.1f} s")
     s.screenshot("monkey_end")
-    problem = s.problem()
-    assert problem is None, f"{problem}\nlast actions: {log[-8:]}"
+    assert s.problem() is None
 
 
 # ------------------------------------------------------------------ the harness's own pieces

@@ -1,4 +1,5 @@
-"""A small real-window harness: Xvfb, ``xdotool`` input, ``xwd`` screenshots as PNG.
+"""A small real-window harness: Xvfb, ``xdotool`` input, ``xwd`` screenshots as PNG, and a count
+of the frames the viewer draws.
 
 The viewer is driven only as a user drives it: a ``meshlap view`` subprocess on a virtual X
 display, real mouse and keyboard events, screenshots of the whole screen. Nothing here imports
@@ -8,27 +9,38 @@ Screenshots come from ``xwd -root -silent`` (X Window Dump, the X11 format); :fu
 decodes the 24/32-bit TrueColor dumps that Xvfb produces into an ``(h, w, 3) uint8`` array and
 :func:`write_png` writes that with numpy and zlib only (PNG, ISO/IEC 15948: IHDR, one IDAT,
 IEND, filter type 2 "Up" on every row).
+
+:class:`Frames` counts the frames a window draws with the X DAMAGE extension (``libXdamage``
+through ``ctypes``): every buffer swap of the viewer damages its window, also when the pixels do
+not change. A test waits for the viewer to have *drawn frames after an input event* (so it has
+processed it) instead of sleeping a guessed time: a loaded machine may take seconds per frame.
 """
 
 from __future__ import annotations
 
+import ctypes
+import ctypes.util
 import os
+import select
 import shutil
 import struct
 import subprocess
 import time
 import zlib
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 TOOLS = ("Xvfb", "xdotool", "xwd")
+LIBS = ("X11", "Xdamage")  # loaded with ctypes by Frames
 
 
 def missing_tools() -> list[str]:
-    """Names of the X tools the harness needs that are not on ``PATH``."""
-    return [t for t in TOOLS if shutil.which(t) is None]
+    """Names of the X tools (on ``PATH``) and libraries the harness needs that are missing."""
+    missing = [t for t in TOOLS if shutil.which(t) is None]
+    return missing + [f"lib{n}" for n in LIBS if ctypes.util.find_library(n) is None]
 
 
 # ---------------------------------------------------------------------------- images
@@ -197,6 +209,102 @@ class XServer:
         terminate(self.proc)
 
 
+# ---------------------------------------------------------------------------- frames drawn
+_XDAMAGE_REPORT_NON_EMPTY = 3  # one DamageNotify each time the damage goes from empty to not
+_XErrorHandler = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, ctypes.c_void_p)
+
+
+@_XErrorHandler
+def _ignore_x_error(_display: int, _event: int) -> int:
+    """Xlib's default handler exits the process (pytest with it) on any error, e.g. a
+    ``BadDamage`` once the viewer's window is gone: ignore instead (the caller sees no frames)."""
+    return 0
+
+
+class Frames:
+    """Count the frames a window draws (X DAMAGE: each buffer swap damages the window).
+
+    Parameters
+    ----------
+    display : str
+        The X display (``":91"``).
+    window : int
+        The window's id (as ``xdotool search`` prints it).
+
+    Notes
+    -----
+    The damage is reported at the "non empty" level and cleared after each report, so one
+    report stands for one or more drawings since the last one. :meth:`mark` clears it (with
+    round trips, so nothing drawn before is counted after); :meth:`wait` then counts reports.
+    """
+
+    def __init__(self, display: str, window: int) -> None:
+        x11 = ctypes.CDLL(ctypes.util.find_library("X11") or "libX11.so.6")
+        xd = ctypes.CDLL(ctypes.util.find_library("Xdamage") or "libXdamage.so.1")
+        vp, ul, ci = ctypes.c_void_p, ctypes.c_ulong, ctypes.c_int
+        x11.XOpenDisplay.restype, x11.XOpenDisplay.argtypes = vp, [ctypes.c_char_p]
+        x11.XSetErrorHandler.argtypes = [_XErrorHandler]
+        for name in ("XPending", "XFlush", "XConnectionNumber", "XCloseDisplay"):
+            getattr(x11, name).argtypes = [vp]
+        x11.XNextEvent.argtypes = [vp, vp]
+        x11.XSync.argtypes = [vp, ci]
+        xd.XDamageQueryExtension.argtypes = [vp, ctypes.POINTER(ci), ctypes.POINTER(ci)]
+        xd.XDamageCreate.restype, xd.XDamageCreate.argtypes = ul, [vp, ul, ci]
+        xd.XDamageSubtract.argtypes = [vp, ul, ul, ul]
+        self._x11, self._xd = x11, xd
+        x11.XSetErrorHandler(_ignore_x_error)
+        self._dpy = x11.XOpenDisplay(display.encode())
+        if not self._dpy:
+            raise RuntimeError(f"cannot open X display {display}")
+        base, err = ctypes.c_int(), ctypes.c_int()
+        if not xd.XDamageQueryExtension(self._dpy, ctypes.byref(base), ctypes.byref(err)):
+            raise RuntimeError(f"X display {display} has no DAMAGE extension")
+        self._notify = base.value  # XDamageNotify is the extension's first event
+        self._damage = xd.XDamageCreate(self._dpy, window, _XDAMAGE_REPORT_NON_EMPTY)
+        self._event = (ctypes.c_long * 24)()  # an XEvent (a union of 24 longs)
+        self.count = 0  # damage reports since the last mark()
+        self.mark()
+
+    def _drain(self) -> None:
+        """Read the events that arrived, counting the damage reports (each re-arms the report).
+        Ends with nothing queued and nothing readable, so ``select`` on the connection wakes
+        at the next report (no round trip here: it would queue events behind ``select``)."""
+        x11 = self._x11
+        while x11.XPending(self._dpy):  # flushes, reads what arrived, counts the queue
+            x11.XNextEvent(self._dpy, self._event)
+            if ctypes.c_int.from_buffer(self._event).value == self._notify:
+                self.count += 1
+                self._xd.XDamageSubtract(self._dpy, self._damage, 0, 0)
+        x11.XFlush(self._dpy)
+
+    def mark(self) -> None:
+        """Count from now: clear the window's damage and forget the reports before (the round
+        trip brings in every report sent before the clear)."""
+        self._xd.XDamageSubtract(self._dpy, self._damage, 0, 0)
+        self._x11.XSync(self._dpy, 0)
+        self._drain()
+        self.count = 0
+
+    def wait(self, n: int, timeout: float, alive: Callable[[], bool] = lambda: True) -> bool:
+        """Wait until ``n`` damage reports arrived since :meth:`mark` (``False`` after
+        ``timeout`` seconds, or as soon as ``alive()`` says the window's owner is gone)."""
+        deadline = time.monotonic() + timeout
+        fd = self._x11.XConnectionNumber(self._dpy)
+        while True:
+            self._drain()
+            if self.count >= n:
+                return True
+            left = deadline - time.monotonic()
+            if left <= 0 or not alive():
+                return False
+            select.select([fd], [], [], min(left, 0.25))
+
+    def close(self) -> None:
+        if self._dpy:
+            self._x11.XCloseDisplay(self._dpy)
+            self._dpy = None
+
+
 # ---------------------------------------------------------------------------- the viewer
 @dataclass
 class App:
@@ -208,6 +316,7 @@ class App:
     proc: subprocess.Popen | None = None
     window: str = ""
     stderr_path: Path = field(init=False)
+    frames: Frames | None = None  # counts the window's frames once it is found
 
     def start(self, title: str = "Polyscope|meshlap", timeout: float = 60.0) -> App:
         self.stderr_path = self.cwd / "stderr.txt"
@@ -230,7 +339,27 @@ class App:
         if not ids:
             raise RuntimeError(f"no window titled {title!r}: {self.stderr()}")
         self.window = ids[0]
+        self.frames = Frames(self.x.display, int(self.window))
         return self
+
+    def drawn(self, n: int = 2, timeout: float = 30.0) -> None:
+        """Wait until the viewer drew ``n`` frames from now on. Called right after an input
+        event was sent, it returns once the viewer has processed the event and drawn the outcome.
+
+        Two frames, not one: the first may end a frame that read its input before the event
+        arrived; the one after it read it.
+
+        Raises
+        ------
+        AssertionError
+            When the viewer died or drew fewer than ``n`` frames in ``timeout`` seconds.
+        """
+        assert self.frames is not None, "App.start() first"
+        self.frames.mark()
+        if not self.frames.wait(n, timeout, self.alive):
+            if not self.alive():
+                raise AssertionError("the viewer died while drawing frames after an input event")
+            raise AssertionError(f"the viewer drew fewer than {n} frames in {timeout:.0f} s")
 
     def title(self) -> str:
         return self.x.xdotool("getwindowname", self.window).strip()
@@ -248,4 +377,7 @@ class App:
         return self.stderr_path.read_text(errors="replace") if self.stderr_path.exists() else ""
 
     def stop(self) -> None:
+        if self.frames is not None:
+            self.frames.close()
+            self.frames = None
         terminate(self.proc)

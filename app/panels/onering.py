@@ -26,7 +26,7 @@ from ..state.onering import (
     arrow_scales,
     weight_segments,
 )
-from ..ui import sig
+from ..text_numbers import sig
 from .base import Host, Panel
 
 NEGATIVE_RGBA = (*scene.NEGATIVE_COLOR, 1.0)

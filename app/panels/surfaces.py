@@ -24,7 +24,7 @@ from ..scene import (
     picked_vertex,
 )
 from ..state.surfaces import ANIMATION, TURN_STEP_DEG, SurfaceState, section_arc
-from ..ui import sig
+from ..text_numbers import sig
 from .base import ExportItem, Host, Panel
 
 
