@@ -30,8 +30,7 @@ import polyscope as ps
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from _util import print_table, shared_mesh
-from meshlap_app.state import CurvatureState, MeshState
-from meshlap_app.state.smoothing import SmoothingState
+from meshlap_app.state import AppState, MeshState
 from meshlap_app.viewer import BUSY_FRAME_S, Viewer, init_polyscope
 
 
@@ -44,7 +43,7 @@ def eigen_in_window(viewer: Viewer, k: int, throttle: float) -> float:
     st.clear()
     st.k_request = k
     t = time.perf_counter()
-    st.start(viewer.mesh.V, viewer.mesh.F)
+    st.start(viewer.state.mesh.V, viewer.state.mesh.F)
     while st.basis is None and not st.error:
         ps.frame_tick()  # the spectral panel adopts the basis when the worker is done
     if st.error:
@@ -74,7 +73,7 @@ def main() -> None:
     mesh.load(path)
     print(f"mesh: {mesh.name}, {len(mesh.V)} vertices")
     init_polyscope("openGL3_egl")
-    viewer = Viewer(mesh, CurvatureState(), panel="spectral")
+    viewer = Viewer(AppState(mesh=mesh, panel="spectral"))
     viewer.sync_mesh()
     ps.set_user_callback(viewer.callback)
     rows = []
@@ -150,16 +149,16 @@ def main() -> None:
     )
 
     # ---- live implicit smoothing -----------------------------------------------------
-    viewer.panel = "smoothing"
+    viewer.state.panel = "smoothing"
     sm = viewer.panels["smoothing"]
-    sm.state = SmoothingState(method="implicit", laplacian="uniform", lam=0.5)
+    sm.state.method, sm.state.laplacian, sm.state.lam = "implicit", "uniform", 0.5
     sm.rebuild(viewer)
     sm.state.step()  # the first step includes the one factorization
-    sm.push()
+    sm.push(viewer)
     t = time.perf_counter()
     for _ in range(args.steps):
         sm.state.step()
-        sm.push()
+        sm.push(viewer)
     ours_sps = args.steps / (time.perf_counter() - t)
     n = len(mesh.V)
     from meshlap_core.laplacian import adjacency_matrix
@@ -188,8 +187,8 @@ def main() -> None:
 
     # ---- idle frame ------------------------------------------------------------------
     for panel in ("curvature", "spectral", "smoothing"):
-        viewer.panel = panel
-        viewer.show_panel()
+        viewer.state.panel = panel
+        viewer.refresh()
         ps.frame_tick()
         cost = []
 
