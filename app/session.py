@@ -111,11 +111,7 @@ def apply(
             raise MeshError(f"cannot open its mesh: {mesh.error}", source)
     check_session_mesh(session, mesh, source)
     state = host.state
-    if mesh is not state.mesh:  # the new mesh goes into the app's MeshState (bumped version)
-        for name in ("V", "F", "name", "info", "path"):
-            setattr(state.mesh, name, getattr(mesh, name))
-        state.mesh.error = ""
-        state.mesh.version += 1
+    state.mesh.show(mesh)  # the app's one MeshState takes it (its version moves on)
     host.set_ui_scale(session.ui_scale)
     sections = session.settings
     for name, p in host.panels.items():

@@ -50,6 +50,21 @@ class MeshState:
     version: int = 0  # bumped on every successful load, so panels know to recompute
     path: Path | None = None  # the file loaded (resolved); None for the generated default
 
+    def show(self, other: MeshState) -> None:
+        """Take the mesh ``other`` loaded (a session's, read before anything changed): its
+        arrays, name, info and path; the version moves on, so everything derived is redone."""
+        if other is self:
+            return
+        self.V, self.F, self.name, self.info, self.path = (
+            other.V,
+            other.F,
+            other.name,
+            other.info,
+            other.path,
+        )
+        self.error = ""
+        self.version += 1
+
     @property
     def stem(self) -> str:
         """The mesh's name without its extension (for output file names)."""
