@@ -31,7 +31,7 @@ from .mesh import Mesh, MeshReport, Polygons
 from .mesh import count_phrase as _count
 from .options import DEGENERATE_REL, MAX_COORDINATE, MIN_EXTENT, SLIVER_ANGLE
 from .topology import sort_with_order as _sort_with_order
-from .topology import topology_report
+from .topology import topology_report, topology_report_with_table
 from .types import BoolArray, FloatArray, IntArray
 
 __all__ = [
@@ -578,16 +578,18 @@ def validate_mesh(
             "vertex (not welded: the surface has a crack or seam there)"
         )
 
-    report = topology_report(F, len(V))
+    F = np.ascontiguousarray(F, dtype=np.int64)
+    report, table = topology_report_with_table(F, len(V))
     report.n_input_vertices = n
     report.n_input_faces = n_faces_in
     report.repairs = rep_list
     report.warnings = warn_list + report.warnings
     return Mesh(
         V=np.ascontiguousarray(V, dtype=np.float64),
-        F=np.ascontiguousarray(F, dtype=np.int64),
+        F=F,
         source=src,
         report=report,
         vertex_map=vmap0,
         face_map=face_map.astype(np.int64),
+        edge_table=table,
     )

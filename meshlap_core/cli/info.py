@@ -20,7 +20,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     mesh = load_mesh(args.mesh)
-    info = mesh_info(mesh.V, mesh.F, mesh.report, str(args.mesh))
+    info = mesh_info(mesh.V, mesh.F, mesh.report, str(args.mesh), table=mesh.edge_table)
     if args.json:
         emit_json(info)
     else:

@@ -1,0 +1,98 @@
+"""Scale work (issue 21): the shared sorted-edge structures equal the graph-based ones."""
+
+import numpy as np
+import pytest
+
+from meshlap_core import primitives, topology, validate_mesh
+from meshlap_core.topology.edges import EdgeTable
+
+
+def _wedges_by_graph(t: EdgeTable) -> np.ndarray:
+    """Wedges per vertex from the corner graph of :meth:`EdgeTable.wedges` (the reference)."""
+    count, labels = t.wedges()
+    wedge_vertex = np.empty(count, dtype=np.int64)
+    wedge_vertex[labels] = t.F.ravel()
+    return np.bincount(wedge_vertex, minlength=t.n)
+
+
+def _bowtie() -> np.ndarray:
+    """Two icospheres glued at one vertex (two closed fans there)."""
+    _, F = primitives.icosphere(1)
+    n = int(F.max()) + 1
+    return np.vstack([F, np.where(F == 0, 0, F + n)])
+
+
+def _flipped() -> np.ndarray:
+    _, F = primitives.icosphere(2)
+    F = F.copy()
+    F[:10] = F[:10, ::-1]  # 10 faces inconsistently oriented
+    return F
+
+
+def _soup() -> np.ndarray:
+    F = np.random.default_rng(0).integers(0, 30, (300, 3))
+    return F[(F[:, 0] != F[:, 1]) & (F[:, 1] != F[:, 2]) & (F[:, 0] != F[:, 2])]
+
+
+def _cones_sharing_boundary_vertex() -> np.ndarray:
+    """Two fans of a grid corner vertex: an open fan plus a closed fan on the same vertex."""
+    _, Fg = primitives.grid(4, 4)
+    _, Fs = primitives.icosphere(1)
+    n = int(Fg.max()) + 1
+    return np.vstack([Fg, np.where(Fs == 0, 5, Fs + n)])
+
+
+CASES = {
+    "icosphere": lambda: primitives.icosphere(3)[1],
+    "torus": lambda: primitives.torus()[1],
+    "grid (boundary)": lambda: primitives.grid(7, 5)[1],
+    "cube": lambda: primitives.cube(1)[1],
+    "bowtie vertex": _bowtie,
+    "non-manifold edge": lambda: np.array([[0, 1, 2], [1, 0, 3], [0, 1, 4], [2, 1, 5]]),
+    "inconsistent orientation": _flipped,
+    "open fan + closed fan": _cones_sharing_boundary_vertex,
+    "single triangle": lambda: np.array([[0, 1, 2]]),
+    "random soup": _soup,
+}
+
+
+@pytest.mark.parametrize("name", list(CASES))
+def test_wedge_counts_equal_the_corner_graph(name):
+    F = CASES[name]()
+    t = EdgeTable.from_faces(F, int(F.max()) + 3)  # two unreferenced vertices
+    got = t.wedge_counts()
+    np.testing.assert_array_equal(got, _wedges_by_graph(t))
+    assert got[-2:].tolist() == [0, 0]
+
+
+@pytest.mark.parametrize("name", list(CASES))
+def test_vertex_components_equal_the_face_graph(name):
+    F = CASES[name]()
+    n = int(F.max()) + 3
+    t = EdgeTable.from_faces(F, n)
+    count, labels = t.vertex_components
+    ref_count, ref_labels = topology.connected_components(F, n)
+    assert count == ref_count
+    # the same partition (numbering may differ)
+    pairs = np.unique(np.stack([labels, ref_labels], axis=1), axis=0)
+    assert len(pairs) == count
+
+
+def test_bowtie_and_two_fans_are_non_manifold_vertices():
+    t = EdgeTable.from_faces(_bowtie())
+    assert t.wedge_counts()[0] == 2
+    t = EdgeTable.from_faces(_cones_sharing_boundary_vertex())
+    assert t.wedge_counts()[5] == 2
+
+
+def test_validated_mesh_shares_its_edge_table():
+    V, F = primitives.icosphere(2)
+    mesh = validate_mesh(V, F)
+    t = mesh.edge_table
+    assert isinstance(t, EdgeTable) and t.n == mesh.n_vertices
+    np.testing.assert_array_equal(t.F, mesh.F)
+    ref = EdgeTable.from_faces(mesh.F, mesh.n_vertices)
+    np.testing.assert_array_equal(t.edges, ref.edges)
+    assert topology.surface_summary(mesh.F, mesh.n_vertices, table=t) == (
+        topology.surface_summary(mesh.F, mesh.n_vertices)
+    )
