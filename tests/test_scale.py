@@ -96,3 +96,56 @@ def test_validated_mesh_shares_its_edge_table():
     assert topology.surface_summary(mesh.F, mesh.n_vertices, table=t) == (
         topology.surface_summary(mesh.F, mesh.n_vertices)
     )
+
+
+# ----------------------------------------------------------------------------- solver back ends
+
+
+def _implicit_run(lam: float = 0.5, iters: int = 3) -> np.ndarray:
+    from meshlap_core import Smoother
+
+    V, F = primitives.bumpy_sphere(2)
+    s = Smoother(V, F, method="implicit", laplacian="cotan", lam=lam * 1e-2)
+    for _ in range(iters):
+        s.step()
+    return s.V.copy()
+
+
+def test_both_solver_backends_give_the_same_solutions(monkeypatch):
+    import scipy.sparse as sp
+
+    from meshlap_core.linalg import spd
+
+    if spd.solver_backend() != "cholmod":
+        pytest.skip("scikit-sparse is not installed (README: Fast solver)")
+    V, F = primitives.bumpy_sphere(2)
+    from meshlap_core.smoothing.stepper import operator_parts
+
+    W, K = operator_parts(V, F, "cotan")
+    A = (sp.diags(W) - 0.01 * K).tocsr()
+    fast = spd.SPDSolver(A)
+    assert fast.backend == "cholmod"
+    fast_run = _implicit_run()
+    monkeypatch.setenv(spd.SOLVER_ENV, "fallback")
+    slow = spd.SPDSolver(A)
+    assert slow.backend == "cholespy"
+    for B in (V, V[:, 0]):
+        np.testing.assert_allclose(fast.solve(B), slow.solve(B), rtol=0, atol=1e-12)
+    np.testing.assert_allclose(fast_run, _implicit_run(), rtol=0, atol=1e-12)
+
+
+def test_info_names_the_solver_backend(monkeypatch, spd_backend, capsys):
+    import json
+
+    from meshlap_core.cli import main
+
+    path = str(__import__("pathlib").Path(__file__).resolve().parents[1] / "assets" / "bumpy.obj")
+    assert main(["info", path, "--json"]) == 0
+    solver = json.loads(capsys.readouterr().out)["solver"]
+    assert solver["backend"] == spd_backend
+    assert solver["fast"] == (spd_backend == "cholmod")
+    assert main(["info", path]) == 0
+    line = capsys.readouterr().out.splitlines()[-1]
+    assert line.startswith("solver") and spd_backend in line
+    if spd_backend != "cholmod":
+        assert "[fast]" in line and "libsuitesparse-dev" in line
