@@ -149,3 +149,77 @@ def test_info_names_the_solver_backend(monkeypatch, spd_backend, capsys):
     assert line.startswith("solver") and spd_backend in line
     if spd_backend != "cholmod":
         assert "[fast]" in line and "libsuitesparse-dev" in line
+
+
+# ----------------------------------------------------------------------------- cancel hooks
+
+
+class _CancelAfter:
+    """A ``cancel`` callable that asks to stop from its ``after``-th poll on (counts polls)."""
+
+    def __init__(self, after: int) -> None:
+        self.after, self.polls = after, 0
+
+    def __call__(self) -> bool:
+        self.polls += 1
+        return self.polls >= self.after
+
+
+def test_cancel_stops_the_eigensolver_between_lanczos_blocks(tmp_path):
+    from meshlap_core import SpectralBasis
+    from meshlap_core.errors import Cancelled
+
+    V, F = primitives.icosphere(4)  # 2,562 vertices: the sparse (Lanczos) solver
+    seen = []
+    cancel = _CancelAfter(5)
+    with pytest.raises(Cancelled, match="eigenbasis cancelled"):
+        SpectralBasis.compute(
+            V, F, 30, cache_dir=tmp_path, progress=lambda f, m: seen.append(f), cancel=cancel
+        )
+    assert cancel.polls == 5  # stopped at the first poll that asked, not at the end
+    assert not list(tmp_path.iterdir())  # nothing cached
+    basis = SpectralBasis.compute(V, F, 30, cache_dir=tmp_path, cancel=_CancelAfter(10**9))
+    assert basis.k_max == 30
+
+
+def test_cancel_event_already_set_stops_before_any_work():
+    import threading
+
+    from meshlap_core import Smoother, SpectralBasis, load_mesh
+    from meshlap_core.errors import Cancelled
+
+    V, F = primitives.icosphere(2)
+    ev = threading.Event()
+    ev.set()
+    with pytest.raises(Cancelled, match="eigenbasis cancelled"):
+        SpectralBasis.compute(V, F, 5, cache=False, cancel=ev)
+    s = Smoother(V, F, "implicit", "cotan", lam=1e-3)
+    with pytest.raises(Cancelled, match="smoothing cancelled"):
+        s.run(5, cancel=ev)
+    assert s.iteration == 0
+    bumpy = __import__("pathlib").Path(__file__).resolve().parents[1] / "assets" / "bumpy.obj"
+    with pytest.raises(Cancelled, match="loading cancelled"):
+        load_mesh(bumpy, cancel=ev)
+
+
+def test_smoothing_run_reports_progress_and_cancels_between_iterations():
+    from meshlap_core import Smoother
+    from meshlap_core.errors import Cancelled
+
+    V, F = primitives.bumpy_sphere(2)
+    s = Smoother(V, F, "implicit", "cotan", lam=1e-3)
+    seen = []
+    s.run(3, progress=lambda f, m: seen.append((f, m)))
+    assert "factorizing" in seen[0][1] and seen[-1][0] == 1.0 and s.iteration == 3
+    with pytest.raises(Cancelled):
+        s.run(10, cancel=_CancelAfter(3))
+    assert s.iteration == 5  # two more done, the third was cancelled before it started
+
+
+def test_load_mesh_reports_its_phases():
+    from meshlap_core import load_mesh
+
+    bumpy = __import__("pathlib").Path(__file__).resolve().parents[1] / "assets" / "bumpy.obj"
+    seen = []
+    mesh = load_mesh(bumpy, progress=lambda f, m: seen.append((f, m)))
+    assert [f for f, _ in seen] == [0.0, 0.1, 0.5, 1.0] and mesh.n_faces > 0
