@@ -223,3 +223,35 @@ def test_load_mesh_reports_its_phases():
     seen = []
     mesh = load_mesh(bumpy, progress=lambda f, m: seen.append((f, m)))
     assert [f for f, _ in seen] == [0.0, 0.1, 0.5, 1.0] and mesh.n_faces > 0
+
+
+def test_shift_invert_on_both_backends_counts_and_solves_alike(spd_backend):
+    import scipy.sparse as sp
+
+    from meshlap_core.linalg import factor
+
+    rng = np.random.default_rng(6)
+    n = 400
+    A = sp.random(n, n, density=0.01, random_state=6)
+    A = (A + A.T + sp.diags(rng.uniform(-3.0, 5.0, n))).tocsr()
+    op = factor.ShiftInvert(A, 0.25, rng=rng, spacing=1.0)
+    kind = factor.CholmodLDLFactor if spd_backend == "cholmod" else factor.QDLDLFactor
+    assert isinstance(op.factor, kind)
+    assert op.n_below == np.count_nonzero(np.linalg.eigvalsh(A.toarray()) < op.sigma)
+    Y = np.asfortranarray(rng.standard_normal((n, 4)))
+    out = np.empty_like(Y)
+    op(Y, out)
+    S = (A - op.sigma * sp.identity(n)).toarray()
+    np.testing.assert_allclose(out, np.linalg.solve(S, Y), rtol=1e-8, atol=1e-10)
+
+
+def test_eigenbasis_is_the_same_on_both_backends(spd_backend):
+    from meshlap_core.linalg.eigsolve import pencil_eigenpairs
+    from meshlap_core.spectral.operators import spectral_operators
+
+    V, F = primitives.bumpy_sphere(3)  # 642 vertices: forced onto the sparse solver below
+    K, m = spectral_operators(V, F, "cotan", "voronoi")
+    lam, U, _ = pencil_eigenpairs(K, m, 40, method="sparse")
+    lam_d, U_d, _ = pencil_eigenpairs(K, m, 40, method="dense")
+    np.testing.assert_allclose(lam, lam_d, rtol=1e-8, atol=1e-10)
+    np.testing.assert_allclose(np.abs(U.T @ (m[:, None] * U_d)).max(axis=1), 1.0, atol=1e-6)

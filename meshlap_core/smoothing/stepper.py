@@ -142,6 +142,15 @@ class Smoother:
     n_factorizations : int
         How many times a linear system was factorized (1 for a frozen implicit smoother).
 
+    Notes
+    -----
+    Memory: the smoother holds two per-vertex position arrays, the input ``V0`` and the
+    current ``V`` (plus ``reference`` when given, and the per-vertex areas), never a history
+    of positions: a step replaces ``V``. :attr:`history` holds scalars only (about 0.5 kB per
+    entry), bounded by ``history_limit`` or ``history_samples`` (the CLI keeps at most
+    :data:`~meshlap_core.cli.smooth.HISTORY_SAMPLES`, the window 1,000); only the default
+    (``None``, for scripts) keeps one entry per iteration.
+
     Examples
     --------
     >>> from meshlap_core.primitives import bumpy_sphere
