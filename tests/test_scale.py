@@ -255,3 +255,21 @@ def test_eigenbasis_is_the_same_on_both_backends(spd_backend):
     lam_d, U_d, _ = pencil_eigenpairs(K, m, 40, method="dense")
     np.testing.assert_allclose(lam, lam_d, rtol=1e-8, atol=1e-10)
     np.testing.assert_allclose(np.abs(U.T @ (m[:, None] * U_d)).max(axis=1), 1.0, atol=1e-6)
+
+
+def test_prefer_gil_free_keeps_the_eigensolver_on_qdldl(spd_backend):
+    import scipy.sparse as sp
+
+    from meshlap_core.linalg import factor, spd
+
+    A = (sp.random(50, 50, density=0.1, random_state=1) + sp.identity(50) * 3).tocsr()
+    A = ((A + A.T) * 0.5).tocsr()
+    rng = np.random.default_rng(0)
+    try:
+        spd.prefer_gil_free(True)
+        assert spd.eigen_backend() == "qdldl"
+        op = factor.ShiftInvert(A, 0.5, rng=rng, spacing=1.0)
+        assert isinstance(op.factor, factor.QDLDLFactor)
+    finally:
+        spd.prefer_gil_free(False)
+    assert spd.eigen_backend() == ("cholmod" if spd_backend == "cholmod" else "qdldl")

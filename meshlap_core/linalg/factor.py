@@ -202,15 +202,16 @@ def cholmod_inertia(
     Raises
     ------
     ImportError
-        scikit-sparse is not installed, or ``MESHLAP_SOLVER=fallback`` (the caller falls back
-        to QDLDL).
+        scikit-sparse is not installed, ``MESHLAP_SOLVER=fallback``, or
+        :func:`~meshlap_core.linalg.spd.prefer_gil_free` is on (the caller falls back to
+        QDLDL). CHOLMOD holds the GIL while it factors and solves.
     UnstableFactorization
         A zero, tiny or non-finite pivot.
     """
-    from .spd import solver_backend
+    from .spd import eigen_backend
 
-    if solver_backend() != "cholmod":
-        raise ImportError("CHOLMOD (scikit-sparse) is not in use")
+    if eigen_backend() != "cholmod":
+        raise ImportError("CHOLMOD (scikit-sparse) is not in use (or prefer_gil_free is on)")
     from sksparse.cholmod import CholmodError, CholmodWarning, analyze
 
     csc = sp.csc_matrix((A.data, A.indices, A.indptr), shape=A.shape)  # symmetric: A itself

@@ -4,9 +4,10 @@
 the first available one is used (:func:`solver_backend` names it):
 
 * ``"cholmod"``: scikit-sparse (``sksparse.cholmod``) on the system's SuiteSparse with an
-  optimised BLAS; the fastest factorization measured (2.2× cholespy's at 692k vertices; see
+  optimised BLAS; the fastest factorization measured (2–3× cholespy's at 692k vertices; see
   ``docs/benchmarks.md``). Optional: ``pip install -e '.[fast]'`` after
-  ``apt-get install libsuitesparse-dev libopenblas0-pthread`` (:data:`FAST_SOLVER_HINT`).
+  ``apt-get install libsuitesparse-dev libopenblas0-pthread gcc python3-dev`` (it builds
+  against the system's SuiteSparse; :data:`FAST_SOLVER_HINT`).
 * ``"cholespy"``: CHOLMOD bundled in a wheel with its reference BLAS (a dependency: always
   there).
 * ``"superlu"``: SciPy's SuperLU, when neither is importable.
@@ -34,12 +35,40 @@ from .quiet import quiet_c_stdout
 SOLVER_ENV = "MESHLAP_SOLVER"
 #: how to get the fast back end (README, "Fast solver")
 FAST_SOLVER_HINT = (
-    "apt-get install libsuitesparse-dev libopenblas0-pthread && pip install -e '.[fast]'"
+    "apt-get install libsuitesparse-dev libopenblas0-pthread gcc python3-dev && "
+    "pip install -e '.[fast]'"
 )
 
 
 #: smallest pivot ratio ``min D / max D`` a CHOLMOD factor may have (64 ε)
 PIVOT_RATIO = 64 * np.finfo(float).eps
+
+
+_GIL_FREE = {"eigen": False}
+
+
+def prefer_gil_free(on: bool = True) -> None:
+    """Keep the eigensolver off CHOLMOD (scikit-sparse), whose factorizations and solves hold
+    the GIL (about 0.3 s per factorization at 43k vertices, 10 s at 692k), for a process whose
+    other threads must keep running meanwhile, such as a window computing an eigenbasis in a
+    worker thread: the shift-invert factors then use QDLDL, which releases it. The
+    implicit smoother's one factorization holds the GIL on every back end (cholespy too).
+
+    Parameters
+    ----------
+    on : bool
+        ``False`` restores the default (CHOLMOD whenever :func:`solver_backend` says so).
+    """
+    _GIL_FREE["eigen"] = bool(on)
+
+
+def eigen_backend() -> str:
+    """The ``LDLᵀ`` back end of the eigensolver: ``"cholmod"`` when :func:`solver_backend` is
+    ``"cholmod"`` and :func:`prefer_gil_free` is off, else ``"qdldl"`` (SuperLU when that is
+    missing)."""
+    if solver_backend() == "cholmod" and not _GIL_FREE["eigen"]:
+        return "cholmod"
+    return "qdldl"
 
 
 def solver_backend() -> str:
@@ -63,12 +92,18 @@ def solver_info() -> dict[str, Any]:
     Returns
     -------
     info : dict
-        ``backend`` (:func:`solver_backend`), ``fast`` (``True`` for CHOLMOD through
-        scikit-sparse) and ``hint`` (how to install the fast one; ``None`` when active).
+        ``backend`` (:func:`solver_backend`), ``eigen_backend`` (:func:`eigen_backend`),
+        ``fast`` (``True`` for CHOLMOD through scikit-sparse) and ``hint`` (how to install
+        the fast one; ``None`` when active).
     """
     backend = solver_backend()
     fast = backend == "cholmod"
-    return {"backend": backend, "fast": fast, "hint": None if fast else FAST_SOLVER_HINT}
+    return {
+        "backend": backend,
+        "eigen_backend": eigen_backend(),
+        "fast": fast,
+        "hint": None if fast else FAST_SOLVER_HINT,
+    }
 
 
 def surely_positive_definite(A: sp.csr_matrix, margin: float = 1e-8) -> bool:
