@@ -40,7 +40,7 @@ FAST_SOLVER_HINT = (
 )
 
 
-#: smallest pivot ratio ``min D / max D`` a CHOLMOD factor may have (64 ε)
+#: smallest ratio ``D_k / A_kk`` (pivot over its diagonal entry) a CHOLMOD factor may have
 PIVOT_RATIO = 64 * np.finfo(float).eps
 
 
@@ -158,7 +158,9 @@ class SPDSolver:
     Raises
     ------
     numpy.linalg.LinAlgError
-        When the factorization finds ``A`` not numerically positive definite.
+        When the factorization finds ``A`` not numerically positive definite (with CHOLMOD
+        through scikit-sparse: when cholespy does too; ``self.backend`` then says which one
+        factored).
     """
 
     def __init__(
@@ -183,8 +185,14 @@ class SPDSolver:
             old = reuse._cholmod if same else None  # type: ignore[union-attr]
             if reuse is not None:
                 reuse._cholmod = None  # spent, whatever happens below
-            self._cholmod = _cholmod_factor(A, old)
-            return
+            try:
+                self._cholmod = _cholmod_factor(A, old)
+                return
+            except np.linalg.LinAlgError:
+                # at the edge of double precision, whether a pivot comes out positive depends
+                # on rounding: the bundled CHOLMOD is asked too before the matrix is refused,
+                # so nothing the fallback factors is refused here
+                self.backend = "cholespy"
         if self.backend == "superlu":
             self._lu = sla.splu(A.tocsc())
             return
@@ -232,10 +240,11 @@ def _cholmod_factor(A: sp.csr_matrix, reuse: Any = None) -> Any:
     except (CholmodError, CholmodWarning):
         raise refused from None
     if not surely_positive_definite(A):
-        # the pivots D = diag(L)²: CHOLMOD only stops at a pivot <= 0, so a pivot within
-        # round-off of the largest (condition beyond ~1e13: W − λK with λ beyond double
-        # precision, where cholespy's reference BLAS happens to meet a negative one) is refused
-        D = factor.D()
-        if not (np.all(np.isfinite(D)) and D.min() > PIVOT_RATIO * D.max()):
+        # the pivots D = diag(L)²: CHOLMOD only stops at a pivot <= 0, so a pivot that
+        # cancelled to round-off of its own diagonal entry (W − λK with λ beyond double
+        # precision, where cholespy's reference BLAS happens to meet a negative one) is refused;
+        # relative to its own row, so components of very different scales are not refused
+        D = factor.D()  # in the factor's order P: pivot k eliminates row P[k]
+        if not (np.all(np.isfinite(D)) and np.all(D > PIVOT_RATIO * A.diagonal()[factor.P()])):
             raise refused
     return factor
