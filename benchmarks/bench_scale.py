@@ -5,6 +5,7 @@ Run from the repository root::
     python benchmarks/bench_scale.py            # the 692k and the 2.77M scan, 3 repeats
     python benchmarks/bench_scale.py --quick    # the 692k scan only, 1-2 repeats
     python benchmarks/bench_scale.py --only load,smooth   # some figures only
+    python benchmarks/bench_scale.py --big-only --only load,cli  # the 2.77M scan only
 
 The scans are made in a temporary folder (never in the checkout) by one and two
 ``igl.upsample`` of ``../shared/meshes/armadillo_loop.obj`` (691,858 and 2,766,274 vertices)
@@ -326,6 +327,7 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=None, help="runs per figure (default 3)")
     ap.add_argument("--only", default="load,cli,smooth,spectral", help="figures to run")
     ap.add_argument("--keep", type=Path, default=None, help="keep/reuse the scans in this folder")
+    ap.add_argument("--big-only", action="store_true", help="the 2.77M scan only")
     args = ap.parse_args()
     repeat = args.repeat or (2 if args.quick else 3)
     only = set(args.only.split(","))
@@ -337,18 +339,21 @@ def main() -> None:
         folder = Path(tmp)
     folder.mkdir(parents=True, exist_ok=True)
     try:
-        scans = make_scans(folder, big=not args.quick)
+        scans = make_scans(folder, big=not args.quick or args.big_only)
+        if args.big_only:
+            scans = scans[1:]
         eigsh_mesh = SHARED / "armadillo_igl.obj"
         rows: list[Row] = []
-        for i, scan in enumerate(scans):
-            reps = 1 if i else repeat  # the 2.77M scan once
+        for scan in scans:
+            big = "2770k" in scan.name
+            reps = 1 if big else repeat  # the 2.77M scan once
             if "load" in only:
                 rows += fig_load(scan, reps)
             if "cli" in only:
                 rows += fig_cli(scan, reps)
             if "smooth" in only:
                 rows += fig_smooth(scan, reps)
-            if "spectral" in only and i == 0:
+            if "spectral" in only and not big:
                 rows += fig_spectral(scan, reps, eigsh_mesh if eigsh_mesh.is_file() else None)
             for fig in VIEWER_FIGURES:
                 rows += fig(scan, reps)

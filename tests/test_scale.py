@@ -273,3 +273,18 @@ def test_prefer_gil_free_keeps_the_eigensolver_on_qdldl(spd_backend):
     finally:
         spd.prefer_gil_free(False)
     assert spd.eigen_backend() == ("cholmod" if spd_backend == "cholmod" else "qdldl")
+
+
+def test_duplicate_faces_beyond_two_million_vertices_match_np_unique():
+    from meshlap_core.validate import duplicate_faces
+
+    rng = np.random.default_rng(0)
+    n = 3_000_000  # n³ overflows int64: the (S0·n + S1, S2) lexsort path
+    F = rng.integers(0, n, (5000, 3))
+    F = np.vstack([F, F[:50, [1, 2, 0]], F[:7, [2, 1, 0]]])
+    F = F[rng.permutation(len(F))]
+    _, first = np.unique(np.sort(F, axis=1), axis=0, return_index=True)
+    ref = np.ones(len(F), dtype=bool)
+    ref[first] = False
+    np.testing.assert_array_equal(duplicate_faces(F, n), ref)
+    assert ref.sum() == 57
