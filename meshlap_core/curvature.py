@@ -51,16 +51,27 @@ def _face_geometry(V: FloatArray, F: IntArray) -> tuple[FloatArray, FloatArray]:
     ``|e₁ × e₂|`` is twice the face area at every corner, so
     ``θ_i = atan2(2A, e₁ · e₂)`` needs only three dot products more.
     """
-    P = V[F]
-    e0 = P[:, 2] - P[:, 1]  # opposite corner 0
-    e1 = P[:, 0] - P[:, 2]  # opposite corner 1
-    e2 = P[:, 1] - P[:, 0]  # opposite corner 2
-    fn = np.cross(e2, -e1)
+    # one contiguous array per coordinate (strided (m,3) slices made this 3x slower at 1.4M
+    # faces); e_i is the edge opposite corner i
+    X = [np.ascontiguousarray(V[:, d]) for d in range(3)]
+    c0, c1, c2 = (np.ascontiguousarray(F[:, i]) for i in range(3))
+    e0 = [x[c2] - x[c1] for x in X]
+    e1 = [x[c0] - x[c2] for x in X]
+    e2 = [x[c1] - x[c0] for x in X]
+    # fn = e2 × (−e1) = e1 × e2
+    fn = np.empty((len(F), 3))
+    fn[:, 0] = e1[1] * e2[2] - e1[2] * e2[1]
+    fn[:, 1] = e1[2] * e2[0] - e1[0] * e2[2]
+    fn[:, 2] = e1[0] * e2[1] - e1[1] * e2[0]
     dbl = np.sqrt(np.einsum("ij,ij->i", fn, fn))
+
+    def dot(a: list[FloatArray], b: list[FloatArray]) -> FloatArray:
+        return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
     theta = np.empty(F.shape)
-    theta[:, 0] = np.arctan2(dbl, -np.einsum("ij,ij->i", e2, e1))
-    theta[:, 1] = np.arctan2(dbl, -np.einsum("ij,ij->i", e0, e2))
-    theta[:, 2] = np.arctan2(dbl, -np.einsum("ij,ij->i", e1, e0))
+    theta[:, 0] = np.arctan2(dbl, -dot(e2, e1))
+    theta[:, 1] = np.arctan2(dbl, -dot(e0, e2))
+    theta[:, 2] = np.arctan2(dbl, -dot(e1, e0))
     fn = np.divide(fn, dbl[:, None], out=np.zeros_like(fn), where=dbl[:, None] > 0)
     return fn, theta
 

@@ -13,7 +13,11 @@ from .types import FloatArray, IntArray, as_mesh
 
 
 def mesh_info(
-    V: FloatArray, F: IntArray, report: Any = None, source: str | None = None
+    V: FloatArray,
+    F: IntArray,
+    report: Any = None,
+    source: str | None = None,
+    table: Any = None,
 ) -> dict[str, Any]:
     """Counts, bounding box, boundary, components, χ, genus, manifoldness and repairs.
 
@@ -25,6 +29,8 @@ def mesh_info(
         The validator's report (repairs, warnings, manifoldness, orientation).
     source : str, optional
         File name to include.
+    table : EdgeTable, optional
+        The edge table of ``F`` (``Mesh.edge_table``), reused instead of rebuilt.
 
     Returns
     -------
@@ -37,7 +43,7 @@ def mesh_info(
     if n == 0:
         raise MeshError("the mesh has no vertices", source or "V")
     lo, hi = V.min(axis=0), V.max(axis=0)
-    summary = topology.surface_summary(F, n)
+    summary = topology.surface_summary(F, n, table=table)
     info: dict[str, Any] = {
         "file": source,
         "n_vertices": n,

@@ -8,6 +8,7 @@ file (or argument) and the problem, e.g. ``"bunny.obj: face 12 has index 40 but 
 from __future__ import annotations
 
 import os
+from typing import Any
 
 #: the short escapes of :func:`printable` (the other non-printable characters get ``\\xNN``)
 _ESCAPES = {"\n": "\\n", "\r": "\\r", "\t": "\\t"}
@@ -75,3 +76,31 @@ class MeshError(ValueError):
 
 class MeshWarning(UserWarning):
     """Something was repaired or is numerically doubtful; the result is still usable."""
+
+
+class Cancelled(Exception):
+    """A long operation stopped because its caller asked it to (the ``cancel`` argument).
+
+    Raised between steps (Lanczos blocks, smoothing iterations, load phases), never in the
+    middle of one; the operation's inputs and any object it belongs to are left as they were
+    before the cancelled call (a :class:`~meshlap_core.Smoother` keeps the steps it finished).
+    """
+
+
+#: what a ``cancel=`` argument accepts: a ``threading.Event`` (set to cancel), a callable
+#: returning ``True`` to cancel, or ``None``
+Cancel = Any
+
+
+def cancelled(cancel: Cancel) -> bool:
+    """Whether ``cancel`` (an object with ``is_set()``, a callable, or ``None``) asks to stop."""
+    if cancel is None:
+        return False
+    is_set = getattr(cancel, "is_set", None)
+    return bool(is_set() if is_set is not None else cancel())
+
+
+def check_cancel(cancel: Cancel, what: str) -> None:
+    """Raise :class:`Cancelled` (``"<what> cancelled"``) when ``cancel`` asks to stop."""
+    if cancelled(cancel):
+        raise Cancelled(f"{what} cancelled")

@@ -136,6 +136,11 @@ class Mesh:
         for STL the index of the first triangle corner welded into vertex ``i``).
     face_map : (m,) int64
         ``face_map[f]`` is the index of the input face (polygon) that triangle ``f`` comes from.
+    edge_table : EdgeTable or None
+        The :class:`~meshlap_core.topology.EdgeTable` of ``F`` the validator built (one sort
+        of the half-edges, with the vertex components), shared by the callers that need edges
+        (``meshlap info``, the boundary of a smoother) instead of rebuilt; ``None`` when the
+        mesh was made by hand. Do not modify ``F`` in place while it is set.
     """
 
     V: FloatArray
@@ -144,6 +149,7 @@ class Mesh:
     report: MeshReport
     vertex_map: IntArray = field(repr=False, default_factory=lambda: np.zeros(0, np.int64))
     face_map: IntArray = field(repr=False, default_factory=lambda: np.zeros(0, np.int64))
+    edge_table: Any = field(repr=False, default=None)  # topology.EdgeTable (no import cycle)
 
     @property
     def n_vertices(self) -> int:

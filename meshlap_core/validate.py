@@ -31,7 +31,7 @@ from .mesh import Mesh, MeshReport, Polygons
 from .mesh import count_phrase as _count
 from .options import DEGENERATE_REL, MAX_COORDINATE, MIN_EXTENT, SLIVER_ANGLE
 from .topology import sort_with_order as _sort_with_order
-from .topology import topology_report
+from .topology import topology_report, topology_report_with_table
 from .types import BoolArray, FloatArray, IntArray, exact_indices, real_array
 
 __all__ = [
@@ -350,8 +350,15 @@ def duplicate_faces(F: IntArray, n: int) -> BoolArray:
             return np.zeros(len(F), dtype=bool)
         # first occurrence in file order = smallest face index of each group
         first = np.minimum.reduceat(order, np.flatnonzero(new))
-    else:
-        _, first = np.unique(S, axis=0, return_index=True)
+    else:  # n^3 overflows int64: sort by (S0·n + S1, S2) (np.unique(axis=0) took minutes)
+        order = np.lexsort((S[:, 2], S[:, 0] * np.int64(n) + S[:, 1]))
+        Ss = S[order]
+        new = np.empty(len(Ss), dtype=bool)
+        new[0] = True
+        np.any(Ss[1:] != Ss[:-1], axis=1, out=new[1:])
+        if new.all():
+            return np.zeros(len(F), dtype=bool)
+        first = np.minimum.reduceat(order, np.flatnonzero(new))
     dup = np.ones(len(F), dtype=bool)
     dup[first] = False
     return dup
@@ -575,16 +582,18 @@ def validate_mesh(
             "vertex (not welded: the surface has a crack or seam there)"
         )
 
-    report = topology_report(F, len(V))
+    F = np.ascontiguousarray(F, dtype=np.int64)
+    report, table = topology_report_with_table(F, len(V))
     report.n_input_vertices = n
     report.n_input_faces = n_faces_in
     report.repairs = rep_list
     report.warnings = warn_list + report.warnings
     return Mesh(
         V=np.ascontiguousarray(V, dtype=np.float64),
-        F=np.ascontiguousarray(F, dtype=np.int64),
+        F=F,
         source=src,
         report=report,
         vertex_map=vmap0,
         face_map=face_map.astype(np.int64),
+        edge_table=table,
     )

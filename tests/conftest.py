@@ -37,6 +37,22 @@ def shared_mesh() -> Callable[[str], Path]:
     return get
 
 
+@pytest.fixture(params=["cholmod", "fallback"])
+def spd_backend(request, monkeypatch) -> str:
+    """Run a solver-sensitive test on both sparse Cholesky back ends: CHOLMOD through
+    scikit-sparse (skipped when not installed, README "Fast solver") and the bundled fallback
+    (``MESHLAP_SOLVER=fallback``). Returns the active back end's name."""
+    from meshlap_core.linalg.spd import SOLVER_ENV, solver_backend
+
+    if request.param == "fallback":
+        monkeypatch.setenv(SOLVER_ENV, "fallback")
+    else:
+        monkeypatch.delenv(SOLVER_ENV, raising=False)
+        if solver_backend() != "cholmod":
+            pytest.skip("scikit-sparse is not installed (README: Fast solver)")
+    return solver_backend()
+
+
 @pytest.fixture(scope="module")
 def polyscope_mock(tmp_path_factory):
     """polyscope on its ``openGL_mock`` backend for one test module, every frame running the

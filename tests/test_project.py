@@ -26,6 +26,16 @@ def test_readme_starts_with_the_two_commands_and_ci_runs_the_second():
     assert test_cmd in ci
 
 
+def test_ci_runs_the_fast_solver_step_of_the_readme():
+    text = (ROOT / "README.md").read_text()
+    block = text.split("**Fast solver (optional).**", 1)[1].split("```", 2)[1]
+    steps = [ln for ln in block.splitlines()[1:] if ln.strip()]
+    assert any("apt-get install" in ln for ln in steps) and any("[fast]" in ln for ln in steps)
+    ci = (ROOT / ".ci" / "run").read_text().splitlines()
+    for ln in steps:
+        assert ln in ci, ln
+
+
 def test_core_never_imports_polyscope():
     code = (
         "import importlib, pkgutil, sys, meshlap_core, meshlap_core.cli\n"

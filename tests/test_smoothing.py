@@ -96,7 +96,7 @@ def test_explicit_step_is_x_plus_lam_L_x(laplacian):
 
 
 @pytest.mark.parametrize("laplacian", LAPLACIAN_KINDS)
-def test_implicit_step_matches_spsolve_on_the_course_system(laplacian):
+def test_implicit_step_matches_spsolve_on_the_course_system(laplacian, spd_backend):
     V, F = bumpy_sphere(2)
     lam = 2.0 if laplacian == "uniform" else 0.05
     n = len(V)
@@ -170,7 +170,7 @@ def test_implicit_never_increases_dirichlet_energy(laplacian, lam):
 
 
 @pytest.mark.parametrize("laplacian", LAPLACIAN_KINDS)
-def test_implicit_with_fixed_boundary_never_increases_energy(laplacian):
+def test_implicit_with_fixed_boundary_never_increases_energy(laplacian, spd_backend):
     V, F = grid(8, 8)
     V[:, 2] = 0.05 * np.random.default_rng(0).standard_normal(len(V))
     _, K = S.operator_parts(V, F, laplacian)
@@ -566,7 +566,7 @@ def test_explicit_with_mass_recompute_uses_the_current_areas():
 # ----------------------------------------------------------------------------- linalg.spd
 
 
-def test_spd_solver_matches_a_direct_solve_and_is_reused():
+def test_spd_solver_matches_a_direct_solve_and_is_reused(spd_backend):
     from meshlap_core.linalg.spd import SPDSolver, surely_positive_definite
 
     V, F = bumpy_sphere(2)
@@ -578,7 +578,7 @@ def test_spd_solver_matches_a_direct_solve_and_is_reused():
         np.testing.assert_allclose(solver.solve(B), sla.spsolve(A.tocsc(), B), atol=1e-12)
 
 
-def test_spd_solver_refuses_an_indefinite_matrix_without_printing(capfd):
+def test_spd_solver_refuses_an_indefinite_matrix_without_printing(capfd, spd_backend):
     from meshlap_core.linalg.spd import SPDSolver, surely_positive_definite
 
     A = sp.csr_matrix(np.array([[1.0, 2.0], [2.0, 1.0]]))  # eigenvalues 3 and −1
@@ -589,7 +589,7 @@ def test_spd_solver_refuses_an_indefinite_matrix_without_printing(capfd):
     assert out == ""  # CHOLMOD's printf never reaches standard output
 
 
-def test_implicit_system_beyond_double_precision_is_refused_naming_lam():
+def test_implicit_system_beyond_double_precision_is_refused_naming_lam(spd_backend):
     V, F = icosphere(1)
     with (
         pytest.raises(MeshError, match=r"^lam: the implicit system .* cannot be factorized"),

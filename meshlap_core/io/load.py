@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
-from ..errors import MeshError
+from ..errors import MeshError, check_cancel
 from ..types import FloatArray
 from ..validate import Mesh, validate_mesh
 from ._scan import Parsed
@@ -26,7 +28,13 @@ __all__ = [
 ]
 
 
-def load_mesh(path: PathLike, *, repair: bool = True) -> Mesh:
+def load_mesh(
+    path: PathLike,
+    *,
+    repair: bool = True,
+    progress: Callable[[float, str], None] | None = None,
+    cancel: Any = None,
+) -> Mesh:
     """Load an OBJ, OFF, PLY (ASCII / binary) or STL (ASCII / binary) triangle mesh.
 
     The format is chosen by the extension (case-insensitive). The result is validated (and,
@@ -37,6 +45,12 @@ def load_mesh(path: PathLike, *, repair: bool = True) -> Mesh:
     path : str or PathLike
     repair : bool
         Remove degenerate / duplicate faces and unreferenced vertices (always reported).
+    progress : callable, optional
+        ``progress(fraction, message)`` at the start of each phase (reading, parsing,
+        validating; fractions 0, 0.1, 0.5 by their typical share of the time) and at the end.
+    cancel : threading.Event or callable, optional
+        Checked between the phases: once set (or returning ``True``) loading stops with
+        :class:`~meshlap_core.errors.Cancelled`.
 
     Returns
     -------
@@ -56,10 +70,19 @@ def load_mesh(path: PathLike, *, repair: bool = True) -> Mesh:
     >>> mesh.V.shape, mesh.report.repairs        # doctest: +SKIP
     ((3485, 3), [])
     """
+
+    def phase(fraction: float, message: str) -> None:
+        check_cancel(cancel, "loading")
+        if progress is not None:
+            progress(fraction, message)
+
+    phase(0.0, "reading the file")
     p, src, data = _read_input(path)
+    phase(0.1, f"parsing {len(data) / 2**20:.0f} MB")
     parsed = _parse(p.suffix.lower(), data, src)
     del data  # the parsed arrays are copies: free the file's bytes before validating
-    return validate_mesh(
+    phase(0.5, f"validating {len(parsed.V):,} vertices")
+    mesh = validate_mesh(
         parsed.V,
         parsed.faces,
         src,
@@ -68,6 +91,8 @@ def load_mesh(path: PathLike, *, repair: bool = True) -> Mesh:
         repairs=parsed.repairs,
         warnings=parsed.warnings,
     )
+    phase(1.0, "loaded")
+    return mesh
 
 
 def load_vertex_scalars(path: PathLike, name: str = "quality") -> FloatArray:

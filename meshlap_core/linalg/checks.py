@@ -18,13 +18,17 @@ RESIDUAL_TOL = 1e-5
 (the solver aims at 1e-6 on its own estimate; its results measure 1e-12 to 1e-7)."""
 
 
+#: elements (n × columns) of one temporary of :func:`pair_residuals` (32 MB of float64)
+CHUNK_ELEMENTS = 4 * 2**20
+
+
 def pair_residuals(
     K: sp.csr_matrix,
     m: FloatArray,
     lam: FloatArray,
     U: FloatArray,
     labels: IntArray | None = None,
-    chunk: int = 64,
+    chunk: int | None = None,
 ) -> FloatArray:
     """Relative residual of every pair, ``(k,)``:
     ``||K u_i − λ_i M u_i||_{M⁻¹} / max(λ_i, λ_ref,i)`` for ``M``-normalized ``u_i``.
@@ -34,9 +38,13 @@ def pair_residuals(
     given ``labels``; else one component, ``λ_ref = tr(K)/(n·tr(M))``), so a zero mode of a
     tiny component is measured against its own scale, while a vector that leaks round-off
     onto a component of a much larger scale is not excused by it. One sparse product ``K U``
-    in column chunks: ``O(nnz(K)·k)`` time, ``O(n·chunk)`` memory.
+    in column chunks: ``O(nnz(K)·k)`` time, ``O(n·chunk)`` memory (default chunk: 64
+    columns, fewer on large meshes so that each temporary stays near 32 MB: 6 at 692k
+    vertices instead of five 350 MB temporaries).
     """
     n, kk = U.shape
+    if chunk is None:
+        chunk = int(min(64, max(4, CHUNK_ELEMENTS // max(n, 1))))
     out = np.zeros(kk)
     if labels is None:
         labels = np.zeros(n, dtype=np.int64)

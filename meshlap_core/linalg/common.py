@@ -4,9 +4,12 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
+
+from ..errors import check_cancel
 
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
@@ -35,6 +38,46 @@ class SolveInfo:
     from_cache: bool = False
     cache_path: str | None = None
     messages: list[str] = field(default_factory=list)
+
+
+class CancellableProgress:
+    """A :data:`ProgressCallback` that raises :class:`~meshlap_core.errors.Cancelled` once
+    ``cancel`` asks to stop, at the next report or :meth:`check` (the slice workers check
+    between Lanczos blocks), and otherwise forwards to ``progress``.
+
+    Parameters
+    ----------
+    progress : callable or None
+        ``progress(fraction, message)``.
+    cancel : threading.Event, callable or None
+        See :func:`meshlap_core.errors.cancelled`.
+    what : str
+        Named in the exception: ``"<what> cancelled"``.
+    """
+
+    def __init__(self, progress: ProgressCallback | None, cancel: Any, what: str) -> None:
+        self.progress, self.cancel, self.what = progress, cancel, what
+
+    def check(self) -> None:
+        """Raise :class:`~meshlap_core.errors.Cancelled` if ``cancel`` asks to stop."""
+        check_cancel(self.cancel, self.what)
+
+    def __call__(self, fraction: float, message: str) -> None:
+        self.check()
+        if self.progress is not None:
+            self.progress(fraction, message)
+
+
+def with_cancel(
+    progress: ProgressCallback | None, cancel: Any, what: str
+) -> ProgressCallback | None:
+    """``progress`` unchanged without ``cancel``, else a :class:`CancellableProgress`."""
+    return progress if cancel is None else CancellableProgress(progress, cancel, what)
+
+
+def cancel_check(progress: ProgressCallback | None) -> Callable[[], None] | None:
+    """The ``check()`` of a :class:`CancellableProgress` (``None`` for any other callback)."""
+    return progress.check if isinstance(progress, CancellableProgress) else None
 
 
 def report_progress(progress: ProgressCallback | None, frac: float, msg: str) -> None:

@@ -43,10 +43,18 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 from scipy.linalg import blas
 
-from ..errors import MeshError
+from ..errors import MeshError, check_cancel
 from .blas import blas_threads as limit_blas_threads
 from .checks import RESIDUAL_TOL, inertia_check, orthogonality, pair_residuals
-from .common import FloatArray, IntArray, ProgressCallback, SolveInfo, report_progress
+from .common import (
+    CancellableProgress,
+    FloatArray,
+    IntArray,
+    ProgressCallback,
+    SolveInfo,
+    report_progress,
+    with_cancel,
+)
 from .components import component_scales, components, null_space, scale_groups, solve_by_groups
 from .slicing import SlicedLanczos, default_workers
 
@@ -149,6 +157,7 @@ def pencil_eigenpairs(
     k: int,
     *,
     progress: ProgressCallback | None = None,
+    cancel: Any = None,
     known: tuple[FloatArray, FloatArray] | None = None,
     method: Literal["auto", "dense", "sparse"] = "auto",
     tol: float = TOL,
@@ -173,6 +182,9 @@ def pencil_eigenpairs(
     progress : callable, optional
         ``progress(fraction, message)`` during long solves, possibly from the solver's worker
         threads (calls are serialized); raise from it to cancel the solve.
+    cancel : threading.Event or callable, optional
+        Checked between Lanczos blocks (and at every report): once set (or returning
+        ``True``) the solve stops with :class:`~meshlap_core.errors.Cancelled`.
     known : (lam (j,), U (n,j)), optional
         The ``j`` smallest eigenpairs, already computed: only the others are solved for.
     method : {"auto", "dense", "sparse"}
@@ -219,6 +231,9 @@ def pencil_eigenpairs(
     (Over 80 lines only because of this docstring: the body is ~35 lines.)
     """
     t0 = time.perf_counter()
+    progress = with_cancel(progress, cancel, "eigensolve")
+    if cancel is not None:
+        check_cancel(cancel, "eigensolve")
     K, m, k = _checked_pencil(K, m, k)
     ncomp, labels = components(K)
     groups = scale_groups(component_scales(K, m, labels, ncomp)) if ncomp > 1 else []
@@ -303,7 +318,13 @@ def _group_progress(
     if progress is None:
         return None
     outer = progress
-    return lambda f, msg: outer((g + f) / count, f"group {g + 1}/{count}: {msg}")
+
+    def inner(f: float, msg: str) -> None:
+        outer((g + f) / count, f"group {g + 1}/{count}: {msg}")
+
+    if isinstance(progress, CancellableProgress):  # the slices keep polling the same cancel
+        return CancellableProgress(inner, progress.cancel, progress.what)
+    return inner
 
 
 def _check_result(

@@ -12,6 +12,7 @@ Mesh-free: matrices in, numbers out.
 from __future__ import annotations
 
 import threading
+import warnings
 from typing import Any
 
 import numpy as np
@@ -175,12 +176,70 @@ def qdldl_inertia(
     return ldl, checked_inertia(A, ldl, D, rng)
 
 
+class CholmodLDLFactor:
+    """CHOLMOD's simplicial ``LDLᵀ`` (scikit-sparse) of a symmetric matrix, with its inertia;
+    see :func:`cholmod_inertia`. Solves a block of right-hand sides in one call."""
+
+    def __init__(self, factor: Any, pattern: tuple[IntArray, IntArray]) -> None:
+        self.factor = factor
+        self.pattern = pattern  # (indptr, indices) of the factored matrix
+
+    def solve(self, B: FloatArray) -> FloatArray:
+        return np.asarray(self.factor.solve_A(np.asarray(B, dtype=np.float64)))
+
+
+def cholmod_inertia(
+    A: sp.csr_matrix, rng: np.random.Generator, reuse: CholmodLDLFactor | None = None
+) -> tuple[CholmodLDLFactor, int]:
+    """CHOLMOD simplicial ``LDLᵀ`` (no pivoting, AMD ordering) of a symmetric matrix and the
+    number of its negative eigenvalues (negative entries of ``D``, Sylvester), checked like
+    :func:`qdldl_inertia`. Measured at 43k vertices: factorization 2× and 4-column solves
+    3× faster than QDLDL's (which solves one column at a time).
+
+    ``reuse``: a factor no longer needed of a matrix with the same pattern, refactorized in
+    place (the symbolic analysis kept).
+
+    Raises
+    ------
+    ImportError
+        scikit-sparse is not installed, ``MESHLAP_SOLVER=fallback``, or
+        :func:`~meshlap_core.linalg.spd.prefer_gil_free` is on (the caller falls back to
+        QDLDL). CHOLMOD holds the GIL while it factors and solves.
+    UnstableFactorization
+        A zero, tiny or non-finite pivot.
+    """
+    from .spd import eigen_backend
+
+    if eigen_backend() != "cholmod":
+        raise ImportError("CHOLMOD (scikit-sparse) is not in use (or prefer_gil_free is on)")
+    from sksparse.cholmod import CholmodError, CholmodWarning, analyze
+
+    csc = sp.csc_matrix((A.data, A.indices, A.indptr), shape=A.shape)  # symmetric: A itself
+    pattern = (A.indptr, A.indices)
+    same = (
+        reuse is not None
+        and np.array_equal(reuse.pattern[0], A.indptr)
+        and np.array_equal(reuse.pattern[1], A.indices)
+    )
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", CholmodWarning)
+            factor = reuse.factor if same else analyze(csc, mode="simplicial")  # type: ignore[union-attr]
+            factor.cholesky_inplace(csc)
+            D = factor.D()
+    except (CholmodError, CholmodWarning) as exc:
+        raise UnstableFactorization(str(exc)) from None
+    ldl = CholmodLDLFactor(factor, pattern)
+    return ldl, checked_inertia(A, ldl, D, rng)
+
+
 class ShiftInvert:
     """``Op(Y) = (A − σI)⁻¹ Y`` for the scaled pencil ``A = M^-½ K M^-½`` (symmetric, same
     eigenvalues ``λ`` as ``K u = λ M u`` with ``y = M^½ u``); ``Op`` has eigenvalues
     ``θ = 1/(λ − σ)``.
 
-    ``LDLᵀ`` without pivoting (QDLDL, else SuperLU in symmetric mode) with its inertia:
+    ``LDLᵀ`` without pivoting (CHOLMOD when scikit-sparse is in use, else QDLDL, else SuperLU
+    in symmetric mode) with its inertia:
     ``n_below`` is the number of eigenvalues ``λ < σ``. A shift that lands (numerically) on an
     eigenvalue (zero or tiny pivot, inaccurate solve) is moved by a small fraction of
     ``spacing``: a singular matrix is never used.
@@ -204,11 +263,16 @@ class ShiftInvert:
             s = sigma + (0.0 if attempt == 0 else (-1) ** attempt * 1e-3 * attempt * spacing)
             S = (A - s * eye).tocsr()
             try:
+                r, reuse = reuse, None
                 try:
-                    r, reuse = (reuse if isinstance(reuse, QDLDLFactor) else None), None
-                    self.factor, self.n_below = qdldl_inertia(S, rng, r)
-                except (ImportError, UnstableFactorization):
-                    self.factor, self.n_below = superlu_ldl_inertia(S, rng, ordering)
+                    c = r if isinstance(r, CholmodLDLFactor) else None
+                    self.factor, self.n_below = cholmod_inertia(S, rng, c)
+                except ImportError:  # (an unstable CHOLMOD factor moves the shift)
+                    try:
+                        q = r if isinstance(r, QDLDLFactor) else None
+                        self.factor, self.n_below = qdldl_inertia(S, rng, q)
+                    except (ImportError, UnstableFactorization):
+                        self.factor, self.n_below = superlu_ldl_inertia(S, rng, ordering)
                 sigma = s
                 break
             except UnstableFactorization:

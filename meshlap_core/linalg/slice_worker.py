@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from .common import FloatArray, ProgressCallback
+from .common import FloatArray, ProgressCallback, cancel_check
 from .factor import ShiftInvert, SymbolicOrdering
 from .lanczos import BlockLanczos
 
@@ -80,6 +80,7 @@ class SliceContext:
         self.base_count = base_count
         self.scale = float(K.diagonal().sum() / (self.n * m.sum()))
         self._progress = progress
+        self._check = cancel_check(progress)  # the caller's cancel, polled between blocks
         self._lock = threading.Lock()
         self._converged: dict[int, int] = {}
         self._done_count = 0
@@ -87,6 +88,22 @@ class SliceContext:
         self.error: BaseException | None = None
         self.local = threading.local()  # per worker thread: a spare factorization to reuse
         self.inertia: dict[int, tuple[float, int]] = {}  # slice -> (shift, eigenvalues below)
+
+    def poll(self) -> bool:
+        """Whether to stop: another slice failed, or the caller's ``cancel`` was set (then
+        :attr:`error` is its :class:`~meshlap_core.errors.Cancelled`)."""
+        if self.cancel.is_set():
+            return True
+        if self._check is not None:
+            try:
+                self._check()
+            except BaseException as exc:
+                with self._lock:
+                    if self.error is None:
+                        self.error = exc
+                self.cancel.set()
+                return True
+        return False
 
     def report(self, index: int, n_conv: int, message: str) -> None:
         if self._progress is None:
@@ -206,7 +223,7 @@ def run_slice(ctx: SliceContext, spec: SliceSpec, seed: int) -> SliceResult:
     next_check = max(2 * b, int(0.8 * spec.expected) // b * b)
     prev: tuple[int, float] | None = None
     while True:
-        if ctx.cancel.is_set():
+        if ctx.poll():
             raise SliceCancelled
         lz.step()
         if lz.j < next_check and not lz.exhausted:

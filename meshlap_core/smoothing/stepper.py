@@ -16,9 +16,10 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 
-from ..errors import MeshError, MeshWarning
+from ..errors import MeshError, MeshWarning, check_cancel
 from ..laplacian import vertex_areas
-from ..linalg.spd import SPDSolver
+from ..linalg.common import ProgressCallback
+from ..linalg.spd import SPDSolver, solver_backend
 from ..metrics import _signed_volume_unchecked, n_boundary_edges, percent_volume_change
 from ..noise import bbox_diagonal
 from ..options import (
@@ -147,6 +148,15 @@ class Smoother:
     n_factorizations : int
         How many times a linear system was factorized (1 for a frozen implicit smoother).
 
+    Notes
+    -----
+    Memory: the smoother holds two per-vertex position arrays, the input ``V0`` and the
+    current ``V`` (plus ``reference`` when given, and the per-vertex areas), never a history
+    of positions: a step replaces ``V``. :attr:`history` holds scalars only (about 0.5 kB per
+    entry), bounded by ``history_limit`` or ``history_samples`` (the CLI keeps at most
+    :data:`~meshlap_core.cli.smooth.HISTORY_SAMPLES`, the window 1,000); only the default
+    (``None``, for scripts) keeps one entry per iteration.
+
     Examples
     --------
     >>> from meshlap_core.primitives import bumpy_sphere
@@ -255,9 +265,13 @@ class Smoother:
         self.pinned = fixed | ~(W > 0)  # fixed boundary, plus vertices with no faces / zero area
         self._free = np.flatnonzero(~self.pinned)
         self._fixed = np.flatnonzero(self.pinned)
-        self._K_free_rows = K[self._free].tocsr()  # rows of free vertices, all columns
-        self._K_ff = self._K_free_rows[:, self._free].tocsr()
-        self._K_fp = self._K_free_rows[:, self._fixed].tocsr()
+        if len(self._fixed):
+            self._K_free_rows = K[self._free].tocsr()  # rows of free vertices, all columns
+            self._K_ff = self._K_free_rows[:, self._free].tocsr()
+            self._K_fp = self._K_free_rows[:, self._fixed].tocsr()
+        else:  # nothing pinned: the blocks are K itself (no copies of a large matrix)
+            self._K_free_rows = self._K_ff = K
+            self._K_fp = K[:, :0].tocsr()
         self._recompute_mass = self.mass_update == "recompute" and self.laplacian == "cotan"
         self._stability: Stability | None = None
         self.n_factorizations = 0
@@ -372,17 +386,47 @@ class Smoother:
             self._record(self._metrics(new, old, elapsed, drift))
         return self.V
 
-    def run(self, n: int) -> FloatArray:
+    def run(
+        self,
+        n: int,
+        *,
+        progress: ProgressCallback | None = None,
+        cancel: Any = None,
+    ) -> FloatArray:
         """Do ``n`` iterations (stops early if the iteration diverges); return the positions.
 
         ``n`` is at most :data:`~meshlap_core.smoothing.params.MAX_ITERS` per call.
+
+        Parameters
+        ----------
+        n : int
+        progress : callable, optional
+            ``progress(fraction, message)`` before every iteration (``fraction`` = iterations
+            done / ``n``); the message says when the implicit system is being factorized.
+        cancel : threading.Event or callable, optional
+            Checked before every iteration: once set (or returning ``True``) the run stops
+            with :class:`~meshlap_core.errors.Cancelled`, keeping the iterations done.
         """
         n = check_iters(n, "n")
-        for _ in range(n):
+        for i in range(n):
+            check_cancel(cancel, "smoothing")
+            if progress is not None:
+                progress(i / n, self._progress_message(i, n))
             self.step()
             if self.diverged:
                 break
+        if progress is not None:
+            progress(1.0, f"smoothing: {self.iteration} iterations")
         return self.V
+
+    def _progress_message(self, i: int, n: int) -> str:
+        key = (self.lam, self.iteration if self._recompute_mass else -1)
+        if self.method == "implicit" and (self._solver is None or self._solver_key != key):
+            return (
+                f"smoothing: factorizing W - lam K ({len(self._free):,} unknowns, "
+                f"{solver_backend()})"
+            )
+        return f"smoothing: iteration {i + 1} of {n}"
 
     # ---------------------------------------------------------------- internals
 
@@ -479,9 +523,12 @@ class Smoother:
         key = (self.lam, self.iteration if self._recompute_mass else -1)
         if self._solver is None or self._solver_key != key:
             Wf = self._W[free]
-            A = (sp.diags(Wf) - self.lam * self._K_ff).tocsr()
+            A = self._K_ff.copy()  # W − λK in place: K stores its diagonal, no new entries
+            A.data *= -self.lam
+            A.setdiag(A.diagonal() + Wf)
+            spent, self._solver = self._solver, None  # refactorized in place (same pattern)
             try:
-                self._solver = SPDSolver(A)
+                self._solver = SPDSolver(A, reuse=spent)
             except np.linalg.LinAlgError:
                 stiff = float(np.max(-self._K_ff.diagonal() / Wf)) if len(free) else 0.0
                 raise MeshError(

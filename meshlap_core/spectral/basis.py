@@ -14,9 +14,9 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import MeshError
+from ..errors import MeshError, check_cancel
 from ..linalg.blas import blas_threads, thread_controller
-from ..linalg.common import ProgressCallback, SolveInfo, report_progress
+from ..linalg.common import ProgressCallback, SolveInfo, report_progress, with_cancel
 from ..linalg.components import components
 from ..linalg.eigsolve import check_k
 from ..options import MASS_AREA, AreaKind, LaplacianKind
@@ -147,6 +147,7 @@ class SpectralBasis:
         cache: bool = True,
         cache_dir: str | os.PathLike | None = None,
         progress: ProgressCallback | None = None,
+        cancel: Any = None,
     ) -> SpectralBasis:
         """Compute (or load from the cache) the ``k`` smallest eigenpairs.
 
@@ -166,7 +167,13 @@ class SpectralBasis:
             Overrides :func:`default_cache_dir`.
         progress : callable, optional
             ``progress(fraction, message)``.
+        cancel : threading.Event or callable, optional
+            Checked before each phase and between Lanczos blocks; once set (or returning
+            ``True``) the computation stops with :class:`~meshlap_core.errors.Cancelled`
+            (nothing is cached).
         """
+        progress = with_cancel(progress, cancel, "eigenbasis")
+        check_cancel(cancel, "eigenbasis")
         V, F = as_mesh(V, F)
         opts = problem_options(laplacian, area)
         k = check_k(k, len(V), "k")
@@ -198,6 +205,7 @@ class SpectralBasis:
                 basis._cache_path = path
                 return basis
         t_ops = time.perf_counter() - t0
+        check_cancel(cancel, "eigenbasis")
         lam, U, info = laplacian_eigenpairs(
             V,
             F,
@@ -319,12 +327,14 @@ class SpectralBasis:
 
     # ---- extension -----------------------------------------------------------------------
 
-    def ensure(self, k: int, progress: ProgressCallback | None = None) -> None:
+    def ensure(self, k: int, progress: ProgressCallback | None = None, cancel: Any = None) -> None:
         """Make at least ``k`` modes available, extending the basis if needed: from the cache
         when it holds enough modes, else by solving for the new modes only (the known ones
         are deflated). The solve runs without holding the reconstruction lock, so another
         thread keeps reconstructing with the modes it already has; call it from a worker
-        thread for large extensions (``reconstruct(k)`` beyond ``k_max`` calls it too)."""
+        thread for large extensions (``reconstruct(k)`` beyond ``k_max`` calls it too).
+        ``cancel`` as in :meth:`compute` (the basis is then left as it was)."""
+        progress = with_cancel(progress, cancel, "eigenbasis")
         k = check_k(k, self.n_vertices, "k")
         if k <= self.k_max:
             return

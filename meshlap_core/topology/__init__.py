@@ -25,6 +25,7 @@ from .surface import (
     genus,
     surface_summary,
     topology_report,
+    topology_report_with_table,
 )
 
 __all__ = [
@@ -43,4 +44,5 @@ __all__ = [
     "sort_with_order",
     "surface_summary",
     "topology_report",
+    "topology_report_with_table",
 ]

@@ -112,6 +112,33 @@ class EdgeTable:
         he_edge[self.edge_halfedges] = np.repeat(np.arange(self.n_edges), self.counts)
         return he_edge
 
+    @cached_property
+    def vertex_components(self) -> tuple[int, IntArray]:
+        """Connected components of the vertex graph (computed on first use, then shared).
+
+        Returns
+        -------
+        count : int
+            Components; an unreferenced vertex is a component of its own.
+        labels : (n,) int
+            Component of each vertex.
+
+        Notes
+        -----
+        The sorted :attr:`edges` are already a CSR adjacency (row ``i`` holds the ``j > i``),
+        so the graph costs no sort; the same count as
+        :func:`~meshlap_core.topology.surface.connected_components` of the faces.
+        """
+        idx = np.int32 if max(self.n, self.n_edges) < 2**31 else np.int64
+        ptr = np.zeros(self.n + 1, dtype=idx)
+        np.cumsum(np.bincount(self.edges[:, 0], minlength=self.n), out=ptr[1:])
+        G = sp.csr_matrix(
+            (np.ones(self.n_edges, dtype=np.int8), self.edges[:, 1].astype(idx), ptr),
+            shape=(self.n, self.n),
+        )
+        count, labels = _cc(G, directed=True, connection="weak")
+        return int(count), labels.astype(np.int64)
+
     @property
     def n_edges(self) -> int:
         """Number of unique undirected edges ``e``."""
@@ -192,6 +219,114 @@ class EdgeTable:
         # weak components of the one-directional graph = components of the undirected one
         count, labels = _cc(G, directed=True, connection="weak")
         return int(count), labels.astype(np.int64)
+
+    def wedge_counts(self) -> IntArray:
+        """Number of wedges at every vertex, ``(n,) int``: the same counts as :meth:`wedges`
+        (one per fan of faces around the vertex), from the sorted edges, without a corner graph.
+
+        Returns
+        -------
+        counts : (n,) int
+            0 for an unreferenced vertex, 1 for a manifold vertex, more for a vertex whose
+            faces form several fans.
+
+        Notes
+        -----
+        At a vertex whose edges are all boundary or consistently oriented two-face edges, each
+        corner ``h`` has at most one successor around the vertex, ``next(twin(h))``, so its
+        corners form disjoint paths (one per pair of boundary edges) and cycles. One walk per
+        vertex, all vertices advanced together (a gather per step, the finished ones dropped),
+        from a corner (an interior vertex) or from the corner that is no corner's successor (a
+        vertex with two boundary edges) proves the vertex manifold when it visits all its
+        corners. The remaining vertices (on a non-manifold or inconsistently oriented edge, with
+        more than two boundary edges, or whose walk came back early; rare) are counted exactly
+        as in :meth:`wedges`, by :func:`scipy.sparse.csgraph.connected_components` on their
+        corners only.
+        """
+        src = self.F.ravel()
+        n3 = len(src)
+        counts = np.zeros(self.n, dtype=np.int64)
+        if n3 == 0:
+            return counts
+        idx = np.int32 if n3 < 2**31 else np.int64
+        pair_edge, h1, h2 = self.face_pairs()
+        ok = src[h1] != src[h2]  # consistently oriented pairs
+        h = np.arange(n3, dtype=idx)
+        twin = h.copy()  # no twin: a boundary (or non-manifold / inconsistent) edge
+        if ok.all():
+            twin[h1], twin[h2] = h2, h1
+        else:
+            twin[h1[ok]], twin[h2[ok]] = h2[ok], h1[ok]
+        succ = twin + 1  # the corner after the twin in its face: the next corner around src
+        succ[twin % 3 == 2] -= 3
+        lone = twin == h
+        succ[lone] = h[lone]  # a path ends at a corner whose edge has no twin
+        bad_edge = self.counts > 2
+        bad_edge[pair_edge[~ok]] = True
+        bad_vertex = np.zeros(self.n, dtype=bool)
+        bad_vertex[self.edges[bad_edge].ravel()] = True
+        n_corners = np.bincount(src, minlength=self.n)
+        n_bnd = np.bincount(self.edges[self.counts == 1].ravel(), minlength=self.n)
+        start = np.full(self.n, -1, dtype=np.int64)
+        start[src] = np.arange(n3)  # any corner of an interior vertex
+        targets = np.zeros(n3, dtype=bool)
+        targets[succ[~lone]] = True
+        path_start = np.flatnonzero(~targets)
+        start[src[path_start]] = path_start
+        walk = (n_corners > 0) & ~bad_vertex & ((n_bnd == 0) | (n_bnd == 2))
+        visited = self._walk(succ, start, np.flatnonzero(walk), n_bnd == 0, int(n_corners.max()))
+        good = walk.copy()
+        good[walk] = visited == n_corners[walk]
+        counts[good] = 1
+        other = ~good & (n_corners > 0)
+        if other.any():
+            counts += self._bad_wedge_counts(other[src])
+        return counts
+
+    @staticmethod
+    def _walk(
+        succ: IntArray, start: IntArray, verts: IntArray, closed: BoolArray, limit: int
+    ) -> IntArray:
+        """Corners visited walking ``succ`` from ``start[v]`` for each ``v`` in ``verts``, until
+        back at the start (``closed[v]``) or at a corner that is its own successor."""
+        visited = np.ones(len(verts), dtype=np.int64)
+        first = start[verts]
+        cur = first.copy()
+        active = np.arange(len(verts))
+        is_closed = closed[verts]
+        for _ in range(limit):
+            if len(active) == 0:
+                break
+            nxt = succ[cur]
+            done = np.where(is_closed[active], nxt == first[active], nxt == cur)
+            go = ~done
+            active, cur = active[go], nxt[go]
+            visited[active] += 1
+        return visited
+
+    def _bad_wedge_counts(self, bad: BoolArray) -> IntArray:
+        """Wedges per vertex counted as in :meth:`wedges`, at the corners marked ``bad`` only."""
+        order = self.edge_halfedges
+        same = np.ones(max(len(order) - 1, 0), dtype=bool)
+        same[self.edge_ptr[1:-1] - 1] = False
+        ha, hb = order[:-1][same], order[1:][same]
+        src, dst = self.halfedge_vertices()
+        touch = bad[ha] | bad[(ha // 3) * 3 + (ha + 1) % 3]
+        ha, hb = ha[touch], hb[touch]
+        nxt_a, nxt_b = (ha // 3) * 3 + (ha + 1) % 3, (hb // 3) * 3 + (hb + 1) % 3
+        fw_a, fw_b = src[ha] < dst[ha], src[hb] < dst[hb]
+        rows = np.concatenate([np.where(fw_a, ha, nxt_a), np.where(fw_a, nxt_a, ha)])
+        cols = np.concatenate([np.where(fw_b, hb, nxt_b), np.where(fw_b, nxt_b, hb)])
+        keep = bad[rows]
+        corners = np.flatnonzero(bad)
+        rows = np.searchsorted(corners, rows[keep])
+        cols = np.searchsorted(corners, cols[keep])
+        k = len(corners)
+        G = sp.csr_matrix((np.ones(len(rows), dtype=np.int8), (rows, cols)), shape=(k, k))
+        n_w, labels = _cc(G, directed=True, connection="weak")
+        wedge_vertex = np.empty(n_w, dtype=np.int64)
+        wedge_vertex[labels] = src[corners]
+        return np.bincount(wedge_vertex, minlength=self.n)
 
 
 def edge_table(F: Any, n: int | None = None) -> EdgeTable:

@@ -131,7 +131,7 @@ def surface_summary(
     n_used = int(np.count_nonzero(used))
     chi = n_used - out["n_edges"] + m
     out["euler_characteristic"] = chi
-    n_all, _ = connected_components(F, n)
+    n_all, _ = t.vertex_components
     out["n_components"] = n_all
     c_faces = n_all - (n - n_used)  # components that have faces
     lengths = _loop_lengths(t.boundary_halfedges())
@@ -152,6 +152,14 @@ def surface_summary(
 
 
 def topology_report(F: Any, n_vertices: int | None = None) -> MeshReport:
+    """Edge / vertex manifoldness, orientation, boundary and components of a triangle list
+    (see :func:`topology_report_with_table`, which also returns the edge table it built)."""
+    return topology_report_with_table(F, n_vertices)[0]
+
+
+def topology_report_with_table(
+    F: Any, n_vertices: int | None = None
+) -> tuple[MeshReport, EdgeTable | None]:
     """Edge / vertex manifoldness, orientation, boundary and components of a triangle list.
 
     Parameters
@@ -165,20 +173,25 @@ def topology_report(F: Any, n_vertices: int | None = None) -> MeshReport:
     -------
     report : MeshReport
         With the topology fields and warnings filled in and no repairs.
+    table : EdgeTable or None
+        The table the report was computed from (``None`` without faces), to be shared by the
+        callers (:attr:`Mesh.edge_table`) instead of rebuilt; its
+        :attr:`~EdgeTable.vertex_components` are already computed.
 
     Notes
     -----
     From one :class:`EdgeTable`: an edge with more than two faces is non-manifold; a two-face
     edge traversed in the same direction by both faces is inconsistently oriented. A vertex
-    with more than one wedge (:meth:`EdgeTable.wedges`) is non-manifold (libigl
-    ``is_vertex_manifold``). All steps are vectorised.
+    with more than one wedge (:meth:`EdgeTable.wedge_counts`, the counts of
+    :meth:`EdgeTable.wedges`) is non-manifold (libigl ``is_vertex_manifold``). All steps are
+    vectorised.
     """
     F = np.asarray(F, dtype=np.int64).reshape(-1, 3)
     m = len(F)
     n = int(F.max()) + 1 if n_vertices is None and m else int(n_vertices or 0)
     rep = MeshReport(n_input_vertices=n, n_input_faces=m)
     if m == 0:
-        return rep
+        return rep, None
     t = EdgeTable.from_faces(F, n)
     rep.n_edges = t.n_edges
     rep.n_boundary_edges = int(np.count_nonzero(t.counts == 1))
@@ -189,18 +202,15 @@ def topology_report(F: Any, n_vertices: int | None = None) -> MeshReport:
     rep.n_inconsistent_edges = int(np.count_nonzero(~t.consistent_pairs()))
     rep.consistently_oriented = rep.n_inconsistent_edges == 0
 
-    n_wedges, labels = t.wedges()
-    wedge_vertex = np.empty(n_wedges, dtype=np.int64)
-    wedge_vertex[labels] = t.F.ravel()
-    wedges_per_vertex = np.bincount(wedge_vertex, minlength=n)
+    wedges_per_vertex = t.wedge_counts()
     nm_v = np.flatnonzero(wedges_per_vertex > 1)
     rep.n_nonmanifold_vertices = len(nm_v)
     rep.nonmanifold_vertices = nm_v.astype(np.int64)
     # components of faces (through shared vertices), ignoring unreferenced vertices
-    n_all, _ = connected_components(F, n)
+    n_all, _ = t.vertex_components
     rep.n_components = n_all - int(np.count_nonzero(wedges_per_vertex == 0))
     rep.warnings.extend(_topology_warnings(rep))
-    return rep
+    return rep, t
 
 
 def _topology_warnings(rep: MeshReport) -> list[str]:

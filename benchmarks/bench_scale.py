@@ -1,0 +1,369 @@
+"""Real scans (issue 21): every core figure at 0.7 M and 2.8 M vertices beside its baseline.
+
+Run from the repository root::
+
+    python benchmarks/bench_scale.py            # the 692k and the 2.77M scan, 3 repeats
+    python benchmarks/bench_scale.py --quick    # the 692k scan only, 1-2 repeats
+    python benchmarks/bench_scale.py --only load,smooth   # some figures only
+    python benchmarks/bench_scale.py --big-only --only load,cli  # the 2.77M scan only
+
+The scans are made in a temporary folder (never in the checkout) by one and two
+``igl.upsample`` of ``../shared/meshes/armadillo_loop.obj`` (691,858 and 2,766,274 vertices)
+and deleted at the end (``--keep DIR`` keeps them in DIR and reuses them next time).
+
+Every figure runs in a child process, so wall-clock and peak memory (``ru_maxrss`` of that
+child, from ``os.wait4``) are those of a fresh process, as a user meets them; "ours" and its
+baseline alternate, ``--repeat`` times, and the best of each is printed with the ratio
+ours / baseline (< 1 is faster). Figures:
+
+* ``load``: ``load_mesh`` (parse + full validation) vs ``igl.read_triangle_mesh``, both in
+  one child, alternating;
+* ``info`` / ``curvature``: ``meshlap info MESH`` and ``meshlap curvature MESH --method cotan``
+  as whole processes vs a libigl script (read + cotmatrix + massmatrix + H) as one;
+* ``smooth``: in one child, the CHOLMOD factorization of ``M − λC`` alone (scikit-sparse,
+  when installed) and cholespy's, then ``Smoother(..., "implicit", "cotan")``: its first step
+  and the next steps; the solver back end is printed;
+* ``spectral``: ``meshlap spectral MESH --k 100 --no-cache`` as a whole process (time, peak
+  RSS; target < 60 s, < 3 GB), and on ``armadillo_igl`` against a script doing what a user
+  would (libigl read + operators + ``scipy.sparse.linalg.eigsh`` shift-invert), as a whole
+  process too.
+
+:data:`VIEWER_FIGURES` is the hook for the window's figures (open → first frame, steps/s,
+idle CPU): functions ``(scan: Path, repeat: int) -> list[Row]`` appended there are run after
+the core figures on every scan.
+
+No thresholds are checked (timings on a shared machine are noisy); the load average is
+printed before and after.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import textwrap
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+SHARED = ROOT.parent / "shared" / "meshes"
+PY = sys.executable
+MESHLAP = [PY, "-m", "meshlap_core.cli"]
+
+
+@dataclass
+class Row:
+    """One line of the table: a figure, ours and the baseline (seconds), peak RSS (MiB)."""
+
+    scan: str
+    figure: str
+    ours: float
+    base: float | None
+    base_name: str
+    rss_ours: float | None = None
+    rss_base: float | None = None
+    note: str = ""
+
+
+#: the window's figures, added by the viewer side: ``fn(scan, repeat) -> list[Row]``
+VIEWER_FIGURES: list[Callable[[Path, int], list[Row]]] = []
+
+
+def run_child(argv: list[str], env: dict[str, str] | None = None) -> tuple[float, float, str]:
+    """Run ``argv``; return (wall seconds, peak RSS in MiB of that child, its stdout)."""
+    t0 = time.perf_counter()
+    with tempfile.TemporaryFile() as out:
+        proc = subprocess.Popen(
+            argv, stdout=out, stderr=subprocess.PIPE, env={**os.environ, **(env or {})}
+        )
+        _, status, usage = os.wait4(proc.pid, 0)
+        wall = time.perf_counter() - t0
+        proc.returncode = os.waitstatus_to_exitcode(status)
+        err = proc.stderr.read().decode() if proc.stderr else ""
+        if proc.returncode != 0:
+            raise RuntimeError(f"{' '.join(argv[:4])}... failed:\n{err[-2000:]}")
+        out.seek(0)
+        text = out.read().decode()
+    return wall, usage.ru_maxrss / 1024.0, text
+
+
+def python_child(code: str) -> tuple[float, float, str]:
+    """Run a Python snippet as a whole process."""
+    return run_child([PY, "-c", textwrap.dedent(code)])
+
+
+def make_scans(folder: Path, big: bool) -> list[Path]:
+    """The 692k (and, with ``big``, the 2.77M) armadillo in ``folder`` (made once)."""
+    src = SHARED / "armadillo_loop.obj"
+    if not src.is_file():
+        sys.exit(f"{src} is needed (the real meshes live beside the checkout)")
+    out = [folder / "armadillo_692k.obj"] + ([folder / "armadillo_2770k.obj"] if big else [])
+    missing = [p for p in out if not p.is_file()]
+    if missing:
+        print(f"making {', '.join(p.name for p in missing)} in {folder} ...", flush=True)
+        python_child(
+            f"""
+            import igl
+            V, F = igl.read_triangle_mesh({str(src)!r})
+            for path in {[str(p) for p in out]!r}:
+                V, F = igl.upsample(V, F)
+                igl.write_triangle_mesh(path, V, F)
+            """
+        )
+    return out
+
+
+# ------------------------------------------------------------------------------ the figures
+
+
+def fig_load(scan: Path, repeat: int) -> list[Row]:
+    """``load_mesh`` vs ``igl.read_triangle_mesh`` in one child, alternating."""
+    _, rss, text = python_child(
+        f"""
+        import time, igl
+        from meshlap_core.io import load_mesh
+        a, b = [], []
+        for _ in range({repeat}):
+            t = time.perf_counter(); igl.read_triangle_mesh({str(scan)!r})
+            a.append(time.perf_counter() - t)
+            t = time.perf_counter(); load_mesh({str(scan)!r})
+            b.append(time.perf_counter() - t)
+        print(min(b), min(a))
+        """
+    )
+    ours, base = map(float, text.split())
+    return [
+        Row(
+            scan.name,
+            "load_mesh (parse + validation)",
+            ours,
+            base,
+            "igl.read_triangle_mesh",
+            rss_ours=rss,
+            note="RSS: the child doing both",
+        )
+    ]
+
+
+IGL_SCRIPT = """
+import sys, numpy as np, igl
+V, F = igl.read_triangle_mesh(sys.argv[1])
+C = igl.cotmatrix(V, F)
+M = igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_VORONOI)
+HN = -0.5 * (C @ V) / M.diagonal()[:, None]  # mean curvature normal (libigl's tutorial)
+N = igl.per_vertex_normals(V, F)
+H = np.sign(np.einsum("ij,ij->i", HN, N)) * np.linalg.norm(HN, axis=1)
+print(float(np.median(H)))
+"""
+
+
+def fig_cli(scan: Path, repeat: int) -> list[Row]:
+    """``meshlap info`` and ``meshlap curvature`` as whole processes vs the libigl script."""
+    rows = []
+    cmds = {
+        "meshlap info, whole process": [*MESHLAP, "info", str(scan)],
+        "meshlap curvature --method cotan, whole process": [
+            *MESHLAP,
+            "curvature",
+            str(scan),
+            "--method",
+            "cotan",
+        ],
+    }
+    for name, argv in cmds.items():
+        ours, base = [], []
+        for _ in range(repeat):
+            ours.append(run_child(argv)[:2])
+            base.append(run_child([PY, "-c", IGL_SCRIPT, str(scan)])[:2])
+        o, b = min(ours), min(base)
+        rows.append(
+            Row(scan.name, name, o[0], b[0], "libigl read+cotmatrix+massmatrix+H", o[1], b[1])
+        )
+    return rows
+
+
+def fig_smooth(scan: Path, repeat: int) -> list[Row]:
+    """Implicit cotan smoothing: factorization alone (CHOLMOD, cholespy) vs our first step."""
+    _, rss, text = python_child(
+        f"""
+        import time, numpy as np, scipy.sparse as sp
+        from meshlap_core.io import load_mesh
+        from meshlap_core.linalg.spd import solver_backend
+        from meshlap_core.smoothing.stepper import Smoother, operator_parts
+        m = load_mesh({str(scan)!r})
+        res = {{"chol": [], "cholespy": [], "first": [], "next": [], "build": []}}
+        for _ in range({repeat}):
+            W, K = operator_parts(m.V, m.F, "cotan")
+            A = (sp.diags(W) - 0.5 * K).tocsc()
+            try:
+                from sksparse.cholmod import cholesky
+                t = time.perf_counter(); f = cholesky(A)
+                res["chol"].append(time.perf_counter() - t)
+                del f
+            except ImportError:
+                pass
+            from cholespy import CholeskySolverD, MatrixType
+            Ac = A.tocsr()
+            t = time.perf_counter()
+            CholeskySolverD(A.shape[0], Ac.indptr.astype(np.int32), Ac.indices.astype(np.int32),
+                            Ac.data, MatrixType.CSR)
+            res["cholespy"].append(time.perf_counter() - t)
+            del W, K, A, Ac
+            t = time.perf_counter()
+            s = Smoother(m.V, m.F, "implicit", "cotan", lam=0.5)
+            res["build"].append(time.perf_counter() - t)
+            t = time.perf_counter(); s.step(); res["first"].append(time.perf_counter() - t)
+            t = time.perf_counter()
+            for _ in range(5):
+                s.step()
+            res["next"].append((time.perf_counter() - t) / 5)
+            del s
+        print(solver_backend(), *[min(v) if v else -1 for v in res.values()])
+        """
+    )
+    backend, chol, cholespy, first, nxt, build = text.split()
+    chol_f, cholespy_f = float(chol), float(cholespy)
+    rows = [
+        Row(
+            scan.name,
+            "CHOLMOD (scikit-sparse) factorization of M - lam C",
+            chol_f,
+            cholespy_f,
+            "cholespy factorization",
+            note="not installed" if chol_f < 0 else "",
+        ),
+        Row(
+            scan.name,
+            f"implicit cotan: first step ({backend})",
+            float(first),
+            chol_f if chol_f > 0 else cholespy_f,
+            "CHOLMOD factorization alone" if chol_f > 0 else "cholespy factorization alone",
+            rss_ours=rss,
+            note=f"Smoother construction {float(build):.2f} s (operators, volume)",
+        ),
+        Row(scan.name, f"implicit cotan: next steps, each ({backend})", float(nxt), None, ""),
+    ]
+    return rows
+
+
+EIGSH_SCRIPT = """
+import sys, numpy as np, igl, scipy.sparse.linalg as sla
+from threadpoolctl import threadpool_limits
+V, F = igl.read_triangle_mesh(sys.argv[1])
+C = igl.cotmatrix(V, F)
+M = igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_VORONOI)
+with threadpool_limits(1):
+    lam, U = sla.eigsh(-C, int(sys.argv[2]), M=M, sigma=-1e-8, which="LM")
+print(lam.max())
+"""
+
+
+def fig_spectral(scan: Path, repeat: int, eigsh_mesh: Path | None) -> list[Row]:
+    """``meshlap spectral --k 100`` on the scan (time, RSS), and vs eigsh on armadillo_igl."""
+    rows = []
+    argv = [*MESHLAP, "spectral", str(scan), "--k", "100", "--no-cache", "--json"]
+    wall, rss, _ = min(run_child(argv) for _ in range(max(1, repeat - 1)))
+    rows.append(
+        Row(
+            scan.name,
+            "meshlap spectral --k 100, whole process",
+            wall,
+            60.0,
+            "target 60 s",
+            rss,
+            None,
+            "target < 3 GB peak",
+        )
+    )
+    if eigsh_mesh is not None:
+        argv = [*MESHLAP, "spectral", str(eigsh_mesh), "--k", "100", "--no-cache", "--json"]
+        ours, base = [], []
+        for _ in range(repeat):
+            ours.append(run_child(argv)[:2])
+            base.append(run_child([PY, "-c", EIGSH_SCRIPT, str(eigsh_mesh), "100"])[:2])
+        o, b = min(ours), min(base)
+        rows.append(
+            Row(
+                eigsh_mesh.name,
+                "meshlap spectral --k 100, whole process",
+                o[0],
+                b[0],
+                "libigl + eigsh shift-invert, whole process",
+                o[1],
+                b[1],
+            )
+        )
+    return rows
+
+
+# ------------------------------------------------------------------------------ the table
+
+
+def print_rows(rows: list[Row]) -> None:
+    print(
+        "| scan | figure | ours [s] | baseline [s] | ratio | baseline | RSS ours / base [MiB] "
+        "| note |"
+    )
+    print("|---|---|---:|---:|---:|---|---|---|")
+    for r in rows:
+        ratio = f"{r.ours / r.base:.2f}x" if r.base else "-"
+        base = f"{r.base:.2f}" if r.base is not None and r.base >= 0 else "-"
+        rss = " / ".join(f"{x:.0f}" if x is not None else "-" for x in (r.rss_ours, r.rss_base))
+        print(
+            f"| {r.scan} | {r.figure} | {r.ours:.2f} | {base} | {ratio} | {r.base_name} "
+            f"| {rss} | {r.note} |",
+            flush=True,
+        )
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--quick", action="store_true", help="the 692k scan only, fewer repeats")
+    ap.add_argument("--repeat", type=int, default=None, help="runs per figure (default 3)")
+    ap.add_argument("--only", default="load,cli,smooth,spectral", help="figures to run")
+    ap.add_argument("--keep", type=Path, default=None, help="keep/reuse the scans in this folder")
+    ap.add_argument("--big-only", action="store_true", help="the 2.77M scan only")
+    args = ap.parse_args()
+    repeat = args.repeat or (2 if args.quick else 3)
+    only = set(args.only.split(","))
+    print(f"load average before: {os.getloadavg()}", flush=True)
+    tmp = None
+    folder = args.keep
+    if folder is None:
+        tmp = tempfile.mkdtemp(prefix="meshlap_scans_")
+        folder = Path(tmp)
+    folder.mkdir(parents=True, exist_ok=True)
+    try:
+        scans = make_scans(folder, big=not args.quick or args.big_only)
+        if args.big_only:
+            scans = scans[1:]
+        eigsh_mesh = SHARED / "armadillo_igl.obj"
+        rows: list[Row] = []
+        for scan in scans:
+            big = "2770k" in scan.name
+            reps = 1 if big else repeat  # the 2.77M scan once
+            if "load" in only:
+                rows += fig_load(scan, reps)
+            if "cli" in only:
+                rows += fig_cli(scan, reps)
+            if "smooth" in only:
+                rows += fig_smooth(scan, reps)
+            if "spectral" in only and not big:
+                rows += fig_spectral(scan, reps, eigsh_mesh if eigsh_mesh.is_file() else None)
+            for fig in VIEWER_FIGURES:
+                rows += fig(scan, reps)
+            print_rows(rows)
+            print()
+    finally:
+        if tmp is not None:
+            shutil.rmtree(tmp, ignore_errors=True)
+    print(f"load average after: {os.getloadavg()}")
+
+
+if __name__ == "__main__":
+    main()
