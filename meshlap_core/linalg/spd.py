@@ -33,6 +33,13 @@ from .quiet import quiet_c_stdout
 
 #: environment variable: ``fallback`` forces the pure-wheel back end (cholespy / SuperLU)
 SOLVER_ENV = "MESHLAP_SOLVER"
+CHOLMOD_MIN_N = 200_000
+"""Below this many unknowns :class:`SPDSolver` keeps the bundled cholespy even when CHOLMOD
+(scikit-sparse) is installed, unless ``MESHLAP_SOLVER=cholmod``: CHOLMOD's supernodal
+factorization wins on scans (9.8 s against 22.5 s at 692k), but its solves for a few
+right-hand sides are 2–4× slower (17–24 ms against 4–7 ms at 43k; 0.59 s against 0.19 s at
+692k), and below this size the factorization takes about a second either way, so the live
+smoother's steps decide (measured by ``benchmarks/bench_scale.py`` and ``bench_viewer.py``)."""
 #: how to get the fast back end (README, "Fast solver")
 FAST_SOLVER_HINT = (
     "apt-get install libsuitesparse-dev libopenblas0-pthread gcc python3-dev && "
@@ -71,17 +78,25 @@ def eigen_backend() -> str:
     return "qdldl"
 
 
-def solver_backend() -> str:
-    """The sparse Cholesky back end :class:`SPDSolver` uses now.
+def solver_backend(n: int | None = None) -> str:
+    """The sparse Cholesky back end :class:`SPDSolver` uses now (for ``n`` unknowns).
+
+    Parameters
+    ----------
+    n : int, optional
+        The system's size: below :data:`CHOLMOD_MIN_N` the bundled cholespy is used unless
+        ``MESHLAP_SOLVER=cholmod``. ``None``: the back end of a large system.
 
     Returns
     -------
     name : {"cholmod", "cholespy", "superlu"}
-        ``"cholmod"`` when scikit-sparse is installed and ``MESHLAP_SOLVER`` is not
-        ``fallback``; else ``"cholespy"`` when importable; else ``"superlu"``.
+        ``"cholmod"`` when scikit-sparse is installed, ``MESHLAP_SOLVER`` is not
+        ``fallback`` and the system is large enough (or ``MESHLAP_SOLVER=cholmod``); else
+        ``"cholespy"`` when importable; else ``"superlu"``.
     """
-    if os.environ.get(SOLVER_ENV, "").strip().lower() != "fallback":
-        if importlib.util.find_spec("sksparse") is not None:
+    choice = os.environ.get(SOLVER_ENV, "").strip().lower()
+    if choice != "fallback" and importlib.util.find_spec("sksparse") is not None:
+        if choice == "cholmod" or n is None or n >= CHOLMOD_MIN_N:
             return "cholmod"
     return "cholespy" if importlib.util.find_spec("cholespy") is not None else "superlu"
 
@@ -170,7 +185,7 @@ class SPDSolver:
         A.sum_duplicates()
         A.sort_indices()
         self.n = A.shape[0]
-        self.backend = solver_backend() if backend is None else backend
+        self.backend = solver_backend(self.n) if backend is None else backend
         self._lu: Any = None
         self._chol: Any = None
         self._cholmod: Any = None  # a sksparse.cholmod.Factor
