@@ -637,8 +637,7 @@ def smooth(
     Raises
     ------
     MeshError
-        On bad arguments (``iters`` above :data:`~meshlap_core.smoothing.params.MAX_ITERS`
-        too).
+        On bad arguments (``iters`` above :data:`~.params.MAX_ITERS` too).
     DivergenceError
         If explicit or Taubin smoothing diverged (see :attr:`Smoother.diverged`).
     """
