@@ -16,7 +16,10 @@ A session file is one JSON object::
 Each section after ``camera`` is one registered panel's settings (:mod:`meshlap_app.registry`):
 its keys, defaults and checks are declared beside the panel's state (``SESSION`` in
 ``app/state/<panel>.py``; :func:`schema` collects them), so a new panel brings its own section.
-``camera`` is polyscope's ``get_view_as_json()`` parsed (or ``null``). A relative ``mesh`` is
+``camera`` is polyscope's ``get_view_as_json()`` parsed (or ``null``), checked like every other
+section (:func:`.camera.check_camera`: its keys, window size, projection, ``fov``,
+``viewMat``). The file is read through :func:`meshlap_core.io.reader.read_json` (a regular file
+of at most 16 MiB) and the mesh checked with ``check_input``. A relative ``mesh`` is
 resolved against the session file's folder; ``null`` means the bundled default mesh. Missing
 keys take the defaults below; unknown keys, wrong types, values out of range, a newer
 ``version`` or a missing mesh are a :class:`MeshError` naming the file and the problem.
