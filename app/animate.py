@@ -36,6 +36,7 @@ from . import scene
 from .registry import REGISTRY
 from .state.animation import Animation, animations
 from .state.app import AppState
+from .state.camera import MAX_WINDOW, window_size
 from .state.mesh import MeshState
 from .state.session import check_session_mesh
 
@@ -92,15 +93,15 @@ def check_spec(spec: AnimationSpec, mesh: MeshState | None) -> None:
     w, h = spec.size
     if not (64 <= w <= 4096 and 64 <= h <= 4096):
         raise MeshError(f"each side must be 64 to 4096 pixels, got {w}x{h}", "--size")
+    if mesh is not None and spec.session is not None:  # the file first, as `view --session`
+        check_session_mesh(spec.session, mesh, spec.session_file or "--session")
     spec.animation.check(spec.options)
     if mesh is not None:
         spec.animation.check_mesh(spec.options, mesh)
     if spec.session is not None:
         window = session_window(spec.session, spec.size, spec.session_file or "--session")
-        if window is not None and window[0][0] > 8192:
+        if window is not None and window[0][0] > MAX_WINDOW:
             raise MeshError(f"too wide for this session's view, got {w}x{h}", "--size")
-    if mesh is not None and spec.session is not None:
-        check_session_mesh(spec.session, mesh, spec.session_file or "--session")
     inputs = [spec.mesh, spec.session_file]
     if spec.session is not None:
         inputs.append(spec.session.mesh)
@@ -186,20 +187,18 @@ def write_frames(
 def _saved_window(session: Any, source: Any) -> tuple[int, int] | None:
     """The window size stored with the session's camera (``None`` without a camera).
 
+    The camera was checked when the session was read (:func:`.state.camera.check_camera`,
+    the same check as ``meshlap view --session``); an animation needs the size too.
+
     Raises
     ------
     MeshError
-        A camera whose ``windowWidth`` / ``windowHeight`` are missing or not 64 to 8192.
+        A camera whose ``windowWidth`` / ``windowHeight`` are missing or out of range
+        (:data:`.state.camera.MIN_WINDOW` to :data:`~.state.camera.MAX_WINDOW`).
     """
     if session.camera is None:
         return None
-    size = []
-    for key in ("windowWidth", "windowHeight"):
-        x = session.camera.get(key)
-        if not isinstance(x, int) or isinstance(x, bool) or not 64 <= x <= 8192:
-            raise MeshError(f'"camera.{key}" must be an integer 64 to 8192, got {x!r}', source)
-        size.append(x)
-    return size[0], size[1]
+    return window_size(session.camera, source)
 
 
 def panel_strip(width: int, ui_scale: float) -> int:

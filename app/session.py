@@ -17,6 +17,7 @@ import polyscope as ps
 
 from meshlap_core.errors import MeshError
 
+from .state.camera import captured
 from .state.mesh import MeshState
 from .state.session import Session, check_session_mesh, read_session, write_session
 
@@ -35,9 +36,11 @@ def _finite_json(x: Any) -> bool:
 
 
 def camera_json() -> dict[str, Any] | None:
-    """polyscope's current view as a dict, or ``None`` before the first frame (NaN matrix)."""
+    """polyscope's current view as a dict, or ``None`` before the first frame (NaN matrix);
+    only the keys a session keeps, the window size within the checked range
+    (:func:`.state.camera.captured`), so that a saved session always reads back."""
     camera = json.loads(ps.get_view_as_json())
-    return camera if _finite_json(camera) else None
+    return captured(camera) if _finite_json(camera) else None
 
 
 def capture(host: Host) -> Session:

@@ -178,6 +178,14 @@ class UI:
             self._ip = psimplot
         return self._ip
 
+    def layout(self) -> str:
+        """The window's UI layout as Dear ImGui's ini text (``SaveIniSettingsToMemory``)."""
+        return str(self.im.SaveIniSettingsToMemory())
+
+    def load_layout(self, text: str) -> None:
+        """Apply a layout saved by :meth:`layout` (before the first frame)."""
+        self.im.LoadIniSettingsFromMemory(text)
+
     def begin_section(self, name: str) -> None:
         """The widgets drawn from now on belong to the panel section ``name``; ``changed``
         starts again from ``False``."""

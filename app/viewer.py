@@ -2,6 +2,8 @@
 
 ``run`` opens a window (or, with ``screenshot``, renders one frame with the EGL backend and
 exits). Paths are resolved before ``polyscope.init()``, which may change the working directory.
+polyscope's own settings files are off: the window's layout lives in meshlap's config folder
+(:mod:`.config`), and nothing is written in the current directory.
 
 The :class:`Viewer` owns the one :class:`~.state.app.AppState`, the UI adapter and the main
 mesh structure; everything else belongs to a panel. Each frame it draws the sections and the
@@ -56,6 +58,9 @@ def init_polyscope(backend: str) -> None:
         raise MeshError(NO_DISPLAY, "view")
     if backend in ("openGL3_egl", "openGL_mock"):
         ps.set_allow_headless_backends(True)
+    # no ./imgui.ini, no ./.polyscope.ini: nothing is read or written in the current directory
+    # (the window keeps its layout in meshlap's config folder, see run and meshlap_app.config)
+    ps.set_use_prefs_file(False)
     try:
         ps.init(backend)
     except RuntimeError as exc:
@@ -465,5 +470,17 @@ def run(
         ps.clear_user_callback()
         ps.remove_all_structures()
         return 0
-    ps.show()
+    show_window(viewer)
     return 0
+
+
+def show_window(viewer: Viewer) -> None:
+    """Run the interactive window with the UI layout of meshlap's config folder
+    (:mod:`.config`): read before the first frame, written when the window closes."""
+    from . import config
+
+    saved = config.read_layout()
+    if saved:
+        viewer.ui.load_layout(saved)
+    ps.show()
+    config.write_layout(viewer.ui.layout())

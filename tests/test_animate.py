@@ -5,6 +5,7 @@ buttons driven through the UI adapter on the openGL_mock backend."""
 
 from __future__ import annotations
 
+import json
 import os
 import subprocess
 import sys
@@ -346,6 +347,11 @@ def _session_file(tmp_path, mesh, panel="smoothing", name="s.json", **changes):
             s.settings[key].update(value)
         else:
             setattr(s, key, value)
+    if changes.get("camera") or changes.get("smoothing", {}).get("iterations", 0) > 5000:
+        # values the reader refuses (write_session checks them): written as it would write them
+        path = tmp_path / name
+        path.write_text(json.dumps(s.to_dict(tmp_path.resolve()), indent=2) + "\n")
+        return path
     path = write_session(tmp_path / f"{name}.json", s)
     return path.rename(tmp_path / name)  # write_session wants .json; a session may be named .gif
 

@@ -323,7 +323,9 @@ class App:
         self.proc = subprocess.Popen(
             self.argv,
             cwd=self.cwd,
-            env=dict(self.x.env(), HOME=str(self.cwd)),  # nothing lands in the user's home
+            # nothing lands in the user's home; the window's layout (meshlap's config folder)
+            # starts fresh in each test, so a layout saved by another run cannot move the panel
+            env=dict(self.x.env(), HOME=str(self.cwd), XDG_CONFIG_HOME=str(self.cwd / ".config")),
             stdout=subprocess.DEVNULL,
             stderr=self.stderr_path.open("w"),
         )

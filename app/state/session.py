@@ -16,7 +16,10 @@ A session file is one JSON object::
 Each section after ``camera`` is one registered panel's settings (:mod:`meshlap_app.registry`):
 its keys, defaults and checks are declared beside the panel's state (``SESSION`` in
 ``app/state/<panel>.py``; :func:`schema` collects them), so a new panel brings its own section.
-``camera`` is polyscope's ``get_view_as_json()`` parsed (or ``null``). A relative ``mesh`` is
+``camera`` is polyscope's ``get_view_as_json()`` parsed (or ``null``), checked like every other
+section (:func:`.camera.check_camera`: its keys, window size, projection, ``fov``,
+``viewMat``). The file is read through :func:`meshlap_core.io.reader.read_json` (a regular file
+of at most 16 MiB) and the mesh checked with ``check_input``. A relative ``mesh`` is
 resolved against the session file's folder; ``null`` means the bundled default mesh. Missing
 keys take the defaults below; unknown keys, wrong types, values out of range, a newer
 ``version`` or a missing mesh are a :class:`MeshError` naming the file and the problem.
@@ -58,8 +61,10 @@ from typing import Any
 from meshlap_core import __version__
 from meshlap_core.errors import MeshError
 from meshlap_core.io import atomic_write, check_output_path
+from meshlap_core.io.reader import check_input, read_json
 
 from ..registry import REGISTRY, VIEWS
+from .camera import check_camera
 from .checks import Check, Schema, number, one_of
 from .mesh import MeshState
 
@@ -191,10 +196,7 @@ def from_dict(
     session = Session(mesh=_mesh_path(data.get("mesh"), source, folder))
     session.panel = _checked(data, "panel", VIEWS[0], one_of(VIEWS), source)
     session.ui_scale = float(_checked(data, "ui_scale", 1.0, number(0.5, 3.0), source))
-    camera = data.get("camera")
-    if camera is not None and not isinstance(camera, dict):
-        raise MeshError(f'"camera" must be an object or null, got {json.dumps(camera)}', source)
-    session.camera = camera
+    session.camera = check_camera(data.get("camera"), source)
     for sec, keys in schema().items():
         values = data.get(sec, {})
         if not isinstance(values, dict):
@@ -230,8 +232,12 @@ def _mesh_path(mesh: Any, source: str | os.PathLike, folder: Path | None) -> Pat
     path = Path(mesh).expanduser()
     if not path.is_absolute() and folder is not None:
         path = folder / path
-    if not path.is_file():
+    if not os.path.lexists(path):
         raise MeshError(f"the mesh {mesh!r} does not exist (looked for {path})", source)
+    try:  # a directory, a device or a FIFO is named as such, never "does not exist"
+        check_input(path, what="mesh file")
+    except MeshError as exc:
+        raise MeshError(f"the mesh {mesh!r} ({path}): {exc.problem}", source) from None
     return path.resolve()
 
 
@@ -257,22 +263,17 @@ def read_session(path: str | os.PathLike) -> Session:
     Raises
     ------
     MeshError
-        The file cannot be read, is not JSON (line and column given), or :func:`from_dict`
-        refuses it; the message starts with the file name.
+        The file cannot be read, is not a regular file, is over the session size limit
+        (16 MiB), is not UTF-8 or not JSON (line and column given), nests too deeply or holds
+        an integer beyond Python's digit limit (:func:`meshlap_core.io.reader.read_json`), or
+        :func:`from_dict` refuses it; the message starts with the file name.
     """
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except UnicodeDecodeError:
-        raise MeshError("not a session file (not UTF-8 text)", path) from None
-    except OSError as exc:
-        raise MeshError(f"cannot read the session: {exc.strerror or exc}", path) from None
-    try:
-        data = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise MeshError(
-            f"not JSON ({exc.msg} at line {exc.lineno}, column {exc.colno})", path
-        ) from None
+    try:  # a missing, special or oversize file: said before a byte is read
+        check_input(path, what="session file")
+    except MeshError as exc:
+        raise MeshError(f"cannot read the session: {exc.problem}", path) from None
+    data = read_json(path, what="session file")  # size, UTF-8, JSON, depth, digits
     return from_dict(data, path, path.resolve().parent)
 
 

@@ -21,7 +21,9 @@ from .animation import Animation, Option
 from .checks import Schema, integer, number, one_of
 
 MAX_FRAMES_ITERS = 5000
-"""Most smoothing iterations an animation renders (one frame each)."""
+"""Most smoothing iterations an animation renders (one frame each), and the most a session may
+hold (``smoothing.iterations``): opening a session replays every step before the first frame,
+so ``meshlap view --session`` and ``meshlap animate --session`` share this one limit."""
 _EMPTY_V = np.zeros((0, 3))
 _EMPTY_F = np.zeros((0, 3), dtype=np.int64)
 
@@ -107,11 +109,15 @@ class SmoothingState:
         Raises
         ------
         MeshError
-            A bad option (named), e.g. a negative noise α or seed; the previous options and
-            stepper stay.
+            A bad option (named), e.g. a negative noise α or seed, a seed beyond
+            ``noise.MAX_SEED`` or an α whose noise would overflow the coordinates
+            (:func:`meshlap_core.noise.check_seed`, :func:`~meshlap_core.noise.check_noise`);
+            the previous options and stepper stay.
         """
-        if seed is not None and not (isinstance(seed, int) and seed >= 0):
-            raise MeshError(f"must be an integer >= 0, got {seed!r}", "noise seed")
+        if seed is not None:
+            seed = check_seed(seed, "noise seed")  # what the field and a session can hold
+        if noise_alpha is not None:
+            check_noise(V, noise_alpha, "noise alpha")  # finite noisy coordinates
         old = (self.method, self.laplacian, self.noise_alpha, self.seed)
         if method is not None:
             self.method = method
@@ -249,16 +255,40 @@ def _lam_steps(x: Any) -> str | None:
     return None
 
 
+def _seed(x: Any) -> str | None:
+    """What is wrong with a saved noise seed (:func:`meshlap_core.noise.check_seed`: an
+    integer ``0..MAX_SEED``, what the panel's seed field holds)."""
+    try:
+        check_seed(x)
+    except MeshError as exc:
+        return exc.problem
+    return None
+
+
+def _iterations(x: Any) -> str | None:
+    """What is wrong with a saved iteration count: an integer ``0..MAX_FRAMES_ITERS`` (each
+    step is replayed before the first frame; an animation has as many frames)."""
+    problem = integer(0)(x)
+    if problem or x <= MAX_FRAMES_ITERS:
+        return problem
+    return (
+        f"must be 0 to {MAX_FRAMES_ITERS} (the smoothing ran {x} iterations; an animation has "
+        f"at most {MAX_FRAMES_ITERS}, and opening a session replays each one before the first "
+        "frame)"
+    )
+
+
 SESSION: Schema = {
     "method": ("implicit", one_of(SMOOTHING_METHODS)),
     "laplacian": ("uniform", one_of(LAPLACIAN_KINDS)),
     "lam": (0.5, number(positive=True)),
     "noise_alpha": (0.0, number(0.0)),
-    "seed": (0, integer(0)),
-    "iterations": (0, integer(0, 100_000)),
+    "seed": (0, _seed),
+    "iterations": (0, _iterations),
     "lam_steps": (None, _lam_steps),
 }
-"""The Smoothing panel's section of a saved session (:mod:`.session`)."""
+"""The Smoothing panel's section of a saved session (:mod:`.session`); ``noise_alpha`` is
+checked against the mesh too (:func:`check_session`)."""
 SESSION_ADDED = ("lam_steps",)
 QUIET: dict[str, Any] = {"iterations": 0}
 """Restored for another panel's animation: no run replayed."""
@@ -285,6 +315,23 @@ def check_section(sm: dict[str, Any], source: Any) -> None:
     sm["lam_steps"] = [[float(lam), int(n)] for lam, n in runs]
 
 
+def check_session(sm: dict[str, Any], mesh: Any, source: Any) -> None:
+    """Refuse a saved noise α whose noise would push this mesh's coordinates past the
+    coordinate limit (:func:`meshlap_core.noise.check_noise`); without it, 1e308 passes the
+    section's check and the noisy mesh is then blamed ("vertex 0 has a NaN ...").
+
+    Raises
+    ------
+    MeshError
+        Naming ``"smoothing.noise_alpha"`` and the largest usable α.
+    """
+    if sm["noise_alpha"]:
+        try:
+            check_noise(mesh.V, sm["noise_alpha"], '"smoothing.noise_alpha"')
+        except MeshError as exc:
+            raise MeshError(f"{exc.source}: {exc.problem}", source) from None
+
+
 def encode_lam_steps(runs: list[list[Any]], lam: float) -> list[list[Any]] | None:
     """``lam_steps`` to save for a run of ``runs`` (``[[λ, steps], ...]``) with ``lam`` set
     now: ``None`` when it says nothing that ``lam`` and ``iterations`` do not (no step, or every
@@ -307,12 +354,6 @@ def _animation_from_session(opts: dict[str, Any], sm: dict[str, Any], source: An
     """Fill the options not typed from the saved section: method, Laplacian, λ (and the λ of
     every saved step unless ``--lam`` is typed), noise, seed, and the iterations (the last
     frame is then the saved view)."""
-    if opts.get("iters") is None and sm["iterations"] > MAX_FRAMES_ITERS:
-        raise MeshError(
-            f"the session's smoothing ran {sm['iterations']} iterations; an animation has at "
-            f"most {MAX_FRAMES_ITERS}: give --iters N",
-            source,
-        )
     opts["lam_steps"] = sm.get("lam_steps") if opts.get("lam") is None else None
     saved = {
         "method": sm["method"],
