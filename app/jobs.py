@@ -124,12 +124,12 @@ class Job:
         return max(0.0, end - self.started)
 
     def line(self) -> str:
-        """``title: phase, 3 s (40 %)``: the progress line (the seconds make it move at least
-        once a second)."""
+        """``title: phase, 3.2 s (40 %)``: the progress line (the tenths make it move on every
+        frame)."""
         r = self.reporter
         frac = f" ({100 * r.fraction:.0f} %)" if r.fraction is not None else ""
         phase = f": {r.phase}" if r.phase else ""
-        return f"{self.title}{phase}, {self.elapsed():.0f} s{frac}"
+        return f"{self.title}{phase}, {self.elapsed():.1f} s{frac}"
 
     def run(self) -> None:
         """The worker's body: ``work(reporter)``, its outcome kept for :meth:`Jobs.poll`."""

@@ -63,7 +63,7 @@ def test_progress_line_phase_fraction_and_elapsed():
         return jobs.running("m").line()
 
     jobs.start("m", "opening x.obj", work, lambda r: None)
-    assert lines == ["opening x.obj: reading, 2 s", "opening x.obj: validating, 3 s (40 %)"]
+    assert lines == ["opening x.obj: reading, 2.0 s", "opening x.obj: validating, 3.0 s (40 %)"]
 
 
 def test_cancel_discards_the_result_and_keeps_the_state():

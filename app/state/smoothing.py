@@ -133,6 +133,8 @@ class SmoothingState:
         """Take the options a job built ``smoother`` from, and the stepper (UI thread)."""
         self.method, self.laplacian, _, self.noise_alpha, self.seed = options
         self.playing = False
+        if smoother.lam != self.lam:  # lambda typed while it was being built
+            smoother.set_lam(self.lam)
         self.adopt(smoother)
 
     def set_lam(self, lam: float) -> None:
