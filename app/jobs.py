@@ -15,6 +15,10 @@ without a ``cancel=`` argument stops at its next progress report.
 cancels the old one (its result is thrown away, never applied) unless ``replace=False``, which
 refuses the new one instead (``start`` returns ``None``).
 
+:func:`in_child` runs a job's work in a child process instead (the load and the curvature
+fields: scipy's sparse conversions hold the GIL for seconds on a big mesh, which would stall
+the window; a child process shares no GIL, and Cancel ends it at once).
+
 :func:`call_hooked` is the one adapter to the core's ``progress=`` / ``cancel=`` keywords: it
 passes each only when the callee accepts it (``inspect.signature``), so the viewer works with
 a core that has them and with one that does not.
@@ -23,10 +27,12 @@ a core that has them and with one that does not.
 from __future__ import annotations
 
 import inspect
+import multiprocessing
 import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from pickle import PicklingError
 from typing import Any
 
 from meshlap_core import errors as _errors
@@ -173,6 +179,7 @@ class Jobs:
         self._lock = threading.Lock()
         self.last_report = clock()  # when a job last reported or finished (the pacer reads it)
         self.cancelled = 0  # jobs cancelled so far (superseded or by the user)
+        self.processes = False  # offload() may use child processes (the window sets it)
 
     # ------------------------------------------------------------------ start / cancel
     def start(
@@ -236,6 +243,13 @@ class Jobs:
         """Cancel every running job (a new mesh makes them all obsolete)."""
         for owner in list(self._jobs):
             self.cancel(owner)
+
+    def offload(self, fn: Callable[..., Any], *args: Any) -> Callable[[Reporter], Any]:
+        """A job's ``work`` calling ``fn(*args, progress=reporter)``: in a child process
+        (:func:`in_child`) when :attr:`processes` is set, else in the job's thread."""
+        if self.processes:
+            return in_child(fn, *args)
+        return lambda reporter: fn(*args, progress=reporter)
 
     # ------------------------------------------------------------------ UI thread
     def poll(self) -> list[Job]:
@@ -305,3 +319,111 @@ def call_hooked(fn: Callable[..., Any], *args: Any, reporter: Reporter, **kwargs
     if accepts(fn, "cancel"):
         kwargs["cancel"] = reporter.cancel
     return fn(*args, **kwargs)
+
+
+# ---------------------------------------------------------------------- child processes
+CHILD_PRELOAD = ("numpy", "scipy.sparse", "meshlap_core.io", "meshlap_core.curvature")
+"""Modules the fork server imports once, so each child starts in milliseconds."""
+
+
+class _ChildReporter:
+    """The reporter a child process's function is given: sends each report to the parent
+    (which checks Cancel and ends the child)."""
+
+    cancel = None  # the parent cancels by ending the process
+
+    def __init__(self, conn: Any) -> None:
+        self.conn = conn
+        self.fraction: float | None = None
+
+    def __call__(self, fraction: float | None, message: str = "") -> None:
+        self.fraction = fraction
+        self.conn.send(("progress", fraction, message))
+
+    def phase_only(self, message: str) -> None:
+        self(self.fraction, message)
+
+    def check(self) -> None:
+        """Nothing to check here (the parent ends the process on Cancel)."""
+
+
+def _child_main(conn: Any, fn: Callable[..., Any], args: tuple[Any, ...]) -> None:
+    """Body of the child process: ``fn(*args, progress=reporter)``, its result or its error
+    sent back as one message."""
+    try:
+        result = fn(*args, progress=_ChildReporter(conn))
+    except MeshError as exc:
+        conn.send(("error", str(exc)))
+    except OSError as exc:
+        name = getattr(exc, "filename", None)
+        conn.send(("error", f"{name}: {exc.strerror or exc}" if name else str(exc)))
+    except BaseException as exc:  # reported to the parent, never lost
+        conn.send(("error", f"{type(exc).__name__}: {exc}"))
+    else:
+        conn.send(("result", result))
+    finally:
+        conn.close()
+
+
+def _context() -> Any:
+    """The fork server (a clean process that imported :data:`CHILD_PRELOAD` once; never a fork
+    of the window's process with its GL context and threads)."""
+    ctx = multiprocessing.get_context("forkserver")
+    ctx.set_forkserver_preload(list(CHILD_PRELOAD))
+    return ctx
+
+
+def warm_up() -> None:
+    """Start the fork server now (in a thread: the first job then starts at once)."""
+
+    def start() -> None:
+        try:
+            from multiprocessing import forkserver
+
+            _context()
+            forkserver.ensure_running()
+        except Exception:  # no fork server here: in_child falls back to a thread
+            pass
+
+    threading.Thread(target=start, daemon=True).start()
+
+
+def in_child(fn: Callable[..., Any], *args: Any) -> Callable[[Reporter], Any]:
+    """A job's ``work`` that runs ``fn(*args, progress=...)`` in a child process (``fn`` a
+    module-level function, its arguments and result picklable). Reports arrive through a
+    pipe; Cancel ends the child. Where no child process can start, ``fn`` runs in the job's
+    thread instead."""
+
+    def work(reporter: Reporter) -> Any:
+        try:
+            ctx = _context()
+            recv, send = ctx.Pipe(duplex=False)
+            proc = ctx.Process(target=_child_main, args=(send, fn, args), daemon=True)
+            proc.start()
+        except (OSError, ValueError, RuntimeError, TypeError, AttributeError, PicklingError):
+            return fn(*args, progress=reporter)  # no child process here (or fn not picklable)
+        send.close()
+        try:
+            while True:
+                reporter.check()  # Cancelled: the finally below ends the child
+                if recv.poll(0.05):
+                    try:
+                        kind, *payload = recv.recv()
+                    except EOFError:
+                        message = f"the worker process ended (exit code {proc.exitcode})"
+                        raise MeshError(message) from None
+                    if kind == "progress":
+                        reporter(*payload)
+                    elif kind == "result":
+                        return payload[0]
+                    else:
+                        raise MeshError(payload[0])
+                elif not proc.is_alive() and not recv.poll():
+                    raise MeshError(f"the worker process ended (exit code {proc.exitcode})")
+        finally:
+            recv.close()
+            if proc.is_alive():
+                proc.kill()
+            proc.join(5)
+
+    return work

@@ -25,7 +25,7 @@ import polyscope as ps
 from meshlap_core.errors import MeshError
 
 from . import scene
-from .jobs import Job, Reporter
+from .jobs import Job, Reporter, warm_up
 from .pacing import Pacer
 from .panels.base import Panel
 from .registry import REGISTRY, VIEWS
@@ -363,18 +363,13 @@ class Viewer:
         fields computed as one job of the Mesh section (the last good mesh stays on screen
         meanwhile; True: started); otherwise right here (True: loaded).
         """
-        from .state.mesh import read_mesh
+        from .state.mesh import read_mesh_with_fields
 
         section = REGISTRY[0].name  # the first section: the mesh's
         state = self.state
         curv = state.curv
         settings = (curv.area, curv.boundary)
-
-        def work(reporter: Reporter) -> Any:
-            loaded = read_mesh(path, reporter)
-            reporter(None, f"curvature fields of {len(loaded.mesh.V):,} vertices")
-            fields = curv.compute(loaded.mesh.V, loaded.mesh.F, *settings)
-            return loaded, fields
+        work = state.jobs.offload(read_mesh_with_fields, path, *settings)  # a child process
 
         def apply(result: Any) -> None:
             loaded, fields = result
@@ -554,6 +549,8 @@ def run(
     ps.set_files_dropped_callback(viewer.files_dropped)
     if shot is None:  # the window: long operations as jobs, paced frames (idle is idle)
         viewer.background = viewer.pace = True
+        state.jobs.processes = True  # load and fields in child processes: no shared GIL
+        warm_up()  # the fork server for them
         ps.set_max_fps(-1)  # polyscope's limit spins a core; the Pacer sleeps instead
         if later is not None:
             viewer.open(later)

@@ -178,3 +178,35 @@ def test_pacer_full_rate_on_input_busy_then_idle():
     p.wait(busy=False)
     assert p.mode == "active"
     assert p.rate(busy=False, animating=True) == p.full_fps
+
+
+def _child_work(n: int, progress=None) -> int:
+    """A child process's work: reports, then sleeps (cancelled from the parent) or fails."""
+    import time
+
+    progress(0.5, "in the child")
+    if n < 0:
+        raise MeshError("refused", "child")
+    if n == 0:
+        time.sleep(60)
+    return n * 2
+
+
+def test_in_child_reports_returns_fails_and_is_ended_by_cancel():
+    from meshlap_app.jobs import in_child
+
+    jobs = Jobs()
+    out: list[int] = []
+    errors: list[str] = []
+    job = jobs.start("c", "child", in_child(_child_work, 21), out.append, errors.append)
+    assert jobs.wait(timeout=120) and out == [42] and job.reporter.phase == "in the child"
+    jobs.start("c", "child", in_child(_child_work, -1), out.append, errors.append)
+    assert jobs.wait(timeout=120) and errors == ["child: refused"]
+    job = jobs.start("c", "child", in_child(_child_work, 0), out.append, errors.append)
+    for _ in range(2000):  # until the child reported
+        if job.reporter.reports:
+            break
+        threading.Event().wait(0.01)
+    jobs.cancel("c")
+    job.thread.join(30)  # the child was ended: no 60 s wait
+    assert not job.thread.is_alive() and job.outcome == "cancelled" and out == [42]

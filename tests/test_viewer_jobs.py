@@ -161,3 +161,32 @@ def test_smoothing_builds_its_stepper_as_a_job_and_stays_usable(viewer, monkeypa
     assert st.smoother is built and st.method == "implicit"
     wait_jobs(viewer)
     assert st.method == "explicit" and st.smoother is not built
+
+
+def test_a_new_area_recomputes_the_fields_as_a_job_and_cancel_goes_back(viewer, monkeypatch):
+    from meshlap_app.state.curvature import CurvatureState
+
+    viewer.background = True
+    curv = viewer.state.curv
+    release = threading.Event()
+    real = CurvatureState.compute
+
+    def slow(V, F, area, boundary, progress=None):
+        release.wait(30)
+        return real(V, F, area, boundary)
+
+    monkeypatch.setattr(CurvatureState, "compute", staticmethod(slow))
+    shown = dict(curv.fields)
+    drive(viewer, "area", "voronoi", panel="curvature")
+    frames(viewer)
+    assert viewer.state.jobs.running("curvature") is not None
+    assert curv.fields == shown  # the map on screen stays meanwhile
+    assert progress_texts(viewer, "curvature")[-1].startswith("curvature fields (voronoi")
+    drive(viewer, "Cancel##curvature", True)
+    frames(viewer)
+    assert curv.area == "barycentric" and curv.fields == shown  # back to what is shown
+    release.set()
+    drive(viewer, "area", "voronoi")
+    wait_jobs(viewer)
+    frames(viewer)
+    assert curv.current(viewer.state.mesh) and curv.computed_for()[1] == "voronoi"

@@ -101,9 +101,16 @@ class CurvatureState:
         """The fields are those of ``mesh`` with the chosen area and boundary rule."""
         return self._key == (mesh.version, self.area, self.boundary)
 
+    def computed_for(self) -> tuple[Any, ...]:
+        """``(mesh version, area, boundary rule)`` the fields were computed for (``()``:
+        none yet)."""
+        return self._key
+
     @staticmethod
-    def compute(V: FloatArray, F: Any, area: str, boundary: str) -> dict[str, FloatArray]:
-        """Every curvature field (any thread: touches no state)."""
+    def compute(
+        V: FloatArray, F: Any, area: str, boundary: str, progress: Any = None
+    ) -> dict[str, FloatArray]:
+        """Every curvature field (any thread or a child process: touches no state)."""
         return all_curvature_fields(V, F, area, boundary)
 
     def adopt(self, mesh: MeshState, fields: dict[str, FloatArray]) -> None:

@@ -123,3 +123,17 @@ def read_mesh(path: str | Path | None, progress: Any = None) -> LoadedMesh:
     phase("describing the mesh")
     info = mesh_info(mesh.V, mesh.F, mesh.report, label or name)
     return LoadedMesh(mesh, name, Path(path).resolve(), info)
+
+
+def read_mesh_with_fields(
+    path: str | Path | None, area: str, boundary: str, progress: Any = None
+) -> tuple[LoadedMesh, dict[str, FloatArray]]:
+    """:func:`read_mesh`, then every curvature field for ``area`` and ``boundary``: the job of
+    opening a file in the window (run in a child process, see
+    :func:`meshlap_app.jobs.in_child`)."""
+    from meshlap_core.curvature import all_curvature_fields
+
+    loaded = read_mesh(path, progress)
+    if progress is not None:
+        progress(None, f"curvature fields of {len(loaded.mesh.V):,} vertices")
+    return loaded, all_curvature_fields(loaded.mesh.V, loaded.mesh.F, area, boundary)
