@@ -9,7 +9,9 @@ gets the core). The rule:
 - *active* (input this frame or less than :data:`IDLE_AFTER_S` ago, something playing or
   recording): :data:`FULL_FPS`;
 - a job runs: :data:`BUSY_FPS` (the progress line still moves several times a second);
-- otherwise *idle*: :data:`IDLE_FPS`; the first input event wakes it within one idle frame.
+- otherwise *idle*: :data:`IDLE_FPS`, and :data:`DEEP_IDLE_FPS` after :data:`DEEP_IDLE_AFTER_S`
+  (each idle frame still costs tens of milliseconds of CPU with a software OpenGL); the first
+  input event wakes it within one idle frame.
 """
 
 from __future__ import annotations
@@ -27,6 +29,10 @@ IDLE_FPS = 4.0
 """Frames per second with nothing happening (< 10 % of a core on a 692k-vertex mesh)."""
 IDLE_AFTER_S = 1.0
 """Seconds without input after which the window drops to the idle rate."""
+DEEP_IDLE_FPS = 2.0
+"""Frames per second after :data:`DEEP_IDLE_AFTER_S` without input (< 10 % of a core with
+Mesa's llvmpipe at 1280×720; the first input is answered within half a second)."""
+DEEP_IDLE_AFTER_S = 4.0
 
 
 @dataclass
@@ -46,6 +52,8 @@ class Pacer:
     busy_fps: float = BUSY_FPS
     idle_fps: float = IDLE_FPS
     idle_after: float = IDLE_AFTER_S
+    deep_fps: float = DEEP_IDLE_FPS
+    deep_after: float = DEEP_IDLE_AFTER_S
     last_input: float = field(default=-1e9)
     last_frame: float | None = None
     max_busy_gap: float = 0.0  # longest time between two frames while a job ran
@@ -61,11 +69,14 @@ class Pacer:
     def rate(self, busy: bool, animating: bool) -> float:
         """Frames per second for the next frame (and :attr:`mode` set to ``active``,
         ``busy`` or ``idle``)."""
-        if animating or self.clock() - self.last_input < self.idle_after:
+        quiet = self.clock() - self.last_input
+        if animating or quiet < self.idle_after:
             self.mode = "active"
             return self.full_fps
         self.mode = "busy" if busy else "idle"
-        return self.busy_fps if busy else self.idle_fps
+        if busy:
+            return self.busy_fps
+        return self.deep_fps if quiet >= self.deep_after else self.idle_fps
 
     def wait(self, busy: bool, animating: bool = False) -> float:
         """Sleep what is left of this frame's period; returns the seconds slept."""

@@ -174,6 +174,10 @@ def test_pacer_full_rate_on_input_busy_then_idle():
     assert p.max_busy_gap == pytest.approx(2.0)  # the longest gap between two busy frames
     p.wait(busy=False)
     assert p.mode == "idle" and slept[-1] == pytest.approx(1 / p.idle_fps)
+    clock.t += p.deep_after  # longer without input: the deep idle rate
+    p.wait(busy=False)
+    p.wait(busy=False)
+    assert p.mode == "idle" and slept[-1] == pytest.approx(1 / p.deep_fps)
     p.touch()
     p.wait(busy=False)
     assert p.mode == "active"
