@@ -301,6 +301,21 @@ class Jobs:
         return self.running(owner) is None
 
 
+def prefer_gil_free_solvers() -> bool:
+    """Ask the core to keep its eigensolver on a factorization that releases the GIL
+    (``meshlap_core.linalg.spd.prefer_gil_free``, where the core has it), so the window keeps
+    drawing while an eigenbasis job runs in a thread. True when the core has the switch."""
+    try:
+        from meshlap_core.linalg import spd
+    except ImportError:
+        return False
+    switch = getattr(spd, "prefer_gil_free", None)
+    if switch is None:
+        return False
+    switch(True)
+    return True
+
+
 def accepts(fn: Callable[..., Any], name: str) -> bool:
     """Whether ``fn`` takes the keyword argument ``name`` (or ``**kwargs``)."""
     try:

@@ -69,6 +69,10 @@ def child(scan: Path) -> dict[str, float]:
     ps.set_user_callback(viewer.callback)
     ps.frame_tick()
     viewer.background = viewer.pace = True
+    state.jobs.processes = True  # as `meshlap view` sets up the window
+    from meshlap_app.jobs import warm_up
+
+    warm_up()
     rss_before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
     t0 = time.perf_counter()
     viewer.open(scan)
