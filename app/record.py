@@ -82,7 +82,11 @@ class Recorder:
             if ui.button("record", "start recording what this panel plays (a frame per change)"):
                 self.start(host)
         elif ui.button("stop", "stop and write the file"):
-            self.status = self.stop()
+            if host.background:
+                self.stop_in_background(host)
+            else:
+                self.status = self.stop()
+        host.draw_job(self._job_owner())
         if self.recording:
             ui.text(f"recording: {self.count} frames")
         if self.status:
@@ -118,6 +122,35 @@ class Recorder:
         except MeshError:
             writer.abort()
             raise
+
+    def _job_owner(self) -> str:
+        return f"record {id(self)}"
+
+    def stop_in_background(self, host: Host) -> None:
+        """*stop* in the window: the file is written (encoded) as a job, the window goes on;
+        the message says where when it is done (or why not)."""
+        writer, self.writer = self.writer, None
+        held, self._held = self._held, None
+        if writer is None:
+            return
+        if held is not None:
+            writer.add(burn_caption(*held))
+        self.status = f"writing {writer.count} frames ..."
+
+        def done(path: Any) -> None:
+            self.status = f"wrote {writer.count} frames ({writer.fps:g} fps) to {path}"
+
+        def failed(message: str) -> None:
+            writer.abort()
+            self.status = message
+
+        host.state.jobs.start(
+            self._job_owner(),
+            f"writing {writer.count} frames",
+            lambda reporter: writer.close(),
+            done,
+            failed,
+        )
 
     def restart(self) -> None:
         """A play starts over right after *record*: drop the frame held from the moment of

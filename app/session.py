@@ -106,6 +106,7 @@ def apply(
     order; then the view and the camera.
     """
     running = [job for p in host.panels.values() if (job := p.busy())]
+    running += [f"{job.title} is still running" for job in host.state.jobs.all_running()]
     if running:
         raise MeshError(f"{running[0]}; load the session when it is done", source)
     if mesh is None:

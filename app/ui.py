@@ -287,7 +287,12 @@ class UI:
         self.im.Separator()
 
     def progress(self, fraction: float, text: str) -> None:
+        """A progress bar (``fraction`` in [0, 1]) with ``text`` on it."""
         self.im.ProgressBar(float(fraction), (-1, 0), text)
+        self._record_progress(float(fraction), text)
+
+    def _record_progress(self, fraction: float, text: str) -> None:
+        """Hook called after :meth:`progress` drew a bar (a job's progress line)."""
 
     def push_width(self, width: float) -> None:
         self.im.PushItemWidth(width * self.scale)
@@ -575,6 +580,22 @@ class UI:
         if io.WantCaptureMouse:
             return None
         return tuple(io.MousePos)
+
+    def activity(self) -> tuple[Any, ...]:
+        """What the user is doing this frame, as a value that changes with any input (mouse
+        position, buttons, wheel, typed characters, modifier keys, an active widget): the
+        host compares it with the last frame's to tell input from idle."""
+        im = self.im
+        io = im.GetIO()
+        return (
+            tuple(io.MousePos),
+            bool(im.IsAnyMouseDown()),
+            float(io.MouseWheel),
+            float(io.MouseWheelH),
+            bool(io.WantTextInput),
+            int(io.KeyMods),
+            bool(im.IsAnyItemActive()),
+        )
 
     def overlay_text(self, pos: tuple[float, float], text: str) -> None:
         """Text drawn over the 3D view at window pixel ``pos``."""

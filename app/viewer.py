@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import os
 import sys
-import time
 import traceback
 from collections.abc import Callable
 from pathlib import Path
@@ -28,6 +27,8 @@ import polyscope as ps
 from meshlap_core.errors import MeshError
 
 from . import scene
+from .jobs import Job, Reporter, prefer_gil_free_solvers, warm_up
+from .pacing import Pacer
 from .panels.base import Panel
 from .registry import REGISTRY, VIEWS
 from .scene import MESH
@@ -40,10 +41,10 @@ NO_DISPLAY = (
     "`meshlap view MESH --screenshot out.png`"
 )
 
-BUSY_FRAME_S = 0.35
-"""While a panel's background job runs, each frame waits this long (about 5 frames/s): the
-render loop then leaves the cores to the worker, so an eigenbasis takes about as long as
-``meshlap spectral``."""
+ASYNC_OPEN_BYTES = 8 * 2**20
+"""``meshlap view FILE`` with a larger file opens the window on the bundled mesh at once and
+loads FILE as a job (progress and Cancel in the Mesh section); a smaller file is loaded before
+the window opens (a bad one exits 2 as every command does)."""
 
 
 def init_polyscope(backend: str) -> None:
@@ -99,7 +100,10 @@ class Viewer:
         self.ui = ui or UI()
         self.ui.scale = state.ui_scale
         self.panels = make_panels(state)
-        self.busy_frame_s = BUSY_FRAME_S
+        self.background = False  # long operations run as jobs (the window; False: inline)
+        self.pace = False  # the window sleeps between frames (Pacer); tests tick freely
+        self.pacer = Pacer()
+        self._activity: tuple[Any, ...] = ()
         self.reframe = True  # frame the visible structures at the end of the next frame
         self.keep_camera = False  # an animation of a saved view: never re-frame
         self.window_size: tuple[int, int] = (0, 0)
@@ -182,11 +186,15 @@ class Viewer:
         ui = self.ui
         for i, name in enumerate(VIEWS):
             if ui.key(str(i + 1)):
+                self.pacer.touch()
                 self.set_panel(name)
         panels = [self.active(), *self.sections]
         keys = dict.fromkeys([*(k for p in self.panels.values() for k in p.keys), "f", "r"])
         for key in keys:
-            if ui.key(key) and not any(p.on_key(self, key) for p in panels):
+            pressed = ui.key(key)
+            if pressed:
+                self.pacer.touch()  # a key: full rate (the idle rate would lag the answer)
+            if pressed and not any(p.on_key(self, key) for p in panels):
                 if key in ("f", "r"):  # nobody used it: frame (R: the camera's reset)
                     self.reframe = True
 
@@ -222,10 +230,13 @@ class Viewer:
         leaves this function, so none ends the session.
         """
         ui = self.ui
-        if self.busy_frame_s > 0 and any(p.busy() for p in self.panels.values()):
-            time.sleep(self.busy_frame_s)  # releases the GIL too
+        jobs = self.state.jobs
+        if self.pace:
+            self.pacer.wait(jobs.busy)  # sleeps (GIL released): idle is idle
+        self.draw_guarded("jobs", lambda host: host.poll_jobs())
         ui.push_width(200)
         try:
+            self.draw_guarded("jobs", lambda host: host.draw_other_jobs())
             viewed = False
             for e in REGISTRY:
                 if not e.view:
@@ -242,6 +253,44 @@ class Viewer:
         self.draw_guarded("keys", lambda host: host.handle_keys())
         self.draw_guarded("labels", self.active().overlay)
         self.draw_guarded("layout", lambda host: host.layout())
+        self.draw_guarded("pacing", lambda host: host.note_activity())
+
+    # ------------------------------------------------------------------ jobs, pacing
+    def poll_jobs(self) -> None:
+        """Apply what the finished jobs computed (here, on the UI thread)."""
+        if self.state.jobs.poll():
+            self.pacer.touch()  # a result to show: full rate for a moment
+
+    def note_activity(self) -> None:
+        """Input this frame (the UI's activity changed, or polyscope was asked to redraw: the
+        camera moved, a structure changed) keeps the window at full rate."""
+        now = self.ui.activity()
+        if now != self._activity or ps.get_redraw_requested():
+            self.pacer.touch()
+        self._activity = now
+
+    def draw_job(self, owner: str) -> bool:
+        """The progress line and a Cancel button of ``owner``'s running job (drawn in the
+        panel that owns it); True when one runs."""
+        job = self.state.jobs.running(owner)
+        if job is None:
+            return False
+        self._draw_job_line(job)
+        return True
+
+    def _draw_job_line(self, job: Job) -> None:
+        r: Reporter = job.reporter
+        self.ui.progress(r.fraction if r.fraction is not None else 0.0, job.line())
+        if self.ui.button(f"Cancel##{job.owner}", f"stop: {job.title} (what is shown stays)"):
+            self.state.jobs.cancel(job.owner)
+
+    def draw_other_jobs(self) -> None:
+        """A status line for each job whose panel is not on screen (so a job is seen whatever
+        view is active)."""
+        shown = {self.state.panel, *(e.name for e in REGISTRY if not e.view)}
+        for job in self.state.jobs.all_running():
+            if job.owner not in shown:
+                self._draw_job_line(job)
 
     def layout(self) -> None:
         """Re-frame after a change of what is shown or of the window size; draw captions."""
@@ -313,12 +362,38 @@ class Viewer:
         )
 
     def open(self, path: Path | None) -> bool:
-        """Load ``path``; on failure the error is shown in the Mesh section, the mesh stays."""
-        if self.state.mesh.load(path):
+        """Load ``path``; on failure the error is shown in the Mesh section, the mesh stays.
+
+        In the window (:attr:`background`) the file is read, validated and its curvature
+        fields computed as one job of the Mesh section (the last good mesh stays on screen
+        meanwhile; True: started); otherwise right here (True: loaded).
+        """
+        from .state.mesh import read_mesh_with_fields
+
+        section = REGISTRY[0].name  # the first section: the mesh's
+        state = self.state
+        curv = state.curv
+        settings = (curv.area, curv.boundary)
+        work = state.jobs.offload(read_mesh_with_fields, path, *settings)  # a child process
+
+        def apply(result: Any) -> None:
+            loaded, fields = result
+            state.jobs.cancel_all()  # what other panels computed belongs to the old mesh
+            state.mesh.adopt(loaded)
+            if (curv.area, curv.boundary) == settings:
+                curv.adopt(state.mesh, fields)
             self.sync_mesh()
             self.reframe = True
-            return True
-        return False
+
+        def fail(message: str) -> None:
+            state.mesh.error = message
+
+        name = Path(path).name if path is not None else "the default mesh"
+        job = state.jobs.start(
+            section, f"opening {name}", work, apply, fail, background=self.background
+        )
+        assert job is not None
+        return self.background or job.status == "done"
 
     # ------------------------------------------------------------------ framing, captions
     def framed_names(self) -> tuple[str, ...]:
@@ -397,6 +472,20 @@ class Viewer:
             self.ui.overlay_text((x, y), text)
 
 
+def opens_later(path: Path | None, shot: Path | None, saved: Any, options: dict[str, Any]) -> bool:
+    """Whether ``meshlap view`` opens the window first and loads ``path`` as a job: a window
+    (no screenshot, no session, no option that needs the mesh) and a file larger than
+    :data:`ASYNC_OPEN_BYTES`."""
+    if path is None or shot is not None or saved is not None:
+        return False
+    if any(v is not None for v in options.values()):
+        return False
+    try:
+        return path.stat().st_size > ASYNC_OPEN_BYTES
+    except OSError:
+        return False  # said by the load, before the window
+
+
 def check_options(options: dict[str, Any], state: AppState) -> None:
     """Each panel's state module checks the ``meshlap view`` options it knows
     (``check_view_options``) against the loaded mesh, before any window opens."""
@@ -436,14 +525,16 @@ def run(
         raise MeshError(f"output directory {shot.parent} does not exist", shot)
     state = AppState(folder=cwd)
     state.panel = state.check_panel(panel or VIEWS[0], "--panel")
-    if not state.mesh.load(path):
+    later = path if opens_later(path, shot, saved, options) else None
+    if not state.mesh.load(None if later is not None else path):
         raise MeshError(state.mesh.error)
     if saved is not None:
         check_session_mesh(saved, state.mesh, session)
     check_options(options, state)
     if not 0.5 <= ui_scale <= 3.0:  # also refuses NaN
         raise MeshError(f"must be between 0.5 and 3, got {ui_scale}", "--ui-scale")
-    ps.set_program_name(f"meshlap — {state.mesh.name}")  # the window title (set before init)
+    title = later.name if later is not None else state.mesh.name
+    ps.set_program_name(f"meshlap — {title}")  # the window title (set before init)
     init_polyscope(backend or ("openGL3_egl" if shot else "auto"))
     viewer = Viewer(state)
     ps.set_build_default_gui_panels(False)  # polyscope's own panels: a toggle in Help
@@ -461,6 +552,14 @@ def run(
             p.start(viewer, options, name == state.panel, shot is not None)
     ps.set_user_callback(viewer.callback)
     ps.set_files_dropped_callback(viewer.files_dropped)
+    if shot is None:  # the window: long operations as jobs, paced frames (idle is idle)
+        viewer.background = viewer.pace = True
+        state.jobs.processes = True  # load and fields in child processes: no shared GIL
+        warm_up()  # the fork server for them
+        prefer_gil_free_solvers()  # an eigenbasis job in a thread must not hold the GIL
+        ps.set_max_fps(-1)  # polyscope's limit spins a core; the Pacer sleeps instead
+        if later is not None:
+            viewer.open(later)
     if shot is not None:
         if saved is None:  # a session brings its own camera
             viewer.frame()

@@ -105,6 +105,7 @@ class ScriptedUI(UI):
         self.tables: dict[tuple[str, str], TableRecord] = {}  # (section, id) -> last drawn
         self._script: dict[str, deque[Any]] = {}
         self._drawing: TableRecord | None = None  # the table being drawn
+        self.progress_lines: list[tuple[str, float, str]] = []  # (section, fraction, text)
 
     # ------------------------------------------------------------------ the script
     def script(self, label: str, *values: Any) -> None:
@@ -138,6 +139,9 @@ class ScriptedUI(UI):
         if kind != "header":
             self.driven.add(key)
         return _as_widget_reads(value, label, kind, current, choices)
+
+    def _record_progress(self, fraction: float, text: str) -> None:
+        self.progress_lines.append((self.section, fraction, text))
 
     def _record_table(self, table_id: str, headers: list[str], tips: list[str]) -> None:
         record = TableRecord(list(headers), list(tips))

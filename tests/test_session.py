@@ -386,9 +386,10 @@ def test_window_size_of_the_camera_and_a_busy_worker(mock, tmp_path, sphere, mon
     # while the eigen worker runs, a session is refused and nothing changes
     spec = viewer.panels["spectral"].state
     done = threading.Event()
-    spec._thread = threading.Thread(target=done.wait, args=(60,))
-    spec._thread.start()
-    viewer.busy_frame_s = 0.0
+    spec._jobs = viewer.state.jobs
+    spec._job = viewer.state.jobs.start(
+        "spectral", "eigenbasis", lambda r: done.wait(60), lambda r: None, background=True
+    )
     tick(viewer)  # the re-frame for the new window size happens first
     before = session.capture(viewer)
     tick(viewer, "session file", str(path))
@@ -396,7 +397,7 @@ def test_window_size_of_the_camera_and_a_busy_worker(mock, tmp_path, sphere, mon
     assert "still being computed" in viewer.state.errors["help"]
     assert session.capture(viewer) == before
     done.set()
-    spec._thread.join()
+    assert viewer.state.jobs.wait(timeout=60)
 
 
 def test_dropping_a_session_file_loads_it(mock, tmp_path, sphere, monkeypatch):

@@ -90,6 +90,15 @@ class Host(Protocol):
         """Display positions ``(n,3)`` of the mesh's vertices (as uploaded)."""
         ...
 
+    background: bool
+    """Long operations run as jobs of ``state.jobs`` (the window); ``False``: right away (the
+    animator, headless renders, tests)."""
+
+    def draw_job(self, owner: str) -> bool:
+        """Draw the progress line and Cancel button of ``owner``'s running job (a panel passes
+        its name); True when one runs."""
+        ...
+
 
 class Panel:
     """Defaults for every hook of the protocol; a panel overrides what it does.
@@ -187,8 +196,8 @@ class Panel:
         follows."""
 
     def busy(self) -> str:
-        """What background job of this panel is running (``""``: none); while one runs the
-        frame yields the CPU and a session is not loaded."""
+        """What background job of this panel is running (``""``: none); while one runs a
+        session is not loaded (jobs of ``state.jobs`` are seen by the host without it)."""
         return ""
 
     # -------------------------------------------------------------- keys, play

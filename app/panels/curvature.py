@@ -31,6 +31,7 @@ class CurvaturePanel(Panel):
     shows_curvature = True
     pick_through = True  # a click on the mesh selects a vertex (the one-ring view takes it)
     framed = (MESH_B,)
+    _fields_job: tuple[tuple[Any, ...], Any] | None = None  # (inputs, job) of the last fields job
 
     def on_new_mesh(self, host: Host) -> None:
         self.watch.forget()
@@ -84,7 +85,8 @@ class CurvaturePanel(Panel):
         colorbar = host.active().shows_curvature
         if not ps.has_surface_mesh(MESH):
             return
-        curv.update(mesh)
+        if not self.fields_ready(host):
+            return  # a job computes them: the map on screen stays until they arrive
         key = (
             mesh.version,
             curv.area,
@@ -105,6 +107,42 @@ class CurvaturePanel(Panel):
             self._add_field(host, ps.get_surface_mesh(MESH_B), curv.second_field)
         elif ps.has_surface_mesh(MESH_B):
             ps.remove_surface_mesh(MESH_B)
+
+    def fields_ready(self, host: Host) -> bool:
+        """Bring the curvature fields up to date: right here for a new mesh or outside the
+        window; as a job (progress and Cancel in this panel) when only the area or the
+        boundary rule changed in the window. False while that job runs. Cancel goes back to
+        the area and rule of the fields on screen."""
+        curv, mesh = host.state.curv, host.state.mesh
+        if curv.current(mesh):
+            return True
+        same_mesh = bool(curv.fields) and curv.computed_for()[0] == mesh.version
+        if not (host.background and same_mesh):
+            curv.update(mesh)
+            return True
+        jobs, wanted = host.state.jobs, (mesh.version, curv.area, curv.boundary)
+        job = self._fields_job
+        if job is not None and job[0] == wanted:
+            if job[1].status == "running":
+                return False
+            if job[1].status == "cancelled":  # the user's Cancel: back to what is shown
+                curv.area, curv.boundary = curv.computed_for()[1:]
+                self._fields_job = None
+                return True
+        V, F, area, boundary = mesh.V, mesh.F, curv.area, curv.boundary
+
+        def apply(fields: dict[str, np.ndarray]) -> None:
+            if (mesh.version, curv.area, curv.boundary) == wanted:
+                curv.adopt(mesh, fields)
+
+        started = jobs.start(
+            self.name,
+            f"curvature fields ({area} areas, boundary {boundary})",
+            jobs.offload(curv.compute, V, F, area, boundary),
+            apply,
+        )
+        self._fields_job = (wanted, started)
+        return False
 
     @staticmethod
     def _add_field(host: Host, sm: Any, name: str, colorbar: bool = False) -> None:
@@ -127,6 +165,7 @@ class CurvaturePanel(Panel):
         ui = host.ui
         if not ui.header(self.title):
             return
+        host.draw_job(self.name)  # new area or boundary rule: the fields' progress, Cancel
         c = host.state.curv
         names = tuple(CURVATURE_FIELD_LABELS)
         ch1, c.field_name = ui.combo("field", c.field_name, names, FIELD_HELP)

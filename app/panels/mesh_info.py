@@ -66,6 +66,7 @@ class MeshPanel(Panel):
         )
         if picked:
             host.open(choices[picked])
+        host.draw_job(self.name)  # opening a file: progress and Cancel (the mesh stays)
         if mesh.error:
             ui.error(mesh.error)
 

@@ -52,8 +52,8 @@ class SmoothingPanel(Panel):
         self.watch.forget()
 
     def show(self, host: Host, active: Panel) -> None:
-        if active is self and self.state.smoother is None:
-            self.rebuild(host)
+        if active is self and self.state.smoother is None and not self.building(host):
+            self.start_build(host, raise_errors=False)  # a job in the window: usable meanwhile
         for name in (SMOOTHED, SMOOTH_INPUT):
             if ps.has_surface_mesh(name):
                 ps.get_surface_mesh(name).set_enabled(active is self)
@@ -61,6 +61,38 @@ class SmoothingPanel(Panel):
     def rebuild(self, host: Host) -> None:
         if self.state.rebuild(host.state.mesh.V, host.state.mesh.F):
             self.push(host, force=True)
+
+    def building(self, host: Host) -> bool:
+        """A stepper is being built (a job of this panel runs)."""
+        return host.state.jobs.running(self.name) is not None
+
+    def start_build(self, host: Host, raise_errors: bool = True, **changes: Any) -> None:
+        """Build a stepper with the options changed by ``changes`` as a job (in the window:
+        noise, operators, factorization, stable lambda off the UI thread; the stepper on
+        screen keeps going meanwhile) and show it when it is done. A bad option changes
+        nothing: said in red (raised right away for a bad seed; a failed build too when
+        ``raise_errors`` and the build runs inline)."""
+        st = self.state
+        options = st.plan(**changes)
+        V, F = host.state.mesh.V, host.state.mesh.F
+
+        def apply(smoother: Any) -> None:
+            st.adopt_built(options, smoother)
+            self.push(host, force=True)
+
+        def fail(message: str) -> None:
+            if raise_errors and not host.background:
+                raise MeshError(message)
+            st.error, st.playing = message, False
+
+        host.state.jobs.start(
+            self.name,
+            f"building the {options[0]} {options[1]} smoother",
+            lambda reporter: st.build(V, F, options, reporter),
+            apply,
+            fail,
+            background=host.background,
+        )
 
     def _shift(self, host: Host) -> np.ndarray:
         st, d = self.state, host.state.display
@@ -190,7 +222,7 @@ class SmoothingPanel(Panel):
         if not ui.header(self.title):
             return
         st = self.state
-        V, F = host.state.mesh.V, host.state.mesh.F
+        host.draw_job(self.name)  # a stepper being built: progress and Cancel
         ch, method = ui.combo(
             "method",
             st.method,
@@ -199,8 +231,7 @@ class SmoothingPanel(Panel):
             "taubin: lam step, then a negative nu step (no shrinkage)",
         )
         if ch:
-            st.configure(V, F, method=method)
-            self.push(host, force=True)
+            self.start_build(host, method=method)
         ch, lap = ui.combo(
             "Laplacian",
             st.laplacian,
@@ -208,8 +239,7 @@ class SmoothingPanel(Panel):
             "uniform: L = D^-1 A - I (lam dimensionless);  cotan: L = M^-1 C (lam in length^2)",
         )
         if ch:
-            st.configure(V, F, laplacian=lap)
-            self.push(host, force=True)
+            self.start_build(host, laplacian=lap)
         ch, lam = ui.input_float(
             "lambda",
             st.lam,
@@ -228,12 +258,10 @@ class SmoothingPanel(Panel):
             "(rebuilds the input)",
         )
         if ch:
-            st.configure(V, F, noise_alpha=alpha)
-            self.push(host, force=True)
+            self.start_build(host, noise_alpha=alpha)
         ch, seed = ui.input_int("noise seed", st.seed, "seed of the noise (an integer >= 0)")
         if ch:
-            st.configure(V, F, seed=seed)
-            self.push(host, force=True)
+            self.start_build(host, seed=seed)
         if ui.button("step", "one iteration"):
             st.step()
         ui.same_line()

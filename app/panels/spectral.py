@@ -35,6 +35,13 @@ class SpectralPanel(Panel):
     def busy(self) -> str:
         return "the eigenbasis is still being computed" if self.state.busy else ""
 
+    def compute(self, host: Host) -> None:
+        """Start the eigenbasis job (in the window; right away otherwise)."""
+        mesh = host.state.mesh
+        self.state.start(
+            mesh.V, mesh.F, background=host.background, jobs=host.state.jobs, owner=self.name
+        )
+
     def on_new_mesh(self, host: Host) -> None:
         self.state.clear()
         self.watch.forget()
@@ -205,10 +212,10 @@ class SpectralPanel(Panel):
         )
         if ch:
             st.set_k_request(k_request, n)
-        if st.busy:
-            ui.progress(st.progress, st.message or "working")
-        elif ui.button("compute eigenbasis", "solve for the modes in the background"):
-            st.start(host.state.mesh.V, host.state.mesh.F)
+        if not host.draw_job(self.name) and ui.button(
+            "compute eigenbasis", "solve for the modes in the background (progress, Cancel)"
+        ):
+            self.compute(host)
         if st.error:
             ui.error(st.error)
         if st.basis is None:

@@ -4,7 +4,7 @@ The viewer (and the headless animator) hold one :class:`AppState`; panels read a
 through their host. What belongs to one panel lives in that panel's *slice*
 (``slices[name]``, made by ``app/state/<name>.py``'s ``make_state()``); what several panels read
 lives here: the mesh, its curvature fields, the display transform, the active view, the UI
-scale and the export folder.
+scale, the export folder and the background jobs (:class:`~meshlap_app.jobs.Jobs`).
 """
 
 from __future__ import annotations
@@ -16,6 +16,7 @@ from typing import Any
 from meshlap_core.errors import MeshError
 from meshlap_core.options import check_choice
 
+from ..jobs import Jobs
 from ..registry import REGISTRY, VIEWS
 from .curvature import CurvatureState
 from .display import Display
@@ -54,6 +55,7 @@ class AppState:
     folder: Path = field(default_factory=Path.cwd)
     slices: dict[str, Any] = field(default_factory=make_slices)
     errors: dict[str, str] = field(default_factory=dict)
+    jobs: Jobs = field(default_factory=Jobs)  # background jobs, applied on the UI thread
 
     def check_panel(self, name: str, flag: str = "view") -> str:
         """``name`` if it is a view, else a :class:`MeshError` naming the views."""

@@ -92,12 +92,31 @@ class CurvatureState:
 
     def update(self, mesh: MeshState) -> bool:
         """Recompute when the mesh, area or boundary rule changed. Returns whether it did."""
-        key = (mesh.version, self.area, self.boundary)
-        if key == self._key:
+        if self.current(mesh):
             return False
-        self.fields = all_curvature_fields(mesh.V, mesh.F, self.area, self.boundary)
-        self._key = key
+        self.adopt(mesh, self.compute(mesh.V, mesh.F, self.area, self.boundary))
         return True
+
+    def current(self, mesh: MeshState) -> bool:
+        """The fields are those of ``mesh`` with the chosen area and boundary rule."""
+        return self._key == (mesh.version, self.area, self.boundary)
+
+    def computed_for(self) -> tuple[Any, ...]:
+        """``(mesh version, area, boundary rule)`` the fields were computed for (``()``:
+        none yet)."""
+        return self._key
+
+    @staticmethod
+    def compute(
+        V: FloatArray, F: Any, area: str, boundary: str, progress: Any = None
+    ) -> dict[str, FloatArray]:
+        """Every curvature field (any thread or a child process: touches no state)."""
+        return all_curvature_fields(V, F, area, boundary)
+
+    def adopt(self, mesh: MeshState, fields: dict[str, FloatArray]) -> None:
+        """Take ``fields``, computed for ``mesh`` with the current area and boundary rule."""
+        self.fields = fields
+        self._key = (mesh.version, self.area, self.boundary)
 
     def set_percentile(self, percentile: float) -> None:
         """Clip percentage of the colour range, in ``[0, 49]``.

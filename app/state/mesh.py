@@ -73,27 +73,82 @@ class MeshState:
     def load(self, path: str | Path | None) -> bool:
         """Load ``path`` (the bundled default when ``None``). Returns success."""
         try:
-            if path is None:
-                default = default_mesh_path()
-                if default is not None:
-                    mesh = load_mesh(default)
-                    name = default.name
-                else:  # installed without assets/: generate the same shape
-                    mesh = validate_mesh(*primitives.bumpy_sphere(), source="bumpy (generated)")
-                    name = "bumpy (generated)"
-            else:
-                mesh = load_mesh(path)
-                name = Path(path).name
+            loaded = read_mesh(path)
         except MeshError as exc:
             self.error = str(exc)
             return False
         except OSError as exc:
             self.error = f"{path}: {exc.strerror or exc}"
             return False
-        self.V, self.F, self.name = mesh.V, mesh.F, name
-        source = path if path is not None else default_mesh_path()
-        self.path = Path(source).resolve() if source is not None else None
-        self.info = mesh_info(mesh.V, mesh.F, mesh.report, str(path) if path else name)
+        self.adopt(loaded)
+        return True
+
+    def adopt(self, loaded: LoadedMesh) -> None:
+        """Show ``loaded`` (read by :func:`read_mesh`, maybe in a job): the new current mesh."""
+        self.V, self.F, self.name = loaded.mesh.V, loaded.mesh.F, loaded.name
+        self.path = loaded.path
+        self.info = loaded.info
         self.error = ""
         self.version += 1
-        return True
+
+
+@dataclass
+class LoadedMesh:
+    """A mesh read and validated off the UI thread, with what the Mesh section shows."""
+
+    mesh: Any
+    name: str
+    path: Path | None
+    info: dict[str, Any]
+
+
+def read_mesh(path: str | Path | None, progress: Any = None) -> LoadedMesh:
+    """Read, validate and describe ``path`` (the bundled default when ``None``).
+
+    ``progress`` is a job's reporter (:class:`meshlap_app.jobs.Reporter`): passed on to
+    ``load_mesh`` as ``progress=`` / ``cancel=`` when the core takes them, and told each phase.
+
+    Raises
+    ------
+    MeshError, OSError
+        The file is refused or unreadable.
+    """
+    from ..jobs import call_hooked
+
+    def phase(message: str) -> None:
+        if progress is not None:
+            progress.phase_only(message)
+
+    if path is None:
+        default = default_mesh_path()
+        if default is None:  # installed without assets/: generate the same shape
+            mesh = validate_mesh(*primitives.bumpy_sphere(), source="bumpy (generated)")
+            name = "bumpy (generated)"
+            return LoadedMesh(mesh, name, None, mesh_info(mesh.V, mesh.F, mesh.report, name))
+        path, label = default, None
+        name = default.name
+    else:
+        label = str(path)
+        name = Path(path).name
+    phase(f"reading {name}")
+    if progress is not None:
+        mesh = call_hooked(load_mesh, path, reporter=progress)
+    else:
+        mesh = load_mesh(path)
+    phase("describing the mesh")
+    info = mesh_info(mesh.V, mesh.F, mesh.report, label or name)
+    return LoadedMesh(mesh, name, Path(path).resolve(), info)
+
+
+def read_mesh_with_fields(
+    path: str | Path | None, area: str, boundary: str, progress: Any = None
+) -> tuple[LoadedMesh, dict[str, FloatArray]]:
+    """:func:`read_mesh`, then every curvature field for ``area`` and ``boundary``: the job of
+    opening a file in the window (run in a child process, see
+    :func:`meshlap_app.jobs.in_child`)."""
+    from meshlap_core.curvature import all_curvature_fields
+
+    loaded = read_mesh(path, progress)
+    if progress is not None:
+        progress(None, f"curvature fields of {len(loaded.mesh.V):,} vertices")
+    return loaded, all_curvature_fields(loaded.mesh.V, loaded.mesh.F, area, boundary)

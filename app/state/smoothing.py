@@ -58,26 +58,86 @@ class SmoothingState:
         (``V0``, ``F``, ``reference``) and this state reads them from there.
         """
         try:
-            start = add_noise(V, F, self.noise_alpha, seed=self.seed) if self.noise_alpha else V
-            smoother = Smoother(
-                start,
-                F,
-                self.method,
-                self.laplacian,
-                self.lam,
-                reference=V,
-                warn=False,
-                history_limit=1000,  # the panel reads only the last entry; playing never grows
-            )
+            smoother = self.build(V, F, self.options())
         except MeshError as exc:
             self.error = str(exc)
             self.playing = False
             return False
+        self.adopt(smoother)
+        return True
+
+    def options(self) -> tuple[str, str, float, float, int]:
+        """``(method, laplacian, lam, noise_alpha, seed)``: what a stepper is built from."""
+        return (self.method, self.laplacian, self.lam, self.noise_alpha, self.seed)
+
+    @staticmethod
+    def build(
+        V: FloatArray,
+        F: IntArray,
+        options: tuple[str, str, float, float, int],
+        progress: Any = None,
+    ) -> Smoother:
+        """A stepper for ``options`` (:meth:`options`), any thread (touches no state): the
+        noise, the operators, the implicit factorization and the stability estimate.
+        ``progress``: a job's reporter, told each phase."""
+        method, laplacian, lam, alpha, seed = options
+        if progress is not None:
+            progress.phase_only("adding noise" if alpha else "operators")
+        start = add_noise(V, F, alpha, seed=seed) if alpha else V
+        if progress is not None:
+            what = "factorizing the implicit system" if method == "implicit" else "operators"
+            progress.phase_only(f"{what} and the stable lambda ({len(V):,} vertices)")
+        return Smoother(
+            start,
+            F,
+            method,
+            laplacian,
+            lam,
+            reference=V,
+            warn=False,
+            history_limit=1000,  # the panel reads only the last entry; playing never grows
+        )
+
+    def adopt(self, smoother: Smoother) -> None:
+        """Step ``smoother`` from now on (built by :meth:`build`, maybe in a job)."""
         self.smoother = smoother
         self.error = ""
         self.version += 1
         self.lam_steps = []
-        return True
+
+    def plan(
+        self,
+        *,
+        method: str | None = None,
+        laplacian: str | None = None,
+        noise_alpha: float | None = None,
+        seed: int | None = None,
+    ) -> tuple[str, str, float, float, int]:
+        """The options with these changes, checked (nothing changes here).
+
+        Raises
+        ------
+        MeshError
+            A bad seed (named); the method, Laplacian and α are checked by the build.
+        """
+        if seed is not None and not (isinstance(seed, int) and seed >= 0):
+            raise MeshError(f"must be an integer >= 0, got {seed!r}", "noise seed")
+        m, lap, lam, alpha, sd = self.options()
+        return (
+            m if method is None else method,
+            lap if laplacian is None else laplacian,
+            lam,
+            alpha if noise_alpha is None else float(noise_alpha),
+            sd if seed is None else seed,
+        )
+
+    def adopt_built(self, options: tuple[str, str, float, float, int], smoother: Smoother) -> None:
+        """Take the options a job built ``smoother`` from, and the stepper (UI thread)."""
+        self.method, self.laplacian, _, self.noise_alpha, self.seed = options
+        self.playing = False
+        if smoother.lam != self.lam:  # lambda typed while it was being built
+            smoother.set_lam(self.lam)
+        self.adopt(smoother)
 
     def set_lam(self, lam: float) -> None:
         """Change ``λ`` keeping the current positions, noise and iteration count

@@ -8,7 +8,6 @@ the previous k.
 
 from __future__ import annotations
 
-import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -50,9 +49,9 @@ class SpectralState:
     errors: Any = None  # ReconstructionErrors for every k of the basis
     reconstruction: FloatArray = field(default_factory=lambda: np.zeros((0, 3)))
     vertex_error: FloatArray = field(default_factory=lambda: np.zeros(0))
-    _thread: threading.Thread | None = None
-    _pending: tuple[SpectralBasis, Any] | None = None
-    _lock: threading.Lock = field(default_factory=threading.Lock)
+    _job: Any = None  # the running job (meshlap_app.jobs.Job) computing the basis
+    _jobs: Any = None  # the Jobs it runs in (the app's, or a private one)
+    _fresh: bool = False  # a basis arrived that poll() has not reported yet
     play_what: str = "k sweep"  # one of PLAY_KINDS
     playing: bool = False
     clock: Callable[[], float] = time.monotonic  # seconds (a test gives its own)
@@ -61,11 +60,13 @@ class SpectralState:
 
     @property
     def busy(self) -> bool:
-        return self._thread is not None and self._thread.is_alive()
+        """The eigenbasis job runs (or its result waits for the host's poll)."""
+        return self._job is not None and self._job.running
 
     def clear(self) -> None:
-        """Forget the basis (a new mesh was loaded)."""
-        self.basis, self.errors, self._pending = None, None, None
+        """Forget the basis (a new mesh was loaded); a running job is cancelled."""
+        self.cancel()
+        self.basis, self.errors, self._fresh = None, None, False
         self.playing = self._paused = False
         self.reconstruction = np.zeros((0, 3))
         self.vertex_error = np.zeros(0)
@@ -74,40 +75,77 @@ class SpectralState:
     def _progress(self, fraction: float, message: str) -> None:
         self.progress, self.message = float(fraction), message
 
-    def _solve(self, V: FloatArray, F: IntArray, k: int) -> None:
-        try:
-            basis = SpectralBasis.compute(V, F, k, progress=self._progress)
-            errors = basis.errors()  # every k at once (cumulative sums)
-            basis.reconstruct(max(1, k // 2))  # builds the slider's checkpoints off the UI thread
-        except Exception as exc:  # a worker must report, never die silently
-            self.error = str(exc) if isinstance(exc, MeshError) else f"{type(exc).__name__}: {exc}"
-            self.message = ""
-            return
-        with self._lock:
-            self._pending = (basis, errors)
+    def solve(self, V: FloatArray, F: IntArray, k: int, progress: Any = None) -> tuple[Any, Any]:
+        """The job's work (any thread): ``k`` eigenpairs, the errors for every k and the
+        slider's checkpoints; touches no state. ``progress``: a job's reporter (progress and
+        cancel handed to the core where it takes them)."""
+        from ..jobs import call_hooked
 
-    def start(self, V: FloatArray, F: IntArray, background: bool = True) -> None:
-        """Compute ``k_request`` eigenpairs (at most n) in a worker thread (or right here)."""
+        report = progress if progress is not None else self._progress
+        if progress is not None:
+            basis = call_hooked(SpectralBasis.compute, V, F, k, reporter=progress)
+        else:
+            basis = SpectralBasis.compute(V, F, k, progress=report)
+        if progress is not None:
+            progress.phase_only("reconstruction errors for every k")
+        errors = basis.errors()  # every k at once (cumulative sums)
+        basis.reconstruct(max(1, k // 2))  # builds the slider's checkpoints off the UI thread
+        return basis, errors
+
+    def _failed(self, message: str) -> None:
+        self.error, self.message = message, ""
+
+    def start(
+        self,
+        V: FloatArray,
+        F: IntArray,
+        background: bool = True,
+        jobs: Any = None,
+        owner: str = "eigenbasis",
+    ) -> None:
+        """Compute ``k_request`` eigenpairs (at most n) as a job of ``jobs`` (a private
+        :class:`~meshlap_app.jobs.Jobs` when ``None``), or right here (``background=False``).
+        The basis is adopted on the UI thread (:meth:`poll`, or the host's ``jobs.poll()``)."""
+        from ..jobs import Jobs
+
         if self.busy:
             return
         self.clear()
         k = int(min(max(self.k_request, 2), len(V)))
         self.message = f"computing {k} eigenpairs ..."
-        if background:
-            self._thread = threading.Thread(target=self._solve, args=(V, F, k), daemon=True)
-            self._thread.start()
-        else:
-            self._solve(V, F, k)
-            self.poll()
+        if jobs is None:
+            jobs = self._jobs if self._jobs is not None else Jobs()
+        self._jobs = jobs
+        self._job = jobs.start(
+            owner,
+            f"eigenbasis ({k} modes)",
+            lambda reporter: self.solve(V, F, k, reporter),
+            self._adopt,
+            self._failed,
+            background=background,
+        )
+
+    def cancel(self) -> bool:
+        """Stop the running eigenbasis job (the basis on screen, if any, stays)."""
+        job, self._job = self._job, None
+        if job is None or not job.running or self._jobs is None:
+            return False
+        self.message = "eigenbasis cancelled"
+        return bool(self._jobs.cancel(job.owner))
 
     def poll(self) -> bool:
-        """Adopt a basis finished by the worker; True when a new one arrived (UI thread)."""
-        with self._lock:
-            pending, self._pending = self._pending, None
-        if pending is None:
-            return False
-        basis, self.errors = pending
+        """Adopt a basis finished by the job; True (once) when a new one arrived (UI
+        thread)."""
+        if self._jobs is not None and self.busy:
+            self._jobs.poll()
+        fresh, self._fresh = self._fresh, False
+        return fresh
+
+    def _adopt(self, result: tuple[SpectralBasis, Any]) -> None:
+        basis, self.errors = result
+        self._job = None
         self.basis = basis
+        self._fresh = True
         self.k = min(self.k, basis.k_max)
         self.mode = min(max(self.mode, 0), basis.k_max - 1)
         info = basis.info
@@ -115,7 +153,6 @@ class SpectralState:
         how = "from the cache" if info.from_cache else f"in {total:.2f} s"
         self.message = f"{basis.k_max} eigenpairs {how}"
         self.set_k(self.k)
-        return True
 
     def eigenfunction(self) -> tuple[FloatArray, float]:
         """The selected eigenfunction (a scalar field) and its frequency λ ≥ 0."""

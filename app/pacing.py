@@ -1,0 +1,94 @@
+"""How often the window draws: full rate on input, a slower pace while a job runs, a low idle
+rate when nothing happens (no polyscope, no imgui).
+
+polyscope's own frame limit (``set_max_fps``) waits by spinning, so it costs a core whatever
+the rate; the viewer therefore turns it off (``set_max_fps(-1)``) and the :class:`Pacer`
+sleeps at the start of each frame instead (``time.sleep`` releases the GIL, so a job's worker
+gets the core). The rule:
+
+- *active* (input this frame or less than :data:`IDLE_AFTER_S` ago, something playing or
+  recording): :data:`FULL_FPS`;
+- a job runs: :data:`BUSY_FPS` (the progress line still moves several times a second);
+- otherwise *idle*: :data:`IDLE_FPS`, and :data:`DEEP_IDLE_FPS` after :data:`DEEP_IDLE_AFTER_S`
+  (each idle frame still costs tens of milliseconds of CPU with a software OpenGL); the first
+  input event wakes it within one idle frame.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+FULL_FPS = 60.0
+"""Frames per second with input (polyscope's default limit)."""
+BUSY_FPS = 6.0
+"""Frames per second while a job runs and the user does nothing: the render loop leaves the
+cores to the worker (an eigenbasis takes about as long as ``meshlap spectral``)."""
+IDLE_FPS = 4.0
+"""Frames per second with nothing happening (< 10 % of a core on a 692k-vertex mesh)."""
+IDLE_AFTER_S = 1.0
+"""Seconds without input after which the window drops to the idle rate."""
+DEEP_IDLE_FPS = 2.0
+"""Frames per second after :data:`DEEP_IDLE_AFTER_S` without input (< 10 % of a core with
+Mesa's llvmpipe at 1280×720; the first input is answered within half a second)."""
+DEEP_IDLE_AFTER_S = 4.0
+
+
+@dataclass
+class Pacer:
+    """Decides (and sleeps) the pause before each frame; records the longest gap between two
+    frames while a job ran (the UI stall a user sees).
+
+    Parameters
+    ----------
+    clock, sleep : callable
+        ``time.monotonic`` and ``time.sleep`` (a test gives its own).
+    """
+
+    clock: Callable[[], float] = time.monotonic
+    sleep: Callable[[float], None] = time.sleep
+    full_fps: float = FULL_FPS
+    busy_fps: float = BUSY_FPS
+    idle_fps: float = IDLE_FPS
+    idle_after: float = IDLE_AFTER_S
+    deep_fps: float = DEEP_IDLE_FPS
+    deep_after: float = DEEP_IDLE_AFTER_S
+    last_input: float = field(default=-1e9)
+    last_frame: float | None = None
+    max_busy_gap: float = 0.0  # longest time between two frames while a job ran
+    mode: str = "active"
+
+    def __post_init__(self) -> None:
+        self.last_input = self.clock()
+
+    def touch(self) -> None:
+        """Input (or a change worth showing at full rate) happened now."""
+        self.last_input = self.clock()
+
+    def rate(self, busy: bool, animating: bool) -> float:
+        """Frames per second for the next frame (and :attr:`mode` set to ``active``,
+        ``busy`` or ``idle``)."""
+        quiet = self.clock() - self.last_input
+        if animating or quiet < self.idle_after:
+            self.mode = "active"
+            return self.full_fps
+        self.mode = "busy" if busy else "idle"
+        if busy:
+            return self.busy_fps
+        return self.deep_fps if quiet >= self.deep_after else self.idle_fps
+
+    def wait(self, busy: bool, animating: bool = False) -> float:
+        """Sleep what is left of this frame's period; returns the seconds slept."""
+        fps = self.rate(busy, animating)
+        now = self.clock()
+        pause = 0.0
+        if self.last_frame is not None and fps > 0:
+            pause = max(0.0, 1.0 / fps - (now - self.last_frame))
+            if pause > 0:
+                self.sleep(pause)
+        now = self.clock()
+        if busy and self.last_frame is not None:
+            self.max_busy_gap = max(self.max_busy_gap, now - self.last_frame)
+        self.last_frame = now
+        return pause

@@ -1,0 +1,176 @@
+"""The window's figures of issue 21 on a big scan: open → first coloured frame, the longest UI
+stall while the job runs, idle CPU and the viewer's peak RSS.
+
+Usage::
+
+    python benchmarks/bench_window_scale.py [SCAN.obj] [--repeat N]
+
+Without ``SCAN`` the 692k armadillo is made once in the temp folder (one ``igl.upsample`` of
+``../shared/meshes/armadillo_loop.obj``, as ``tests/test_window_scale.py`` does). Each run is
+a fresh child process (``python benchmarks/bench_window_scale.py --child SCAN``) that renders
+with polyscope's EGL backend at 1280×720 through the viewer's own frame loop, paced as in the
+window (:class:`meshlap_app.pacing.Pacer`): it opens the bundled mesh, then opens ``SCAN`` as
+the Mesh section's job, ticks frames until the scan is on screen coloured, then stays idle
+6 s and measures 5 s of its CPU time. The parent prints one table; no threshold is checked
+(timings on a shared machine are noisy): the load average is printed before and after.
+
+:func:`figures` is the hook for ``benchmarks/bench_scale.py`` (``VIEWER_FIGURES``) once both
+sides of issue 21 are merged: ``VIEWER_FIGURES.append(lambda scan, repeat: figures(scan,
+repeat, Row))``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import resource
+import subprocess
+import sys
+import tempfile
+import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+ROOT = Path(__file__).resolve().parents[1]
+SOURCE = ROOT.parent / "shared" / "meshes" / "armadillo_loop.obj"
+
+
+def default_scan() -> Path:
+    """The 692k scan in the temp folder (made once)."""
+    folder = Path(tempfile.gettempdir()) / "meshlap-scans"
+    path = folder / "armadillo_692k.obj"
+    if not path.exists():
+        import igl
+
+        folder.mkdir(exist_ok=True)
+        V, F = igl.read_triangle_mesh(str(SOURCE))
+        V2, F2 = igl.upsample(V, F)
+        tmp = folder / f".armadillo_692k.{os.getpid()}.obj"
+        igl.write_triangle_mesh(str(tmp), V2, F2)
+        tmp.replace(path)
+    return path
+
+
+def child(scan: Path) -> dict[str, float]:
+    """One measurement in this process (see the module docstring); returns the figures."""
+    import polyscope as ps
+    from meshlap_app.state import AppState
+    from meshlap_app.viewer import Viewer, init_polyscope
+
+    init_polyscope("openGL3_egl")
+    ps.set_max_fps(-1)
+    ps.set_window_size(1280, 720)
+    state = AppState()
+    state.mesh.load(None)
+    viewer = Viewer(state)
+    viewer.sync_mesh()
+    ps.set_user_callback(viewer.callback)
+    ps.frame_tick()
+    viewer.background = viewer.pace = True
+    state.jobs.processes = True  # as `meshlap view` sets up the window
+    from meshlap_app.jobs import warm_up
+
+    warm_up()
+    rss_before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+    t0 = time.perf_counter()
+    viewer.open(scan)
+    last, stall, frames, upload = t0, 0.0, 0, 0.0
+    while True:
+        ps.frame_tick()  # the frame that adopts the scan also draws it (colour map included)
+        now = time.perf_counter()
+        dt, last, frames = now - last, now, frames + 1
+        if state.mesh.name == scan.name and not state.jobs.busy:
+            upload = dt
+            break
+        stall = max(stall, dt)
+        if now - t0 > 900:
+            raise RuntimeError("the scan did not load in 900 s")
+    first_frame = last - t0
+    rss_view = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+    end = time.perf_counter() + 6.0
+    while time.perf_counter() < end:  # 1 s to fall idle, 5 s more without input
+        ps.frame_tick()
+    c0, w0 = sum(os.times()[:2]), time.perf_counter()
+    while time.perf_counter() - w0 < 5.0:
+        ps.frame_tick()
+    idle = (sum(os.times()[:2]) - c0) / (time.perf_counter() - w0)
+    return {
+        "open_to_coloured_s": first_frame,
+        "max_stall_loading_s": stall,
+        "first_draw_s": upload,
+        "frames_while_loading": float(frames),
+        "idle_cpu_fraction": idle,
+        "rss_before_mb": rss_before,
+        "rss_view_mb": rss_view,
+    }
+
+
+def run_child(scan: Path) -> dict[str, float]:
+    """:func:`child` in a fresh process (its peak RSS is the viewer's alone)."""
+    out = subprocess.run(
+        [sys.executable, __file__, "--child", str(scan)],
+        capture_output=True,
+        text=True,
+        check=True,
+        timeout=1800,
+    )
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def figures(scan: Path, repeat: int, row: Callable[..., Any] | None = None) -> list[Any]:
+    """The window figures of ``scan``, best of ``repeat`` runs (smallest time; idle CPU and RSS
+    of the same run): ``row(scan=, figure=, ours=, base=, base_name=, ...)`` objects (the
+    ``Row`` of ``bench_scale.py``) or dicts when ``row`` is ``None``."""
+    runs = [run_child(scan) for _ in range(repeat)]
+    best = min(runs, key=lambda r: r["open_to_coloured_s"])
+    make = row or (lambda **kw: kw)
+    name = scan.name
+    return [
+        make(
+            scan=name,
+            figure="window: open → first coloured frame [s]",
+            ours=best["open_to_coloured_s"],
+            base=None,
+            base_name="",
+            rss_ours=best["rss_view_mb"],
+            note=f"max stall while loading {best['max_stall_loading_s']:.2f} s, "
+            f"first draw {best['first_draw_s']:.2f} s",
+        ),
+        make(
+            scan=name,
+            figure="window: idle CPU [fraction of a core]",
+            ours=best["idle_cpu_fraction"],
+            base=None,
+            base_name="",
+        ),
+    ]
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("scan", nargs="?", type=Path)
+    parser.add_argument("--repeat", type=int, default=1)
+    parser.add_argument("--child", type=Path, help=argparse.SUPPRESS)
+    args = parser.parse_args()
+    if args.child is not None:
+        print(json.dumps(child(args.child)))
+        return
+    scan = args.scan or default_scan()
+    print(f"load average before: {os.getloadavg()}")
+    for _ in range(args.repeat):
+        r = run_child(scan)
+        print(
+            f"{scan.name}: open → coloured frame {r['open_to_coloured_s']:.2f} s; longest UI "
+            f"stall while loading {r['max_stall_loading_s']:.2f} s "
+            f"({r['frames_while_loading']:.0f} frames); first draw of the scan "
+            f"{r['first_draw_s']:.2f} s; idle CPU {100 * r['idle_cpu_fraction']:.1f} % of a "
+            f"core; peak RSS {r['rss_view_mb']:.0f} MiB (bundled mesh only: "
+            f"{r['rss_before_mb']:.0f} MiB)"
+        )
+    print(f"load average after: {os.getloadavg()}")
+
+
+if __name__ == "__main__":
+    main()
