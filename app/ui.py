@@ -224,6 +224,10 @@ class UI:
     def _record_table(self, table_id: str, headers: list[str], tips: list[str]) -> None:
         """Hook called when :meth:`table` starts a table, before imgui's ``BeginTable``."""
 
+    def _record_plot(self, label: str, kind: str, x: Any, y: Any) -> None:
+        """Hook called after a plot item was drawn: ``kind`` is ``line`` (``x``, ``y``),
+        ``vlines`` (``x``) or ``hlines`` (``y``)."""
+
     def _record_row(self, cells: list[str], rgba: RGBA | None, highlight: bool) -> None:
         """Hook called for each row of the open table (also when imgui does not draw it)."""
 
@@ -429,6 +433,7 @@ class UI:
 
     def plot_line(self, label: str, x: Any, y: Any) -> None:
         self.ip.PlotLine(label, _f64(x), _f64(y))
+        self._record_plot(label, "line", x, y)
 
     def plot_bars(
         self, label: str, x: Any, y: Any, width: float, colors: Any | None = None
@@ -444,9 +449,11 @@ class UI:
 
     def plot_vlines(self, label: str, x: Any) -> None:
         self.ip.PlotInfLines(label, _f64(x))
+        self._record_plot(label, "vlines", x, None)
 
     def plot_hlines(self, label: str, y: Any) -> None:
         self.ip.PlotInfLines(label, _f64(y), self.ip.ImPlotInfLinesFlags_Horizontal)
+        self._record_plot(label, "hlines", None, y)
 
     # ------------------------------------------------------------------ tables
     @contextmanager

@@ -105,6 +105,8 @@ class ScriptedUI(UI):
         self.tables: dict[tuple[str, str], TableRecord] = {}  # (section, id) -> last drawn
         self._script: dict[str, deque[Any]] = {}
         self._drawing: TableRecord | None = None  # the table being drawn
+        # (section, label) -> (kind, x, y) of the last plot item drawn
+        self.plots: dict[tuple[str, str], tuple[str, Any, Any]] = {}
 
     # ------------------------------------------------------------------ the script
     def script(self, label: str, *values: Any) -> None:
@@ -144,6 +146,9 @@ class ScriptedUI(UI):
         record.avail = float(self.im.GetContentRegionAvail()[0])
         self.tables[(self.section, table_id)] = record
         self._drawing = record
+
+    def _record_plot(self, label: str, kind: str, x: Any, y: Any) -> None:
+        self.plots[(self.section, label)] = (kind, x, y)
 
     def _record_row(self, cells: list[str], rgba: RGBA | None, highlight: bool) -> None:
         record = self._drawing
