@@ -3,6 +3,8 @@ polyscope's openGL_mock backend, the ``viewer`` fixture)."""
 
 from __future__ import annotations
 
+from itertools import pairwise
+
 import numpy as np
 import pytest
 
@@ -72,3 +74,47 @@ def test_euler_plot_is_in_the_geometric_angle(viewer):
     phi = np.radians(marked)
     assert kn == pytest.approx(s.point.k1 * np.cos(phi) ** 2 + s.point.k2 * np.sin(phi) ** 2)
     assert "in (u, v), φ = " in s.section_caption()
+
+
+# ---------------------------------------------------------------- item 4: play beyond the limit
+def test_play_beyond_the_stable_limit_stops_at_the_first_growing_step(viewer):
+    viewer.set_panel("smoothing")
+    frames(viewer)
+    st = viewer.panels["smoothing"].state
+    drive(viewer, "method", "explicit")
+    drive(viewer, "noise alpha", 0.01)
+    limit = st.smoother.stability.max_stable_lam
+    assert limit is not None
+    drive(viewer, "lambda", str(1.5 * limit))
+    assert st.smoother.stability.message()  # the warning is shown
+
+    def rms_move(before: np.ndarray) -> float:
+        return float(np.sqrt(np.mean(np.sum((np.array(st.V) - before) ** 2, axis=1))))
+
+    before = np.array(st.V)
+    drive(viewer, "play", True)  # the frame that presses play takes the first step
+    moves = [rms_move(before)]
+    for _ in range(60):
+        if not st.playing:
+            break
+        before = np.array(st.V)
+        frames(viewer)
+        moves.append(rms_move(before))
+    assert not st.playing, "play ran on beyond the stable limit"
+    assert "play stopped at iteration" in st.error and "stable limit" in st.error
+    # it stopped at the first step that grew (the last one), well before the mesh blows up
+    assert len(moves) >= 2 and moves[-1] > moves[-2]
+    assert all(b <= a for a, b in pairwise(moves[:-1]))
+    assert f"iteration {st.smoother.iteration}:" in st.error
+    drift = float(np.sqrt(np.mean(np.sum((np.array(st.V) - st.V_start) ** 2, axis=1))))
+    diagonal = float(np.linalg.norm(np.ptp(st.V_start, axis=0)))
+    assert drift < 0.5 * diagonal
+    # the panel shows why (in red, under the buttons); a stable lambda plays on
+    drive(viewer, "reset", True)
+    drive(viewer, "lambda", str(0.5 * limit))
+    drive(viewer, "play", True)
+    frames(viewer, 30)
+    assert st.playing and st.smoother.iteration >= 30 and not st.error
+    viewer.ui.script("key space", True)
+    frames(viewer)
+    assert not st.playing

@@ -120,7 +120,7 @@ class SmoothingPanel(Panel):
     def on_key(self, host: Host, key: str) -> bool:
         st = self.state
         if key == "space":
-            st.playing = not st.playing
+            st.toggle_play()
         elif key == "right":
             st.step()
         elif key == "r":
@@ -237,14 +237,18 @@ class SmoothingPanel(Panel):
         if ui.button("step", "one iteration"):
             st.step()
         ui.same_line()
-        if ui.button("pause" if st.playing else "play", "step every frame (space)"):
-            st.playing = not st.playing
+        if ui.button(
+            "pause" if st.playing else "play",
+            "step every frame (space); beyond the stable lambda, play stops at the first step "
+            "that grows",
+        ):
+            st.toggle_play()
         ui.same_line()
         if ui.button("reset", "back to the (noisy) input, iteration 0"):
             st.reset()
             self.push(host, force=True)
         if st.playing:
-            st.step()
+            st.play_step()
         self.push(host)
         if st.error:
             ui.error(st.error)
