@@ -141,6 +141,25 @@ def check_return(name: str, result: Any) -> Any:
     return result
 
 
+def read_float(text: str, label: str) -> float:
+    """The number typed into the float field ``label``, as a double (C's ``strtod``, as
+    Python's ``float``: ``1e308`` stays ``1e308``, ``1e309`` is ``inf``, which the panel's
+    check then refuses).
+
+    Raises
+    ------
+    ValueError
+        ``text`` is empty or not a number, naming the field.
+    """
+    t = text.strip()
+    if not t:
+        raise ValueError(f"{label}: the field is empty; type a number and press Enter")
+    try:
+        return float(t)
+    except ValueError:
+        raise ValueError(f"{label}: {text!r} is not a number") from None
+
+
 class UI:
     """imgui/implot for the panels (see the module docstring).
 
@@ -160,6 +179,11 @@ class UI:
         self.section = ""
         self.changed = False  # some widget reported a change since begin_section
         self._table: tuple[int, bool] | None = None  # the open table: (columns, shown)
+        # the field entered (Enter) in this section this frame: (section, label, typed text)
+        self.entered: tuple[str, str, str] | None = None
+        # (section, label) -> the error of a typed value, drawn under that field
+        self.field_errors: dict[tuple[str, str], str] = {}
+        self._field_error_shown = False  # a field of this section drew its error this frame
 
     # ------------------------------------------------------------------ set-up
     @property
@@ -183,6 +207,41 @@ class UI:
         starts again from ``False``."""
         self.section = name
         self.changed = False
+        self.entered = None
+        self._field_error_shown = False
+
+    # ------------------------------------------------------------------ field errors
+    def field_failed(self, message: str) -> str:
+        """``message`` (a refused value) belongs to the field entered in this section this
+        frame, if one was: it is kept to be drawn right under that field (from the next frame
+        on), quoting what was typed. Returns the message to keep for the section."""
+        if self.entered is None or self.entered[0] != self.section:
+            return message
+        _, label, typed = self.entered
+        typed = typed.strip()
+        if typed and typed not in message:
+            message = f"{message} (you typed {typed!r})"
+        self.field_errors[(self.section, label)] = message
+        return message
+
+    def clear_field_errors(self, section: str | None = None) -> None:
+        """Forget the field errors of ``section`` (``None``: of every section)."""
+        self.field_errors = {
+            k: m for k, m in self.field_errors.items() if section is not None and k[0] != section
+        }
+
+    def field_error_shown(self) -> bool:
+        """Whether a field of the current section drew its error this frame."""
+        return self._field_error_shown
+
+    def _draw_field_error(self, label: str) -> None:
+        message = self.field_errors.get((self.section, label))
+        if message:
+            self.error(message)
+            self._field_error_shown = True
+
+    def _entered(self, label: str, text: str) -> None:
+        self.entered = (self.section, label, text)
 
     # ------------------------------------------------------------------ hooks
     def _record(
@@ -375,32 +434,61 @@ class UI:
     def input_float(
         self, label: str, value: float, fmt: str = "%.4g", tooltip: str = ""
     ) -> tuple[bool, float]:
-        """A typed float, applied on Enter only: ``(entered, value)``."""
-        flags = self.im.ImGuiInputTextFlags_EnterReturnsTrue
-        changed, new = check_return(
-            "InputFloat", self.im.InputFloat(label, float(value), 0.0, 0.0, fmt, flags)
-        )
-        v = self._widget(label, "input", tooltip, float(value))
+        """A typed float, applied on Enter only: ``(entered, value)``.
+
+        The field is text read as a double (imgui's ``InputFloat`` holds a float32, so 1e308
+        would arrive as inf); the typed text is kept (:attr:`entered`) for an error to quote,
+        and a refused value's error is drawn under the field (:meth:`field_failed`).
+
+        Raises
+        ------
+        ValueError
+            The text is empty or not a number (naming the field and quoting the text).
+        """
+        im = self.im
+        flags = im.ImGuiInputTextFlags_EnterReturnsTrue | im.ImGuiInputTextFlags_CharsScientific
+        shown = fmt % float(value)
+        entered, text = check_return("InputText", im.InputText(label, shown, flags))
+        try:
+            v = self._widget(label, "input", tooltip, shown)
+        finally:
+            self._draw_field_error(label)
         if v is not None:
-            changed, new = True, v
-        return self._changed(changed), new
+            entered, text = True, str(v)
+        if not entered:
+            return self._changed(False), float(value)
+        self._entered(label, text)
+        return self._changed(True), read_float(text, label)
 
     def input_int(self, label: str, value: int, tooltip: str = "") -> tuple[bool, int]:
-        """A typed integer with -/+ buttons, applied on Enter or a button: ``(changed, value)``."""
+        """A typed integer with -/+ buttons, applied on Enter or a button: ``(changed, value)``
+        (a refused value's error is drawn under the field)."""
         flags = self.im.ImGuiInputTextFlags_EnterReturnsTrue
         changed, new = check_return("InputInt", self.im.InputInt(label, int(value), 1, 100, flags))
-        v = self._widget(label, "input", tooltip, int(value))
+        try:
+            v = self._widget(label, "input", tooltip, int(value))
+        except ValueError:  # typed text that is not a whole number (the tests' adapter)
+            self._entered(label, "")
+            raise
+        finally:
+            self._draw_field_error(label)
         if v is not None:
             changed, new = True, v
+        if changed:
+            self._entered(label, str(new))
         return self._changed(changed), new
 
     def input_text(self, label: str, text: str, tooltip: str = "") -> tuple[bool, str]:
-        """A text field: ``(Enter pressed, current text)`` (the text is kept while typing)."""
+        """A text field: ``(Enter pressed, current text)`` (the text is kept while typing; a
+        refused value's error is drawn under the field)."""
         flags = self.im.ImGuiInputTextFlags_EnterReturnsTrue
         entered, new = check_return("InputText", self.im.InputText(label, text, flags))
         v = self._widget(label, "input", tooltip, str(text))
+        self._draw_field_error(label)
         if v is not None:
             entered, new = True, v
+        if entered:
+            self._entered(label, new)
         return self._changed(entered), new
 
     # ------------------------------------------------------------------ plots

@@ -133,6 +133,8 @@ class Viewer:
         show the active view."""
         mesh = self.state.mesh
         if self.watch.changed("mesh", mesh.version, id(mesh)):
+            for view in VIEWS:  # a refused value of the last mesh's context
+                self.forget_errors(view)
             scene.remove_structure(MESH)
             self.state.display.fit(mesh.V)
             ps.register_surface_mesh(MESH, self.mesh_points(), mesh.F, smooth_shade=True)
@@ -141,6 +143,11 @@ class Viewer:
         for p in self.panels.values():
             p.sync(self)
         self.refresh()
+
+    def forget_errors(self, section: str) -> None:
+        """Drop the refused-value errors of ``section`` (its context changed)."""
+        self.state.errors.pop(section, None)
+        self.ui.clear_field_errors(section)
 
     def refresh(self) -> None:
         """Show the structures of the active view and hide the others."""
@@ -151,8 +158,12 @@ class Viewer:
             p.show(self, active)
 
     def set_panel(self, name: str) -> None:
-        """Switch to the view ``name``, show its structures and frame them."""
-        self.state.panel = self.state.check_panel(name)
+        """Switch to the view ``name``, show its structures and frame them (the errors of the
+        view left behind go: they belonged to that context)."""
+        name = self.state.check_panel(name)
+        if name != self.state.panel:
+            self.forget_errors(self.state.panel)
+        self.state.panel = name
         self.refresh()
         self.reframe = True
 
@@ -281,14 +292,15 @@ class Viewer:
         try:
             draw(self)
         except ValueError as exc:  # MeshError is a ValueError: bad input, said in its message
-            errors[section] = str(exc)
+            errors[section] = ui.field_failed(str(exc))  # under its field, if one was typed
         except Exception as exc:  # a bug or an API change: keep the session, say what failed
             errors[section] = self._internal_error(section, exc)
         else:
             if ui.changed:
                 errors.pop(section, None)
+                ui.clear_field_errors(section)
         message = errors.get(section)
-        if message and show:
+        if message and show and not ui.field_error_shown():
             ui.error(message)
         ui.section, ui.changed = outer[0], outer[1] or ui.changed
 

@@ -59,7 +59,8 @@ class SmoothingState:
         """One step of *play*. Beyond the stable ``λ`` (the stability warning is shown), *play*
         stops at the first step that moves the vertices farther (RMS) than the step before (the
         unstable high-frequency modes have taken over: the flow grows from there) and says why;
-        that step stays on screen, and *step* goes on by hand.
+        that step stays on screen and the run counts as diverged (``smoother.diverged``: a
+        smaller ``λ`` goes on from there, as after any divergence).
 
         Returns
         -------
@@ -79,12 +80,13 @@ class SmoothingState:
             return True
         limit = "" if stab.max_stable_lam is None else f" {stab.max_stable_lam:.4g}"
         self.playing, self.last_move = False, None
+        s.diverged = True  # a growing step beyond the limit: the run diverges from here on
         self.error = (
-            f"play stopped at iteration {s.iteration}: that step moved the vertices "
-            f"{move:.3g} (RMS), more than the step before, because lam = {s.lam:g} is beyond "
-            f"the stable limit{limit}: the highest mode grows x{abs(stab.high_freq_gain):.3g} "
-            "per step and the mesh would blow up. Lower lambda (or use implicit), or press "
-            "step to go on by hand"
+            f"play stopped at iteration {s.iteration}: the run diverged (that step moved the "
+            f"vertices {move:.3g} RMS, more than the step before) because lam = {s.lam:g} is "
+            f"beyond the stable limit{limit}: the highest mode grows "
+            f"x{abs(stab.high_freq_gain):.3g} per step and the mesh would blow up. Lower lambda "
+            "(or use implicit) to go on, or press reset"
         )
         return False
 
