@@ -32,6 +32,7 @@ from typing import Any
 
 import numpy as np
 
+from .field_errors import FieldErrors, read_float
 from .text_numbers import is_number
 
 RED = (1.0, 0.35, 0.35, 1.0)
@@ -141,26 +142,7 @@ def check_return(name: str, result: Any) -> Any:
     return result
 
 
-def read_float(text: str, label: str) -> float:
-    """The number typed into the float field ``label``, as a double (C's ``strtod``, as
-    Python's ``float``: ``1e308`` stays ``1e308``, ``1e309`` is ``inf``, which the panel's
-    check then refuses).
-
-    Raises
-    ------
-    ValueError
-        ``text`` is empty or not a number, naming the field.
-    """
-    t = text.strip()
-    if not t:
-        raise ValueError(f"{label}: the field is empty; type a number and press Enter")
-    try:
-        return float(t)
-    except ValueError:
-        raise ValueError(f"{label}: {text!r} is not a number") from None
-
-
-class UI:
+class UI(FieldErrors):
     """imgui/implot for the panels (see the module docstring).
 
     Parameters
@@ -179,11 +161,9 @@ class UI:
         self.section = ""
         self.changed = False  # some widget reported a change since begin_section
         self._table: tuple[int, bool] | None = None  # the open table: (columns, shown)
-        # the field entered (Enter) in this section this frame: (section, label, typed text)
-        self.entered: tuple[str, str, str] | None = None
-        # (section, label) -> the error of a typed value, drawn under that field
+        self.entered: tuple[str, str, str] | None = None  # see FieldErrors
         self.field_errors: dict[tuple[str, str], str] = {}
-        self._field_error_shown = False  # a field of this section drew its error this frame
+        self._field_error_shown = False
 
     # ------------------------------------------------------------------ set-up
     @property
@@ -209,39 +189,6 @@ class UI:
         self.changed = False
         self.entered = None
         self._field_error_shown = False
-
-    # ------------------------------------------------------------------ field errors
-    def field_failed(self, message: str) -> str:
-        """``message`` (a refused value) belongs to the field entered in this section this
-        frame, if one was: it is kept to be drawn right under that field (from the next frame
-        on), quoting what was typed. Returns the message to keep for the section."""
-        if self.entered is None or self.entered[0] != self.section:
-            return message
-        _, label, typed = self.entered
-        typed = typed.strip()
-        if typed and typed not in message:
-            message = f"{message} (you typed {typed!r})"
-        self.field_errors[(self.section, label)] = message
-        return message
-
-    def clear_field_errors(self, section: str | None = None) -> None:
-        """Forget the field errors of ``section`` (``None``: of every section)."""
-        self.field_errors = {
-            k: m for k, m in self.field_errors.items() if section is not None and k[0] != section
-        }
-
-    def field_error_shown(self) -> bool:
-        """Whether a field of the current section drew its error this frame."""
-        return self._field_error_shown
-
-    def _draw_field_error(self, label: str) -> None:
-        message = self.field_errors.get((self.section, label))
-        if message:
-            self.error(message)
-            self._field_error_shown = True
-
-    def _entered(self, label: str, text: str) -> None:
-        self.entered = (self.section, label, text)
 
     # ------------------------------------------------------------------ hooks
     def _record(
@@ -501,14 +448,20 @@ class UI:
         y_label: str,
         y_log: bool = False,
         fit_y: bool = True,
+        legend_outside: bool = False,
     ) -> Iterator[bool]:
         """``with ui.plot(...) as shown:`` an ImPlot with labelled axes, refitted to the data
-        every frame (``fit_y=False``: the caller sets the y limits); EndPlot always runs."""
+        every frame (``fit_y=False``: the caller sets the y limits; ``legend_outside``: the
+        legend in a row above the plot, never over the curves); EndPlot always runs."""
         shown = check_return("BeginPlot", self.ip.BeginPlot(title, (-1, height * self.scale)))
         try:
             if shown:
                 fit = self.ip.ImPlotAxisFlags_AutoFit
                 self.ip.SetupAxes(x_label, y_label, fit, fit if fit_y else 0)
+                if legend_outside:
+                    ip = self.ip
+                    flags = ip.ImPlotLegendFlags_Outside | ip.ImPlotLegendFlags_Horizontal
+                    ip.SetupLegend(ip.ImPlotLocation_North, flags)
                 if y_log:
                     self.ip.SetupAxisScale(self.ip.ImAxis_Y1, self.ip.ImPlotScale_Log10)
             yield shown

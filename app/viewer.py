@@ -419,7 +419,7 @@ def run(
     screenshot: str | Path | None = None,
     panel: str | None = None,
     backend: str | None = None,
-    ui_scale: float = 1.0,
+    ui_scale: float | None = None,
     session: str | Path | None = None,
     **options: Any,
 ) -> int:
@@ -427,7 +427,9 @@ def run(
 
     With ``screenshot`` a single frame is rendered headless (EGL) into that PNG and the
     function returns. With ``session`` (a saved session file) its mesh, settings and camera
-    replace ``path``, ``panel``, ``options`` and ``ui_scale``. ``options`` are the panels'
+    replace ``path``, ``panel`` and ``options``; a ``ui_scale`` given wins over the session's
+    (the room's projector, not the saved view; ``None``: the session's, else 1). ``options``
+    are the panels'
     start options (``field``, ``vertex``, ``k``: ``None`` when not given), each checked by its
     panel's state module before the window opens.
     """
@@ -448,13 +450,13 @@ def run(
     if saved is not None:
         check_session_mesh(saved, state.mesh, session)
     check_options(options, state)
-    if not 0.5 <= ui_scale <= 3.0:  # also refuses NaN
+    if ui_scale is not None and not 0.5 <= ui_scale <= 3.0:  # also refuses NaN
         raise MeshError(f"must be between 0.5 and 3, got {ui_scale}", "--ui-scale")
     ps.set_program_name(f"meshlap — {state.mesh.name}")  # the window title (set before init)
     init_polyscope(backend or ("openGL3_egl" if shot else "auto"))
     viewer = Viewer(state)
     ps.set_build_default_gui_panels(False)  # polyscope's own panels: a toggle in Help
-    if ui_scale != 1.0:
+    if ui_scale is not None and ui_scale != 1.0:
         viewer.set_ui_scale(ui_scale)
     viewer.sync_mesh()
     if shot is not None:
@@ -463,6 +465,8 @@ def run(
         from .session import apply
 
         apply(viewer, saved, session, mesh=state.mesh)
+        if ui_scale is not None:  # typed with --session: wins over the saved scale
+            viewer.set_ui_scale(ui_scale)
     else:
         for name, p in viewer.panels.items():
             p.start(viewer, options, name == state.panel, shot is not None)

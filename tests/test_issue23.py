@@ -55,11 +55,12 @@ def test_euler_plot_is_in_the_geometric_angle(viewer):
         phi = np.radians(phi_deg)
         euler = p.k1 * np.cos(phi) ** 2 + p.k2 * np.sin(phi) ** 2
         assert np.allclose(kn, euler, atol=1e-9 * max(1.0, abs(p.k1), abs(p.k2)))
-        # k1 and k2 are marked, at their values and their directions
-        assert plots[f"k1 = {p.k1:.4g}"][2][0] == pytest.approx(p.k1)
-        assert plots[f"k2 = {p.k2:.4g}"][2][0] == pytest.approx(p.k2)
-        assert list(plots["k1 direction"][1]) == [0.0, 180.0, 360.0]
-        assert list(plots["k2 direction"][1]) == [90.0, 270.0]
+        # k1 and k2 are marked (named with their values) where the curve reaches them
+        for name, k in (("k1", p.k1), ("k2", p.k2)):
+            at = np.asarray(plots[f"{name} = {k:.3g}"][1])
+            assert np.allclose(np.interp(at, phi_deg, kn), k)
+        assert list(plots[f"k1 = {p.k1:.3g}"][1]) == [0.0, 180.0, 360.0]
+        assert list(plots[f"k2 = {p.k2:.3g}"][1]) == [90.0, 270.0]
     # the parameter angle θ is kept, labelled as such, and the section is marked at its φ
     tip = viewer.ui.tooltips[("surfaces", "section theta")]
     assert "(u, v) plane" in tip and "tangent plane from the first principal" in tip
@@ -161,3 +162,122 @@ def test_a_typed_value_error_sits_under_its_field_quotes_the_text_and_goes(viewe
     assert errors_under(viewer, "smoothing")[0][1] == "noise seed"
     assert viewer.open(sphere)
     assert not errors_under(viewer, "smoothing")
+
+
+# ---------------------------------------------------------------- class check: every legend
+KEPT_ON_PURPOSE = {"curvature": "the views that shows_curvature keep the mesh's field"}
+
+
+def legend_problems(viewer: Viewer, ledger, where: str) -> list[str]:
+    """Every visible colour-mapped quantity has an on-screen colour bar with its name and a
+    range, and belongs to the active view (or to the curvature field a view keeps)."""
+    active = viewer.active()
+    out = []
+    for (structure, name), q in ledger.visible().items():
+        if q.kind != "scalar":
+            continue  # RGB colours carry no colour map (their meaning is in the panel's text)
+        if not (q.colorbar and name and q.vminmax is not None):
+            out.append(f"{where}: {structure} / {name!r} is visible without a colour bar")
+        kept = q.owner in KEPT_ON_PURPOSE and active.shows_curvature
+        if q.owner != active.name and not kept:
+            out.append(f"{where}: {structure} / {name!r} of {q.owner!r} visible in {active.name}")
+    return out
+
+
+def test_every_visible_quantity_has_a_legend_and_belongs_to_the_view(viewer, sphere, monkeypatch):
+    from legend_ledger import Ledger
+    from meshlap_app.registry import VIEWS
+
+    from meshlap_core.options import CURVATURE_FIELD_LABELS
+
+    ledger = Ledger().install(monkeypatch)
+    assert viewer.open(sphere)  # everything registered again, through the ledger
+    frames(viewer)
+    problems: list[str] = []
+    fields = list(CURVATURE_FIELD_LABELS)
+    viewer.set_panel("onering")
+    drive(viewer, "vertex", 5)  # the ring and the inspector's weights are on screen
+    assert viewer.panels["onering"].state.vertex == 5
+    for basis in (False, True):
+        if basis:
+            viewer.set_panel("spectral")
+            drive(viewer, "modes to compute", 12)
+            drive(viewer, "compute eigenbasis", True)
+            st = viewer.panels["spectral"].state
+            while st.busy:
+                frames(viewer)
+            frames(viewer, 2)
+            assert st.basis is not None
+        for i, field in enumerate(fields):
+            for side in (False, True):
+                viewer.set_panel("curvature")
+                drive(viewer, "field", field)
+                c = viewer.state.curv
+                if c.side_by_side != side:
+                    drive(viewer, "side by side", side)
+                if side:
+                    drive(viewer, "second field", fields[(i + 1) % len(fields)])
+                for view in VIEWS:
+                    viewer.set_panel(view)
+                    frames(viewer, 2)
+                    where = f"basis={basis} field={field} side={side} view={view}"
+                    problems += legend_problems(viewer, ledger, where)
+    assert not problems, "\n".join(dict.fromkeys(problems))
+
+
+# ---------------------------------------------------------------- item 1: second mesh, basis
+def compute_basis(viewer: Viewer, modes: int = 12) -> None:
+    viewer.set_panel("spectral")
+    drive(viewer, "modes to compute", modes)
+    drive(viewer, "compute eigenbasis", True)
+    st = viewer.panels["spectral"].state
+    while st.busy:
+        frames(viewer)
+    frames(viewer, 2)
+    assert st.basis is not None
+
+
+def test_second_mesh_then_eigenbasis_shows_the_reconstruction(viewer):
+    from pathlib import Path
+
+    recon = "reconstruction"
+    compute_basis(viewer)
+    assert ps.get_surface_mesh(recon).is_enabled()
+    viewer.set_panel("curvature")  # the copy is hidden with its view
+    frames(viewer)
+    assert not ps.get_surface_mesh(recon).is_enabled()
+    second = Path(__file__).parents[1] / "assets" / "icosphere.obj"
+    assert viewer.open(second)
+    frames(viewer)
+    compute_basis(viewer)
+    sm = ps.get_surface_mesh(recon)
+    assert sm.is_enabled(), "the reconstruction came back hidden"
+    st = viewer.panels["spectral"].state
+    before = np.array(st.reconstruction)
+    drive(viewer, "k (reconstruct)", 3)
+    assert st.k == 3 and sm.is_enabled()
+    assert not np.allclose(before, st.reconstruction)  # the k slider changes what is shown
+
+
+# ---------------------------------------------------------------- item 9: --ui-scale --session
+def test_view_accepts_ui_scale_with_a_session(viewer, tmp_path, sphere, monkeypatch):
+    import meshlap_app.viewer as viewer_module
+    from meshlap_app.state.session import Session, write_session
+
+    from meshlap_core.cli import main
+
+    path = write_session(tmp_path / "s.json", Session(mesh=sphere, panel="curvature"))
+    seen: dict = {}
+
+    def show() -> None:  # the window's loop: read what the viewer was given instead
+        seen["ok"] = True
+
+    monkeypatch.setattr(viewer_module, "init_polyscope", lambda backend: None)
+    monkeypatch.setattr(ps, "show", show)
+    applied = []
+    real = viewer_module.Viewer.set_ui_scale
+    monkeypatch.setattr(
+        viewer_module.Viewer, "set_ui_scale", lambda v, s: (applied.append(s), real(v, s))
+    )
+    assert main(["view", "--ui-scale", "2", "--session", str(path)]) == 0
+    assert seen["ok"] and applied[-1] == 2.0  # the typed scale wins over the session's

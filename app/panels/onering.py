@@ -30,7 +30,6 @@ from ..text_numbers import sig
 from .base import Host, Panel
 
 NEGATIVE_RGBA = (*scene.NEGATIVE_COLOR, 1.0)
-WEIGHTS_COLORBAR_AT = (15.0, 300.0)  # below the mesh field's colour bar (scene.COLORBAR_AT)
 
 # glyphs the viewer's font lacks, written out (the CLI prints the originals)
 ASCII_MATH = str.maketrans(
@@ -167,7 +166,12 @@ class OneRingPanel(Panel):
         cn.set_color((0.1, 0.1, 0.1))
         pc = ps.register_point_cloud(RING_POINTS, ring, radius=1.5 * scale)
         pc.set_radius(1.5 * scale, relative=False)
-        pc.add_scalar_quantity("order", r.order_t, cmap="viridis", enabled=True, vminmax=(0, 1))
+        # the order as RGB colours (viridis, first to last): their legend is the numbers the
+        # overlay draws on the neighbours, not a third colour bar over the ring
+        from matplotlib import colormaps
+
+        order_rgb = colormaps["viridis"](np.clip(np.asarray(r.order_t, dtype=float), 0, 1))[:, :3]
+        pc.add_color_quantity("order (numbered)", order_rgb, enabled=True)
         pc.add_vector_quantity(
             "direction",
             0.85 * d.vectors(r.arrows),
@@ -227,7 +231,8 @@ class OneRingPanel(Panel):
             vminmax=(-m, m),
             enabled=True,
             onscreen_colorbar_enabled=True,
-            onscreen_colorbar_location=WEIGHTS_COLORBAR_AT,
+            # below the mesh field's colour bar, spaced for the UI scale (no overlap at 1.5)
+            onscreen_colorbar_location=scene.colorbar_at(1, host.state.ui_scale),
         )
         neg = w < 0
         if neg.any():

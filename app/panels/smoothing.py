@@ -22,6 +22,7 @@ from ..state.smoothing import (
     encode_lam_steps,
     replay_steps,
 )
+from ..text_numbers import plural
 from ..ui import UI
 from .base import ExportItem, Host, Panel
 
@@ -106,7 +107,7 @@ class SmoothingPanel(Panel):
         noisy = f"noisy alpha = {sm.noise_alpha:g}" if sm.noise_alpha else "no noise"
         return {
             SMOOTH_INPUT: f"input, {noisy}",
-            SMOOTHED: f"{sm.method}, lambda = {sm.lam:g}, {sm.smoother.iteration} steps",
+            SMOOTHED: f"{sm.method}, lambda = {sm.lam:g}, {plural(sm.smoother.iteration, 'step')}",
         }
 
     def export_items(self, host: Host) -> list[ExportItem]:

@@ -88,13 +88,22 @@ class SpectralPanel(Panel):
             return
         X = host.state.display.points(st.reconstruction) + self._offset(host)
         if not ps.has_surface_mesh(RECON):
-            ps.register_surface_mesh(RECON, X, host.state.mesh.F, smooth_shade=True)
+            sm = ps.register_surface_mesh(RECON, X, host.state.mesh.F, smooth_shade=True)
+            # polyscope remembers a structure's enabled flag by name: a copy removed while
+            # hidden (a new mesh opened in another view) would come back hidden
+            sm.set_enabled(host.active() is self)
             host.request_frame()  # a new copy beside the mesh
         else:
             ps.get_surface_mesh(RECON).update_vertex_positions(X)
         hi = float(st.errors.max[st.k]) or 1.0  # precomputed for every k
         ps.get_surface_mesh(RECON).add_scalar_quantity(
-            "error |x - x_k|", st.vertex_error, cmap="reds", vminmax=(0.0, hi), enabled=True
+            "error |x - x_k|",
+            st.vertex_error,
+            cmap="reds",
+            vminmax=(0.0, hi),
+            enabled=True,
+            onscreen_colorbar_enabled=True,  # below the eigenfunction's
+            onscreen_colorbar_location=scene.colorbar_at(1, host.state.ui_scale),
         )
 
     def points(self, host: Host, name: str) -> np.ndarray | None:

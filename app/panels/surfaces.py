@@ -211,14 +211,16 @@ class SurfacesPanel(Panel):
         if p is None:
             return
         with ui.plot(
-            "normal curvature k_n(phi)", 180, "phi (deg) from the k1 direction", "k_n"
+            "normal curvature k_n(phi)",
+            200,
+            "phi (deg) from the k1 direction",
+            "k_n",
+            legend_outside=True,
         ) as shown:
             if shown:
                 ui.plot_line("k_n", np.degrees(s.phi), s.kn_phi)
-                ui.plot_hlines(f"k1 = {p.k1:.4g}", np.array([p.k1]))
-                ui.plot_hlines(f"k2 = {p.k2:.4g}", np.array([p.k2]))
-                ui.plot_vlines("k1 direction", np.array([0.0, 180.0, 360.0]))
-                ui.plot_vlines("k2 direction", np.array([90.0, 270.0]))
+                ui.plot_vlines(f"k1 = {p.k1:.3g}", np.array([0.0, 180.0, 360.0]))
+                ui.plot_vlines(f"k2 = {p.k2:.3g}", np.array([90.0, 270.0]))
                 ui.plot_vlines("section", np.array([s.section_phi_deg()]))
 
     def draw_section(self, host: Host) -> None:
@@ -230,8 +232,7 @@ class SurfacesPanel(Panel):
             s.section_deg,
             0.0,
             360.0,
-            # κₙ shown in the slider (no row of its own), φ beside the parameter angle
-            f"%.1f deg in (u, v) = phi {s.section_phi_deg():.1f} deg: k_n = {kn:.4g}",
+            f"%.1f deg: k_n = {kn:.4g}",  # κₙ shown in the slider, φ in the row below
             "direction of the normal section (orange) as a parameter angle theta: degrees in "
             "the (u, v) plane from the u axis towards v, i.e. the tangent p_u cos theta + "
             "p_v sin theta (normalized). phi is the same direction measured in the tangent "
@@ -249,6 +250,10 @@ class SurfacesPanel(Panel):
             s.toggle_turn()
         elif s.tick_turn():
             self.push_section(host)
+        ui.text(
+            f"section: theta = {s.section_deg:.1f} deg in (u, v) = phi "
+            f"{s.section_phi_deg():.1f} deg from the k1 direction"
+        )
 
     # ------------------------------------------------------------------ meshlap animate
     def frames(self, host: Host, options: dict[str, Any]) -> Iterator[str]:

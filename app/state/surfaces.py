@@ -17,6 +17,7 @@ from meshlap_core import surfaces
 from meshlap_core.errors import MeshError
 from meshlap_core.types import FloatArray
 
+from ..text_numbers import sig
 from .animation import Animation, Option
 from .checks import Schema, integer, number, one_of
 
@@ -40,6 +41,13 @@ def section_arc(
     else:
         along, up = s, 0.5 * kn * s * s
     return p.p[None, :] + along[:, None] * t[None, :] + up[:, None] * p.n[None, :]
+
+
+def signed_sig(x: float, scale: float) -> str:
+    """``x`` with its sign to 4 significant digits, or ``0`` when it is round-off against
+    ``scale`` (κₙ = 4.4e-16 beside κ₁ = 1 is 0: :func:`..text_numbers.sig`)."""
+    text = sig(x, scale)
+    return text if text == "0" or text.startswith("-") else f"+{text}"
 
 
 def tangent_frame(p: surfaces.PointGeometry) -> tuple[FloatArray, FloatArray]:
@@ -213,7 +221,9 @@ class SurfaceState:
         return (
             f"{self.name} at (u, v) = ({self.u:.3g}, {self.v:.3g})   θ = {self.section_deg:5.1f}°"
             f" in (u, v), φ = {self.section_phi_deg():5.1f}° from κ₁"
-            f"   κₙ = {kn:+.4g}   (κ₁ = {p.k1:.4g}, κ₂ = {p.k2:.4g})"
+            f"   κₙ = {signed_sig(kn, max(abs(p.k1), abs(p.k2)))}"
+            f"   (κ₁ = {sig(p.k1, max(abs(p.k1), abs(p.k2)))}, "
+            f"κ₂ = {sig(p.k2, max(abs(p.k1), abs(p.k2)))})"
         )
 
     def section_phi_deg(self) -> float:
