@@ -96,6 +96,7 @@ class Viewer:
         self.panels = make_panels(state)
         self.busy_frame_s = BUSY_FRAME_S
         self.reframe = True  # frame the visible structures at the end of the next frame
+        self.whole = False  # R: the next framing shows the whole subject (no view's focus)
         self.keep_camera = False  # an animation of a saved view: never re-frame
         self.window_size: tuple[int, int] = (0, 0)
         self.watch = Watch()
@@ -193,8 +194,9 @@ class Viewer:
         keys = dict.fromkeys([*(k for p in self.panels.values() for k in p.keys), "f", "r"])
         for key in keys:
             if ui.key(key) and not any(p.on_key(self, key) for p in panels):
-                if key in ("f", "r"):  # nobody used it: frame (R: the camera's reset)
+                if key in ("f", "r"):  # nobody used it: F frames, R resets to the whole subject
                     self.reframe = True
+                    self.whole = key == "r"
 
     def files_dropped(self, paths: list[str]) -> None:
         """polyscope's drag-and-drop callback: open the first file dropped on the window (a
@@ -255,7 +257,8 @@ class Viewer:
         if self.reframe or size != self.window_size:
             self.window_size = size
             self.reframe = False
-            self.frame()
+            self.frame(whole=self.whole)
+            self.whole = False
         self.draw_captions()
 
     def keep_view(self) -> None:
@@ -348,18 +351,19 @@ class Viewer:
         own = getattr(self.active(), "view_direction", None)
         return own or scene.FRONT_VIEWS.get(self.state.mesh.name, scene.DEFAULT_VIEW)
 
-    def frame(self, strip: float | None = None) -> None:
+    def frame(self, strip: float | None = None, whole: bool = False) -> None:
         """Frame what the active view shows in the part of the window left of meshlap's panel
-        (a view may frame its own way: the one-ring its selected vertex). ``strip``: an
-        animation frame (no panel), keeping that left fraction of the width clear for the
-        colour bar; nothing happens when the animation keeps a saved camera."""
+        (a view may frame its own way: the one-ring its selected vertex; ``whole``: not that
+        way, the whole subject, as R does). ``strip``: an animation frame (no panel), keeping
+        that left fraction of the width clear for the colour bar; nothing happens when the
+        animation keeps a saved camera."""
         if strip is not None:
             if not self.keep_camera:
                 scene.frame_scene_left(
                     self.framed_names(), self.structure_points, 0.95, self.view_direction(), strip
                 )
             return
-        if self.active().focus(self):
+        if not whole and self.active().focus(self):
             return
         w, _ = ps.get_window_size()
         fraction = scene.scene_fraction(w, self.state.ui_scale)

@@ -3,7 +3,9 @@ polyscope's openGL_mock backend, the ``viewer`` fixture)."""
 
 from __future__ import annotations
 
+import re
 from itertools import pairwise
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -281,3 +283,95 @@ def test_view_accepts_ui_scale_with_a_session(viewer, tmp_path, sphere, monkeypa
     )
     assert main(["view", "--ui-scale", "2", "--session", str(path)]) == 0
     assert seen["ok"] and applied[-1] == 2.0  # the typed scale wins over the session's
+
+
+# ---------------------------------------------------------------- class check: every key
+README = Path(__file__).parents[1] / "README.md"
+SYMBOLS = {"→": "right", "←": "left", "space": "space"}
+# where a key can act (the panel named in its help row, else this view)
+DEFAULT_VIEW = "onering"
+
+
+def readme_keys() -> list[str]:
+    """The keys in the README's **Keys:** item, as the adapter names them."""
+    text = README.read_text(encoding="utf-8")
+    start = text.index("**Keys:**")
+    item = text[start : text.index("\n\n", start)]
+    keys: list[str] = []
+    for token in re.findall(r"`([^`]+)`", item):
+        if re.fullmatch(r"\d", token):
+            keys.append(token)
+        elif token in SYMBOLS:
+            keys.append(SYMBOLS[token])
+        elif re.fullmatch(r"[A-Z]", token):
+            keys.append(token.lower())
+        elif token.startswith("--"):
+            continue  # an option, not a key
+        else:
+            raise AssertionError(f"README key {token!r} is not understood by this check")
+    if "1" in keys and "5" in keys:  # `1`–`5`
+        keys += ["2", "3", "4"]
+    return sorted(set(keys))
+
+
+def help_keys(viewer: Viewer) -> list[tuple[str, str]]:
+    """(key, panel it belongs to) for every key row of the Help window."""
+    from meshlap_app.panels.help import shortcut_rows
+
+    out = []
+    for key, what in shortcut_rows(viewer):
+        if key in ("mouse", "drop"):
+            continue  # gestures: driven by their own tests
+        panel = what.split(":")[0] if ":" in what and " " not in what.split(":")[0] else ""
+        if "-" in key and key[0].isdigit():
+            lo, hi = key.split("-")
+            out += [(str(i), "") for i in range(int(lo), int(hi) + 1)]
+        else:
+            out += [(k.strip().lower(), panel) for k in key.split("/")]
+    return out
+
+
+def snapshot(viewer: Viewer) -> tuple:
+    sm, sp = viewer.panels["smoothing"].state, viewer.panels["spectral"].state
+    help_panel = viewer.panels["help"]
+    camera = np.round(np.asarray(ps.get_camera_view_matrix()), 6).tobytes()
+    it = sm.smoother.iteration if sm.smoother is not None else None
+    return (viewer.state.panel, help_panel.shown, sm.playing, it, sp.k, camera)
+
+
+def test_every_documented_key_does_something(viewer):
+    keys = help_keys(viewer)
+    documented = {k for k, _ in keys}
+    missing = set(readme_keys()) - documented
+    assert not missing, f"keys in the README but not in the Help window: {missing}"
+    compute_basis(viewer)
+    viewer.set_panel("onering")
+    drive(viewer, "vertex", 5)
+    viewer.set_panel("smoothing")
+    drive(viewer, "noise alpha", 0.01)
+    failures = []
+    for key, panel in keys:
+        view = panel or DEFAULT_VIEW
+        if key.isdigit():
+            view = "curvature" if key != "1" else "spectral"  # away from the key's own view
+        viewer.set_panel(view)
+        frames(viewer, 2)
+        ps.look_at((3.0, 1.0, 2.0), (0.0, 0.0, 0.0))  # a camera F and R must change
+        before = snapshot(viewer)
+        viewer.ui.script(f"key {key}", True)
+        frames(viewer, 2)
+        if snapshot(viewer) == before:
+            failures.append(f"{key!r} in the {view} view did nothing")
+        if key == "space" and viewer.panels["smoothing"].state.playing:
+            viewer.ui.script("key space", True)
+            frames(viewer)
+    assert not failures, failures
+    # R is not F in the one-ring: F frames the ring, R the whole mesh
+    viewer.set_panel("onering")
+    frames(viewer)
+    cams = []
+    for key in ("f", "r"):
+        viewer.ui.script(f"key {key}", True)
+        frames(viewer, 2)
+        cams.append(np.asarray(ps.get_camera_view_matrix()))
+    assert not np.allclose(cams[0], cams[1]), "R did the same as F"
