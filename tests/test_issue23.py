@@ -375,3 +375,29 @@ def test_every_documented_key_does_something(viewer):
         frames(viewer, 2)
         cams.append(np.asarray(ps.get_camera_view_matrix()))
     assert not np.allclose(cams[0], cams[1]), "R did the same as F"
+
+
+# ---------------------------------------------------------------- items 10, 11: small ones
+def test_genus_none_is_explained_and_small_texts(viewer, tmp_path):
+    from meshlap_app.panels.mesh_info import genus_reason
+    from meshlap_app.state.surfaces import SurfaceState
+    from meshlap_app.text_numbers import plural
+
+    from meshlap_core.frames import VIDEO_EXTRA
+
+    fin = tmp_path / "fin.obj"  # three triangles on one edge: not a manifold
+    fin.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nf 1 2 3\nf 1 4 2\nf 1 2 5\n")
+    assert viewer.open(fin)
+    frames(viewer)
+    info = viewer.state.mesh.info
+    assert info["genus"] is None
+    why = genus_reason(info)
+    assert "not a manifold" in why and "boundary is not a set of loops" in why
+    # "1 step", the README's install hint in the MP4 error, κₙ round-off shown as 0
+    assert plural(1, "step") == "1 step" and plural(3, "step") == "3 steps"
+    assert "pip install -e '.[video]'" in VIDEO_EXTRA
+    assert "pip install -e '.[video]'" in README.read_text(encoding="utf-8")
+    s = SurfaceState()
+    s.set_surface("saddle")
+    s.set_section(45.0)  # κₙ = 4.4e-16 in floating point
+    assert "κₙ = 0 " in s.section_caption()

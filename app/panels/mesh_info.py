@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import time
 from pathlib import Path
+from typing import Any
 
 from ..state.mesh import list_meshes
 from .base import Host, Panel
@@ -33,11 +34,14 @@ class MeshPanel(Panel):
             return
         mesh = host.state.mesh
         info = mesh.info
+        genus = info.get("genus")
         ui.text(
             f"{mesh.name}: {info.get('n_vertices', 0)} vertices, "
             f"{info.get('n_faces', 0)} faces, chi = {info.get('euler_characteristic')}, "
-            f"genus = {info.get('genus')}"
+            + (f"genus = {genus}" if genus is not None else "genus undefined (see below)")
         )
+        if genus is None:
+            ui.note(genus_reason(info))
         ui.text(
             f"boundary loops {info.get('n_boundary_loops')}, components "
             f"{info.get('n_components')}, manifold {'yes' if info.get('manifold') else 'no'}"
@@ -76,3 +80,18 @@ class MeshPanel(Panel):
 
 
 PANEL = MeshPanel
+
+
+def genus_reason(info: dict[str, Any]) -> str:
+    """Why a mesh has no genus: the core's note (``2c − χ − b`` negative: not a manifold; the
+    boundary not a set of loops), the manifold flag and the number of components."""
+    why = [str(info.get("genus_note") or "genus undefined")]
+    if not info.get("manifold"):
+        why.append(
+            "the mesh is not a manifold (an edge with more than two faces, or a vertex "
+            "whose faces do not form one fan)"
+        )
+    n = info.get("n_components") or 1
+    if n > 1:
+        why.append(f"{n} components: the genus is a property of one connected surface")
+    return "; ".join(why)
