@@ -401,3 +401,17 @@ def test_genus_none_is_explained_and_small_texts(viewer, tmp_path):
     s.set_surface("saddle")
     s.set_section(45.0)  # κₙ = 4.4e-16 in floating point
     assert "κₙ = 0 " in s.section_caption()
+
+
+def test_k_sweep_error_colour_bar_keeps_one_range(viewer, monkeypatch):
+    from legend_ledger import Ledger
+
+    ledger = Ledger().install(monkeypatch)
+    compute_basis(viewer, 12)
+    panel = viewer.panels["spectral"]
+    ranges = []
+    for _ in panel.frames(viewer, {"k": (1, 8)}):
+        q = ledger.quantities["reconstruction"]["error |x - x_k|"]
+        assert q.colorbar
+        ranges.append(q.vminmax)
+    assert len(ranges) == 8 and len(set(ranges)) == 1, ranges

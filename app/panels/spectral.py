@@ -314,7 +314,7 @@ class SpectralPanel(Panel):
 
     def frames(self, host: Host, options: dict[str, Any]) -> Iterator[str]:
         """The k sweep (``options["k"] = (A, B)``: the reconstruction from the first k modes
-        beside the mesh, coloured by the error |x - x_k| on each k's own scale) or the
+        beside the mesh, coloured by the error |x - x_k| on one scale for the sweep) or the
         eigenmodes (``options["modes"]``: u_A..u_B as colour maps on the mesh)."""
         if options.get("modes") is not None:
             yield from self._mode_frames(host, options["modes"])
@@ -330,6 +330,9 @@ class SpectralPanel(Panel):
         self.push_k(host, force=True)
         host.frame(scene.COLORBAR_STRIP)
         e = st.errors
+        # one colour range for the whole sweep (the largest error of any of its k), so the
+        # colours of two frames compare
+        hi = float(max(e.max[k] for k in range(a, b + 1))) or 1.0
         for k in range(a, b + 1):
             st.set_k(k)
             self.push_k(host)
@@ -337,7 +340,7 @@ class SpectralPanel(Panel):
                 "error |x - x_k|",
                 st.vertex_error,
                 cmap="reds",
-                vminmax=(0.0, float(e.max[k]) or 1.0),  # as the viewer: this k's largest error
+                vminmax=(0.0, hi),
                 enabled=True,
                 onscreen_colorbar_enabled=True,
                 onscreen_colorbar_location=COLORBAR_AT,
