@@ -415,3 +415,18 @@ def test_k_sweep_error_colour_bar_keeps_one_range(viewer, monkeypatch):
         assert q.colorbar
         ranges.append(q.vminmax)
     assert len(ranges) == 8 and len(set(ranges)) == 1, ranges
+
+
+def test_path_field_opens_a_session_and_empties(viewer, tmp_path, sphere):
+    from meshlap_app.state.session import Session, write_session
+
+    path = write_session(tmp_path / "s.json", Session(mesh=sphere, panel="smoothing"))
+    viewer.set_panel("curvature")
+    drive(viewer, "path", str(path))
+    assert viewer.state.panel == "smoothing" and "mesh_info" not in viewer.state.errors
+    assert viewer.panels["mesh_info"].path_text == ""
+    drive(viewer, "path", str(sphere))
+    assert viewer.panels["mesh_info"].path_text == ""  # not the old path any more
+    drive(viewer, "path", str(tmp_path / "missing.json"))
+    assert viewer.state.errors["mesh_info"]  # refused, said under the field
+    assert viewer.panels["mesh_info"].path_text.endswith("missing.json")

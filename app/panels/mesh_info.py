@@ -28,6 +28,16 @@ class MeshPanel(Panel):
         if opened_before and host.state.mesh.path is not None:
             self.remember(host.state.mesh.path)
 
+    def open_path(self, host: Host, path: Path) -> None:
+        """Open the mesh or the saved session (``.json``, as when dropped on the window) that
+        the path field names; the field is emptied once it opened (a refused file raises
+        :class:`MeshError` or sets the mesh's error, and the field keeps the text)."""
+        if path.suffix.lower() == ".json":
+            _load_session(host, path)
+            self.path_text = ""
+        elif host.open(path):
+            self.path_text = ""
+
     def draw(self, host: Host) -> None:
         ui = host.ui
         if not ui.header(self.title):
@@ -49,13 +59,15 @@ class MeshPanel(Panel):
         for r in info.get("repairs", []):
             ui.text(f"repaired: {r}")
         entered, self.path_text = ui.input_text(
-            "path", self.path_text, "a mesh file (.obj .off .ply .stl); Enter or Open loads it"
+            "path",
+            self.path_text,
+            "a mesh file (.obj .off .ply .stl) or a saved session (.json); Enter or Open loads it",
         )
         ui.same_line()
         if (ui.button("Open", "load the file named in the path field") or entered) and (
             self.path_text.strip()
         ):
-            host.open(Path(self.path_text.strip()).expanduser())
+            self.open_path(host, Path(self.path_text.strip()).expanduser())
         now = time.monotonic()
         if now - self._listed[0] > 2.0:  # the folders are listed at most every 2 s, not per frame
             self._listed = (now, list_meshes())
@@ -80,6 +92,12 @@ class MeshPanel(Panel):
 
 
 PANEL = MeshPanel
+
+
+def _load_session(host: Host, path: Path) -> None:
+    from ..session import load
+
+    load(host, path)
 
 
 def genus_reason(info: dict[str, Any]) -> str:
