@@ -430,3 +430,11 @@ def test_path_field_opens_a_session_and_empties(viewer, tmp_path, sphere):
     drive(viewer, "path", str(tmp_path / "missing.json"))
     assert viewer.state.errors["mesh_info"]  # refused, said under the field
     assert viewer.panels["mesh_info"].path_text.endswith("missing.json")
+
+
+def test_a_missing_export_folder_is_reported_with_where_files_go(viewer, tmp_path):
+    from meshlap_core.errors import MeshError
+
+    with pytest.raises(MeshError, match="create it first") as err:
+        viewer.state.set_folder(str(tmp_path / "nope"))
+    assert str(viewer.state.folder) in str(err.value)
