@@ -438,3 +438,19 @@ def test_a_missing_export_folder_is_reported_with_where_files_go(viewer, tmp_pat
     with pytest.raises(MeshError, match="create it first") as err:
         viewer.state.set_folder(str(tmp_path / "nope"))
     assert str(viewer.state.folder) in str(err.value)
+
+
+def test_hovering_a_neighbour_sphere_shows_its_weight(viewer, monkeypatch):
+    from types import SimpleNamespace
+
+    viewer.set_panel("onering")
+    drive(viewer, "vertex", 5)
+    panel = viewer.panels["onering"]
+    r = panel.state
+    hit = SimpleNamespace(is_hit=True, structure_name="one-ring neighbours", local_index=2)
+    monkeypatch.setattr(ps, "pick", lambda screen_coords: hit)
+    text = panel.hover_text(viewer, (10.0, 10.0))
+    j = r.neighbors[2]
+    w = next(t.weight_cotan for t in r.inspection.neighbors if t.index == j)
+    assert text == f"neighbour 2 = vertex {j}: w_ij = {w:.4g}"
+    assert panel.hovered_vertex == j  # its table row is lit

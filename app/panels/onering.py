@@ -344,9 +344,12 @@ class OneRingPanel(Panel):
             self.hovered_vertex = -1  # a table row is lit only while its label shows
 
     def hover_text(self, host: Host, pos: tuple[float, float]) -> str:
-        """``"vertex i: <field> = value"`` for the mesh vertex under ``pos``, else ``""``."""
+        """``"vertex i: <field> = value"`` for the mesh vertex under ``pos``; over a neighbour's
+        sphere, that neighbour's number, vertex and cotangent weight ``w_ij``; else ``""``."""
         self.hovered_vertex = -1
         res = ps.pick(screen_coords=pos)
+        if res.is_hit and res.structure_name == RING_POINTS:
+            return self.neighbour_text(int(res.local_index))
         if not res.is_hit or res.structure_name != MESH:
             return ""
         idx = picked_vertex(res, host.mesh_points(), host.state.mesh.F)
@@ -358,6 +361,19 @@ class OneRingPanel(Panel):
         if values is None:
             return f"vertex {idx}"
         return f"vertex {idx}: {curv.field_name} = {float(values[idx]):.4g}"
+
+    def neighbour_text(self, i: int) -> str:
+        """``"neighbour 2 = vertex 17: w_ij = 0.53"`` for the ``i``-th sphere of the ring (its
+        table row is lit), ``""`` for an index outside the ring."""
+        r = self.state
+        if not 0 <= i < len(r.neighbors):
+            return ""
+        j = r.neighbors[i]
+        self.hovered_vertex = j
+        ins = r.inspection
+        terms = [t for t in (ins.neighbors if ins is not None else []) if t.index == j]
+        weight = f": w_ij = {terms[0].weight_cotan:.4g}" if terms else ""
+        return f"neighbour {i} = vertex {j}{weight}"
 
     def draw(self, host: Host) -> None:
         ui = host.ui
