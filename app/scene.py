@@ -16,6 +16,9 @@ import polyscope as ps
 from meshlap_core.io import atomic_write
 
 # ---------------------------------------------------------------- structure names
+PANE_WIDTH = 500
+"""polyscope's width of the right-hand pane at UI scale 1 (``set_right_gui_pane_width``; the
+viewer narrows it so that the pane never covers more than half the window)."""
 PANEL_PX = 520
 """Width of meshlap's panel on the right (pixels at UI scale 1): framing keeps clear of it."""
 

@@ -97,6 +97,7 @@ class Viewer:
         self.busy_frame_s = BUSY_FRAME_S
         self.reframe = True  # frame the visible structures at the end of the next frame
         self.whole = False  # R: the next framing shows the whole subject (no view's focus)
+        self.wrap_default = self.ui.wrap_width  # fit_panel narrows it with the pane
         self.keep_camera = False  # an animation of a saved view: never re-frame
         self.window_size: tuple[int, int] = (0, 0)
         self.watch = Watch()
@@ -116,7 +117,21 @@ class Viewer:
         value = self.state.set_ui_scale(scale)
         ps.set_ui_scale(value)
         self.ui.scale = value
+        self.fit_panel()
         self.reframe = True
+
+    def fit_panel(self) -> None:
+        """Keep meshlap's panel within half the window: polyscope draws it
+        ``right_gui_pane_width × UI scale`` pixels wide, so at a large scale on a small window
+        the pane gets narrower (its text wraps) instead of covering the scene."""
+        w = max(int(ps.get_window_size()[0]), 1)
+        scale = max(self.state.ui_scale, 1e-3)
+        width = min(scene.PANE_WIDTH, int(0.5 * w / scale))
+        if width != ps.get_right_gui_pane_width():
+            ps.set_right_gui_pane_width(max(width, 1))
+        # text wraps inside the pane (the default 430 of 500 pixels; in a narrower pane, at
+        # its right edge)
+        self.ui.wrap_width = float(min(self.wrap_default, width - 20))
 
     def mesh_points(self) -> np.ndarray:
         d, mesh = self.state.display, self.state.mesh
@@ -255,6 +270,8 @@ class Viewer:
         """Re-frame after a change of what is shown or of the window size; draw captions."""
         size = tuple(ps.get_window_size())
         if self.reframe or size != self.window_size:
+            if size != self.window_size:
+                self.fit_panel()
             self.window_size = size
             self.reframe = False
             self.frame(whole=self.whole)
@@ -366,7 +383,8 @@ class Viewer:
         if not whole and self.active().focus(self):
             return
         w, _ = ps.get_window_size()
-        fraction = scene.scene_fraction(w, self.state.ui_scale)
+        pane = ps.get_right_gui_pane_width() * self.state.ui_scale  # at most half (fit_panel)
+        fraction = max(scene.scene_fraction(w, self.state.ui_scale), 0.95 * (1 - pane / w))
         left = scene.COLORBAR_PX * self.state.ui_scale / max(w, 1)  # clear of the colour bar
         names = self.framed_names()
         scene.frame_scene_left(names, self.structure_points, fraction, self.view_direction(), left)

@@ -454,3 +454,26 @@ def test_hovering_a_neighbour_sphere_shows_its_weight(viewer, monkeypatch):
     w = next(t.weight_cotan for t in r.inspection.neighbors if t.index == j)
     assert text == f"neighbour 2 = vertex {j}: w_ij = {w:.4g}"
     assert panel.hovered_vertex == j  # its table row is lit
+
+
+# ---------------------------------------------------------------- item 8: UI scale 1e308
+def test_ui_scale_keeps_the_panel_within_half_the_window(viewer):
+    w = ps.get_window_size()[0]
+    help_header = "Help and window (H)"
+
+    def set_scale(value) -> None:
+        viewer.ui.script(help_header, True)
+        drive(viewer, "UI scale", value)
+
+    set_scale(1.0)
+    assert ps.get_right_gui_pane_width() * 1.0 <= w / 2 + 1
+    before = (viewer.state.ui_scale, ps.get_right_gui_pane_width())
+    for refused in ("nan", "-1", "1e309"):
+        set_scale(refused)
+        assert "UI scale" in viewer.state.errors["help"]
+        assert (viewer.state.ui_scale, ps.get_right_gui_pane_width()) == before  # nothing changed
+    set_scale("1e308")  # a double, out of range: clamped to the largest scale, no error
+    assert viewer.state.ui_scale == 3.0 and "help" not in viewer.state.errors
+    assert ps.get_right_gui_pane_width() * viewer.state.ui_scale <= w / 2 + 1
+    set_scale(1.0)
+    assert ps.get_right_gui_pane_width() == 500
