@@ -477,3 +477,27 @@ def test_ui_scale_keeps_the_panel_within_half_the_window(viewer):
     assert ps.get_right_gui_pane_width() * viewer.state.ui_scale <= w / 2 + 1
     set_scale(1.0)
     assert ps.get_right_gui_pane_width() == 500
+
+
+# ---------------------------------------------------------------- item 7: frame the ring
+@pytest.mark.parametrize("scale", [1.0, 1.5])
+def test_f_frames_the_ring_clear_of_the_colour_bars_and_the_panel(viewer, scale):
+    from meshlap_app import scene
+    from meshlap_app.camera import project_to_screen
+
+    viewer.set_ui_scale(scale)
+    viewer.set_panel("onering")
+    drive(viewer, "vertex", 5)
+    ps.look_at((5.0, 2.0, 3.0), (0.0, 0.0, 0.0))
+    viewer.ui.script("key f", True)
+    frames(viewer, 2)
+    r = viewer.panels["onering"].state
+    params = ps.get_view_camera_parameters()
+    w, h = ps.get_window_size()
+    pts = viewer.state.display.points(np.vstack([r.polyline, viewer.state.mesh.V[[r.vertex]]]))
+    xy, front = project_to_screen(pts, params.get_view_mat(), params.get_fov_vertical_deg(), w, h)
+    assert front.all()  # nothing behind the camera (or cut by the near plane)
+    bars = scene.COLORBAR_PX * scale
+    pane = w - ps.get_right_gui_pane_width() * scale
+    assert (xy[:, 0] > bars).all() and (xy[:, 0] < pane).all(), (xy[:, 0], bars, pane)
+    assert (xy[:, 1] > 0).all() and (xy[:, 1] < h).all()

@@ -286,17 +286,24 @@ class OneRingPanel(Panel):
         if np.linalg.norm(np.cross([0.0, 1.0, 0.0], back)) < 1e-6 * np.linalg.norm(back):
             ps.look_at(center + size * back, center)  # frame_points needs a non-vertical view
             return True
-        w, _ = ps.get_window_size()
-        fraction = scene_fraction(w, host.state.ui_scale)
-        # as scene.frame_points does: shift the target right so the vertex lands in the middle
-        # of the part of the window left of meshlap's panel
+        w, h = ps.get_window_size()
+        ui_scale = host.state.ui_scale
+        pane = ps.get_right_gui_pane_width() * ui_scale  # at most half the window
+        fraction = max(scene_fraction(w, ui_scale), 0.95 * (1.0 - pane / max(w, 1)))
+        left = min(scene.COLORBAR_PX * ui_scale / max(w, 1), 0.5 * fraction)  # the bars' strip
         right = np.cross([0.0, 1.0, 0.0], back)
         right /= np.linalg.norm(right)
         fov = np.radians(ps.get_view_camera_parameters().get_fov_vertical_deg())
-        tan_h = np.tan(fov / 2.0) * w / max(ps.get_window_size()[1], 1)
-        d = size * float(np.linalg.norm(back))
-        target = center + (1.0 - fraction) * d * tan_h * right
-        ps.look_at(target + size * back, target)
+        tan_v = float(np.tan(fov / 2.0))
+        tan_h = tan_v * w / max(h, 1)
+        # far enough that the ring (with a margin for its labels and arrows) fits between the
+        # colour bars and meshlap's panel, and in the height
+        free = max(fraction - left, 0.1)
+        d = max(float(np.linalg.norm(back)), 1.4 / (tan_h * free), 1.4 / tan_v) * size
+        # shift the target so the vertex lands in the middle of that free strip
+        ndc = left + fraction - 1.0
+        target = center - ndc * d * tan_h * right
+        ps.look_at(target + d * back / np.linalg.norm(back), target)
         return True
 
     def ring_labels(self, host: Host) -> list[tuple[tuple[float, float], str]]:
