@@ -175,6 +175,10 @@ def legend_problems(viewer: Viewer, ledger, where: str) -> list[str]:
     range, and belongs to the active view (or to the curvature field a view keeps)."""
     active = viewer.active()
     out = []
+    for structure, qs in ledger.quantities.items():
+        for name, q in qs.items():  # polyscope draws these bars even for a hidden structure
+            if q.enabled and q.colorbar and not ledger.structure_enabled(structure):
+                out.append(f"{where}: colour bar of hidden {structure} / {name!r} on screen")
     for (structure, name), q in ledger.visible().items():
         if q.kind != "scalar":
             continue  # RGB colours carry no colour map (their meaning is in the panel's text)

@@ -94,6 +94,7 @@ class CurvaturePanel(Panel):
             curv.side_by_side,
             curv.second_field,
             colorbar,
+            host.active() is self,  # the copy (and its colour bar) only in this view
             host.state.ui_scale,
         )
         if not self.watch.changed("uploaded", *key):
@@ -106,7 +107,8 @@ class CurvaturePanel(Panel):
                 V = host.mesh_points()
                 ps.register_surface_mesh(MESH_B, V + side_offset(V), mesh.F, smooth_shade=True)
             # its own labelled colour bar, below the first one
-            self._add_field(host, ps.get_surface_mesh(MESH_B), curv.second_field, True, 1)
+            mine = host.active() is self  # polyscope draws a hidden copy's bar too
+            self._add_field(host, ps.get_surface_mesh(MESH_B), curv.second_field, mine, 1)
         elif ps.has_surface_mesh(MESH_B):
             ps.remove_surface_mesh(MESH_B)
 

@@ -18,6 +18,8 @@ from ..scene import COLORBAR_AT, EIGEN, MESH, RECON, side_offset
 from ..state.spectral import ANIMATION, PLAY_KINDS, SCREENSHOT_K, SpectralState
 from .base import ExportItem, Host, Panel
 
+ERROR_NAME = "error |x - x_k|"  # the reconstruction's per-vertex error quantity
+
 
 class SpectralPanel(Panel):
     """Eigenmode browser and k slider; the reconstruction sits beside the original."""
@@ -43,8 +45,12 @@ class SpectralPanel(Panel):
     def show(self, host: Host, active: Panel) -> None:
         if ps.has_surface_mesh(RECON):
             ps.get_surface_mesh(RECON).set_enabled(active is self)
+            if active is not self:  # a hidden copy's error colour bar would stay on screen
+                ps.get_surface_mesh(RECON).remove_quantity(ERROR_NAME)
+                self.watch.forget("k")
         if active is self and self.state.basis is not None:
             self.push_mode(host, force=True)
+            self.push_k(host, force=True)
         elif self.watch.seen("mode") is not None and ps.has_surface_mesh(MESH):
             # the eigenfunction's colour bar stays on screen while the mesh is hidden
             ps.get_surface_mesh(MESH).remove_quantity(EIGEN)
@@ -97,12 +103,12 @@ class SpectralPanel(Panel):
             ps.get_surface_mesh(RECON).update_vertex_positions(X)
         hi = float(st.errors.max[st.k]) or 1.0  # precomputed for every k
         ps.get_surface_mesh(RECON).add_scalar_quantity(
-            "error |x - x_k|",
+            ERROR_NAME,
             st.vertex_error,
             cmap="reds",
             vminmax=(0.0, hi),
             enabled=True,
-            onscreen_colorbar_enabled=True,  # below the eigenfunction's
+            onscreen_colorbar_enabled=host.active() is self,  # below the eigenfunction's
             onscreen_colorbar_location=scene.colorbar_at(1, host.state.ui_scale),
         )
 
