@@ -16,6 +16,9 @@ import polyscope as ps
 from meshlap_core.io import atomic_write
 
 # ---------------------------------------------------------------- structure names
+PANE_WIDTH = 500
+"""polyscope's width of the right-hand pane at UI scale 1 (``set_right_gui_pane_width``; the
+viewer narrows it so that the pane never covers more than half the window)."""
 PANEL_PX = 520
 """Width of meshlap's panel on the right (pixels at UI scale 1): framing keeps clear of it."""
 
@@ -67,6 +70,15 @@ SMOOTH_INPUT = "smoothing input"
 # ---------------------------------------------------------------- colours (RGBA / RGB)
 RED = (1.0, 0.35, 0.35, 1.0)
 COLORBAR_AT = (15.0, 15.0)  # polyscope's on-screen colour bar: top-left, clear of the panel
+COLORBAR_STEP_PX = 285.0  # a colour bar's height plus a gap, at UI scale 1
+
+
+def colorbar_at(slot: int, ui_scale: float = 1.0) -> tuple[float, float]:
+    """Where the ``slot``-th on-screen colour bar goes (0: :data:`COLORBAR_AT`, 1 below it,
+    ...), spaced for ``ui_scale`` so that two bars never overlap."""
+    return COLORBAR_AT[0], COLORBAR_AT[1] + slot * COLORBAR_STEP_PX * float(ui_scale)
+
+
 COLORBAR_STRIP = 0.17
 """Left fraction of an animation frame kept clear for polyscope's colour bar (``COLORBAR_AT``)."""
 COLORBAR_PX = 150.0  # width of the colour bar's box at UI scale 1: the camera frames right of it

@@ -64,3 +64,8 @@ def is_number(cell: str) -> bool:
     except ValueError:
         return False
     return True
+
+
+def plural(n: int, noun: str) -> str:
+    """``"1 step"``, ``"3 steps"``: ``n`` and ``noun``, with an ``s`` unless ``n`` is 1."""
+    return f"{n} {noun}" if n == 1 else f"{n} {noun}s"

@@ -32,6 +32,7 @@ from typing import Any
 
 import numpy as np
 
+from .field_errors import FieldErrors, read_float
 from .text_numbers import is_number
 
 RED = (1.0, 0.35, 0.35, 1.0)
@@ -141,7 +142,7 @@ def check_return(name: str, result: Any) -> Any:
     return result
 
 
-class UI:
+class UI(FieldErrors):
     """imgui/implot for the panels (see the module docstring).
 
     Parameters
@@ -160,6 +161,9 @@ class UI:
         self.section = ""
         self.changed = False  # some widget reported a change since begin_section
         self._table: tuple[int, bool] | None = None  # the open table: (columns, shown)
+        self.entered: tuple[str, str, str] | None = None  # see FieldErrors
+        self.field_errors: dict[tuple[str, str], str] = {}
+        self._field_error_shown = False
 
     # ------------------------------------------------------------------ set-up
     @property
@@ -191,6 +195,8 @@ class UI:
         starts again from ``False``."""
         self.section = name
         self.changed = False
+        self.entered = None
+        self._field_error_shown = False
 
     # ------------------------------------------------------------------ hooks
     def _record(
@@ -231,6 +237,10 @@ class UI:
 
     def _record_table(self, table_id: str, headers: list[str], tips: list[str]) -> None:
         """Hook called when :meth:`table` starts a table, before imgui's ``BeginTable``."""
+
+    def _record_plot(self, label: str, kind: str, x: Any, y: Any) -> None:
+        """Hook called after a plot item was drawn: ``kind`` is ``line`` (``x``, ``y``),
+        ``vlines`` (``x``) or ``hlines`` (``y``)."""
 
     def _record_row(self, cells: list[str], rgba: RGBA | None, highlight: bool) -> None:
         """Hook called for each row of the open table (also when imgui does not draw it)."""
@@ -384,32 +394,61 @@ class UI:
     def input_float(
         self, label: str, value: float, fmt: str = "%.4g", tooltip: str = ""
     ) -> tuple[bool, float]:
-        """A typed float, applied on Enter only: ``(entered, value)``."""
-        flags = self.im.ImGuiInputTextFlags_EnterReturnsTrue
-        changed, new = check_return(
-            "InputFloat", self.im.InputFloat(label, float(value), 0.0, 0.0, fmt, flags)
-        )
-        v = self._widget(label, "input", tooltip, float(value))
+        """A typed float, applied on Enter only: ``(entered, value)``.
+
+        The field is text read as a double (imgui's ``InputFloat`` holds a float32, so 1e308
+        would arrive as inf); the typed text is kept (:attr:`entered`) for an error to quote,
+        and a refused value's error is drawn under the field (:meth:`field_failed`).
+
+        Raises
+        ------
+        ValueError
+            The text is empty or not a number (naming the field and quoting the text).
+        """
+        im = self.im
+        flags = im.ImGuiInputTextFlags_EnterReturnsTrue | im.ImGuiInputTextFlags_CharsScientific
+        shown = fmt % float(value)
+        entered, text = check_return("InputText", im.InputText(label, shown, flags))
+        try:
+            v = self._widget(label, "input", tooltip, shown)
+        finally:
+            self._draw_field_error(label)
         if v is not None:
-            changed, new = True, v
-        return self._changed(changed), new
+            entered, text = True, str(v)
+        if not entered:
+            return self._changed(False), float(value)
+        self._entered(label, text)
+        return self._changed(True), read_float(text, label)
 
     def input_int(self, label: str, value: int, tooltip: str = "") -> tuple[bool, int]:
-        """A typed integer with -/+ buttons, applied on Enter or a button: ``(changed, value)``."""
+        """A typed integer with -/+ buttons, applied on Enter or a button: ``(changed, value)``
+        (a refused value's error is drawn under the field)."""
         flags = self.im.ImGuiInputTextFlags_EnterReturnsTrue
         changed, new = check_return("InputInt", self.im.InputInt(label, int(value), 1, 100, flags))
-        v = self._widget(label, "input", tooltip, int(value))
+        try:
+            v = self._widget(label, "input", tooltip, int(value))
+        except ValueError:  # typed text that is not a whole number (the tests' adapter)
+            self._entered(label, "")
+            raise
+        finally:
+            self._draw_field_error(label)
         if v is not None:
             changed, new = True, v
+        if changed:
+            self._entered(label, str(new))
         return self._changed(changed), new
 
     def input_text(self, label: str, text: str, tooltip: str = "") -> tuple[bool, str]:
-        """A text field: ``(Enter pressed, current text)`` (the text is kept while typing)."""
+        """A text field: ``(Enter pressed, current text)`` (the text is kept while typing; a
+        refused value's error is drawn under the field)."""
         flags = self.im.ImGuiInputTextFlags_EnterReturnsTrue
         entered, new = check_return("InputText", self.im.InputText(label, text, flags))
         v = self._widget(label, "input", tooltip, str(text))
+        self._draw_field_error(label)
         if v is not None:
             entered, new = True, v
+        if entered:
+            self._entered(label, new)
         return self._changed(entered), new
 
     # ------------------------------------------------------------------ plots
@@ -422,14 +461,20 @@ class UI:
         y_label: str,
         y_log: bool = False,
         fit_y: bool = True,
+        legend_outside: bool = False,
     ) -> Iterator[bool]:
         """``with ui.plot(...) as shown:`` an ImPlot with labelled axes, refitted to the data
-        every frame (``fit_y=False``: the caller sets the y limits); EndPlot always runs."""
+        every frame (``fit_y=False``: the caller sets the y limits; ``legend_outside``: the
+        legend in a row above the plot, never over the curves); EndPlot always runs."""
         shown = check_return("BeginPlot", self.ip.BeginPlot(title, (-1, height * self.scale)))
         try:
             if shown:
                 fit = self.ip.ImPlotAxisFlags_AutoFit
                 self.ip.SetupAxes(x_label, y_label, fit, fit if fit_y else 0)
+                if legend_outside:
+                    ip = self.ip
+                    flags = ip.ImPlotLegendFlags_Outside | ip.ImPlotLegendFlags_Horizontal
+                    ip.SetupLegend(ip.ImPlotLocation_North, flags)
                 if y_log:
                     self.ip.SetupAxisScale(self.ip.ImAxis_Y1, self.ip.ImPlotScale_Log10)
             yield shown
@@ -442,6 +487,7 @@ class UI:
 
     def plot_line(self, label: str, x: Any, y: Any) -> None:
         self.ip.PlotLine(label, _f64(x), _f64(y))
+        self._record_plot(label, "line", x, y)
 
     def plot_bars(
         self, label: str, x: Any, y: Any, width: float, colors: Any | None = None
@@ -457,9 +503,11 @@ class UI:
 
     def plot_vlines(self, label: str, x: Any) -> None:
         self.ip.PlotInfLines(label, _f64(x))
+        self._record_plot(label, "vlines", x, None)
 
     def plot_hlines(self, label: str, y: Any) -> None:
         self.ip.PlotInfLines(label, _f64(y), self.ip.ImPlotInfLinesFlags_Horizontal)
+        self._record_plot(label, "hlines", None, y)
 
     # ------------------------------------------------------------------ tables
     @contextmanager

@@ -105,6 +105,8 @@ class Viewer:
         self.pacer = Pacer()
         self._activity: tuple[Any, ...] = ()
         self.reframe = True  # frame the visible structures at the end of the next frame
+        self.whole = False  # R: the next framing shows the whole subject (no view's focus)
+        self.wrap_default = self.ui.wrap_width  # fit_panel narrows it with the pane
         self.keep_camera = False  # an animation of a saved view: never re-frame
         self.window_size: tuple[int, int] = (0, 0)
         self.watch = Watch()
@@ -124,7 +126,21 @@ class Viewer:
         value = self.state.set_ui_scale(scale)
         ps.set_ui_scale(value)
         self.ui.scale = value
+        self.fit_panel()
         self.reframe = True
+
+    def fit_panel(self) -> None:
+        """Keep meshlap's panel within half the window: polyscope draws it
+        ``right_gui_pane_width × UI scale`` pixels wide, so at a large scale on a small window
+        the pane gets narrower (its text wraps) instead of covering the scene."""
+        w = max(int(ps.get_window_size()[0]), 1)
+        scale = max(self.state.ui_scale, 1e-3)
+        width = min(scene.PANE_WIDTH, int(0.5 * w / scale))
+        if width != ps.get_right_gui_pane_width():
+            ps.set_right_gui_pane_width(max(width, 1))
+        # text wraps inside the pane (the default 430 of 500 pixels; in a narrower pane, at
+        # its right edge)
+        self.ui.wrap_width = float(min(self.wrap_default, width - 20))
 
     def mesh_points(self) -> np.ndarray:
         d, mesh = self.state.display, self.state.mesh
@@ -142,6 +158,8 @@ class Viewer:
         show the active view."""
         mesh = self.state.mesh
         if self.watch.changed("mesh", mesh.version, id(mesh)):
+            for view in VIEWS:  # a refused value of the last mesh's context
+                self.forget_errors(view)
             scene.remove_structure(MESH)
             self.state.display.fit(mesh.V)
             ps.register_surface_mesh(MESH, self.mesh_points(), mesh.F, smooth_shade=True)
@@ -150,6 +168,11 @@ class Viewer:
         for p in self.panels.values():
             p.sync(self)
         self.refresh()
+
+    def forget_errors(self, section: str) -> None:
+        """Drop the refused-value errors of ``section`` (its context changed)."""
+        self.state.errors.pop(section, None)
+        self.ui.clear_field_errors(section)
 
     def refresh(self) -> None:
         """Show the structures of the active view and hide the others."""
@@ -160,8 +183,12 @@ class Viewer:
             p.show(self, active)
 
     def set_panel(self, name: str) -> None:
-        """Switch to the view ``name``, show its structures and frame them."""
-        self.state.panel = self.state.check_panel(name)
+        """Switch to the view ``name``, show its structures and frame them (the errors of the
+        view left behind go: they belonged to that context)."""
+        name = self.state.check_panel(name)
+        if name != self.state.panel:
+            self.forget_errors(self.state.panel)
+        self.state.panel = name
         self.refresh()
         self.reframe = True
 
@@ -195,8 +222,9 @@ class Viewer:
             if pressed:
                 self.pacer.touch()  # a key: full rate (the idle rate would lag the answer)
             if pressed and not any(p.on_key(self, key) for p in panels):
-                if key in ("f", "r"):  # nobody used it: frame (R: the camera's reset)
+                if key in ("f", "r"):  # nobody used it: F frames, R resets to the whole subject
                     self.reframe = True
+                    self.whole = key == "r"
 
     def files_dropped(self, paths: list[str]) -> None:
         """polyscope's drag-and-drop callback: open the first file dropped on the window (a
@@ -296,9 +324,12 @@ class Viewer:
         """Re-frame after a change of what is shown or of the window size; draw captions."""
         size = tuple(ps.get_window_size())
         if self.reframe or size != self.window_size:
+            if size != self.window_size:
+                self.fit_panel()
             self.window_size = size
             self.reframe = False
-            self.frame()
+            self.frame(whole=self.whole)
+            self.whole = False
         self.draw_captions()
 
     def keep_view(self) -> None:
@@ -335,14 +366,15 @@ class Viewer:
         try:
             draw(self)
         except ValueError as exc:  # MeshError is a ValueError: bad input, said in its message
-            errors[section] = str(exc)
+            errors[section] = ui.field_failed(str(exc))  # under its field, if one was typed
         except Exception as exc:  # a bug or an API change: keep the session, say what failed
             errors[section] = self._internal_error(section, exc)
         else:
             if ui.changed:
                 errors.pop(section, None)
+                ui.clear_field_errors(section)
         message = errors.get(section)
-        if message and show:
+        if message and show and not ui.field_error_shown():
             ui.error(message)
         ui.section, ui.changed = outer[0], outer[1] or ui.changed
 
@@ -416,21 +448,23 @@ class Viewer:
         own = getattr(self.active(), "view_direction", None)
         return own or scene.FRONT_VIEWS.get(self.state.mesh.name, scene.DEFAULT_VIEW)
 
-    def frame(self, strip: float | None = None) -> None:
+    def frame(self, strip: float | None = None, whole: bool = False) -> None:
         """Frame what the active view shows in the part of the window left of meshlap's panel
-        (a view may frame its own way: the one-ring its selected vertex). ``strip``: an
-        animation frame (no panel), keeping that left fraction of the width clear for the
-        colour bar; nothing happens when the animation keeps a saved camera."""
+        (a view may frame its own way: the one-ring its selected vertex; ``whole``: not that
+        way, the whole subject, as R does). ``strip``: an animation frame (no panel), keeping
+        that left fraction of the width clear for the colour bar; nothing happens when the
+        animation keeps a saved camera."""
         if strip is not None:
             if not self.keep_camera:
                 scene.frame_scene_left(
                     self.framed_names(), self.structure_points, 0.95, self.view_direction(), strip
                 )
             return
-        if self.active().focus(self):
+        if not whole and self.active().focus(self):
             return
         w, _ = ps.get_window_size()
-        fraction = scene.scene_fraction(w, self.state.ui_scale)
+        pane = ps.get_right_gui_pane_width() * self.state.ui_scale  # at most half (fit_panel)
+        fraction = max(scene.scene_fraction(w, self.state.ui_scale), 0.95 * (1 - pane / w))
         left = scene.COLORBAR_PX * self.state.ui_scale / max(w, 1)  # clear of the colour bar
         names = self.framed_names()
         scene.frame_scene_left(names, self.structure_points, fraction, self.view_direction(), left)
@@ -501,7 +535,7 @@ def run(
     screenshot: str | Path | None = None,
     panel: str | None = None,
     backend: str | None = None,
-    ui_scale: float = 1.0,
+    ui_scale: float | None = None,
     session: str | Path | None = None,
     **options: Any,
 ) -> int:
@@ -509,7 +543,9 @@ def run(
 
     With ``screenshot`` a single frame is rendered headless (EGL) into that PNG and the
     function returns. With ``session`` (a saved session file) its mesh, settings and camera
-    replace ``path``, ``panel``, ``options`` and ``ui_scale``. ``options`` are the panels'
+    replace ``path``, ``panel`` and ``options``; a ``ui_scale`` given wins over the session's
+    (the room's projector, not the saved view; ``None``: the session's, else 1). ``options``
+    are the panels'
     start options (``field``, ``vertex``, ``k``: ``None`` when not given), each checked by its
     panel's state module before the window opens.
     """
@@ -531,14 +567,14 @@ def run(
     if saved is not None:
         check_session_mesh(saved, state.mesh, session)
     check_options(options, state)
-    if not 0.5 <= ui_scale <= 3.0:  # also refuses NaN
+    if ui_scale is not None and not 0.5 <= ui_scale <= 3.0:  # also refuses NaN
         raise MeshError(f"must be between 0.5 and 3, got {ui_scale}", "--ui-scale")
     title = later.name if later is not None else state.mesh.name
     ps.set_program_name(f"meshlap — {title}")  # the window title (set before init)
     init_polyscope(backend or ("openGL3_egl" if shot else "auto"))
     viewer = Viewer(state)
     ps.set_build_default_gui_panels(False)  # polyscope's own panels: a toggle in Help
-    if ui_scale != 1.0:
+    if ui_scale is not None and ui_scale != 1.0:
         viewer.set_ui_scale(ui_scale)
     viewer.sync_mesh()
     if shot is not None:
@@ -547,6 +583,8 @@ def run(
         from .session import apply
 
         apply(viewer, saved, session, mesh=state.mesh)
+        if ui_scale is not None:  # typed with --session: wins over the saved scale
+            viewer.set_ui_scale(ui_scale)
     else:
         for name, p in viewer.panels.items():
             p.start(viewer, options, name == state.panel, shot is not None)

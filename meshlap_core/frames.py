@@ -25,7 +25,10 @@ from .io.atomic import os_cause, unwritable_cause
 from .progress import Progress, bar
 
 SUFFIXES = (".gif", ".mp4")
-VIDEO_EXTRA = "pip install 'meshlap[video]'"
+VIDEO_EXTRA = (
+    "pip install -e '.[video]' in the meshlap checkout, as the README says (from a package "
+    "index: pip install 'meshlap[video]')"
+)
 
 
 def parse_range(text: str, name: str, lo: int = 1, hi: int | None = None) -> tuple[int, int]:

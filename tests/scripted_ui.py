@@ -106,6 +106,11 @@ class ScriptedUI(UI):
         self._script: dict[str, deque[Any]] = {}
         self._drawing: TableRecord | None = None  # the table being drawn
         self.progress_lines: list[tuple[str, float, str]] = []  # (section, fraction, text)
+        # (section, label) -> (kind, x, y) of the last plot item drawn
+        self.plots: dict[tuple[str, str], tuple[str, Any, Any]] = {}
+        # every error line drawn: (section, text, label of the widget drawn just before it)
+        self.errors_drawn: list[tuple[str, str, str]] = []
+        self._last_label = ""
 
     # ------------------------------------------------------------------ the script
     def script(self, label: str, *values: Any) -> None:
@@ -128,6 +133,7 @@ class ScriptedUI(UI):
         """Record the widget (headers are layout, not recorded) and hand out its next scripted
         value, read as the widget reads it (the type of ``current``; one of ``choices``)."""
         key = (SECTION_OF_KIND.get(kind, self.section), label)
+        self._last_label = label
         if kind != "header":
             self.seen[key] = kind
             if tooltip:
@@ -148,6 +154,13 @@ class ScriptedUI(UI):
         record.avail = float(self.im.GetContentRegionAvail()[0])
         self.tables[(self.section, table_id)] = record
         self._drawing = record
+
+    def error(self, text: str) -> None:
+        super().error(text)
+        self.errors_drawn.append((self.section, text, self._last_label))
+
+    def _record_plot(self, label: str, kind: str, x: Any, y: Any) -> None:
+        self.plots[(self.section, label)] = (kind, x, y)
 
     def _record_row(self, cells: list[str], rgba: RGBA | None, highlight: bool) -> None:
         record = self._drawing

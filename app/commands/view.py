@@ -41,7 +41,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--ui-scale",
         type=float,
-        help="size of the panel's text and widgets, 0.5 to 3 (projectors: 1.5-2)",
+        help="size of the panel's text and widgets, 0.5 to 3 (projectors: 1.5-2); with "
+        "--session it replaces the session's scale",
     )
     p.set_defaults(func=run)
 
@@ -50,7 +51,7 @@ def run(args: argparse.Namespace) -> int:
     if args.session is not None:
         given = [("MESH", args.mesh)] + [
             (f"--{name.replace('_', '-')}", getattr(args, name))
-            for name in (*START_OPTIONS, "panel", "ui_scale")
+            for name in (*START_OPTIONS, "panel")  # --ui-scale: the projector's, wins
         ]
         given = [flag for flag, value in given if value is not None]
         if given:
@@ -76,7 +77,7 @@ def run(args: argparse.Namespace) -> int:
         args.mesh,
         screenshot=args.screenshot,
         panel=args.panel,
-        ui_scale=1.0 if args.ui_scale is None else args.ui_scale,
+        ui_scale=args.ui_scale,
         session=args.session,
         **{name: getattr(args, name) for name in START_OPTIONS},
     )

@@ -28,8 +28,8 @@ the scalars) when V is given, else the scalars alone (CSV)."""
 
 
 HOST_SHORTCUTS: tuple[tuple[str, str], ...] = (
-    ("F", "frame what the view shows"),
-    ("R", "reset the camera (a view may use R for its own reset)"),
+    ("F", "frame what the view shows (the one-ring: the selected vertex's ring)"),
+    ("R", "reset the camera to the whole subject (a view may use R for its own reset)"),
     ("mouse", "left-drag rotate, right-drag pan, wheel zoom; click a vertex for its one-ring"),
     ("drop", "drop a mesh file (or a session .json) on the window to open it"),
 )

@@ -10,7 +10,7 @@ import polyscope as ps
 from meshlap_core.options import AREA_KINDS as AREAS
 from meshlap_core.options import BOUNDARY_RULES, CURVATURE_FIELD_LABELS
 
-from ..scene import COLORBAR_AT, MESH, MESH_B, scalar_for_upload, side_offset
+from ..scene import MESH, MESH_B, colorbar_at, scalar_for_upload, side_offset
 from .base import Host, Panel
 
 FIELD_HELP = (
@@ -96,15 +96,21 @@ class CurvaturePanel(Panel):
             curv.side_by_side,
             curv.second_field,
             colorbar,
+            host.active() is self,  # the copy (and its colour bar) only in this view
+            host.state.ui_scale,
         )
         if not self.watch.changed("uploaded", *key):
             return
+        # shown only with its colour bar: a view that does not show the curvature (the
+        # spectral view before its eigenbasis) sees the plain mesh, not colours with no legend
         self._add_field(host, ps.get_surface_mesh(MESH), curv.field_name, colorbar)
         if curv.side_by_side:
             if not ps.has_surface_mesh(MESH_B):
                 V = host.mesh_points()
                 ps.register_surface_mesh(MESH_B, V + side_offset(V), mesh.F, smooth_shade=True)
-            self._add_field(host, ps.get_surface_mesh(MESH_B), curv.second_field)
+            # its own labelled colour bar, below the first one
+            mine = host.active() is self  # polyscope draws a hidden copy's bar too
+            self._add_field(host, ps.get_surface_mesh(MESH_B), curv.second_field, mine, 1)
         elif ps.has_surface_mesh(MESH_B):
             ps.remove_surface_mesh(MESH_B)
 
@@ -145,7 +151,9 @@ class CurvaturePanel(Panel):
         return False
 
     @staticmethod
-    def _add_field(host: Host, sm: Any, name: str, colorbar: bool = False) -> None:
+    def _add_field(host: Host, sm: Any, name: str, colorbar: bool = False, slot: int = 0) -> None:
+        """Upload the field ``name`` on ``sm``: enabled with its colour bar (at ``slot``,
+        :func:`.scene.colorbar_at`) when ``colorbar``, else uploaded but hidden."""
         curv = host.state.curv
         label, signed = CURVATURE_FIELD_LABELS[name]
         label += " [1/length^2]" if name == "gaussian" else " [1/length]"
@@ -156,9 +164,9 @@ class CurvaturePanel(Panel):
             defined_on="vertices",
             cmap="coolwarm" if signed else "viridis",
             vminmax=(lo, hi),
-            enabled=True,
+            enabled=colorbar,
             onscreen_colorbar_enabled=colorbar,
-            onscreen_colorbar_location=COLORBAR_AT,
+            onscreen_colorbar_location=colorbar_at(slot, host.state.ui_scale),
         )
 
     def draw(self, host: Host) -> None:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import time
 from pathlib import Path
+from typing import Any
 
 from ..state.mesh import list_meshes
 from .base import Host, Panel
@@ -27,17 +28,30 @@ class MeshPanel(Panel):
         if opened_before and host.state.mesh.path is not None:
             self.remember(host.state.mesh.path)
 
+    def open_path(self, host: Host, path: Path) -> None:
+        """Open the mesh or the saved session (``.json``, as when dropped on the window) that
+        the path field names; the field is emptied once it opened (a refused file raises
+        :class:`MeshError` or sets the mesh's error, and the field keeps the text)."""
+        if path.suffix.lower() == ".json":
+            _load_session(host, path)
+            self.path_text = ""
+        elif host.open(path):
+            self.path_text = ""
+
     def draw(self, host: Host) -> None:
         ui = host.ui
         if not ui.header(self.title):
             return
         mesh = host.state.mesh
         info = mesh.info
+        genus = info.get("genus")
         ui.text(
             f"{mesh.name}: {info.get('n_vertices', 0)} vertices, "
             f"{info.get('n_faces', 0)} faces, chi = {info.get('euler_characteristic')}, "
-            f"genus = {info.get('genus')}"
+            + (f"genus = {genus}" if genus is not None else "genus undefined (see below)")
         )
+        if genus is None:
+            ui.note(genus_reason(info))
         ui.text(
             f"boundary loops {info.get('n_boundary_loops')}, components "
             f"{info.get('n_components')}, manifold {'yes' if info.get('manifold') else 'no'}"
@@ -45,13 +59,15 @@ class MeshPanel(Panel):
         for r in info.get("repairs", []):
             ui.text(f"repaired: {r}")
         entered, self.path_text = ui.input_text(
-            "path", self.path_text, "a mesh file (.obj .off .ply .stl); Enter or Open loads it"
+            "path",
+            self.path_text,
+            "a mesh file (.obj .off .ply .stl) or a saved session (.json); Enter or Open loads it",
         )
         ui.same_line()
         if (ui.button("Open", "load the file named in the path field") or entered) and (
             self.path_text.strip()
         ):
-            host.open(Path(self.path_text.strip()).expanduser())
+            self.open_path(host, Path(self.path_text.strip()).expanduser())
         now = time.monotonic()
         if now - self._listed[0] > 2.0:  # the folders are listed at most every 2 s, not per frame
             self._listed = (now, list_meshes())
@@ -77,3 +93,24 @@ class MeshPanel(Panel):
 
 
 PANEL = MeshPanel
+
+
+def _load_session(host: Host, path: Path) -> None:
+    from ..session import load
+
+    load(host, path)
+
+
+def genus_reason(info: dict[str, Any]) -> str:
+    """Why a mesh has no genus: the core's note (``2c − χ − b`` negative: not a manifold; the
+    boundary not a set of loops), the manifold flag and the number of components."""
+    why = [str(info.get("genus_note") or "genus undefined")]
+    if not info.get("manifold"):
+        why.append(
+            "the mesh is not a manifold (an edge with more than two faces, or a vertex "
+            "whose faces do not form one fan)"
+        )
+    n = info.get("n_components") or 1
+    if n > 1:
+        why.append(f"{n} components: the genus is a property of one connected surface")
+    return "; ".join(why)

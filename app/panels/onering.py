@@ -30,7 +30,6 @@ from ..text_numbers import sig
 from .base import Host, Panel
 
 NEGATIVE_RGBA = (*scene.NEGATIVE_COLOR, 1.0)
-WEIGHTS_COLORBAR_AT = (15.0, 300.0)  # below the mesh field's colour bar (scene.COLORBAR_AT)
 
 # glyphs the viewer's font lacks, written out (the CLI prints the originals)
 ASCII_MATH = str.maketrans(
@@ -167,7 +166,12 @@ class OneRingPanel(Panel):
         cn.set_color((0.1, 0.1, 0.1))
         pc = ps.register_point_cloud(RING_POINTS, ring, radius=1.5 * scale)
         pc.set_radius(1.5 * scale, relative=False)
-        pc.add_scalar_quantity("order", r.order_t, cmap="viridis", enabled=True, vminmax=(0, 1))
+        # the order as RGB colours (viridis, first to last): their legend is the numbers the
+        # overlay draws on the neighbours, not a third colour bar over the ring
+        from matplotlib import colormaps
+
+        order_rgb = colormaps["viridis"](np.clip(np.asarray(r.order_t, dtype=float), 0, 1))[:, :3]
+        pc.add_color_quantity("order (numbered)", order_rgb, enabled=True)
         pc.add_vector_quantity(
             "direction",
             0.85 * d.vectors(r.arrows),
@@ -227,7 +231,8 @@ class OneRingPanel(Panel):
             vminmax=(-m, m),
             enabled=True,
             onscreen_colorbar_enabled=True,
-            onscreen_colorbar_location=WEIGHTS_COLORBAR_AT,
+            # below the mesh field's colour bar, spaced for the UI scale (no overlap at 1.5)
+            onscreen_colorbar_location=scene.colorbar_at(1, host.state.ui_scale),
         )
         neg = w < 0
         if neg.any():
@@ -281,17 +286,24 @@ class OneRingPanel(Panel):
         if np.linalg.norm(np.cross([0.0, 1.0, 0.0], back)) < 1e-6 * np.linalg.norm(back):
             ps.look_at(center + size * back, center)  # frame_points needs a non-vertical view
             return True
-        w, _ = ps.get_window_size()
-        fraction = scene_fraction(w, host.state.ui_scale)
-        # as scene.frame_points does: shift the target right so the vertex lands in the middle
-        # of the part of the window left of meshlap's panel
+        w, h = ps.get_window_size()
+        ui_scale = host.state.ui_scale
+        pane = ps.get_right_gui_pane_width() * ui_scale  # at most half the window
+        fraction = max(scene_fraction(w, ui_scale), 0.95 * (1.0 - pane / max(w, 1)))
+        left = min(scene.COLORBAR_PX * ui_scale / max(w, 1), 0.5 * fraction)  # the bars' strip
         right = np.cross([0.0, 1.0, 0.0], back)
         right /= np.linalg.norm(right)
         fov = np.radians(ps.get_view_camera_parameters().get_fov_vertical_deg())
-        tan_h = np.tan(fov / 2.0) * w / max(ps.get_window_size()[1], 1)
-        d = size * float(np.linalg.norm(back))
-        target = center + (1.0 - fraction) * d * tan_h * right
-        ps.look_at(target + size * back, target)
+        tan_v = float(np.tan(fov / 2.0))
+        tan_h = tan_v * w / max(h, 1)
+        # far enough that the ring (with a margin for its labels and arrows) fits between the
+        # colour bars and meshlap's panel, and in the height
+        free = max(fraction - left, 0.1)
+        d = max(float(np.linalg.norm(back)), 1.4 / (tan_h * free), 1.4 / tan_v) * size
+        # shift the target so the vertex lands in the middle of that free strip
+        ndc = left + fraction - 1.0
+        target = center - ndc * d * tan_h * right
+        ps.look_at(target + d * back / np.linalg.norm(back), target)
         return True
 
     def ring_labels(self, host: Host) -> list[tuple[tuple[float, float], str]]:
@@ -339,9 +351,12 @@ class OneRingPanel(Panel):
             self.hovered_vertex = -1  # a table row is lit only while its label shows
 
     def hover_text(self, host: Host, pos: tuple[float, float]) -> str:
-        """``"vertex i: <field> = value"`` for the mesh vertex under ``pos``, else ``""``."""
+        """``"vertex i: <field> = value"`` for the mesh vertex under ``pos``; over a neighbour's
+        sphere, that neighbour's number, vertex and cotangent weight ``w_ij``; else ``""``."""
         self.hovered_vertex = -1
         res = ps.pick(screen_coords=pos)
+        if res.is_hit and res.structure_name == RING_POINTS:
+            return self.neighbour_text(int(res.local_index))
         if not res.is_hit or res.structure_name != MESH:
             return ""
         idx = picked_vertex(res, host.mesh_points(), host.state.mesh.F)
@@ -353,6 +368,19 @@ class OneRingPanel(Panel):
         if values is None:
             return f"vertex {idx}"
         return f"vertex {idx}: {curv.field_name} = {float(values[idx]):.4g}"
+
+    def neighbour_text(self, i: int) -> str:
+        """``"neighbour 2 = vertex 17: w_ij = 0.53"`` for the ``i``-th sphere of the ring (its
+        table row is lit), ``""`` for an index outside the ring."""
+        r = self.state
+        if not 0 <= i < len(r.neighbors):
+            return ""
+        j = r.neighbors[i]
+        self.hovered_vertex = j
+        ins = r.inspection
+        terms = [t for t in (ins.neighbors if ins is not None else []) if t.index == j]
+        weight = f": w_ij = {terms[0].weight_cotan:.4g}" if terms else ""
+        return f"neighbour {i} = vertex {j}{weight}"
 
     def draw(self, host: Host) -> None:
         ui = host.ui

@@ -22,6 +22,7 @@ from ..state.smoothing import (
     encode_lam_steps,
     replay_steps,
 )
+from ..text_numbers import plural
 from ..ui import UI
 from .base import ExportItem, Host, Panel
 
@@ -138,7 +139,7 @@ class SmoothingPanel(Panel):
         noisy = f"noisy alpha = {sm.noise_alpha:g}" if sm.noise_alpha else "no noise"
         return {
             SMOOTH_INPUT: f"input, {noisy}",
-            SMOOTHED: f"{sm.method}, lambda = {sm.lam:g}, {sm.smoother.iteration} steps",
+            SMOOTHED: f"{sm.method}, lambda = {sm.lam:g}, {plural(sm.smoother.iteration, 'step')}",
         }
 
     def export_items(self, host: Host) -> list[ExportItem]:
@@ -152,7 +153,7 @@ class SmoothingPanel(Panel):
     def on_key(self, host: Host, key: str) -> bool:
         st = self.state
         if key == "space":
-            st.playing = not st.playing
+            st.toggle_play()
         elif key == "right":
             st.step()
         elif key == "r":
@@ -265,14 +266,18 @@ class SmoothingPanel(Panel):
         if ui.button("step", "one iteration"):
             st.step()
         ui.same_line()
-        if ui.button("pause" if st.playing else "play", "step every frame (space)"):
-            st.playing = not st.playing
+        if ui.button(
+            "pause" if st.playing else "play",
+            "step every frame (space); beyond the stable lambda, play stops at the first step "
+            "that grows",
+        ):
+            st.toggle_play()
         ui.same_line()
         if ui.button("reset", "back to the (noisy) input, iteration 0"):
             st.reset()
             self.push(host, force=True)
         if st.playing:
-            st.step()
+            st.play_step()
         self.push(host)
         if st.error:
             ui.error(st.error)

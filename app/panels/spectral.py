@@ -18,6 +18,8 @@ from ..scene import COLORBAR_AT, EIGEN, MESH, RECON, side_offset
 from ..state.spectral import ANIMATION, PLAY_KINDS, SCREENSHOT_K, SpectralState
 from .base import ExportItem, Host, Panel
 
+ERROR_NAME = "error |x - x_k|"  # the reconstruction's per-vertex error quantity
+
 
 class SpectralPanel(Panel):
     """Eigenmode browser and k slider; the reconstruction sits beside the original."""
@@ -50,8 +52,12 @@ class SpectralPanel(Panel):
     def show(self, host: Host, active: Panel) -> None:
         if ps.has_surface_mesh(RECON):
             ps.get_surface_mesh(RECON).set_enabled(active is self)
+            if active is not self:  # a hidden copy's error colour bar would stay on screen
+                ps.get_surface_mesh(RECON).remove_quantity(ERROR_NAME)
+                self.watch.forget("k")
         if active is self and self.state.basis is not None:
             self.push_mode(host, force=True)
+            self.push_k(host, force=True)
         elif self.watch.seen("mode") is not None and ps.has_surface_mesh(MESH):
             # the eigenfunction's colour bar stays on screen while the mesh is hidden
             ps.get_surface_mesh(MESH).remove_quantity(EIGEN)
@@ -95,13 +101,22 @@ class SpectralPanel(Panel):
             return
         X = host.state.display.points(st.reconstruction) + self._offset(host)
         if not ps.has_surface_mesh(RECON):
-            ps.register_surface_mesh(RECON, X, host.state.mesh.F, smooth_shade=True)
+            sm = ps.register_surface_mesh(RECON, X, host.state.mesh.F, smooth_shade=True)
+            # polyscope remembers a structure's enabled flag by name: a copy removed while
+            # hidden (a new mesh opened in another view) would come back hidden
+            sm.set_enabled(host.active() is self)
             host.request_frame()  # a new copy beside the mesh
         else:
             ps.get_surface_mesh(RECON).update_vertex_positions(X)
         hi = float(st.errors.max[st.k]) or 1.0  # precomputed for every k
         ps.get_surface_mesh(RECON).add_scalar_quantity(
-            "error |x - x_k|", st.vertex_error, cmap="reds", vminmax=(0.0, hi), enabled=True
+            ERROR_NAME,
+            st.vertex_error,
+            cmap="reds",
+            vminmax=(0.0, hi),
+            enabled=True,
+            onscreen_colorbar_enabled=host.active() is self,  # below the eigenfunction's
+            onscreen_colorbar_location=scene.colorbar_at(1, host.state.ui_scale),
         )
 
     def points(self, host: Host, name: str) -> np.ndarray | None:
@@ -312,7 +327,7 @@ class SpectralPanel(Panel):
 
     def frames(self, host: Host, options: dict[str, Any]) -> Iterator[str]:
         """The k sweep (``options["k"] = (A, B)``: the reconstruction from the first k modes
-        beside the mesh, coloured by the error |x - x_k| on each k's own scale) or the
+        beside the mesh, coloured by the error |x - x_k| on one scale for the sweep) or the
         eigenmodes (``options["modes"]``: u_A..u_B as colour maps on the mesh)."""
         if options.get("modes") is not None:
             yield from self._mode_frames(host, options["modes"])
@@ -328,6 +343,9 @@ class SpectralPanel(Panel):
         self.push_k(host, force=True)
         host.frame(scene.COLORBAR_STRIP)
         e = st.errors
+        # one colour range for the whole sweep (the largest error of any of its k), so the
+        # colours of two frames compare
+        hi = float(max(e.max[k] for k in range(a, b + 1))) or 1.0
         for k in range(a, b + 1):
             st.set_k(k)
             self.push_k(host)
@@ -335,7 +353,7 @@ class SpectralPanel(Panel):
                 "error |x - x_k|",
                 st.vertex_error,
                 cmap="reds",
-                vminmax=(0.0, float(e.max[k]) or 1.0),  # as the viewer: this k's largest error
+                vminmax=(0.0, hi),
                 enabled=True,
                 onscreen_colorbar_enabled=True,
                 onscreen_colorbar_location=COLORBAR_AT,

@@ -192,18 +192,36 @@ class SurfacesPanel(Panel):
         ui.text(f"II: e = {sig(p.e, s2)}  f = {sig(p.f, s2)}  g = {sig(p.g, s2)}")
         ui.text(f"K = {sig(p.K, sk * sk)}  H = {sig(p.H, sk)}  ({p.classification})")
         ui.text(
-            f"k1 = {sig(p.k1, sk)} at {np.degrees(p.theta_max):.1f} deg,  "
-            f"k2 = {sig(p.k2, sk)} at {np.degrees(p.theta_min):.1f} deg"
+            f"k1 = {sig(p.k1, sk)} at parameter angle {np.degrees(p.theta_max):.1f} deg,  "
+            f"k2 = {sig(p.k2, sk)} at {np.degrees(p.theta_min):.1f} deg (in the (u, v) plane; "
+            "90 deg apart in the tangent plane)"
         )
         ui.text("signs: e = p_uu . n with n = p_u x p_v (do Carmo)")
         self.draw_section(host)
-        with ui.plot("normal curvature k_n(theta)", 180, "theta (deg)", "k_n") as shown:
-            if shown:
-                ui.plot_line("k_n", np.degrees(s.theta), s.kn)
-                ui.plot_vlines("theta max/min", np.degrees([p.theta_max, p.theta_min]))
-                ui.plot_vlines("section theta", np.array([s.section_deg]))
+        self.draw_euler_plot(host)
         key = (s.version, s.u, s.v, s.section_deg)
         draw_record(host, self.recorder, key, s.section_caption, ANIMATION.fps["theta"])
+
+    def draw_euler_plot(self, host: Host) -> None:
+        """κₙ against φ, the angle in the tangent plane from the first principal direction
+        (Euler's curve ``κ₁ cos² φ + κ₂ sin² φ``): k1 at φ = 0, 180, k2 at φ = 90, 270 marked,
+        and the section's φ."""
+        ui, s = host.ui, self.state
+        p = s.point
+        if p is None:
+            return
+        with ui.plot(
+            "normal curvature k_n(phi)",
+            200,
+            "phi (deg) from the k1 direction",
+            "k_n",
+            legend_outside=True,
+        ) as shown:
+            if shown:
+                ui.plot_line("k_n", np.degrees(s.phi), s.kn_phi)
+                ui.plot_vlines(f"k1 = {p.k1:.3g}", np.array([0.0, 180.0, 360.0]))
+                ui.plot_vlines(f"k2 = {p.k2:.3g}", np.array([90.0, 270.0]))
+                ui.plot_vlines("section", np.array([s.section_phi_deg()]))
 
     def draw_section(self, host: Host) -> None:
         """The θ slider (showing κₙ(θ)), *turn* / *pause turn* and this frame's turn step."""
@@ -214,10 +232,12 @@ class SurfacesPanel(Panel):
             s.section_deg,
             0.0,
             360.0,
-            f"%.1f deg: k_n = {kn:.4g}",  # κₙ(θ) shown in the slider (no row of its own)
-            "direction of the normal section (orange) in the tangent plane, in degrees from "
-            "p_u towards p_v: its tangent t(theta) and its osculating arc of curvature "
-            "k_n(theta)",
+            f"%.1f deg: k_n = {kn:.4g}",  # κₙ shown in the slider, φ in the row below
+            "direction of the normal section (orange) as a parameter angle theta: degrees in "
+            "the (u, v) plane from the u axis towards v, i.e. the tangent p_u cos theta + "
+            "p_v sin theta (normalized). phi is the same direction measured in the tangent "
+            "plane from the first principal direction (the plot's axis). Drawn: its tangent "
+            "t and its osculating arc of curvature k_n",
         )
         if ch:
             self.push_section(host, deg)
@@ -230,6 +250,10 @@ class SurfacesPanel(Panel):
             s.toggle_turn()
         elif s.tick_turn():
             self.push_section(host)
+        ui.text(
+            f"section: theta = {s.section_deg:.1f} deg in (u, v) = phi "
+            f"{s.section_phi_deg():.1f} deg from the k1 direction"
+        )
 
     # ------------------------------------------------------------------ meshlap animate
     def frames(self, host: Host, options: dict[str, Any]) -> Iterator[str]:

@@ -86,7 +86,11 @@ class AppState:
         """
         folder = Path(text.strip()).expanduser()
         if not folder.is_dir():
-            raise MeshError(f"{text!r} is not an existing folder", "export folder")
+            raise MeshError(
+                f"{text!r} is not an existing folder; create it first (exports and recordings "
+                f"still go to {self.folder})",
+                "export folder",
+            )
         self.folder = folder.resolve()
         return self.folder
 

@@ -50,6 +50,47 @@ class SmoothingState:
     smoother: Smoother | None = None
     version: int = 0  # bumped when the stepper is rebuilt (connectivity may need re-upload)
     lam_steps: list[list[Any]] = field(default_factory=list)  # [[λ, steps], ...] of this run
+    last_move: float | None = None  # RMS displacement of the last step *play* took
+
+    def toggle_play(self) -> None:
+        """*play* / *pause* (the button and ``space``)."""
+        self.playing = not self.playing
+        self.last_move = None
+
+    def play_step(self) -> bool:
+        """One step of *play*. Beyond the stable ``λ`` (the stability warning is shown), *play*
+        stops at the first step that moves the vertices farther (RMS) than the step before (the
+        unstable high-frequency modes have taken over: the flow grows from there) and says why;
+        that step stays on screen and the run counts as diverged (``smoother.diverged``: a
+        smaller ``λ`` goes on from there, as after any divergence).
+
+        Returns
+        -------
+        bool
+            Whether *play* goes on.
+        """
+        s = self.smoother
+        if s is None:
+            return False
+        before = np.array(s.V, dtype=float)
+        if not self.step():
+            return False
+        move = float(np.sqrt(np.mean(np.sum((np.asarray(s.V) - before) ** 2, axis=1))))
+        stab = s.stability
+        if stab.stable or self.last_move is None or move <= self.last_move:
+            self.last_move = move
+            return True
+        limit = "" if stab.max_stable_lam is None else f" {stab.max_stable_lam:.4g}"
+        self.playing, self.last_move = False, None
+        s.diverged = True  # a growing step beyond the limit: the run diverges from here on
+        self.error = (
+            f"play stopped at iteration {s.iteration}: the run diverged (that step moved the "
+            f"vertices {move:.3g} RMS, more than the step before) because lam = {s.lam:g} is "
+            f"beyond the stable limit{limit}: the highest mode grows "
+            f"x{abs(stab.high_freq_gain):.3g} per step and the mesh would blow up. Lower lambda "
+            "(or use implicit) to go on, or press reset"
+        )
+        return False
 
     def rebuild(self, V: FloatArray, F: IntArray) -> bool:
         """Build the stepper for the current options from the clean mesh ``V`` (+ noise).

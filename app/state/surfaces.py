@@ -17,6 +17,7 @@ from meshlap_core import surfaces
 from meshlap_core.errors import MeshError
 from meshlap_core.types import FloatArray
 
+from ..text_numbers import sig
 from .animation import Animation, Option
 from .checks import Schema, integer, number, one_of
 
@@ -42,6 +43,52 @@ def section_arc(
     return p.p[None, :] + along[:, None] * t[None, :] + up[:, None] * p.n[None, :]
 
 
+def signed_sig(x: float, scale: float) -> str:
+    """``x`` with its sign to 4 significant digits, or ``0`` when it is round-off against
+    ``scale`` (κₙ = 4.4e-16 beside κ₁ = 1 is 0: :func:`..text_numbers.sig`)."""
+    text = sig(x, scale)
+    return text if text == "0" or text.startswith("-") else f"+{text}"
+
+
+def tangent_frame(p: surfaces.PointGeometry) -> tuple[FloatArray, FloatArray]:
+    """The orthonormal tangent frame ``(e1, e2)`` at ``p``: ``e1`` the first principal direction
+    (of ``κ₁``), ``e2 = n × e1`` (along the second)."""
+    e1 = p.dir1 / np.linalg.norm(p.dir1)
+    return e1, np.cross(p.n, e1)
+
+
+def geometric_angle(p: surfaces.PointGeometry, theta: float) -> float:
+    """The angle φ in ``[0, 2π)``, measured in the tangent plane from the first principal
+    direction (towards ``n × e1``), of the direction of parameter angle ``theta`` (radians,
+    ``d = p_u cos θ + p_v sin θ``): the first fundamental form turns the parameter-plane angle
+    into the true one."""
+    d = p.p_u * math.cos(theta) + p.p_v * math.sin(theta)
+    e1, e2 = tangent_frame(p)
+    return float(math.atan2(float(d @ e2), float(d @ e1)) % (2 * np.pi))
+
+
+def euler_curve(p: surfaces.PointGeometry, n: int = 181) -> tuple[FloatArray, FloatArray]:
+    """``κₙ(φ)`` at ``n`` angles ``φ ∈ [0, 2π]`` measured in the tangent plane from the first
+    principal direction: each unit tangent ``t = e1 cos φ + e2 sin φ`` is written in the
+    parameter basis (``t = a p_u + b p_v``) and ``κₙ = II(t, t) / I(t, t)`` is evaluated from
+    the point's forms, so the curve is Euler's ``κ₁ cos² φ + κ₂ sin² φ`` (what the tests
+    check), not an assumption of it.
+
+    Returns
+    -------
+    phi : (n,) float
+        Radians.
+    kn : (n,) float
+    """
+    phi = np.linspace(0.0, 2 * np.pi, int(n))
+    e1, e2 = tangent_frame(p)
+    t = np.cos(phi)[:, None] * e1[None, :] + np.sin(phi)[:, None] * e2[None, :]
+    J = np.column_stack([p.p_u, p.p_v])  # (3, 2)
+    ab, *_ = np.linalg.lstsq(J, t.T, rcond=None)  # (2, n) parameter components
+    theta = np.arctan2(ab[1], ab[0])
+    return phi, np.asarray(surfaces.normal_curvature_from_forms(p, theta), dtype=float)
+
+
 @dataclass
 class SurfaceState:
     """The chosen surface, its mesh at ``res`` and everything at ``(u, v)``."""
@@ -55,6 +102,8 @@ class SurfaceState:
     point: surfaces.PointGeometry | None = None
     theta: FloatArray = field(default_factory=lambda: np.zeros(0))
     kn: FloatArray = field(default_factory=lambda: np.zeros(0))
+    phi: FloatArray = field(default_factory=lambda: np.zeros(0))  # geometric angles (radians)
+    kn_phi: FloatArray = field(default_factory=lambda: np.zeros(0))  # κₙ at ``phi``
     version: int = 0  # bumped when the mesh changes (re-register), not when (u, v) moves
     section_deg: float = 0.0  # θ of the normal section drawn in 3D, degrees in [0, 360)
     turning: bool = False  # *turn*: θ advances TURN_STEP_DEG per frame
@@ -116,6 +165,7 @@ class SurfaceState:
             self.error = str(exc)
             return False
         self.u, self.v, self.point, self.theta, self.kn = u, v, point, theta, kn
+        self.phi, self.kn_phi = euler_curve(point, n=181)
         self.error = ""
         return True
 
@@ -170,8 +220,19 @@ class SurfaceState:
         _, kn = self.section()
         return (
             f"{self.name} at (u, v) = ({self.u:.3g}, {self.v:.3g})   θ = {self.section_deg:5.1f}°"
-            f"   κₙ(θ) = {kn:+.4g}   (κ₁ = {p.k1:.4g}, κ₂ = {p.k2:.4g})"
+            f" in (u, v), φ = {self.section_phi_deg():5.1f}° from κ₁"
+            f"   κₙ = {signed_sig(kn, max(abs(p.k1), abs(p.k2)))}"
+            f"   (κ₁ = {sig(p.k1, max(abs(p.k1), abs(p.k2)))}, "
+            f"κ₂ = {sig(p.k2, max(abs(p.k1), abs(p.k2)))})"
         )
+
+    def section_phi_deg(self) -> float:
+        """The section's direction as the geometric angle φ in degrees, ``[0, 360)``, measured
+        in the tangent plane from the first principal direction (:func:`geometric_angle` of
+        the parameter angle ``section_deg``)."""
+        if self.point is None:
+            raise MeshError("no point selected on the surface yet", "surface")
+        return float(np.degrees(geometric_angle(self.point, np.radians(self.section_deg))))
 
     def toggle_turn(self) -> None:
         """*turn* / *pause turn*: one full turn of θ from where it is, ``TURN_STEP_DEG`` per

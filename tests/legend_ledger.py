@@ -1,0 +1,148 @@
+"""What colour quantities the viewer left visible, and with which legend.
+
+polyscope's Python API cannot say whether a quantity is enabled or has an on-screen colour bar,
+so :class:`Ledger` wraps the calls that add or remove quantities and structures (a pytest
+``monkeypatch``) and keeps, per structure name, each scalar or colour quantity's last
+arguments. polyscope enables one colour quantity per structure: enabling one disables the
+others, as here. Tests import it as a plain module (``from legend_ledger import Ledger``).
+"""
+
+from __future__ import annotations
+
+import sys
+from dataclasses import dataclass, field
+from typing import Any
+
+import polyscope as ps
+
+KINDS = {
+    "surface_mesh": (ps.SurfaceMesh, ps.has_surface_mesh, ps.get_surface_mesh),
+    "point_cloud": (ps.PointCloud, ps.has_point_cloud, ps.get_point_cloud),
+    "curve_network": (ps.CurveNetwork, ps.has_curve_network, ps.get_curve_network),
+}
+
+
+@dataclass
+class Quantity:
+    """One colour quantity as last added: ``scalar`` (a colour map) or ``color`` (RGB)."""
+
+    kind: str
+    enabled: bool
+    colorbar: bool
+    vminmax: tuple[float, float] | None
+    owner: str = ""  # the panel whose code added it ("" for the host)
+
+
+def _calling_panel() -> str:
+    """The name of the panel whose method is on the call stack (innermost), or ``""``."""
+    from meshlap_app.panels.base import Panel
+
+    f = sys._getframe(2)
+    while f is not None:
+        obj = f.f_locals.get("self")
+        if isinstance(obj, Panel):
+            return obj.name
+        f = f.f_back
+    return ""
+
+
+@dataclass
+class Ledger:
+    """Per structure name, its colour quantities (see the module docstring)."""
+
+    quantities: dict[str, dict[str, Quantity]] = field(default_factory=dict)
+    kind_of: dict[str, str] = field(default_factory=dict)
+
+    def install(self, monkeypatch: Any) -> Ledger:
+        """Wrap polyscope's calls with ``monkeypatch``; returns ``self``."""
+        for kind, (cls, _, _) in KINDS.items():
+            self._wrap_class(monkeypatch, cls)
+            self._wrap_register(monkeypatch, kind)
+            self._wrap_remove(monkeypatch, kind)
+        real_all = ps.remove_all_structures
+
+        def remove_all() -> None:
+            real_all()
+            self.quantities.clear()
+
+        monkeypatch.setattr(ps, "remove_all_structures", remove_all)
+        return self
+
+    def _add(self, structure: str, name: str, q: Quantity) -> None:
+        q.owner = _calling_panel()
+        qs = self.quantities.setdefault(structure, {})
+        if q.enabled:
+            for other in qs.values():
+                other.enabled = False
+        qs[name] = q
+
+    def _wrap_class(self, monkeypatch: Any, cls: type) -> None:
+        ledger = self
+        real_scalar, real_color = cls.add_scalar_quantity, cls.add_color_quantity
+        real_remove, real_remove_all = cls.remove_quantity, cls.remove_all_quantities
+
+        def add_scalar(obj: Any, name: str, values: Any, *args: Any, **kw: Any) -> Any:
+            out = real_scalar(obj, name, values, *args, **kw)
+            vm = kw.get("vminmax")
+            q = Quantity(
+                "scalar",
+                bool(kw.get("enabled", False)),
+                bool(kw.get("onscreen_colorbar_enabled", False)),
+                None if vm is None else (float(vm[0]), float(vm[1])),
+            )
+            ledger._add(obj.get_name(), name, q)
+            return out
+
+        def add_color(obj: Any, name: str, values: Any, *args: Any, **kw: Any) -> Any:
+            out = real_color(obj, name, values, *args, **kw)
+            q = Quantity("color", bool(kw.get("enabled")), False, None)
+            ledger._add(obj.get_name(), name, q)
+            return out
+
+        def remove(obj: Any, name: str, *args: Any, **kw: Any) -> Any:
+            out = real_remove(obj, name, *args, **kw)
+            ledger.quantities.get(obj.get_name(), {}).pop(name, None)
+            return out
+
+        def remove_all(obj: Any) -> Any:
+            out = real_remove_all(obj)
+            ledger.quantities.pop(obj.get_name(), None)
+            return out
+
+        monkeypatch.setattr(cls, "add_scalar_quantity", add_scalar)
+        monkeypatch.setattr(cls, "add_color_quantity", add_color)
+        monkeypatch.setattr(cls, "remove_quantity", remove)
+        monkeypatch.setattr(cls, "remove_all_quantities", remove_all)
+
+    def _wrap_register(self, monkeypatch: Any, kind: str) -> None:
+        real = getattr(ps, f"register_{kind}")
+
+        def register(name: str, *args: Any, **kw: Any) -> Any:
+            self.quantities.pop(name, None)
+            self.kind_of[name] = kind
+            return real(name, *args, **kw)
+
+        monkeypatch.setattr(ps, f"register_{kind}", register)
+
+    def _wrap_remove(self, monkeypatch: Any, kind: str) -> None:
+        real = getattr(ps, f"remove_{kind}")
+
+        def remove(name: str, *args: Any, **kw: Any) -> Any:
+            self.quantities.pop(name, None)
+            return real(name, *args, **kw)
+
+        monkeypatch.setattr(ps, f"remove_{kind}", remove)
+
+    # ------------------------------------------------------------------ reading
+    def structure_enabled(self, name: str) -> bool:
+        return any(has(name) and get(name).is_enabled() for _, has, get in KINDS.values())
+
+    def visible(self) -> dict[tuple[str, str], Quantity]:
+        """The enabled colour quantities of the enabled structures: (structure, name) ->."""
+        return {
+            (s, n): q
+            for s, qs in self.quantities.items()
+            if self.structure_enabled(s)
+            for n, q in qs.items()
+            if q.enabled
+        }
