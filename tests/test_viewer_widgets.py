@@ -112,7 +112,8 @@ def test_shortcut_keys_are_any_letter_or_digit_or_a_named_key(mock):
     """A new panel declares a new shortcut (``ui.key("g")``) without editing ``ui.py``; the
     production adapter, unscripted, asks imgui and records nothing."""
     import polyscope.imgui as psim
-    from meshlap_app.ui import KEYS, UI, imgui_key
+    from meshlap_app.keys import KEYS, imgui_key
+    from meshlap_app.ui import UI
 
     assert imgui_key("space") == "ImGuiKey_Space" and imgui_key("left") == "ImGuiKey_LeftArrow"
     assert imgui_key("g") == imgui_key("G") == "ImGuiKey_G" and imgui_key("0") == "ImGuiKey_0"
