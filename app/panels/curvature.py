@@ -222,13 +222,13 @@ class CurvaturePanel(Panel):
             "vertices",
         ) as shown:
             if shown:
-                ui.plot_bars(
-                    "vertices",
-                    st["centers"],
-                    st["counts"],
-                    st["width"],
-                    _bar_colors(st["centers"], lo, hi, CURVATURE_FIELD_LABELS[c.field_name][1]),
+                signed = CURVATURE_FIELD_LABELS[c.field_name][1]
+                colors = self.watch.cached(  # a colour map lookup: once per histogram
+                    "bar colours",
+                    (id(st), lo, hi, signed),
+                    lambda: _bar_colors(st["centers"], lo, hi, signed),
                 )
+                ui.plot_bars("vertices", st["centers"], st["counts"], st["width"], colors)
 
 
 def _bar_colors(centers: np.ndarray, lo: float, hi: float, signed: bool) -> np.ndarray:
