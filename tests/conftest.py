@@ -42,7 +42,12 @@ def spd_backend(request, monkeypatch) -> str:
     """Run a solver-sensitive test on both sparse Cholesky back ends: CHOLMOD through
     scikit-sparse (skipped when not installed, README "Fast solver") and the bundled fallback
     (``MESHLAP_SOLVER=fallback``). Returns the active back end's name."""
+    from meshlap_core.linalg import spd
     from meshlap_core.linalg.spd import SOLVER_ENV, solver_backend
+
+    # a window run earlier in this process (viewer.run) keeps its eigensolver GIL-free:
+    # each test starts from the core's default
+    monkeypatch.setattr(spd, "_GIL_FREE", {"eigen": False})
 
     if request.param == "fallback":
         monkeypatch.setenv(SOLVER_ENV, "fallback")
