@@ -182,6 +182,9 @@ class UI(FieldErrors):
         """
         return None
 
+    def _record_button_width(self, label: str, width: float) -> None:
+        """Hook called before :meth:`button` draws: its width in pixels (0: its label's)."""
+
     def _record_table(self, table_id: str, headers: list[str], tips: list[str]) -> None:
         """Hook called when :meth:`table` starts a table, before imgui's ``BeginTable``."""
 
@@ -267,8 +270,25 @@ class UI(FieldErrors):
         v = self._record(label, "header", "", result)
         return result if v is None else bool(v)
 
-    def button(self, label: str, tooltip: str = "") -> bool:
-        result = check_return("Button", self.im.Button(label))
+    def button(self, label: str, tooltip: str = "", width_of: Sequence[str] = ()) -> bool:
+        """A button: was it pressed this frame?
+
+        Parameters
+        ----------
+        label : str
+            Its text.
+        tooltip : str
+            Shown when the mouse rests on it.
+        width_of : sequence of str
+            Labels the button takes turns with (*play* / *pause*): it is as wide as the widest,
+            so the widgets after it keep their place when the label changes.
+        """
+        width = 0.0
+        if width_of:
+            pad = float(self.im.GetStyle().FramePadding[0])
+            width = max(float(self.im.CalcTextSize(t)[0]) for t in (label, *width_of)) + 2 * pad
+        self._record_button_width(label, width)
+        result = check_return("Button", self.im.Button(label, (width, 0.0)))
         v = self._widget(label, "button", tooltip, False)
         return self._changed(result if v is None else bool(v))
 
@@ -596,6 +616,10 @@ class UI(FieldErrors):
         """Text drawn over the 3D view at window pixel ``pos``."""
         dl = self.im.GetForegroundDrawList()
         dl.AddText(pos, self.im.GetColorU32((0.05, 0.05, 0.05, 1.0)), text)
+        self._record_overlay(pos, text)
+
+    def _record_overlay(self, pos: tuple[float, float], text: str) -> None:
+        """Hook called after :meth:`overlay_text` drew ``text`` at window pixel ``pos``."""
 
 
 def _f64(a: Any) -> np.ndarray:

@@ -505,3 +505,21 @@ def test_f_frames_the_ring_clear_of_the_colour_bars_and_the_panel(viewer, scale)
     pane = w - ps.get_right_gui_pane_width() * scale
     assert (xy[:, 0] > bars).all() and (xy[:, 0] < pane).all(), (xy[:, 0], bars, pane)
     assert (xy[:, 1] > 0).all() and (xy[:, 1] < h).all()
+
+
+# ---------------------------------------------------------------- item 9: the k sweep's play
+def test_play_and_pause_are_one_width(viewer):
+    compute_basis(viewer)
+    st = viewer.panels["spectral"].state
+    drive(viewer, "play what", "k sweep")
+    widths = viewer.ui.button_widths
+    drive(viewer, "play", True)
+    assert st.playing
+    frames(viewer, 2)
+    drive(viewer, "pause", True)
+    assert not st.playing
+    frames(viewer)
+    # play and pause take turns in one place: the same width, wide enough for either label
+    w_play, w_pause = widths[("spectral", "play")], widths[("spectral", "pause")]
+    assert w_play == w_pause > 0
+    assert w_play >= max(ps.imgui.CalcTextSize(t)[0] for t in ("play", "pause"))

@@ -289,6 +289,7 @@ class SpectralPanel(Panel):
             "pause" if st.playing else "play",
             "play the k sweep or the eigenmodes from the first (or go on after a pause); "
             "while recording, each k or mode shown adds a frame",
+            width_of=("play", "pause"),
         ):
             if st.toggle_play():
                 self.recorder.restart()  # the file starts with the first k (or mode) played
