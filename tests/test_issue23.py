@@ -523,3 +523,21 @@ def test_play_and_pause_are_one_width(viewer):
     w_play, w_pause = widths[("spectral", "play")], widths[("spectral", "pause")]
     assert w_play == w_pause > 0
     assert w_play >= max(ps.imgui.CalcTextSize(t)[0] for t in ("play", "pause"))
+
+
+def test_the_caption_shows_the_k_of_the_slider_drawn_in_the_same_frame(viewer):
+    compute_basis(viewer)
+    st = viewer.panels["spectral"].state
+    drive(viewer, "play what", "k sweep")
+    drive(viewer, "play", True)
+    assert st.playing
+    viewer.ui.overlays.clear()
+    for _ in range(5):
+        frames(viewer)
+        # the slider drawn this frame and the caption under the copy name the same k
+        k = viewer.ui.drawn[("spectral", "k (reconstruct)")]
+        assert k == st.k
+        captions = [t for _, t in viewer.ui.overlays if t.startswith("k = ")]
+        assert captions == [f"k = {k} of {st.basis.k_max} modes"]
+        viewer.ui.overlays.clear()
+    drive(viewer, "pause", True)

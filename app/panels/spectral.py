@@ -238,6 +238,9 @@ class SpectralPanel(Panel):
                 ui.text("-C u = lambda M u (cotangent stiffness, Voronoi mass)")
             return
         ui.text(st.message)
+        if st.tick():  # what plays advances before the sliders, so they show this frame's k
+            self.push_k(host)  # (or mode), as the captions drawn after the panels do
+            self.push_mode(host)
         ch, mode = ui.slider_int(
             "eigenmode i",
             st.mode,
@@ -293,10 +296,8 @@ class SpectralPanel(Panel):
         ):
             if st.toggle_play():
                 self.recorder.restart()  # the file starts with the first k (or mode) played
-        elif not st.tick():  # the first k (or mode) of a play shows for a frame of its own
-            return
-        self.push_k(host)
-        self.push_mode(host)
+            self.push_k(host)  # the first k (or mode) of a play shows for a frame of its own
+            self.push_mode(host)
 
     def _record_kind(self) -> str:
         """What changed since the last recorded frame: ``k`` or ``modes`` (the play choice for
