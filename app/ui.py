@@ -35,6 +35,7 @@ import numpy as np
 from .field_errors import FieldErrors, read_float
 from .keys import imgui_key
 from .text_numbers import is_number
+from .text_wrap import wrap_at_spaces
 
 RED = (1.0, 0.35, 0.35, 1.0)
 GREY = (0.7, 0.7, 0.7, 1.0)
@@ -221,6 +222,19 @@ class UI(FieldErrors):
         self.im.PushTextWrapPos(self.wrap_width * self.scale)
         self.im.TextUnformatted(text)
         self.im.PopTextWrapPos()
+
+    def text_whole_words(self, text: str) -> None:
+        """Text wrapped at the panel width only at spaces: a file name or a number stays whole
+        (imgui's wrap also breaks after ``.``: ``smoothing.`` / ``gif``)."""
+        lines = wrap_at_spaces(
+            text, self.wrap_width * self.scale, lambda s: float(self.im.CalcTextSize(s)[0])
+        )
+        for line in lines:
+            self.im.TextUnformatted(line)
+        self._record_lines(lines)
+
+    def _record_lines(self, lines: list[str]) -> None:
+        """Hook called after :meth:`text_whole_words` drew its ``lines``."""
 
     def error(self, text: str) -> None:
         """Text in red, wrapped (a refused input or a failed action)."""

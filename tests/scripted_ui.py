@@ -114,6 +114,7 @@ class ScriptedUI(UI):
         # (section, label) -> the width in pixels each button was last drawn with (0: its label's)
         self.button_widths: dict[tuple[str, str], float] = {}
         self.drawn: dict[tuple[str, str], Any] = {}  # (section, label) -> value last drawn with
+        self.lines: list[tuple[str, str]] = []  # (section, line) of text wrapped at spaces
         self.overlays: list[tuple[tuple[float, float], str]] = []  # text over the 3D view
 
     # ------------------------------------------------------------------ the script
@@ -153,6 +154,9 @@ class ScriptedUI(UI):
 
     def _record_button_width(self, label: str, width: float) -> None:
         self.button_widths[(self.section, label)] = width
+
+    def _record_lines(self, lines: list[str]) -> None:
+        self.lines += [(self.section, line) for line in lines]
 
     def _record_overlay(self, pos: tuple[float, float], text: str) -> None:
         self.overlays.append(((float(pos[0]), float(pos[1])), text))

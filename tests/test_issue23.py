@@ -541,3 +541,36 @@ def test_the_caption_shows_the_k_of_the_slider_drawn_in_the_same_frame(viewer):
         assert captions == [f"k = {k} of {st.basis.k_max} modes"]
         viewer.ui.overlays.clear()
     drive(viewer, "pause", True)
+
+
+# ---------------------------------------------------------------- item 10: file names whole
+def test_the_recorded_file_name_is_never_broken_at_its_dot(viewer, tmp_path):
+    from meshlap_app.record import RECORD_HEADER
+    from meshlap_app.text_wrap import wrap_at_spaces
+
+    viewer.set_panel("smoothing")
+    frames(viewer)
+    folder = tmp_path / ("a_long_folder_name_" * 4)
+    folder.mkdir()
+    path = folder / "smoothing.gif"
+
+    def opened(label: str, value) -> None:  # the record header is open in that frame
+        viewer.ui.script(RECORD_HEADER, True)
+        drive(viewer, label, value)
+
+    opened("record file", str(path))
+    opened("record", True)
+    for _ in range(3):
+        opened("step", True)
+    opened("stop", True)
+    assert path.exists()
+    viewer.ui.lines.clear()
+    viewer.ui.script(RECORD_HEADER, True)
+    frames(viewer)
+    lines = [line for sec, line in viewer.ui.lines if sec == "smoothing"]
+    assert any(line.startswith("wrote ") for line in lines), lines
+    # the status is wider than the panel: wrapped, but the path stays one word, whole
+    assert len(lines) > 1 and str(path) in lines
+    assert " ".join(lines) == viewer.panels["smoothing"].recorder.status
+    # only at spaces: a dotted name is never split (imgui's own wrap breaks after the dot)
+    assert wrap_at_spaces("to smoothing.gif", 1.0, len) == ["to", "smoothing.gif"]
