@@ -105,6 +105,8 @@ class UI(FieldErrors):
         self._im = imgui
         self._ip = implot
         self.wrap_width = wrap_width
+        # window pixel x where meshlap's panel starts: text over the 3D view ends left of it
+        self.overlay_right: float | None = None
         self.scale = 1.0
         self.section = ""
         self.changed = False  # some widget reported a change since begin_section
@@ -627,7 +629,13 @@ class UI(FieldErrors):
         )
 
     def overlay_text(self, pos: tuple[float, float], text: str) -> None:
-        """Text drawn over the 3D view at window pixel ``pos``."""
+        """Text drawn over the 3D view at window pixel ``pos``, moved left to end before
+        :attr:`overlay_right` (meshlap's panel), not drawn when it has no room there."""
+        if self.overlay_right is not None:
+            x = min(float(pos[0]), self.overlay_right - float(self.im.CalcTextSize(text)[0]))
+            if x < 0:
+                return
+            pos = (x, float(pos[1]))
         dl = self.im.GetForegroundDrawList()
         dl.AddText(pos, self.im.GetColorU32((0.05, 0.05, 0.05, 1.0)), text)
         self._record_overlay(pos, text)

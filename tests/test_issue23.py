@@ -574,3 +574,40 @@ def test_the_recorded_file_name_is_never_broken_at_its_dot(viewer, tmp_path):
     assert " ".join(lines) == viewer.panels["smoothing"].recorder.status
     # only at spaces: a dotted name is never split (imgui's own wrap breaks after the dot)
     assert wrap_at_spaces("to smoothing.gif", 1.0, len) == ["to", "smoothing.gif"]
+
+
+# ---------------------------------------------------------------- item 10: text under the panel
+def test_hover_labels_and_captions_end_left_of_the_panel(viewer, monkeypatch):
+    from meshlap_app.scene import scene_width
+    from meshlap_app.state.onering import HoverThrottle
+
+    viewer.set_panel("onering")
+    frames(viewer)
+    panel = viewer.panels["onering"]
+    t = [0.0]
+    panel.clock, panel.throttle = (lambda: t[0]), HoverThrottle()
+    label = "vertex 12345   field value -0.000123456"
+    monkeypatch.setattr(panel, "hover_text", lambda host, pos: label)
+    w, _ = ps.get_window_size()
+    right = scene_width(w, viewer.state.ui_scale)
+    for x in (40.0, right - 30.0, w - 5.0):  # clear of the panel, near it, under it
+        for _ in range(3):  # the cursor rests: picked, then shown
+            viewer.ui.overlays.clear()
+            drive(viewer, "hover", (x, 100.0))
+            t[0] += 0.2
+        shown = [pos for pos, text in viewer.ui.overlays if text == label]
+        assert shown, f"no hover label at x={x}"
+        (lx, _), width = shown[-1], ps.imgui.CalcTextSize(label)[0]
+        assert lx + width <= viewer.ui.overlay_right <= right
+        if x + 16 + width <= right:
+            assert lx == x + 16  # where it was when there is room
+    # captions of side-by-side copies too (curvature side by side)
+    viewer.set_panel("curvature")
+    drive(viewer, "side by side", True)
+    viewer.ui.overlays.clear()
+    frames(viewer, 2)
+    captions = viewer.ui.overlays
+    assert captions
+    for (cx, _), text in captions:
+        assert 0 <= cx and cx + ps.imgui.CalcTextSize(text)[0] <= right
+    drive(viewer, "side by side", False)
