@@ -611,3 +611,37 @@ def test_hover_labels_and_captions_end_left_of_the_panel(viewer, monkeypatch):
     for (cx, _), text in captions:
         assert 0 <= cx and cx + ps.imgui.CalcTextSize(text)[0] <= right
     drive(viewer, "side by side", False)
+
+
+# ---------------------------------------------------------------- item 5: the primary's side
+def test_the_primary_keeps_the_left_side_whichever_front_the_mesh_has(viewer, tmp_path):
+    from meshlap_app.camera import project_to_screen
+    from meshlap_app.scene import FRONT_VIEWS, MESH, MESH_B
+
+    from meshlap_core import primitives
+    from meshlap_core.io import save_mesh
+
+    V, F = primitives.icosphere(2)
+    V = V * np.array([2.0, 1.0, 0.5])  # not symmetric: the copy's width is the screen's
+    # the default front (eye at -z) and a mesh known to face +z (its eye on the other side)
+    names = ["blob.obj", next(iter(FRONT_VIEWS))]
+    for name in names:
+        path = tmp_path / name
+        save_mesh(path, V, F)
+        assert viewer.open(path)
+        viewer.set_panel("curvature")
+        frames(viewer)
+        if not viewer.state.curv.side_by_side:
+            drive(viewer, "side by side", True)
+        frames(viewer, 2)
+        params = ps.get_view_camera_parameters()
+        w, h = ps.get_window_size()
+        centres = np.array(
+            [viewer.structure_points(n).mean(axis=0) for n in (MESH, MESH_B)], dtype=float
+        )
+        xy, front = project_to_screen(
+            centres, params.get_view_mat(), params.get_fov_vertical_deg(), w, h
+        )
+        assert front.all()
+        assert xy[0, 0] < xy[1, 0], f"{name}: the copy is left of the mesh"
+    drive(viewer, "side by side", False)

@@ -14,7 +14,7 @@ from meshlap_core.errors import MeshError
 
 from .. import scene
 from ..record import Recorder, draw_record
-from ..scene import COLORBAR_AT, EIGEN, MESH, RECON, side_offset
+from ..scene import COLORBAR_AT, EIGEN, MESH, RECON, front_view, side_offset
 from ..state.spectral import ANIMATION, PLAY_KINDS, SCREENSHOT_K, SpectralState
 from .base import ExportItem, Host, Panel
 
@@ -73,7 +73,8 @@ class SpectralPanel(Panel):
         mesh and display fit (not on every k move)."""
         d, mesh = host.state.display, host.state.mesh
         key = (id(mesh), mesh.version, d.scale, *d.centre.tolist())
-        return self.watch.cached("offset", key, lambda: side_offset(host.mesh_points()))
+        front = front_view(mesh.name)
+        return self.watch.cached("offset", key, lambda: side_offset(host.mesh_points(), front))
 
     def push_mode(self, host: Host, force: bool = False) -> None:
         st = self.state
