@@ -90,7 +90,7 @@ class Recorder:
         if self.recording:
             ui.text(f"recording: {self.count} frames")
         if self.status:
-            ui.text(self.status)
+            ui.text_whole_words(self.status)
 
     def start(self, host: Host) -> None:
         """Begin a recording into the file named in the field.

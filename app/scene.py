@@ -108,9 +108,23 @@ def scalar_for_upload(
     return np.asarray(values) * f, (vminmax[0] * f, vminmax[1] * f), f" (x 1e{e})"
 
 
-def side_offset(V: np.ndarray) -> np.ndarray:
-    """Offset of a copy shown beside a mesh: to its right as seen from the default camera."""
-    return np.array([-1.15 * float(np.ptp(V[:, 0])) - 1e-9, 0.0, 0.0])
+def side_offset(
+    V: np.ndarray, toward_eye: tuple[float, float, float] = (0.0, 0.15, -1.0)
+) -> np.ndarray:
+    """Offset of a copy shown beside a mesh ``V (n,3)``: to its right on screen as seen from
+    ``toward_eye`` (the mesh's front view, y up), so the mesh keeps the left side whichever
+    way the camera looks at it."""
+    d = -np.asarray(toward_eye, dtype=np.float64)  # where the camera looks
+    right = np.array([-d[2], 0.0, d[0]])  # d x y: the screen's right, in the ground plane
+    right /= max(float(np.linalg.norm(right)), 1e-12)
+    width = float(np.ptp(np.asarray(V, dtype=np.float64) @ right))
+    return right * (1.15 * width + 1e-9)
+
+
+def front_view(mesh_name: str) -> tuple[float, float, float]:
+    """The direction from the mesh named ``mesh_name`` towards the camera: its entry of
+    :data:`FRONT_VIEWS`, else :data:`DEFAULT_VIEW`."""
+    return FRONT_VIEWS.get(mesh_name, DEFAULT_VIEW)
 
 
 def picked_vertex(hit: Any, V: np.ndarray, F: np.ndarray) -> int | None:

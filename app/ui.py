@@ -35,6 +35,7 @@ import numpy as np
 from .field_errors import FieldErrors, read_float
 from .keys import imgui_key
 from .text_numbers import is_number
+from .text_wrap import wrap_at_spaces
 
 RED = (1.0, 0.35, 0.35, 1.0)
 GREY = (0.7, 0.7, 0.7, 1.0)
@@ -104,6 +105,8 @@ class UI(FieldErrors):
         self._im = imgui
         self._ip = implot
         self.wrap_width = wrap_width
+        # window pixel x where meshlap's panel starts: text over the 3D view ends left of it
+        self.overlay_right: float | None = None
         self.scale = 1.0
         self.section = ""
         self.changed = False  # some widget reported a change since begin_section
@@ -182,6 +185,9 @@ class UI(FieldErrors):
         """
         return None
 
+    def _record_button_width(self, label: str, width: float) -> None:
+        """Hook called before :meth:`button` draws: its width in pixels (0: its label's)."""
+
     def _record_table(self, table_id: str, headers: list[str], tips: list[str]) -> None:
         """Hook called when :meth:`table` starts a table, before imgui's ``BeginTable``."""
 
@@ -218,6 +224,19 @@ class UI(FieldErrors):
         self.im.PushTextWrapPos(self.wrap_width * self.scale)
         self.im.TextUnformatted(text)
         self.im.PopTextWrapPos()
+
+    def text_whole_words(self, text: str) -> None:
+        """Text wrapped at the panel width only at spaces: a file name or a number stays whole
+        (imgui's wrap also breaks after ``.``: ``smoothing.`` / ``gif``)."""
+        lines = wrap_at_spaces(
+            text, self.wrap_width * self.scale, lambda s: float(self.im.CalcTextSize(s)[0])
+        )
+        for line in lines:
+            self.im.TextUnformatted(line)
+        self._record_lines(lines)
+
+    def _record_lines(self, lines: list[str]) -> None:
+        """Hook called after :meth:`text_whole_words` drew its ``lines``."""
 
     def error(self, text: str) -> None:
         """Text in red, wrapped (a refused input or a failed action)."""
@@ -267,8 +286,25 @@ class UI(FieldErrors):
         v = self._record(label, "header", "", result)
         return result if v is None else bool(v)
 
-    def button(self, label: str, tooltip: str = "") -> bool:
-        result = check_return("Button", self.im.Button(label))
+    def button(self, label: str, tooltip: str = "", width_of: Sequence[str] = ()) -> bool:
+        """A button: was it pressed this frame?
+
+        Parameters
+        ----------
+        label : str
+            Its text.
+        tooltip : str
+            Shown when the mouse rests on it.
+        width_of : sequence of str
+            Labels the button takes turns with (*play* / *pause*): it is as wide as the widest,
+            so the widgets after it keep their place when the label changes.
+        """
+        width = 0.0
+        if width_of:
+            pad = float(self.im.GetStyle().FramePadding[0])
+            width = max(float(self.im.CalcTextSize(t)[0]) for t in (label, *width_of)) + 2 * pad
+        self._record_button_width(label, width)
+        result = check_return("Button", self.im.Button(label, (width, 0.0)))
         v = self._widget(label, "button", tooltip, False)
         return self._changed(result if v is None else bool(v))
 
@@ -593,9 +629,19 @@ class UI(FieldErrors):
         )
 
     def overlay_text(self, pos: tuple[float, float], text: str) -> None:
-        """Text drawn over the 3D view at window pixel ``pos``."""
+        """Text drawn over the 3D view at window pixel ``pos``, moved left to end before
+        :attr:`overlay_right` (meshlap's panel), not drawn when it has no room there."""
+        if self.overlay_right is not None:
+            x = min(float(pos[0]), self.overlay_right - float(self.im.CalcTextSize(text)[0]))
+            if x < 0:
+                return
+            pos = (x, float(pos[1]))
         dl = self.im.GetForegroundDrawList()
         dl.AddText(pos, self.im.GetColorU32((0.05, 0.05, 0.05, 1.0)), text)
+        self._record_overlay(pos, text)
+
+    def _record_overlay(self, pos: tuple[float, float], text: str) -> None:
+        """Hook called after :meth:`overlay_text` drew ``text`` at window pixel ``pos``."""
 
 
 def _f64(a: Any) -> np.ndarray:

@@ -279,6 +279,7 @@ class Viewer:
             self.draw_guarded(name, p.sync, show=False)
         self.draw_guarded("picking", lambda host: host.handle_click())
         self.draw_guarded("keys", lambda host: host.handle_keys())
+        self.draw_guarded("labels", lambda host: host.limit_overlays())
         self.draw_guarded("labels", self.active().overlay)
         self.draw_guarded("layout", lambda host: host.layout())
         self.draw_guarded("pacing", lambda host: host.note_activity())
@@ -331,6 +332,13 @@ class Viewer:
             self.frame(whole=self.whole)
             self.whole = False
         self.draw_captions()
+
+    def limit_overlays(self) -> None:
+        """Text over the 3D view (hover labels, ring labels, captions) ends left of meshlap's
+        panel: the narrower of its scene width and the panel's real left edge."""
+        w, _ = ps.get_window_size()
+        pane = ps.get_right_gui_pane_width() * self.state.ui_scale
+        self.ui.overlay_right = float(min(scene.scene_width(w, self.state.ui_scale), w - pane))
 
     def keep_view(self) -> None:
         """Keep the camera as it is now: no pending re-frame, the window size taken as seen."""

@@ -111,6 +111,11 @@ class ScriptedUI(UI):
         # every error line drawn: (section, text, label of the widget drawn just before it)
         self.errors_drawn: list[tuple[str, str, str]] = []
         self._last_label = ""
+        # (section, label) -> the width in pixels each button was last drawn with (0: its label's)
+        self.button_widths: dict[tuple[str, str], float] = {}
+        self.drawn: dict[tuple[str, str], Any] = {}  # (section, label) -> value last drawn with
+        self.lines: list[tuple[str, str]] = []  # (section, line) of text wrapped at spaces
+        self.overlays: list[tuple[tuple[float, float], str]] = []  # text over the 3D view
 
     # ------------------------------------------------------------------ the script
     def script(self, label: str, *values: Any) -> None:
@@ -136,6 +141,7 @@ class ScriptedUI(UI):
         self._last_label = label
         if kind != "header":
             self.seen[key] = kind
+            self.drawn[key] = current
             if tooltip:
                 self.tooltips[key] = tooltip
         queue = self._script.get(label)
@@ -145,6 +151,15 @@ class ScriptedUI(UI):
         if kind != "header":
             self.driven.add(key)
         return _as_widget_reads(value, label, kind, current, choices)
+
+    def _record_button_width(self, label: str, width: float) -> None:
+        self.button_widths[(self.section, label)] = width
+
+    def _record_lines(self, lines: list[str]) -> None:
+        self.lines += [(self.section, line) for line in lines]
+
+    def _record_overlay(self, pos: tuple[float, float], text: str) -> None:
+        self.overlays.append(((float(pos[0]), float(pos[1])), text))
 
     def _record_progress(self, fraction: float, text: str) -> None:
         self.progress_lines.append((self.section, fraction, text))

@@ -508,3 +508,143 @@ def test_f_frames_the_ring_clear_of_the_colour_bars_and_the_panel(viewer, scale)
     pane = w - ps.get_right_gui_pane_width() * scale
     assert (xy[:, 0] > bars).all() and (xy[:, 0] < pane).all(), (xy[:, 0], bars, pane)
     assert (xy[:, 1] > 0).all() and (xy[:, 1] < h).all()
+
+
+# ---------------------------------------------------------------- item 9: the k sweep's play
+def test_play_and_pause_are_one_width(viewer):
+    compute_basis(viewer)
+    st = viewer.panels["spectral"].state
+    drive(viewer, "play what", "k sweep")
+    widths = viewer.ui.button_widths
+    drive(viewer, "play", True)
+    assert st.playing
+    frames(viewer, 2)
+    drive(viewer, "pause", True)
+    assert not st.playing
+    frames(viewer)
+    # play and pause take turns in one place: the same width, wide enough for either label
+    w_play, w_pause = widths[("spectral", "play")], widths[("spectral", "pause")]
+    assert w_play == w_pause > 0
+    assert w_play >= max(ps.imgui.CalcTextSize(t)[0] for t in ("play", "pause"))
+
+
+def test_the_caption_shows_the_k_of_the_slider_drawn_in_the_same_frame(viewer):
+    compute_basis(viewer)
+    st = viewer.panels["spectral"].state
+    drive(viewer, "play what", "k sweep")
+    drive(viewer, "play", True)
+    assert st.playing
+    viewer.ui.overlays.clear()
+    for _ in range(5):
+        frames(viewer)
+        # the slider drawn this frame and the caption under the copy name the same k
+        k = viewer.ui.drawn[("spectral", "k (reconstruct)")]
+        assert k == st.k
+        captions = [t for _, t in viewer.ui.overlays if t.startswith("k = ")]
+        assert captions == [f"k = {k} of {st.basis.k_max} modes"]
+        viewer.ui.overlays.clear()
+    drive(viewer, "pause", True)
+
+
+# ---------------------------------------------------------------- item 10: file names whole
+def test_the_recorded_file_name_is_never_broken_at_its_dot(viewer, tmp_path):
+    from meshlap_app.record import RECORD_HEADER
+    from meshlap_app.text_wrap import wrap_at_spaces
+
+    viewer.set_panel("smoothing")
+    frames(viewer)
+    folder = tmp_path / ("a_long_folder_name_" * 4)
+    folder.mkdir()
+    path = folder / "smoothing.gif"
+
+    def opened(label: str, value) -> None:  # the record header is open in that frame
+        viewer.ui.script(RECORD_HEADER, True)
+        drive(viewer, label, value)
+
+    opened("record file", str(path))
+    opened("record", True)
+    for _ in range(3):
+        opened("step", True)
+    opened("stop", True)
+    assert path.exists()
+    viewer.ui.lines.clear()
+    viewer.ui.script(RECORD_HEADER, True)
+    frames(viewer)
+    lines = [line for sec, line in viewer.ui.lines if sec == "smoothing"]
+    assert any(line.startswith("wrote ") for line in lines), lines
+    # the status is wider than the panel: wrapped, but the path stays one word, whole
+    assert len(lines) > 1 and str(path) in lines
+    assert " ".join(lines) == viewer.panels["smoothing"].recorder.status
+    # only at spaces: a dotted name is never split (imgui's own wrap breaks after the dot)
+    assert wrap_at_spaces("to smoothing.gif", 1.0, len) == ["to", "smoothing.gif"]
+
+
+# ---------------------------------------------------------------- item 10: text under the panel
+def test_hover_labels_and_captions_end_left_of_the_panel(viewer, monkeypatch):
+    from meshlap_app.scene import scene_width
+    from meshlap_app.state.onering import HoverThrottle
+
+    viewer.set_panel("onering")
+    frames(viewer)
+    panel = viewer.panels["onering"]
+    t = [0.0]
+    panel.clock, panel.throttle = (lambda: t[0]), HoverThrottle()
+    label = "vertex 12345   field value -0.000123456"
+    monkeypatch.setattr(panel, "hover_text", lambda host, pos: label)
+    w, _ = ps.get_window_size()
+    right = scene_width(w, viewer.state.ui_scale)
+    for x in (40.0, right - 30.0, w - 5.0):  # clear of the panel, near it, under it
+        for _ in range(3):  # the cursor rests: picked, then shown
+            viewer.ui.overlays.clear()
+            drive(viewer, "hover", (x, 100.0))
+            t[0] += 0.2
+        shown = [pos for pos, text in viewer.ui.overlays if text == label]
+        assert shown, f"no hover label at x={x}"
+        (lx, _), width = shown[-1], ps.imgui.CalcTextSize(label)[0]
+        assert lx + width <= viewer.ui.overlay_right <= right
+        if x + 16 + width <= right:
+            assert lx == x + 16  # where it was when there is room
+    # captions of side-by-side copies too (curvature side by side)
+    viewer.set_panel("curvature")
+    drive(viewer, "side by side", True)
+    viewer.ui.overlays.clear()
+    frames(viewer, 2)
+    captions = viewer.ui.overlays
+    assert captions
+    for (cx, _), text in captions:
+        assert 0 <= cx and cx + ps.imgui.CalcTextSize(text)[0] <= right
+    drive(viewer, "side by side", False)
+
+
+# ---------------------------------------------------------------- item 5: the primary's side
+def test_the_primary_keeps_the_left_side_whichever_front_the_mesh_has(viewer, tmp_path):
+    from meshlap_app.camera import project_to_screen
+    from meshlap_app.scene import FRONT_VIEWS, MESH, MESH_B
+
+    from meshlap_core import primitives
+    from meshlap_core.io import save_mesh
+
+    V, F = primitives.icosphere(2)
+    V = V * np.array([2.0, 1.0, 0.5])  # not symmetric: the copy's width is the screen's
+    # the default front (eye at -z) and a mesh known to face +z (its eye on the other side)
+    names = ["blob.obj", next(iter(FRONT_VIEWS))]
+    for name in names:
+        path = tmp_path / name
+        save_mesh(path, V, F)
+        assert viewer.open(path)
+        viewer.set_panel("curvature")
+        frames(viewer)
+        if not viewer.state.curv.side_by_side:
+            drive(viewer, "side by side", True)
+        frames(viewer, 2)
+        params = ps.get_view_camera_parameters()
+        w, h = ps.get_window_size()
+        centres = np.array(
+            [viewer.structure_points(n).mean(axis=0) for n in (MESH, MESH_B)], dtype=float
+        )
+        xy, front = project_to_screen(
+            centres, params.get_view_mat(), params.get_fov_vertical_deg(), w, h
+        )
+        assert front.all()
+        assert xy[0, 0] < xy[1, 0], f"{name}: the copy is left of the mesh"
+    drive(viewer, "side by side", False)

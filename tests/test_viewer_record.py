@@ -171,9 +171,9 @@ def test_spectral_copy_offset_is_cached_per_mesh(viewer, tmp_path, monkeypatch):
     calls = []
     real = spectral_panel.side_offset
 
-    def counting(V):
+    def counting(V, *front):  # front: the mesh's front view (item 5 of issue 23)
         calls.append(len(V))
-        return real(V)
+        return real(V, *front)
 
     monkeypatch.setattr(spectral_panel, "side_offset", counting)
     viewer.set_panel("spectral")

@@ -10,7 +10,7 @@ import polyscope as ps
 from meshlap_core.options import AREA_KINDS as AREAS
 from meshlap_core.options import BOUNDARY_RULES, CURVATURE_FIELD_LABELS
 
-from ..scene import MESH, MESH_B, colorbar_at, scalar_for_upload, side_offset
+from ..scene import MESH, MESH_B, colorbar_at, front_view, scalar_for_upload, side_offset
 from .base import Host, Panel
 
 FIELD_HELP = (
@@ -44,7 +44,7 @@ class CurvaturePanel(Panel):
     def points(self, host: Host, name: str) -> np.ndarray | None:
         if name == MESH_B:
             shown = host.mesh_points()
-            return shown + side_offset(shown)
+            return shown + side_offset(shown, front_view(host.state.mesh.name))
         return None
 
     def captions(self, host: Host) -> dict[str, str]:
@@ -107,7 +107,8 @@ class CurvaturePanel(Panel):
         if curv.side_by_side:
             if not ps.has_surface_mesh(MESH_B):
                 V = host.mesh_points()
-                ps.register_surface_mesh(MESH_B, V + side_offset(V), mesh.F, smooth_shade=True)
+                X = V + side_offset(V, front_view(mesh.name))
+                ps.register_surface_mesh(MESH_B, X, mesh.F, smooth_shade=True)
             # its own labelled colour bar, below the first one
             mine = host.active() is self  # polyscope draws a hidden copy's bar too
             self._add_field(host, ps.get_surface_mesh(MESH_B), curv.second_field, mine, 1)

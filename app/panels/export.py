@@ -44,7 +44,7 @@ class ExportPanel(Panel):
         if ui.button("export what is shown", "write the shown mesh / field to the folder"):
             self.status = self.export(host, host.state.folder)
         if self.status:
-            ui.text(self.status)
+            ui.text_whole_words(self.status)
 
     def set_folder(self, host: Host, text: str) -> None:
         """Use ``text`` as the export folder.

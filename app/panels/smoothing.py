@@ -14,7 +14,7 @@ from meshlap_core.options import LAPLACIAN_KINDS, SMOOTHING_METHODS
 
 from .. import scene
 from ..record import Recorder, draw_record
-from ..scene import INPUT_COLOR, SMOOTH_INPUT, SMOOTHED, SMOOTHED_COLOR, side_offset
+from ..scene import INPUT_COLOR, SMOOTH_INPUT, SMOOTHED, SMOOTHED_COLOR, front_view, side_offset
 from ..state.smoothing import (
     ANIMATION,
     SmoothingState,
@@ -97,8 +97,9 @@ class SmoothingPanel(Panel):
 
     def _shift(self, host: Host) -> np.ndarray:
         st, d = self.state, host.state.display
-        key = (st.version, d.scale, *d.centre.tolist())
-        return self.watch.cached("shift", key, lambda: side_offset(d.points(st.V_start)))
+        front = front_view(host.state.mesh.name)
+        key = (st.version, d.scale, *d.centre.tolist(), *front)
+        return self.watch.cached("shift", key, lambda: side_offset(d.points(st.V_start), front))
 
     def push(self, host: Host, force: bool = False) -> None:
         """Upload the current positions (position update; re-register only on a rebuild)."""

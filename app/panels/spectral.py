@@ -14,7 +14,7 @@ from meshlap_core.errors import MeshError
 
 from .. import scene
 from ..record import Recorder, draw_record
-from ..scene import COLORBAR_AT, EIGEN, MESH, RECON, side_offset
+from ..scene import COLORBAR_AT, EIGEN, MESH, RECON, front_view, side_offset
 from ..state.spectral import ANIMATION, PLAY_KINDS, SCREENSHOT_K, SpectralState
 from .base import ExportItem, Host, Panel
 
@@ -73,7 +73,8 @@ class SpectralPanel(Panel):
         mesh and display fit (not on every k move)."""
         d, mesh = host.state.display, host.state.mesh
         key = (id(mesh), mesh.version, d.scale, *d.centre.tolist())
-        return self.watch.cached("offset", key, lambda: side_offset(host.mesh_points()))
+        front = front_view(mesh.name)
+        return self.watch.cached("offset", key, lambda: side_offset(host.mesh_points(), front))
 
     def push_mode(self, host: Host, force: bool = False) -> None:
         st = self.state
@@ -238,6 +239,9 @@ class SpectralPanel(Panel):
                 ui.text("-C u = lambda M u (cotangent stiffness, Voronoi mass)")
             return
         ui.text(st.message)
+        if st.tick():  # what plays advances before the sliders, so they show this frame's k
+            self.push_k(host)  # (or mode), as the captions drawn after the panels do
+            self.push_mode(host)
         ch, mode = ui.slider_int(
             "eigenmode i",
             st.mode,
@@ -289,13 +293,12 @@ class SpectralPanel(Panel):
             "pause" if st.playing else "play",
             "play the k sweep or the eigenmodes from the first (or go on after a pause); "
             "while recording, each k or mode shown adds a frame",
+            width_of=("play", "pause"),
         ):
             if st.toggle_play():
                 self.recorder.restart()  # the file starts with the first k (or mode) played
-        elif not st.tick():  # the first k (or mode) of a play shows for a frame of its own
-            return
-        self.push_k(host)
-        self.push_mode(host)
+            self.push_k(host)  # the first k (or mode) of a play shows for a frame of its own
+            self.push_mode(host)
 
     def _record_kind(self) -> str:
         """What changed since the last recorded frame: ``k`` or ``modes`` (the play choice for
