@@ -19,12 +19,14 @@ refuses the new one instead (``start`` returns ``None``).
 fields: scipy's sparse conversions hold the GIL for seconds on a big mesh, which would stall
 the window; a child process shares no GIL, and Cancel ends it at once).
 
-A job's :class:`Reporter` is what the core's long operations take as ``progress=`` (it raises
-:class:`Cancelled` once Cancel is pressed), and its ``cancel`` event their ``cancel=``.
+:func:`call_hooked` is the one adapter to the core's ``progress=`` / ``cancel=`` keywords: it
+passes each only when the callee accepts it (``inspect.signature``), so the viewer works with
+a core that has them and with one that does not.
 """
 
 from __future__ import annotations
 
+import inspect
 import multiprocessing
 import threading
 import time
@@ -33,7 +35,13 @@ from dataclasses import dataclass, field
 from pickle import PicklingError
 from typing import Any
 
-from meshlap_core.errors import Cancelled, MeshError
+from meshlap_core import errors as _errors
+from meshlap_core.errors import MeshError
+
+Cancelled: type[Exception] = getattr(_errors, "Cancelled", None) or type(
+    "Cancelled", (Exception,), {"__doc__": "A job stopped because it was cancelled."}
+)
+"""The core's :class:`meshlap_core.errors.Cancelled` (or a stand-in when the core has none)."""
 
 RUNNING, DONE, FAILED, CANCELLED = "running", "done", "failed", "cancelled"
 
@@ -291,6 +299,41 @@ class Jobs:
                 job.thread.join(left)
         self.poll()
         return self.running(owner) is None
+
+
+def prefer_gil_free_solvers() -> bool:
+    """Ask the core to keep its eigensolver on a factorization that releases the GIL
+    (``meshlap_core.linalg.spd.prefer_gil_free``, where the core has it), so the window keeps
+    drawing while an eigenbasis job runs in a thread. True when the core has the switch."""
+    try:
+        from meshlap_core.linalg import spd
+    except ImportError:
+        return False
+    switch = getattr(spd, "prefer_gil_free", None)
+    if switch is None:
+        return False
+    switch(True)
+    return True
+
+
+def accepts(fn: Callable[..., Any], name: str) -> bool:
+    """Whether ``fn`` takes the keyword argument ``name`` (or ``**kwargs``)."""
+    try:
+        params = inspect.signature(fn).parameters
+    except (TypeError, ValueError):
+        return False
+    return name in params or any(p.kind is p.VAR_KEYWORD for p in params.values())
+
+
+def call_hooked(fn: Callable[..., Any], *args: Any, reporter: Reporter, **kwargs: Any) -> Any:
+    """``fn(*args, **kwargs)`` with ``progress=reporter`` and ``cancel=reporter.cancel`` when
+    ``fn`` accepts them (the core's hooks: ``load_mesh``, ``SpectralBasis.compute``,
+    ``Smoother.run``); without them the job still stops at its next report."""
+    if accepts(fn, "progress") and "progress" not in kwargs:
+        kwargs["progress"] = reporter
+    if accepts(fn, "cancel"):
+        kwargs["cancel"] = reporter.cancel
+    return fn(*args, **kwargs)
 
 
 # ---------------------------------------------------------------------- child processes

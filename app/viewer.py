@@ -25,10 +25,9 @@ import numpy as np
 import polyscope as ps
 
 from meshlap_core.errors import MeshError
-from meshlap_core.linalg.spd import prefer_gil_free
 
 from . import scene
-from .jobs import Job, Reporter, warm_up
+from .jobs import Job, Reporter, prefer_gil_free_solvers, warm_up
 from .pacing import Pacer
 from .panels.base import Panel
 from .registry import REGISTRY, VIEWS
@@ -603,7 +602,7 @@ def run(
         viewer.background = viewer.pace = True
         state.jobs.processes = True  # load and fields in child processes: no shared GIL
         warm_up()  # the fork server for them
-        prefer_gil_free()  # an eigenbasis job in a thread must not hold the GIL
+        prefer_gil_free_solvers()  # an eigenbasis job in a thread must not hold the GIL
         ps.set_max_fps(-1)  # polyscope's limit spins a core; the Pacer sleeps instead
         if later is not None:
             viewer.open(later)

@@ -7,7 +7,7 @@ from __future__ import annotations
 import threading
 
 import pytest
-from meshlap_app.jobs import Cancelled, Jobs, Reporter
+from meshlap_app.jobs import Cancelled, Jobs, Reporter, accepts, call_hooked
 from meshlap_app.pacing import Pacer
 
 from meshlap_core.errors import MeshError
@@ -132,12 +132,21 @@ def test_one_job_per_owner_new_replaces_old_or_is_refused():
     assert sorted(out) == ["q", "three"] and other.status == "done"
 
 
-def test_a_reporter_is_the_cores_progress_and_its_event_the_cores_cancel():
-    from meshlap_core.errors import check_cancel
-
+def test_call_hooked_passes_progress_and_cancel_only_when_accepted():
     reporter = Reporter(threading.Event())
-    reporter(0.25, "a phase")  # what load_mesh / SpectralBasis.compute call as progress=
-    check_cancel(reporter.cancel, "work")  # not cancelled: nothing happens
+    got: dict[str, object] = {}
+
+    def old_core(x: int) -> int:
+        return x
+
+    def new_core(x: int, progress=None, cancel=None) -> int:
+        got.update(progress=progress, cancel=cancel)
+        return x + 1
+
+    assert call_hooked(old_core, 1, reporter=reporter) == 1
+    assert call_hooked(new_core, 1, reporter=reporter) == 2
+    assert got == {"progress": reporter, "cancel": reporter.cancel}
+    assert accepts(new_core, "cancel") and not accepts(old_core, "cancel")
     reporter.cancel.set()
     with pytest.raises(Cancelled):
         reporter(0.5, "next phase")

@@ -11,6 +11,7 @@ import threading
 import meshlap_app.state.mesh as mesh_module
 import polyscope as ps
 import pytest
+from meshlap_app.jobs import call_hooked
 from test_viewer_widgets import drive, frames
 
 
@@ -100,7 +101,7 @@ def test_eigenbasis_job_progress_cancel_and_status_line_elsewhere(viewer, monkey
         while not release.wait(0.005):
             if progress is not None:
                 progress(0.25, "Lanczos")
-        return real(V, F, k, **kwargs)
+        return call_hooked(real, V, F, k, reporter=progress)
 
     monkeypatch.setattr(spectral_state.SpectralBasis, "compute", staticmethod(slow))
     st = viewer.panels["spectral"].state

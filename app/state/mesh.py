@@ -113,6 +113,7 @@ def read_mesh(path: str | Path | None, progress: Any = None) -> LoadedMesh:
     MeshError, OSError
         The file is refused or unreadable.
     """
+    from ..jobs import call_hooked
 
     def phase(message: str) -> None:
         if progress is not None:
@@ -131,7 +132,7 @@ def read_mesh(path: str | Path | None, progress: Any = None) -> LoadedMesh:
         name = Path(path).name
     phase(f"reading {name}")
     if progress is not None:
-        mesh = load_mesh(path, progress=progress, cancel=progress.cancel)
+        mesh = call_hooked(load_mesh, path, reporter=progress)
     else:
         mesh = load_mesh(path)
     phase("describing the mesh")

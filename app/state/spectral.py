@@ -79,9 +79,11 @@ class SpectralState:
         """The job's work (any thread): ``k`` eigenpairs, the errors for every k and the
         slider's checkpoints; touches no state. ``progress``: a job's reporter (progress and
         cancel handed to the core where it takes them)."""
+        from ..jobs import call_hooked
+
         report = progress if progress is not None else self._progress
         if progress is not None:
-            basis = SpectralBasis.compute(V, F, k, progress=progress, cancel=progress.cancel)
+            basis = call_hooked(SpectralBasis.compute, V, F, k, reporter=progress)
         else:
             basis = SpectralBasis.compute(V, F, k, progress=report)
         if progress is not None:
