@@ -160,3 +160,39 @@ DEGENERATE_REL = 0.5e-12
 ``|(b−a)×(c−a)| ≤ DEGENERATE_REL · (l₀² + l₁² + l₂²)``. The validator removes such faces and the
 cotangent code gives them zero weights; in the squared form the Laplacian uses,
 ``16 A² ≤ (2·DEGENERATE_REL)² (Σ l²)²``, so both select exactly the same faces."""
+
+# ---- exercises (meshlap check) ---------------------------------------------------------------
+
+ExerciseTask = Literal[
+    "uniform_laplacian",
+    "cotan_laplacian",
+    "barycentric_areas",
+    "voronoi_areas",
+    "mass_matrix",
+    "mean_curvature_normal",
+    "mean_curvature",
+    "angle_defect",
+    "one_ring",
+    "eigenbasis",
+    "spectral_reconstruction",
+    "explicit_step",
+    "implicit_step",
+    "taubin_step",
+]
+EXERCISE_TASKS: tuple[str, ...] = get_args(ExerciseTask)
+"""The exercises of ``meshlap exercises init`` / ``meshlap check --task``, in template order."""
+EXERCISE_RTOL = 1e-7
+"""A student's value passes when ``|got − expected| ≤ EXERCISE_RTOL · max(max|expected|, h^p)``
+on every vertex, ``h`` the mesh's mean edge length and ``p`` the quantity's units (length^p):
+the tolerance follows the mesh scale, so a copy scaled by 250 is judged alike."""
+EXERCISE_EIGEN_RTOL = 1e-6
+"""The same for eigenvalues and the eigen-residual (an iterative solver's accuracy)."""
+EXERCISE_SLOW_RATIO = 100.0
+"""A correct answer that takes this many times the reference's time on the large mesh is
+reported as a slow Python loop (and fails)."""
+EXERCISE_SLOW_MIN_SECONDS = 0.05
+"""...and only when it takes at least this long (tiny times are noise)."""
+EXERCISE_TIMEOUT = 60.0
+"""Seconds one task of a student file may run before it is stopped (``meshlap check --timeout``)."""
+EXERCISE_MEMORY_MB = 2048
+"""Address space a student file may add to the checker's worker, in MiB (``--memory``)."""

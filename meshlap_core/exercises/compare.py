@@ -1,0 +1,206 @@
+"""Compare a student's answer with the reference at a tolerance that follows the mesh scale.
+
+A quantity with units length^p on a mesh of mean edge length ``h`` passes when, at every vertex,
+``|got − expected| ≤ EXERCISE_RTOL · max(max|expected|, h^p)`` (:mod:`meshlap_core.options`):
+a copy of a mesh scaled by 250 is judged exactly like the original, and an all-zero answer (the
+angle defect of a flat patch) is compared at the natural unit ``h^p`` instead of at zero.
+Eigenvectors are compared without fixing their sign or their basis inside a repeated
+eigenvalue's space: ``UᵀMU = I`` and the residual ``KU − MUΛ`` are checked instead.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..options import EXERCISE_EIGEN_RTOL, EXERCISE_RTOL, MASS_AREA
+from .meshes import Case
+
+
+@dataclass
+class Comparison:
+    """The outcome of one comparison.
+
+    Attributes
+    ----------
+    ok : bool
+    vertex : int or None
+        The vertex (row) with the largest error.
+    expected, got : Any
+        That vertex's reference and student values (a row: ``[(column, value), ...]`` for a
+        matrix, a number or a 3-vector, or a neighbour list).
+    error, tol : float
+        The largest error and the tolerance it was held to.
+    difference : (n,) float or None
+        Per-vertex student − reference (signed for a scalar, the row's largest magnitude
+        otherwise): the difference map.
+    message : str
+        What is wrong when it is not a value (shape, type, NaN).
+    """
+
+    ok: bool
+    vertex: int | None = None
+    expected: Any = None
+    got: Any = None
+    error: float = 0.0
+    tol: float = 0.0
+    difference: np.ndarray | None = field(default=None, repr=False)
+    message: str = ""
+
+
+def _tolerance(ref_max: float, case: Case, power: int, rtol: float) -> float:
+    return rtol * max(ref_max, case.scale**power)
+
+
+def _shape_message(got_shape: tuple[int, ...], want: tuple[int, ...], case: Case) -> str:
+    text = f"shape {got_shape}, expected {want}"
+    if len(case.F) and got_shape and got_shape[0] == int(case.F.max()) + 1 != len(case.V):
+        text += " (sized by F.max()+1: vertices in no face still need their row; use len(V))"
+    return text
+
+
+def as_matrix(x: Any) -> sp.csr_matrix:
+    """A student's matrix as CSR float (sparse, dense, ``np.matrix`` or nested lists)."""
+    if sp.issparse(x):
+        return sp.csr_matrix(x, dtype=np.float64)
+    a = np.asarray(x, dtype=np.float64)
+    if a.ndim != 2:
+        raise ValueError(f"a {a.ndim}-d array, expected a 2-d matrix")
+    return sp.csr_matrix(a)
+
+
+def _row(A: sp.csr_matrix, i: int, cols: np.ndarray) -> list[tuple[int, float]]:
+    return [(int(j), float(A[i, j])) for j in cols]
+
+
+def compare_matrix(got: Any, ref: sp.spmatrix, case: Case, power: int) -> Comparison:
+    R = sp.csr_matrix(ref, dtype=np.float64)
+    try:
+        G = as_matrix(got)
+    except (TypeError, ValueError) as exc:
+        return Comparison(False, message=f"returned {type(got).__name__}: {exc}")
+    if G.shape != R.shape:
+        return Comparison(False, message=_shape_message(G.shape, R.shape, case))
+    if not np.isfinite(G.data).all():
+        bad = int(np.flatnonzero(~np.isfinite(G.toarray()).all(axis=1))[0])
+        return Comparison(
+            False, vertex=bad, message="NaN or inf in the answer (a division by zero?)"
+        )
+    D = (G - R).tocsr()
+    D.eliminate_zeros()
+    rows = np.zeros(R.shape[0])
+    if D.nnz:
+        rows = np.asarray(abs(D).max(axis=1).toarray()).ravel()
+    tol = _tolerance(float(abs(R).max()) if R.nnz else 0.0, case, power, EXERCISE_RTOL)
+    i = int(np.argmax(rows)) if len(rows) else 0
+    cols = np.union1d(R[i].indices, G[i].indices) if len(rows) else np.zeros(0, int)
+    return Comparison(
+        bool(rows.max(initial=0.0) <= tol), i, _row(R, i, cols), _row(G, i, cols),
+        float(rows.max(initial=0.0)), tol, rows,
+    )  # fmt: skip
+
+
+def compare_array(got: Any, ref: np.ndarray, case: Case, power: int) -> Comparison:
+    ref = np.asarray(ref, dtype=np.float64)
+    try:
+        g = np.asarray(got.toarray() if sp.issparse(got) else got, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        return Comparison(False, message=f"returned {type(got).__name__}: {exc}")
+    if g.shape != ref.shape and g.size == ref.size and ref.ndim == 1:
+        g = g.reshape(ref.shape)  # an (n,1) column is the same answer
+    if g.shape != ref.shape:
+        return Comparison(False, message=_shape_message(g.shape, ref.shape, case))
+    if not np.isfinite(g).all():
+        bad = int(np.flatnonzero(~np.isfinite(g.reshape(len(g), -1)).all(axis=1))[0])
+        return Comparison(
+            False, vertex=bad, message="NaN or inf in the answer (a division by zero?)"
+        )
+    d = (g - ref).reshape(len(ref), -1)
+    rows = np.abs(d).max(axis=1) if d.size else np.zeros(len(ref))
+    tol = _tolerance(float(np.abs(ref).max(initial=0.0)), case, power, EXERCISE_RTOL)
+    i = int(np.argmax(rows)) if len(rows) else 0
+    diff = d[:, 0] if ref.ndim == 1 else rows
+    show = (lambda a: float(a[i])) if ref.ndim == 1 else (lambda a: [float(x) for x in a[i]])
+    ok = bool(rows.max(initial=0.0) <= tol)
+    return Comparison(ok, i, show(ref), show(g), float(rows.max(initial=0.0)), tol, diff)
+
+
+def _same_ring(got: list[int], ref: list[int], closed: bool) -> bool:
+    if len(got) != len(ref):
+        return False
+    if not closed or not ref:
+        return got == ref
+    k = got.index(ref[0]) if ref[0] in got else -1
+    return k >= 0 and got[k:] + got[:k] == ref
+
+
+def compare_ring(got: Any, ref: list[np.ndarray], case: Case, power: int) -> Comparison:
+    from ..topology.rings import one_ring
+
+    try:
+        rings = [[int(j) for j in np.asarray(r).ravel()] for r in got]
+    except (TypeError, ValueError) as exc:
+        return Comparison(False, message=f"returned {type(got).__name__}: {exc}")
+    if len(rings) != len(ref):
+        return Comparison(False, message=_shape_message((len(rings),), (len(ref),), case))
+    closed = ~one_ring(case.F, len(case.V)).boundary
+    bad = [i for i in range(len(ref)) if not _same_ring(rings[i], ref[i].tolist(), bool(closed[i]))]
+    diff = np.zeros(len(ref))
+    diff[bad] = 1.0
+    if not bad:
+        return Comparison(True, difference=diff)
+    i = bad[0]
+    return Comparison(False, i, ref[i].tolist(), rings[i], float(len(bad)), 0.0, diff)
+
+
+def compare_eigen(
+    got: Any, ref: tuple[np.ndarray, np.ndarray], case: Case, power: int
+) -> Comparison:
+    from ..laplacian import cotan_stiffness, vertex_areas
+
+    lam_ref, _ = ref
+    try:
+        lam, U = (np.asarray(x, dtype=np.float64) for x in got)
+    except (TypeError, ValueError) as exc:
+        return Comparison(False, message=f"expected (lam, U), got {type(got).__name__}: {exc}")
+    n, k = len(case.V), len(lam_ref)
+    if lam.shape != (k,) or U.shape != (n, k):
+        return Comparison(
+            False, message=f"shapes {lam.shape}, {U.shape}; expected ({k},), ({n}, {k})"
+        )
+    if not (np.isfinite(lam).all() and np.isfinite(U).all()):
+        return Comparison(False, message="NaN or inf in the answer")
+    tol = _tolerance(float(np.abs(lam_ref).max()), case, power, EXERCISE_EIGEN_RTOL)
+    if np.abs(lam - lam_ref).max() > tol:
+        j = int(np.argmax(np.abs(lam - lam_ref)))
+        err = float(np.abs(lam - lam_ref).max())
+        return Comparison(False, None, lam_ref.tolist(), lam.tolist(), err, tol,
+                          message=f"eigenvalue {j} differs")  # fmt: skip
+    m = vertex_areas(case.V, case.F, MASS_AREA)
+    G = U.T @ (m[:, None] * U)
+    ortho = float(np.abs(G - np.eye(k)).max())
+    if ortho > 1e-5:
+        got = f"max |UᵀMU − I| = {ortho:.3g}"
+        why = "eigenvectors not M-orthonormal"
+        return Comparison(False, None, "UᵀMU = I", got, ortho, 1e-5, message=why)
+    K = -cotan_stiffness(case.V, case.F)
+    R = (K @ U) - m[:, None] * U * lam_ref
+    # K is dimensionless (cot weights), U has units 1/length: the residual is relative to |K||U|
+    rows = np.abs(R).max(axis=1) / (abs(K).max() * np.abs(U).max())
+    rtol = EXERCISE_EIGEN_RTOL * 10
+    i = int(np.argmax(rows))
+    ok = bool(rows[i] <= rtol)
+    why = "" if ok else "the columns of U are not eigenvectors (K u ≠ λ M u)"
+    return Comparison(ok, i, 0.0, float(rows[i]), float(rows[i]), rtol, rows, why)
+
+
+COMPARE = {
+    "matrix": compare_matrix,
+    "array": compare_array,
+    "ring": compare_ring,
+    "eigen": compare_eigen,
+}
+"""Task kind -> ``compare(got, ref, case, power) -> Comparison``."""

@@ -1,0 +1,143 @@
+"""The battery of meshes every exercise is checked on, each chosen to expose a classic mistake.
+
+=====================  ==========================================================================
+case                   what it catches
+=====================  ==========================================================================
+``one_triangle``       the hand-computable case: wrong factors (2, ½, 3) show at once
+``tetrahedron``        a closed regular mesh: sign and orientation, angle defect π per vertex
+``obtuse_fan``         an interior vertex with an obtuse triangle: barycentric vs Voronoi vs mixed
+``boundary_fan``       an open fan: the boundary rule of the angle defect, one-sided cot weights
+``cube_corner``        three squares around a corner: defect exactly π/2, zero-curvature faces
+``non_delaunay_pair``  two triangles whose opposite angles sum past π: a negative cot weight
+``unreferenced``       vertices in no face (one in the middle, one last): shape ``(n,n)`` not
+                       ``F.max()+1``, zero rows, no division by zero
+``scaled``             a bumpy sphere scaled by 250 and moved: units and scale-aware tolerances
+``small_sphere``       a closed bumpy sphere (42 vertices) for the eigenproblem
+``large``              an icosphere of 2562 vertices, perturbed: correctness at size and speed
+=====================  ==========================================================================
+
+Every mesh is generated here (seeded), never read from disk, and oriented counter-clockwise
+seen from outside.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..primitives import icosphere
+from ..types import FloatArray, IntArray
+
+
+@dataclass(frozen=True)
+class Case:
+    """One mesh of the battery.
+
+    Attributes
+    ----------
+    name : str
+    V : (n,3) float
+    F : (m,3) int
+    catches : str
+        The mistake this mesh is there to expose (shown with a failure).
+    closed : bool
+        No boundary and no unreferenced vertex (the eigenproblem needs it).
+    """
+
+    name: str
+    V: FloatArray
+    F: IntArray
+    catches: str
+    closed: bool = False
+    tags: tuple[str, ...] = field(default=())
+
+    @property
+    def scale(self) -> float:
+        """Mean edge length ``h``: a quantity with units of length^p is compared at ``h^p``."""
+        P = self.V[self.F]
+        e = np.concatenate([P[:, 1] - P[:, 0], P[:, 2] - P[:, 1], P[:, 0] - P[:, 2]])
+        return float(np.mean(np.linalg.norm(e, axis=1)))
+
+
+def _outward(V: FloatArray, F: IntArray, inside: FloatArray) -> IntArray:
+    """Flip faces whose normal points towards ``inside`` (a convex-ish patch or solid)."""
+    P = V[F]
+    n = np.cross(P[:, 1] - P[:, 0], P[:, 2] - P[:, 0])
+    flip = np.einsum("ij,ij->i", n, P.mean(axis=1) - inside) < 0
+    F = F.copy()
+    F[flip] = F[flip][:, ::-1]
+    return F
+
+
+def _fan(angles: list[float], radii: list[float], heights: list[float], closed: bool):
+    """A fan around vertex 0 at the origin: ring vertices at the given polar angles (degrees)."""
+    t = np.radians(angles)
+    ring = np.column_stack([np.cos(t) * radii, np.sin(t) * radii, heights])
+    V = np.vstack([[0.0, 0.0, 0.0], ring])
+    k = len(angles)
+    stop = k if closed else k - 1
+    F = np.array([[0, 1 + j, 1 + (j + 1) % k] for j in range(stop)], dtype=np.int64)
+    return V, F
+
+
+def _bumpy_sphere(subdivisions: int, seed: int, amount: float = 0.08):
+    V, F = icosphere(subdivisions)
+    rng = np.random.default_rng(seed)
+    V = V * (1.0 + amount * rng.uniform(-1.0, 1.0, size=(len(V), 1)))
+    return V, F
+
+
+def battery() -> list[Case]:
+    """All cases, in the order they are tried (the small hand-checkable ones first)."""
+    cases: list[Case] = []
+    V = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.3, 0.8, 0.0]])
+    cases.append(Case("one_triangle", V, np.array([[0, 1, 2]]), "factors 2, ½, 3 by hand"))
+
+    s = 1.0 / np.sqrt(2.0)
+    V = np.array([[1.0, 0.0, -s], [-1.0, 0.0, -s], [0.0, 1.0, s], [0.0, -1.0, s]])
+    F = _outward(V, np.array([[0, 1, 2], [0, 1, 3], [0, 2, 3], [1, 2, 3]]), V.mean(axis=0))
+    cases.append(Case("tetrahedron", V, F, "sign and orientation on a closed mesh", True))
+
+    V, F = _fan([0, 70, 130, 250, 310], [1.0, 0.8, 1.2, 0.9, 1.1], [0.3, 0.1, 0.4, 0.2, 0.35], True)
+    cases.append(Case("obtuse_fan", V, F, "barycentric instead of Voronoi (obtuse triangle)"))
+
+    V, F = _fan(
+        [0, 50, 110, 160, 210], [1.0, 1.1, 0.9, 1.0, 1.2], [0.2, 0.0, 0.3, 0.1, 0.25], False
+    )
+    cases.append(Case("boundary_fan", V, F, "the boundary rule, one-sided cot weights"))
+
+    V = np.array(
+        [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 1, 0], [0, 1, 1], [1, 0, 1]], float
+    )
+    F = np.array([[0, 2, 4], [0, 4, 1], [0, 1, 6], [0, 6, 3], [0, 3, 5], [0, 5, 2]])
+    F = _outward(V, F, np.array([0.5, 0.5, 0.5]))
+    cases.append(Case("cube_corner", V, F, "defect π/2 at the corner, flat faces"))
+
+    V = np.array([[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.2, 0.0], [0.1, -0.3, 0.1]])
+    F = np.array([[0, 1, 2], [1, 0, 3]])
+    cases.append(Case("non_delaunay_pair", V, F, "a negative cot weight (no abs, no clamp)"))
+
+    V0, F0 = _fan([0, 80, 150, 220, 290], [1.0, 0.9, 1.1, 1.0, 0.95], [0.2] * 5, True)
+    V0[0, 2] = 0.5
+    # insert an unreferenced vertex in the middle and one at the end
+    V = np.vstack([V0[:3], [[5.0, 5.0, 5.0]], V0[3:], [[-4.0, 2.0, 1.0]]])
+    F = np.where(F0 >= 3, F0 + 1, F0)
+    cases.append(Case("unreferenced", V, F, "shape (n,n) with zero rows for vertices in no face"))
+
+    V, F = _bumpy_sphere(1, seed=3)
+    cases.append(Case("small_sphere", V, F, "a closed surface for the eigenproblem", True))
+    cases.append(
+        Case("scaled", 250.0 * V + [40.0, -7.0, 3.0], F, "units: a copy scaled by 250", True)
+    )
+    V, F = _bumpy_sphere(4, seed=7, amount=0.02)
+    cases.append(Case("large", V, F, "correct at size, and not 100× slower", True, ("speed",)))
+    return cases
+
+
+def case_named(name: str) -> Case:
+    """The battery case called ``name``."""
+    for c in battery():
+        if c.name == name:
+            return c
+    raise KeyError(name)

@@ -1,0 +1,224 @@
+"""The result of a check: per task passed or why not, as text, JSON, JUnit XML, and for
+notebooks an HTML table (``_repr_html_``) and a small picture (``_repr_png_``, matplotlib)."""
+
+from __future__ import annotations
+
+import html
+import io
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+STATUS_WORDS = {
+    "passed": "passed",
+    "failed": "FAILED",
+    "error": "ERROR (your code raised)",
+    "timeout": "TIMEOUT",
+    "memory": "OUT OF MEMORY",
+    "crashed": "CRASHED",
+    "missing": "missing",
+    "not_implemented": "not implemented",
+    "import_error": "ERROR (the file does not import)",
+}
+
+
+@dataclass
+class TaskResult:
+    """One task's verdict.
+
+    Attributes
+    ----------
+    task, status : str
+        ``status`` is a key of :data:`STATUS_WORDS`.
+    case, label : str
+        The first failing mesh and call (``boundary=pi``, ``k=6``...).
+    vertex : int or None
+        The vertex with the largest error there.
+    expected, got : Any
+        That vertex's reference and student values.
+    error, tol : float
+    diagnosis : str or None
+        A key of :data:`~.diagnose.DIAGNOSES`; ``diagnosis_text`` its sentence.
+    message, traceback : str
+    n_failed, n_calls : int
+    speed_ratio : float or None
+        Student time / reference time on the large mesh (speed-checked tasks).
+    difference : (n,) float or None
+        Student − reference per vertex of ``case`` (the difference map).
+    """
+
+    task: str
+    status: str
+    case: str = ""
+    label: str = ""
+    vertex: int | None = None
+    expected: Any = None
+    got: Any = None
+    error: float = 0.0
+    tol: float = 0.0
+    diagnosis: str | None = None
+    diagnosis_text: str = ""
+    message: str = ""
+    traceback: str = ""
+    n_failed: int = 0
+    n_calls: int = 0
+    speed_ratio: float | None = None
+    difference: np.ndarray | None = field(default=None, repr=False)
+
+    @property
+    def passed(self) -> bool:
+        return self.status == "passed"
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready fields (no difference array)."""
+        out = {k: v for k, v in vars(self).items() if k != "difference"}
+        out["passed"] = self.passed
+        return out
+
+    def lines(self) -> list[str]:
+        """The text report of this task (first line: name and verdict)."""
+        head = f"{self.task:<24} {STATUS_WORDS.get(self.status, self.status)}"
+        if self.passed:
+            speed = f", {self.speed_ratio:.0f}× the reference's time" if self.speed_ratio else ""
+            return [f"{head} ({self.n_calls} calls{speed})"]
+        out = [head]
+        if self.case:
+            where = f"  on mesh {self.case}" + (f" ({self.label})" if self.label else "")
+            if self.n_failed > 1:
+                where += f", and {self.n_failed - 1} more failing call(s)"
+            out.append(where)
+        if self.vertex is not None:
+            out.append(f"  at vertex {self.vertex}:")
+            out.append(f"    expected {_short(self.expected)}")
+            out.append(f"    got      {_short(self.got)}")
+            if self.tol:
+                out.append(f"    largest error {self.error:.3g} (tolerance {self.tol:.3g})")
+        if self.diagnosis_text:
+            out.append(f"  likely mistake: {self.diagnosis_text}")
+        if self.message and self.message != self.traceback:
+            out.append(f"  {self.message}")
+        if self.traceback:
+            out.extend("  " + line for line in self.traceback.splitlines())
+        return out
+
+
+def _short(value: Any, limit: int = 160) -> str:
+    if isinstance(value, list) and value and isinstance(value[0], tuple):
+        text = ", ".join(f"[{j}] {v:.6g}" for j, v in value)
+    elif isinstance(value, float):
+        text = f"{value:.9g}"
+    elif isinstance(value, list) and value and isinstance(value[0], float):
+        text = "[" + ", ".join(f"{v:.6g}" for v in value) + "]"
+    else:
+        text = str(value)
+    return text if len(text) <= limit else text[: limit - 1] + "…"
+
+
+@dataclass
+class CheckResult:
+    """All tasks of one student file."""
+
+    file: str
+    tasks: list[TaskResult]
+
+    @property
+    def passed(self) -> bool:
+        return all(t.passed for t in self.tasks)
+
+    @property
+    def n_passed(self) -> int:
+        return sum(t.passed for t in self.tasks)
+
+    def __getitem__(self, name: str) -> TaskResult:
+        for t in self.tasks:
+            if t.task == name:
+                return t
+        raise KeyError(name)
+
+    def format_text(self) -> str:
+        lines = [f"{self.file}: {self.n_passed}/{len(self.tasks)} tasks passed"]
+        for t in self.tasks:
+            lines.extend(t.lines())
+        return "\n".join(lines)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "file": self.file,
+            "passed": self.n_passed,
+            "total": len(self.tasks),
+            "tasks": [t.to_dict() for t in self.tasks],
+        }
+
+    def to_junit(self) -> str:
+        """A JUnit XML report (one ``testsuite``, one ``testcase`` per task)."""
+        failures = sum(t.status == "failed" for t in self.tasks)
+        errors = sum(t.status not in ("passed", "failed") for t in self.tasks)
+        suite = ET.Element(
+            "testsuite",
+            name=f"meshlap check {self.file}",
+            tests=str(len(self.tasks)),
+            failures=str(failures),
+            errors=str(errors),
+        )
+        for t in self.tasks:
+            case = ET.SubElement(suite, "testcase", classname="meshlap.exercises", name=t.task)
+            if t.passed:
+                continue
+            tag = "failure" if t.status == "failed" else "error"
+            text = "\n".join(t.lines()[1:])
+            node = ET.SubElement(case, tag, message=t.diagnosis_text or t.message or t.status)
+            node.text = text
+        return ET.tostring(suite, encoding="unicode", xml_declaration=True) + "\n"
+
+    # ---- notebooks ------------------------------------------------------------------------
+
+    def _repr_html_(self) -> str:
+        rows = []
+        for t in self.tasks:
+            colour = "#1a7f37" if t.passed else "#cf222e"
+            detail = "" if t.passed else "<br>".join(html.escape(x) for x in t.lines()[1:6])
+            rows.append(
+                f"<tr><td><code>{html.escape(t.task)}</code></td>"
+                f"<td style='color:{colour};font-weight:bold'>"
+                f"{html.escape(STATUS_WORDS.get(t.status, t.status))}</td>"
+                f"<td style='text-align:left'>{detail}</td></tr>"
+            )
+        return (
+            f"<p><b>{html.escape(self.file)}</b>: {self.n_passed}/{len(self.tasks)} passed</p>"
+            "<table><tr><th>task</th><th>verdict</th><th>where and why</th></tr>"
+            + "".join(rows)
+            + "</table>"
+        )
+
+    def _repr_png_(self) -> bytes:
+        """A small picture: one coloured cell per task, and the first failure's difference per
+        vertex (student − reference) as a bar chart over the vertices."""
+        import matplotlib
+
+        matplotlib.use("Agg", force=False)
+        from matplotlib.figure import Figure
+
+        fig = Figure(figsize=(6.4, 2.4), dpi=80)
+        ax = fig.add_axes((0.02, 0.1, 0.42, 0.85))
+        n = len(self.tasks)
+        for k, t in enumerate(self.tasks):
+            y = n - 1 - k
+            ax.barh(y, 1.0, color="#2da44e" if t.passed else "#cf222e", height=0.9)
+            ax.text(0.03, y, t.task, va="center", fontsize=7, color="white")
+        ax.set_axis_off()
+        fail = next((t for t in self.tasks if t.difference is not None and not t.passed), None)
+        ax2 = fig.add_axes((0.55, 0.2, 0.42, 0.7))
+        if fail is not None and len(fail.difference):
+            d = np.asarray(fail.difference, dtype=float)
+            ax2.bar(np.arange(len(d)), d, color="#cf222e", width=1.0)
+            ax2.set_title(f"{fail.task} on {fail.case}: student − reference", fontsize=7)
+            ax2.set_xlabel("vertex", fontsize=7)
+            ax2.tick_params(labelsize=6)
+        else:
+            ax2.set_axis_off()
+            ax2.text(0.5, 0.5, f"{self.n_passed}/{n} passed", ha="center", fontsize=12)
+        buf = io.BytesIO()
+        fig.savefig(buf, format="png")
+        return buf.getvalue()
