@@ -147,6 +147,8 @@ COMMANDS: tuple[str, ...] = (
     "denoise_eval",
     "report",
     "spectral",
+    "exercises",
+    "check",
 )
 COMMAND_GROUP = "meshlap.commands"
 """Entry points of this group name modules with ``register(sub)``: other packages (the viewer)

@@ -60,9 +60,7 @@ def evaluate(task: Task, run: TaskRun, cases: dict[str, Case]) -> TaskResult:
             first_fail = first_fail or cmp
     if failures:
         case, args, answer, cmp, label = failures[0]
-        valued = [
-            (c, a, g) for c, a, g, cm, _ in failures if not cm.message or cm.vertex is not None
-        ]
+        valued = [(c, a, g) for c, a, g, cm, _ in failures if not cm.structural]
         key = diagnose(task, valued) if len(valued) == len(failures) else None
         if key is None and any("F.max()+1" in f[3].message for f in failures):
             key = "sized_by_faces"

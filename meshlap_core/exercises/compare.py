@@ -49,6 +49,12 @@ class Comparison:
     tol: float = 0.0
     difference: np.ndarray | None = field(default=None, repr=False)
     message: str = ""
+    structural: bool = False
+    """The answer could not be compared value by value (type, shape, NaN)."""
+
+
+def _bad(message: str, vertex: int | None = None) -> Comparison:
+    return Comparison(False, vertex, message=message, structural=True)
 
 
 def _tolerance(ref_max: float, case: Case, power: int, rtol: float) -> float:
@@ -81,14 +87,12 @@ def compare_matrix(got: Any, ref: sp.spmatrix, case: Case, power: int) -> Compar
     try:
         G = as_matrix(got)
     except (TypeError, ValueError) as exc:
-        return Comparison(False, message=f"returned {type(got).__name__}: {exc}")
+        return _bad(f"returned {type(got).__name__}: {exc}")
     if G.shape != R.shape:
-        return Comparison(False, message=_shape_message(G.shape, R.shape, case))
+        return _bad(_shape_message(G.shape, R.shape, case))
     if not np.isfinite(G.data).all():
         bad = int(np.flatnonzero(~np.isfinite(G.toarray()).all(axis=1))[0])
-        return Comparison(
-            False, vertex=bad, message="NaN or inf in the answer (a division by zero?)"
-        )
+        return _bad("NaN or inf in the answer (a division by zero?)", bad)
     D = (G - R).tocsr()
     D.eliminate_zeros()
     rows = np.zeros(R.shape[0])
@@ -108,16 +112,14 @@ def compare_array(got: Any, ref: np.ndarray, case: Case, power: int) -> Comparis
     try:
         g = np.asarray(got.toarray() if sp.issparse(got) else got, dtype=np.float64)
     except (TypeError, ValueError) as exc:
-        return Comparison(False, message=f"returned {type(got).__name__}: {exc}")
+        return _bad(f"returned {type(got).__name__}: {exc}")
     if g.shape != ref.shape and g.size == ref.size and ref.ndim == 1:
         g = g.reshape(ref.shape)  # an (n,1) column is the same answer
     if g.shape != ref.shape:
-        return Comparison(False, message=_shape_message(g.shape, ref.shape, case))
+        return _bad(_shape_message(g.shape, ref.shape, case))
     if not np.isfinite(g).all():
         bad = int(np.flatnonzero(~np.isfinite(g.reshape(len(g), -1)).all(axis=1))[0])
-        return Comparison(
-            False, vertex=bad, message="NaN or inf in the answer (a division by zero?)"
-        )
+        return _bad("NaN or inf in the answer (a division by zero?)", bad)
     d = (g - ref).reshape(len(ref), -1)
     rows = np.abs(d).max(axis=1) if d.size else np.zeros(len(ref))
     tol = _tolerance(float(np.abs(ref).max(initial=0.0)), case, power, EXERCISE_RTOL)
@@ -143,9 +145,9 @@ def compare_ring(got: Any, ref: list[np.ndarray], case: Case, power: int) -> Com
     try:
         rings = [[int(j) for j in np.asarray(r).ravel()] for r in got]
     except (TypeError, ValueError) as exc:
-        return Comparison(False, message=f"returned {type(got).__name__}: {exc}")
+        return _bad(f"returned {type(got).__name__}: {exc}")
     if len(rings) != len(ref):
-        return Comparison(False, message=_shape_message((len(rings),), (len(ref),), case))
+        return _bad(_shape_message((len(rings),), (len(ref),), case))
     closed = ~one_ring(case.F, len(case.V)).boundary
     bad = [i for i in range(len(ref)) if not _same_ring(rings[i], ref[i].tolist(), bool(closed[i]))]
     diff = np.zeros(len(ref))
@@ -165,14 +167,12 @@ def compare_eigen(
     try:
         lam, U = (np.asarray(x, dtype=np.float64) for x in got)
     except (TypeError, ValueError) as exc:
-        return Comparison(False, message=f"expected (lam, U), got {type(got).__name__}: {exc}")
+        return _bad(f"expected (lam, U), got {type(got).__name__}: {exc}")
     n, k = len(case.V), len(lam_ref)
     if lam.shape != (k,) or U.shape != (n, k):
-        return Comparison(
-            False, message=f"shapes {lam.shape}, {U.shape}; expected ({k},), ({n}, {k})"
-        )
+        return _bad(f"shapes {lam.shape}, {U.shape}; expected ({k},), ({n}, {k})")
     if not (np.isfinite(lam).all() and np.isfinite(U).all()):
-        return Comparison(False, message="NaN or inf in the answer")
+        return _bad("NaN or inf in the answer")
     tol = _tolerance(float(np.abs(lam_ref).max()), case, power, EXERCISE_EIGEN_RTOL)
     if np.abs(lam - lam_ref).max() > tol:
         j = int(np.argmax(np.abs(lam - lam_ref)))

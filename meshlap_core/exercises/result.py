@@ -89,8 +89,8 @@ class TaskResult:
             if self.n_failed > 1:
                 where += f", and {self.n_failed - 1} more failing call(s)"
             out.append(where)
-        if self.vertex is not None:
-            out.append(f"  at vertex {self.vertex}:")
+        if self.vertex is not None or self.expected is not None:
+            out.append(f"  at vertex {self.vertex}:" if self.vertex is not None else "  values:")
             out.append(f"    expected {_short(self.expected)}")
             out.append(f"    got      {_short(self.got)}")
             if self.tol:
@@ -153,6 +153,10 @@ class CheckResult:
 
     def to_junit(self) -> str:
         """A JUnit XML report (one ``testsuite``, one ``testcase`` per task)."""
+        return junit_document([self])
+
+    def junit_suite(self) -> ET.Element:
+        """This file's ``testsuite`` element (one ``testcase`` per task)."""
         failures = sum(t.status == "failed" for t in self.tasks)
         errors = sum(t.status not in ("passed", "failed") for t in self.tasks)
         suite = ET.Element(
@@ -170,7 +174,7 @@ class CheckResult:
             text = "\n".join(t.lines()[1:])
             node = ET.SubElement(case, tag, message=t.diagnosis_text or t.message or t.status)
             node.text = text
-        return ET.tostring(suite, encoding="unicode", xml_declaration=True) + "\n"
+        return suite
 
     # ---- notebooks ------------------------------------------------------------------------
 
@@ -222,3 +226,10 @@ class CheckResult:
         buf = io.BytesIO()
         fig.savefig(buf, format="png")
         return buf.getvalue()
+
+
+def junit_document(results: list[CheckResult]) -> str:
+    """A JUnit XML document: one ``testsuite`` per checked file inside ``testsuites``."""
+    root = ET.Element("testsuites")
+    root.extend(r.junit_suite() for r in results)
+    return ET.tostring(root, encoding="unicode", xml_declaration=True) + "\n"
