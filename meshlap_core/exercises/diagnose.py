@@ -1,7 +1,7 @@
 """Name the likely mistake behind a wrong answer.
 
 Every classic mistake is written as the wrong answer it produces (the task's own
-:class:`~.tasks.Mistake` list, then the generic ones: sign flip, factor 2, factor ½, transposed).
+:class:`~.tasks.Mistake` list, then the generic ones: sign flip, factor 2, factor ½).
 A wrong answer is diagnosed as the first mistake whose wrong answer matches the student's on
 *every* failing call (each mesh, each boundary rule): one mesh where two mistakes coincide (on a
 single acute triangle clamping the cot weights changes nothing) cannot mislead the diagnosis.
@@ -76,8 +76,6 @@ def _generic(task: Task) -> list[Mistake]:
         Mistake("factor_2", lambda c, a: _scaled(task.reference(c, a), 2.0)),
         Mistake("factor_half", lambda c, a: _scaled(task.reference(c, a), 0.5)),
     ]
-    if task.kind == "matrix":
-        out.append(Mistake("transposed", lambda c, a: sp.csr_matrix(task.reference(c, a).T)))
     return out
 
 
@@ -113,7 +111,8 @@ def _matches(task: Task, mistake: Mistake, case: Case, args: Args, got: Any) -> 
 
 
 def _eigen_matches(key: str, got: Any, wrong: tuple[np.ndarray, np.ndarray]) -> bool:
-    """Eigenvalues as the mistake gives them (and, for ``not_m_orthonormal``, ``UᵀU = I``)."""
+    """Eigenvalues as the mistake gives them (and, for ``not_m_orthonormal``, columns of unit
+    Euclidean length)."""
     try:
         lam, U = (np.asarray(x, dtype=np.float64) for x in got)
     except (TypeError, ValueError):
@@ -124,7 +123,7 @@ def _eigen_matches(key: str, got: Any, wrong: tuple[np.ndarray, np.ndarray]) -> 
     if not np.allclose(lam, lam_w, rtol=1e-5, atol=1e-8 * np.abs(lam_w).max()):
         return False
     if key == "not_m_orthonormal":
-        return bool(np.allclose(U.T @ U, np.eye(len(lam)), atol=1e-5))
+        return bool(np.allclose(np.linalg.norm(U, axis=0), 1.0, atol=1e-6))
     return True
 
 

@@ -182,7 +182,7 @@ class CheckResult:
         rows = []
         for t in self.tasks:
             colour = "#1a7f37" if t.passed else "#cf222e"
-            detail = "" if t.passed else "<br>".join(html.escape(x) for x in t.lines()[1:6])
+            detail = "" if t.passed else "<br>".join(html.escape(x) for x in t.lines()[1:14])
             rows.append(
                 f"<tr><td><code>{html.escape(t.task)}</code></td>"
                 f"<td style='color:{colour};font-weight:bold'>"

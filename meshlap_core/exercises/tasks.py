@@ -73,7 +73,7 @@ class Task:
     mistakes : tuple of Mistake
         Task-specific mistakes, tried before the generic ones.
     generic : bool
-        Also try the generic mistakes (sign, factor 2, factor ½, transposed).
+        Also try the generic mistakes (sign, factor 2, factor ½).
     speed : bool
         Time the student against the reference on the large case.
     """
@@ -322,11 +322,13 @@ def _taubin(variant: str = ""):
 
 
 def _table() -> dict[str, Task]:
+    """Long because it is the table itself: one entry per exercise, read top to bottom."""
     M = Mistake
     tasks = [
         Task(
             "uniform_laplacian", "matrix", 0, OPERATOR_CASES, _vf, _uniform,
-            (M("graph_not_normalised", _graph),), speed=True,
+            (M("graph_not_normalised", _graph),
+             M("transposed", lambda c, a: _uniform(c, a).T.tocsr())), speed=True,
         ),
         Task(
             "cotan_laplacian", "matrix", 0, OPERATOR_CASES, _vf, _cotan,

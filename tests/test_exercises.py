@@ -1,0 +1,299 @@
+"""The exercises checker, checked: wrong student files fail with the named diagnosis, right
+ones written unlike the reference pass, hostile ones are stopped while the checker survives.
+
+The student files live in ``tests/exercises/``; each runs sandboxed (a spawned process) once per
+module (``checked``), and every test reads its verdicts.
+"""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from meshlap_core import curvature as cv
+from meshlap_core import laplacian as lap
+from meshlap_core.exercises import check_file, template
+from meshlap_core.exercises.compare import COMPARE
+from meshlap_core.exercises.diagnose import DIAGNOSES, candidates, diagnose
+from meshlap_core.exercises.meshes import battery, case_named
+from meshlap_core.exercises.tasks import TASKS
+from meshlap_core.options import EXERCISE_TASKS
+from meshlap_core.topology.rings import one_ring
+
+STUDENTS = Path(__file__).parent / "exercises"
+
+WRONG = [  # (student file, task, the diagnosis it must get)
+    ("wrong_uniform_sign", "uniform_laplacian", "sign_flip"),
+    ("wrong_uniform_transposed", "uniform_laplacian", "transposed"),
+    ("wrong_uniform_graph", "uniform_laplacian", "graph_not_normalised"),
+    ("wrong_uniform_fmax", "uniform_laplacian", "sized_by_faces"),
+    ("wrong_cotan_full", "cotan_laplacian", "cot_not_half"),
+    ("wrong_cotan_quarter", "cotan_laplacian", "factor_half"),
+    ("wrong_cotan_abs", "cotan_laplacian", "clamped_weights"),
+    ("wrong_cotan_rownorm", "cotan_laplacian", "row_normalised"),
+    ("wrong_cotan_slow", "cotan_laplacian", "slow_loop"),
+    ("wrong_areas", "barycentric_areas", "not_divided_by_3"),
+    ("wrong_areas", "voronoi_areas", "barycentric_not_voronoi"),
+    ("wrong_areas", "mass_matrix", "barycentric_not_voronoi"),
+    ("wrong_voronoi_no_obtuse", "voronoi_areas", "no_obtuse_rule"),
+    ("wrong_curvature", "mean_curvature_normal", "sign_flip"),
+    ("wrong_curvature", "mean_curvature", "factor_2"),
+    ("wrong_defect", "angle_defect", "missing_boundary_term"),
+    ("wrong_defect_degrees", "angle_defect", "degrees"),
+    ("wrong_ring_cw", "one_ring", "wrong_orientation"),
+    ("wrong_spectral", "eigenbasis", "ordinary_eigenproblem"),
+    ("wrong_spectral", "spectral_reconstruction", "projection_without_mass"),
+    ("wrong_eigen_euclid", "eigenbasis", "not_m_orthonormal"),
+    ("wrong_steps", "explicit_step", "sign_flip"),
+    ("wrong_steps", "taubin_step", "mu_sign"),
+    ("wrong_implicit", "implicit_step", "missing_mass"),
+    ("wrong_implicit_explicit", "implicit_step", "explicit_not_implicit"),
+]
+RIGHT = ["right_vectorized", "right_loops", "right_dense", "right_other_order", "right_igl"]
+HOSTILE_TIMEOUT = 4.0
+
+
+def _tasks_in(name: str) -> list[str]:
+    tree = ast.parse((STUDENTS / f"{name}.py").read_text())
+    defined = {n.name for n in tree.body if isinstance(n, ast.FunctionDef)}
+    return [t for t in EXERCISE_TASKS if t in defined]
+
+
+@pytest.fixture(scope="module")
+def checked():
+    """File name -> CheckResult, each student file checked once (on the tasks it defines)."""
+    cache = {}
+
+    def get(name: str, **kw):
+        if name not in cache:
+            cache[name] = check_file(STUDENTS / f"{name}.py", _tasks_in(name), **kw)
+        return cache[name]
+
+    return get
+
+
+# ---- the wrong-solution suite --------------------------------------------------------------
+
+
+def test_the_suites_are_as_large_as_the_issue_asks():
+    assert len(WRONG) >= 10 and len(RIGHT) >= 5
+    assert {d for _, _, d in WRONG} >= {
+        "sign_flip", "factor_2", "factor_half", "barycentric_not_voronoi", "cot_not_half",
+        "missing_boundary_term", "transposed", "row_normalised", "wrong_orientation",
+        "ordinary_eigenproblem", "projection_without_mass", "slow_loop",
+    }  # fmt: skip
+
+
+@pytest.mark.parametrize(("name", "task", "diagnosis"), WRONG, ids=lambda x: str(x))
+def test_a_wrong_solution_fails_with_its_diagnosis(checked, name, task, diagnosis):
+    result = checked(name)[task]
+    assert result.status == "failed", result.lines()
+    assert result.diagnosis == diagnosis, result.lines()
+    assert DIAGNOSES[diagnosis].split(":")[0].split("{")[0] in "\n".join(result.lines())
+
+
+@pytest.mark.parametrize("name", RIGHT)
+def test_a_right_solution_written_differently_passes(checked, name):
+    result = checked(name)
+    assert len(result.tasks) >= 4
+    assert result.passed, result.format_text()
+
+
+def test_the_right_solutions_cover_every_task():
+    covered = {t for name in RIGHT for t in _tasks_in(name)}
+    assert covered == set(EXERCISE_TASKS)
+
+
+def test_a_wrong_value_names_the_mesh_the_vertex_expected_and_got(checked):
+    r = checked("wrong_cotan_abs")["cotan_laplacian"]
+    # the obtuse fan's and the non-Delaunay pair's negative weights: nowhere else
+    assert r.case in ("obtuse_fan", "non_delaunay_pair") and r.n_failed == 2
+    got, expected = dict(r.got), dict(r.expected)
+    assert got.keys() == expected.keys()
+    assert any(
+        e < 0 and np.isclose(g, -e) for g, e in zip(got.values(), expected.values(), strict=True)
+    )
+
+
+# ---- every mistake in the table is recognised from its own wrong answer (no sandbox) -------
+
+
+def _mistake_cases():
+    for task in TASKS.values():
+        for mistake in candidates(task):
+            yield pytest.param(task.name, mistake, id=f"{task.name}-{mistake.key}")
+
+
+@pytest.mark.parametrize(("name", "mistake"), list(_mistake_cases()))
+def test_each_mistake_is_diagnosed_from_its_wrong_answer(name, mistake):
+    task = TASKS[name]
+    failures = []
+    for case in (case_named(c) for c in task.cases):
+        for _, args in task.calls(case):
+            wrong = mistake.wrong(case, args)
+            if wrong is None:
+                continue
+            cmp = COMPARE[task.kind](wrong, task.reference(case, args), case, task.power)
+            if not cmp.ok:
+                failures.append((case, args, wrong))
+    assert failures, "the battery cannot tell this mistake from the right answer"
+    key = diagnose(task, failures)
+    # a mistake equal to an earlier one on every mesh gets the earlier (same-meaning) name
+    assert key is not None
+    assert (
+        key == mistake.key or DIAGNOSES[key] == DIAGNOSES[mistake.key] or _same(task, key, mistake)
+    )
+
+
+def _same(task, key, mistake) -> bool:
+    first = next(m for m in candidates(task) if m.key == key)
+    for case in (case_named(c) for c in task.cases):
+        for _, args in task.calls(case):
+            a, b = first.wrong(case, args), mistake.wrong(case, args)
+            if a is None or b is None:
+                continue
+            if not COMPARE[task.kind](a, b, case, task.power).ok:
+                return False
+    return True
+
+
+def test_every_diagnosis_has_a_sentence():
+    keys = {m.key for t in TASKS.values() for m in candidates(t)}
+    assert keys | {"slow_loop", "sized_by_faces"} <= set(DIAGNOSES)
+
+
+# ---- the battery is what it says (hand-computed) ---------------------------------------------
+
+
+def test_battery_hand_values():
+    tri = case_named("one_triangle")
+    # area ½·1·0.8 = 0.4, a third to each vertex
+    assert np.allclose(lap.vertex_areas(tri.V, tri.F, "barycentric"), 0.4 / 3)
+    L = lap.uniform_laplacian(tri.F, 3).toarray()
+    assert np.allclose(L, [[-1, 0.5, 0.5], [0.5, -1, 0.5], [0.5, 0.5, -1]])
+    tet = case_named("tetrahedron")
+    assert np.allclose(cv.angle_deficit(tet.V, tet.F), np.pi)  # 3 angles of π/3 each
+    corner = case_named("cube_corner")
+    assert np.isclose(cv.angle_deficit(corner.V, corner.F)[0], np.pi / 2)
+    pair = case_named("non_delaunay_pair")
+    assert lap.cotan_stiffness(pair.V, pair.F)[0, 1] < 0  # the edge's weight is negative
+    fan = case_named("obtuse_fan")
+    assert (cv.corner_angles(fan.V, fan.F) > np.pi / 2).any()
+    assert not np.allclose(
+        lap.vertex_areas(fan.V, fan.F, "voronoi"), lap.vertex_areas(fan.V, fan.F)
+    )
+    unref = case_named("unreferenced")
+    assert unref.F.max() + 1 < len(unref.V)
+    assert set(range(len(unref.V))) - set(unref.F.ravel()) == {3, len(unref.V) - 1}
+    assert one_ring(case_named("boundary_fan").F, 6).boundary[0]
+
+
+def test_every_battery_mesh_is_oriented_outwards():
+    for case in battery():
+        if case.closed:
+            P = case.V[case.F]
+            vol = np.einsum("ij,ij->i", P[:, 0], np.cross(P[:, 1], P[:, 2])).sum() / 6
+            assert vol > 0, case.name
+
+
+# ---- scale-aware tolerances ----------------------------------------------------------------
+
+
+@pytest.mark.parametrize("name", ["small_sphere", "scaled"])
+def test_tolerance_follows_the_scale(name):
+    case = case_named(name)
+    ref = lap.vertex_areas(case.V, case.F, "voronoi")
+    assert COMPARE["array"](ref * (1 + 1e-10), ref, case, 2).ok
+    assert not COMPARE["array"](ref * (1 + 1e-5), ref, case, 2).ok
+
+
+def test_an_all_zero_answer_is_compared_at_the_natural_unit():
+    case = case_named("scaled")
+    ref = np.zeros(len(case.V))
+    assert COMPARE["array"](ref + 1e-12, ref, case, 0).ok
+    assert not COMPARE["array"](ref + 1e-3, ref, case, 0).ok
+
+
+def test_a_ring_may_start_anywhere_only_when_closed():
+    case = case_named("obtuse_fan")  # vertex 0 interior, the others on the boundary
+    ref = TASKS["one_ring"].reference(case, ())
+    rolled = [np.roll(r, 1) for r in ref]
+    result = COMPARE["ring"](rolled, ref, case, 0)
+    assert not result.ok and result.vertex != 0
+    rolled_center = [np.roll(ref[0], 2), *ref[1:]]
+    assert COMPARE["ring"](rolled_center, ref, case, 0).ok
+
+
+# ---- the template ----------------------------------------------------------------------------
+
+
+def test_template_has_one_stub_per_task_and_no_solution(tmp_path):
+    text = template()
+    tree = ast.parse(text)
+    funcs = {n.name: n for n in tree.body if isinstance(n, ast.FunctionDef)}
+    assert list(funcs) == list(EXERCISE_TASKS)
+    for f in funcs.values():
+        doc = ast.get_docstring(f)
+        assert doc and ("Returns" in doc or "returns" in doc.lower()), f.name
+        body = [s for s in f.body if not isinstance(s, ast.Expr)]
+        assert len(body) == 1 and isinstance(body[0], ast.Raise), f.name
+    path = tmp_path / "exercises.py"
+    path.write_text(text)
+    result = check_file(path, ["uniform_laplacian", "eigenbasis"])
+    assert [t.status for t in result.tasks] == ["not_implemented", "not_implemented"]
+
+
+# ---- hostile files: stopped and reported, the checker survives --------------------------------
+
+
+@pytest.mark.parametrize(
+    ("name", "status"),
+    [("hostile_loop", "timeout"), ("hostile_memory", "memory"), ("hostile_crash", "crashed")],
+)
+def test_a_hostile_task_is_stopped_and_the_next_one_still_runs(name, status):
+    result = check_file(
+        STUDENTS / f"{name}.py", ["uniform_laplacian", "barycentric_areas"], timeout=HOSTILE_TIMEOUT
+    )
+    assert result["uniform_laplacian"].status == status
+    assert result["barycentric_areas"].passed
+
+
+def test_a_students_exception_shows_their_frames_only():
+    result = check_file(STUDENTS / "hostile_raise.py", ["uniform_laplacian"])
+    tb = result["uniform_laplacian"].traceback
+    assert result["uniform_laplacian"].status == "error"
+    assert "hostile_raise.py" in tb and "_degrees" in tb and "IndexError" in tb
+    assert (
+        "meshlap_core" not in tb
+        and "multiprocessing" not in tb
+        and "numpy" not in tb.split("IndexError")[0].replace("np.", "")
+    )
+
+
+def test_a_file_that_does_not_parse_is_reported_for_every_task(tmp_path):
+    bad = tmp_path / "bad.py"
+    bad.write_text("def uniform_laplacian(V, F)\n    return None\n")
+    result = check_file(bad, ["uniform_laplacian", "one_ring"])
+    assert [t.status for t in result.tasks] == ["import_error", "import_error"]
+    assert "SyntaxError" in result.tasks[0].traceback
+
+
+# ---- notebook rendering ----------------------------------------------------------------------
+
+
+def test_result_renders_in_a_notebook(checked):
+    result = checked("wrong_cotan_full")
+    page = result._repr_html_()
+    assert "<table" in page and "cotan_laplacian" in page and "cot instead of cot/2" in page
+    png = result._repr_png_()
+    assert png[:8] == b"\x89PNG\r\n\x1a\n"
+    import io
+
+    from PIL import Image
+
+    img = np.asarray(Image.open(io.BytesIO(png)).convert("RGB"), dtype=int)
+    red = (img[..., 0] > 150) & (img[..., 1] < 90) & (img[..., 2] < 90)
+    assert red.sum() > 100  # the failed task's cell and the difference bars are drawn in red
