@@ -505,6 +505,10 @@ def test_every_widget_is_driven(viewer, tmp_path, sphere):
     from test_viewer_record import drive_record_widgets  # play, θ and record widgets
 
     drive_record_widgets(viewer, tmp_path)
+
+    from test_viewer_check import drive_check_widgets  # the Check panel's widgets
+
+    drive_check_widgets(viewer, tmp_path)
     ui = viewer.ui
     undriven = sorted(set(ui.seen) - ui.driven)
     assert not undriven, f"widgets no test drives: {undriven}"

@@ -7,9 +7,14 @@
 
 from __future__ import annotations
 
+import contextlib
 import os
 from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import Any
+
+import numpy as np
+import scipy.sparse as sp
 
 from ..errors import MeshError
 from ..options import (
@@ -20,7 +25,7 @@ from ..options import (
     EXERCISE_TIMEOUT,
     check_choice,
 )
-from .compare import COMPARE, Comparison
+from .compare import COMPARE, Comparison, as_matrix
 from .diagnose import describe, diagnose
 from .meshes import Case, battery
 from .result import CheckResult, TaskResult
@@ -131,3 +136,101 @@ def check_file(
     cases = _cases(extra)
     results = [evaluate(TASKS[n], runs[n], cases) for n in names]
     return CheckResult(os.fspath(path), results)
+
+
+@dataclass
+class MeshCheck:
+    """A task checked on the battery and on one more mesh (the viewer's), with the student's
+    and the reference's whole answers on that mesh.
+
+    Attributes
+    ----------
+    result : CheckResult
+        The verdict (battery and this mesh).
+    expected, got : Any
+        Reference and student answers on the mesh (``got`` is None when the student's call
+        failed there).
+    difference : (n,) float or None
+        Per vertex: student − reference (signed for a scalar per vertex, the largest magnitude
+        of the row otherwise).
+    signed : bool
+    """
+
+    result: CheckResult
+    expected: Any
+    got: Any
+    difference: np.ndarray | None
+    signed: bool
+
+    def rows(self, vertex: int) -> list[tuple[str, str, str]]:
+        """``(term, student, reference)`` for every entry of the vertex's row."""
+        return vertex_rows(self.expected, self.got, vertex)
+
+
+def _cell(value: Any) -> str:
+    return "—" if value is None else f"{value:.6g}"
+
+
+def vertex_rows(expected: Any, got: Any, i: int) -> list[tuple[str, str, str]]:
+    """The terms of vertex ``i``'s row: matrix entries ``[i,j]`` (the union of both rows'
+    non-zeros), vector components, or ring positions."""
+    if sp.issparse(expected):
+        E = sp.csr_matrix(expected)
+        G = None
+        with contextlib.suppress(TypeError, ValueError):
+            G = as_matrix(got) if got is not None else None
+        if G is not None and G.shape != E.shape:
+            G = None
+        cols = E[i].indices if G is None else np.union1d(E[i].indices, G[i].indices)
+        return [
+            (f"[{i},{j}]", _cell(None if G is None else G[i, j]), _cell(E[i, j]))
+            for j in sorted(int(c) for c in cols)
+        ]
+    if isinstance(expected, list):  # a ring
+        mine = None
+        with contextlib.suppress(TypeError, ValueError, IndexError):
+            mine = [int(x) for x in np.asarray(got[i]).ravel()] if got is not None else None
+        return [("ring", str(mine if mine is not None else "—"), str(expected[i].tolist()))]
+    e = np.asarray(expected, dtype=float)
+    g = None
+    with contextlib.suppress(TypeError, ValueError):
+        g = np.asarray(got, dtype=float).reshape(e.shape) if got is not None else None
+    if e.ndim == 1:
+        return [("value", _cell(None if g is None else g[i]), _cell(e[i]))]
+    return [
+        (
+            "xyz"[c] if e.shape[1] == 3 else str(c),
+            _cell(None if g is None else g[i, c]),
+            _cell(e[i, c]),
+        )
+        for c in range(e.shape[1])
+    ]
+
+
+def check_on_mesh(
+    path: str | os.PathLike,
+    task: str,
+    V: np.ndarray,
+    F: np.ndarray,
+    *,
+    timeout: float = EXERCISE_TIMEOUT,
+    memory_mb: int = EXERCISE_MEMORY_MB,
+) -> MeshCheck:
+    """Check ``task`` of the student file on the battery and on the mesh ``(V, F)``; keep both
+    whole answers on that mesh for the viewer's difference map and row inspector."""
+    check_choice(task, EXERCISE_TASKS, "exercise", "task")
+    if not os.path.isfile(path):
+        raise MeshError("no such file", os.fspath(path))
+    case = Case("your_mesh", np.asarray(V, float), np.asarray(F, np.int64), "the mesh on screen")
+    t = TASKS[task]
+    runs = run_student(path, [task], [case], timeout=timeout, memory_mb=memory_mb)
+    result = CheckResult(os.fspath(path), [evaluate(t, runs[task], _cases([case]))])
+    (_, args), *_ = t.calls(case)
+    expected = t.reference(case, args)
+    got = next((a for c, _, a, _ in runs[task].calls if c == case.name), None)
+    difference, signed = None, False
+    if got is not None:
+        cmp = COMPARE[t.kind](got, expected, case, t.power)
+        difference = cmp.difference
+        signed = t.kind == "array" and np.ndim(expected) == 1
+    return MeshCheck(result, expected, got, difference, signed)

@@ -1,0 +1,149 @@
+"""The Check panel: a student's exercises file checked on the mesh on screen.
+
+The file is run (in a separate process, as a background job with progress and Cancel) by
+:func:`meshlap_core.exercises.check.check_on_mesh`; the panel shows the verdict with its
+diagnosis, the difference map student − reference on the mesh with its colour bar, and at a
+clicked vertex the student's row beside the reference's, term by term.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import polyscope as ps
+
+from ..scene import MESH, colorbar_at, picked_vertex, scalar_for_upload
+from ..state.check import VIEWER_TASKS, CheckState
+from ..ui import RED
+from .base import Host, Panel
+
+DIFF = "student - reference"
+
+
+class CheckPanel(Panel):
+    """Student file, task, *check*; verdict; difference map; the clicked vertex's rows."""
+
+    title = "Check (exercises)"
+    state: CheckState
+
+    def on_new_mesh(self, host: Host) -> None:
+        self.watch.forget()
+        self.state.vertex = -1
+
+    def show(self, host: Host, active: Panel) -> None:
+        if not ps.has_surface_mesh(MESH):
+            return
+        if active is self:
+            self.sync(host)
+        elif self.watch.seen("map") is not None:
+            # the map's colour bar would stay on screen over another view
+            ps.get_surface_mesh(MESH).remove_quantity(DIFF)
+            self.watch.forget("map")
+
+    def sync(self, host: Host) -> None:
+        """Upload the difference map (this view active, a check made on this mesh)."""
+        st, mesh = self.state, host.state.mesh
+        if host.active() is not self or not ps.has_surface_mesh(MESH):
+            return
+        if not st.current(mesh.version) or st.check.difference is None:
+            if self.watch.seen("map") is not None:
+                ps.get_surface_mesh(MESH).remove_quantity(DIFF)
+                self.watch.forget("map")
+            return
+        if not self.watch.changed("map", mesh.version, id(st.check), host.state.ui_scale):
+            return
+        d = np.asarray(st.check.difference, dtype=np.float64)
+        r = float(np.abs(d).max()) if d.size else 0.0
+        r = r if r > 0 else 1.0
+        lo, hi = (-r, r) if st.check.signed else (0.0, r)
+        values, (lo, hi), factor = scalar_for_upload(d, (lo, hi))
+        ps.get_surface_mesh(MESH).add_scalar_quantity(
+            DIFF + factor,
+            values,
+            defined_on="vertices",
+            cmap="coolwarm" if st.check.signed else "viridis",
+            vminmax=(lo, hi),
+            enabled=True,
+            onscreen_colorbar_enabled=True,
+            onscreen_colorbar_location=colorbar_at(0, host.state.ui_scale),
+        )
+
+    def pick(self, host: Host, hit: Any, active: Panel) -> bool:
+        """A click on the mesh in this view selects the vertex whose rows are shown."""
+        if active is not self or hit.structure_name != MESH:
+            return False
+        idx = picked_vertex(hit, host.mesh_points(), host.state.mesh.F)
+        if idx is None:
+            return False
+        self.state.select(idx, len(host.state.mesh.V))
+        return True
+
+    def capture(self, host: Host) -> dict[str, Any]:
+        return {"task": self.state.task, "file": self.state.file}
+
+    def configure(self, host: Host, values: dict[str, Any]) -> None:
+        self.state.set_task(values["task"])
+        self.state.file = values["file"]
+
+    def start_check(self, host: Host) -> None:
+        """Check the typed file's task on the mesh: a job in the window, right away outside.
+
+        Raises
+        ------
+        MeshError
+            No file typed, or it does not exist (the last check stays).
+        """
+        st, mesh = self.state, host.state.mesh
+        path = st.student_path(host.state.folder)
+        key = (mesh.version, str(path), st.task)
+
+        def apply(check: Any) -> None:
+            if host.state.mesh.version == key[0]:
+                st.adopt(check, key)
+                host.state.errors.pop(self.name, None)
+
+        def fail(message: str) -> None:
+            host.state.errors[self.name] = message
+
+        jobs = host.state.jobs
+        work = jobs.offload(st.compute, path, st.task, mesh.V, mesh.F)
+        jobs.start(self.name, f"check {st.task}", work, apply, fail, background=host.background)
+
+    def draw(self, host: Host) -> None:
+        ui, st = host.ui, self.state
+        if not ui.header(self.title):
+            return
+        _, st.file = ui.input_text(
+            "student file", st.file, "your exercises .py (meshlap exercises init DIR writes one)"
+        )
+        changed, task = ui.combo("task", st.task, VIEWER_TASKS, "the function of your file")
+        if changed:
+            st.set_task(task)
+        running = host.draw_job(self.name)
+        if not running and ui.button("check", "run your function on this mesh and the battery"):
+            self.start_check(host)
+        for k, line in enumerate(st.verdict()):
+            passed = st.check is not None and st.check.result.passed
+            (ui.text if k == 0 and passed else ui.error if k == 0 else ui.note)(line.strip())
+        if st.check is not None and not st.current(host.state.mesh.version):
+            ui.note("(checked on another mesh: check again)")
+        if st.check is not None and st.current(host.state.mesh.version):
+            self._draw_rows(host)
+
+    def _draw_rows(self, host: Host) -> None:
+        ui, st = host.ui, self.state
+        changed, vertex = ui.input_int("vertex", st.vertex, "click the mesh, or type a vertex")
+        if changed:
+            st.select(vertex, len(host.state.mesh.V))
+        rows = st.rows()
+        if not rows:
+            ui.note("click a vertex: your row beside the reference's")
+            return
+        with ui.table("check rows", ("term", "student", "reference")) as shown:
+            if shown:
+                for term, mine, ref in rows:
+                    ui.row((term, mine, ref), RED if mine != ref else None)
+
+
+PANEL = CheckPanel

@@ -1,0 +1,130 @@
+"""The Check panel's state (``CheckState``): a student's exercises file checked on the mesh on
+screen, the difference map student − reference and the rows at a clicked vertex (no polyscope).
+
+The check itself is :func:`meshlap_core.exercises.check.check_on_mesh`: the student's file runs
+in a separate process with a time and memory limit, so a hung or crashing student function
+never touches the viewer; the panel runs it as a background job.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from meshlap_core.errors import MeshError
+from meshlap_core.exercises.check import MeshCheck, check_on_mesh
+from meshlap_core.exercises.tasks import TASKS
+from meshlap_core.options import EXERCISE_TASKS, check_choice
+
+from .checks import Schema, one_of
+
+VIEWER_TASKS: tuple[str, ...] = tuple(
+    name for name in EXERCISE_TASKS if TASKS[name].kind in ("matrix", "array", "ring")
+    and name != "spectral_reconstruction"
+)  # fmt: skip
+"""The tasks with an answer per vertex of any mesh (the eigenproblem and the reconstruction
+need a small closed mesh: ``meshlap check`` covers them)."""
+
+
+def _text(x: Any) -> str | None:
+    return None if isinstance(x, str) else f"must be a string, got {type(x).__name__}"
+
+
+SESSION: Schema = {"task": ("cotan_laplacian", one_of(VIEWER_TASKS)), "file": ("", _text)}
+"""The Check panel's section of a saved session (:mod:`.session`)."""
+
+
+def make_state() -> CheckState:
+    """The Check panel's slice of the :class:`~.app.AppState`."""
+    return CheckState()
+
+
+@dataclass
+class CheckState:
+    """What the Check panel shows.
+
+    Attributes
+    ----------
+    file : str
+        The student's file as typed.
+    task : str
+        One of :data:`VIEWER_TASKS`.
+    check : MeshCheck or None
+        The last finished check (kept while a new one runs, and when a new one fails).
+    checked_for : tuple
+        ``(mesh version, file, task)`` of ``check``.
+    vertex : int
+        The clicked vertex (``-1``: none).
+    """
+
+    file: str = ""
+    task: str = "cotan_laplacian"
+    check: MeshCheck | None = None
+    checked_for: tuple[Any, ...] = ()
+    vertex: int = -1
+
+    def set_task(self, task: str) -> None:
+        self.task = check_choice(task, VIEWER_TASKS, "exercise", "task")
+
+    def student_path(self, folder: Path) -> Path:
+        """The typed file (relative to ``folder``), checked to exist.
+
+        Raises
+        ------
+        MeshError
+            Empty, missing, or not a ``.py`` file.
+        """
+        text = self.file.strip()
+        if not text:
+            raise MeshError("type the path of your exercises file (.py) first", "student file")
+        path = Path(text).expanduser()
+        path = path if path.is_absolute() else folder / path
+        if not path.is_file():
+            raise MeshError(f"{os.fspath(path)!r} does not exist", "student file")
+        if path.suffix != ".py":
+            raise MeshError(f"{path.name!r} is not a Python file (.py)", "student file")
+        return path
+
+    @staticmethod
+    def compute(path: Path, task: str, V: np.ndarray, F: np.ndarray, progress: Any = None):
+        """The check (any thread: touches no state)."""
+        if progress is not None:
+            progress(None, f"checking {task} of {path.name} (separate process)")
+        return check_on_mesh(path, task, V, F)
+
+    def adopt(self, check: MeshCheck, key: tuple[Any, ...]) -> None:
+        self.check, self.checked_for = check, key
+
+    def current(self, version: int) -> bool:
+        """The shown check was made on this mesh version."""
+        return self.check is not None and self.checked_for[:1] == (version,)
+
+    def select(self, vertex: int, n: int) -> None:
+        """Select ``vertex`` (its rows are shown beside the reference's).
+
+        Raises
+        ------
+        MeshError
+            Out of range.
+        """
+        if not 0 <= vertex < n:
+            raise MeshError(
+                f"vertex {vertex} is out of range (the mesh has {n} vertices)", "vertex"
+            )
+        self.vertex = int(vertex)
+
+    def rows(self) -> list[tuple[str, str, str]]:
+        """``(term, student, reference)`` at the selected vertex (``[]``: nothing to show)."""
+        if self.check is None or self.vertex < 0:
+            return []
+        return self.check.rows(self.vertex)
+
+    def verdict(self) -> list[str]:
+        """The check's text report, one line each."""
+        if self.check is None:
+            return []
+        return self.check.result.tasks[0].lines()

@@ -1,0 +1,132 @@
+"""The Check panel: its state headless, its widgets through the UI adapter (openGL_mock).
+
+:func:`drive_check_widgets` is also part of the every-widget tour of ``test_viewer_widgets.py``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+from meshlap_app.state.check import VIEWER_TASKS, CheckState
+
+from meshlap_core import primitives
+from meshlap_core.errors import MeshError
+from meshlap_core.laplacian import cotan_stiffness
+
+STUDENTS = Path(__file__).parent / "exercises"
+
+
+# ---------------------------------------------------------------- state (no polyscope)
+def test_state_checks_the_file_the_task_and_the_vertex(tmp_path):
+    st = CheckState()
+    with pytest.raises(MeshError, match="type the path"):
+        st.student_path(tmp_path)
+    st.file = "missing.py"
+    with pytest.raises(MeshError, match="does not exist"):
+        st.student_path(tmp_path)
+    (tmp_path / "notes.txt").write_text("x")
+    st.file = "notes.txt"
+    with pytest.raises(MeshError, match="not a Python file"):
+        st.student_path(tmp_path)
+    with pytest.raises(MeshError, match="eigenbasis"):
+        st.set_task("eigenbasis")  # no answer per vertex of any mesh: meshlap check covers it
+    assert st.task == "cotan_laplacian"
+    assert "eigenbasis" not in VIEWER_TASKS and "one_ring" in VIEWER_TASKS
+    with pytest.raises(MeshError, match="out of range"):
+        st.select(10, 10)
+    assert st.rows() == [] and st.verdict() == []
+
+
+def test_state_rows_put_the_student_beside_the_reference():
+    V, F = primitives.icosphere(1)
+    check = CheckState.compute(STUDENTS / "wrong_cotan_full.py", "cotan_laplacian", V, F)
+    st = CheckState()
+    st.adopt(check, (0, "f", "cotan_laplacian"))
+    st.select(3, len(V))
+    C = cotan_stiffness(V, F)
+    rows = st.rows()
+    assert [r[0] for r in rows] == [f"[3,{j}]" for j in sorted(C[3].indices)]
+    for term, mine, ref in rows:
+        j = int(term.split(",")[1][:-1])
+        assert float(ref) == pytest.approx(C[3, j], rel=1e-5)
+        assert float(mine) == pytest.approx(2 * C[3, j], rel=1e-5)  # cot instead of cot/2
+    # the difference map: the row's largest |student − reference| = the row's largest |C_ij|
+    assert np.allclose(check.difference, abs(C).max(axis=1).toarray().ravel())
+    assert st.verdict()[0].startswith("cotan_laplacian") and "cot/2" in "\n".join(st.verdict())
+
+
+# ---------------------------------------------------------------- widgets (openGL_mock)
+ps = pytest.importorskip("polyscope")
+
+import test_viewer_widgets as widgets  # noqa: E402
+from legend_ledger import Ledger  # noqa: E402
+from meshlap_app.scene import MESH  # noqa: E402
+
+mock = widgets.mock  # `sphere` and `viewer` come from conftest
+drive = widgets.drive
+
+
+def drive_check_widgets(viewer, tmp_path: Path) -> None:
+    """Every Check widget with good and bad values (also run by the every-widget tour)."""
+    viewer.set_panel("check")
+    st = viewer.panels["check"].state
+    drive(viewer, "check", True)  # nothing typed: said in red, nothing checked
+    assert "student file" in viewer.state.errors["check"] and st.check is None
+    drive(viewer, "student file", str(STUDENTS / "wrong_cotan_full.py"))
+    for bad in ("eigenbasis", "nonsense"):
+        drive(viewer, "task", bad)
+        assert st.task == "cotan_laplacian" and "check" in viewer.state.errors
+    drive(viewer, "task", "cotan_laplacian")
+    drive(viewer, "check", True)
+    assert st.check is not None and st.check.result.tasks[0].diagnosis == "cot_not_half"
+    assert "check" not in viewer.state.errors
+    drive(viewer, "vertex", 5)
+    table = viewer.ui.tables[("check", "check rows")]
+    assert table.headers == ["term", "student", "reference"]
+    assert table.rows and all(
+        float(s) == pytest.approx(2 * float(r), rel=1e-5) for _, s, r in table.rows
+    )
+    for bad in (-2, 10**6):
+        drive(viewer, "vertex", bad)
+        assert st.vertex == 5 and "out of range" in viewer.state.errors["check"]
+    drive(viewer, "vertex", 6)
+    # a crashing student file: reported, the viewer and the last good map stay
+    drive(viewer, "student file", str(STUDENTS / "hostile_crash.py"))
+    drive(viewer, "task", "uniform_laplacian")
+    drive(viewer, "check", True)
+    assert st.check.result.tasks[0].status == "crashed"
+    assert st.verdict()[0].split()[-1] == "CRASHED"
+
+
+def test_check_widgets(viewer, tmp_path):
+    drive_check_widgets(viewer, tmp_path)
+
+
+def test_difference_map_has_its_colour_bar_only_in_this_view(viewer, monkeypatch):
+    ledger = Ledger().install(monkeypatch)
+    viewer.set_panel("check")
+    drive(viewer, "student file", str(STUDENTS / "wrong_curvature.py"))
+    drive(viewer, "task", "mean_curvature")
+    drive(viewer, "check", True)
+    widgets.frames(viewer, 2)
+    q = ledger.quantities[MESH]["student - reference"]
+    assert q.enabled and q.colorbar and q.owner == "check"
+    lo, hi = q.vminmax
+    assert lo == -hi and hi > 0  # a signed scalar per vertex: a symmetric range around 0
+    d = viewer.panels["check"].state.check.difference
+    assert np.isclose(hi, np.abs(d).max())
+    viewer.set_panel("curvature")
+    widgets.frames(viewer, 2)
+    assert "student - reference" not in ledger.quantities.get(MESH, {})
+
+
+def test_a_click_selects_the_vertex_in_this_view_only(viewer):
+    panel = viewer.panels["check"]
+    hit = SimpleNamespace(
+        structure_name=MESH, structure_data={"element_type": "vertex", "index": 9}, position=None
+    )
+    assert not panel.pick(viewer, hit, viewer.panels["curvature"])
+    assert panel.pick(viewer, hit, panel) and panel.state.vertex == 9
