@@ -297,3 +297,22 @@ def test_result_renders_in_a_notebook(checked):
     img = np.asarray(Image.open(io.BytesIO(png)).convert("RGB"), dtype=int)
     red = (img[..., 0] > 150) & (img[..., 1] < 90) & (img[..., 2] < 90)
     assert red.sum() > 100  # the failed task's cell and the difference bars are drawn in red
+
+
+def test_cancel_stops_a_running_check_and_its_worker():
+    import multiprocessing
+    import threading
+
+    from meshlap_core.errors import Cancelled
+    from meshlap_core.exercises.check import check_on_mesh
+
+    case = case_named("small_sphere")
+    stop = threading.Event()
+    timer = threading.Timer(2.0, stop.set)
+    timer.start()
+    with pytest.raises(Cancelled):
+        check_on_mesh(
+            STUDENTS / "hostile_loop.py", "uniform_laplacian", case.V, case.F, cancel=stop
+        )
+    timer.cancel()
+    assert not multiprocessing.active_children()

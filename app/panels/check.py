@@ -79,13 +79,6 @@ class CheckPanel(Panel):
         self.state.select(idx, len(host.state.mesh.V))
         return True
 
-    def capture(self, host: Host) -> dict[str, Any]:
-        return {"task": self.state.task, "file": self.state.file}
-
-    def configure(self, host: Host, values: dict[str, Any]) -> None:
-        self.state.set_task(values["task"])
-        self.state.file = values["file"]
-
     def start_check(self, host: Host) -> None:
         """Check the typed file's task on the mesh: a job in the window, right away outside.
 
@@ -106,9 +99,13 @@ class CheckPanel(Panel):
         def fail(message: str) -> None:
             host.state.errors[self.name] = message
 
+        V, F, task = mesh.V, mesh.F, st.task
+
+        def work(reporter: Any) -> Any:  # a thread, not jobs.offload: the check spawns its own
+            return st.compute(path, task, V, F, progress=reporter)  # process (no daemon child)
+
         jobs = host.state.jobs
-        work = jobs.offload(st.compute, path, st.task, mesh.V, mesh.F)
-        jobs.start(self.name, f"check {st.task}", work, apply, fail, background=host.background)
+        jobs.start(self.name, f"check {task}", work, apply, fail, background=host.background)
 
     def draw(self, host: Host) -> None:
         ui, st = host.ui, self.state

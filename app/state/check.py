@@ -20,8 +20,6 @@ from meshlap_core.exercises.check import MeshCheck, check_on_mesh
 from meshlap_core.exercises.tasks import TASKS
 from meshlap_core.options import EXERCISE_TASKS, check_choice
 
-from .checks import Schema, one_of
-
 VIEWER_TASKS: tuple[str, ...] = tuple(
     name for name in EXERCISE_TASKS if TASKS[name].kind in ("matrix", "array", "ring")
     and name != "spectral_reconstruction"
@@ -30,16 +28,9 @@ VIEWER_TASKS: tuple[str, ...] = tuple(
 need a small closed mesh: ``meshlap check`` covers them)."""
 
 
-def _text(x: Any) -> str | None:
-    return None if isinstance(x, str) else f"must be a string, got {type(x).__name__}"
-
-
-SESSION: Schema = {"task": ("cotan_laplacian", one_of(VIEWER_TASKS)), "file": ("", _text)}
-"""The Check panel's section of a saved session (:mod:`.session`)."""
-
-
 def make_state() -> CheckState:
-    """The Check panel's slice of the :class:`~.app.AppState`."""
+    """The Check panel's slice of the :class:`~.app.AppState` (no session section: a student
+    file's path belongs to one machine, and a check is re-run in a second)."""
     return CheckState()
 
 
@@ -91,10 +82,12 @@ class CheckState:
 
     @staticmethod
     def compute(path: Path, task: str, V: np.ndarray, F: np.ndarray, progress: Any = None):
-        """The check (any thread: touches no state)."""
+        """The check (any thread: touches no state). The student's code runs in a process of
+        its own, so a job's thread only waits; ``progress.cancel`` (a job's Cancel) kills it."""
         if progress is not None:
             progress(None, f"checking {task} of {path.name} (separate process)")
-        return check_on_mesh(path, task, V, F)
+        cancel = getattr(progress, "cancel", None)
+        return check_on_mesh(path, task, V, F, cancel=cancel)
 
     def adopt(self, check: MeshCheck, key: tuple[Any, ...]) -> None:
         self.check, self.checked_for = check, key

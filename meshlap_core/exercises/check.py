@@ -78,20 +78,19 @@ def evaluate(task: Task, run: TaskRun, cases: dict[str, Case]) -> TaskResult:
     if ratio is not None and ratio >= EXERCISE_SLOW_RATIO and seconds >= EXERCISE_SLOW_MIN_SECONDS:
         return TaskResult(
             task.name, "failed", "large", diagnosis="slow_loop",
-            diagnosis_text=describe("slow_loop", ratio=ratio, n=n), n_calls=len(run.calls),
-            speed_ratio=ratio,
+            diagnosis_text=describe("slow_loop", ratio=ratio, n=n, seconds=seconds),
+            n_calls=len(run.calls), speed_ratio=ratio,
         )  # fmt: skip
     return TaskResult(task.name, "passed", n_calls=len(run.calls), speed_ratio=ratio)
 
 
 def _speed(task: Task, run: TaskRun, cases: dict[str, Case]) -> tuple[float | None, float, int]:
     """(student time / reference time, student seconds, vertices) on the speed case."""
-    if not task.speed or not run.ref_seconds:
+    if not task.speed or run.speed is None:
         return None, 0.0, 0
-    for case_name, _label, _answer, seconds in run.calls:
-        if "speed" in cases[case_name].tags:
-            return seconds / max(run.ref_seconds, 1e-9), seconds, len(cases[case_name].V)
-    return None, 0.0, 0
+    mine, ref = run.speed
+    n = next((len(c.V) for c in cases.values() if "speed" in c.tags), 0)
+    return mine / max(ref, 1e-9), mine, n
 
 
 def check_file(
@@ -215,15 +214,17 @@ def check_on_mesh(
     *,
     timeout: float = EXERCISE_TIMEOUT,
     memory_mb: int = EXERCISE_MEMORY_MB,
+    cancel: Any = None,
 ) -> MeshCheck:
     """Check ``task`` of the student file on the battery and on the mesh ``(V, F)``; keep both
-    whole answers on that mesh for the viewer's difference map and row inspector."""
+    whole answers on that mesh for the viewer's difference map and row inspector (``cancel``:
+    an event or callable that stops the worker and raises ``Cancelled``)."""
     check_choice(task, EXERCISE_TASKS, "exercise", "task")
     if not os.path.isfile(path):
         raise MeshError("no such file", os.fspath(path))
     case = Case("your_mesh", np.asarray(V, float), np.asarray(F, np.int64), "the mesh on screen")
     t = TASKS[task]
-    runs = run_student(path, [task], [case], timeout=timeout, memory_mb=memory_mb)
+    runs = run_student(path, [task], [case], timeout=timeout, memory_mb=memory_mb, cancel=cancel)
     result = CheckResult(os.fspath(path), [evaluate(t, runs[task], _cases([case]))])
     (_, args), *_ = t.calls(case)
     expected = t.reference(case, args)

@@ -64,8 +64,9 @@ DIAGNOSES: dict[str, str] = {
     "step's result",
     "sized_by_faces": "the answer is sized by F.max()+1: a vertex in no face (the last one here) "
     "still has its row; use n = len(V)",
-    "slow_loop": "correct, but a Python loop about {ratio:.0f}× slower than the vectorized "
-    "reference on {n} vertices: build the matrix from arrays (np.bincount, COO triplets)",
+    "slow_loop": "correct, but {seconds:.1f} s on {n} vertices, about {ratio:.0f}× the "
+    "reference's time: a Python loop per vertex or per entry? build from arrays (np.bincount, "
+    "COO triplets)",
 }
 """Diagnosis key -> the sentence shown to the student."""
 
