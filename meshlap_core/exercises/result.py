@@ -47,6 +47,8 @@ class TaskResult:
         Student time / reference time on the large mesh (speed-checked tasks).
     difference : (n,) float or None
         Student − reference per vertex of ``case`` (the difference map).
+    picture : (V, F, difference, mesh name) or None
+        The largest failing mesh and its difference map (the notebook picture).
     """
 
     task: str
@@ -66,6 +68,7 @@ class TaskResult:
     n_calls: int = 0
     speed_ratio: float | None = None
     difference: np.ndarray | None = field(default=None, repr=False)
+    picture: tuple | None = field(default=None, repr=False)
 
     @property
     def passed(self) -> bool:
@@ -73,7 +76,7 @@ class TaskResult:
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready fields (no difference array)."""
-        out = {k: v for k, v in vars(self).items() if k != "difference"}
+        out = {k: v for k, v in vars(self).items() if k not in ("difference", "picture")}
         out["passed"] = self.passed
         return out
 
@@ -197,35 +200,55 @@ class CheckResult:
         )
 
     def _repr_png_(self) -> bytes:
-        """A small picture: one coloured cell per task, and the first failure's difference per
-        vertex (student − reference) as a bar chart over the vertices."""
+        """A small picture: one cell per task (green passed, red failed, grey not done), and
+        the first failure's largest failing mesh coloured by |student − reference|."""
         import matplotlib
 
         matplotlib.use("Agg", force=False)
         from matplotlib.figure import Figure
 
-        fig = Figure(figsize=(6.4, 2.4), dpi=80)
-        ax = fig.add_axes((0.02, 0.1, 0.42, 0.85))
+        fig = Figure(figsize=(6.4, 2.6), dpi=80)
+        ax = fig.add_axes((0.02, 0.05, 0.42, 0.9))
         n = len(self.tasks)
         for k, t in enumerate(self.tasks):
-            y = n - 1 - k
-            ax.barh(y, 1.0, color="#2da44e" if t.passed else "#cf222e", height=0.9)
-            ax.text(0.03, y, t.task, va="center", fontsize=7, color="white")
+            colour = CELL_COLOURS.get(t.status, CELL_COLOURS["failed"])
+            ax.barh(n - 1 - k, 1.0, color=colour, height=0.9)
+            ax.text(0.03, n - 1 - k, f"{t.task}: {t.status}", va="center", fontsize=7, color="w")
         ax.set_axis_off()
-        fail = next((t for t in self.tasks if t.difference is not None and not t.passed), None)
-        ax2 = fig.add_axes((0.55, 0.2, 0.42, 0.7))
-        if fail is not None and len(fail.difference):
-            d = np.asarray(fail.difference, dtype=float)
-            ax2.bar(np.arange(len(d)), d, color="#cf222e", width=1.0)
-            ax2.set_title(f"{fail.task} on {fail.case}: student − reference", fontsize=7)
-            ax2.set_xlabel("vertex", fontsize=7)
-            ax2.tick_params(labelsize=6)
+        fail = next((t for t in self.tasks if t.picture is not None and not t.passed), None)
+        if fail is None:
+            fig.text(0.72, 0.5, f"{self.n_passed}/{n} passed", ha="center", fontsize=12)
         else:
-            ax2.set_axis_off()
-            ax2.text(0.5, 0.5, f"{self.n_passed}/{n} passed", ha="center", fontsize=12)
+            _draw_difference(fig, fail)
         buf = io.BytesIO()
         fig.savefig(buf, format="png")
         return buf.getvalue()
+
+
+CELL_COLOURS = {
+    "passed": "#2da44e",
+    "failed": "#cf222e",
+    "missing": "#8c959f",
+    "not_implemented": "#8c959f",
+}
+
+
+def _draw_difference(fig: Any, t: TaskResult) -> None:
+    """The mesh in 3D, each face coloured by its vertices' mean |student − reference|."""
+    from matplotlib import colormaps
+
+    V, F, d, name = t.picture
+    ax = fig.add_axes((0.5, 0.05, 0.45, 0.8), projection="3d")
+    face = np.abs(np.asarray(d, dtype=float))[F].mean(axis=1)
+    top = float(face.max()) or 1.0
+    colours = colormaps["viridis"](face / top)
+    poly = ax.plot_trisurf(V[:, 0], V[:, 1], V[:, 2], triangles=F, linewidth=0.2)
+    poly.set_facecolors(colours)
+    ax.set_axis_off()
+    extent = np.ptp(V, axis=0)
+    ax.set_box_aspect(np.maximum(extent, 0.05 * max(float(extent.max()), 1e-300)))
+    fig.text(0.72, 0.92, f"{t.task} on {name}: |student − reference| ≤ {top:.3g}",
+             ha="center", fontsize=7)  # fmt: skip
 
 
 def junit_document(results: list[CheckResult]) -> str:
