@@ -51,6 +51,13 @@ WRONG = [  # (student file, task, the diagnosis it must get)
     ("wrong_steps", "taubin_step", "mu_sign"),
     ("wrong_implicit", "implicit_step", "missing_mass"),
     ("wrong_implicit_explicit", "implicit_step", "explicit_not_implicit"),
+    ("wrong_cotan_lb", "cotan_laplacian", "divided_by_area"),
+    ("wrong_bary_voronoi", "barycentric_areas", "voronoi_not_barycentric"),
+    ("wrong_hn_uniform", "mean_curvature_normal", "uniform_not_cotan"),
+    ("wrong_defect_rule", "angle_defect", "wrong_boundary_rule"),
+    ("wrong_ring_sorted", "one_ring", "unordered"),
+    ("wrong_taubin_parallel", "taubin_step", "not_sequential"),
+    ("wrong_eigen_negative", "eigenbasis", "sign_flip"),
 ]
 RIGHT = ["right_vectorized", "right_loops", "right_dense", "right_other_order", "right_igl"]
 HOSTILE_TIMEOUT = 4.0
