@@ -313,8 +313,9 @@ def readme_keys() -> list[str]:
             continue  # an option, not a key
         else:
             raise AssertionError(f"README key {token!r} is not understood by this check")
-    if "1" in keys and "5" in keys:  # `1`–`5`
-        keys += ["2", "3", "4"]
+    digits = sorted(int(k) for k in keys if k.isdigit())
+    if len(digits) >= 2:  # `1`–`6`: the range
+        keys += [str(i) for i in range(digits[0], digits[-1] + 1)]
     return sorted(set(keys))
 
 
