@@ -14,7 +14,7 @@ Every widget of every panel is drawn through a :class:`UI`. It calls the real im
   or digit).
 
 Numeric fields apply on Enter only (``ImGuiInputTextFlags_EnterReturnsTrue``): a half-typed
-number (the ``0`` of ``0.5``) is never applied.
+number (the ``0`` of ``0.5``) is never applied; a click selects the whole number.
 
 **Hooks.** The adapter knows nothing of tests. Each interactive widget, shortcut key, scene click
 and hover calls :meth:`UI._record` once per frame after imgui drew it; its return value, when not
@@ -389,7 +389,7 @@ class UI(FieldErrors):
             The text is empty or not a number (naming the field and quoting the text).
         """
         im = self.im
-        flags = im.ImGuiInputTextFlags_EnterReturnsTrue | im.ImGuiInputTextFlags_CharsScientific
+        flags = self._number_flags() | im.ImGuiInputTextFlags_CharsScientific
         shown = fmt % float(value)
         entered, text = check_return("InputText", im.InputText(label, shown, flags))
         try:
@@ -406,7 +406,7 @@ class UI(FieldErrors):
     def input_int(self, label: str, value: int, tooltip: str = "") -> tuple[bool, int]:
         """A typed integer with -/+ buttons, applied on Enter or a button: ``(changed, value)``
         (a refused value's error is drawn under the field)."""
-        flags = self.im.ImGuiInputTextFlags_EnterReturnsTrue
+        flags = self._number_flags()
         changed, new = check_return("InputInt", self.im.InputInt(label, int(value), 1, 100, flags))
         try:
             v = self._widget(label, "input", tooltip, int(value))
