@@ -26,7 +26,7 @@ import polyscope as ps
 
 from meshlap_core.errors import MeshError
 
-from . import scene
+from . import scene, window
 from .jobs import Job, Reporter, prefer_gil_free_solvers, warm_up
 from .pacing import Pacer
 from .panels.base import Panel
@@ -163,6 +163,7 @@ class Viewer:
             scene.remove_structure(MESH)
             self.state.display.fit(mesh.V)
             ps.register_surface_mesh(MESH, self.mesh_points(), mesh.F, smooth_shade=True)
+            window.set_title(window.window_title(mesh.name, True))  # the window's, if any
             for p in self.panels.values():
                 p.on_new_mesh(self)
         for p in self.panels.values():
@@ -578,8 +579,12 @@ def run(
     if ui_scale is not None and not 0.5 <= ui_scale <= 3.0:  # also refuses NaN
         raise MeshError(f"must be between 0.5 and 3, got {ui_scale}", "--ui-scale")
     title = later.name if later is not None else state.mesh.name
-    ps.set_program_name(f"meshlap — {title}")  # the window title (set before init)
+    # the title polyscope gives the window when it creates it: the mesh's name only when
+    # it can follow the meshes opened later (window.title_follows), else the product's
+    ps.set_program_name(window.window_title(title, window.can_follow()))
     init_polyscope(backend or ("openGL3_egl" if shot else "auto"))
+    if shot is None:
+        window.place_window(tuple(ps.get_window_size()))  # inside the screen, centred
     viewer = Viewer(state)
     ps.set_build_default_gui_panels(False)  # polyscope's own panels: a toggle in Help
     if ui_scale is not None and ui_scale != 1.0:

@@ -304,7 +304,8 @@ def opened(s: Session) -> None:
 
 def pick_mesh(s: Session) -> None:
     """The mesh list (first combo of the Mesh section): the torus, or with the torus open,
-    bumpy; the Mesh section describes the new mesh and the scene shows it."""
+    bumpy; the Mesh section describes the new mesh, the scene shows it and the window's
+    title names it (polyscope sets a title only when it creates the window)."""
     entry = 0 if s.mesh == SECOND_MESH else MESH_LIST.index("torus.obj")
     before = s.screenshot()
     mesh_box = section_box(parse(before), 0)
@@ -315,6 +316,9 @@ def pick_mesh(s: Session) -> None:
     if changed_fraction(before, s.img, mesh_box) < 0.002:
         raise AssertionError("the Mesh section still describes the previous mesh")
     s.subject_ok(layout, 1, "the picked mesh")
+    assert s.app is not None
+    if s.app.title() != TITLE + MESH_LIST[entry]:
+        raise AssertionError(f"window title {s.app.title()!r} after picking {MESH_LIST[entry]}")
 
 
 def curvature(s: Session) -> None:
