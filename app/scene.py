@@ -231,6 +231,8 @@ def look_at(eye: np.ndarray, target: np.ndarray) -> None:
     view = json.loads(ps.get_view_as_json())
     if None in view.get("viewMat", [None]):  # no valid view (eye at the target): keep it
         return
+    for key in ("windowWidth", "windowHeight"):  # the camera only: never resize the window
+        view.pop(key, None)
     view["nearClip"] = NEAR_CLIP
     view["farClip"] = max(20.0, 1.5 * reach / d) if np.isfinite(reach) else 20.0
     ps.set_view_from_json(json.dumps(view))
