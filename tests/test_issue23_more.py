@@ -283,3 +283,30 @@ def test_every_plot_legend_covers_none_of_its_data(mock, viewer, panel):
             limits = (limits[0], limits[1], *placer.y_limits[title])
         box = corner_box(where, limits, placer.sizes[title])
         assert not data_in_box(items, box), (title, where, data_in_box(items, box))
+
+
+# ---------------------------------------------------------------- the tour's second mesh
+def test_a_second_mesh_after_side_by_side_and_an_eigenbasis_shows_no_error(mock, viewer):
+    """The tour's order (side by side on the torus, a vertex, its eigenbasis, then bumpy
+    opened): the side-by-side copy of the torus (1152 vertices) took bumpy's field, an error
+    ("'values' should be a length n_vertices array") shown on every panel."""
+    from meshlap_app.scene import MESH_B
+
+    assets = Path(__file__).resolve().parents[1] / "assets"
+    assert viewer.open(assets / "torus.obj")
+    ps.frame_tick()
+    viewer.set_panel("curvature")
+    viewer.ui.script("side by side", True)
+    ps.frame_tick()
+    assert ps.get_surface_mesh(MESH_B).n_vertices() == 1152
+    viewer.set_panel("spectral")
+    viewer.ui.script("compute eigenbasis", True)
+    for _ in range(4):
+        ps.frame_tick()
+    assert viewer.open(assets / "bumpy.obj")
+    for view in ("spectral", "curvature", "smoothing"):
+        viewer.set_panel(view)
+        for _ in range(3):
+            ps.frame_tick()
+        assert not viewer.state.errors, (view, viewer.state.errors)
+    assert ps.get_surface_mesh(MESH_B).n_vertices() == len(viewer.state.mesh.V) == 2562
