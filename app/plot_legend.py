@@ -116,6 +116,7 @@ class LegendPlacer:
     items: dict[str, list[Item]] = field(default_factory=dict)
     labels: dict[str, list[str]] = field(default_factory=dict)  # the legend's entries
     sizes: dict[str, tuple[float, float]] = field(default_factory=dict)  # fractions of the axes
+    log_y: set[str] = field(default_factory=set)  # plots with a log10 y axis
     y_limits: dict[str, tuple[float, float]] = field(default_factory=dict)
     drawing: str = ""
     _next: list[Item] = field(default_factory=list)
@@ -139,6 +140,8 @@ class LegendPlacer:
         """The corner (or :data:`OUTSIDE`) for ``title``'s legend of ``size_px`` in a plot
         area of ``plot_px`` pixels, from the last frame's items."""
         items = self.items.get(title, [])
+        if title in self.log_y:  # the corners are boxes on screen: in log10 y
+            items = [(k, x, None if y is None else _log10(y)) for k, x, y in items]
         size = (size_px[0] / max(plot_px[0], 1.0), size_px[1] / max(plot_px[1], 1.0))
         self.sizes[title] = size
         if size[0] >= 1.0 or size[1] >= 1.0:
@@ -147,3 +150,10 @@ class LegendPlacer:
         if limits is not None and title in self.y_limits:
             limits = (limits[0], limits[1], *self.y_limits[title])
         return legend_corner(items, size, limits)
+
+
+def _log10(y: Any) -> np.ndarray:
+    """log10 of the positive values (the others are not drawn on a log axis)."""
+    y = np.asarray(y, dtype=float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(y > 0, np.log10(np.where(y > 0, y, 1.0)), np.nan)

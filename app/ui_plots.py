@@ -44,8 +44,11 @@ class Plots:
             return CORNERS[0]
         s = self.scale
         text_w = max(float(self.im.CalcTextSize(t)[0]) for t in labels)
-        size = (text_w + 30.0 * s, len(labels) * (self.im.GetTextLineHeight() + 4.0 * s) + 8 * s)
-        area = (float(self.im.GetContentRegionAvail()[0]) - 60.0 * s, (height - 60.0) * s)
+        # the box (swatch, text, inner padding) plus ImPlot's 10-pixel inset from the corner
+        rows = len(labels) * (self.im.GetTextLineHeight() + 4.0 * s)
+        size = (text_w + 40.0 * s, rows + 18.0 * s)
+        # the data area: less the y axis' labels, the title, the x axis' ticks and label
+        area = (float(self.im.GetContentRegionAvail()[0]) - 70.0 * s, (height - 90.0) * s)
         return self.legends.place(title, size, area)
 
     def _plotted(self, label: str, kind: str, x: Any, y: Any) -> None:
@@ -60,6 +63,7 @@ class Plots:
         """``with ui.plot(...) as shown:`` an ImPlot with labelled axes, refitted to the data
         every frame (``fit_y=False``: the caller sets the y limits), its legend where no data
         is (a corner, else a row above the plot); EndPlot always runs."""
+        (self.legends.log_y.add if y_log else self.legends.log_y.discard)(title)
         where = self._legend_place(title, height)
         self._record_legend(title, where)
         shown = check_return("BeginPlot", self.ip.BeginPlot(title, (-1, height * self.scale)))

@@ -278,6 +278,8 @@ def test_every_plot_legend_covers_none_of_its_data(mock, viewer, panel):
         if where == OUTSIDE:
             continue
         items = placer.items[title]
+        if title in placer.log_y:  # corners are boxes on screen: log10 y
+            items = [(k, x, None if y is None else np.log10(y)) for k, x, y in items]
         limits = data_limits(items)
         if title in placer.y_limits:
             limits = (limits[0], limits[1], *placer.y_limits[title])
