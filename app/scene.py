@@ -6,6 +6,7 @@ Every panel registers its structures under the names defined here and places cop
 
 from __future__ import annotations
 
+import json
 from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
@@ -157,6 +158,7 @@ def remove_structure(name: str) -> None:
 DEFAULT_VIEW = (0.0, 0.15, -1.0)
 FRONT_VIEWS: dict[str, tuple[float, float, float]] = {
     "armadillo_igl.obj": (0.0, 0.15, 1.0),
+    "nefertiti.obj": (0.0, 0.15, 1.0),  # in display coordinates: z-up, turned (UP_BY_MESH)
 }
 OBLIQUE_VIEW = (0.55, 0.75, -1.0)
 
@@ -201,7 +203,39 @@ def frame_points(
     span = max(fraction - left, 0.05)
     d = max(w / (2 * span * tan_h), h / (2 * 0.85 * tan_v), 1e-12) + 0.5 * depth
     target = c + (1.0 - left - fraction) * d * tan_h * right
-    ps.look_at(target + d * back, target)
+    look_at(target + d * back, target)
+
+
+NEAR_CLIP = 0.005
+"""The near plane's distance as a fraction of the distance to what is framed (polyscope's
+ratio, applied to the framed target instead of a stale view centre)."""
+
+
+def look_at(eye: np.ndarray, target: np.ndarray) -> None:
+    """Put the camera at ``eye`` looking at ``target`` (display coordinates), with the clip
+    planes fitted to that view.
+
+    polyscope places its near and far planes at ``nearClip`` and ``farClip`` times the
+    distance from the camera to its view centre ("Center Relative"), and ``look_at`` leaves
+    that centre at the old view's distance: a one-ring framed 0.01 from the camera after a
+    whole-mesh view 2.5 away got a near plane at 0.0125, through the ring. Here the view
+    centre becomes ``target`` (turning the view turns it about what is framed), the near plane
+    :data:`NEAR_CLIP` of the distance, and the far plane beyond every structure's bounding box.
+    """
+    eye, target = np.asarray(eye, dtype=np.float64), np.asarray(target, dtype=np.float64)
+    ps.look_at(tuple(eye), tuple(target))
+    ps.set_view_center_raw(tuple(target))
+    d = max(float(np.linalg.norm(target - eye)), 1e-30)
+    lo, hi = (np.asarray(b, dtype=np.float64) for b in ps.get_bounding_box())
+    reach = float(np.linalg.norm(0.5 * (lo + hi) - eye) + 0.5 * np.linalg.norm(hi - lo))
+    view = json.loads(ps.get_view_as_json())
+    if None in view.get("viewMat", [None]):  # no valid view (eye at the target): keep it
+        return
+    for key in ("windowWidth", "windowHeight"):  # the camera only: never resize the window
+        view.pop(key, None)
+    view["nearClip"] = NEAR_CLIP
+    view["farClip"] = max(20.0, 1.5 * reach / d) if np.isfinite(reach) else 20.0
+    ps.set_view_from_json(json.dumps(view))
 
 
 def frame_scene_left(

@@ -16,8 +16,10 @@ from typing import TYPE_CHECKING, Any
 import polyscope as ps
 
 from meshlap_core.errors import MeshError
+from meshlap_core.options import DEFAULT_UP
 
 from .state.camera import captured
+from .state.display import UP_BY_MESH
 from .state.mesh import MeshState
 from .state.session import Session, check_session_mesh, read_session, write_session
 
@@ -45,10 +47,13 @@ def camera_json() -> dict[str, Any] | None:
 
 def capture(host: Host) -> Session:
     """The host's current settings (each panel's section), view, UI scale and camera."""
+    state = host.state
+    up = state.up_for(state.mesh.name)  # written only when not the mesh's rule
     s = Session(
-        mesh=host.state.mesh.path,
-        panel=host.state.panel,
-        ui_scale=float(host.state.ui_scale),
+        mesh=state.mesh.path,
+        panel=state.panel,
+        ui_scale=float(state.ui_scale),
+        up=None if up == UP_BY_MESH.get(state.mesh.name, DEFAULT_UP) else up,
         camera=camera_json(),
     )
     for name, p in host.panels.items():
@@ -116,6 +121,10 @@ def apply(
     check_session_mesh(session, mesh, source)
     state = host.state
     state.mesh.show(mesh)  # the app's one MeshState takes it (its version moves on)
+    if session.up is not None:  # the mesh's axis shown up (else the mesh's rule)
+        state.up_given[mesh.name] = session.up
+    else:
+        state.up_given.pop(mesh.name, None)
     host.set_ui_scale(session.ui_scale)
     sections = session.settings
     for name, p in host.panels.items():

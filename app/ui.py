@@ -14,7 +14,7 @@ Every widget of every panel is drawn through a :class:`UI`. It calls the real im
   or digit).
 
 Numeric fields apply on Enter only (``ImGuiInputTextFlags_EnterReturnsTrue``): a half-typed
-number (the ``0`` of ``0.5``) is never applied.
+number (the ``0`` of ``0.5``) is never applied; a click selects the whole number.
 
 **Hooks.** The adapter knows nothing of tests. Each interactive widget, shortcut key, scene click
 and hover calls :meth:`UI._record` once per frame after imgui drew it; its return value, when not
@@ -30,12 +30,12 @@ from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from typing import Any
 
-import numpy as np
-
 from .field_errors import FieldErrors, read_float
 from .keys import imgui_key
 from .text_numbers import is_number
 from .text_wrap import wrap_at_spaces
+from .ui_checks import EXPECTED, UIApiMismatch, check_return
+from .ui_plots import Plots
 
 RED = (1.0, 0.35, 0.35, 1.0)
 GREY = (0.7, 0.7, 0.7, 1.0)
@@ -44,53 +44,8 @@ TABLE_ROWS = ((0.11, 0.11, 0.12, 0.94), (0.17, 0.17, 0.19, 0.94))  # opaque: rea
 
 RGBA = tuple[float, float, float, float]
 
-# the return types the adapter was written for (polyscope 2.6.x; pyproject pins the range)
-EXPECTED: dict[str, tuple[type, ...]] = {
-    "Combo": (bool, int),
-    "Selectable": (bool,),
-    "BeginCombo": (bool,),
-    "Checkbox": (bool, bool),
-    "Button": (bool,),
-    "CollapsingHeader": (bool,),
-    "SliderFloat": (bool, float),
-    "SliderInt": (bool, int),
-    "InputFloat": (bool, float),
-    "InputInt": (bool, int),
-    "InputText": (bool, str),
-    "BeginPlot": (bool,),
-    "BeginTable": (bool,),
-}
 
-
-class UIApiMismatch(TypeError):
-    """polyscope's imgui returned a type this adapter does not expect (its API changed)."""
-
-
-def check_return(name: str, result: Any) -> Any:
-    """Check ``result`` of ``polyscope.imgui.<name>`` against :data:`EXPECTED`.
-
-    Raises
-    ------
-    UIApiMismatch
-        When the shape or the element types differ (e.g. ``Selectable`` returning a tuple).
-    """
-    want = EXPECTED[name]
-    got = result if len(want) > 1 else (result,)
-    ok = isinstance(got, tuple) and len(got) == len(want)
-    ok = ok and all(
-        isinstance(g, w) and (w is not int or not isinstance(g, bool))
-        for g, w in zip(got, want, strict=False)
-    )
-    if not ok:
-        shape = " ".join(t.__name__ for t in want)
-        raise UIApiMismatch(
-            f"polyscope.imgui.{name} returned {result!r} ({type(result).__name__}); this viewer "
-            f"expects ({shape}): the installed polyscope differs from the tested range"
-        )
-    return result
-
-
-class UI(FieldErrors):
+class UI(FieldErrors, Plots):
     """imgui/implot for the panels (see the module docstring).
 
     Parameters
@@ -190,10 +145,6 @@ class UI(FieldErrors):
 
     def _record_table(self, table_id: str, headers: list[str], tips: list[str]) -> None:
         """Hook called when :meth:`table` starts a table, before imgui's ``BeginTable``."""
-
-    def _record_plot(self, label: str, kind: str, x: Any, y: Any) -> None:
-        """Hook called after a plot item was drawn: ``kind`` is ``line`` (``x``, ``y``),
-        ``vlines`` (``x``) or ``hlines`` (``y``)."""
 
     def _record_row(self, cells: list[str], rgba: RGBA | None, highlight: bool) -> None:
         """Hook called for each row of the open table (also when imgui does not draw it)."""
@@ -389,7 +340,7 @@ class UI(FieldErrors):
             The text is empty or not a number (naming the field and quoting the text).
         """
         im = self.im
-        flags = im.ImGuiInputTextFlags_EnterReturnsTrue | im.ImGuiInputTextFlags_CharsScientific
+        flags = self._number_flags() | im.ImGuiInputTextFlags_CharsScientific
         shown = fmt % float(value)
         entered, text = check_return("InputText", im.InputText(label, shown, flags))
         try:
@@ -406,7 +357,7 @@ class UI(FieldErrors):
     def input_int(self, label: str, value: int, tooltip: str = "") -> tuple[bool, int]:
         """A typed integer with -/+ buttons, applied on Enter or a button: ``(changed, value)``
         (a refused value's error is drawn under the field)."""
-        flags = self.im.ImGuiInputTextFlags_EnterReturnsTrue
+        flags = self._number_flags()
         changed, new = check_return("InputInt", self.im.InputInt(label, int(value), 1, 100, flags))
         try:
             v = self._widget(label, "input", tooltip, int(value))
@@ -433,64 +384,6 @@ class UI(FieldErrors):
         if entered:
             self._entered(label, new)
         return self._changed(entered), new
-
-    # ------------------------------------------------------------------ plots
-    @contextmanager
-    def plot(
-        self,
-        title: str,
-        height: float,
-        x_label: str,
-        y_label: str,
-        y_log: bool = False,
-        fit_y: bool = True,
-        legend_outside: bool = False,
-    ) -> Iterator[bool]:
-        """``with ui.plot(...) as shown:`` an ImPlot with labelled axes, refitted to the data
-        every frame (``fit_y=False``: the caller sets the y limits; ``legend_outside``: the
-        legend in a row above the plot, never over the curves); EndPlot always runs."""
-        shown = check_return("BeginPlot", self.ip.BeginPlot(title, (-1, height * self.scale)))
-        try:
-            if shown:
-                fit = self.ip.ImPlotAxisFlags_AutoFit
-                self.ip.SetupAxes(x_label, y_label, fit, fit if fit_y else 0)
-                if legend_outside:
-                    ip = self.ip
-                    flags = ip.ImPlotLegendFlags_Outside | ip.ImPlotLegendFlags_Horizontal
-                    ip.SetupLegend(ip.ImPlotLocation_North, flags)
-                if y_log:
-                    self.ip.SetupAxisScale(self.ip.ImAxis_Y1, self.ip.ImPlotScale_Log10)
-            yield shown
-        finally:
-            if shown:
-                self.ip.EndPlot()
-
-    def plot_y_limits(self, lo: float, hi: float) -> None:
-        self.ip.SetupAxisLimits(self.ip.ImAxis_Y1, float(lo), float(hi), self.ip.ImPlotCond_Always)
-
-    def plot_line(self, label: str, x: Any, y: Any) -> None:
-        self.ip.PlotLine(label, _f64(x), _f64(y))
-        self._record_plot(label, "line", x, y)
-
-    def plot_bars(
-        self, label: str, x: Any, y: Any, width: float, colors: Any | None = None
-    ) -> None:
-        """Bars at ``x`` of heights ``y``; ``colors (k,4)`` gives each bar its own fill (one
-        legend entry, ``label``, for all of them)."""
-        if colors is None:
-            self.ip.PlotBars(label, _f64(x), _f64(y), float(width))
-            return
-        for i, (xi, yi, c) in enumerate(zip(_f64(x), _f64(y), colors, strict=True)):
-            self.ip.SetNextFillStyle(tuple(float(t) for t in c))
-            self.ip.PlotBars(label if i == 0 else f"##{label}{i}", _f64([xi]), _f64([yi]), width)
-
-    def plot_vlines(self, label: str, x: Any) -> None:
-        self.ip.PlotInfLines(label, _f64(x))
-        self._record_plot(label, "vlines", x, None)
-
-    def plot_hlines(self, label: str, y: Any) -> None:
-        self.ip.PlotInfLines(label, _f64(y), self.ip.ImPlotInfLinesFlags_Horizontal)
-        self._record_plot(label, "hlines", None, y)
 
     # ------------------------------------------------------------------ tables
     @contextmanager
@@ -644,5 +537,4 @@ class UI(FieldErrors):
         """Hook called after :meth:`overlay_text` drew ``text`` at window pixel ``pos``."""
 
 
-def _f64(a: Any) -> np.ndarray:
-    return np.ascontiguousarray(a, dtype=np.float64).ravel()
+__all__ = ["EXPECTED", "RGBA", "UI", "UIApiMismatch", "check_return"]

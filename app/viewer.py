@@ -25,8 +25,9 @@ import numpy as np
 import polyscope as ps
 
 from meshlap_core.errors import MeshError
+from meshlap_core.options import UP_AXES, check_choice
 
-from . import scene
+from . import scene, window
 from .jobs import Job, Reporter, prefer_gil_free_solvers, warm_up
 from .pacing import Pacer
 from .panels.base import Panel
@@ -161,8 +162,9 @@ class Viewer:
             for view in VIEWS:  # a refused value of the last mesh's context
                 self.forget_errors(view)
             scene.remove_structure(MESH)
-            self.state.display.fit(mesh.V)
+            self.state.display.fit(mesh.V, self.state.up_for(mesh.name))
             ps.register_surface_mesh(MESH, self.mesh_points(), mesh.F, smooth_shade=True)
+            window.set_title(window.window_title(mesh.name, True))  # the window's, if any
             for p in self.panels.values():
                 p.on_new_mesh(self)
         for p in self.panels.values():
@@ -545,17 +547,19 @@ def run(
     backend: str | None = None,
     ui_scale: float | None = None,
     session: str | Path | None = None,
+    up: str | None = None,
     **options: Any,
 ) -> int:
     """Open the viewer on ``path`` (the bundled default mesh when ``None``).
 
     With ``screenshot`` a single frame is rendered headless (EGL) into that PNG and the
-    function returns. With ``session`` (a saved session file) its mesh, settings and camera
-    replace ``path``, ``panel`` and ``options``; a ``ui_scale`` given wins over the session's
-    (the room's projector, not the saved view; ``None``: the session's, else 1). ``options``
-    are the panels'
-    start options (``field``, ``vertex``, ``k``: ``None`` when not given), each checked by its
-    panel's state module before the window opens.
+    function returns. With ``session`` (a saved session file) its mesh, settings, up axis and
+    camera replace ``path``, ``panel``, ``up`` and ``options``; ``up``: the mesh's axis shown
+    up (:func:`.state.display.up_rotation`; ``None``: the mesh's rule); a ``ui_scale`` given
+    wins over the session's (the room's projector, not the saved view; ``None``: the
+    session's, else 1). ``options`` are the panels' start options (``field``, ``vertex``,
+    ``k``: ``None`` when not given), each checked by its panel's state module before the
+    window opens.
     """
     from .state.session import check_session_mesh, read_session
 
@@ -578,8 +582,14 @@ def run(
     if ui_scale is not None and not 0.5 <= ui_scale <= 3.0:  # also refuses NaN
         raise MeshError(f"must be between 0.5 and 3, got {ui_scale}", "--ui-scale")
     title = later.name if later is not None else state.mesh.name
-    ps.set_program_name(f"meshlap — {title}")  # the window title (set before init)
+    if up is not None:
+        state.up_given[title] = check_choice(up, UP_AXES, "up axis", "--up")
+    # the title polyscope gives the window when it creates it: the mesh's name only when
+    # it can follow the meshes opened later (window.title_follows), else the product's
+    ps.set_program_name(window.window_title(title, window.can_follow()))
     init_polyscope(backend or ("openGL3_egl" if shot else "auto"))
+    if shot is None:
+        window.place_window(tuple(ps.get_window_size()))  # inside the screen, centred
     viewer = Viewer(state)
     ps.set_build_default_gui_panels(False)  # polyscope's own panels: a toggle in Help
     if ui_scale is not None and ui_scale != 1.0:

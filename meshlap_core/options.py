@@ -40,6 +40,10 @@ DerivativeMethod
 Mesher
     How a convergence study meshes a parametric surface: ``"grid"`` (the (u, v) grid) or
     ``"icosphere"`` (the sphere only).
+UpAxis
+    The mesh's axis that points up on screen (``meshlap view --up``): ``"y"`` (the default,
+    most scans and the course meshes), ``"z"`` (CAD and some scans, e.g. nefertiti),
+    ``"x"``, or one of them negated.
 
 Every choice is checked by :func:`check_choice`, which raises the one standard message
 ``unknown <what> <value>; choose one of a, b, c``.
@@ -138,6 +142,11 @@ def check_choice(value: str, choices: tuple[str, ...], what: str, where: str | N
             what if where is None else where,
         )
     return value
+
+
+UpAxis = Literal["y", "z", "x", "-y", "-z", "-x"]
+UP_AXES: tuple[str, ...] = get_args(UpAxis)
+DEFAULT_UP: UpAxis = "y"
 
 
 # ------------------------------------------------------------------------------ tolerances

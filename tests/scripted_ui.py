@@ -108,6 +108,7 @@ class ScriptedUI(UI):
         self.progress_lines: list[tuple[str, float, str]] = []  # (section, fraction, text)
         # (section, label) -> (kind, x, y) of the last plot item drawn
         self.plots: dict[tuple[str, str], tuple[str, Any, Any]] = {}
+        self.legend_at: dict[str, str] = {}  # plot title -> where its legend was placed
         # every error line drawn: (section, text, label of the widget drawn just before it)
         self.errors_drawn: list[tuple[str, str, str]] = []
         self._last_label = ""
@@ -176,6 +177,9 @@ class ScriptedUI(UI):
 
     def _record_plot(self, label: str, kind: str, x: Any, y: Any) -> None:
         self.plots[(self.section, label)] = (kind, x, y)
+
+    def _record_legend(self, title: str, where: str) -> None:
+        self.legend_at[title] = where
 
     def _record_row(self, cells: list[str], rgba: RGBA | None, highlight: bool) -> None:
         record = self._drawing

@@ -122,6 +122,7 @@ def test_choices_match_their_literal_types():
         "NOISE_MODES": options.NoiseMode,
         "DERIVATIVE_METHODS": options.DerivativeMethod,
         "MESHERS": options.Mesher,
+        "UP_AXES": options.UpAxis,
     }
     for name, kind in literal.items():
         assert getattr(options, name) == get_args(kind), name
@@ -132,6 +133,7 @@ def test_choices_match_their_literal_types():
     assert set(options.EULER_METHODS) < set(options.SMOOTHING_METHODS)
     assert options.DEFAULT_MASS_UPDATE in options.MASS_UPDATES
     assert options.DEFAULT_NOISE_MODE in options.NOISE_MODES
+    assert options.DEFAULT_UP in options.UP_AXES
 
 
 def test_the_two_forms_of_the_degeneracy_threshold_agree():

@@ -5,14 +5,15 @@ serves two tests, in this order:
 
 - ``test_scripted_tour``: pick a mesh from the list, then every panel through its shortcut (1–5)
   with its widgets (curvature field and side by side, click a vertex and type one, compute the
-  eigenbasis and drag k, type λ and press Enter, space to play and to pause, a surface and its u
-  slider), export what is shown, the Help pane (H), and at 1280×720 a recording of the normal
-  section turning (record, turn, stop: a GIF of several frames). After each step the test checks
-  what a user sees on a screenshot: the subject left of meshlap's panel and not running behind it,
-  the second mesh (side by side, reconstruction, smoothed copy) beside it, λ applied on Enter and
-  not before, the export message, and that the process is alive with nothing on stderr but
-  polyscope's own ``[polyscope]`` lines. A failing step is recorded (the viewer is restarted if it
-  died) and the tour goes on, so one run reports every failing step.
+  eigenbasis and drag k, open another mesh and compute its eigenbasis, type λ and press Enter,
+  space to play and to pause, a surface and its u slider), export what is shown, the Help pane
+  (H), and at 1280×720 a recording of the normal section turning (record, turn, stop: a GIF of
+  several frames). After each step the test checks what a user sees on a screenshot: the
+  subject left of meshlap's panel and not running behind it, the second mesh (side by side,
+  reconstruction, smoothed copy) beside it, λ applied on Enter and not before, the export
+  message, the window's title naming the mesh shown, and that the process is alive with
+  nothing on stderr but polyscope's own ``[polyscope]`` lines. A failing step is recorded (the
+  viewer is restarted if it died) and the tour goes on, so one run reports every failing step.
 - ``test_monkey``: ``MESHLAP_MONKEY_ACTIONS`` (default 40, about 20 s when idle) random clicks,
   drags and keys anywhere, drawn from ``MESHLAP_MONKEY_SEED``; the viewer survives. A failure
   names the seed and the action's index, and the command that replays exactly those actions.
@@ -304,7 +305,8 @@ def opened(s: Session) -> None:
 
 def pick_mesh(s: Session) -> None:
     """The mesh list (first combo of the Mesh section): the torus, or with the torus open,
-    bumpy; the Mesh section describes the new mesh and the scene shows it."""
+    bumpy; the Mesh section describes the new mesh, the scene shows it and the window's
+    title names it (polyscope sets a title only when it creates the window)."""
     entry = 0 if s.mesh == SECOND_MESH else MESH_LIST.index("torus.obj")
     before = s.screenshot()
     mesh_box = section_box(parse(before), 0)
@@ -315,6 +317,9 @@ def pick_mesh(s: Session) -> None:
     if changed_fraction(before, s.img, mesh_box) < 0.002:
         raise AssertionError("the Mesh section still describes the previous mesh")
     s.subject_ok(layout, 1, "the picked mesh")
+    assert s.app is not None
+    if s.app.title() != TITLE + MESH_LIST[entry]:
+        raise AssertionError(f"window title {s.app.title()!r} after picking {MESH_LIST[entry]}")
 
 
 def curvature(s: Session) -> None:
@@ -421,6 +426,30 @@ def spectral(s: Session) -> None:
         "change of the reconstruction after dragging k, the mesh and the reconstruction shown",
     )
     s.subject_ok(parse(s.settled((0, 0, *s.size))), 2, "after dragging k")
+
+
+def second_mesh_spectral(s: Session) -> None:
+    """Key 3 with the eigenbasis of the picked mesh shown; open another mesh by typing its
+    path (bumpy after the torus, the torus after bumpy) and Enter, then compute its
+    eigenbasis: the reconstruction is shown beside the new mesh (issue 23: it came back
+    registered but hidden) and dragging k changes it (the steps of :func:`spectral`)."""
+    layout = s.goto(3, "Spectral")
+    name = "bumpy.obj" if s.mesh != SECOND_MESH else "torus.obj"
+    before = s.img
+    s.click(layout.find(0, "input", 0).center)  # the Mesh section's path field
+    s.x.xdotool("type", "--delay", "30", str(ROOT / "assets" / name))
+    s.drawn()
+    s.key("Return")
+    s.until(
+        lambda img: changed_fraction(before, img, scene_box(s, layout)) > 0.02,
+        30,
+        f"{name} in place of the shown mesh",
+    )
+    s.settled((0, 0, *s.size))
+    assert s.app is not None
+    if s.app.title() != TITLE + name:
+        raise AssertionError(f"window title {s.app.title()!r} after opening {name}")
+    spectral(s)
 
 
 def smoothing(s: Session) -> None:
@@ -633,6 +662,7 @@ TOUR: list[tuple[str, Callable[[Session], None]]] = [
     ("curvature", curvature),
     ("onering", onering),
     ("spectral", spectral),
+    ("second_mesh_spectral", second_mesh_spectral),
     ("smoothing", smoothing),
     ("surfaces", surfaces),
     ("export", export),

@@ -10,7 +10,7 @@ from __future__ import annotations
 import argparse
 
 from meshlap_core.errors import MeshError
-from meshlap_core.options import CURVATURE_FIELDS
+from meshlap_core.options import CURVATURE_FIELDS, UP_AXES
 
 from ..registry import VIEWS
 
@@ -44,6 +44,12 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="size of the panel's text and widgets, 0.5 to 3 (projectors: 1.5-2); with "
         "--session it replaces the session's scale",
     )
+    p.add_argument(
+        "--up",
+        choices=UP_AXES,
+        help="the mesh's axis shown up (default: y, or the mesh's known axis, e.g. z for "
+        "nefertiti.obj; a negated axis as --up=-z); kept in a saved session",
+    )
     p.set_defaults(func=run)
 
 
@@ -51,7 +57,7 @@ def run(args: argparse.Namespace) -> int:
     if args.session is not None:
         given = [("MESH", args.mesh)] + [
             (f"--{name.replace('_', '-')}", getattr(args, name))
-            for name in (*START_OPTIONS, "panel")  # --ui-scale: the projector's, wins
+            for name in (*START_OPTIONS, "panel", "up")  # --ui-scale: the projector's, wins
         ]
         given = [flag for flag, value in given if value is not None]
         if given:
@@ -79,5 +85,6 @@ def run(args: argparse.Namespace) -> int:
         panel=args.panel,
         ui_scale=args.ui_scale,
         session=args.session,
+        up=args.up,
         **{name: getattr(args, name) for name in START_OPTIONS},
     )

@@ -35,6 +35,8 @@ class CurvaturePanel(Panel):
 
     def on_new_mesh(self, host: Host) -> None:
         self.watch.forget()
+        if ps.has_surface_mesh(MESH_B):  # the side-by-side copy of the previous mesh
+            ps.remove_surface_mesh(MESH_B)
 
     def show(self, host: Host, active: Panel) -> None:
         self.sync(host)

@@ -284,7 +284,7 @@ class OneRingPanel(Panel):
         # obliquely (about 40° off the normal), so the arrows n and Δx at the vertex show
         back = 2.4 * normal + 2.0 * tilt
         if np.linalg.norm(np.cross([0.0, 1.0, 0.0], back)) < 1e-6 * np.linalg.norm(back):
-            ps.look_at(center + size * back, center)  # frame_points needs a non-vertical view
+            scene.look_at(center + size * back, center)  # frame_points needs a non-vertical view
             return True
         w, h = ps.get_window_size()
         ui_scale = host.state.ui_scale
@@ -303,7 +303,7 @@ class OneRingPanel(Panel):
         # shift the target so the vertex lands in the middle of that free strip
         ndc = left + fraction - 1.0
         target = center - ndc * d * tan_h * right
-        ps.look_at(target + d * back / np.linalg.norm(back), target)
+        scene.look_at(target + d * back / np.linalg.norm(back), target)
         return True
 
     def ring_labels(self, host: Host) -> list[tuple[tuple[float, float], str]]:

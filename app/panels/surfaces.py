@@ -215,7 +215,6 @@ class SurfacesPanel(Panel):
             200,
             "phi (deg) from the k1 direction",
             "k_n",
-            legend_outside=True,
         ) as shown:
             if shown:
                 ui.plot_line("k_n", np.degrees(s.phi), s.kn_phi)

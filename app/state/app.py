@@ -14,12 +14,12 @@ from pathlib import Path
 from typing import Any
 
 from meshlap_core.errors import MeshError
-from meshlap_core.options import check_choice
+from meshlap_core.options import DEFAULT_UP, check_choice
 
 from ..jobs import Jobs
 from ..registry import REGISTRY, VIEWS
 from .curvature import CurvatureState
-from .display import Display
+from .display import UP_BY_MESH, Display
 from .mesh import MeshState
 
 UI_SCALES = (0.5, 3.0)
@@ -56,6 +56,12 @@ class AppState:
     slices: dict[str, Any] = field(default_factory=make_slices)
     errors: dict[str, str] = field(default_factory=dict)
     jobs: Jobs = field(default_factory=Jobs)  # background jobs, applied on the UI thread
+    up_given: dict[str, str] = field(default_factory=dict)  # file name -> --up / session's
+
+    def up_for(self, name: str) -> str:
+        """The up axis of the mesh file ``name``: given (``--up``, a session), else its
+        entry of :data:`.display.UP_BY_MESH`, else ``"y"`` (the rule of :mod:`.display`)."""
+        return self.up_given.get(name) or UP_BY_MESH.get(name, DEFAULT_UP)
 
     def check_panel(self, name: str, flag: str = "view") -> str:
         """``name`` if it is a view, else a :class:`MeshError` naming the views."""

@@ -36,7 +36,9 @@ replays the runs exactly (bit for bit). The key is written only when it says som
 **Keys added after the first files** (``SESSION_ADDED`` of a state module, :func:`added_keys`):
 ``smoothing.lam_steps``, ``spectral.play`` (what the Spectral panel's *play* plays: ``k sweep``
 or ``modes``) and ``surfaces.theta`` (the normal section's θ in degrees). Each is written only
-when it differs from its default, and a missing one takes its default.
+when it differs from its default, and a missing one takes its default. The top-level ``up``
+(the mesh's axis shown up, ``meshlap view --up``) is written only when it is not the mesh's
+rule (:data:`.display.UP_BY_MESH`, else ``"y"``), which a missing ``up`` means.
 
 **Why the version stays 1.** A file is bumped only when an older reader would *misread* it. A
 reader of this version refuses every unknown key (``unknown key(s) in 'smoothing'``), so an
@@ -62,6 +64,7 @@ from meshlap_core import __version__
 from meshlap_core.errors import MeshError
 from meshlap_core.io import atomic_write, check_output_path
 from meshlap_core.io.reader import check_input, read_json
+from meshlap_core.options import UP_AXES
 
 from ..registry import REGISTRY, VIEWS
 from .camera import check_camera
@@ -101,7 +104,7 @@ def added_keys() -> tuple[tuple[str, str], ...]:
 
 def top_level() -> tuple[str, ...]:
     """The keys a session object may have."""
-    return ("format", "version", "meshlap", "mesh", "panel", "ui_scale", "camera", *schema())
+    return ("format", "version", "meshlap", "mesh", "panel", "ui_scale", "up", "camera", *schema())
 
 
 def default_settings() -> dict[str, dict[str, Any]]:
@@ -120,6 +123,7 @@ class Session:
     mesh: Path | None = None
     panel: str = VIEWS[0]
     ui_scale: float = 1.0
+    up: str | None = None  # the mesh's up axis when not its rule's (UP_BY_MESH, else y)
     camera: dict[str, Any] | None = None
     settings: dict[str, dict[str, Any]] = field(default_factory=default_settings)
 
@@ -141,6 +145,7 @@ class Session:
             "mesh": mesh,
             "panel": self.panel,
             "ui_scale": self.ui_scale,
+            **({"up": self.up} if self.up is not None else {}),  # added: written when set
             "camera": copy.deepcopy(self.camera),
             **_without_default_added_keys(copy.deepcopy(self.settings)),
         }
@@ -196,6 +201,8 @@ def from_dict(
     session = Session(mesh=_mesh_path(data.get("mesh"), source, folder))
     session.panel = _checked(data, "panel", VIEWS[0], one_of(VIEWS), source)
     session.ui_scale = float(_checked(data, "ui_scale", 1.0, number(0.5, 3.0), source))
+    up = data.get("up")
+    session.up = None if up is None else _checked(data, "up", None, one_of(UP_AXES), source)
     session.camera = check_camera(data.get("camera"), source)
     for sec, keys in schema().items():
         values = data.get(sec, {})

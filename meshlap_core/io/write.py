@@ -88,7 +88,7 @@ def save_mesh(
 def _write_ply(
     f: IO[bytes], V: FloatArray, F: IntArray, q: FloatArray | None, binary: bool
 ) -> None:
-    props = ["x", "y", "z"] + (["quality"] if q is not None else [])
+    props = list("xyz") + (["quality"] if q is not None else [])
     head = [
         "ply",
         f"format {'binary_little_endian' if binary else 'ascii'} 1.0",
