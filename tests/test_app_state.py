@@ -17,6 +17,28 @@ def test_default_mesh_loads():
     assert m.info["n_vertices"] > 100 and m.info["genus"] == 0 and not m.error
 
 
+def test_opening_job_reuses_the_edge_table_and_drops_it(tmp_path):
+    """The window's opening job (read, describe, every curvature field) gives what the core's
+    functions give without the loader's edge table, and leaves the table behind (the viewer
+    never uses it; it would double what the child process sends back)."""
+    from meshlap_app.state.mesh import read_mesh_with_fields
+
+    from meshlap_core.describe import mesh_info
+
+    path = tmp_path / "torus.obj"
+    save_mesh(path, *primitives.torus_mesh())
+    loaded, fields = read_mesh_with_fields(path, "voronoi", "pi")
+    m = loaded.mesh
+    assert m.edge_table is None
+    expected = all_curvature_fields(m.V, m.F, "voronoi", "pi")
+    assert set(fields) == set(expected)
+    for name, values in expected.items():
+        np.testing.assert_array_equal(fields[name], values, err_msg=name)
+    info = mesh_info(m.V, m.F, m.report, str(path))
+    assert loaded.info["n_edges"] == info["n_edges"] == 3 * len(m.F) // 2
+    assert loaded.info["genus"] == info["genus"] == 1
+
+
 def test_bad_file_keeps_last_good_mesh(tmp_path):
     m = MeshState()
     good = tmp_path / "cube.obj"
