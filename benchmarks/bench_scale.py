@@ -258,7 +258,7 @@ def fig_smooth(scan: Path, repeat: int) -> list[Row]:
                 t = time.perf_counter(); s._solver.solve(B)
                 res["solve"].append(time.perf_counter() - t)
             del s
-        print(solver_backend(), *[min(v) if v else -1 for v in res.values()])
+        print(solver_backend(len(m.V)), *[min(v) if v else -1 for v in res.values()])
         """
     )
     backend, chol, cholespy, first, nxt, build, solve, cholespy_solve = text.split()
