@@ -260,8 +260,9 @@ def mean_curvature_cotan(V: FloatArray, F: IntArray, area: AreaKind = DEFAULT_AR
     V, F = as_mesh(V, F)
     n = len(V)
     fr = _face_frame(V, F)
+    A, Cx = _areas_from(V, F, fr, area), _cotan_Cx(fr, F, n)
     N = _normals_from(F, n, *_geometry_of(fr))
-    return _cotan_H(_cotan_Cx(fr, F, n), _areas_from(V, F, fr, area), N)
+    return _cotan_H(Cx, A, N)
 
 
 def angle_deficit(
@@ -396,10 +397,13 @@ def all_curvature_fields(
         table = EdgeTable.from_faces(F, n)
     fr = _face_frame(V, F)
     fn, theta = _geometry_of(fr)
-    N = _normals_from(F, n, fn, theta)
     A = _areas_from(V, F, fr, area)
+    Cx = _cotan_Cx(fr, F, n)
+    del fr  # the per-face edge vectors: 9 arrays of m floats (400 MB at 2.77M vertices)
+    N = _normals_from(F, n, fn, theta)
+    del fn
     H_u = -0.5 * np.sum(_uniform_Lx(V, table.edges) * N, axis=1)
-    H_c = _cotan_H(_cotan_Cx(fr, F, n), A, N)
+    H_c = _cotan_H(Cx, A, N)
     d = _deficit_from(F, n, theta, boundary, table.boundary_vertex_mask())
     K = np.divide(d, A, out=np.zeros_like(d), where=A > 0)
     k1, k2 = principal_from_HK(H_c, K)
