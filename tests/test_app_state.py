@@ -183,3 +183,32 @@ def test_smoothing_state_unstable_explicit_stops():
             break
     assert not s.playing and "diverged" in s.error
     assert not SmoothingState(lam=float("nan")).rebuild(V, F)
+
+
+def test_smoother_build_does_the_slow_work_the_panel_reads(monkeypatch):
+    """The smoothing panel's build job leaves nothing slow for the UI thread: the implicit
+    system is factorized and the stability estimate (an eigensolve) computed there, so the
+    panel's figures and its first step compute neither again."""
+    from meshlap_app.state.smoothing import SmoothingState
+
+    from meshlap_core.smoothing import stepper
+
+    calls = []
+    real = stepper.most_negative_eigenvalue
+
+    def counted(*args, **kwargs):
+        calls.append(1)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(stepper, "most_negative_eigenvalue", counted)
+    V, F = primitives.icosphere(2)
+    st = SmoothingState(method="implicit", laplacian="cotan", lam=1e-3)
+    smoother = SmoothingState.build(V, F, st.options())
+    assert smoother.n_factorizations == 1 and len(calls) == 1
+    st.adopt_built(st.options(), smoother)
+    fig = st.figures()
+    mu, g = st.amplification()
+    assert st.step() and smoother.iteration == 1
+    assert smoother.n_factorizations == 1 and len(calls) == 1  # nothing more on the UI side
+    assert fig["stable_limit"] is None  # implicit: unconditionally stable
+    assert mu[0] < 0 and np.all((g > 0) & (g <= 1 + 1e-12))  # backward Euler damps every mode

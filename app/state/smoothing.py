@@ -139,6 +139,7 @@ class SmoothingState:
             history_limit=1000,  # the panel reads only the last entry; playing never grows
         )
         smoother.prepare()  # the factorization here, not in the first step on the UI thread
+        smoother.stability  # noqa: B018 -- its eigensolve here, not in the panel's first draw
         return smoother
 
     def adopt(self, smoother: Smoother) -> None:
