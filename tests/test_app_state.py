@@ -110,6 +110,35 @@ def test_one_ring_state_open_fan(tmp_path):
     np.testing.assert_allclose(r.arrows[-1], 0.0)  # the fan ends at its last neighbour
 
 
+def test_one_ring_of_a_vertex_from_its_own_faces_equals_the_whole_meshs(tmp_path):
+    """The selection reads the ring and normal from the vertex's own faces only (a big scan's
+    whole-mesh ring took minutes): the same ordered fans, flags and angle-weighted normal as the
+    whole mesh's, at interior, boundary and corner vertices, in both orders."""
+    from meshlap_app.state.onering import OneRingState
+
+    from meshlap_core.curvature import vertex_normals
+    from meshlap_core.topology import one_ring
+
+    V, F = primitives.grid(5, 4)
+    V = V.copy()
+    V[:, 2] = 0.2 * np.sin(4 * V[:, 0] + V[:, 1])
+    path = tmp_path / "bent.obj"
+    save_mesh(path, V, F)
+    m = MeshState()
+    assert m.load(path)
+    ring, N = one_ring(m.F, len(m.V)), vertex_normals(m.V, m.F)
+    back = ring.reversed()
+    c, r = CurvatureState(), OneRingState()
+    for v in range(len(m.V)):
+        assert r.select(m, c, v)
+        assert r.neighbors == ring[v].tolist(), v
+        assert (r.boundary, r.ordered) == (bool(ring.boundary[v]), bool(ring.regular[v]))
+        np.testing.assert_array_equal(r.normal, N[v])
+        r.toggle_reverse(m, c)
+        assert r.neighbors == back[v].tolist(), v
+        r.toggle_reverse(m, c)
+
+
 def test_spectral_state_k_slider(tmp_path, monkeypatch):
     from meshlap_app.state.spectral import SpectralState
 
