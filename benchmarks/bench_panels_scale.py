@@ -148,8 +148,13 @@ def child(scan: Path, k: int, wait_basis: bool, out: Path) -> list[dict[str, Any
         ps.frame_tick()
     ok = bool(refused) or sp.busy or sp.basis is not None
     row("spectral", f"k = {k}: " + ("refused" if refused else "computing"), t, ok, refused)
-    if sp.busy:
+    if sp.busy:  # cancelled, and waited for, before the next panel's memory is counted
+        t = time.perf_counter()
         viewer.state.jobs.cancel_all()
+        while sp.busy:
+            time.sleep(0.1)
+            ps.frame_tick()
+        row("spectral", "cancelled", t, not sp.busy)
 
     sm = viewer.panels["smoothing"].state
     t = time.perf_counter()
