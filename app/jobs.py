@@ -389,7 +389,9 @@ def _context() -> Any:
 
 
 def warm_up() -> None:
-    """Start the fork server now (in a thread: the first job then starts at once)."""
+    """Start the fork server now, then import matplotlib's colour maps (in a thread: the first
+    job then starts at once, and the first coloured frame of a mesh does not import them on
+    the UI thread, 0.5-1.5 s)."""
 
     def start() -> None:
         try:
@@ -398,6 +400,10 @@ def warm_up() -> None:
             _context()
             forkserver.ensure_running()
         except Exception:  # no fork server here: in_child falls back to a thread
+            pass
+        try:
+            from matplotlib import colormaps  # noqa: F401
+        except ImportError:  # the panels that use it say so when they draw
             pass
 
     threading.Thread(target=start, daemon=True).start()

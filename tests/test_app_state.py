@@ -17,6 +17,28 @@ def test_default_mesh_loads():
     assert m.info["n_vertices"] > 100 and m.info["genus"] == 0 and not m.error
 
 
+def test_opening_job_reuses_the_edge_table_and_drops_it(tmp_path):
+    """The window's opening job (read, describe, every curvature field) gives what the core's
+    functions give without the loader's edge table, and leaves the table behind (the viewer
+    never uses it; it would double what the child process sends back)."""
+    from meshlap_app.state.mesh import read_mesh_with_fields
+
+    from meshlap_core.describe import mesh_info
+
+    path = tmp_path / "torus.obj"
+    save_mesh(path, *primitives.torus_mesh())
+    loaded, fields = read_mesh_with_fields(path, "voronoi", "pi")
+    m = loaded.mesh
+    assert m.edge_table is None
+    expected = all_curvature_fields(m.V, m.F, "voronoi", "pi")
+    assert set(fields) == set(expected)
+    for name, values in expected.items():
+        np.testing.assert_array_equal(fields[name], values, err_msg=name)
+    info = mesh_info(m.V, m.F, m.report, str(path))
+    assert loaded.info["n_edges"] == info["n_edges"] == 3 * len(m.F) // 2
+    assert loaded.info["genus"] == info["genus"] == 1
+
+
 def test_bad_file_keeps_last_good_mesh(tmp_path):
     m = MeshState()
     good = tmp_path / "cube.obj"
@@ -86,6 +108,35 @@ def test_one_ring_state_open_fan(tmp_path):
     assert r.select(m, CurvatureState(), 1)  # an edge vertex of the grid
     assert r.boundary and len(r.edges) == r.valence - 1
     np.testing.assert_allclose(r.arrows[-1], 0.0)  # the fan ends at its last neighbour
+
+
+def test_one_ring_of_a_vertex_from_its_own_faces_equals_the_whole_meshs(tmp_path):
+    """The selection reads the ring and normal from the vertex's own faces only (a big scan's
+    whole-mesh ring took minutes): the same ordered fans, flags and angle-weighted normal as the
+    whole mesh's, at interior, boundary and corner vertices, in both orders."""
+    from meshlap_app.state.onering import OneRingState
+
+    from meshlap_core.curvature import vertex_normals
+    from meshlap_core.topology import one_ring
+
+    V, F = primitives.grid(5, 4)
+    V = V.copy()
+    V[:, 2] = 0.2 * np.sin(4 * V[:, 0] + V[:, 1])
+    path = tmp_path / "bent.obj"
+    save_mesh(path, V, F)
+    m = MeshState()
+    assert m.load(path)
+    ring, N = one_ring(m.F, len(m.V)), vertex_normals(m.V, m.F)
+    back = ring.reversed()
+    c, r = CurvatureState(), OneRingState()
+    for v in range(len(m.V)):
+        assert r.select(m, c, v)
+        assert r.neighbors == ring[v].tolist(), v
+        assert (r.boundary, r.ordered) == (bool(ring.boundary[v]), bool(ring.regular[v]))
+        np.testing.assert_array_equal(r.normal, N[v])
+        r.toggle_reverse(m, c)
+        assert r.neighbors == back[v].tolist(), v
+        r.toggle_reverse(m, c)
 
 
 def test_spectral_state_k_slider(tmp_path, monkeypatch):
@@ -161,3 +212,32 @@ def test_smoothing_state_unstable_explicit_stops():
             break
     assert not s.playing and "diverged" in s.error
     assert not SmoothingState(lam=float("nan")).rebuild(V, F)
+
+
+def test_smoother_build_does_the_slow_work_the_panel_reads(monkeypatch):
+    """The smoothing panel's build job leaves nothing slow for the UI thread: the implicit
+    system is factorized and the stability estimate (an eigensolve) computed there, so the
+    panel's figures and its first step compute neither again."""
+    from meshlap_app.state.smoothing import SmoothingState
+
+    from meshlap_core.smoothing import stepper
+
+    calls = []
+    real = stepper.most_negative_eigenvalue
+
+    def counted(*args, **kwargs):
+        calls.append(1)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(stepper, "most_negative_eigenvalue", counted)
+    V, F = primitives.icosphere(2)
+    st = SmoothingState(method="implicit", laplacian="cotan", lam=1e-3)
+    smoother = SmoothingState.build(V, F, st.options())
+    assert smoother.n_factorizations == 1 and len(calls) == 1
+    st.adopt_built(st.options(), smoother)
+    fig = st.figures()
+    mu, g = st.amplification()
+    assert st.step() and smoother.iteration == 1
+    assert smoother.n_factorizations == 1 and len(calls) == 1  # nothing more on the UI side
+    assert fig["stable_limit"] is None  # implicit: unconditionally stable
+    assert mu[0] < 0 and np.all((g > 0) & (g <= 1 + 1e-12))  # backward Euler damps every mode

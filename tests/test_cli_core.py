@@ -183,3 +183,21 @@ def test_sigint_during_startup_exits_130_quietly(cube_obj, trigger, how):
     assert code == 130, err
     assert len(err) <= 1 and not any("Traceback" in x for x in err), err
     assert err == [] or err[0] == "meshlap: interrupted\n"
+
+
+def test_a_named_command_builds_its_parser_alone():
+    """``meshlap curvature ...`` registers only that subcommand (start-up time), with the same
+    arguments as the full parser; an unknown or absent command gets the full parser."""
+    from meshlap_core.cli import _named_command, build_parser
+
+    assert _named_command(["curvature", "x.obj"]) == "curvature"
+    assert _named_command(["--version"]) is None
+    assert _named_command(["view", "x.obj"]) is None  # the viewer's, from the entry points
+    assert _named_command([]) is None
+    argv = ["curvature", "m.obj", "--method", "k1", "--area", "voronoi", "--json"]
+    alone, full = build_parser("curvature"), build_parser()
+    assert vars(alone.parse_args(argv)) == vars(full.parse_args(argv))
+    choices = alone._subparsers._group_actions[0].choices  # type: ignore[union-attr]
+    assert list(choices) == ["curvature"]
+    full_choices = full._subparsers._group_actions[0].choices  # type: ignore[union-attr]
+    assert {"info", "curvature", "spectral", "view"} <= set(full_choices)

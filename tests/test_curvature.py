@@ -135,6 +135,53 @@ def test_agreement_with_libigl():
     np.testing.assert_allclose(np.abs(np.sum(d1 * d2, axis=1)), 0, atol=1e-6)
 
 
+def test_matrix_free_cotan_laplacian_equals_libigl_cotmatrix():
+    """``C x`` summed face by face (no sparse matrix) is libigl's ``cotmatrix @ V``; with a
+    zero-area face it is the guarded matrix ``cotan_stiffness`` falls back to, finite."""
+    from meshlap_core.laplacian import cotan_stiffness
+
+    V, F = primitives.bumpy_sphere(3)
+    n = len(V)
+    Cx = curv._cotan_Cx(curv._face_frame(V, F), F, n)
+    np.testing.assert_allclose(Cx, igl.cotmatrix(V, F) @ V, atol=1e-12 * np.abs(Cx).max())
+    np.testing.assert_allclose(Cx.sum(axis=0), 0.0, atol=1e-12)  # 1ᵀC = 0: the pulls cancel
+    # one triangle by hand: (0,0,0), (1,0,0), (0,1,0); cot 90° = 0 and cot 45° = 1, so the
+    # legs carry weight ½ and the hypotenuse none: (C x)_0 = ½((1,0,0) + (0,1,0))
+    T = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0]])
+    Ct = curv._cotan_Cx(curv._face_frame(T, np.array([[0, 1, 2]])), np.array([[0, 1, 2]]), 3)
+    np.testing.assert_allclose(Ct[0], [0.5, 0.5, 0.0], atol=1e-15)
+    Vd = np.array([[0.0, 0, 0], [1, 0, 0], [2, 0, 0], [0, 1, 0], [1, 1, 0.5]])
+    Fd = np.array([[0, 1, 2], [0, 1, 3], [1, 4, 3], [1, 2, 4]])  # face 0 has zero area
+    Cd = curv._cotan_Cx(curv._face_frame(Vd, Fd), Fd, 5)
+    assert np.isfinite(Cd).all()
+    np.testing.assert_allclose(Cd, cotan_stiffness(Vd, Fd) @ Vd, atol=1e-12)
+
+
+def test_all_fields_from_the_edge_table_equal_the_assembled_operators():
+    """The fields computed edge by edge (with or without a loaded mesh's edge table) are those
+    of the assembled ``uniform_laplacian`` and the boundary rule on an open, bent surface."""
+    from meshlap_core.laplacian import uniform_laplacian
+    from meshlap_core.validate import validate_mesh
+
+    V, F = primitives.grid(9, 7)
+    V = V.copy()
+    V[:, 2] = 0.3 * np.sin(3 * V[:, 0]) * np.cos(2 * V[:, 1])  # bent, with a boundary
+    m = validate_mesh(V, F)
+    with_table = curv.all_curvature_fields(m.V, m.F, table=m.edge_table)
+    without = curv.all_curvature_fields(m.V, m.F)
+    for name in with_table:
+        np.testing.assert_array_equal(with_table[name], without[name], err_msg=name)
+    N = curv.vertex_normals(m.V, m.F)
+    H_u = -0.5 * np.sum((uniform_laplacian(m.F, len(m.V)) @ m.V) * N, axis=1)
+    np.testing.assert_allclose(with_table["uniform"], H_u, atol=1e-12)
+    np.testing.assert_allclose(with_table["cotan"], curv.mean_curvature_cotan(m.V, m.F))
+    K = curv.gaussian_curvature(m.V, m.F)  # the boundary rule from its own boundary mask
+    np.testing.assert_allclose(with_table["gaussian"], K, atol=1e-12)
+    other = validate_mesh(*primitives.icosphere(1)).edge_table  # another mesh's: not used
+    again = curv.all_curvature_fields(m.V, m.F, table=other)
+    np.testing.assert_array_equal(again["uniform"], without["uniform"])
+
+
 def test_degenerate_faces_never_give_nan():
     V = np.array([[0.0, 0, 0], [1, 0, 0], [2, 0, 0], [0, 1, 0], [1, 1, 0.5]])
     F = np.array([[0, 1, 2], [0, 1, 3], [1, 4, 3], [1, 2, 4]])  # face 0 has zero area

@@ -244,6 +244,25 @@ def test_fixed_boundary_vertices_do_not_move(method, laplacian):
     assert np.abs(X[~b] - V[~b]).max() > 0
 
 
+def test_prepare_factorizes_before_the_first_step(spd_backend):
+    """``prepare`` does the implicit factorization up front (a job's work, not the window's
+    first step): the steps after it factorize nothing more and give the same mesh; with a
+    pinned boundary too (the pinned vertices' pull is set up by ``prepare``)."""
+    for V, F, kw in ((*bumpy_sphere(2), {}), (*grid(6, 5), {"fix_boundary": True})):
+        V = V + 0.01 * np.sin(7 * V[:, [1, 2, 0]])  # bent: the grid is not already smooth
+        ready = S.Smoother(V, F, "implicit", "cotan", 0.01, **kw)
+        ready.prepare()
+        assert ready.n_factorizations == 1 and ready.iteration == 0
+        ready.prepare()  # current: nothing to do
+        assert ready.n_factorizations == 1
+        lazy = S.Smoother(V, F, "implicit", "cotan", 0.01, **kw)
+        np.testing.assert_array_equal(ready.run(3), lazy.run(3))
+        assert ready.n_factorizations == lazy.n_factorizations == 1
+    taubin = S.Smoother(*bumpy_sphere(1), "taubin", "uniform", 0.5)
+    taubin.prepare()  # explicit steps factorize nothing
+    assert taubin.n_factorizations == 0
+
+
 def test_mass_recompute_refactorizes_frozen_reuses():
     V, F = bumpy_sphere(2)
     frozen = S.Smoother(V, F, "implicit", "cotan", 0.01)

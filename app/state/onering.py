@@ -80,9 +80,6 @@ class OneRingState:
     H: float = float("nan")
     K: float = float("nan")
     normal: FloatArray = field(default_factory=lambda: np.zeros(3))
-    _ring_key: int = -1
-    _ring: Any = None
-    _normals: Any = None
     polyline: FloatArray = field(default_factory=lambda: np.zeros((0, 3)))
     edges: IntArray = field(default_factory=lambda: np.zeros((0, 2), dtype=np.int64))
     arrows: FloatArray = field(default_factory=lambda: np.zeros((0, 3)))
@@ -104,16 +101,15 @@ class OneRingState:
         """Select ``vertex``; returns False (and keeps the old selection) when out of range."""
         if not 0 <= vertex < len(mesh.V):
             return False
-        from meshlap_core.topology import one_ring  # local: keeps app.state import light
+        from meshlap_core.curvature import vertex_normals  # local: keeps app.state import light
+        from meshlap_core.topology import one_ring
 
-        if self._ring_key != mesh.version:
-            from meshlap_core.curvature import vertex_normals
-
-            self._ring = one_ring(mesh.F, len(mesh.V))
-            self._normals = vertex_normals(mesh.V, mesh.F)
-            self._ring_key = mesh.version
-        self.normal = self._normals[vertex]
-        ring = self._ring.reversed() if self.reverse else self._ring
+        # the ring and normal of one vertex need only its own faces: the same fans, order and
+        # angle-weighted normal as the whole mesh's, in O(m) instead of minutes at 2.77M vertices
+        F = mesh.F[np.flatnonzero((mesh.F == vertex).any(axis=1))]
+        ring = one_ring(F, len(mesh.V))
+        self.normal = vertex_normals(mesh.V, F)[vertex]
+        ring = ring.reversed() if self.reverse else ring
         nb = ring[vertex]
         self.vertex = int(vertex)
         self.neighbors = [int(j) for j in nb]

@@ -128,7 +128,7 @@ class SmoothingState:
         if progress is not None:
             what = "factorizing the implicit system" if method == "implicit" else "operators"
             progress.phase_only(f"{what} and the stable lambda ({len(V):,} vertices)")
-        return Smoother(
+        smoother = Smoother(
             start,
             F,
             method,
@@ -138,6 +138,9 @@ class SmoothingState:
             warn=False,
             history_limit=1000,  # the panel reads only the last entry; playing never grows
         )
+        smoother.prepare()  # the factorization here, not in the first step on the UI thread
+        smoother.stability  # noqa: B018 -- its eigensolve here, not in the panel's first draw
+        return smoother
 
     def adopt(self, smoother: Smoother) -> None:
         """Step ``smoother`` from now on (built by :meth:`build`, maybe in a job)."""

@@ -162,19 +162,31 @@ class _Parser(argparse.ArgumentParser):
         raise SystemExit(_fail(message))
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The full parser with every subcommand registered."""
+def build_parser(only: str | None = None) -> argparse.ArgumentParser:
+    """The full parser with every subcommand registered.
+
+    ``only``, one of :data:`COMMANDS`, registers that subcommand alone (what :func:`main` does
+    when the command line names one): the other commands' modules, and the entry points'
+    lookup, are not imported, which a whole ``meshlap curvature`` process notices at start-up.
+    """
     parser = _Parser(prog="meshlap", description="A Laplacian geometry lab for triangle meshes.")
     parser.add_argument("--version", action="version", version=f"meshlap {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
-    for name in COMMANDS:
+    for name in COMMANDS if only not in COMMANDS else (only,):
         importlib.import_module(f"{__name__}.{name}").register(sub)
+    if only in COMMANDS:
+        return parser
     from importlib.metadata import entry_points
 
     for ep in sorted(entry_points(group=COMMAND_GROUP), key=lambda e: e.name):
         ep.load().register(sub)
     return parser
+
+
+def _named_command(argv: Sequence[str]) -> str | None:
+    """The built-in command ``argv`` starts with, else ``None`` (the full parser then)."""
+    return argv[0] if len(argv) and argv[0] in COMMANDS else None
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -187,7 +199,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     """
     prepare_streams()
     try:
-        parser = build_parser()  # imports numpy, scipy and libigl: the slow part of start-up
+        # imports numpy, scipy and libigl: the slow part of start-up
+        parser = build_parser(_named_command(sys.argv[1:] if argv is None else argv))
     except KeyboardInterrupt:
         sys.stderr.write("meshlap: interrupted\n")
         return 130

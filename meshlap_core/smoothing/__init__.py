@@ -35,7 +35,9 @@ Modules
 ``stability``
     ``W`` and ``K``, the most negative eigenvalue, amplification curves, stable ``λ``.
 ``stepper``
-    :class:`Smoother` and :func:`smooth`.
+    :class:`Smoother`.
+``oneshot``
+    :func:`smooth`.
 ``denoise``
     :func:`denoise_sweep` and :func:`best_rows`.
 
@@ -52,6 +54,7 @@ SGP 2012 (stiffness frozen, mass recomputed).
 
 from ..linalg.quiet import quiet_c_stdout
 from .denoise import best_rows, denoise_sweep
+from .oneshot import smooth
 from .params import (
     DEFAULT_PASS_BAND,
     MAX_ITERS,
@@ -66,7 +69,7 @@ from .stability import (
     operator_parts,
     stability,
 )
-from .stepper import ILL_CONDITIONED, DivergenceError, Smoother, smooth
+from .stepper import ILL_CONDITIONED, DivergenceError, Smoother
 
 __all__ = [
     "DEFAULT_PASS_BAND",

@@ -305,6 +305,14 @@ class Smoother:
             )
         return self._stability
 
+    def prepare(self) -> None:
+        """Do now the one-time work of the next step: the implicit system's factorization
+        (nothing for the explicit and Taubin steppers, or when it is current). A caller that
+        builds the stepper in a job calls it there, so that the first :meth:`step` on the
+        window's thread is as cheap as the others."""
+        if self.method == "implicit" and len(self._free) and not self.diverged:
+            self._factorize(self._V)
+
     def set_lam(self, lam: float) -> None:
         """Change ``λ`` (and Taubin's ``ν`` if it was derived from it) without losing the state.
 
@@ -520,35 +528,44 @@ class Smoother:
         free = self._free
         if len(free) == 0:
             return x.copy()
-        key = (self.lam, self.iteration if self._recompute_mass else -1)
-        if self._solver is None or self._solver_key != key:
-            Wf = self._W[free]
-            A = self._K_ff.copy()  # W − λK in place: K stores its diagonal, no new entries
-            A.data *= -self.lam
-            A.setdiag(A.diagonal() + Wf)
-            spent, self._solver = self._solver, None  # refactorized in place (same pattern)
-            try:
-                self._solver = SPDSolver(A, reuse=spent)
-            except np.linalg.LinAlgError:
-                stiff = float(np.max(-self._K_ff.diagonal() / Wf)) if len(free) else 0.0
-                raise MeshError(
-                    f"the implicit system W - lam K cannot be factorized: lam = {self.lam:g} "
-                    f"times the stiffest vertex's -L_ii = {stiff:.3g} is {self.lam * stiff:.3g}, "
-                    "beyond double precision (use a smaller lam, or rescale the mesh; the cotan "
-                    "lam is in units of length²)",
-                    "lam",
-                ) from None
-            self._solver_key = key
-            self.n_factorizations += 1
-            self._rhs_fixed = self.lam * (self._K_fp @ x[self._fixed]) if len(self._fixed) else None
+        self._factorize(x)
+        solver = self._solver
+        assert solver is not None
         if len(self._fixed) == 0:  # nothing pinned: no gathers or scatters
-            return self._solver.solve(self._W[:, None] * x)
+            return solver.solve(self._W[:, None] * x)
         rhs = self._W[free][:, None] * x[free]
         if self._rhs_fixed is not None:
             rhs = rhs + self._rhs_fixed
         new = x.copy()
-        new[free] = self._solver.solve(rhs)
+        new[free] = solver.solve(rhs)
         return new
+
+    def _factorize(self, x: FloatArray) -> None:
+        """Factorize ``W − λK`` (free block) unless the current factor is for this ``λ`` (and,
+        recomputing the mass, this iteration); ``x`` gives the pinned vertices' pull."""
+        free = self._free
+        key = (self.lam, self.iteration if self._recompute_mass else -1)
+        if self._solver is not None and self._solver_key == key:
+            return
+        Wf = self._W[free]
+        A = self._K_ff.copy()  # W − λK in place: K stores its diagonal, no new entries
+        A.data *= -self.lam
+        A.setdiag(A.diagonal() + Wf)
+        spent, self._solver = self._solver, None  # refactorized in place (same pattern)
+        try:
+            self._solver = SPDSolver(A, reuse=spent)
+        except np.linalg.LinAlgError:
+            stiff = float(np.max(-self._K_ff.diagonal() / Wf)) if len(free) else 0.0
+            raise MeshError(
+                f"the implicit system W - lam K cannot be factorized: lam = {self.lam:g} "
+                f"times the stiffest vertex's -L_ii = {stiff:.3g} is {self.lam * stiff:.3g}, "
+                "beyond double precision (use a smaller lam, or rescale the mesh; the cotan "
+                "lam is in units of length²)",
+                "lam",
+            ) from None
+        self._solver_key = key
+        self.n_factorizations += 1
+        self._rhs_fixed = self.lam * (self._K_fp @ x[self._fixed]) if len(self._fixed) else None
 
     def _rescale_volume(self, x: FloatArray) -> FloatArray:
         vol = _signed_volume_unchecked(x, self.F, self._FT)
@@ -601,50 +618,3 @@ class Smoother:
             dr = x - self.reference
             entry["rmse"] = float(np.sqrt(np.einsum("ij,ij->", dr, dr) / max(self.n, 1)))
         return entry
-
-
-def smooth(
-    V: FloatArray,
-    F: IntArray,
-    method: SmoothingMethod = "explicit",
-    laplacian: LaplacianKind = "uniform",
-    lam: float = 0.5,
-    iters: int = 10,
-    **options: Any,
-) -> FloatArray:
-    """One-shot smoothing: ``Smoother(V, F, method, laplacian, lam, **options).run(iters)``.
-
-    Parameters
-    ----------
-    V : (n,3) float
-    F : (m,3) int
-    method : {"explicit", "implicit", "taubin"}
-    laplacian : {"uniform", "cotan"}
-        Negative semidefinite ``L = W⁻¹K`` (see :class:`Smoother`).
-    lam : float
-        ``> 0``.
-    iters : int
-        ``>= 0``.
-    **options
-        Keyword options of :class:`Smoother` (``fix_boundary``, ``preserve_volume``,
-        ``mass_update``, ...).
-
-    Returns
-    -------
-    V_smooth : (n,3) float
-        A new array.
-
-    Raises
-    ------
-    MeshError
-        On bad arguments (``iters`` above :data:`~.params.MAX_ITERS` too).
-    DivergenceError
-        If explicit or Taubin smoothing diverged (see :attr:`Smoother.diverged`).
-    """
-    iters = check_iters(iters)
-    s = Smoother(V, F, method, laplacian, lam, track_history=False, **options)
-    s.run(iters)
-    message = s.divergence_message()
-    if message is not None:
-        raise DivergenceError(message, "lam")
-    return s.V.copy()
