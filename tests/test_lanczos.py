@@ -240,3 +240,17 @@ def test_qdldl_refactors_a_spare_factorization_of_the_same_pattern():
     other, neg_b = qdldl_inertia(B, rng, reuse=again)
     assert other.solver is not again.solver
     assert neg_b == np.count_nonzero(np.linalg.eigvalsh(B.toarray()) < 0)
+
+
+def test_scaled_pencil_equals_the_two_diagonal_products():
+    from meshlap_core.linalg.slice_worker import scaled_pencil
+
+    rng = np.random.default_rng(3)
+    K = sp.random(60, 60, density=0.15, random_state=3, format="csr")
+    K = (K + K.T).tocsr()
+    s = rng.uniform(0.5, 2.0, 60)
+    ref = (sp.diags(s) @ K @ sp.diags(s)).toarray()
+    A = scaled_pencil(K, s)
+    np.testing.assert_allclose(A.toarray(), ref, rtol=1e-15, atol=0)
+    assert A.nnz == K.nnz and np.array_equal(A.indices, K.indices)
+    np.testing.assert_allclose(A.toarray(), A.toarray().T)  # symmetric stays symmetric

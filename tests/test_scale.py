@@ -247,6 +247,36 @@ def test_shift_invert_on_both_backends_counts_and_solves_alike(spd_backend):
     np.testing.assert_allclose(out, np.linalg.solve(S, Y), rtol=1e-8, atol=1e-10)
 
 
+def test_cholmod_inertia_with_metis_ordering_counts_like_the_dense_spectrum(monkeypatch):
+    """The nested-dissection ordering used on scans (METIS_MIN_N) on a small indefinite
+    matrix: same inertia as LAPACK, solves to round-off, and a refactorization at another
+    shift (the analysis reused) still counts right."""
+    import scipy.sparse as sp
+
+    from meshlap_core.linalg import factor, spd
+
+    pytest.importorskip("sksparse", reason="scikit-sparse (CHOLMOD) is not installed")
+    monkeypatch.setenv(spd.SOLVER_ENV, "cholmod")
+    monkeypatch.setattr(spd, "_GIL_FREE", {"eigen": False})
+    monkeypatch.setattr(factor, "METIS_MIN_N", 0)
+    rng = np.random.default_rng(8)
+    V, F = primitives.bumpy_sphere(2)
+    from meshlap_core.spectral.operators import spectral_operators
+
+    K, m = spectral_operators(V, F, "cotan", "voronoi")
+    inv = sp.diags(1.0 / np.sqrt(m))
+    A = (inv @ K @ inv).tocsr()
+    ev = np.linalg.eigvalsh(A.toarray())
+    eye = sp.identity(len(m), format="csr")
+    ldl = None
+    for sigma in (0.5 * (ev[10] + ev[11]), 0.5 * (ev[40] + ev[41])):
+        S = (A - sigma * eye).tocsr()
+        ldl, count = factor.cholmod_inertia(S, rng, ldl)
+        assert count == np.count_nonzero(ev < sigma)
+        b = rng.standard_normal((len(m), 3))
+        np.testing.assert_allclose(S @ ldl.solve(b), b, atol=1e-8)
+
+
 def test_eigenbasis_is_the_same_on_both_backends(spd_backend):
     from meshlap_core.linalg.eigsolve import pencil_eigenpairs
     from meshlap_core.spectral.operators import spectral_operators

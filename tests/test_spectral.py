@@ -223,6 +223,33 @@ def test_reconstruction_error_is_non_increasing_and_matches_direct():
     assert np.mean(np.linalg.norm(V - wrong, axis=1)) > 10 * errs.mean[50]
 
 
+def test_errors_at_chosen_k_match_the_direct_projection_and_the_full_table():
+    V, F = bumpy_sphere(3)
+    basis = S.SpectralBasis.compute(V, F, 120, cache=False)
+    m = basis.mass
+    ks = [120, 0, 7, 64, 7]
+    errs = basis.errors_at(ks)
+    assert errs.k.tolist() == [0, 7, 64, 120]  # sorted, unique
+    full = basis.errors(k_max=120)
+    for i, k in enumerate(errs.k):
+        Uk = basis.vectors[:, :k]
+        e = np.linalg.norm(V - Uk @ (Uk.T @ (m[:, None] * V)), axis=1)
+        assert errs.mean[i] == pytest.approx(e.mean(), rel=1e-9, abs=1e-14)
+        assert errs.max[i] == pytest.approx(e.max(), rel=1e-9, abs=1e-14)
+        assert errs.rms[i] == pytest.approx(np.sqrt(np.mean(e**2)), rel=1e-9, abs=1e-14)
+        assert errs.l2[i] == pytest.approx(np.sqrt(m @ e**2 / m.sum()), rel=1e-9, abs=1e-14)
+        assert errs.row(int(k)) == pytest.approx(full.row(int(k)), rel=1e-9, abs=1e-14)
+    with pytest.raises(MeshError, match="k = 8"):
+        errs.row(8)
+    # another field than the vertices: a single column
+    X = V[:, 2] ** 2
+    one = basis.errors_at([3, 50], X)
+    U3 = basis.vectors[:, :3]
+    assert one.max[0] == pytest.approx(np.abs(X - U3 @ (U3.T @ (m * X))).max(), rel=1e-9)
+    with pytest.raises(MeshError):
+        basis.errors_at([-1, 4])
+
+
 def test_incremental_reconstruction_equals_the_direct_product():
     V, F = bumpy_sphere(3)
     basis = S.SpectralBasis.compute(V, F, 120, cache=False)

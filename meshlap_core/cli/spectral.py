@@ -162,7 +162,7 @@ def run(args: argparse.Namespace) -> int:
     info = basis.info
 
     t0 = time.perf_counter()
-    errs = basis.errors(k_max=max(recon))
+    errs = basis.errors_at(recon)  # (the rows asked for only: not every k up to the largest)
     rows = [errs.row(r) for r in recon]
     t_err = time.perf_counter() - t0
 

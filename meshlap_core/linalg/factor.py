@@ -176,6 +176,16 @@ def qdldl_inertia(
     return ldl, checked_inertia(A, ldl, D, rng)
 
 
+METIS_MIN_N = 150_000
+"""From this many unknowns :func:`cholmod_inertia` orders with METIS's nested dissection
+instead of CHOLMOD's default (AMD on meshes): its analysis costs more (12–16 s against
+4–5 s at 692k vertices) but the factor has 27 % fewer entries (25.4M against 34.7M) and
+each numeric factorization takes about half the time (11–16 s against 26–30 s, the same
+run on a busy machine), which pays off from the second factorization of the pencil on
+(the inertia check above ``λ_k`` reuses the analysis). On small meshes AMD is faster
+(0.10 + 0.12 s against 0.55 + 0.19 s at 43k)."""
+
+
 class CholmodLDLFactor:
     """CHOLMOD's simplicial ``LDLᵀ`` (scikit-sparse) of a symmetric matrix, with its inertia;
     see :func:`cholmod_inertia`. Solves a block of right-hand sides in one call."""
@@ -191,7 +201,8 @@ class CholmodLDLFactor:
 def cholmod_inertia(
     A: sp.csr_matrix, rng: np.random.Generator, reuse: CholmodLDLFactor | None = None
 ) -> tuple[CholmodLDLFactor, int]:
-    """CHOLMOD simplicial ``LDLᵀ`` (no pivoting, AMD ordering) of a symmetric matrix and the
+    """CHOLMOD simplicial ``LDLᵀ`` (no pivoting; AMD ordering, METIS from :data:`METIS_MIN_N`
+    unknowns) of a symmetric matrix and the
     number of its negative eigenvalues (negative entries of ``D``, Sylvester), checked like
     :func:`qdldl_inertia`. Measured at 43k vertices: factorization 2× and 4-column solves
     3× faster than QDLDL's (which solves one column at a time).
@@ -224,7 +235,11 @@ def cholmod_inertia(
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("error", CholmodWarning)
-            factor = reuse.factor if same else analyze(csc, mode="simplicial")  # type: ignore[union-attr]
+            if same:
+                factor = reuse.factor  # type: ignore[union-attr]
+            else:
+                order = "metis" if A.shape[0] >= METIS_MIN_N else "default"
+                factor = analyze(csc, mode="simplicial", ordering_method=order)
             factor.cholesky_inplace(csc)
             D = factor.D()
     except (CholmodError, CholmodWarning) as exc:

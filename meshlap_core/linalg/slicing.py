@@ -482,7 +482,10 @@ class SlicedLanczos:
             raise RuntimeError(f"eigensolver: found only {found.count} of {k} eigenpairs")
         o = np.argsort(found.lam, kind="stable")[:k]
         lam = found.lam[o]
-        Y = np.asfortranarray(found.Y[:, o])
+        if np.array_equal(o, np.arange(k)):  # (in order already: a view, no n × k copy)
+            Y = found.Y[:, :k]
+        else:
+            Y = np.asfortranarray(found.Y[:, o])
         self.info.messages.append(
             f"inertia checks at {len(self.checks)} shifts: every eigenvalue below "
             f"{max(s for s, _ in self.checks):.6g} was found"
