@@ -147,6 +147,9 @@ COMMANDS: tuple[str, ...] = (
     "denoise_eval",
     "report",
     "spectral",
+    "geodesic",
+    "heat",
+    "filter",
 )
 COMMAND_GROUP = "meshlap.commands"
 """Entry points of this group name modules with ``register(sub)``: other packages (the viewer)
