@@ -1,0 +1,422 @@
+"""The Diffusion panel: heat from clicked vertices two ways (backward Euler and the
+eigen-expansion, their difference on one colour range, the truncation bound), geodesic distance
+by the heat method with isolines (the exact distance on demand, as a job), spectral filters over
+the computed eigenvalues, and the heat kernel signature. State in :mod:`..state.diffusion`."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import polyscope as ps
+
+from meshlap_core.diffusion import HeatGeodesic, exact_distance, mean_edge_length
+from meshlap_core.options import FILTER_KINDS, HEAT_BOUNDARIES
+
+from .. import scene
+from ..scene import MESH, front_view, picked_vertex, side_offset
+from ..state.diffusion import (
+    HEAT_FIELDS,
+    HKS_SCALES,
+    LOG_T_RANGE,
+    SHOWS,
+    DiffusionState,
+    find_basis,
+    isoline_period,
+    symmetric_range,
+)
+from .base import ExportItem, Host, Panel
+
+FIELD = "diffusion field"
+SOURCES = "heat sources"
+FILTERED = "filtered"
+NEEDS_BASIS = "needs an eigenbasis: compute one in the Spectral view first"
+
+
+class DiffusionPanel(Panel):
+    """Heat, distance, filters and HKS from clicked vertices."""
+
+    title = "Diffusion"
+    framed = (FILTERED,)
+    shortcuts = (("click", "diffusion: heat / distance source (add more with the checkbox)"),)
+
+    def __init__(self, name: str, state: DiffusionState) -> None:
+        super().__init__(name, state)
+        self.state: DiffusionState = state
+
+    # ------------------------------------------------------------------ the scene
+    def on_new_mesh(self, host: Host) -> None:
+        host.state.jobs.cancel(self.name)
+        self.state.clear()
+        self.watch.forget()
+        scene.remove_structure(SOURCES)
+        scene.remove_structure(FILTERED)
+
+    def show(self, host: Host, active: Panel) -> None:
+        mine = active is self
+        for name in (SOURCES, FILTERED):
+            if ps.has_point_cloud(name):
+                ps.get_point_cloud(name).set_enabled(mine)
+            if ps.has_surface_mesh(name):
+                ps.get_surface_mesh(name).set_enabled(mine)
+        if mine:
+            self.push(host, force=True)
+        elif self.watch.seen("field") is not None and ps.has_surface_mesh(MESH):
+            ps.get_surface_mesh(MESH).remove_quantity(FIELD)
+            self.watch.forget("field")
+
+    def pick(self, host: Host, hit: Any, active: Panel) -> bool:
+        if active is not self or hit.structure_name != MESH:
+            return False
+        idx = picked_vertex(hit, host.mesh_points(), host.state.mesh.F)
+        if idx is None:
+            return False
+        return self.select(host, idx)
+
+    def select(self, host: Host, vertex: int) -> bool:
+        """Make ``vertex`` a source and recompute what is shown."""
+        if not self.state.select(len(host.state.mesh.V), vertex):
+            return False
+        self.recompute(host)
+        return True
+
+    def _basis(self, host: Host) -> Any:
+        slices = [p.state for p in host.panels.values() if p is not self]
+        return find_basis(slices, host.state.mesh.V)
+
+    def _h(self, host: Host) -> float:
+        mesh = host.state.mesh
+        return self.watch.cached(
+            "h", (id(mesh), mesh.version), lambda: mean_edge_length(mesh.V, mesh.F)
+        )
+
+    def recompute(self, host: Host) -> None:
+        """Compute the field of the current view (a precomputation runs as a job)."""
+        st, mesh = self.state, host.state.mesh
+        basis = self._basis(host)
+        if st.show == "heat":
+            st.compute_heat(mesh.V, mesh.F, self._h(host), basis)
+        elif st.show == "distance":
+            if st.geodesic_ready(mesh.version):
+                st.compute_distance()
+            elif st.sources:
+                self.precompute(host)
+        elif basis is not None and st.show == "filter":
+            st.compute_filter(basis)
+        elif basis is not None and st.show == "hks":
+            st.compute_hks(basis)
+        self.push(host)
+
+    def precompute(self, host: Host) -> None:
+        """Factorize the heat method's matrices (a job: about 0.7 s at 43k vertices)."""
+        st, mesh = self.state, host.state.mesh
+        key = st.geodesic_key(mesh.version)
+        V, F, m, rule = mesh.V, mesh.F, st.m, st.boundary
+
+        def apply(solver: HeatGeodesic) -> None:
+            st.adopt_geodesic(solver, key)
+            st.compute_distance()
+            self.push(host)
+
+        host.state.jobs.start(
+            self.name,
+            "heat method: factorizing",
+            lambda reporter: HeatGeodesic(V, F, m=m, boundary=rule),
+            apply,
+            self._failed(host),
+            background=host.background,
+        )
+
+    def start_exact(self, host: Host) -> None:
+        """The exact polyhedral distance as a cancellable job (a child process when the
+        window allows: libigl holds the GIL for the whole propagation)."""
+        st, mesh, jobs = self.state, host.state.mesh, host.state.jobs
+        if not st.sources:
+            return
+        work = jobs.offload(exact_distance, mesh.V, mesh.F, np.asarray(st.sources))
+
+        def apply(d: np.ndarray) -> None:
+            st.adopt_exact(d)
+            self.push(host)
+
+        jobs.start(
+            self.name, "exact geodesic distance", work, apply, self._failed(host),
+            background=host.background,
+        )  # fmt: skip
+
+    def _failed(self, host: Host) -> Any:
+        def fail(message: str) -> None:
+            host.state.errors[self.name] = message
+
+        return fail
+
+    def _field(self) -> tuple[np.ndarray | None, tuple[float, float] | None, str]:
+        """The field on the mesh, its colour range (``None``: its own) and colour map."""
+        st = self.state
+        if st.show == "heat":
+            f, vr = st.heat_shown()
+            return f, vr, "coolwarm"
+        if st.show == "distance":
+            if st.exact_error is not None and st.heat_field == "difference":
+                return st.exact_error, None, "reds"
+            return st.distance, None, "viridis"
+        if st.show == "hks":
+            f = st.hks_dist if st.hks_dist is not None else st.hks
+            return f, None, "viridis"
+        return None, None, "viridis"
+
+    def push(self, host: Host, force: bool = False) -> None:
+        """Upload the shown field (with isolines), the sources and the filtered copy."""
+        if host.active() is not self or not ps.has_surface_mesh(MESH):
+            return
+        st = self.state
+        key = (st.version, st.show, st.heat_field, st.isolines, st.isoline_count)
+        if not self.watch.changed("field", *key) and not force:
+            return
+        f, vr, cmap = self._field()
+        sm = ps.get_surface_mesh(MESH)
+        if f is None or len(f) != len(host.state.mesh.V):
+            sm.remove_quantity(FIELD)
+        else:
+            shown = np.where(np.isfinite(f), f, np.nan)
+            if vr is None:
+                fin = f[np.isfinite(f)]
+                vr = (float(fin.min()), float(fin.max())) if fin.size else (0.0, 1.0)
+            sm.add_scalar_quantity(
+                FIELD,
+                shown,
+                cmap=cmap,
+                vminmax=vr,
+                enabled=True,
+                isolines_enabled=st.isolines and st.show != "filter",
+                isoline_period=isoline_period(f, st.isoline_count),
+                onscreen_colorbar_enabled=True,
+                onscreen_colorbar_location=scene.COLORBAR_AT,
+            )
+        self._push_sources(host)
+        self._push_filtered(host)
+
+    def _push_sources(self, host: Host) -> None:
+        if not self.state.sources:
+            scene.remove_structure(SOURCES)
+            return
+        P = host.mesh_points()[np.asarray(self.state.sources)]
+        pc = ps.register_point_cloud(SOURCES, P, color=scene.RED[:3])
+        pc.set_radius(0.01, relative=True)
+
+    def _push_filtered(self, host: Host) -> None:
+        st = self.state
+        if st.show != "filter" or st.filtered is None:
+            scene.remove_structure(FILTERED)
+            return
+        mesh = host.state.mesh
+        off = side_offset(host.mesh_points(), front_view(mesh.name))
+        X = host.state.display.points(st.filtered) + off
+        if ps.has_surface_mesh(FILTERED):
+            ps.get_surface_mesh(FILTERED).update_vertex_positions(X)
+        else:
+            ps.register_surface_mesh(FILTERED, X, mesh.F, smooth_shade=True)
+            host.request_frame()
+
+    def points(self, host: Host, name: str) -> np.ndarray | None:
+        if name == FILTERED and self.state.filtered is not None:
+            mesh = host.state.mesh
+            return host.mesh_points() + side_offset(host.mesh_points(), front_view(mesh.name))
+        return None
+
+    def captions(self, host: Host) -> dict[str, str]:
+        st = self.state
+        if st.show == "filter" and st.filtered is not None:
+            return {FILTERED: f"{st.filter} filter"}
+        return {}
+
+    def export_items(self, host: Host) -> list[ExportItem]:
+        f, _, _ = self._field()
+        stem = host.state.mesh.stem
+        items: list[ExportItem] = []
+        if f is not None:
+            items.append((f"{stem}_{self.state.show}.csv", None, None, f))
+        if self.state.filtered is not None and self.state.show == "filter":
+            items.append((f"{stem}_filtered.ply", self.state.filtered, host.state.mesh.F, None))
+        return items
+
+    # ------------------------------------------------------------------ sessions
+    def capture(self, host: Host) -> dict[str, Any]:
+        st = self.state
+        return {
+            "show": st.show,
+            "sources": [int(v) for v in st.sources],
+            "log_t": float(st.log_t),
+            "steps": int(st.steps),
+            "heat_field": st.heat_field,
+            "m": float(st.m),
+            "boundary": st.boundary,
+            "isolines": bool(st.isolines),
+            "isoline_count": int(st.isoline_count),
+            "filter": st.filter,
+            "keep": int(st.keep),
+            "gain": float(st.gain),
+            "hks_scale": int(st.hks_scale),
+        }
+
+    def configure(self, host: Host, values: dict[str, Any]) -> None:
+        st = self.state
+        for key, value in values.items():
+            if key != "sources":
+                setattr(st, key, value)
+
+    def restore(self, host: Host, values: dict[str, Any], active: bool) -> None:
+        self.configure(host, values)
+        self.state.sources = list(values["sources"])
+        if self.state.sources and active:
+            self.recompute(host)
+
+    # ------------------------------------------------------------------ widgets
+    def draw(self, host: Host) -> None:
+        ui = host.ui
+        if not ui.header(self.title):
+            return
+        st = self.state
+        host.draw_job(self.name)
+        ch, show = ui.combo(
+            "show", st.show, SHOWS,
+            "heat: u_t = Lap u from the clicked vertices; distance: heat method (Crane et al. "
+            "2013); filter: U h(Lambda) U^T M X; hks: heat kernel signature",
+        )  # fmt: skip
+        if ch:
+            st.set_choice("show", show, SHOWS)
+            self.recompute(host)
+        ch, add = ui.checkbox(
+            "add clicked vertices", st.add_sources, "on: a click adds a source; off: replaces"
+        )
+        if ch:
+            st.add_sources = add
+        if ui.button("clear sources", "forget the clicked vertices"):
+            st.sources = []
+            st.version += 1
+            self.push(host)
+        ui.text(f"sources: {', '.join(map(str, st.sources)) or 'click a vertex'}")
+        basis = self._basis(host)
+        {"heat": self._draw_heat, "distance": self._draw_distance}.get(
+            st.show, self._draw_spectral
+        )(host, basis)
+        if st.show != "filter":
+            self._draw_isolines(host)
+
+    def _draw_isolines(self, host: Host) -> None:
+        ui, st = host.ui, self.state
+        ch, on = ui.checkbox("isolines", st.isolines, "level curves of the field on the mesh")
+        if ch:
+            st.isolines = on
+            self.push(host)
+        ch, count = ui.input_int("isoline count", st.isoline_count, "curves over the range")
+        if ch:
+            st.isoline_count = int(min(max(count, 1), 200))
+            self.push(host)
+
+    def _draw_heat(self, host: Host, basis: Any) -> None:
+        ui, st = host.ui, self.state
+        h = self._h(host)
+        lo, hi = LOG_T_RANGE
+        ch, x = ui.slider_float(
+            "log10 t/h^2", st.log_t, lo, hi, "%.2f", "heat time t = 10^x h^2 (h: mean edge)"
+        )
+        if ch:
+            st.set_log_t(x)
+            self.recompute(host)
+        ch, steps = ui.input_int("Euler steps", st.steps, "(M + tau K) u' = M u, tau = t/steps")
+        if ch:
+            st.steps = int(min(max(steps, 1), 1000))
+            self.recompute(host)
+        ch, which = ui.combo(
+            "heat field", st.heat_field, HEAT_FIELDS,
+            "euler, spectral (sum exp(-lambda_i t) phi_i phi_i^T M u0) or spectral - euler; "
+            "all three on one colour range",
+        )  # fmt: skip
+        if ch:
+            st.set_choice("heat_field", which, HEAT_FIELDS)
+            self.push(host)
+        ui.text(f"t = {st.t(h):.4g}")
+        if basis is None:
+            ui.note(f"spectral heat {NEEDS_BASIS}")
+        elif st.k_used:
+            ui.text(
+                f"k = {st.k_used}: omitted modes damped by <= exp(-lambda_k t) = {st.bound:.3g}"
+            )
+            if "difference" in st.heat:
+                _, hi_ = symmetric_range(st.heat["difference"])
+                ui.text(f"max |spectral - euler| = {hi_:.3g}")
+
+    def _draw_distance(self, host: Host, basis: Any) -> None:
+        ui, st = host.ui, self.state
+        ch, m = ui.input_float("m (t = m h^2)", st.m, "%.4g", "heat time factor (default 1)")
+        if ch:
+            st.set_m(m)
+            self.recompute(host)
+        ch, rule = ui.combo(
+            "boundary condition", st.boundary, HEAT_BOUNDARIES,
+            "heat step on open meshes: Neumann, Dirichlet or their average (the paper's)",
+        )  # fmt: skip
+        if ch:
+            st.set_choice("boundary", rule, HEAT_BOUNDARIES)
+            self.recompute(host)
+        if ui.button("exact distance", "igl.exact_geodesic (MMP) as a job; error map after"):
+            self.start_exact(host)
+        if st.exact_stats:
+            ui.text(
+                f"heat vs exact: max {100 * st.exact_stats['max']:.3g}%, "
+                f"mean {100 * st.exact_stats['mean']:.3g}% relative error"
+            )
+            ch, err = ui.checkbox(
+                "show error map", st.heat_field == "difference", "|d - d_exact| / d_exact"
+            )
+            if ch:
+                st.heat_field = "difference" if err else "euler"
+                self.push(host)
+
+    def _draw_spectral(self, host: Host, basis: Any) -> None:
+        ui, st = host.ui, self.state
+        if basis is None:
+            ui.note(f"{st.show} {NEEDS_BASIS}")
+            return
+        if st.show == "hks":
+            ch, s = ui.slider_int("HKS time", st.hks_scale, 0, HKS_SCALES - 1, "log-spaced t")
+            if ch:
+                st.hks_scale = int(min(max(s, 0), HKS_SCALES - 1))
+                self.recompute(host)
+            ui.text(f"t = {st.hks_time():.4g}; with a source: signature distance from it")
+            return
+        self._draw_filter(host, basis)
+
+    def _draw_filter(self, host: Host, basis: Any) -> None:
+        ui, st = host.ui, self.state
+        ch, kind = ui.combo(
+            "filter", st.filter, FILTER_KINDS,
+            "low-pass: first modes; band: gain on modes; explicit/implicit/taubin: the "
+            "smoothers' transfer functions (1 - s lam)^n, (1 + s lam)^-n, ...",
+        )  # fmt: skip
+        if ch:
+            st.set_choice("filter", kind, FILTER_KINDS)
+        ch, keep = ui.slider_int("modes kept", st.keep, 0, basis.k_max, "low-pass / band end")
+        if ch:
+            st.keep = int(min(max(keep, 0), basis.k_max))
+            st.band = (1, max(st.keep, 2))
+        ch, gain = ui.slider_float("band gain", st.gain, -2.0, 5.0, "%.2f", "gain of the band")
+        if ch:
+            st.gain = float(gain)
+        ch, iters = ui.input_int("smoother steps", st.iters, "n of the smoothers' filters")
+        if ch:
+            st.iters = int(min(max(iters, 0), 10_000))
+        ch, res = ui.checkbox("keep residual", st.residual, "add X - U U^T M X back")
+        if ch:
+            st.residual = res
+        if st.filtered is None or ui.changed:
+            st.compute_filter(basis)
+            self.push(host)
+        if st.gains is not None:
+            with ui.plot("transfer function h(lambda)", 150, "lambda", "h") as ok:
+                if ok:
+                    ui.plot_line("h(lambda)", basis.eigenvalues, st.gains)
+
+
+PANEL = DiffusionPanel

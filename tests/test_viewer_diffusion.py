@@ -1,0 +1,167 @@
+"""The Diffusion panel through its widgets (ScriptedUI on polyscope's openGL_mock) and its
+polyscope-free state. ``drive_diffusion_widgets`` is also part of the widget tour of
+``tests/test_viewer_widgets.py`` (every widget driven)."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+
+ps = pytest.importorskip("polyscope")
+
+from test_viewer_widgets import drive, frames  # noqa: E402
+
+from meshlap_core.diffusion import (  # noqa: E402
+    HeatDiffusion,
+    HeatGeodesic,
+    SpectralFilter,
+    exact_distance,
+    mean_edge_length,
+    transfer,
+    unit_heat,
+)
+
+
+@pytest.fixture(scope="module")
+def mock(polyscope_mock):
+    return polyscope_mock
+
+
+def settle(viewer, owner: str = "diffusion") -> None:
+    """Wait for the panel's job and let the host apply it."""
+    t0 = time.monotonic()
+    while viewer.state.jobs.running(owner) is not None:
+        assert time.monotonic() - t0 < 120, "the diffusion job never finished"
+        time.sleep(0.02)
+    frames(viewer, 2)
+
+
+def compute_basis(viewer, k: int = 40) -> None:
+    viewer.set_panel("spectral")
+    drive(viewer, "modes to compute", k)
+    drive(viewer, "compute eigenbasis", True)
+    st = viewer.panels["spectral"].state
+    t0 = time.monotonic()
+    while st.busy:
+        assert time.monotonic() - t0 < 300
+        time.sleep(0.02)
+    frames(viewer, 2)
+    assert st.basis is not None
+
+
+def drive_diffusion_widgets(viewer) -> None:
+    """Every widget of the Diffusion panel, with good and bad values."""
+    mesh = viewer.state.mesh
+    V, F = mesh.V, mesh.F
+    panel = viewer.panels["diffusion"]
+    st = panel.state
+    viewer.set_panel("diffusion")
+    frames(viewer)
+    drive(viewer, "show", "distance")
+    assert panel.select(viewer, 7)
+    settle(viewer)
+    np.testing.assert_allclose(st.distance, HeatGeodesic(V, F).distance([7]), atol=1e-12)
+    assert ps.get_surface_mesh("mesh").get_quantity_buffer  # the field is on the mesh
+    drive(viewer, "add clicked vertices", True)
+    assert panel.select(viewer, 40)
+    settle(viewer)
+    assert st.sources == [7, 40]
+    np.testing.assert_allclose(st.distance, HeatGeodesic(V, F).distance([7, 40]), atol=1e-12)
+    drive(viewer, "add clicked vertices", False)
+    drive(viewer, "m (t = m h^2)", "4")
+    settle(viewer)
+    np.testing.assert_allclose(st.distance, HeatGeodesic(V, F, m=4).distance([7, 40]), atol=1e-12)
+    for bad in ("0", "-1", "nan", "abc"):
+        drive(viewer, "m (t = m h^2)", bad)
+        assert st.m == 4.0 and "m (t = m h^2)" in viewer.state.errors["diffusion"]
+    drive(viewer, "boundary condition", "neumann")
+    settle(viewer)
+    assert st.boundary == "neumann"
+    drive(viewer, "exact distance", True)
+    settle(viewer)
+    ex = exact_distance(V, F, [7, 40])
+    np.testing.assert_allclose(st.exact, ex)
+    assert 0 < st.exact_stats["mean"] < st.exact_stats["max"] < 1
+    drive(viewer, "show error map", True)
+    assert st.heat_field == "difference"
+    drive(viewer, "show error map", False)
+    drive(viewer, "isolines", False)
+    assert not st.isolines
+    drive(viewer, "isolines", True)
+    drive(viewer, "isoline count", 5, 0, 10**6)
+    assert st.isoline_count == 200  # clamped
+
+    # heat: Euler alone, then with the Spectral view's basis the two ways and their difference
+    drive(viewer, "show", "heat")
+    drive(viewer, "log10 t/h^2", 1.0)
+    drive(viewer, "Euler steps", 3, 0)
+    assert st.steps == 1  # clamped to >= 1
+    drive(viewer, "Euler steps", 2)
+    hd = HeatDiffusion(V, F)
+    t = 10.0 * mean_edge_length(V, F) ** 2
+    u = hd.euler(unit_heat(np.array(st.sources), hd.mass), t, 2)
+    np.testing.assert_allclose(st.heat["euler"], u, atol=1e-12)
+    drive(viewer, "log10 t/h^2", float("nan"))
+    assert st.log_t == 1.0
+    compute_basis(viewer, k=len(V))  # the full basis: the two ways agree up to Euler's error
+    viewer.set_panel("diffusion")
+    drive(viewer, "Euler steps", 200)
+    assert st.k_used == len(V) and st.bound < 1e-6
+    diff = np.abs(st.heat["difference"]).max()
+    assert diff < 0.05 * np.abs(st.heat["euler"]).max()
+    drive(viewer, "heat field", "difference")
+    _, (lo, hi) = st.heat_shown()
+    assert lo == -hi  # one colour range for the three fields
+    assert hi == pytest.approx(
+        max(np.abs(st.heat["euler"]).max(), np.abs(st.heat["spectral"]).max())
+    )
+    drive(viewer, "heat field", "euler")
+
+    # filter over the basis
+    drive(viewer, "show", "filter")
+    basis = viewer.panels["spectral"].state.basis
+    drive(viewer, "filter", "low-pass")
+    drive(viewer, "modes kept", 10)
+    ref = SpectralFilter(basis).apply(transfer("low-pass", basis.eigenvalues, keep=10))
+    np.testing.assert_allclose(st.filtered, ref, atol=1e-12)
+    assert ps.has_surface_mesh("filtered")
+    drive(viewer, "filter", "band")
+    drive(viewer, "band gain", 1.0)
+    np.testing.assert_allclose(st.filtered, V, atol=1e-9)  # h ≡ 1 on the full basis
+    drive(viewer, "filter", "implicit")
+    drive(viewer, "smoother steps", 3, -5)
+    assert st.iters == 0
+    np.testing.assert_allclose(st.gains, 1.0)  # no step: identity
+    drive(viewer, "keep residual", True)
+    drive(viewer, "keep residual", False)
+
+    # heat kernel signature
+    drive(viewer, "show", "hks")
+    drive(viewer, "HKS time", 3, 99)
+    assert st.hks_scale == 15 and st.hks is not None and st.hks_dist is not None
+    assert st.hks_dist[st.sources[0]] == 0.0
+    drive(viewer, "clear sources", True)
+    assert st.sources == []
+
+
+def test_diffusion_widgets(viewer):
+    drive_diffusion_widgets(viewer)
+    ui = viewer.ui
+    mine = {k for k in ui.seen if k[0] == "diffusion"}
+    assert mine and not sorted(mine - ui.driven)
+
+
+def test_state_headless_without_a_basis(sphere):
+    from meshlap_app.state.diffusion import DiffusionState, find_basis
+
+    from meshlap_core.io import load_mesh
+
+    mesh = load_mesh(sphere)
+    st = DiffusionState(show="heat")
+    assert not st.select(len(mesh.V), len(mesh.V))  # out of range: nothing changes
+    assert st.select(len(mesh.V), 3)
+    st.compute_heat(mesh.V, mesh.F, mean_edge_length(mesh.V, mesh.F), None)
+    assert set(st.heat) == {"euler"} and np.isnan(st.bound)
+    assert find_basis([object(), st], mesh.V) is None
