@@ -130,6 +130,13 @@ def drive_diffusion_widgets(viewer) -> None:
     drive(viewer, "filter", "band")
     drive(viewer, "band gain", 1.0)
     np.testing.assert_allclose(st.filtered, V, atol=1e-9)  # h ≡ 1 on the full basis
+    drive(viewer, "filter", "explicit")
+    drive(viewer, "smoother steps", 4)
+    drive(viewer, "measure by smoothing", True)
+    settle(viewer)
+    ok = np.isfinite(st.measured)  # the modes the round sphere's coordinates contain
+    assert ok.sum() >= 3
+    np.testing.assert_allclose(st.measured[ok], st.gains[ok], atol=1e-8)  # frozen operator
     drive(viewer, "filter", "implicit")
     drive(viewer, "smoother steps", 3, -5)
     assert st.iters == 0

@@ -11,7 +11,7 @@ import numpy as np
 import polyscope as ps
 
 from meshlap_core.diffusion import HeatGeodesic, exact_distance, mean_edge_length
-from meshlap_core.options import FILTER_KINDS, HEAT_BOUNDARIES
+from meshlap_core.options import FILTER_KINDS, HEAT_BOUNDARIES, SMOOTHING_METHODS
 
 from .. import scene
 from ..scene import MESH, front_view, picked_vertex, side_offset
@@ -178,10 +178,12 @@ class DiffusionPanel(Panel):
         if f is None or len(f) != len(host.state.mesh.V):
             sm.remove_quantity(FIELD)
         else:
-            shown = np.where(np.isfinite(f), f, np.nan)
             if vr is None:
                 fin = f[np.isfinite(f)]
                 vr = (float(fin.min()), float(fin.max())) if fin.size else (0.0, 1.0)
+            # unreachable vertices (another component) and undefined errors take the top
+            # colour: polyscope refuses non-finite values
+            shown = np.where(np.isfinite(f), f, vr[1])
             sm.add_scalar_quantity(
                 FIELD,
                 shown,
@@ -411,12 +413,37 @@ class DiffusionPanel(Panel):
         if ch:
             st.residual = res
         if st.filtered is None or ui.changed:
+            st.measured = None  # for another filter
             st.compute_filter(basis)
             self.push(host)
+        if st.filter in SMOOTHING_METHODS and ui.button(
+            "measure by smoothing",
+            "run the smoother on the mesh and project on the modes: the measured gain per mode "
+            "(equal to the formula for these frozen-operator methods)",
+        ):
+            self.start_measure(host, basis)
+        if st.measured is not None and st.gains is not None:
+            ok = np.isfinite(st.measured)
+            gap = float(np.abs(st.measured[ok] - st.gains[ok]).max()) if ok.any() else 0.0
+            ui.text(f"measured vs formula: max |difference| = {gap:.2g}")
         if st.gains is not None:
             with ui.plot("transfer function h(lambda)", 150, "lambda", "h") as ok:
                 if ok:
                     ui.plot_line("h(lambda)", basis.eigenvalues, st.gains)
+                    if st.measured is not None:
+                        ui.plot_line("measured", basis.eigenvalues, st.measured)
+
+    def start_measure(self, host: Host, basis: Any) -> None:
+        """Run the smoother and project (a job: the implicit one factorizes)."""
+        st = self.state
+
+        def apply(g: np.ndarray) -> None:
+            st.measured = g
+
+        host.state.jobs.start(
+            self.name, f"{st.filter} smoother, projected", lambda reporter: st.measure(basis),
+            apply, self._failed(host), background=host.background,
+        )  # fmt: skip
 
 
 PANEL = DiffusionPanel

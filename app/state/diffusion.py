@@ -148,6 +148,7 @@ class DiffusionState:
     exact_stats: dict[str, float] = field(default_factory=dict)
     filtered: FloatArray | None = None
     gains: FloatArray | None = None
+    measured: FloatArray | None = None  # per-mode amplification of the smoother, projected
     hks: FloatArray | None = None
     hks_dist: FloatArray | None = None
     version: int = 0  # bumped whenever a shown field changes
@@ -164,7 +165,7 @@ class DiffusionState:
         self.heat, self.bound, self.k_used = {}, float("nan"), 0
         self.distance = self.exact = self.exact_error = None
         self.exact_stats = {}
-        self.filtered = self.gains = self.hks = self.hks_dist = None
+        self.filtered = self.gains = self.hks = self.hks_dist = self.measured = None
         self._heat_solver = self._geodesic = self._geodesic_key = None
         self._filter = self._hks = None
         self.error = self.message = ""
@@ -268,10 +269,24 @@ class DiffusionState:
         self.version += 1
 
     # ------------------------------------------------------------------ filters
+    def smoother_step(self, basis: SpectralBasis) -> tuple[float, float]:
+        """The smoothers' step ``s`` (default ``0.5 / λ_max`` of the basis) and Taubin's
+        ``ν = −1.02 s`` (a pass band near 0)."""
+        step = self.step or 0.5 / float(basis.eigenvalues[-1] or 1.0)
+        return step, -1.02 * step
+
+    def measure(self, basis: SpectralBasis) -> FloatArray:
+        """Run the current smoother on the mesh (cotangent, frozen operator, the basis's mass)
+        and project: the per-mode amplification (any thread; nothing stored)."""
+        from meshlap_core.diffusion import smoother_transfer
+
+        step, nu = self.smoother_step(basis)
+        extra = {"taubin_nu": nu} if self.filter == "taubin" else {}
+        return smoother_transfer(basis, self.filter, step, self.iters, **extra)[1]
+
     def filter_gains(self, basis: SpectralBasis) -> FloatArray:
         lam = basis.eigenvalues
-        step = self.step or 0.5 / float(lam[-1] or 1.0)
-        nu = -1.02 * step  # Taubin's ν just beyond −λ (pass band near 0)
+        step, nu = self.smoother_step(basis)
         return transfer(
             self.filter,  # type: ignore[arg-type]
             lam,

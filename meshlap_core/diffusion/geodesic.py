@@ -149,7 +149,9 @@ class HeatGeodesic:
             if len(self._interior):
                 sub = A[self._interior][:, self._interior]
                 self._heat_dirichlet = SPDSolver(sub, backend)
+        self._corners = [np.ascontiguousarray(self.F[:, i]) for i in range(3)]
         self._grad = igl.grad(self.V, self.F).tocsr()  # (3m, n): x rows, then y, then z
+        self._div = self._grad.T.tocsr()  # Gᵀ, stored for the divergence
         self._area3 = np.tile(0.5 * igl.doublearea(self.V, self.F).ravel(), 3)
         self.n_components, self.labels = components(K)
         first = np.full(self.n_components, n)
@@ -195,9 +197,11 @@ class HeatGeodesic:
         norm = np.sqrt(np.sum(g * g, axis=0))
         # a gradient at the round-off of the face's own heat has no direction (a face at
         # constant heat, e.g. opposite the source on a tetrahedron): it is left out
-        noise = _ROUNDOFF * np.abs(u)[self.F].max(axis=1) / self.h
+        a = np.abs(u)
+        c0, c1, c2 = self._corners
+        noise = (_ROUNDOFF / self.h) * np.maximum(np.maximum(a[c0], a[c1]), a[c2])
         X = np.divide(-g, norm, out=np.zeros_like(g), where=norm > noise).ravel()
-        b = self._grad.T @ (self._area3 * X)
+        b = self._div @ (self._area3 * X)
         phi = np.zeros(n)
         if self._poisson is not None:
             phi[self._free] = self._poisson.solve(b[self._free])
