@@ -111,6 +111,10 @@ def drive_diffusion_widgets(viewer) -> None:
     assert st.k_used == len(V) and st.bound < 1e-6
     diff = np.abs(st.heat["difference"]).max()
     assert diff < 0.05 * np.abs(st.heat["euler"]).max()
+    # the two other fields on copies beside the mesh, on the same colour range
+    assert ps.has_surface_mesh("heat (second way)") and ps.has_surface_mesh("heat (third field)")
+    caps = panel.captions(viewer)
+    assert caps["mesh"] == "backward Euler" and "eigen-expansion" in caps["heat (second way)"]
     drive(viewer, "heat field", "difference")
     _, (lo, hi) = st.heat_shown()
     assert lo == -hi  # one colour range for the three fields
@@ -172,3 +176,51 @@ def test_state_headless_without_a_basis(sphere):
     st.compute_heat(mesh.V, mesh.F, mean_edge_length(mesh.V, mesh.F), None)
     assert set(st.heat) == {"euler"} and np.isnan(st.bound)
     assert find_basis([object(), st], mesh.V) is None
+
+
+# ---------------------------------------------------------------- meshlap animate --heat
+def _animate(tmp_path, *args: str):
+    import os
+    import subprocess
+    import sys
+
+    env = dict(os.environ, MESHLAP_CACHE_DIR=str(tmp_path / "cache"))
+    cmd = [sys.executable, "-m", "meshlap_core.cli", "animate", *args]
+    return subprocess.run(cmd, capture_output=True, text=True, timeout=600, cwd=tmp_path, env=env)
+
+
+@pytest.mark.parametrize(
+    ("args", "needle"),
+    [
+        (["--panel", "diffusion"], "--heat"),
+        (["--panel", "diffusion", "--heat", "--heat-t", "2:1"], "--heat-t"),
+        (["--panel", "diffusion", "--heat", "--heat-frames", "1"], "--heat-frames"),
+        (["--panel", "diffusion", "--heat", "--heat-vertex", "100000"], "--heat-vertex"),
+    ],
+)
+def test_heat_animation_bad_arguments(tmp_path, sphere, args, needle):
+    res = _animate(tmp_path, str(sphere), *args, "--out", str(tmp_path / "h.gif"))
+    assert res.returncode == 2 and needle in res.stderr
+    assert res.stderr.count("meshlap: error:") == 1
+    assert not (tmp_path / "h.gif").exists()
+
+
+@pytest.mark.egl
+def test_heat_animation_renders(tmp_path, sphere):
+    from PIL import Image
+
+    out = tmp_path / "heat.gif"
+    res = _animate(
+        tmp_path, str(sphere), "--panel", "diffusion", "--heat", "--heat-frames", "3",
+        "--size", "320x180", "--out", str(out),
+    )  # fmt: skip
+    assert res.returncode == 0, res.stderr
+    im = Image.open(out)
+    assert im.n_frames == 3
+    frames = []
+    for i in range(3):
+        im.seek(i)
+        frames.append(np.asarray(im.convert("RGB")).astype(int))
+    corner = frames[0][5:100, 5:40]  # the colour bar
+    assert ((corner.max(axis=2) - corner.min(axis=2)) > 80).sum() > 50
+    assert not np.array_equal(frames[0], frames[2])  # the heat spreads

@@ -5,6 +5,7 @@ the computed eigenvalues, and the heat kernel signature. State in :mod:`..state.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
@@ -30,6 +31,8 @@ from .base import ExportItem, Host, Panel
 FIELD = "diffusion field"
 SOURCES = "heat sources"
 FILTERED = "filtered"
+HEAT_COPIES = ("heat (second way)", "heat (third field)")
+"""The two heat fields not on the mesh, on copies beside it (same colour range)."""
 NEEDS_BASIS = "needs an eigenbasis: compute one in the Spectral view first"
 
 
@@ -37,7 +40,7 @@ class DiffusionPanel(Panel):
     """Heat, distance, filters and HKS from clicked vertices."""
 
     title = "Diffusion"
-    framed = (FILTERED,)
+    framed = (FILTERED, *HEAT_COPIES)
     shortcuts = (("click", "diffusion: heat / distance source (add more with the checkbox)"),)
 
     def __init__(self, name: str, state: DiffusionState) -> None:
@@ -49,12 +52,12 @@ class DiffusionPanel(Panel):
         host.state.jobs.cancel(self.name)
         self.state.clear()
         self.watch.forget()
-        scene.remove_structure(SOURCES)
-        scene.remove_structure(FILTERED)
+        for name in (SOURCES, FILTERED, *HEAT_COPIES):
+            scene.remove_structure(name)
 
     def show(self, host: Host, active: Panel) -> None:
         mine = active is self
-        for name in (SOURCES, FILTERED):
+        for name in (SOURCES, FILTERED, *HEAT_COPIES):
             if ps.has_point_cloud(name):
                 ps.get_point_cloud(name).set_enabled(mine)
             if ps.has_surface_mesh(name):
@@ -184,19 +187,24 @@ class DiffusionPanel(Panel):
             # unreachable vertices (another component) and undefined errors take the top
             # colour: polyscope refuses non-finite values
             shown = np.where(np.isfinite(f), f, vr[1])
+            lines = st.isolines and st.show in ("distance", "hks")
+            # (heat is ~0 over most of the mesh: its level 0 would blacken it); the period is
+            # only passed with isolines on: setting it turns polyscope's on
+            iso = {"isoline_period": isoline_period(f, st.isoline_count)}
             sm.add_scalar_quantity(
                 FIELD,
                 shown,
                 cmap=cmap,
                 vminmax=vr,
                 enabled=True,
-                isolines_enabled=st.isolines and st.show != "filter",
-                isoline_period=isoline_period(f, st.isoline_count),
+                isolines_enabled=lines,
                 onscreen_colorbar_enabled=True,
                 onscreen_colorbar_location=scene.COLORBAR_AT,
+                **(iso if lines else {}),
             )
         self._push_sources(host)
         self._push_filtered(host)
+        self._push_heat_copies(host)
 
     def _push_sources(self, host: Host) -> None:
         if not self.state.sources:
@@ -212,24 +220,62 @@ class DiffusionPanel(Panel):
             scene.remove_structure(FILTERED)
             return
         mesh = host.state.mesh
-        off = side_offset(host.mesh_points(), front_view(mesh.name))
-        X = host.state.display.points(st.filtered) + off
+        X = host.state.display.points(st.filtered) + self._offset(host)
         if ps.has_surface_mesh(FILTERED):
             ps.get_surface_mesh(FILTERED).update_vertex_positions(X)
         else:
             ps.register_surface_mesh(FILTERED, X, mesh.F, smooth_shade=True)
             host.request_frame()
 
+    def _offset(self, host: Host, slot: int = 1) -> np.ndarray:
+        mesh = host.state.mesh
+        return slot * side_offset(host.mesh_points(), front_view(mesh.name))
+
+    def _copy_fields(self) -> list[str]:
+        """The heat fields shown on the copies (the two not on the mesh), when all three
+        exist."""
+        st = self.state
+        if st.show != "heat" or len(st.heat) < 3:
+            return []
+        return [f for f in HEAT_FIELDS if f != st.heat_field]
+
+    def _push_heat_copies(self, host: Host) -> None:
+        fields = self._copy_fields()
+        if not fields:
+            for name in HEAT_COPIES:
+                scene.remove_structure(name)
+            return
+        _, vr = self.state.heat_shown()
+        F = host.state.mesh.F
+        for slot, (name, which) in enumerate(zip(HEAT_COPIES, fields, strict=True), start=1):
+            X = host.mesh_points() + self._offset(host, slot)
+            if ps.has_surface_mesh(name):
+                ps.get_surface_mesh(name).update_vertex_positions(X)
+            else:
+                ps.register_surface_mesh(name, X, F, smooth_shade=True)
+                host.request_frame()
+            ps.get_surface_mesh(name).add_scalar_quantity(
+                which, self.state.heat[which], cmap="coolwarm", vminmax=vr, enabled=True
+            )
+
     def points(self, host: Host, name: str) -> np.ndarray | None:
         if name == FILTERED and self.state.filtered is not None:
-            mesh = host.state.mesh
-            return host.mesh_points() + side_offset(host.mesh_points(), front_view(mesh.name))
+            return host.mesh_points() + self._offset(host)
+        if name in HEAT_COPIES and self._copy_fields():
+            return host.mesh_points() + self._offset(host, 1 + HEAT_COPIES.index(name))
         return None
 
     def captions(self, host: Host) -> dict[str, str]:
         st = self.state
         if st.show == "filter" and st.filtered is not None:
             return {FILTERED: f"{st.filter} filter"}
+        fields = self._copy_fields()
+        if fields:
+            words = {"euler": "backward Euler", "difference": "spectral - Euler"}
+            words[HEAT_FIELDS[1]] = f"eigen-expansion, k = {st.k_used}"
+            out = {MESH: words[st.heat_field]}
+            out.update({n: words[f] for n, f in zip(HEAT_COPIES, fields, strict=True)})
+            return out
         return {}
 
     def export_items(self, host: Host) -> list[ExportItem]:
@@ -273,6 +319,12 @@ class DiffusionPanel(Panel):
         if self.state.sources and active:
             self.recompute(host)
 
+    def start(self, host: Host, options: dict[str, Any], shown: bool, screenshot: bool) -> None:
+        """``meshlap view --panel diffusion --vertex I``: that vertex is the source."""
+        vertex = options.get("vertex")
+        if shown and vertex is not None:
+            self.select(host, int(vertex))
+
     # ------------------------------------------------------------------ widgets
     def draw(self, host: Host) -> None:
         ui = host.ui
@@ -302,7 +354,7 @@ class DiffusionPanel(Panel):
         {"heat": self._draw_heat, "distance": self._draw_distance}.get(
             st.show, self._draw_spectral
         )(host, basis)
-        if st.show != "filter":
+        if st.show in ("distance", "hks"):
             self._draw_isolines(host)
 
     def _draw_isolines(self, host: Host) -> None:
@@ -444,6 +496,35 @@ class DiffusionPanel(Panel):
             self.name, f"{st.filter} smoother, projected", lambda reporter: st.measure(basis),
             apply, self._failed(host), background=host.background,
         )  # fmt: skip
+
+    # ------------------------------------------------------------------ meshlap animate
+    def frames(self, host: Host, options: dict[str, Any]) -> Iterator[str]:
+        """Heat from ``--heat-vertex`` (default: the vertex facing the camera) by backward
+        Euler, t swept on a log scale; each frame coloured from 0 to its own maximum (the
+        caption gives it: the peak falls as the heat spreads)."""
+        st, mesh = self.state, host.state.mesh
+        st.show, st.heat_field, st.add_sources = "heat", "euler", False
+        source = int(options["heat_vertex"])
+        if source < 0:
+            P = mesh.V - mesh.V.mean(axis=0)
+            source = int(np.argmax(P @ np.asarray(front_view(mesh.name))))
+        st.select(len(mesh.V), source)
+        host.refresh()
+        host.frame(scene.COLORBAR_STRIP)
+        a, b = options["heat_t"]
+        h = self._h(host)
+        for x in np.linspace(a, b, int(options["heat_frames"])):
+            st.log_t = float(x)
+            st.compute_heat(mesh.V, mesh.F, h, None)
+            f = st.heat["euler"]
+            top = float(f.max()) or 1.0
+            ps.get_surface_mesh(MESH).add_scalar_quantity(
+                FIELD, f, cmap="viridis", vminmax=(0.0, top), enabled=True,
+                isolines_enabled=st.isolines, isoline_period=top / st.isoline_count,
+                onscreen_colorbar_enabled=True, onscreen_colorbar_location=scene.COLORBAR_AT,
+            )  # fmt: skip
+            self._push_sources(host)
+            yield f"heat from vertex {source}: t = {st.t(h):.3g} = 10^{x:.2f} h^2, peak {top:.3g}"
 
 
 PANEL = DiffusionPanel

@@ -40,13 +40,14 @@ from meshlap_core.options import (
 from meshlap_core.spectral import SpectralBasis
 from meshlap_core.types import FloatArray
 
+from .animation import Animation, Option
 from .checks import Schema, boolean, integer, number, one_of
 
 SHOWS: tuple[str, ...] = ("heat", "distance", "filter", "hks")
 """What the Diffusion view shows on the mesh."""
 HEAT_FIELDS: tuple[str, ...] = (*HEAT_METHODS, "difference")
 """The heat field on the mesh: backward Euler, the eigen-expansion, or spectral − Euler."""
-LOG_T_RANGE = (-5.0, 1.0)
+LOG_T_RANGE = (-3.0, 4.0)
 """The t slider's range, as log10 of t relative to the mesh's h² (t = 10^x · h²)."""
 HKS_SCALES = 16
 """Times of the heat kernel signature (log-spaced, Sun et al. 2009)."""
@@ -331,3 +332,73 @@ def isoline_period(values: FloatArray | None, count: int) -> float:
     v = v[np.isfinite(v)]
     span = float(v.max() - v.min()) if v.size else 0.0
     return span / max(int(count), 1) if span > 0 else 1.0
+
+
+# ---------------------------------------------------------------- meshlap animate
+def parse_log_range(text: str, flag: str) -> tuple[float, float]:
+    """``"A:B"`` (log10 of t/h², ``A < B`` inside :data:`LOG_T_RANGE`) as two floats."""
+    parts = str(text).split(":")
+    try:
+        a, b = (float(x) for x in parts)
+    except ValueError:
+        raise MeshError(f"expected A:B (log10 of t/h^2), got {text!r}", flag) from None
+    lo, hi = LOG_T_RANGE
+    if not (lo <= a < b <= hi):
+        raise MeshError(f"needs {lo:g} <= A < B <= {hi:g}, got {text!r}", flag)
+    return a, b
+
+
+def _animation_check(opts: dict[str, Any]) -> None:
+    if not opts.get("heat"):
+        raise MeshError("the diffusion animation is the heat flow: add --heat", "--panel")
+    if isinstance(opts.get("heat_t"), str):
+        opts["heat_t"] = parse_log_range(opts["heat_t"], "--heat-t")
+    if not 2 <= int(opts["heat_frames"]) <= 2000:
+        raise MeshError(f"must be 2 to 2000, got {opts['heat_frames']}", "--heat-frames")
+    if int(opts["heat_vertex"]) < -1:
+        raise MeshError(f"must be a vertex index, got {opts['heat_vertex']}", "--heat-vertex")
+
+
+def _animation_check_mesh(opts: dict[str, Any], mesh: Any) -> None:
+    n = len(mesh.V)
+    if not -1 <= int(opts["heat_vertex"]) < n:
+        raise MeshError(
+            f"vertex {opts['heat_vertex']} is out of range (the mesh has {n} vertices)",
+            "--heat-vertex",
+        )
+
+
+def _animation_from_session(opts: dict[str, Any], values: dict[str, Any], source: Any) -> None:
+    """A saved view: its first source heats (``--heat`` implied)."""
+    opts["heat"] = True
+    if opts.get("heat_vertex") is None and values.get("sources"):
+        opts["heat_vertex"] = int(values["sources"][0])
+
+
+ANIMATION = Animation(
+    summary="heat flowing from a vertex (--heat): backward Euler, t swept on a log scale",
+    options=(
+        Option("--heat", "diffusion: heat flowing from --heat-vertex", store_true=True),
+        Option(
+            "--heat-vertex",
+            "diffusion: the source vertex (default -1: the one facing the camera)",
+            -1,
+            int,
+        ),
+        Option(
+            "--heat-t",
+            "diffusion: log10 of t/h^2 from A to B (default -1:3)",
+            "-1:3",
+            metavar="A:B",
+        ),
+        Option("--heat-frames", "diffusion: number of frames (default 30)", 30, int),
+    ),
+    session_help="diffusion  the session's first source heats; --heat is implied",
+    check=_animation_check,
+    kind=lambda opts: "heat",
+    fps={"heat": 10.0},
+    frame_count=lambda opts: int(opts["heat_frames"]),
+    from_session=_animation_from_session,
+    check_mesh=_animation_check_mesh,
+)
+"""``meshlap animate --panel diffusion --heat``."""
