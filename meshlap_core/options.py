@@ -181,3 +181,8 @@ DEGENERATE_REL = 0.5e-12
 ``|(b−a)×(c−a)| ≤ DEGENERATE_REL · (l₀² + l₁² + l₂²)``. The validator removes such faces and the
 cotangent code gives them zero weights; in the squared form the Laplacian uses,
 ``16 A² ≤ (2·DEGENERATE_REL)² (Σ l²)²``, so both select exactly the same faces."""
+
+MAX_STIFFNESS_RATIO = 1e14
+"""Largest ``τ · max_i K_ii / m_i`` (about ``τ λ_max``) of a backward Euler heat step
+``(M + τK) u' = M u``: beyond it the mass is round-off of ``τK`` and the total heat (the
+constant mode) is lost, so the step is refused."""

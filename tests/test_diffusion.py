@@ -324,3 +324,12 @@ def test_filter_incremental_updates_equal_full_products(full_basis):
         np.testing.assert_allclose(got, ref, atol=1e-12)
     got[:] = 0.0  # the caller's copy: the filter's own result is untouched
     np.testing.assert_allclose(f.apply(h), ref, atol=1e-12)
+
+
+def test_an_euler_step_too_long_for_the_mesh_scale_is_refused():
+    V, F = icosphere(2)
+    hd = HeatDiffusion(V * 1e-40, F)
+    with pytest.raises(MeshError, match="too long"):
+        hd.euler(unit_heat(np.array([0]), hd.mass), 1.0)
+    u = hd.euler(unit_heat(np.array([0]), hd.mass), 1e-82)  # a step at this scale is fine
+    assert hd.mass @ u == pytest.approx(1.0)

@@ -55,7 +55,10 @@ def run(args: argparse.Namespace) -> int:
     u0 = unit_heat(src, hd.mass)
     result: dict = {"file": str(args.mesh), "method": args.method, "t": t, "sources": src.tolist()}
     if args.method == "euler":
-        u = hd.euler(u0, t, args.steps)
+        try:
+            u = hd.euler(u0, t, args.steps)
+        except MeshError as exc:
+            raise MeshError(exc.problem, "--t") from None
         result["steps"] = args.steps
     else:
         from .spectral import _compute

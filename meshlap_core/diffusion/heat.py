@@ -27,7 +27,7 @@ from scipy.sparse.linalg import expm_multiply
 
 from ..errors import MeshError
 from ..linalg.spd import SPDSolver
-from ..options import MASS_AREA, AreaKind
+from ..options import MASS_AREA, MAX_STIFFNESS_RATIO, AreaKind
 from ..spectral.basis import SpectralBasis
 from ..spectral.operators import spectral_operators
 from ..types import FloatArray, IntArray, as_mesh
@@ -79,6 +79,15 @@ class HeatDiffusion:
     def _solver(self, tau: float) -> SPDSolver:
         solver = self._solvers.get(tau)
         if solver is None:
+            # τ·max(K_ii/m_i) bounds τ λ_max: beyond 1e14 the mass is round-off of τK and the
+            # constant mode (the total heat) is lost
+            top = float(np.max(self.K.diagonal() / self.mass)) if len(self.mass) else 0.0
+            if tau * top > MAX_STIFFNESS_RATIO:
+                raise MeshError(
+                    f"the step {tau:.3g} is too long for this mesh's scale (M + τK is singular "
+                    f"in double precision); use t/steps below {MAX_STIFFNESS_RATIO / top:.3g}",
+                    "t",
+                )
             if len(self._solvers) >= 4:  # a slider sweeps many τ: keep only the latest few
                 self._solvers.pop(next(iter(self._solvers)))
             A = (sp.diags(self.mass) + tau * self.K).tocsr()
