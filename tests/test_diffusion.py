@@ -12,6 +12,7 @@ from meshlap_core.diffusion import (
     HeatDiffusion,
     HeatGeodesic,
     SpectralFilter,
+    boundary_vertices,
     exact_distance,
     heat_kernel_column,
     heat_kernel_signature,
@@ -333,3 +334,13 @@ def test_an_euler_step_too_long_for_the_mesh_scale_is_refused():
         hd.euler(unit_heat(np.array([0]), hd.mass), 1.0)
     u = hd.euler(unit_heat(np.array([0]), hd.mass), 1e-82)  # a step at this scale is fine
     assert hd.mass @ u == pytest.approx(1.0)
+
+
+@pytest.mark.parametrize("mesh", ["sphere", "grid", "two"])
+def test_mean_edge_length_and_boundary_match_libigl(mesh):
+    import igl
+
+    V, F = {"sphere": icosphere(2), "grid": grid(7, 5), "two": two_spheres()}[mesh]
+    assert mean_edge_length(V, F) == pytest.approx(igl.avg_edge_length(V, F), rel=1e-12)
+    expected = np.unique(igl.boundary_facets(F)[0]) if mesh == "grid" else np.zeros(0)
+    np.testing.assert_array_equal(boundary_vertices(F, len(V)), expected)
