@@ -99,6 +99,7 @@ def drive_diffusion_widgets(viewer) -> None:
     drive(viewer, "Euler steps", 3, 0)
     assert st.steps == 1  # clamped to >= 1
     drive(viewer, "Euler steps", 2)
+    settle(viewer)
     hd = HeatDiffusion(V, F)
     t = 10.0 * mean_edge_length(V, F) ** 2
     u = hd.euler(unit_heat(np.array(st.sources), hd.mass), t, 2)
@@ -108,6 +109,7 @@ def drive_diffusion_widgets(viewer) -> None:
     compute_basis(viewer, k=len(V))  # the full basis: the two ways agree up to Euler's error
     viewer.set_panel("diffusion")
     drive(viewer, "Euler steps", 200)
+    settle(viewer)
     assert st.k_used == len(V) and st.bound < 1e-6
     diff = np.abs(st.heat["difference"]).max()
     assert diff < 0.05 * np.abs(st.heat["euler"]).max()

@@ -98,7 +98,7 @@ class DiffusionPanel(Panel):
         st, mesh = self.state, host.state.mesh
         basis = self._basis(host)
         if st.show == "heat":
-            st.compute_heat(mesh.V, mesh.F, self._h(host), basis)
+            self.start_heat(host, basis)
         elif st.show == "distance":
             if st.geodesic_ready(mesh.version):
                 st.compute_distance()
@@ -109,6 +109,23 @@ class DiffusionPanel(Panel):
         elif basis is not None and st.show == "hks":
             st.compute_hks(basis)
         self.push(host)
+
+    def start_heat(self, host: Host, basis: Any) -> None:
+        """The heat fields as a job (a new t refactorizes ``M + τK``: about a second at 43k
+        vertices); what is shown stays until they arrive."""
+        st, mesh = self.state, host.state.mesh
+        if not st.sources:
+            return
+        V, F, h = mesh.V, mesh.F, self._h(host)
+
+        def apply(result: Any) -> None:
+            st.adopt_heat(result)
+            self.push(host)
+
+        host.state.jobs.start(
+            self.name, "heat", lambda reporter: st.heat_work(V, F, h, basis), apply,
+            self._failed(host), background=host.background,
+        )  # fmt: skip
 
     def precompute(self, host: Host) -> None:
         """Factorize the heat method's matrices (a job: about 0.7 s at 43k vertices)."""

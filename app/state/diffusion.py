@@ -213,23 +213,31 @@ class DiffusionState:
             self._heat_solver = HeatDiffusion(V, F)
         return self._heat_solver
 
-    def compute_heat(self, V: FloatArray, F: Any, h: float, basis: SpectralBasis | None) -> None:
-        """Heat at ``t`` from a unit at each source: backward Euler (``steps`` steps) and, with
-        a basis, the eigen-expansion over all its modes and their difference."""
-        if not self.sources:
-            return
+    def heat_work(
+        self, V: FloatArray, F: Any, h: float, basis: SpectralBasis | None
+    ) -> tuple[dict[str, FloatArray], float, int]:
+        """The heat fields for the current settings, computed without changing what is shown
+        (a job's work: a new τ refactorizes ``M + τK``): ``(fields, bound, k)``."""
         hd = self.heat_solver(V, F)
         t = self.t(h)
         u0 = unit_heat(np.asarray(self.sources), hd.mass)
-        self.heat = {"euler": hd.euler(u0, t, self.steps)}
-        self.bound, self.k_used = float("nan"), 0
-        if basis is not None:
-            euler, spectral = HEAT_METHODS  # the two ways
-            self.heat[spectral] = heat_spectral(basis, u0, t)
-            self.heat["difference"] = self.heat[spectral] - self.heat[euler]
-            self.k_used = basis.k_max
-            self.bound = truncation_bound(basis.eigenvalues, t, basis.k_max)
+        euler, spectral = HEAT_METHODS  # the two ways
+        fields = {euler: hd.euler(u0, t, self.steps)}
+        if basis is None:
+            return fields, float("nan"), 0
+        fields[spectral] = heat_spectral(basis, u0, t)
+        fields["difference"] = fields[spectral] - fields[euler]
+        return fields, truncation_bound(basis.eigenvalues, t, basis.k_max), basis.k_max
+
+    def adopt_heat(self, result: tuple[dict[str, FloatArray], float, int]) -> None:
+        self.heat, self.bound, self.k_used = result
         self.version += 1
+
+    def compute_heat(self, V: FloatArray, F: Any, h: float, basis: SpectralBasis | None) -> None:
+        """Heat at ``t`` from a unit at each source: backward Euler (``steps`` steps) and, with
+        a basis, the eigen-expansion over all its modes and their difference."""
+        if self.sources:
+            self.adopt_heat(self.heat_work(V, F, h, basis))
 
     def heat_shown(self) -> tuple[FloatArray | None, tuple[float, float]]:
         """The heat field on the mesh and the one colour range of all three."""
