@@ -33,6 +33,9 @@ SOURCES = "heat sources"
 FILTERED = "filtered"
 HEAT_COPIES = ("heat (second way)", "heat (third field)")
 """The two heat fields not on the mesh, on copies beside it (same colour range)."""
+INLINE_DISTANCE_MAX = 100_000
+"""Up to this many vertices a new source's distance is solved on the UI thread (about 40 ms
+at 43k once factorized); above, as a job."""
 NEEDS_BASIS = "needs an eigenbasis: compute one in the Spectral view first"
 
 
@@ -100,7 +103,7 @@ class DiffusionPanel(Panel):
         if st.show == "heat":
             self.start_heat(host, basis)
         elif st.show == "distance":
-            if st.geodesic_ready(mesh.version):
+            if st.geodesic_ready(mesh.version) and len(mesh.V) <= INLINE_DISTANCE_MAX:
                 st.compute_distance()
             elif st.sources:
                 self.precompute(host)
@@ -128,23 +131,28 @@ class DiffusionPanel(Panel):
         )  # fmt: skip
 
     def precompute(self, host: Host) -> None:
-        """Factorize the heat method's matrices (a job: about 0.7 s at 43k vertices)."""
+        """The heat method's distance as a job: its two factorizations first when the mesh,
+        ``m`` or the boundary rule changed (about a second at 43k vertices), then the solve
+        (inline instead for meshes up to :data:`INLINE_DISTANCE_MAX` vertices once
+        factorized)."""
         st, mesh = self.state, host.state.mesh
         key = st.geodesic_key(mesh.version)
         V, F, m, rule = mesh.V, mesh.F, st.m, st.boundary
+        known = st._geodesic if st.geodesic_ready(mesh.version) else None
+        sources = list(st.sources)
 
-        def apply(solver: HeatGeodesic) -> None:
-            st.adopt_geodesic(solver, key)
-            st.compute_distance()
+        def work(reporter: Any) -> tuple[HeatGeodesic, np.ndarray]:
+            solver = known if known is not None else HeatGeodesic(V, F, m=m, boundary=rule)
+            return solver, solver.distance(sources)
+
+        def apply(result: tuple[HeatGeodesic, np.ndarray]) -> None:
+            st.adopt_geodesic(result[0], key)
+            st.adopt_distance(result[1])
             self.push(host)
 
+        title = "heat method: distance" if known else "heat method: factorizing"
         host.state.jobs.start(
-            self.name,
-            "heat method: factorizing",
-            lambda reporter: HeatGeodesic(V, F, m=m, boundary=rule),
-            apply,
-            self._failed(host),
-            background=host.background,
+            self.name, title, work, apply, self._failed(host), background=host.background
         )
 
     def start_exact(self, host: Host) -> None:

@@ -254,6 +254,10 @@ class DiffusionState:
     def adopt_geodesic(self, solver: HeatGeodesic, key: tuple[Any, ...]) -> None:
         self._geodesic, self._geodesic_key = solver, key
 
+    def adopt_distance(self, d: FloatArray) -> None:
+        self.distance = d
+        self.version += 1
+
     def compute_distance(self) -> None:
         """The heat method's distance from the sources (its solver precomputed)."""
         if self._geodesic is None or not self.sources:
