@@ -40,32 +40,50 @@ from meshlap_core.diffusion import (
 from meshlap_core.io import load_mesh
 
 
+def _timed(fn):
+    t0 = time.perf_counter()
+    out = fn()
+    return time.perf_counter() - t0, out
+
+
+def _igl_precompute(V: np.ndarray, F: np.ndarray):
+    data = igl.HeatGeodesicsData()
+    igl.heat_geodesics_precompute(V, F, data)
+    return data
+
+
 def heat_rows(V: np.ndarray, F: np.ndarray, repeat: int, src: int) -> tuple[list, np.ndarray]:
-    """Precompute and solve times of ours and the peers; our distance."""
-    rows = []
-    t_ours, hg = best_of(lambda: HeatGeodesic(V, F), repeat)
-    s_ours, d = best_of(lambda: hg.distance([src]), repeat)
+    """Precompute and solve times of ours and the peers, alternating (ours, libigl,
+    potpourri3d, ours, ...), best of ``repeat``; our distance."""
+    have_pp = importlib.util.find_spec("potpourri3d") is not None
+    if not have_pp:
+        print("potpourri3d not installed: its row is skipped (pip install potpourri3d)")
+    names = ["meshlap HeatGeodesic", "igl heat_geodesics"] + (["potpourri3d"] if have_pp else [])
+    best = {n: [np.inf, np.inf] for n in names}
+    dist: dict[str, np.ndarray] = {}
+    for _ in range(repeat):
+        for name in names:
+            if name.startswith("meshlap"):
+                tp, hg = _timed(lambda: HeatGeodesic(V, F))
+                ts, d = _timed(lambda: hg.distance([src]))  # noqa: B023
+            elif name.startswith("igl"):
+                tp, data = _timed(lambda: _igl_precompute(V, F))
+                ts, d = _timed(lambda: igl.heat_geodesics_solve(data, np.array([src])))  # noqa: B023
+            else:
+                import potpourri3d as pp3d
 
-    def igl_pre():
-        data = igl.HeatGeodesicsData()
-        igl.heat_geodesics_precompute(V, F, data)
-        return data
-
-    t_igl, data = best_of(igl_pre, repeat)
-    s_igl, d_igl = best_of(lambda: igl.heat_geodesics_solve(data, np.array([src])), repeat)
-    rows.append(["meshlap HeatGeodesic", t_ours, s_ours, 1.0, 1.0, 0.0])
-    diff = float(np.abs(d - d_igl).max() / d.max())
-    rows.append(["igl heat_geodesics", t_igl, s_igl, t_igl / t_ours, s_igl / s_ours, diff])
-    if importlib.util.find_spec("potpourri3d") is not None:
-        import potpourri3d as pp3d
-
-        t_pp, solver = best_of(lambda: pp3d.MeshHeatMethodDistanceSolver(V, F), repeat)
-        s_pp, d_pp = best_of(lambda: solver.compute_distance(src), repeat)
-        diff = float(np.abs(d - d_pp).max() / d.max())
-        rows.append(["potpourri3d", t_pp, s_pp, t_pp / t_ours, s_pp / s_ours, diff])
-    else:
-        print("potpourri3d not installed: its column is skipped (pip install potpourri3d)")
-    return rows, d
+                tp, solver = _timed(lambda: pp3d.MeshHeatMethodDistanceSolver(V, F))
+                ts, d = _timed(lambda: solver.compute_distance(src))  # noqa: B023
+            best[name] = [min(best[name][0], tp), min(best[name][1], ts)]
+            dist[name] = np.asarray(d)
+    ours = dist[names[0]]
+    t0, s0 = best[names[0]]
+    rows = [
+        [n, best[n][0], best[n][1], best[n][0] / t0, best[n][1] / s0,
+         float(np.abs(ours - dist[n]).max() / ours.max())]
+        for n in names
+    ]  # fmt: skip
+    return rows, ours
 
 
 def run_mesh(name: str, V: np.ndarray, F: np.ndarray, args: argparse.Namespace) -> None:

@@ -46,6 +46,10 @@ from .sources import check_sources
 
 _ROUNDOFF = 64 * np.finfo(float).eps
 """A heat gradient below this times (the face's largest heat / h) is round-off."""
+_UNDERFLOW = 1e-250
+"""A face whose largest heat is below this times the largest heat anywhere has underflowed."""
+_FAR_LEVELS = 4
+"""Longer heat times tried where the heat underflowed: t·100 … t·100⁴ (reach ×10 each)."""
 
 
 def edge_counts(F: IntArray, n: int) -> sp.csr_matrix:
@@ -162,6 +166,9 @@ class HeatGeodesic:
         self._div = self._grad.T.tocsr()  # Gᵀ, stored for the divergence
         self._area3 = np.tile(0.5 * igl.doublearea(self.V, self.F).ravel(), 3)
         self.n_components, self.labels = components(K)
+        self._K = K
+        self._face_label = self.labels[self.F[:, 0]] if len(self.F) else np.zeros(0, np.int64)
+        self._far: dict[int, SPDSolver] = {}
         first = np.full(self.n_components, n)
         np.minimum.at(first, self.labels, np.arange(n))
         free = np.ones(n, bool)
@@ -184,6 +191,36 @@ class HeatGeodesic:
             return u
         return ud if self.rule == "dirichlet" else 0.5 * (u + ud)
 
+    def _directions(self, u: FloatArray) -> tuple[FloatArray, np.ndarray, np.ndarray]:
+        """``X = −∇u/|∇u|`` per face ``(3,m)`` (0 where a gradient at the round-off of the
+        face's own heat has no direction: a face at constant heat, e.g. opposite the source on
+        a tetrahedron), where it is trusted ``(m,)``, and where the heat underflowed ``(m,)``
+        (below :data:`_UNDERFLOW` of the largest: denormal or 0, its gradient meaningless)."""
+        g = (self._grad @ u).reshape(3, -1)
+        # |g| scaled by its largest component: squaring a gradient of 1e-161 would underflow
+        big = np.abs(g).max(axis=0)
+        unit = np.divide(g, big, out=np.zeros_like(g), where=big > 0)
+        norm = big * np.sqrt(np.sum(unit * unit, axis=0))
+        a = np.abs(u)
+        c0, c1, c2 = self._corners
+        noise = (_ROUNDOFF / self.h) * np.maximum(np.maximum(a[c0], a[c1]), a[c2])
+        known = (norm > noise) & (norm > 0)
+        # a face whose heat underflowed (not one at constant heat by symmetry) waits for a
+        # longer time's direction
+        top = np.maximum(np.maximum(a[c0], a[c1]), a[c2])
+        lost = top <= _UNDERFLOW * float(a.max(initial=0.0))
+        return np.divide(-g, norm, out=np.zeros_like(g), where=known), known & ~lost, lost
+
+    def _far_heat(self, level: int, sources: IntArray) -> FloatArray:
+        """The Neumann heat at ``t·100^level`` from the sources (its factorization cached)."""
+        solver = self._far.get(level)
+        if solver is None:
+            A = (sp.diags(self.mass) + (self.t * 100.0**level) * self._K).tocsr()
+            solver = self._far[level] = SPDSolver(A, self._backend)
+        delta = np.zeros(len(self.V))
+        delta[sources] = 1.0
+        return solver.solve(delta)
+
     def distance(self, sources: int | IntArray) -> FloatArray:
         """Approximate geodesic distance to the nearest source.
 
@@ -200,15 +237,20 @@ class HeatGeodesic:
         """
         n = len(self.V)
         src = check_sources(sources, n)
-        u = self.heat(src)
-        g = (self._grad @ u).reshape(3, -1)
-        norm = np.sqrt(np.sum(g * g, axis=0))
-        # a gradient at the round-off of the face's own heat has no direction (a face at
-        # constant heat, e.g. opposite the source on a tetrahedron): it is left out
-        a = np.abs(u)
-        c0, c1, c2 = self._corners
-        noise = (_ROUNDOFF / self.h) * np.maximum(np.maximum(a[c0], a[c1]), a[c2])
-        X = np.divide(-g, norm, out=np.zeros_like(g), where=norm > noise).ravel()
+        X, known, lost = self._directions(self.heat(src))
+        # far from the sources the heat of t = m·h² underflows to 0 (it decays like
+        # exp(−d/√t): beyond about 700 √t): those faces take the direction of the heat of a
+        # longer time, t·100, t·100², ... (each factorized once, when first needed)
+        wanted = np.bincount(self.labels[src], minlength=self.n_components)[self._face_label] > 0
+        redo = wanted & (lost | ~known) if np.any(wanted & lost) else np.zeros_like(lost)
+        level = 0
+        while np.any(redo) and level < _FAR_LEVELS:
+            level += 1
+            X2, known2, _ = self._directions(self._far_heat(level, src))
+            fill = redo & known2
+            X[:, fill] = X2[:, fill]
+            redo &= ~fill
+        X = X.ravel()
         b = self._div @ (self._area3 * X)
         phi = np.zeros(n)
         if self._poisson is not None:
