@@ -12,7 +12,11 @@ The heat method (Crane, Weischedel & Wardetzky, "Geodesics in heat", ACM TOG 201
 4. ``d = φ − mean(φ[γ])`` in each component holding a source.
 
 Both matrices are factorized once (:class:`HeatGeodesic`); a new source costs two or three
-triangular solves and two sparse products. On a mesh with boundary the heat step takes the
+triangular solves and two sparse products. The heat decays like ``exp(−d/√t)``, so beyond
+about ``700 √t`` from the sources it underflows to 0 and has no direction (1.3 % of the 692k
+armadillo with ``t = h²``; libigl's answer there differs from ours by 93 % of the largest
+distance): those faces take the direction of the heat of a longer time, ``t·100ʲ``
+(``j = 1 … 4``, each factorized when first needed). On a mesh with boundary the heat step takes the
 paper's boundary condition (``"neumann"``, ``"dirichlet"`` or their ``"average"``, sec.
 3.2.4). Vertices in components without a source get ``inf`` (no path reaches them).
 
