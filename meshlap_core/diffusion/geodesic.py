@@ -14,9 +14,11 @@ The heat method (Crane, Weischedel & Wardetzky, "Geodesics in heat", ACM TOG 201
 Both matrices are factorized once (:class:`HeatGeodesic`); a new source costs two or three
 triangular solves and two sparse products. The heat decays like ``exp(−d/√t)``, so beyond
 about ``700 √t`` from the sources it underflows to 0 and has no direction (1.3 % of the 692k
-armadillo with ``t = h²``; libigl's answer there differs from ours by 93 % of the largest
-distance): those faces take the direction of the heat of a longer time, ``t·100ʲ``
-(``j = 1 … 4``, each factorized when first needed). On a mesh with boundary the heat step takes the
+armadillo with ``t = h²``): those faces take the direction of the heat of a longer time,
+``t·100ʲ`` (``j = 1 … 4``, each factorized when first needed). Measured on the 692k scan
+(one ``igl.upsample`` of the 173k ``armadillo_loop``, whose vertices it keeps): our distance
+there differs from ours on the 173k mesh by 0.4 % on average (1.0 % at most), potpourri3d's
+from its own 173k answer by 7.4 % (36 % at most). On a mesh with boundary the heat step takes the
 paper's boundary condition (``"neumann"``, ``"dirichlet"`` or their ``"average"``, sec.
 3.2.4). Vertices in components without a source get ``inf`` (no path reaches them).
 
