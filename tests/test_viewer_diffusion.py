@@ -226,3 +226,28 @@ def test_heat_animation_renders(tmp_path, sphere):
     corner = frames[0][5:100, 5:40]  # the colour bar
     assert ((corner.max(axis=2) - corner.min(axis=2)) > 80).sum() > 50
     assert not np.array_equal(frames[0], frames[2])  # the heat spreads
+
+
+@pytest.mark.egl
+def test_view_screenshot_on_a_clicked_vertex(tmp_path, sphere):
+    """``meshlap view --panel diffusion --vertex I --screenshot``: the distance from I with its
+    colour bar and isolines, rendered headless."""
+    import os
+    import subprocess
+    import sys
+
+    from PIL import Image
+
+    out = tmp_path / "d.png"
+    env = dict(os.environ, MESHLAP_CACHE_DIR=str(tmp_path / "cache"))
+    cmd = [sys.executable, "-m", "meshlap_core.cli", "view", str(sphere), "--panel", "diffusion",
+           "--vertex", "5", "--screenshot", str(out)]  # fmt: skip
+    res = subprocess.run(cmd, capture_output=True, text=True, timeout=600, cwd=tmp_path, env=env)
+    assert res.returncode == 0, res.stderr
+    img = np.asarray(Image.open(out).convert("RGB")).astype(int)
+    corner = img[20:250, 10:40]  # the colour bar of the distance
+    assert ((corner.max(axis=2) - corner.min(axis=2)) > 80).sum() > 100
+    h, w, _ = img.shape
+    line = img[int(0.25 * h) : int(0.7 * h), int(0.37 * w)].sum(axis=1)  # down the mesh
+    jumps = np.count_nonzero(np.abs(np.diff(line)) > 40)  # the isoline bands' edges
+    assert jumps >= 4, jumps  # (5 on this view: smooth shading changes by <= 3 a pixel)
