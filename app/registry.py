@@ -49,6 +49,7 @@ REGISTRY: tuple[Entry, ...] = (
     Entry("smoothing"),
     Entry("surfaces"),
     Entry("check"),
+    Entry("diffusion"),
     Entry("export", view=False),
     Entry("help", view=False),
 )

@@ -106,6 +106,27 @@ DERIVATIVE_METHODS: tuple[str, ...] = get_args(DerivativeMethod)
 Mesher = Literal["grid", "icosphere"]
 MESHERS: tuple[str, ...] = get_args(Mesher)
 
+HeatBoundary = Literal["neumann", "dirichlet", "average"]
+HEAT_BOUNDARIES: tuple[str, ...] = get_args(HeatBoundary)
+DEFAULT_HEAT_BOUNDARY: HeatBoundary = "average"
+"""Boundary condition of the heat step of the heat method (Crane, Weischedel & Wardetzky 2013,
+sec. 3.2.4): zero flux (``"neumann"``), zero heat on the boundary (``"dirichlet"``), or the mean
+of the two heat fields (``"average"``, the paper's recommendation and libigl's choice)."""
+
+HeatMethod = Literal["euler", "spectral"]
+HEAT_METHODS: tuple[str, ...] = get_args(HeatMethod)
+"""How ``meshlap heat`` solves ``u_t = Δu``: backward Euler steps or the eigen-expansion."""
+
+GeodesicMethod = Literal["heat", "igl-heat", "exact"]
+GEODESIC_METHODS: tuple[str, ...] = get_args(GeodesicMethod)
+"""Geodesic distance: this project's heat method, libigl's, or the exact polyhedral (MMP)
+distance of ``igl.exact_geodesic``."""
+
+FilterKind = Literal["low-pass", "band", "explicit", "implicit", "taubin"]
+FILTER_KINDS: tuple[str, ...] = get_args(FilterKind)
+"""Spectral transfer functions: an ideal low-pass, a band gain (exaggeration), and the transfer
+functions of the three smoothing methods."""
+
 
 def check_choice(value: str, choices: tuple[str, ...], what: str, where: str | None = None) -> str:
     """Return ``value`` if it is one of ``choices``, else raise the one standard error.
@@ -210,3 +231,7 @@ EXERCISE_TIMEOUT = 60.0
 """Seconds one task of a student file may run before it is stopped (``meshlap check --timeout``)."""
 EXERCISE_MEMORY_MB = 2048
 """Address space a student file may add to the checker's worker, in MiB (``--memory``)."""
+MAX_STIFFNESS_RATIO = 1e14
+"""Largest ``τ · max_i K_ii / m_i`` (about ``τ λ_max``) of a backward Euler heat step
+``(M + τK) u' = M u``: beyond it the mass is round-off of ``τK`` and the total heat (the
+constant mode) is lost, so the step is refused."""

@@ -60,6 +60,21 @@ def non_default_session(mesh) -> Session:
             "lam_steps": [[0.5, 2], [0.25, 3]],
         },
         "surfaces": {"surface": "torus", "res": 30, "u": 1.25, "v": -0.5, "theta": 30.0},
+        "diffusion": {
+            "show": "heat",
+            "sources": [3, 5],
+            "log_t": -1.5,
+            "steps": 4,
+            "heat_field": "difference",
+            "m": 2.0,
+            "boundary": "neumann",
+            "isolines": False,
+            "isoline_count": 7,
+            "filter": "band",
+            "keep": 12,
+            "gain": 3.0,
+            "hks_scale": 2,
+        },
     }
     return s
 

@@ -509,6 +509,9 @@ def test_every_widget_is_driven(viewer, tmp_path, sphere):
     from test_viewer_check import drive_check_widgets  # the Check panel's widgets
 
     drive_check_widgets(viewer, tmp_path)
+    from test_viewer_diffusion import drive_diffusion_widgets  # the Diffusion panel
+
+    drive_diffusion_widgets(viewer)
     ui = viewer.ui
     undriven = sorted(set(ui.seen) - ui.driven)
     assert not undriven, f"widgets no test drives: {undriven}"

@@ -149,6 +149,9 @@ COMMANDS: tuple[str, ...] = (
     "spectral",
     "exercises",
     "check",
+    "geodesic",
+    "heat",
+    "filter",
 )
 COMMAND_GROUP = "meshlap.commands"
 """Entry points of this group name modules with ``register(sub)``: other packages (the viewer)

@@ -1,0 +1,555 @@
+"""The Diffusion panel: heat from clicked vertices two ways (backward Euler and the
+eigen-expansion, their difference on one colour range, the truncation bound), geodesic distance
+by the heat method with isolines (the exact distance on demand, as a job), spectral filters over
+the computed eigenvalues, and the heat kernel signature. State in :mod:`..state.diffusion`."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from typing import Any
+
+import numpy as np
+import polyscope as ps
+
+from meshlap_core.diffusion import HeatGeodesic, exact_distance, mean_edge_length
+from meshlap_core.options import FILTER_KINDS, HEAT_BOUNDARIES, SMOOTHING_METHODS
+
+from .. import scene
+from ..scene import MESH, front_view, picked_vertex, side_offset
+from ..state.diffusion import (
+    HEAT_FIELDS,
+    HKS_SCALES,
+    LOG_T_RANGE,
+    SHOWS,
+    DiffusionState,
+    find_basis,
+    isoline_period,
+    symmetric_range,
+)
+from .base import ExportItem, Host, Panel
+
+FIELD = "diffusion field"
+SOURCES = "heat sources"
+FILTERED = "filtered"
+HEAT_COPIES = ("heat (second way)", "heat (third field)")
+"""The two heat fields not on the mesh, on copies beside it (same colour range)."""
+INLINE_DISTANCE_MAX = 100_000
+"""Up to this many vertices a new source's distance is solved on the UI thread (about 40 ms
+at 43k once factorized); above, as a job."""
+NEEDS_BASIS = "needs an eigenbasis: compute one in the Spectral view first"
+
+
+class DiffusionPanel(Panel):
+    """Heat, distance, filters and HKS from clicked vertices."""
+
+    title = "Diffusion"
+    framed = (FILTERED, *HEAT_COPIES)
+    shortcuts = (("click", "diffusion: heat / distance source (add more with the checkbox)"),)
+
+    def __init__(self, name: str, state: DiffusionState) -> None:
+        super().__init__(name, state)
+        self.state: DiffusionState = state
+
+    # ------------------------------------------------------------------ the scene
+    def on_new_mesh(self, host: Host) -> None:
+        host.state.jobs.cancel(self.name)
+        self.state.clear()
+        self.watch.forget()
+        for name in (SOURCES, FILTERED, *HEAT_COPIES):
+            scene.remove_structure(name)
+
+    def show(self, host: Host, active: Panel) -> None:
+        mine = active is self
+        for name in (SOURCES, FILTERED, *HEAT_COPIES):
+            if ps.has_point_cloud(name):
+                ps.get_point_cloud(name).set_enabled(mine)
+            if ps.has_surface_mesh(name):
+                ps.get_surface_mesh(name).set_enabled(mine)
+        if mine:
+            self.push(host, force=True)
+        elif self.watch.seen("field") is not None and ps.has_surface_mesh(MESH):
+            ps.get_surface_mesh(MESH).remove_quantity(FIELD)
+            self.watch.forget("field")
+
+    def pick(self, host: Host, hit: Any, active: Panel) -> bool:
+        if active is not self or hit.structure_name != MESH:
+            return False
+        idx = picked_vertex(hit, host.mesh_points(), host.state.mesh.F)
+        if idx is None:
+            return False
+        return self.select(host, idx)
+
+    def select(self, host: Host, vertex: int) -> bool:
+        """Make ``vertex`` a source and recompute what is shown."""
+        if not self.state.select(len(host.state.mesh.V), vertex):
+            return False
+        self.recompute(host)
+        return True
+
+    def _basis(self, host: Host) -> Any:
+        slices = [p.state for p in host.panels.values() if p is not self]
+        return find_basis(slices, host.state.mesh.V)
+
+    def _h(self, host: Host) -> float:
+        mesh = host.state.mesh
+        return self.watch.cached(
+            "h", (id(mesh), mesh.version), lambda: mean_edge_length(mesh.V, mesh.F)
+        )
+
+    def recompute(self, host: Host) -> None:
+        """Compute the field of the current view (a precomputation runs as a job)."""
+        st, mesh = self.state, host.state.mesh
+        basis = self._basis(host)
+        if st.show == "heat":
+            self.start_heat(host, basis)
+        elif st.show == "distance":
+            if st.geodesic_ready(mesh.version) and len(mesh.V) <= INLINE_DISTANCE_MAX:
+                st.compute_distance()
+            elif st.sources:
+                self.precompute(host)
+        elif basis is not None and st.show == "filter":
+            st.compute_filter(basis)
+        elif basis is not None and st.show == "hks":
+            st.compute_hks(basis)
+        self.push(host)
+
+    def start_heat(self, host: Host, basis: Any) -> None:
+        """The heat fields as a job (a new t refactorizes ``M + τK``: about a second at 43k
+        vertices); what is shown stays until they arrive."""
+        st, mesh = self.state, host.state.mesh
+        if not st.sources:
+            return
+        V, F, h = mesh.V, mesh.F, self._h(host)
+
+        def apply(result: Any) -> None:
+            st.adopt_heat(result)
+            self.push(host)
+
+        host.state.jobs.start(
+            self.name, "heat", lambda reporter: st.heat_work(V, F, h, basis), apply,
+            self._failed(host), background=host.background,
+        )  # fmt: skip
+
+    def precompute(self, host: Host) -> None:
+        """The heat method's distance as a job: its two factorizations first when the mesh,
+        ``m`` or the boundary rule changed (about a second at 43k vertices), then the solve
+        (inline instead for meshes up to :data:`INLINE_DISTANCE_MAX` vertices once
+        factorized)."""
+        st, mesh = self.state, host.state.mesh
+        key = st.geodesic_key(mesh.version)
+        V, F, m, rule = mesh.V, mesh.F, st.m, st.boundary
+        known = st._geodesic if st.geodesic_ready(mesh.version) else None
+        sources = list(st.sources)
+
+        def work(reporter: Any) -> tuple[HeatGeodesic, np.ndarray]:
+            solver = known if known is not None else HeatGeodesic(V, F, m=m, boundary=rule)
+            return solver, solver.distance(sources)
+
+        def apply(result: tuple[HeatGeodesic, np.ndarray]) -> None:
+            st.adopt_geodesic(result[0], key)
+            st.adopt_distance(result[1])
+            self.push(host)
+
+        title = "heat method: distance" if known else "heat method: factorizing"
+        host.state.jobs.start(
+            self.name, title, work, apply, self._failed(host), background=host.background
+        )
+
+    def start_exact(self, host: Host) -> None:
+        """The exact polyhedral distance as a cancellable job (a child process when the
+        window allows: libigl holds the GIL for the whole propagation)."""
+        st, mesh, jobs = self.state, host.state.mesh, host.state.jobs
+        if not st.sources:
+            return
+        work = jobs.offload(exact_distance, mesh.V, mesh.F, np.asarray(st.sources))
+
+        def apply(d: np.ndarray) -> None:
+            st.adopt_exact(d)
+            self.push(host)
+
+        jobs.start(
+            self.name, "exact geodesic distance", work, apply, self._failed(host),
+            background=host.background,
+        )  # fmt: skip
+
+    def _failed(self, host: Host) -> Any:
+        def fail(message: str) -> None:
+            host.state.errors[self.name] = message
+
+        return fail
+
+    def _field(self) -> tuple[np.ndarray | None, tuple[float, float] | None, str]:
+        """The field on the mesh, its colour range (``None``: its own) and colour map."""
+        st = self.state
+        if st.show == "heat":
+            f, vr = st.heat_shown()
+            return f, vr, "coolwarm"
+        if st.show == "distance":
+            if st.exact_error is not None and st.heat_field == "difference":
+                return st.exact_error, None, "reds"
+            return st.distance, None, "viridis"
+        if st.show == "hks":
+            f = st.hks_dist if st.hks_dist is not None else st.hks
+            return f, None, "viridis"
+        return None, None, "viridis"
+
+    def push(self, host: Host, force: bool = False) -> None:
+        """Upload the shown field (with isolines), the sources and the filtered copy."""
+        if host.active() is not self or not ps.has_surface_mesh(MESH):
+            return
+        st = self.state
+        key = (st.version, st.show, st.heat_field, st.isolines, st.isoline_count)
+        if not self.watch.changed("field", *key) and not force:
+            return
+        f, vr, cmap = self._field()
+        sm = ps.get_surface_mesh(MESH)
+        if f is None or len(f) != len(host.state.mesh.V):
+            sm.remove_quantity(FIELD)
+        else:
+            if vr is None:
+                fin = f[np.isfinite(f)]
+                vr = (float(fin.min()), float(fin.max())) if fin.size else (0.0, 1.0)
+            # unreachable vertices (another component) and undefined errors take the top
+            # colour: polyscope refuses non-finite values
+            shown = np.where(np.isfinite(f), f, vr[1])
+            lines = st.isolines and st.show in ("distance", "hks")
+            # (heat is ~0 over most of the mesh: its level 0 would blacken it); the period is
+            # only passed with isolines on: setting it turns polyscope's on
+            iso = {"isoline_period": isoline_period(f, st.isoline_count)}
+            sm.add_scalar_quantity(
+                FIELD,
+                shown,
+                cmap=cmap,
+                vminmax=vr,
+                enabled=True,
+                isolines_enabled=lines,
+                onscreen_colorbar_enabled=True,
+                onscreen_colorbar_location=scene.COLORBAR_AT,
+                **(iso if lines else {}),
+            )
+        self._push_sources(host)
+        self._push_filtered(host)
+        self._push_heat_copies(host)
+
+    def _push_sources(self, host: Host) -> None:
+        if not self.state.sources:
+            scene.remove_structure(SOURCES)
+            return
+        P = host.mesh_points()[np.asarray(self.state.sources)]
+        pc = ps.register_point_cloud(SOURCES, P, color=scene.RED[:3])
+        pc.set_radius(0.01, relative=True)
+
+    def _push_filtered(self, host: Host) -> None:
+        st = self.state
+        if st.show != "filter" or st.filtered is None:
+            scene.remove_structure(FILTERED)
+            return
+        mesh = host.state.mesh
+        X = host.state.display.points(st.filtered) + self._offset(host)
+        if ps.has_surface_mesh(FILTERED):
+            ps.get_surface_mesh(FILTERED).update_vertex_positions(X)
+        else:
+            ps.register_surface_mesh(FILTERED, X, mesh.F, smooth_shade=True)
+            host.request_frame()
+
+    def _offset(self, host: Host, slot: int = 1) -> np.ndarray:
+        mesh = host.state.mesh
+        return slot * side_offset(host.mesh_points(), front_view(mesh.name))
+
+    def _copy_fields(self) -> list[str]:
+        """The heat fields shown on the copies (the two not on the mesh), when all three
+        exist."""
+        st = self.state
+        if st.show != "heat" or len(st.heat) < 3:
+            return []
+        return [f for f in HEAT_FIELDS if f != st.heat_field]
+
+    def _push_heat_copies(self, host: Host) -> None:
+        fields = self._copy_fields()
+        if not fields:
+            for name in HEAT_COPIES:
+                scene.remove_structure(name)
+            return
+        _, vr = self.state.heat_shown()
+        F = host.state.mesh.F
+        for slot, (name, which) in enumerate(zip(HEAT_COPIES, fields, strict=True), start=1):
+            X = host.mesh_points() + self._offset(host, slot)
+            if ps.has_surface_mesh(name):
+                ps.get_surface_mesh(name).update_vertex_positions(X)
+            else:
+                ps.register_surface_mesh(name, X, F, smooth_shade=True)
+                host.request_frame()
+            ps.get_surface_mesh(name).add_scalar_quantity(
+                which, self.state.heat[which], cmap="coolwarm", vminmax=vr, enabled=True
+            )
+
+    def points(self, host: Host, name: str) -> np.ndarray | None:
+        if name == FILTERED and self.state.filtered is not None:
+            return host.mesh_points() + self._offset(host)
+        if name in HEAT_COPIES and self._copy_fields():
+            return host.mesh_points() + self._offset(host, 1 + HEAT_COPIES.index(name))
+        return None
+
+    def captions(self, host: Host) -> dict[str, str]:
+        st = self.state
+        if st.show == "filter" and st.filtered is not None:
+            return {FILTERED: f"{st.filter} filter"}
+        fields = self._copy_fields()
+        if fields:
+            words = {"euler": "backward Euler", "difference": "spectral - Euler"}
+            words[HEAT_FIELDS[1]] = f"eigen-expansion, k = {st.k_used}"
+            out = {MESH: words[st.heat_field]}
+            out.update({n: words[f] for n, f in zip(HEAT_COPIES, fields, strict=True)})
+            return out
+        return {}
+
+    def export_items(self, host: Host) -> list[ExportItem]:
+        f, _, _ = self._field()
+        stem = host.state.mesh.stem
+        items: list[ExportItem] = []
+        if f is not None:
+            items.append((f"{stem}_{self.state.show}.csv", None, None, f))
+        if self.state.filtered is not None and self.state.show == "filter":
+            items.append((f"{stem}_filtered.ply", self.state.filtered, host.state.mesh.F, None))
+        return items
+
+    # ------------------------------------------------------------------ sessions
+    def capture(self, host: Host) -> dict[str, Any]:
+        st = self.state
+        return {
+            "show": st.show,
+            "sources": [int(v) for v in st.sources],
+            "log_t": float(st.log_t),
+            "steps": int(st.steps),
+            "heat_field": st.heat_field,
+            "m": float(st.m),
+            "boundary": st.boundary,
+            "isolines": bool(st.isolines),
+            "isoline_count": int(st.isoline_count),
+            "filter": st.filter,
+            "keep": int(st.keep),
+            "gain": float(st.gain),
+            "hks_scale": int(st.hks_scale),
+        }
+
+    def configure(self, host: Host, values: dict[str, Any]) -> None:
+        st = self.state
+        for key, value in values.items():
+            if key != "sources":
+                setattr(st, key, value)
+
+    def restore(self, host: Host, values: dict[str, Any], active: bool) -> None:
+        self.configure(host, values)
+        self.state.sources = list(values["sources"])
+        if self.state.sources and active:
+            self.recompute(host)
+
+    def start(self, host: Host, options: dict[str, Any], shown: bool, screenshot: bool) -> None:
+        """``meshlap view --panel diffusion --vertex I``: that vertex is the source."""
+        vertex = options.get("vertex")
+        if shown and vertex is not None:
+            self.select(host, int(vertex))
+
+    # ------------------------------------------------------------------ widgets
+    def draw(self, host: Host) -> None:
+        ui = host.ui
+        if not ui.header(self.title):
+            return
+        st = self.state
+        host.draw_job(self.name)
+        ch, show = ui.combo(
+            "show", st.show, SHOWS,
+            "heat: u_t = Lap u from the clicked vertices; distance: heat method (Crane et al. "
+            "2013); filter: U h(Lambda) U^T M X; hks: heat kernel signature",
+        )  # fmt: skip
+        if ch:
+            st.set_choice("show", show, SHOWS)
+            self.recompute(host)
+        ch, add = ui.checkbox(
+            "add clicked vertices", st.add_sources, "on: a click adds a source; off: replaces"
+        )
+        if ch:
+            st.add_sources = add
+        if ui.button("clear sources", "forget the clicked vertices"):
+            st.sources = []
+            st.version += 1
+            self.push(host)
+        ui.text(f"sources: {', '.join(map(str, st.sources)) or 'click a vertex'}")
+        basis = self._basis(host)
+        {"heat": self._draw_heat, "distance": self._draw_distance}.get(
+            st.show, self._draw_spectral
+        )(host, basis)
+        if st.show in ("distance", "hks"):
+            self._draw_isolines(host)
+
+    def _draw_isolines(self, host: Host) -> None:
+        ui, st = host.ui, self.state
+        ch, on = ui.checkbox("isolines", st.isolines, "level curves of the field on the mesh")
+        if ch:
+            st.isolines = on
+            self.push(host)
+        ch, count = ui.input_int("isoline count", st.isoline_count, "curves over the range")
+        if ch:
+            st.isoline_count = int(min(max(count, 1), 200))
+            self.push(host)
+
+    def _draw_heat(self, host: Host, basis: Any) -> None:
+        ui, st = host.ui, self.state
+        h = self._h(host)
+        lo, hi = LOG_T_RANGE
+        ch, x = ui.slider_float(
+            "log10 t/h^2", st.log_t, lo, hi, "%.2f", "heat time t = 10^x h^2 (h: mean edge)"
+        )
+        if ch:
+            st.set_log_t(x)
+            self.recompute(host)
+        ch, steps = ui.input_int("Euler steps", st.steps, "(M + tau K) u' = M u, tau = t/steps")
+        if ch:
+            st.steps = int(min(max(steps, 1), 1000))
+            self.recompute(host)
+        ch, which = ui.combo(
+            "heat field", st.heat_field, HEAT_FIELDS,
+            "euler, spectral (sum exp(-lambda_i t) phi_i phi_i^T M u0) or spectral - euler; "
+            "all three on one colour range",
+        )  # fmt: skip
+        if ch:
+            st.set_choice("heat_field", which, HEAT_FIELDS)
+            self.push(host)
+        ui.text(f"t = {st.t(h):.4g}")
+        if basis is None:
+            ui.note(f"spectral heat {NEEDS_BASIS}")
+        elif st.k_used:
+            ui.text(
+                f"k = {st.k_used}: omitted modes damped by <= exp(-lambda_k t) = {st.bound:.3g}"
+            )
+            if "difference" in st.heat:
+                _, hi_ = symmetric_range(st.heat["difference"])
+                ui.text(f"max |spectral - euler| = {hi_:.3g}")
+
+    def _draw_distance(self, host: Host, basis: Any) -> None:
+        ui, st = host.ui, self.state
+        ch, m = ui.input_float("m (t = m h^2)", st.m, "%.4g", "heat time factor (default 1)")
+        if ch:
+            st.set_m(m)
+            self.recompute(host)
+        ch, rule = ui.combo(
+            "boundary condition", st.boundary, HEAT_BOUNDARIES,
+            "heat step on open meshes: Neumann, Dirichlet or their average (the paper's)",
+        )  # fmt: skip
+        if ch:
+            st.set_choice("boundary", rule, HEAT_BOUNDARIES)
+            self.recompute(host)
+        if ui.button("exact distance", "igl.exact_geodesic (MMP) as a job; error map after"):
+            self.start_exact(host)
+        if st.exact_stats:
+            ui.text(
+                f"heat vs exact: max {100 * st.exact_stats['max']:.3g}%, "
+                f"mean {100 * st.exact_stats['mean']:.3g}% relative error"
+            )
+            ch, err = ui.checkbox(
+                "show error map", st.heat_field == "difference", "|d - d_exact| / d_exact"
+            )
+            if ch:
+                st.heat_field = "difference" if err else "euler"
+                self.push(host)
+
+    def _draw_spectral(self, host: Host, basis: Any) -> None:
+        ui, st = host.ui, self.state
+        if basis is None:
+            ui.note(f"{st.show} {NEEDS_BASIS}")
+            return
+        if st.show == "hks":
+            ch, s = ui.slider_int("HKS time", st.hks_scale, 0, HKS_SCALES - 1, "log-spaced t")
+            if ch:
+                st.hks_scale = int(min(max(s, 0), HKS_SCALES - 1))
+                self.recompute(host)
+            ui.text(f"t = {st.hks_time():.4g}; with a source: signature distance from it")
+            return
+        self._draw_filter(host, basis)
+
+    def _draw_filter(self, host: Host, basis: Any) -> None:
+        ui, st = host.ui, self.state
+        ch, kind = ui.combo(
+            "filter", st.filter, FILTER_KINDS,
+            "low-pass: first modes; band: gain on modes; explicit/implicit/taubin: the "
+            "smoothers' transfer functions (1 - s lam)^n, (1 + s lam)^-n, ...",
+        )  # fmt: skip
+        if ch:
+            st.set_choice("filter", kind, FILTER_KINDS)
+        ch, keep = ui.slider_int("modes kept", st.keep, 0, basis.k_max, "low-pass / band end")
+        if ch:
+            st.keep = int(min(max(keep, 0), basis.k_max))
+            st.band = (1, max(st.keep, 2))
+        ch, gain = ui.slider_float("band gain", st.gain, -2.0, 5.0, "%.2f", "gain of the band")
+        if ch:
+            st.gain = float(gain)
+        ch, iters = ui.input_int("smoother steps", st.iters, "n of the smoothers' filters")
+        if ch:
+            st.iters = int(min(max(iters, 0), 10_000))
+        ch, res = ui.checkbox("keep residual", st.residual, "add X - U U^T M X back")
+        if ch:
+            st.residual = res
+        if st.filtered is None or ui.changed:
+            st.measured = None  # for another filter
+            st.compute_filter(basis)
+            self.push(host)
+        if st.filter in SMOOTHING_METHODS and ui.button(
+            "measure by smoothing",
+            "run the smoother on the mesh and project on the modes: the measured gain per mode "
+            "(equal to the formula for these frozen-operator methods)",
+        ):
+            self.start_measure(host, basis)
+        if st.measured is not None and st.gains is not None:
+            ok = np.isfinite(st.measured)
+            gap = float(np.abs(st.measured[ok] - st.gains[ok]).max()) if ok.any() else 0.0
+            ui.text(f"measured vs formula: max |difference| = {gap:.2g}")
+        if st.gains is not None:
+            with ui.plot("transfer function h(lambda)", 150, "lambda", "h") as ok:
+                if ok:
+                    ui.plot_line("h(lambda)", basis.eigenvalues, st.gains)
+                    if st.measured is not None:
+                        ui.plot_line("measured", basis.eigenvalues, st.measured)
+
+    def start_measure(self, host: Host, basis: Any) -> None:
+        """Run the smoother and project (a job: the implicit one factorizes)."""
+        st = self.state
+
+        def apply(g: np.ndarray) -> None:
+            st.measured = g
+
+        host.state.jobs.start(
+            self.name, f"{st.filter} smoother, projected", lambda reporter: st.measure(basis),
+            apply, self._failed(host), background=host.background,
+        )  # fmt: skip
+
+    # ------------------------------------------------------------------ meshlap animate
+    def frames(self, host: Host, options: dict[str, Any]) -> Iterator[str]:
+        """Heat from ``--heat-vertex`` (default: the vertex facing the camera) by backward
+        Euler, t swept on a log scale; each frame coloured from 0 to its own maximum (the
+        caption gives it: the peak falls as the heat spreads)."""
+        st, mesh = self.state, host.state.mesh
+        st.show, st.heat_field, st.add_sources = "heat", "euler", False
+        source = int(options["heat_vertex"])
+        if source < 0:
+            P = mesh.V - mesh.V.mean(axis=0)
+            source = int(np.argmax(P @ np.asarray(front_view(mesh.name))))
+        st.select(len(mesh.V), source)
+        host.refresh()
+        host.frame(scene.COLORBAR_STRIP)
+        a, b = options["heat_t"]
+        h = self._h(host)
+        for x in np.linspace(a, b, int(options["heat_frames"])):
+            st.log_t = float(x)
+            st.compute_heat(mesh.V, mesh.F, h, None)
+            f = st.heat["euler"]
+            top = float(f.max()) or 1.0
+            ps.get_surface_mesh(MESH).add_scalar_quantity(
+                FIELD, f, cmap="viridis", vminmax=(0.0, top), enabled=True,
+                isolines_enabled=st.isolines, isoline_period=top / st.isoline_count,
+                onscreen_colorbar_enabled=True, onscreen_colorbar_location=scene.COLORBAR_AT,
+            )  # fmt: skip
+            self._push_sources(host)
+            yield f"heat from vertex {source}: t = {st.t(h):.3g} = 10^{x:.2f} h^2, peak {top:.3g}"
+
+
+PANEL = DiffusionPanel

@@ -1,0 +1,416 @@
+"""Diffusion panel state: heat from clicked vertices two ways, geodesic distance (heat method,
+exact on demand), spectral filters and the heat kernel signature. No polyscope import.
+
+The heavy objects are built once and reused: the backward Euler factorization
+(:class:`~meshlap_core.diffusion.HeatDiffusion`, per mesh), the heat method's two
+factorizations (:class:`~meshlap_core.diffusion.HeatGeodesic`, per mesh, ``m`` and boundary
+rule) and the filter's projected coefficients (per eigenbasis). The eigenbasis is the one the
+Spectral view computed (:func:`find_basis` finds it among the panels' states without naming a
+panel).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from meshlap_core.diffusion import (
+    HeatDiffusion,
+    HeatGeodesic,
+    SpectralFilter,
+    heat_kernel_signature,
+    heat_spectral,
+    hks_distance,
+    hks_times,
+    transfer,
+    truncation_bound,
+    unit_heat,
+)
+from meshlap_core.errors import MeshError
+from meshlap_core.options import (
+    DEFAULT_HEAT_BOUNDARY,
+    FILTER_KINDS,
+    HEAT_BOUNDARIES,
+    HEAT_METHODS,
+    check_choice,
+)
+from meshlap_core.spectral import SpectralBasis
+from meshlap_core.types import FloatArray
+
+from .animation import Animation, Option
+from .checks import Schema, boolean, integer, number, one_of
+
+SHOWS: tuple[str, ...] = ("heat", "distance", "filter", "hks")
+"""What the Diffusion view shows on the mesh."""
+HEAT_FIELDS: tuple[str, ...] = (*HEAT_METHODS, "difference")
+"""The heat field on the mesh: backward Euler, the eigen-expansion, or spectral − Euler."""
+LOG_T_RANGE = (-3.0, 4.0)
+"""The t slider's range, as log10 of t relative to the mesh's h² (t = 10^x · h²)."""
+HKS_SCALES = 16
+"""Times of the heat kernel signature (log-spaced, Sun et al. 2009)."""
+
+SESSION: Schema = {
+    "show": ("distance", one_of(SHOWS)),
+    "sources": ([], lambda x: None if isinstance(x, list) else "must be a list of vertices"),
+    "log_t": (0.0, number(*LOG_T_RANGE)),
+    "steps": (1, integer(1, 1000)),
+    "heat_field": ("euler", one_of(HEAT_FIELDS)),
+    "m": (1.0, number(1e-3, 1e4)),
+    "boundary": (DEFAULT_HEAT_BOUNDARY, one_of(HEAT_BOUNDARIES)),
+    "isolines": (True, boolean),
+    "isoline_count": (12, integer(1, 200)),
+    "filter": ("low-pass", one_of(FILTER_KINDS)),
+    "keep": (10, integer(0)),
+    "gain": (2.0, number(-100.0, 100.0)),
+    "hks_scale": (8, integer(0, HKS_SCALES - 1)),
+}
+"""The Diffusion panel's section of a saved session (:mod:`.session`)."""
+
+
+def make_state() -> DiffusionState:
+    """The Diffusion panel's slice of the :class:`~.app.AppState`."""
+    return DiffusionState()
+
+
+def check_view_options(options: dict[str, Any], state: Any) -> None:
+    """No ``meshlap view`` option of its own (``--vertex`` is the one-ring's)."""
+
+
+def check_session(values: dict[str, Any], mesh: Any, source: Any) -> None:
+    """Saved sources the session's mesh has.
+
+    Raises
+    ------
+    MeshError
+        A source that is not a vertex index of the mesh.
+    """
+    n = len(mesh.V)
+    for v in values["sources"]:
+        if not isinstance(v, int) or isinstance(v, bool) or not 0 <= v < n:
+            raise MeshError(f'"diffusion.sources" has {v!r}; vertices are 0..{n - 1}', source)
+
+
+def find_basis(slices: Any, V: FloatArray) -> SpectralBasis | None:
+    """The eigenbasis some panel's state holds for the mesh ``V`` (``None``: none computed)."""
+    for st in slices:
+        basis = getattr(st, "basis", None)
+        if isinstance(basis, SpectralBasis) and basis.V.shape == V.shape:
+            if np.array_equal(basis.V, V):
+                return basis
+    return None
+
+
+def symmetric_range(*fields: FloatArray) -> tuple[float, float]:
+    """One colour range ``[-r, r]`` over several fields (finite values)."""
+    r = 0.0
+    for f in fields:
+        f = np.asarray(f)
+        f = f[np.isfinite(f)]
+        if f.size:
+            r = max(r, float(np.abs(f).max()))
+    r = r or 1.0
+    return -r, r
+
+
+@dataclass
+class DiffusionState:
+    """Settings, the reusable solvers, and the fields the panel shows."""
+
+    show: str = "distance"
+    sources: list[int] = field(default_factory=list)
+    add_sources: bool = False  # a click adds a source instead of replacing them
+    log_t: float = 0.0  # t = 10^log_t · h²
+    steps: int = 1
+    heat_field: str = "euler"
+    m: float = 1.0
+    boundary: str = DEFAULT_HEAT_BOUNDARY
+    isolines: bool = True
+    isoline_count: int = 12
+    filter: str = "low-pass"
+    keep: int = 10
+    gain: float = 2.0
+    band: tuple[int, int] = (1, 10)
+    step: float = 0.0  # smoother step; 0: 0.5 / λ_max of the basis
+    iters: int = 10
+    residual: bool = False
+    hks_scale: int = 8
+    error: str = ""
+    message: str = ""
+    # results
+    heat: dict[str, FloatArray] = field(default_factory=dict)
+    bound: float = float("nan")
+    k_used: int = 0
+    distance: FloatArray | None = None
+    exact: FloatArray | None = None
+    exact_error: FloatArray | None = None
+    exact_stats: dict[str, float] = field(default_factory=dict)
+    filtered: FloatArray | None = None
+    gains: FloatArray | None = None
+    measured: FloatArray | None = None  # per-mode amplification of the smoother, projected
+    hks: FloatArray | None = None
+    hks_dist: FloatArray | None = None
+    version: int = 0  # bumped whenever a shown field changes
+    _heat_solver: Any = None
+    _geodesic: Any = None
+    _geodesic_key: Any = None
+    _filter: Any = None
+    _hks: Any = None  # (basis id, H (n,s), times (s,))
+
+    # ------------------------------------------------------------------ lifetime
+    def clear(self) -> None:
+        """Forget the mesh's solvers and fields (a new mesh); the settings stay."""
+        self.sources = []
+        self.heat, self.bound, self.k_used = {}, float("nan"), 0
+        self.distance = self.exact = self.exact_error = None
+        self.exact_stats = {}
+        self.filtered = self.gains = self.hks = self.hks_dist = self.measured = None
+        self._heat_solver = self._geodesic = self._geodesic_key = None
+        self._filter = self._hks = None
+        self.error = self.message = ""
+        self.version += 1
+
+    def t(self, h: float) -> float:
+        """The heat time ``10^log_t · h²``."""
+        return float(10.0**self.log_t * h * h)
+
+    # ------------------------------------------------------------------ sources
+    def select(self, n: int, vertex: int) -> bool:
+        """Make ``vertex`` the source (or add it, with :attr:`add_sources`); False when out of
+        range (nothing changes)."""
+        if not 0 <= int(vertex) < n:
+            return False
+        v = int(vertex)
+        if self.add_sources:
+            if v not in self.sources:
+                self.sources = [*self.sources, v]
+        else:
+            self.sources = [v]
+        self.exact = self.exact_error = None  # for the previous sources
+        self.exact_stats = {}
+        return True
+
+    # ------------------------------------------------------------------ settings
+    def set_log_t(self, value: float) -> None:
+        lo, hi = LOG_T_RANGE
+        if not math.isfinite(value):
+            raise MeshError(f"must be a number between {lo:g} and {hi:g}", "log10 t/h^2")
+        self.log_t = float(min(max(value, lo), hi))
+
+    def set_m(self, value: float) -> None:
+        if not (math.isfinite(value) and value > 0):
+            raise MeshError(f"must be a positive number, got {value!r}", "m (t = m h^2)")
+        self.m = float(value)
+
+    def set_choice(self, name: str, value: str, choices: tuple[str, ...]) -> None:
+        setattr(self, name, check_choice(value, choices, name))
+
+    # ------------------------------------------------------------------ heat
+    def heat_solver(self, V: FloatArray, F: Any) -> HeatDiffusion:
+        if self._heat_solver is None:
+            self._heat_solver = HeatDiffusion(V, F)
+        return self._heat_solver
+
+    def heat_work(
+        self, V: FloatArray, F: Any, h: float, basis: SpectralBasis | None
+    ) -> tuple[dict[str, FloatArray], float, int]:
+        """The heat fields for the current settings, computed without changing what is shown
+        (a job's work: a new τ refactorizes ``M + τK``): ``(fields, bound, k)``."""
+        hd = self.heat_solver(V, F)
+        t = self.t(h)
+        u0 = unit_heat(np.asarray(self.sources), hd.mass)
+        euler, spectral = HEAT_METHODS  # the two ways
+        fields = {euler: hd.euler(u0, t, self.steps)}
+        if basis is None:
+            return fields, float("nan"), 0
+        fields[spectral] = heat_spectral(basis, u0, t)
+        fields["difference"] = fields[spectral] - fields[euler]
+        return fields, truncation_bound(basis.eigenvalues, t, basis.k_max), basis.k_max
+
+    def adopt_heat(self, result: tuple[dict[str, FloatArray], float, int]) -> None:
+        self.heat, self.bound, self.k_used = result
+        self.version += 1
+
+    def compute_heat(self, V: FloatArray, F: Any, h: float, basis: SpectralBasis | None) -> None:
+        """Heat at ``t`` from a unit at each source: backward Euler (``steps`` steps) and, with
+        a basis, the eigen-expansion over all its modes and their difference."""
+        if self.sources:
+            self.adopt_heat(self.heat_work(V, F, h, basis))
+
+    def heat_shown(self) -> tuple[FloatArray | None, tuple[float, float]]:
+        """The heat field on the mesh and the one colour range of all three."""
+        f = self.heat.get(self.heat_field, self.heat.get("euler"))
+        return f, symmetric_range(*self.heat.values())
+
+    # ------------------------------------------------------------------ distance
+    def geodesic_key(self, mesh_version: int) -> tuple[Any, ...]:
+        return (mesh_version, self.m, self.boundary)
+
+    def geodesic_ready(self, mesh_version: int) -> bool:
+        return self._geodesic is not None and self._geodesic_key == self.geodesic_key(mesh_version)
+
+    def adopt_geodesic(self, solver: HeatGeodesic, key: tuple[Any, ...]) -> None:
+        self._geodesic, self._geodesic_key = solver, key
+
+    def adopt_distance(self, d: FloatArray) -> None:
+        self.distance = d
+        self.version += 1
+
+    def compute_distance(self) -> None:
+        """The heat method's distance from the sources (its solver precomputed)."""
+        if self._geodesic is None or not self.sources:
+            return
+        self.distance = self._geodesic.distance(self.sources)
+        self.version += 1
+
+    def adopt_exact(self, exact: FloatArray) -> None:
+        """The exact distance arrived: the relative error map of the heat method and its
+        max/mean (vertices at distance 0 or unreachable left out)."""
+        self.exact = np.asarray(exact)
+        err = np.full(len(self.exact), np.nan)
+        if self.distance is not None and len(self.distance) == len(self.exact):
+            ok = np.isfinite(self.exact) & (self.exact > 0)
+            err[ok] = np.abs(self.distance[ok] - self.exact[ok]) / self.exact[ok]
+            good = err[ok]
+            self.exact_stats = {
+                "max": float(good.max()) if good.size else 0.0,
+                "mean": float(good.mean()) if good.size else 0.0,
+            }
+        self.exact_error = err
+        self.version += 1
+
+    # ------------------------------------------------------------------ filters
+    def smoother_step(self, basis: SpectralBasis) -> tuple[float, float]:
+        """The smoothers' step ``s`` (default ``0.5 / λ_max`` of the basis) and Taubin's
+        ``ν = −1.02 s`` (a pass band near 0)."""
+        step = self.step or 0.5 / float(basis.eigenvalues[-1] or 1.0)
+        return step, -1.02 * step
+
+    def measure(self, basis: SpectralBasis) -> FloatArray:
+        """Run the current smoother on the mesh (cotangent, frozen operator, the basis's mass)
+        and project: the per-mode amplification (any thread; nothing stored)."""
+        from meshlap_core.diffusion import smoother_transfer
+
+        step, nu = self.smoother_step(basis)
+        extra = {"taubin_nu": nu} if self.filter == "taubin" else {}
+        return smoother_transfer(basis, self.filter, step, self.iters, **extra)[1]
+
+    def filter_gains(self, basis: SpectralBasis) -> FloatArray:
+        lam = basis.eigenvalues
+        step, nu = self.smoother_step(basis)
+        return transfer(
+            self.filter,  # type: ignore[arg-type]
+            lam,
+            step=step,
+            iters=self.iters,
+            nu=nu,
+            keep=self.keep,
+            band=self.band,
+            gain=self.gain,
+        )
+
+    def compute_filter(self, basis: SpectralBasis) -> None:
+        """``U h(Λ) Uᵀ M X`` for the current transfer function (coefficients projected once
+        per basis)."""
+        if self._filter is None or self._filter.basis is not basis:
+            self._filter = SpectralFilter(basis)
+        self.gains = self.filter_gains(basis)
+        self.filtered = self._filter.apply(self.gains, residual=self.residual)
+        self.version += 1
+
+    # ------------------------------------------------------------------ HKS
+    def compute_hks(self, basis: SpectralBasis) -> None:
+        """The scaled signature at the chosen time and, with a source, the signature distance
+        from it."""
+        if self._hks is None or self._hks[0] is not basis:
+            times = hks_times(basis.eigenvalues, HKS_SCALES)
+            self._hks = (basis, heat_kernel_signature(basis, times, scaled=True), times)
+        H = self._hks[1]
+        self.hks = H[:, min(self.hks_scale, H.shape[1] - 1)]
+        self.hks_dist = hks_distance(H, self.sources[0]) if self.sources else None
+        self.version += 1
+
+    def hks_time(self) -> float:
+        return float(self._hks[2][self.hks_scale]) if self._hks is not None else float("nan")
+
+
+def isoline_period(values: FloatArray | None, count: int) -> float:
+    """The spacing of ``count`` isolines over the finite range of ``values``."""
+    if values is None:
+        return 1.0
+    v = np.asarray(values)
+    v = v[np.isfinite(v)]
+    span = float(v.max() - v.min()) if v.size else 0.0
+    return span / max(int(count), 1) if span > 0 else 1.0
+
+
+# ---------------------------------------------------------------- meshlap animate
+def parse_log_range(text: str, flag: str) -> tuple[float, float]:
+    """``"A:B"`` (log10 of t/h², ``A < B`` inside :data:`LOG_T_RANGE`) as two floats."""
+    parts = str(text).split(":")
+    try:
+        a, b = (float(x) for x in parts)
+    except ValueError:
+        raise MeshError(f"expected A:B (log10 of t/h^2), got {text!r}", flag) from None
+    lo, hi = LOG_T_RANGE
+    if not (lo <= a < b <= hi):
+        raise MeshError(f"needs {lo:g} <= A < B <= {hi:g}, got {text!r}", flag)
+    return a, b
+
+
+def _animation_check(opts: dict[str, Any]) -> None:
+    if not opts.get("heat"):
+        raise MeshError("the diffusion animation is the heat flow: add --heat", "--panel")
+    if isinstance(opts.get("heat_t"), str):
+        opts["heat_t"] = parse_log_range(opts["heat_t"], "--heat-t")
+    if not 2 <= int(opts["heat_frames"]) <= 2000:
+        raise MeshError(f"must be 2 to 2000, got {opts['heat_frames']}", "--heat-frames")
+    if int(opts["heat_vertex"]) < -1:
+        raise MeshError(f"must be a vertex index, got {opts['heat_vertex']}", "--heat-vertex")
+
+
+def _animation_check_mesh(opts: dict[str, Any], mesh: Any) -> None:
+    n = len(mesh.V)
+    if not -1 <= int(opts["heat_vertex"]) < n:
+        raise MeshError(
+            f"vertex {opts['heat_vertex']} is out of range (the mesh has {n} vertices)",
+            "--heat-vertex",
+        )
+
+
+def _animation_from_session(opts: dict[str, Any], values: dict[str, Any], source: Any) -> None:
+    """A saved view: its first source heats (``--heat`` implied)."""
+    opts["heat"] = True
+    if opts.get("heat_vertex") is None and values.get("sources"):
+        opts["heat_vertex"] = int(values["sources"][0])
+
+
+ANIMATION = Animation(
+    summary="heat flowing from a vertex (--heat): backward Euler, t swept on a log scale",
+    options=(
+        Option("--heat", "diffusion: heat flowing from --heat-vertex", store_true=True),
+        Option(
+            "--heat-vertex",
+            "diffusion: the source vertex (default -1: the one facing the camera)",
+            -1,
+            int,
+        ),
+        Option(
+            "--heat-t",
+            "diffusion: log10 of t/h^2 from A to B (default -1:3)",
+            "-1:3",
+            metavar="A:B",
+        ),
+        Option("--heat-frames", "diffusion: number of frames (default 30)", 30, int),
+    ),
+    session_help="diffusion  the session's first source heats; --heat is implied",
+    check=_animation_check,
+    kind=lambda opts: "heat",
+    fps={"heat": 10.0},
+    frame_count=lambda opts: int(opts["heat_frames"]),
+    from_session=_animation_from_session,
+    check_mesh=_animation_check_mesh,
+)
+"""``meshlap animate --panel diffusion --heat``."""

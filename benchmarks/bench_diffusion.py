@@ -1,0 +1,170 @@
+"""Benchmark: heat-method geodesics, exact distance, isolines and the filter drag, beside the
+peers a user would otherwise call, in one process.
+
+    python benchmarks/bench_diffusion.py [--mesh armadillo_igl.obj] [--scan] [--exact]
+                                         [--filter-k 300] [--repeat 3]
+
+* precompute (factorizations) and one solve of :class:`meshlap_core.diffusion.HeatGeodesic`
+  against ``igl.heat_geodesics_precompute`` / ``_solve`` and, when installed (not a
+  dependency), ``potpourri3d.MeshHeatMethodDistanceSolver``; all with ``t = h²``;
+* ``--exact``: ``igl.exact_geodesic`` from one source (18–39 s at 43k) and the heat method's
+  relative error against it;
+* ``igl.isolines`` with 10 levels of the distance;
+* ``--filter-k K``: one drag update of the filter editor, ``U h(Λ) Uᵀ M X`` with the
+  coefficients projected once (the eigenbasis read from the cache, computed the first time);
+* ``--scan``: the same on the 692k scan (``igl.upsample`` of ``armadillo_loop``, made once in
+  memory).
+
+The runs alternate (ours, peer, ...) and the best of ``--repeat`` is kept; the ratios are
+peer / ours (above 1: ours faster). Meshes missing from ``../shared/meshes`` are skipped.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib.util
+import time
+
+import igl
+import numpy as np
+from _util import best_of, print_table, shared_mesh
+
+from meshlap_core.diffusion import (
+    HeatGeodesic,
+    SpectralFilter,
+    exact_distance,
+    isoline_values,
+    isolines,
+    transfer,
+)
+from meshlap_core.io import load_mesh
+
+
+def _timed(fn):
+    t0 = time.perf_counter()
+    out = fn()
+    return time.perf_counter() - t0, out
+
+
+def _igl_precompute(V: np.ndarray, F: np.ndarray):
+    data = igl.HeatGeodesicsData()
+    igl.heat_geodesics_precompute(V, F, data)
+    return data
+
+
+def heat_rows(V: np.ndarray, F: np.ndarray, repeat: int, src: int) -> tuple[list, np.ndarray]:
+    """Precompute and solve times of ours and the peers, alternating (ours, libigl,
+    potpourri3d, ours, ...), best of ``repeat``; our distance."""
+    have_pp = importlib.util.find_spec("potpourri3d") is not None
+    if not have_pp:
+        print("potpourri3d not installed: its row is skipped (pip install potpourri3d)")
+    names = ["meshlap HeatGeodesic", "igl heat_geodesics"] + (["potpourri3d"] if have_pp else [])
+    best = {n: [np.inf, np.inf] for n in names}
+    dist: dict[str, np.ndarray] = {}
+    for _ in range(repeat):
+        for name in names:
+            if name.startswith("meshlap"):
+                tp, hg = _timed(lambda: HeatGeodesic(V, F))
+                ts, d = _timed(lambda: hg.distance([src]))  # noqa: B023
+            elif name.startswith("igl"):
+                tp, data = _timed(lambda: _igl_precompute(V, F))
+                ts, d = _timed(lambda: igl.heat_geodesics_solve(data, np.array([src])))  # noqa: B023
+            else:
+                import potpourri3d as pp3d
+
+                tp, solver = _timed(lambda: pp3d.MeshHeatMethodDistanceSolver(V, F))
+                ts, d = _timed(lambda: solver.compute_distance(src))  # noqa: B023
+            best[name] = [min(best[name][0], tp), min(best[name][1], ts)]
+            dist[name] = np.asarray(d)
+    ours = dist[names[0]]
+    t0, s0 = best[names[0]]
+    rows = [
+        [n, best[n][0], best[n][1], best[n][0] / t0, best[n][1] / s0,
+         float(np.abs(ours - dist[n]).max() / ours.max())]
+        for n in names
+    ]  # fmt: skip
+    return rows, ours
+
+
+def run_mesh(name: str, V: np.ndarray, F: np.ndarray, args: argparse.Namespace) -> None:
+    print(f"\n## {name}: {len(V)} vertices, {len(F)} faces")
+    src = 0
+    rows, d = heat_rows(V, F, args.repeat, src)
+    print_table(
+        ["solver", "precompute s", "solve s", "precompute ratio", "solve ratio", "max |Δd|/max d"],
+        rows,
+    )
+    t_iso, (_, E, _) = best_of(lambda: isolines(V, F, d, isoline_values(d, 10)), args.repeat)
+    t_iso_raw, _ = best_of(lambda: igl.isolines(V, F, d, isoline_values(d, 10)), args.repeat)
+    print(
+        f"isolines, 10 levels: ours {t_iso:.3f} s, igl.isolines {t_iso_raw:.3f} s "
+        f"({len(E)} segments)"
+    )
+    if args.exact:
+        t0 = time.perf_counter()
+        ex = exact_distance(V, F, [src])
+        t_ex = time.perf_counter() - t0
+        ok = np.isfinite(ex) & (ex > 0)
+        rel = np.abs(d[ok] - ex[ok]) / ex[ok]
+        print(
+            f"igl.exact_geodesic (one source): {t_ex:.1f} s; heat method relative error "
+            f"mean {100 * rel.mean():.2f} %, median {100 * np.median(rel):.2f} %, "
+            f"max {100 * rel.max():.1f} %"
+        )
+    if args.filter_k:
+        from meshlap_core.spectral import SpectralBasis
+
+        t0 = time.perf_counter()
+        basis = SpectralBasis.compute(V, F, args.filter_k)
+        print(
+            f"eigenbasis k={args.filter_k}: {time.perf_counter() - t0:.1f} s ({basis.info.method})"
+        )
+        f = SpectralFilter(basis)
+        k = args.filter_k
+        h = transfer("low-pass", basis.eigenvalues, keep=k // 2)
+        X = basis.V
+
+        def full():  # what a user writes: every gain, one product
+            return basis.vectors[:, :k] @ (
+                h[:, None] * (basis.vectors[:, :k].T @ (basis.mass[:, None] * X))
+            )
+
+        t_full, _ = best_of(full, max(args.repeat, 5))
+        f.apply(h)
+        state = {"keep": k // 2}
+
+        def drag():  # the low-pass edge moved by one mode
+            state["keep"] = k // 2 + (1 if state["keep"] == k // 2 else 0)
+            return f.apply(transfer("low-pass", basis.eigenvalues, keep=state["keep"]))
+
+        t_drag, _ = best_of(drag, max(args.repeat, 5))
+        print(
+            f"filter at k={k}: projection + product {1000 * t_full:.1f} ms; "
+            f"drag update (one mode changed) {1000 * t_drag:.2f} ms (goal < 16 ms); "
+            f"ratio {t_full / t_drag:.0f}"
+        )
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--mesh", default="armadillo_igl.obj", help="a mesh of ../shared/meshes")
+    ap.add_argument("--scan", action="store_true", help="also the 692k scan")
+    ap.add_argument("--exact", action="store_true", help="igl.exact_geodesic too (slow)")
+    ap.add_argument("--filter-k", type=int, default=0, help="time the filter drag at this k")
+    ap.add_argument("--repeat", type=int, default=3)
+    args = ap.parse_args()
+    path = shared_mesh(args.mesh)
+    if path is not None:
+        mesh = load_mesh(path)
+        run_mesh(args.mesh, mesh.V, mesh.F, args)
+    if args.scan:
+        src = shared_mesh("armadillo_loop.obj")
+        if src is not None:
+            mesh = load_mesh(src)
+            V, F = igl.upsample(mesh.V, mesh.F)
+            scan = argparse.Namespace(**{**vars(args), "exact": False, "filter_k": 0})
+            run_mesh("armadillo 692k (upsampled armadillo_loop)", V, F, scan)
+
+
+if __name__ == "__main__":
+    main()

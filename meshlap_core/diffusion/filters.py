@@ -1,0 +1,218 @@
+"""Spectral filters: a transfer function ``h(λ)`` applied in the eigenbasis, and the transfer
+functions of the smoothing methods.
+
+The filtered geometry is ``X̃ = U h(Λ) Uᵀ M X`` over the ``k`` computed modes (Taubin 1995;
+Vallet & Lévy, "Spectral geometry processing with manifold harmonics", 2008), plus, when
+``residual`` is set, the part of ``X`` the modes do not represent (``X − U Uᵀ M X``), so that a
+band exaggeration keeps the fine detail. With the full basis and ``h ≡ 1`` it returns ``X``.
+
+The smoothers of :mod:`meshlap_core.smoothing` with the cotangent Laplacian ``L = M⁻¹C`` and a
+frozen operator are linear maps with the eigenvectors ``φ_i`` (``Lφ_i = −λ_i φ_i``), so ``n``
+steps multiply mode ``i`` by exactly
+
+* explicit ``x' = x + s L x``: ``(1 − sλ)ⁿ``;
+* implicit ``(I − sL) x' = x``: ``(1 + sλ)^{−n}``;
+* Taubin (``s`` then ``ν < 0``): ``((1 − sλ)(1 − νλ))ⁿ``
+
+(:func:`transfer`); :func:`measured_amplification` runs the smoother and projects, which
+agrees with them to the accuracy of the eigenvectors.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ..errors import MeshError
+from ..options import FILTER_KINDS, FilterKind, check_choice
+from ..spectral.basis import SpectralBasis
+from ..types import FloatArray
+
+
+def low_pass(eigenvalues: FloatArray, keep: int) -> FloatArray:
+    """``h = 1`` on the ``keep`` lowest modes, 0 above (an ideal low-pass), ``(k,)``."""
+    h = np.zeros(len(eigenvalues))
+    h[: max(int(keep), 0)] = 1.0
+    return h
+
+
+def band_gain(eigenvalues: FloatArray, lo: int, hi: int, gain: float) -> FloatArray:
+    """``h = gain`` on modes ``lo … hi−1`` and 1 elsewhere (band exaggeration for ``gain > 1``,
+    attenuation below 1), ``(k,)``."""
+    h = np.ones(len(eigenvalues))
+    h[max(int(lo), 0) : max(int(hi), 0)] = float(gain)
+    return h
+
+
+def transfer(
+    kind: FilterKind,
+    eigenvalues: FloatArray,
+    *,
+    step: float = 0.0,
+    iters: int = 1,
+    nu: float = 0.0,
+    keep: int = 0,
+    band: tuple[int, int] = (0, 0),
+    gain: float = 1.0,
+) -> FloatArray:
+    """The gain ``h(λ_i)`` of each mode for a filter ``kind``.
+
+    Parameters
+    ----------
+    kind : {"low-pass", "band", "explicit", "implicit", "taubin"}
+    eigenvalues : (k,) float
+        Frequencies ``λ ≥ 0`` of ``−Δ``.
+    step, iters, nu : float, int, float
+        The smoother's ``s > 0``, number of steps and Taubin's ``ν < 0``.
+    keep : int
+        Modes a low-pass keeps.
+    band, gain : (int, int), float
+        Band ``[lo, hi)`` of mode indices and its gain.
+
+    Returns
+    -------
+    h : (k,) float
+    """
+    check_choice(kind, FILTER_KINDS, "filter")
+    lam = np.asarray(eigenvalues, dtype=np.float64)
+    if kind == "low-pass":
+        return low_pass(lam, keep)
+    if kind == "band":
+        return band_gain(lam, band[0], band[1], gain)
+    n = int(iters)
+    if kind == "explicit":
+        return (1.0 - step * lam) ** n
+    if kind == "implicit":
+        return (1.0 + step * lam) ** (-n)
+    return ((1.0 - step * lam) * (1.0 - nu * lam)) ** n
+
+
+class SpectralFilter:
+    """Filtered geometry ``U h(Λ) Uᵀ M X``, with the coefficients projected once.
+
+    Parameters
+    ----------
+    basis : SpectralBasis
+    X : (n,c) float, optional
+        The signal (default the basis's vertex positions).
+    k : int, optional
+        Modes used (default all of the basis).
+
+    Notes
+    -----
+    A full :meth:`apply` is one ``(n,k)·(k,c)`` product, which reads all of ``U`` (100 MB at
+    43k vertices and ``k = 300``: memory-bound). A drag of a transfer-function editor changes a
+    few gains at a time, so :meth:`apply` updates the previous result with the changed modes
+    only, ``X̃ += U_J diag(Δh_J) C_J``, when fewer than a quarter of the gains changed (and
+    recomputes in full every :data:`RESYNC` incremental updates, so round-off cannot build up).
+    """
+
+    RESYNC = 64
+
+    def __init__(self, basis: SpectralBasis, X: FloatArray | None = None, k: int | None = None):
+        self.basis = basis
+        self.k = basis.k_max if k is None else int(k)
+        if not 1 <= self.k <= basis.k_max:
+            raise MeshError(
+                f"must be between 1 and {basis.k_max} (the modes computed), got {k}", "k"
+            )
+        X = basis.V if X is None else np.asarray(X, dtype=np.float64)
+        self.X = X.reshape(len(X), -1)
+        self.U = basis.vectors[:, : self.k]
+        self.eigenvalues = basis.eigenvalues[: self.k]
+        self.coefficients = self.U.T @ (basis.mass[:, None] * self.X)  # (k,c)
+        self._residual: FloatArray | None = None
+        self._last: tuple[FloatArray, FloatArray] | None = None  # (h, U h C) of the last apply
+        self._updates = 0
+
+    @property
+    def residual(self) -> FloatArray:
+        """``X − U Uᵀ M X``: what the ``k`` modes do not represent, ``(n,c)``."""
+        if self._residual is None:
+            self._residual = self.X - self.U @ self.coefficients
+        return self._residual
+
+    def apply(self, h: FloatArray, residual: bool = False) -> FloatArray:
+        """``U diag(h) Uᵀ M X`` (``+ X − U Uᵀ M X`` with ``residual``), ``(n,c)``."""
+        h = np.asarray(h, dtype=np.float64)
+        if h.shape != (self.k,):
+            raise MeshError(f"needs one gain per mode ({self.k}), got shape {h.shape}", "h")
+        out = self._filtered(h)
+        return out + self.residual if residual else out
+
+    def _filtered(self, h: FloatArray) -> FloatArray:
+        """``U diag(h) C``, from the last result when only a few gains changed."""
+        last = self._last
+        if last is not None and self._updates < self.RESYNC:
+            changed = np.flatnonzero(h != last[0])
+            if len(changed) < self.k // 4:
+                self._updates += 1
+                out = last[1].copy()
+                if len(changed):
+                    dh = (h - last[0])[changed]
+                    out += self.U[:, changed] @ (dh[:, None] * self.coefficients[changed])
+                self._last = (h.copy(), out)
+                return out.copy()
+        out = self.U @ (h[:, None] * self.coefficients)
+        self._last, self._updates = (h.copy(), out), 0
+        return out.copy()
+
+
+def measured_amplification(
+    basis: SpectralBasis, X_before: FloatArray, X_after: FloatArray, k: int | None = None
+) -> FloatArray:
+    """Per-mode amplification measured by projection: ``c_after_i / c_before_i`` with
+    ``c = Uᵀ M X`` taken in the coordinate where ``|c_before_i|`` is largest.
+
+    Parameters
+    ----------
+    basis : SpectralBasis
+    X_before, X_after : (n,c) float
+        A signal before and after a linear filter (e.g. a smoother's positions).
+    k : int, optional
+
+    Returns
+    -------
+    g : (k,) float
+        ``NaN`` for modes the signal does not contain (``|c_before| ≤ 1e-12 · max|c_before|``).
+    """
+    k = basis.k_max if k is None else int(k)
+    U = basis.vectors[:, :k]
+    m = basis.mass[:, None]
+    before = U.T @ (m * np.asarray(X_before, dtype=np.float64).reshape(len(U), -1))
+    after = U.T @ (m * np.asarray(X_after, dtype=np.float64).reshape(len(U), -1))
+    j = np.argmax(np.abs(before), axis=1)
+    rows = np.arange(k)
+    b, a = before[rows, j], after[rows, j]
+    ok = np.abs(b) > 1e-12 * np.abs(before).max()
+    return np.where(ok, a / np.where(ok, b, 1.0), np.nan)
+
+
+def smoother_transfer(
+    basis: SpectralBasis, method: str, step: float, iters: int, **options: Any
+) -> tuple[FloatArray, FloatArray]:
+    """The formula and the measurement side by side for a cotangent smoother run on the
+    basis's mesh: ``(h_formula (k,), h_measured (k,))``.
+
+    The smoother uses the basis's Laplacian (cotangent, frozen operator, the basis's mass);
+    ``options`` go to :class:`~meshlap_core.smoothing.Smoother` (e.g. ``taubin_nu``).
+    """
+    from ..smoothing import Smoother
+
+    s = Smoother(
+        basis.V,
+        basis.F,
+        method,  # type: ignore[arg-type]
+        "cotan",
+        step,
+        area=basis.options.get("mass", "voronoi"),  # type: ignore[arg-type]
+        mass_update="frozen",
+        track_history=False,
+        warn=False,
+        **options,
+    )
+    after = s.run(int(iters))
+    nu = float(s.taubin_nu) if s.taubin_nu is not None else 0.0
+    formula = transfer(method, basis.eigenvalues, step=step, iters=iters, nu=nu)  # type: ignore[arg-type]
+    return formula, measured_amplification(basis, basis.V, after)

@@ -1,0 +1,253 @@
+"""The Diffusion panel through its widgets (ScriptedUI on polyscope's openGL_mock) and its
+polyscope-free state. ``drive_diffusion_widgets`` is also part of the widget tour of
+``tests/test_viewer_widgets.py`` (every widget driven)."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+
+ps = pytest.importorskip("polyscope")
+
+from test_viewer_widgets import drive, frames  # noqa: E402
+
+from meshlap_core.diffusion import (  # noqa: E402
+    HeatDiffusion,
+    HeatGeodesic,
+    SpectralFilter,
+    exact_distance,
+    mean_edge_length,
+    transfer,
+    unit_heat,
+)
+
+
+@pytest.fixture(scope="module")
+def mock(polyscope_mock):
+    return polyscope_mock
+
+
+def settle(viewer, owner: str = "diffusion") -> None:
+    """Wait for the panel's job and let the host apply it."""
+    t0 = time.monotonic()
+    while viewer.state.jobs.running(owner) is not None:
+        assert time.monotonic() - t0 < 120, "the diffusion job never finished"
+        time.sleep(0.02)
+    frames(viewer, 2)
+
+
+def compute_basis(viewer, k: int = 40) -> None:
+    viewer.set_panel("spectral")
+    drive(viewer, "modes to compute", k)
+    drive(viewer, "compute eigenbasis", True)
+    st = viewer.panels["spectral"].state
+    t0 = time.monotonic()
+    while st.busy:
+        assert time.monotonic() - t0 < 300
+        time.sleep(0.02)
+    frames(viewer, 2)
+    assert st.basis is not None
+
+
+def drive_diffusion_widgets(viewer) -> None:
+    """Every widget of the Diffusion panel, with good and bad values."""
+    mesh = viewer.state.mesh
+    V, F = mesh.V, mesh.F
+    panel = viewer.panels["diffusion"]
+    st = panel.state
+    viewer.set_panel("diffusion")
+    frames(viewer)
+    drive(viewer, "show", "distance")
+    assert panel.select(viewer, 7)
+    settle(viewer)
+    np.testing.assert_allclose(st.distance, HeatGeodesic(V, F).distance([7]), atol=1e-12)
+    assert ps.get_surface_mesh("mesh").get_quantity_buffer  # the field is on the mesh
+    drive(viewer, "add clicked vertices", True)
+    assert panel.select(viewer, 40)
+    settle(viewer)
+    assert st.sources == [7, 40]
+    np.testing.assert_allclose(st.distance, HeatGeodesic(V, F).distance([7, 40]), atol=1e-12)
+    drive(viewer, "add clicked vertices", False)
+    drive(viewer, "m (t = m h^2)", "4")
+    settle(viewer)
+    np.testing.assert_allclose(st.distance, HeatGeodesic(V, F, m=4).distance([7, 40]), atol=1e-12)
+    for bad in ("0", "-1", "nan", "abc"):
+        drive(viewer, "m (t = m h^2)", bad)
+        assert st.m == 4.0 and "m (t = m h^2)" in viewer.state.errors["diffusion"]
+    drive(viewer, "boundary condition", "neumann")
+    settle(viewer)
+    assert st.boundary == "neumann"
+    drive(viewer, "exact distance", True)
+    settle(viewer)
+    ex = exact_distance(V, F, [7, 40])
+    np.testing.assert_allclose(st.exact, ex)
+    assert 0 < st.exact_stats["mean"] < st.exact_stats["max"] < 1
+    drive(viewer, "show error map", True)
+    assert st.heat_field == "difference"
+    drive(viewer, "show error map", False)
+    drive(viewer, "isolines", False)
+    assert not st.isolines
+    drive(viewer, "isolines", True)
+    drive(viewer, "isoline count", 5, 0, 10**6)
+    assert st.isoline_count == 200  # clamped
+
+    # heat: Euler alone, then with the Spectral view's basis the two ways and their difference
+    drive(viewer, "show", "heat")
+    drive(viewer, "log10 t/h^2", 1.0)
+    drive(viewer, "Euler steps", 3, 0)
+    assert st.steps == 1  # clamped to >= 1
+    drive(viewer, "Euler steps", 2)
+    settle(viewer)
+    hd = HeatDiffusion(V, F)
+    t = 10.0 * mean_edge_length(V, F) ** 2
+    u = hd.euler(unit_heat(np.array(st.sources), hd.mass), t, 2)
+    np.testing.assert_allclose(st.heat["euler"], u, atol=1e-12)
+    drive(viewer, "log10 t/h^2", float("nan"))
+    assert st.log_t == 1.0
+    compute_basis(viewer, k=len(V))  # the full basis: the two ways agree up to Euler's error
+    viewer.set_panel("diffusion")
+    drive(viewer, "Euler steps", 200)
+    settle(viewer)
+    assert st.k_used == len(V) and st.bound < 1e-6
+    diff = np.abs(st.heat["difference"]).max()
+    assert diff < 0.05 * np.abs(st.heat["euler"]).max()
+    # the two other fields on copies beside the mesh, on the same colour range
+    assert ps.has_surface_mesh("heat (second way)") and ps.has_surface_mesh("heat (third field)")
+    caps = panel.captions(viewer)
+    assert caps["mesh"] == "backward Euler" and "eigen-expansion" in caps["heat (second way)"]
+    drive(viewer, "heat field", "difference")
+    _, (lo, hi) = st.heat_shown()
+    assert lo == -hi  # one colour range for the three fields
+    assert hi == pytest.approx(
+        max(np.abs(st.heat["euler"]).max(), np.abs(st.heat["spectral"]).max())
+    )
+    drive(viewer, "heat field", "euler")
+
+    # filter over the basis
+    drive(viewer, "show", "filter")
+    basis = viewer.panels["spectral"].state.basis
+    drive(viewer, "filter", "low-pass")
+    drive(viewer, "modes kept", 10)
+    ref = SpectralFilter(basis).apply(transfer("low-pass", basis.eigenvalues, keep=10))
+    np.testing.assert_allclose(st.filtered, ref, atol=1e-12)
+    assert ps.has_surface_mesh("filtered")
+    drive(viewer, "filter", "band")
+    drive(viewer, "band gain", 1.0)
+    np.testing.assert_allclose(st.filtered, V, atol=1e-9)  # h ≡ 1 on the full basis
+    drive(viewer, "filter", "explicit")
+    drive(viewer, "smoother steps", 4)
+    drive(viewer, "measure by smoothing", True)
+    settle(viewer)
+    ok = np.isfinite(st.measured)  # the modes the round sphere's coordinates contain
+    assert ok.sum() >= 3
+    np.testing.assert_allclose(st.measured[ok], st.gains[ok], atol=1e-8)  # frozen operator
+    drive(viewer, "filter", "implicit")
+    drive(viewer, "smoother steps", 3, -5)
+    assert st.iters == 0
+    np.testing.assert_allclose(st.gains, 1.0)  # no step: identity
+    drive(viewer, "keep residual", True)
+    drive(viewer, "keep residual", False)
+
+    # heat kernel signature
+    drive(viewer, "show", "hks")
+    drive(viewer, "HKS time", 3, 99)
+    assert st.hks_scale == 15 and st.hks is not None and st.hks_dist is not None
+    assert st.hks_dist[st.sources[0]] == 0.0
+    drive(viewer, "clear sources", True)
+    assert st.sources == []
+
+
+def test_diffusion_widgets(viewer):
+    drive_diffusion_widgets(viewer)
+    ui = viewer.ui
+    mine = {k for k in ui.seen if k[0] == "diffusion"}
+    assert mine and not sorted(mine - ui.driven)
+
+
+def test_state_headless_without_a_basis(sphere):
+    from meshlap_app.state.diffusion import DiffusionState, find_basis
+
+    from meshlap_core.io import load_mesh
+
+    mesh = load_mesh(sphere)
+    st = DiffusionState(show="heat")
+    assert not st.select(len(mesh.V), len(mesh.V))  # out of range: nothing changes
+    assert st.select(len(mesh.V), 3)
+    st.compute_heat(mesh.V, mesh.F, mean_edge_length(mesh.V, mesh.F), None)
+    assert set(st.heat) == {"euler"} and np.isnan(st.bound)
+    assert find_basis([object(), st], mesh.V) is None
+
+
+# ---------------------------------------------------------------- meshlap animate --heat
+def _animate(tmp_path, *args: str):
+    import os
+    import subprocess
+    import sys
+
+    env = dict(os.environ, MESHLAP_CACHE_DIR=str(tmp_path / "cache"))
+    cmd = [sys.executable, "-m", "meshlap_core.cli", "animate", *args]
+    return subprocess.run(cmd, capture_output=True, text=True, timeout=600, cwd=tmp_path, env=env)
+
+
+@pytest.mark.parametrize(
+    ("args", "needle"),
+    [
+        (["--panel", "diffusion"], "--heat"),
+        (["--panel", "diffusion", "--heat", "--heat-t", "2:1"], "--heat-t"),
+        (["--panel", "diffusion", "--heat", "--heat-frames", "1"], "--heat-frames"),
+        (["--panel", "diffusion", "--heat", "--heat-vertex", "100000"], "--heat-vertex"),
+    ],
+)
+def test_heat_animation_bad_arguments(tmp_path, sphere, args, needle):
+    res = _animate(tmp_path, str(sphere), *args, "--out", str(tmp_path / "h.gif"))
+    assert res.returncode == 2 and needle in res.stderr
+    assert res.stderr.count("meshlap: error:") == 1
+    assert not (tmp_path / "h.gif").exists()
+
+
+@pytest.mark.egl
+def test_heat_animation_renders(tmp_path, sphere):
+    from PIL import Image
+
+    out = tmp_path / "heat.gif"
+    res = _animate(
+        tmp_path, str(sphere), "--panel", "diffusion", "--heat", "--heat-frames", "3",
+        "--size", "320x180", "--out", str(out),
+    )  # fmt: skip
+    assert res.returncode == 0, res.stderr
+    im = Image.open(out)
+    assert im.n_frames == 3
+    frames = []
+    for i in range(3):
+        im.seek(i)
+        frames.append(np.asarray(im.convert("RGB")).astype(int))
+    corner = frames[0][5:100, 5:40]  # the colour bar
+    assert ((corner.max(axis=2) - corner.min(axis=2)) > 80).sum() > 50
+    assert not np.array_equal(frames[0], frames[2])  # the heat spreads
+
+
+@pytest.mark.egl
+def test_view_screenshot_on_a_clicked_vertex(tmp_path, sphere):
+    """``meshlap view --panel diffusion --vertex I --screenshot``: the distance from I with its
+    colour bar and isolines, rendered headless."""
+    import os
+    import subprocess
+    import sys
+
+    from PIL import Image
+
+    out = tmp_path / "d.png"
+    env = dict(os.environ, MESHLAP_CACHE_DIR=str(tmp_path / "cache"))
+    cmd = [sys.executable, "-m", "meshlap_core.cli", "view", str(sphere), "--panel", "diffusion",
+           "--vertex", "5", "--screenshot", str(out)]  # fmt: skip
+    res = subprocess.run(cmd, capture_output=True, text=True, timeout=600, cwd=tmp_path, env=env)
+    assert res.returncode == 0, res.stderr
+    img = np.asarray(Image.open(out).convert("RGB")).astype(int)
+    corner = img[20:250, 10:40]  # the colour bar of the distance
+    assert ((corner.max(axis=2) - corner.min(axis=2)) > 80).sum() > 100
+    h, w, _ = img.shape
+    line = img[int(0.25 * h) : int(0.7 * h), int(0.37 * w)].sum(axis=1)  # down the mesh
+    jumps = np.count_nonzero(np.abs(np.diff(line)) > 40)  # the isoline bands' edges
+    assert jumps >= 4, jumps  # (5 on this view: smooth shading changes by <= 3 a pixel)
