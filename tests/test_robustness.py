@@ -614,7 +614,9 @@ FUNCS = {
     "vertex_normals": lambda V, F: vertex_normals(V, F).ravel(),
     "curvature_voronoi": lambda V, F: np.concatenate(list(all_curvature_fields(V, F, "voronoi")
                                                            .values())),
-    "curvature_barycentric": lambda V, F: np.concatenate(list(all_curvature_fields(V, F).values())),
+    "curvature_barycentric": lambda V, F: np.concatenate(
+        list(all_curvature_fields(V, F, "barycentric").values())
+    ),
     "quadric_fit": lambda V, F: np.concatenate([np.ravel(x)
                                                 for x in principal_curvature_quadric(V, F)]),
     "smooth_explicit_uniform": lambda V, F: Smoother(V, F, "explicit", "uniform", 0.5,

@@ -13,8 +13,8 @@ from ..io import check_output_path, load_mesh, save_mesh, save_scalars
 from ..options import (
     AREA_KINDS,
     BOUNDARY_RULES,
+    CURVATURE_AREA,
     CURVATURE_METHODS,
-    DEFAULT_AREA,
     DEFAULT_BOUNDARY,
     DEFAULT_CURVATURE_FIELD,
 )
@@ -35,8 +35,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--area",
         choices=AREA_KINDS,
-        default=DEFAULT_AREA,
-        help="vertex area (default barycentric, as in the course; voronoi converges)",
+        default=CURVATURE_AREA,
+        help="vertex area (default voronoi, the mixed area that converges; barycentric: the "
+        "course's)",
     )
     p.add_argument(
         "--boundary",
