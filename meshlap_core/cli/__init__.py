@@ -147,6 +147,7 @@ COMMANDS: tuple[str, ...] = (
     "denoise_eval",
     "report",
     "spectral",
+    "curvature_study",
 )
 COMMAND_GROUP = "meshlap.commands"
 """Entry points of this group name modules with ``register(sub)``: other packages (the viewer)
