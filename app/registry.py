@@ -48,6 +48,7 @@ REGISTRY: tuple[Entry, ...] = (
     Entry("spectral"),
     Entry("smoothing"),
     Entry("surfaces"),
+    Entry("curvature_lab"),
     Entry("export", view=False),
     Entry("help", view=False),
 )

@@ -104,6 +104,14 @@ PRINCIPAL_FIELDS: tuple[str, ...] = get_args(PrincipalField)
 """Scalar fields of an estimator's result: ``k1 ≥ k2``, ``H = (k1+k2)/2``, ``K = k1 k2``,
 ``abs_max = max(|k1|, |k2|)``."""
 
+LabSource = Literal["surface", "mesh"]
+LAB_SOURCES: tuple[str, ...] = get_args(LabSource)
+"""The curvature lab's mesh: a parametric surface's (exact values known) or the loaded one."""
+LabShow = Literal["estimate", "error", "disagreement"]
+LAB_SHOWS: tuple[str, ...] = get_args(LabShow)
+"""What the curvature lab colours: the estimate, its error against the exact surface, or the
+largest difference between the estimators (no exact values needed: scans)."""
+
 SmoothingMethod = Literal["explicit", "implicit", "taubin"]
 SMOOTHING_METHODS: tuple[str, ...] = get_args(SmoothingMethod)
 DEFAULT_SMOOTHING_METHOD: SmoothingMethod = "explicit"

@@ -505,6 +505,9 @@ def test_every_widget_is_driven(viewer, tmp_path, sphere):
     from test_viewer_record import drive_record_widgets  # play, θ and record widgets
 
     drive_record_widgets(viewer, tmp_path)
+    from test_curvature_lab import drive_curvature_lab  # the curvature lab's widgets
+
+    drive_curvature_lab(viewer)
     ui = viewer.ui
     undriven = sorted(set(ui.seen) - ui.driven)
     assert not undriven, f"widgets no test drives: {undriven}"
