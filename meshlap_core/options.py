@@ -88,13 +88,14 @@ CURVATURE_FIELD_LABELS: dict[str, tuple[str, bool]] = {
 }
 """Curvature field -> (the label shown to users, whether the field is signed)."""
 
-CurvatureEstimator = Literal["cotan", "quadric", "rusinkiewicz", "jet"]
+CurvatureEstimator = Literal["cotan", "quadric", "rusinkiewicz", "normal_cycle", "jet"]
 CURVATURE_ESTIMATORS: tuple[str, ...] = get_args(CurvatureEstimator)
 DEFAULT_CURVATURE_ESTIMATOR: CurvatureEstimator = "cotan"
 CURVATURE_ESTIMATOR_LABELS: dict[str, str] = {
     "cotan": "cotangent H + angle-deficit K (Meyer et al. 2003)",
     "quadric": "libigl quadric fit over edge rings (Panozzo et al. 2010)",
     "rusinkiewicz": "per-face tensors averaged to vertices (Rusinkiewicz 2004)",
+    "normal_cycle": "normal-cycle tensor over the Voronoi cell (Cohen-Steiner & Morvan 2003)",
     "jet": "jet fit over a world-radius ball (Cazals & Pouget 2003), robust to noise",
 }
 """Principal-curvature estimator -> its label shown to users

@@ -70,7 +70,9 @@ def test_sphere_of_radius_two_is_positive_half(name: str) -> None:
     # at an umbilic, k1 - k2 = 2√(H² - K) magnifies small tensor errors: 2.4 % measured for the
     # per-face tensors; libigl's 5-ring fit is biased at this size (its H is 1.097 on the unit
     # level-3 icosphere)
-    tol = {"cotan": 0.02, "quadric": 0.1}.get(name, 0.05)
+    # the normal cycle splits k1, k2 by 5.8 % next to the 12 valence-5 vertices (the paper's
+    # convergence needs a regular enough triangulation)
+    tol = {"cotan": 0.02, "quadric": 0.1, "normal_cycle": 0.06}.get(name, 0.05)
     np.testing.assert_allclose(r.k1, 0.5, rtol=tol)
     np.testing.assert_allclose(r.k2, 0.5, rtol=tol)
     np.testing.assert_allclose(r.H, 0.5, rtol=tol)
@@ -184,6 +186,8 @@ def _l2_errors(s: ParametricSurface, name: str, levels: tuple[int, ...]) -> np.n
         ("torus", "rusinkiewicz", 1.9),  # measured 2.0
         ("ellipsoid", "rusinkiewicz", 1.3),  # measured 1.5 (lat-long cells away from poles)
         ("torus", "quadric", 1.8),  # measured 2.0 between the finer levels
+        ("torus", "normal_cycle", 1.9),  # measured 2.0 on these regular grids
+        ("helicoid", "normal_cycle", 1.9),
         ("saddle", "jet", 1.6),  # automatic radius ∝ h^0.6 on clean meshes: measured 1.8-1.9
     ],
 )
