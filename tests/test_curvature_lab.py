@@ -97,6 +97,14 @@ def drive_curvature_lab(viewer) -> None:
     assert lab.result is not None and ps.has_surface_mesh(LAB)
     drive(viewer, "resolution", 12)
     assert lab.res == 12 and lab.result.V.shape[0] == 2 * 12 * 12
+    # the log-log plot of the error against h, with the fitted order in the legend
+    conv = lab.result.convergence
+    assert [row["res"] for row in conv] == [4, 6, 12]
+    order = conv[-1]["H_order"]
+    assert order == pytest.approx(2.0, abs=0.3)  # cotan on the regular torus grid
+    _kind, x, y = viewer.ui.plots[("curvature_lab", f"H, order {order:.2f}")]
+    np.testing.assert_allclose(x, np.log10([row["h"] for row in conv]))
+    assert len(x) == 3 and np.all(np.diff(x) < 0) and np.all(np.diff(y) < 0)  # finer: smaller
     drive(viewer, "noise", 0.001)
     drive(viewer, "jitter", 0.2)
     assert lab.computed_for[-2:] == (0.001, 0.2)

@@ -219,8 +219,19 @@ def test_curvature_is_finite_and_satisfies_gauss_bonnet(capsys, loaded, case):
     """Σ deficit = 2πχ (boundary term π − Σθ) on every loadable file whose vertices are
     manifold, however degenerate its triangles; every field finite, repairs reported."""
     mesh, out = loaded(case)
+    # K divided by the barycentric area, which the sum below multiplies back (the default is
+    # the mixed Voronoi area)
     code, stdout, err = run_cli(
-        capsys, "curvature", mesh, "--method", "gaussian", "--json", "--out", out / "K.npy"
+        capsys,
+        "curvature",
+        mesh,
+        "--method",
+        "gaussian",
+        "--area",
+        "barycentric",
+        "--json",
+        "--out",
+        out / "K.npy",
     )
     assert code == 0, err
     r = json.loads(stdout)

@@ -210,6 +210,21 @@ class CurvatureLabPanel(Panel):
         if lab.result is not None:
             ui.text(lab.result.label)
             ui.text(lab.result.summary)
+            self._draw_convergence(host, lab.result)
+
+    @staticmethod
+    def _draw_convergence(host: Host, r: LabResult) -> None:
+        """log10(relative RMS error) against log10(h) for H and K, the order in the legend."""
+        rows = [row for row in r.convergence if row["H_rel"] > 0 and row["K_rel"] > 0]
+        if len(rows) < 2:
+            return
+        x = np.log10([row["h"] for row in rows])
+        with host.ui.plot("error vs h (log-log)", 150, "log10 h", "log10 rel. error") as shown:
+            if shown:
+                for q in PRINCIPAL_FIELDS[2:4]:  # H and K
+                    order = rows[-1][f"{q}_order"]
+                    tag = f"{q}, order {order:.2f}" if order is not None else q
+                    host.ui.plot_line(tag, x, np.log10([row[f"{q}_rel"] for row in rows]))
 
 
 PANEL = CurvatureLabPanel

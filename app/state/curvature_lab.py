@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 
 from meshlap_core.curvature_estimators import disagreement, estimate_curvature
-from meshlap_core.curvature_study import exact_principal, perturbed_mesh
+from meshlap_core.curvature_study import curvature_study, exact_principal, perturbed_mesh
 from meshlap_core.errors import MeshError
 from meshlap_core.options import (
     CURVATURE_ESTIMATORS,
@@ -54,6 +54,10 @@ class LabResult:
         The exact direction of ``k1`` (parametric surfaces).
     summary : str
         One line: the RMS error (surface) or the largest disagreement (mesh).
+    convergence : list of dict
+        On a surface with ``show == "error"``: the :func:`~meshlap_core.curvature_study.
+        curvature_study` rows of this estimator at a quarter, half and the full resolution
+        (``h``, ``H_rel``, ``K_rel``, ``H_order``, ...): the log-log plot of error against h.
     """
 
     V: FloatArray
@@ -63,6 +67,7 @@ class LabResult:
     principal: PrincipalCurvatures
     exact_d1: FloatArray | None
     summary: str
+    convergence: list[dict[str, Any]] = field(default_factory=list)
 
 
 def _exact(m: Any) -> tuple[PrincipalCurvatures, np.ndarray]:
@@ -170,7 +175,8 @@ class CurvatureLabState:
                 values, label = r.field(q), f"{q} ({est})"
                 ex = exact.field(q)
                 summary = f"exact {q} in [{np.nanmin(ex):.4g}, {np.nanmax(ex):.4g}]"
-            return LabResult(Vs, m.F, values, label, r, exact.d1, summary)
+            conv = _convergence(params) if params["show"] == "error" else []
+            return LabResult(Vs, m.F, values, label, r, exact.d1, summary, conv)
         V = np.asarray(V, dtype=np.float64)
         F = np.asarray(F, dtype=np.int64)
         r = estimate_curvature(V, F, est)
@@ -191,6 +197,19 @@ class CurvatureLabState:
     def adopt(self, inputs: tuple[Any, ...], result: LabResult) -> None:
         """Take ``result``, computed for ``inputs``."""
         self.result, self.computed_for = result, inputs
+
+
+def _convergence(params: dict[str, Any]) -> list[dict[str, Any]]:
+    """The estimator's errors at a quarter, half and the full resolution (at least 4 cells)."""
+    n = int(params["res"])
+    levels = sorted({max(4, n // 4), max(4, n // 2), n})
+    return curvature_study(
+        [params["surface"]],
+        [params["estimator"]],
+        levels,
+        params["noise"],
+        params["jitter"],
+    )
 
 
 def _disagreement(V: FloatArray, F: IntArray, q: str) -> FloatArray:
