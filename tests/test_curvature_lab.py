@@ -67,6 +67,23 @@ def test_disagreement_on_a_loaded_mesh():
     assert "disagree" in r.summary
 
 
+def test_shape_operator_at_a_vertex_has_the_principal_values_and_euler_matches_exact():
+    lab = CurvatureLabState()  # the torus, cotan
+    lab.set_number("res", 32)
+    lab.adopt(lab.inputs(0), _compute(lab))
+    with pytest.raises(MeshError, match="vertex"):
+        lab.pick(10**6)
+    lab.pick(0)  # u = v = 0: the outer equator, k1 = 1 (around the tube), k2 = 1/4
+    so = lab.shape_operator()
+    S = np.array(so["S"])
+    np.testing.assert_allclose(S, S.T)
+    np.testing.assert_allclose(np.linalg.eigvalsh(S)[::-1], [so["k1"], so["k2"]], atol=1e-12)
+    assert (so["k1"], so["k2"]) == pytest.approx((1.0, 0.25), abs=2e-3)
+    # Euler's formula: the extremes of kn are k1 (θ = 0) and k2 (θ = 90°), close to exact
+    assert so["kn"][0] == pytest.approx(so["k1"]) and so["kn"].min() == pytest.approx(so["k2"])
+    np.testing.assert_allclose(so["kn"], so["exact_kn"], atol=3e-3)
+
+
 def test_cross_field_is_the_direction_in_the_tangent_basis():
     V, F = primitives.torus_mesh(24, 12)
     p = ce.estimate_curvature(V, F, "rusinkiewicz")
@@ -105,6 +122,14 @@ def drive_curvature_lab(viewer) -> None:
     _kind, x, y = viewer.ui.plots[("curvature_lab", f"H, order {order:.2f}")]
     np.testing.assert_allclose(x, np.log10([row["h"] for row in conv]))
     assert len(x) == 3 and np.all(np.diff(x) < 0) and np.all(np.diff(y) < 0)  # finer: smaller
+    drive(viewer, "vertex", 5)
+    assert lab.vertex == 5
+    # what the Euler plot draws (the plot itself is clipped when the panel is long)
+    so = lab.shape_operator()
+    assert so["kn"][0] == pytest.approx(lab.result.principal.k1[5])
+    assert so["exact_kn"] is not None
+    drive(viewer, "vertex", 10**6)
+    assert lab.vertex == 5 and "vertex" in viewer.state.errors["curvature_lab"]
     drive(viewer, "noise", 0.001)
     drive(viewer, "jitter", 0.2)
     assert lab.computed_for[-2:] == (0.001, 0.2)

@@ -18,7 +18,7 @@ from meshlap_core.options import (
 )
 from meshlap_core.surfaces import SURFACES
 
-from ..scene import COLORBAR_AT
+from ..scene import COLORBAR_AT, picked_vertex
 from ..state.curvature_lab import (
     MAX_JITTER,
     MAX_NOISE,
@@ -61,6 +61,17 @@ class CurvatureLabPanel(Panel):
     def points(self, host: Host, name: str) -> np.ndarray | None:
         r = self.state.result
         return r.V if name == LAB and r is not None else None
+
+    def pick(self, host: Host, hit: Any, active: Panel) -> bool:
+        """A click on the lab's mesh picks the vertex whose shape operator is shown."""
+        r = self.state.result
+        if active is not self or r is None or hit.structure_name != LAB:
+            return False
+        idx = picked_vertex(hit, r.V, r.F)
+        if idx is None:
+            return False
+        self.state.pick(idx)
+        return True
 
     def sync(self, host: Host) -> None:
         """Compute (a job in the window) when an input changed, upload when a result is new."""
@@ -210,7 +221,31 @@ class CurvatureLabPanel(Panel):
         if lab.result is not None:
             ui.text(lab.result.label)
             ui.text(lab.result.summary)
+            self._draw_shape_operator(host)
             self._draw_convergence(host, lab.result)
+
+    def _draw_shape_operator(self, host: Host) -> None:
+        """The picked vertex's 2×2 tensor with its basis and Euler's κn(θ), exact beside it."""
+        ui, lab = host.ui, self.state
+        ch, v = ui.input_int(
+            "vertex", lab.vertex, "pick a vertex (or click the mesh): its shape operator"
+        )
+        if ch:
+            lab.pick(v)
+        so = lab.shape_operator()
+        if so is None:
+            return
+        (a, b), (_, c) = so["S"]
+        t1, t2 = so["t1"], so["t2"]
+        ui.text(f"S = [[{a:.4g}, {b:.4g}], [{b:.4g}, {c:.4g}]]")
+        ui.text(f"k1 = {so['k1']:.4g}, k2 = {so['k2']:.4g}")
+        fmt = lambda t: f"({t[0]:.3f}, {t[1]:.3f}, {t[2]:.3f})"  # noqa: E731
+        ui.text(f"in the basis t1 = {fmt(t1)}, t2 = {fmt(t2)}")
+        with ui.plot("Euler: kn(theta) from d1", 150, "theta (deg)", "kn") as shown:
+            if shown:
+                ui.plot_line("estimate", so["theta_deg"], so["kn"])
+                if so["exact_kn"] is not None:
+                    ui.plot_line("exact", so["theta_deg"], so["exact_kn"])
 
     @staticmethod
     def _draw_convergence(host: Host, r: LabResult) -> None:

@@ -68,6 +68,7 @@ class LabResult:
     exact_d1: FloatArray | None
     summary: str
     convergence: list[dict[str, Any]] = field(default_factory=list)
+    exact: tuple[FloatArray, FloatArray] | None = None  # exact (k1, k2) on a parametric mesh
 
 
 def _exact(m: Any) -> tuple[PrincipalCurvatures, np.ndarray]:
@@ -92,6 +93,7 @@ class CurvatureLabState:
     jitter: float = 0.0
     result: LabResult | None = None
     computed_for: tuple[Any, ...] = field(default=())
+    vertex: int = -1  # the picked vertex of the result's mesh (-1: none)
 
     def inputs(self, mesh_version: int) -> tuple[Any, ...]:
         """Everything the result depends on (the mesh version only for the loaded mesh)."""
@@ -176,7 +178,9 @@ class CurvatureLabState:
                 ex = exact.field(q)
                 summary = f"exact {q} in [{np.nanmin(ex):.4g}, {np.nanmax(ex):.4g}]"
             conv = _convergence(params) if params["show"] == "error" else []
-            return LabResult(Vs, m.F, values, label, r, exact.d1, summary, conv)
+            return LabResult(
+                Vs, m.F, values, label, r, exact.d1, summary, conv, (exact.k1, exact.k2)
+            )
         V = np.asarray(V, dtype=np.float64)
         F = np.asarray(F, dtype=np.int64)
         r = estimate_curvature(V, F, est)
@@ -195,8 +199,28 @@ class CurvatureLabState:
         return LabResult(V, F, values, f"{q} ({est})", r, None, summary)
 
     def adopt(self, inputs: tuple[Any, ...], result: LabResult) -> None:
-        """Take ``result``, computed for ``inputs``."""
+        """Take ``result``, computed for ``inputs`` (a picked vertex stays if it exists)."""
         self.result, self.computed_for = result, inputs
+        if self.vertex >= len(result.V):
+            self.vertex = -1
+
+    def pick(self, vertex: int) -> None:
+        """Pick a vertex of the shown mesh for the shape-operator readout.
+
+        Raises
+        ------
+        MeshError
+            No result yet, or ``vertex`` outside it.
+        """
+        if self.result is None or not 0 <= int(vertex) < len(self.result.V):
+            raise MeshError(f"no vertex {vertex} in the lab's mesh", "vertex")
+        self.vertex = int(vertex)
+
+    def shape_operator(self) -> dict[str, Any] | None:
+        """The picked vertex's discrete shape operator (see :func:`shape_operator_at`)."""
+        if self.result is None or self.vertex < 0:
+            return None
+        return shape_operator_at(self.result, self.vertex)
 
 
 def _convergence(params: dict[str, Any]) -> list[dict[str, Any]]:
@@ -210,6 +234,45 @@ def _convergence(params: dict[str, Any]) -> list[dict[str, Any]]:
         params["noise"],
         params["jitter"],
     )
+
+
+def shape_operator_at(r: LabResult, i: int, n: int = 73) -> dict[str, Any]:
+    """The 2×2 shape operator of the estimate at vertex ``i`` in the tangent basis ``(t1, t2)``
+    of its normal, ``S = Σ k_j d_j d_jᵀ``, and Euler's formula
+    ``κn(θ) = k1 cos²θ + k2 sin²θ`` (θ from ``d1``) on ``n`` angles in ``[0°, 360°]``, beside the
+    exact one at the same vertex when the surface is known (the exact ``d1`` sits at the angle
+    ``φ`` from the estimate's, so the exact curve is ``k1* cos²(θ − φ) + k2* sin²(θ − φ)``).
+
+    Returns
+    -------
+    dict
+        ``S`` (2×2 list), ``t1``, ``t2`` (3-vectors), ``k1``, ``k2``, ``theta_deg`` and
+        ``kn`` ((n,) arrays), and ``exact_kn`` ((n,) or None).
+    """
+    p = r.principal
+    t1, t2 = tangent_frames(p.normal[i : i + 1])
+    c1 = np.array([p.d1[i] @ t1[0], p.d1[i] @ t2[0]])
+    c2 = np.array([p.d2[i] @ t1[0], p.d2[i] @ t2[0]])
+    S = p.k1[i] * np.outer(c1, c1) + p.k2[i] * np.outer(c2, c2)
+    th = np.radians(np.linspace(0.0, 360.0, n))
+    kn = p.k1[i] * np.cos(th) ** 2 + p.k2[i] * np.sin(th) ** 2
+    exact_kn = None
+    if r.exact_d1 is not None and r.exact is not None:
+        ek1, ek2 = float(r.exact[0][i]), float(r.exact[1][i])
+        if np.isfinite(ek1) and np.isfinite(ek2):
+            d = r.exact_d1[i]
+            phi = np.arctan2(d @ p.d2[i], d @ p.d1[i])
+            exact_kn = ek1 * np.cos(th - phi) ** 2 + ek2 * np.sin(th - phi) ** 2
+    return {
+        "S": S.tolist(),
+        "t1": t1[0],
+        "t2": t2[0],
+        "k1": float(p.k1[i]),
+        "k2": float(p.k2[i]),
+        "theta_deg": np.degrees(th),
+        "kn": kn,
+        "exact_kn": exact_kn,
+    }
 
 
 def _disagreement(V: FloatArray, F: IntArray, q: str) -> FloatArray:
