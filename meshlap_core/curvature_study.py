@@ -4,7 +4,8 @@ refinement (``meshlap curvature-study``).
 
 The meshes are :func:`meshlap_core.surfaces.mesh_surface` grids, optionally made irregular
 (``jitter``: every interior vertex moves in the parameter plane by up to ``jitter`` of a cell,
-and is evaluated on the surface there, so the exact values stay exact) and noisy (``noise``:
+and is evaluated on the surface there, so the exact values stay exact; ``flips``: a fraction of
+the edges flipped) and noisy (``noise``:
 Gaussian displacement along the normal of standard deviation ``noise × bounding-box
 diagonal``, the exact values being those of the clean point). Errors are measured at the
 vertices away from the boundary and the poles (one-sided stencils and sliver cells there), in
@@ -33,7 +34,7 @@ from .surfaces import (
     surface_curvature_fields,
     surface_derivatives,
 )
-from .types import BoolArray, FloatArray
+from .types import BoolArray, FloatArray, IntArray
 
 STUDY_COLUMNS: tuple[str, ...] = (
     "surface",
@@ -105,12 +106,56 @@ def exact_principal(m: SurfaceMesh, surface: ParametricSurface | str) -> ExactPr
     return ExactPrincipal(cf.k1, cf.k2, cf.H, cf.K, dirs[0], dirs[1], compared_vertices(m, s))
 
 
+def flip_edges(V: FloatArray, F: IntArray, fraction: float, seed: int = 0) -> IntArray:
+    """Flip a random ``fraction`` of the interior edges (an irregular triangulation of the same
+    vertices), vectorized: candidates whose two faces no other candidate touches, that stay
+    convex in their quad (both new triangles keep the orientation of the old normal) and do not
+    create an existing edge.
+
+    Returns
+    -------
+    F2 : (m,3) int
+        Same faces count and orientation; ``F`` is not modified.
+    """
+    if not 0.0 <= float(fraction) <= 1.0:
+        raise MeshError(f"must be between 0 and 1, got {fraction!r}", "flips")
+    F = np.asarray(F, dtype=np.int64)
+    n, m = len(V), len(F)
+    A, B = F.ravel(), np.roll(F, -1, axis=1).ravel()
+    C = np.roll(F, -2, axis=1).ravel()  # the corner opposite the half-edge A -> B
+    fid = np.repeat(np.arange(m), 3)
+    key = A * n + B
+    order = np.argsort(key)
+    sk = key[order]
+    pos = np.clip(np.searchsorted(sk, B * n + A), 0, len(sk) - 1)
+    twin = np.where(sk[pos] == B * n + A, order[pos], -1)
+    cand = np.flatnonzero((twin >= 0) & (A < B))
+    rng = np.random.default_rng(seed)
+    cand = cand[rng.random(len(cand)) < fraction]
+    f1, f2 = fid[cand], fid[twin[cand]]
+    used = np.bincount(np.concatenate([f1, f2]), minlength=m)
+    keep = (used[f1] == 1) & (used[f2] == 1)
+    h, a, b, c, d = cand[keep], A[cand[keep]], B[cand[keep]], C[cand[keep]], C[twin[cand[keep]]]
+    # the new edge c-d: refuse if it exists already or a new triangle turns over
+    exists = np.isin(c * n + d, key) | np.isin(d * n + c, key)
+    nrm = np.cross(V[b] - V[a], V[c] - V[a]) + np.cross(V[a] - V[b], V[d] - V[b])
+    # the quad a, d, b, c (counter-clockwise) gets the diagonal d-c: faces (a, d, c), (d, b, c)
+    t1 = np.cross(V[d] - V[a], V[c] - V[a])
+    t2 = np.cross(V[b] - V[d], V[c] - V[d])
+    ok = ~exists & (np.einsum("ij,ij->i", t1, nrm) > 0) & (np.einsum("ij,ij->i", t2, nrm) > 0)
+    F2 = F.copy()
+    F2[fid[h[ok]]] = np.stack([a[ok], d[ok], c[ok]], axis=1)
+    F2[fid[twin[h[ok]]]] = np.stack([d[ok], b[ok], c[ok]], axis=1)
+    return F2
+
+
 def perturbed_mesh(
     surface: ParametricSurface | str,
     res: int | Sequence[int],
     noise: float = 0.0,
     jitter: float = 0.0,
     seed: int = 0,
+    flips: float = 0.0,
 ) -> tuple[SurfaceMesh, FloatArray]:
     """A surface mesh made irregular and noisy (see the module notes).
 
@@ -123,6 +168,8 @@ def perturbed_mesh(
     jitter : float
         Largest parameter displacement of an interior vertex, a fraction of a cell (0 to 0.45).
     seed : int
+    flips : float
+        Fraction of the interior edges to flip (:func:`flip_edges`), 0 to 1.
 
     Returns
     -------
@@ -147,6 +194,10 @@ def perturbed_mesh(
         V = m.V.copy()
         V[free] = s(uv[free, 0], uv[free, 1])
         m = SurfaceMesh(V, m.F, uv, m.pole, m.boundary, m.surface, m.res)
+    if flips > 0:
+        m = SurfaceMesh(
+            m.V, flip_edges(m.V, m.F, flips, seed), m.uv, m.pole, m.boundary, m.surface, m.res
+        )
     V = add_noise(m.V, m.F, noise, mode="normal", seed=seed) if noise > 0 else m.V
     return m, V
 
@@ -187,6 +238,7 @@ def curvature_study(
     jitter: float = 0.0,
     seed: int = 0,
     options: dict[str, dict[str, Any]] | None = None,
+    flips: float = 0.0,
 ) -> list[dict[str, Any]]:
     """Errors of every estimator on every surface at every resolution, with observed orders.
 
@@ -195,7 +247,7 @@ def curvature_study(
     surfaces : names of :data:`meshlap_core.surfaces.SURFACES`
     estimators : names of :data:`~meshlap_core.options.CURVATURE_ESTIMATORS`
     levels : cells per direction (the torus gets twice as many around its axis)
-    noise, jitter, seed : see :func:`perturbed_mesh`
+    noise, jitter, seed, flips : see :func:`perturbed_mesh`
     options : estimator name -> its keyword options (e.g. ``{"jet": {"radius": 0.2}}``)
 
     Returns
@@ -214,7 +266,7 @@ def curvature_study(
         meshes = []
         for n in levels:
             res = (2 * int(n), int(n)) if s.name == "torus" else (int(n), int(n))
-            m, V = perturbed_mesh(s, res, noise, jitter, seed)
+            m, V = perturbed_mesh(s, res, noise, jitter, seed, flips)
             E = np.concatenate([m.F[:, [0, 1]], m.F[:, [1, 2]], m.F[:, [2, 0]]])
             h = float(np.mean(np.linalg.norm(m.V[E[:, 0]] - m.V[E[:, 1]], axis=1)))
             meshes.append((n, m, V, h, exact_principal(m, s)))

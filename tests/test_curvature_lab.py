@@ -132,7 +132,8 @@ def drive_curvature_lab(viewer) -> None:
     assert lab.vertex == 5 and "vertex" in viewer.state.errors["curvature_lab"]
     drive(viewer, "noise", 0.001)
     drive(viewer, "jitter", 0.2)
-    assert lab.computed_for[-2:] == (0.001, 0.2)
+    drive(viewer, "edge flips", 0.1)
+    assert lab.computed_for[-3:] == (0.001, 0.2, 0.1)
     drive(viewer, "noise", -1.0)
     assert lab.noise == 0.001 and "noise" in viewer.state.errors["curvature_lab"]
     drive(viewer, "estimator", "rusinkiewicz")

@@ -210,6 +210,7 @@ class CurvatureLabPanel(Panel):
                     MAX_JITTER,
                     "parameter jitter of interior vertices, a fraction of a cell",
                 ),
+                ("edge flips", "flips", 1.0, "fraction of the interior edges flipped"),
             ):
                 ch, value = ui.slider_float(what, getattr(lab, key), 0.0, hi, "%.4f", tip)
                 if ch:

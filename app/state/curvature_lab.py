@@ -91,6 +91,7 @@ class CurvatureLabState:
     res: int = 32
     noise: float = 0.0
     jitter: float = 0.0
+    flips: float = 0.0
     result: LabResult | None = None
     computed_for: tuple[Any, ...] = field(default=())
     vertex: int = -1  # the picked vertex of the result's mesh (-1: none)
@@ -100,7 +101,7 @@ class CurvatureLabState:
         base = (self.source, self.estimator, self.quantity, self.show)
         if self.source == "mesh":
             return (*base, mesh_version)
-        return (*base, self.surface, self.res, self.noise, self.jitter)
+        return (*base, self.surface, self.res, self.noise, self.jitter, self.flips)
 
     def set_choice(self, what: str, value: str) -> None:
         """Set ``source``, ``estimator``, ``quantity``, ``show`` or ``surface`` (checked).
@@ -120,14 +121,20 @@ class CurvatureLabState:
         setattr(self, what, check_choice(value, choices, what))
 
     def set_number(self, what: str, value: Any) -> None:
-        """Set ``res`` (3..MAX_RES), ``noise`` (0..MAX_NOISE) or ``jitter`` (0..MAX_JITTER).
+        """Set ``res`` (3..MAX_RES), ``noise`` (0..MAX_NOISE), ``jitter`` (0..MAX_JITTER) or
+        ``flips`` (0..1, the fraction of edges flipped).
 
         Raises
         ------
         MeshError
             Not a finite number in range (the previous value stays).
         """
-        lo, hi = {"res": (3, MAX_RES), "noise": (0.0, MAX_NOISE), "jitter": (0.0, MAX_JITTER)}[what]
+        lo, hi = {
+            "res": (3, MAX_RES),
+            "noise": (0.0, MAX_NOISE),
+            "jitter": (0.0, MAX_JITTER),
+            "flips": (0.0, 1.0),
+        }[what]
         try:
             x = float(value)
         except (TypeError, ValueError):
@@ -149,6 +156,7 @@ class CurvatureLabState:
                 "res",
                 "noise",
                 "jitter",
+                "flips",
             )
         }
 
@@ -160,7 +168,9 @@ class CurvatureLabState:
         if params["source"] == "surface":
             n = int(params["res"])
             res = (2 * n, n) if params["surface"] == "torus" else (n, n)
-            m, Vs = perturbed_mesh(params["surface"], res, params["noise"], params["jitter"])
+            m, Vs = perturbed_mesh(
+                params["surface"], res, params["noise"], params["jitter"], flips=params["flips"]
+            )
             r = estimate_curvature(Vs, m.F, est)
             exact, compared = _exact(m)
             if params["show"] == "error":
@@ -233,6 +243,7 @@ def _convergence(params: dict[str, Any]) -> list[dict[str, Any]]:
         levels,
         params["noise"],
         params["jitter"],
+        flips=params["flips"],
     )
 
 

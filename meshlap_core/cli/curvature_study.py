@@ -47,7 +47,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--noise", type=float, default=0.0, help="normal noise, fraction of bbox diagonal"
     )
     p.add_argument("--jitter", type=float, default=0.0, help="parameter jitter, fraction of a cell")
-    p.add_argument("--seed", type=int, default=0, help="noise and jitter seed")
+    p.add_argument("--flips", type=float, default=0.0, help="fraction of interior edges flipped")
+    p.add_argument("--seed", type=int, default=0, help="noise, jitter and flips seed")
     p.add_argument("--csv", default=None, help="write the table as CSV here")
     add_json_flag(p)
     p.set_defaults(func=run)
@@ -80,7 +81,9 @@ def run(args: argparse.Namespace) -> int:
     if not (math.isfinite(args.noise) and 0 <= args.noise <= 0.1):
         raise MeshError(f"must be 0 to 0.1 of the diagonal, got {args.noise}", "--noise")
     seed = check_seed(args.seed, "--seed")
-    rows = curvature_study(surfaces, estimators, levels, args.noise, args.jitter, seed)
+    rows = curvature_study(
+        surfaces, estimators, levels, args.noise, args.jitter, seed, flips=args.flips
+    )
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
     w.writerow(STUDY_COLUMNS)
