@@ -50,6 +50,7 @@ REGISTRY: tuple[Entry, ...] = (
     Entry("surfaces"),
     Entry("check"),
     Entry("diffusion"),
+    Entry("curvature_lab"),
     Entry("export", view=False),
     Entry("help", view=False),
 )

@@ -33,6 +33,7 @@ SHOTS = {
     ],
     "smoothing": [str(ROOT / "assets" / "bumpy.obj"), "--panel", "smoothing"],
     "surfaces": ["--panel", "surfaces"],
+    "curvature_lab": ["--panel", "curvature_lab"],
 }
 
 

@@ -61,6 +61,10 @@ _PUBLIC: dict[str, str | tuple[str, str]] = {
     "curvature_field": "curvature",
     "all_curvature_fields": "curvature",
     "vertex_normals": "curvature",
+    "principal_curvature_quadric": "curvature",
+    "estimate_curvature": "curvature_estimators",
+    "PrincipalCurvatures": "principal",
+    "jet_curvatures": "curvature_fit",
     # spectral
     "SpectralBasis": "spectral",
     # smoothing

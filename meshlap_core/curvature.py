@@ -5,10 +5,11 @@ Conventions. Normals are unit **angle-weighted** vertex normals (Thürmer & Wüt
 outward for counter-clockwise faces. Laplacians are negative semidefinite, ``Δx = −2 H n``,
 so ``H = −½ (Δx · n)`` is positive on a sphere with outward normals.
 
-Vertex areas decide convergence. With the **Voronoi (mixed)** area of Meyer et al. 2003, the
-cotangent mean curvature and the angle-deficit Gaussian curvature converge on refined
-icospheres (max error shrinks about 4× per subdivision). With the **barycentric** area (⅓ of the
-incident faces, the course's choice and our default, to match its figures) they do not: on
+Vertex areas decide convergence. With the **Voronoi (mixed)** area of Meyer et al. 2003 (the
+default, :data:`~meshlap_core.options.CURVATURE_AREA`), the cotangent mean curvature and the
+angle-deficit Gaussian curvature converge on refined icospheres (max error shrinks about 4× per
+subdivision). With the **barycentric** area (⅓ of the incident faces, the course's choice,
+``area="barycentric"``) they do not: on
 icospheres the error stalls near 15 %, because the barycentric cell is not the region the
 cotangent formula integrates over. The uniform Laplacian is not a discretisation of Δ at all:
 ``H_uniform`` carries units of length and depends on the triangulation.
@@ -31,8 +32,8 @@ from .laplacian import cotangents_intrinsic, uniform_laplacian, vertex_areas
 from .options import (
     AREA_KINDS,
     BOUNDARY_RULES,
+    CURVATURE_AREA,
     CURVATURE_FIELDS,
-    DEFAULT_AREA,
     DEFAULT_BOUNDARY,
     AreaKind,
     BoundaryRule,
@@ -245,12 +246,12 @@ def _areas_from(V: FloatArray, F: IntArray, fr: _FaceFrame, area: str) -> FloatA
     return np.bincount(F.ravel(), weights=np.repeat(fr.dbl / 6.0, 3), minlength=len(V))
 
 
-def mean_curvature_cotan(V: FloatArray, F: IntArray, area: AreaKind = DEFAULT_AREA) -> FloatArray:
+def mean_curvature_cotan(V: FloatArray, F: IntArray, area: AreaKind = CURVATURE_AREA) -> FloatArray:
     """Mean curvature from the Laplace–Beltrami operator, ``H = −½ (M⁻¹C x · n)``.
 
     ``C`` is the cotangent stiffness (negative semidefinite), ``M`` the lumped ``area``
-    (barycentric by default; ``"voronoi"`` for the mixed area that converges, see the module
-    notes). Zero-area vertices get 0.
+    (the mixed Voronoi area that converges by default; ``"barycentric"`` for the course's, see
+    the module notes). Zero-area vertices get 0.
 
     Returns
     -------
@@ -285,7 +286,7 @@ def angle_deficit(
 def gaussian_curvature(
     V: FloatArray,
     F: IntArray,
-    area: AreaKind = DEFAULT_AREA,
+    area: AreaKind = CURVATURE_AREA,
     boundary: BoundaryRule = DEFAULT_BOUNDARY,
 ) -> FloatArray:
     """Angle-deficit Gaussian curvature ``K = (2π − Σθ) / A_i`` (see :func:`angle_deficit`).
@@ -295,7 +296,7 @@ def gaussian_curvature(
     V : (n,3) float
     F : (m,3) int
     area : {"barycentric", "voronoi"}
-        Vertex area ``A_i`` (barycentric by default, as in the course).
+        Vertex area ``A_i`` (mixed Voronoi by default; barycentric as in the course).
     boundary : {"pi", "2pi", "zero"}
         Rule at boundary vertices.
 
@@ -320,7 +321,7 @@ def principal_from_HK(H: FloatArray, K: FloatArray) -> tuple[FloatArray, FloatAr
 def principal_curvatures(
     V: FloatArray,
     F: IntArray,
-    area: AreaKind = DEFAULT_AREA,
+    area: AreaKind = CURVATURE_AREA,
     boundary: BoundaryRule = DEFAULT_BOUNDARY,
 ) -> tuple[FloatArray, FloatArray]:
     """Principal curvatures from the cotangent ``H`` and the angle-deficit ``K`` (same area).
@@ -339,6 +340,11 @@ def principal_curvature_quadric(
 ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
     """libigl's quadric-fit principal curvatures (Panozzo et al. 2010), in our sign convention.
 
+    ``radius`` is libigl's: the fit uses the vertices within ``radius`` rings (an integer count
+    of edge rings, not a world distance). libigl measures curvature against the normal of the
+    face orientation, positive on a sphere with counter-clockwise faces, and returns ``PV1`` as
+    the maximum: ``k1 = PV1, k2 = PV2`` (reversing the faces negates and swaps both).
+
     Call only on a validated mesh (libigl crashes on unreferenced vertices): this function
     refuses a mesh with unreferenced vertices.
 
@@ -355,13 +361,12 @@ def principal_curvature_quadric(
     if len(F) == 0 or not used.all():
         raise MeshError("the quadric fit needs a mesh with faces and no unreferenced vertices")
     PD1, PD2, PV1, PV2, _bad = igl.principal_curvature(V, F, radius)
-    # libigl measures curvature against its own normal orientation: flip so H > 0 on spheres
-    H_ours = mean_curvature_cotan(V, F, "voronoi")
-    s = np.sign(np.sum(H_ours * (PV1 + PV2))) or 1.0
-    k_a, k_b = s * PV1, s * PV2
-    swap = k_b > k_a
-    k1 = np.where(swap, k_b, k_a)
-    k2 = np.where(swap, k_a, k_b)
+    # libigl fits against the angle-weighted normal of the face orientation and returns
+    # PV1 = max ≥ PV2 = min, already this module's sign (positive on a sphere with CCW faces):
+    # the sign is never taken from the data (a minimal surface has Σ H ≈ 0, any sign)
+    swap = PV2 > PV1
+    k1 = np.where(swap, PV2, PV1)
+    k2 = np.where(swap, PV1, PV2)
     d1 = np.where(swap[:, None], PD2, PD1)
     d2 = np.where(swap[:, None], PD1, PD2)
     clean = lambda x: np.nan_to_num(x, nan=0.0, posinf=0.0, neginf=0.0)  # noqa: E731
@@ -371,7 +376,7 @@ def principal_curvature_quadric(
 def all_curvature_fields(
     V: FloatArray,
     F: IntArray,
-    area: AreaKind = DEFAULT_AREA,
+    area: AreaKind = CURVATURE_AREA,
     boundary: BoundaryRule = DEFAULT_BOUNDARY,
     table: EdgeTable | None = None,
 ) -> dict[str, FloatArray]:
@@ -421,7 +426,7 @@ def curvature_field(
     V: FloatArray,
     F: IntArray,
     method: CurvatureField,
-    area: AreaKind = DEFAULT_AREA,
+    area: AreaKind = CURVATURE_AREA,
     boundary: BoundaryRule = DEFAULT_BOUNDARY,
 ) -> FloatArray:
     """One named field of :func:`all_curvature_fields` (``method`` in uniform, cotan, gaussian, k1,

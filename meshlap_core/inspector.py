@@ -31,7 +31,7 @@ from .errors import MeshError
 from .options import (
     AREA_KINDS,
     BOUNDARY_RULES,
-    DEFAULT_AREA,
+    CURVATURE_AREA,
     DEFAULT_BOUNDARY,
     AreaKind,
     BoundaryRule,
@@ -207,7 +207,7 @@ def inspect_vertex(
     V: FloatArray,
     F: IntArray,
     vertex: int,
-    area: AreaKind = DEFAULT_AREA,
+    area: AreaKind = CURVATURE_AREA,
     boundary: BoundaryRule = DEFAULT_BOUNDARY,
 ) -> VertexInspection:
     """Recompute, step by step, every operator term at one vertex.

@@ -19,6 +19,9 @@ BoundaryRule
     The angle a boundary vertex's angle sum is compared with in the angle-deficit Gaussian
     curvature ``K = (θ₀ − Σθ)/A``: ``"pi"`` (θ₀ = π, a flat boundary has K = 0), ``"2pi"``
     (θ₀ = 2π, as if the vertex were interior) or ``"zero"`` (K = 0 on the boundary).
+CurvatureEstimator, PrincipalField
+    The principal-curvature estimators side by side (``meshlap curvature --estimator``, see
+    :mod:`meshlap_core.curvature_estimators`) and the scalar fields of their results.
 CurvatureMethod, CurvatureField
     The per-vertex curvature estimators (``meshlap curvature --method``): ``"uniform"`` and
     ``"cotan"`` (mean curvature H from that Laplacian), ``"gaussian"`` (angle deficit K),
@@ -59,6 +62,10 @@ AreaKind = Literal["barycentric", "voronoi"]
 AREA_KINDS: tuple[str, ...] = get_args(AreaKind)
 DEFAULT_AREA: AreaKind = "barycentric"
 """Default area of the curvature and Laplacian functions (the course's formulas)."""
+CURVATURE_AREA: AreaKind = "voronoi"
+"""Default area of the curvature estimators (``meshlap_core.curvature``, ``meshlap curvature``, the
+Curvature panel): the mixed Voronoi area, with which the cotangent ``H`` and the angle-deficit
+``K`` converge (L2 order 2); ``"barycentric"`` (the course's) is one argument away."""
 MASS_AREA: AreaKind = "voronoi"
 """Default area of the mass matrix wherever a positive-definite M that converges under
 refinement matters more than matching the course: spectral bases, smoothing, ``mass_matrix``."""
@@ -84,6 +91,31 @@ CURVATURE_FIELD_LABELS: dict[str, tuple[str, bool]] = {
     "difference": ("H uniform - H cotangent", True),
 }
 """Curvature field -> (the label shown to users, whether the field is signed)."""
+
+CurvatureEstimator = Literal["cotan", "quadric", "rusinkiewicz", "normal_cycle", "jet"]
+CURVATURE_ESTIMATORS: tuple[str, ...] = get_args(CurvatureEstimator)
+DEFAULT_CURVATURE_ESTIMATOR: CurvatureEstimator = "cotan"
+CURVATURE_ESTIMATOR_LABELS: dict[str, str] = {
+    "cotan": "cotangent H + angle-deficit K (Meyer et al. 2003)",
+    "quadric": "libigl quadric fit over edge rings (Panozzo et al. 2010)",
+    "rusinkiewicz": "per-face tensors averaged to vertices (Rusinkiewicz 2004)",
+    "normal_cycle": "normal-cycle tensor over the Voronoi cell (Cohen-Steiner & Morvan 2003)",
+    "jet": "jet fit over a world-radius ball (Cazals & Pouget 2003), robust to noise",
+}
+"""Principal-curvature estimator -> its label shown to users
+(:mod:`meshlap_core.curvature_estimators`)."""
+PrincipalField = Literal["k1", "k2", "H", "K", "abs_max"]
+PRINCIPAL_FIELDS: tuple[str, ...] = get_args(PrincipalField)
+"""Scalar fields of an estimator's result: ``k1 ≥ k2``, ``H = (k1+k2)/2``, ``K = k1 k2``,
+``abs_max = max(|k1|, |k2|)``."""
+
+LabSource = Literal["surface", "mesh"]
+LAB_SOURCES: tuple[str, ...] = get_args(LabSource)
+"""The curvature lab's mesh: a parametric surface's (exact values known) or the loaded one."""
+LabShow = Literal["estimate", "error", "disagreement"]
+LAB_SHOWS: tuple[str, ...] = get_args(LabShow)
+"""What the curvature lab colours: the estimate, its error against the exact surface, or the
+largest difference between the estimators (no exact values needed: scans)."""
 
 SmoothingMethod = Literal["explicit", "implicit", "taubin"]
 SMOOTHING_METHODS: tuple[str, ...] = get_args(SmoothingMethod)

@@ -60,7 +60,7 @@ def test_curvature_state_recomputes_only_on_change():
     c = CurvatureState()
     assert c.update(m) and not c.update(m)
     np.testing.assert_allclose(c.fields["cotan"], all_curvature_fields(m.V, m.F)["cotan"])
-    c.area = "voronoi"
+    c.area = "barycentric"  # the default is the mixed Voronoi area
     assert c.update(m)
     lo, hi = c.color_range("gaussian")
     assert lo == -hi and hi > 0

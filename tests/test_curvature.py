@@ -11,12 +11,16 @@ from meshlap_core.laplacian import vertex_areas
 
 def test_cube_corner_by_hand():
     V, F = primitives.cube()
-    K = curv.gaussian_curvature(V, F)
+    K = curv.gaussian_curvature(V, F, "barycentric")
     # vertex 0 touches 6 triangles of area 1/2 (barycentric area 1) and has 3 right angles
     assert K[0] == pytest.approx((np.pi / 2) / 1.0)
     # vertex 1 touches 4 triangles: area 2/3, same deficit
     assert K[1] == pytest.approx((np.pi / 2) / (2 / 3))
     np.testing.assert_allclose(curv.angle_deficit(V, F), np.pi / 2)
+    # the default mixed Voronoi area: no triangle is obtuse (right ones are not), and the
+    # Voronoi cell of a corner of a unit square is its quarter whatever the diagonal, so every
+    # corner has A = 3/4 and K = (π/2)/(3/4) = 2π/3
+    np.testing.assert_allclose(curv.gaussian_curvature(V, F), 2 * np.pi / 3)
 
 
 def test_regular_tetrahedron_by_hand():

@@ -365,14 +365,16 @@ def test_tables_agree_with_the_mathematics(quick):
     # Gauss–Bonnet holds exactly with the pi boundary rule (closed and open meshes)
     for r in read_table(quick, "gauss_bonnet"):
         assert float(r["abs_difference"]) < 1e-9 * max(1.0, abs(float(r["two_pi_chi"])))
-    # helicoid at the origin: E = G = 1, F = 0, e = g = 0, f = -1, K = -1, k = ±1
+    # helicoid at the origin: E = G = 1, F = 0, e = g = 0, f = 1 (II = -p_uv . n), K = -1, k = ±1
     for r in read_table(quick, "helicoid_origin"):
         assert float(r["abs_difference"]) < 1e-8, r
     for r in read_table(quick, "helicoid_principal"):
         u = float(r["u"])
         assert float(r["k1"]) == pytest.approx(1 / (1 + u * u), abs=1e-9)
         assert float(r["k2"]) == pytest.approx(-1 / (1 + u * u), abs=1e-9)
-        assert float(r["H_core_sign"]) == pytest.approx(-float(r["H_surfaces"]), abs=1e-12)
+        # one sign convention: the core's H is the surfaces' H (0 on the minimal helicoid)
+        assert float(r["H_core_sign"]) == pytest.approx(float(r["H_surfaces"]), abs=1e-12)
+        assert float(r["H_surfaces"]) == pytest.approx(0.0, abs=1e-12)
     # convergence under refinement (analytic references): second order with the Voronoi area
     # on the icospheres, a stall near 15 % with the barycentric one; H uniform never converges
     # on the sphere (it is O(h^2), so its error tends to |H| = 1)

@@ -219,8 +219,19 @@ def test_curvature_is_finite_and_satisfies_gauss_bonnet(capsys, loaded, case):
     """Σ deficit = 2πχ (boundary term π − Σθ) on every loadable file whose vertices are
     manifold, however degenerate its triangles; every field finite, repairs reported."""
     mesh, out = loaded(case)
+    # K divided by the barycentric area, which the sum below multiplies back (the default is
+    # the mixed Voronoi area)
     code, stdout, err = run_cli(
-        capsys, "curvature", mesh, "--method", "gaussian", "--json", "--out", out / "K.npy"
+        capsys,
+        "curvature",
+        mesh,
+        "--method",
+        "gaussian",
+        "--area",
+        "barycentric",
+        "--json",
+        "--out",
+        out / "K.npy",
     )
     assert code == 0, err
     r = json.loads(stdout)
@@ -614,7 +625,9 @@ FUNCS = {
     "vertex_normals": lambda V, F: vertex_normals(V, F).ravel(),
     "curvature_voronoi": lambda V, F: np.concatenate(list(all_curvature_fields(V, F, "voronoi")
                                                            .values())),
-    "curvature_barycentric": lambda V, F: np.concatenate(list(all_curvature_fields(V, F).values())),
+    "curvature_barycentric": lambda V, F: np.concatenate(
+        list(all_curvature_fields(V, F, "barycentric").values())
+    ),
     "quadric_fit": lambda V, F: np.concatenate([np.ravel(x)
                                                 for x in principal_curvature_quadric(V, F)]),
     "smooth_explicit_uniform": lambda V, F: Smoother(V, F, "explicit", "uniform", 0.5,

@@ -39,6 +39,9 @@ CALLS: dict[str, Callable[[Any, Any, Any], Any]] = {
     "curvature_field": lambda V, F, t: mc.curvature_field(V, F, "cotan"),
     "all_curvature_fields": lambda V, F, t: mc.all_curvature_fields(V, F),
     "vertex_normals": lambda V, F, t: mc.vertex_normals(V, F),
+    "estimate_curvature": lambda V, F, t: mc.estimate_curvature(V, F, "rusinkiewicz"),
+    "principal_curvature_quadric": lambda V, F, t: mc.principal_curvature_quadric(V, F),
+    "jet_curvatures": lambda V, F, t: mc.jet_curvatures(V, F),
     "SpectralBasis": lambda V, F, t: mc.SpectralBasis.compute(V, F, 3, cache=False),
     "Smoother": lambda V, F, t: mc.Smoother(V, F),
     "smooth": lambda V, F, t: mc.smooth(V, F, iters=1),
@@ -51,6 +54,7 @@ NO_MESH_ARRAYS = {
     "MeshWarning",
     "__version__",
     "Mesh",  # a record built by validate_mesh (tested there)
+    "PrincipalCurvatures",  # a record built by the curvature estimators
     "MeshReport",
     "OneRing",  # built by one_ring
     "EdgeTable",  # built by the topology functions

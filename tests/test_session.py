@@ -42,7 +42,7 @@ def non_default_session(mesh) -> Session:
     s.settings = {
         "curvature": {
             "field": "gaussian",
-            "area": "voronoi",
+            "area": "barycentric",  # the default is voronoi
             "boundary": "2pi",
             "clip": 7.5,
             "side_by_side": True,
@@ -313,7 +313,7 @@ def set_up_everything(viewer) -> None:
     assert isinstance(viewer.panels["help"], HelpPanel)
     viewer.set_ui_scale(1.25)
     c = viewer.state.curv
-    c.field_name, c.area, c.boundary = "k2", "voronoi", "2pi"
+    c.field_name, c.area, c.boundary = "k2", "barycentric", "2pi"  # default: voronoi
     c.set_percentile(4.5)
     viewer.state.curv.side_by_side = True
     viewer.state.curv.second_field = "gaussian"

@@ -60,7 +60,8 @@ def test_helicoid_exact_values(u: float, v: float, method: str) -> None:
     assert g.G == pytest.approx(w, abs=1e-10)
     assert g.e == pytest.approx(0, abs=1e-9)
     assert g.g == pytest.approx(0, abs=1e-9)
-    assert g.f == pytest.approx(-1 / np.sqrt(w), abs=1e-9)
+    # f = -p_uv . n = -(-sin v, cos v, 0) . (sin v, -cos v, u)/√w = 1/√w
+    assert g.f == pytest.approx(1 / np.sqrt(w), abs=1e-9)
     assert g.K == pytest.approx(-1 / w**2, abs=1e-9)
     assert g.H == pytest.approx(0, abs=1e-9)
     assert g.k1 == pytest.approx(1 / w, abs=1e-9)
@@ -70,14 +71,15 @@ def test_helicoid_exact_values(u: float, v: float, method: str) -> None:
     np.testing.assert_allclose(g.n, np.array([np.sin(v), -np.cos(v), u]) / np.sqrt(w), atol=1e-12)
 
 
-def test_helicoid_origin_normal_curvature_is_minus_sin_2theta() -> None:
+def test_helicoid_origin_normal_curvature_is_sin_2theta() -> None:
+    # at the origin E = G = 1, F = e = g = 0, f = 1: κₙ = 2 f cs / 1 = sin 2θ
     theta, kn = normal_curvature_curve("helicoid", 0.0, 0.0)
     assert theta.shape == kn.shape == (361,)
     assert theta[0] == 0 and theta[-1] == pytest.approx(2 * np.pi)
-    np.testing.assert_allclose(kn, -np.sin(2 * theta), atol=1e-12)
+    np.testing.assert_allclose(kn, np.sin(2 * theta), atol=1e-12)
     g = point_geometry("helicoid", 0.0, 0.0)
-    assert g.theta_max == pytest.approx(3 * np.pi / 4)  # -sin 2θ = +1
-    assert g.theta_min == pytest.approx(np.pi / 4)  # -sin 2θ = -1
+    assert g.theta_max == pytest.approx(np.pi / 4)  # sin 2θ = +1
+    assert g.theta_min == pytest.approx(3 * np.pi / 4)  # sin 2θ = -1
 
 
 @pytest.mark.parametrize("r", [0.5, 1.0, 2.0])
@@ -86,14 +88,14 @@ def test_sphere_is_umbilic_with_K_one_over_r2(r: float) -> None:
     for u, v in [(0.3, 0.1), (np.pi / 2, 3.0), (2.9, 6.0)]:
         g = point_geometry(s, u, v)
         assert g.K == pytest.approx(1 / r**2, rel=1e-12)
-        # n points outwards, the surface bends away from it: κ = -1/r (do Carmo's sign)
-        assert g.k1 == pytest.approx(-1 / r, rel=1e-12)
-        assert g.k2 == pytest.approx(-1 / r, rel=1e-12)
-        assert g.H == pytest.approx(-1 / r, rel=1e-12)
+        # n points outwards, the surface bends away from it: κ = +1/r (the project's sign)
+        assert g.k1 == pytest.approx(1 / r, rel=1e-12)
+        assert g.k2 == pytest.approx(1 / r, rel=1e-12)
+        assert g.H == pytest.approx(1 / r, rel=1e-12)
         np.testing.assert_allclose(g.n, g.p / r, atol=1e-12)
         assert g.classification == "umbilic"
         _, kn = normal_curvature_curve(s, u, v, 50)
-        np.testing.assert_allclose(kn, -1 / r, rtol=1e-12)
+        np.testing.assert_allclose(kn, 1 / r, rtol=1e-12)
 
 
 def test_torus_sign_of_K_inside_and_outside() -> None:
@@ -120,19 +122,21 @@ def test_torus_sign_of_K_inside_and_outside() -> None:
 def test_cylinder_is_parabolic(r: float) -> None:
     g = point_geometry(get_surface("cylinder", r=r), 1.1, 0.4)
     assert g.K == pytest.approx(0, abs=1e-12)
-    assert g.k1 == pytest.approx(0, abs=1e-12)
-    assert g.k2 == pytest.approx(-1 / r, rel=1e-12)
+    # outward n: the circle around the axis bends away from it, κ = +1/r; flat along the axis
+    assert g.k1 == pytest.approx(1 / r, rel=1e-12)
+    assert g.k2 == pytest.approx(0, abs=1e-12)
     assert g.classification == "parabolic"
-    np.testing.assert_allclose(np.abs(g.dir1), [0, 0, 1], atol=1e-12)  # flat along the axis
-    assert abs(g.dir2[2]) < 1e-12  # curved around it
+    np.testing.assert_allclose(np.abs(g.dir2), [0, 0, 1], atol=1e-12)  # flat along the axis
+    assert abs(g.dir1[2]) < 1e-12  # curved around it
 
 
 def test_saddles_at_the_origin() -> None:
-    g = point_geometry("saddle", 0.0, 0.0)  # z = u² - v²: e = 2, g = -2
-    assert (g.e, g.f, g.g) == pytest.approx((2, 0, -2), abs=1e-12)
+    # z = u² - v², n = +z: e = -p_uu . n = -2, g = +2 (bends towards n along u, away along v)
+    g = point_geometry("saddle", 0.0, 0.0)
+    assert (g.e, g.f, g.g) == pytest.approx((-2, 0, 2), abs=1e-12)
     assert (g.k1, g.k2, g.K, g.H) == pytest.approx((2, -2, -4, 0), abs=1e-12)
-    np.testing.assert_allclose(np.abs(g.dir1), [1, 0, 0], atol=1e-12)
-    np.testing.assert_allclose(np.abs(g.dir2), [0, 1, 0], atol=1e-12)
+    np.testing.assert_allclose(np.abs(g.dir1), [0, 1, 0], atol=1e-12)
+    np.testing.assert_allclose(np.abs(g.dir2), [1, 0, 0], atol=1e-12)
     m = point_geometry("monkey_saddle", 0.0, 0.0)
     assert (m.e, m.f, m.g) == pytest.approx((0, 0, 0), abs=1e-12)
     assert m.classification == "planar"
@@ -232,7 +236,8 @@ def test_numeric_derivatives_match_exact(name: str, method: str) -> None:
 
 
 def test_adding_a_surface_needs_only_p() -> None:
-    # elliptic paraboloid z = (a u² + b v²)/2, at the origin k = a, b along the axes
+    # elliptic paraboloid z = (a u² + b v²)/2, n = +z at the origin: it bends towards n,
+    # so κ = -a along u and -b along v; a > b gives k1 = -b (along v), k2 = -a
     a, b = 3.0, 0.5
     s = ParametricSurface(
         "paraboloid",
@@ -240,9 +245,9 @@ def test_adding_a_surface_needs_only_p() -> None:
         (-1, 1, -1, 1),
     )
     g = point_geometry(s, 0.0, 0.0)
-    assert (g.k1, g.k2, g.K, g.H) == pytest.approx((a, b, a * b, (a + b) / 2), abs=1e-9)
+    assert (g.k1, g.k2, g.K, g.H) == pytest.approx((-b, -a, a * b, -(a + b) / 2), abs=1e-9)
     assert g.classification == "elliptic"
-    np.testing.assert_allclose(np.abs(g.dir1), [1, 0, 0], atol=1e-9)
+    np.testing.assert_allclose(np.abs(g.dir1), [0, 1, 0], atol=1e-9)
 
 
 def test_non_analytic_p_falls_back_to_central_differences() -> None:
@@ -255,7 +260,7 @@ def test_non_analytic_p_falls_back_to_central_differences() -> None:
         (-1, 1, -1, 1),
     )
     g = point_geometry(s, 0.0, 0.0)
-    assert (g.k1, g.k2) == pytest.approx((1, 1), abs=1e-8)
+    assert (g.k1, g.k2) == pytest.approx((-1, -1), abs=1e-8)  # bends towards n = +z
     assert g.classification == "umbilic"
     with pytest.raises(MeshError, match="complex"):
         surface_derivatives(s, 0.0, 0.0, "complex-step")
@@ -499,7 +504,7 @@ def test_cli_point_json(capsys) -> None:
     assert code == 0
     d = json.loads(out)
     assert d["G"] == pytest.approx(1.25)
-    assert d["f"] == pytest.approx(-1 / np.sqrt(1.25))
+    assert d["f"] == pytest.approx(1 / np.sqrt(1.25))
     assert d["k1"] == pytest.approx(0.8) and d["k2"] == pytest.approx(-0.8)
     assert d["classification"] == "hyperbolic"
     assert len(d["dir1"]) == 3 and len(d["dir1_uv"]) == 2
@@ -608,11 +613,11 @@ def test_an_undeclared_apex_is_found_by_the_scale_test(scale: float) -> None:
     with pytest.raises(MeshError, match="area scale"):
         point_geometry(cone, 0.0, 1.0)
     # K = 0 (developable); n = (−cos v, −sin v, 1)/√2 points into the cone, so the circle
-    # around the axis bends towards n: κ₁ = +1/(√2 u · scale), κ₂ = 0 along the rulings
+    # around the axis bends towards n: κ₂ = -1/(√2 u · scale), κ₁ = 0 along the rulings
     g = point_geometry(cone, 0.5, 1.0)
     assert g.K == pytest.approx(0, abs=1e-6 / scale**2)
-    assert g.k1 == pytest.approx(1 / (np.sqrt(2) * 0.5 * scale), rel=1e-6)
-    assert g.k2 == pytest.approx(0, abs=1e-6 / scale)
+    assert g.k2 == pytest.approx(-1 / (np.sqrt(2) * 0.5 * scale), rel=1e-6)
+    assert g.k1 == pytest.approx(0, abs=1e-6 / scale)
 
 
 @pytest.mark.parametrize("name", list(surfaces.SURFACES))

@@ -131,7 +131,9 @@ def test_state_follows_area_and_boundary_rule(tmp_path):
     mesh, curv, ring = MeshState(), CurvatureState(), OneRingState()
     assert mesh.load(path)
     assert ring.select(mesh, curv, 0)  # a corner of the grid: boundary
-    assert ring.inspection.boundary and ring.inspection.area_kind == "barycentric"
+    assert ring.inspection.boundary and ring.inspection.area_kind == "voronoi"  # the default
+    ring.set_rules(mesh, curv, "barycentric", "pi")
+    assert ring.inspection.area_kind == "barycentric" and curv.area == "barycentric"
     ring.set_rules(mesh, curv, "voronoi", "zero")
     assert (curv.area, curv.boundary) == ("voronoi", "zero")
     assert ring.inspection.area_kind == "voronoi" and ring.inspection.K == 0.0

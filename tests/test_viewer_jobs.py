@@ -177,16 +177,16 @@ def test_a_new_area_recomputes_the_fields_as_a_job_and_cancel_goes_back(viewer, 
 
     monkeypatch.setattr(CurvatureState, "compute", staticmethod(slow))
     shown = dict(curv.fields)
-    drive(viewer, "area", "voronoi", panel="curvature")
+    drive(viewer, "area", "barycentric", panel="curvature")  # the default is voronoi
     frames(viewer)
     assert viewer.state.jobs.running("curvature") is not None
     assert curv.fields == shown  # the map on screen stays meanwhile
-    assert progress_texts(viewer, "curvature")[-1].startswith("curvature fields (voronoi")
+    assert progress_texts(viewer, "curvature")[-1].startswith("curvature fields (barycentric")
     drive(viewer, "Cancel##curvature", True)
     frames(viewer)
-    assert curv.area == "barycentric" and curv.fields == shown  # back to what is shown
+    assert curv.area == "voronoi" and curv.fields == shown  # back to what is shown
     release.set()
-    drive(viewer, "area", "voronoi")
+    drive(viewer, "area", "barycentric")
     wait_jobs(viewer)
     frames(viewer)
-    assert curv.current(viewer.state.mesh) and curv.computed_for()[1] == "voronoi"
+    assert curv.current(viewer.state.mesh) and curv.computed_for()[1] == "barycentric"

@@ -512,6 +512,9 @@ def test_every_widget_is_driven(viewer, tmp_path, sphere):
     from test_viewer_diffusion import drive_diffusion_widgets  # the Diffusion panel
 
     drive_diffusion_widgets(viewer)
+    from test_curvature_lab import drive_curvature_lab  # the curvature lab's widgets
+
+    drive_curvature_lab(viewer)
     ui = viewer.ui
     undriven = sorted(set(ui.seen) - ui.driven)
     assert not undriven, f"widgets no test drives: {undriven}"

@@ -196,7 +196,7 @@ class SurfacesPanel(Panel):
             f"k2 = {sig(p.k2, sk)} at {np.degrees(p.theta_min):.1f} deg (in the (u, v) plane; "
             "90 deg apart in the tangent plane)"
         )
-        ui.text("signs: e = p_uu . n with n = p_u x p_v (do Carmo)")
+        ui.text("signs: e = -p_uu . n, n = p_u x p_v (H > 0 on a sphere, as on meshes)")
         self.draw_section(host)
         self.draw_euler_plot(host)
         key = (s.version, s.u, s.v, s.section_deg)

@@ -12,6 +12,7 @@ from meshlap_core.errors import MeshError
 from meshlap_core.options import (
     AREA_KINDS,
     BOUNDARY_RULES,
+    CURVATURE_AREA,
     CURVATURE_FIELD_LABELS,
     CURVATURE_FIELDS,
     check_choice,
@@ -23,7 +24,7 @@ from .mesh import MeshState
 
 SESSION: Schema = {
     "field": ("cotan", one_of(CURVATURE_FIELDS)),
-    "area": ("barycentric", one_of(AREA_KINDS)),
+    "area": (CURVATURE_AREA, one_of(AREA_KINDS)),
     "boundary": ("pi", one_of(BOUNDARY_RULES)),
     "clip": (2.0, number(0.0, 49.0)),
     "side_by_side": (False, boolean),
@@ -80,7 +81,7 @@ class CurvatureState:
     """Curvature fields of the current mesh for the chosen area and boundary rule, and how
     they are shown (the field, its clip percentage, a second field side by side)."""
 
-    area: str = "barycentric"
+    area: str = CURVATURE_AREA
     boundary: str = "pi"
     field_name: str = "cotan"
     percentile: float = 2.0

@@ -4,7 +4,7 @@ A session file is one JSON object::
 
     {"format": "meshlap-session", "version": 1, "meshlap": "0.1.0",
      "mesh": "bumpy.obj", "panel": "smoothing", "ui_scale": 1.0, "camera": {...},
-     "curvature": {"field": "cotan", "area": "barycentric", "boundary": "pi", "clip": 2.0,
+     "curvature": {"field": "cotan", "area": "voronoi", "boundary": "pi", "clip": 2.0,
                    "side_by_side": false, "second_field": "uniform"},
      "onering": {"vertex": -1, "reverse": false},
      "spectral": {"computed": false, "k_request": 100, "k": 10, "mode": 1, "play": "modes"},

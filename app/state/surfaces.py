@@ -1,8 +1,7 @@
 """Surfaces panel state: a parametric surface, its mesh, and the geometry at a chosen (u, v).
 
-No polyscope import. Signs follow ``meshlap_core.surfaces`` (``e = p_uu · n`` with
-``n = p_u × p_v``), which is the opposite of the mesh convention ``Δx = −2Hn`` for ``H``:
-the panel says so next to the numbers.
+No polyscope import. Signs follow ``meshlap_core.surfaces`` (``e = −p_uu · n`` with
+``n = p_u × p_v``: ``H > 0`` on a sphere, the mesh convention ``Δx = −2Hn`` too).
 """
 
 from __future__ import annotations

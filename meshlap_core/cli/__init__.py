@@ -152,6 +152,7 @@ COMMANDS: tuple[str, ...] = (
     "geodesic",
     "heat",
     "filter",
+    "curvature_study",
 )
 COMMAND_GROUP = "meshlap.commands"
 """Entry points of this group name modules with ``register(sub)``: other packages (the viewer)

@@ -1,4 +1,12 @@
-"""``meshlap curvature MESH --method ...``: a per-vertex curvature field and its statistics."""
+"""``meshlap curvature MESH --method ... [--estimator NAME]``: a per-vertex curvature field and
+its statistics.
+
+Without ``--estimator`` the fields of :mod:`meshlap_core.curvature` (``--method uniform, cotan,
+gaussian, k1, k2``); with it (or with ``--method H, K, abs_max``) a field of the principal
+curvatures of :mod:`meshlap_core.curvature_estimators` (``--method k1, k2, H, K, abs_max``,
+estimator ``cotan`` when not given), ``--radius`` its scale (quadric: edge rings; jet: world
+units) and ``--directions FILE.npy`` the ``(n, 2, 3)`` principal directions ``d1, d2``.
+"""
 
 from __future__ import annotations
 
@@ -8,19 +16,26 @@ from pathlib import Path
 import numpy as np
 
 from ..curvature import curvature_field
+from ..curvature_estimators import estimate_curvature
 from ..errors import MeshError
 from ..io import check_output_path, load_mesh, save_mesh, save_scalars
+from ..io.atomic import atomic_write
 from ..options import (
     AREA_KINDS,
     BOUNDARY_RULES,
+    CURVATURE_AREA,
+    CURVATURE_ESTIMATORS,
     CURVATURE_METHODS,
-    DEFAULT_AREA,
     DEFAULT_BOUNDARY,
     DEFAULT_CURVATURE_FIELD,
+    PRINCIPAL_FIELDS,
 )
 from ._common import add_json_flag, emit_json, print_report, summary_stats
 
 OUT_SUFFIXES = (".csv", ".npy", ".ply")
+METHODS: tuple[str, ...] = CURVATURE_METHODS + tuple(
+    m for m in PRINCIPAL_FIELDS if m not in CURVATURE_METHODS
+)
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -28,15 +43,30 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("mesh", help="mesh file (OBJ, OFF, PLY, STL)")
     p.add_argument(
         "--method",
-        choices=CURVATURE_METHODS,
-        default=DEFAULT_CURVATURE_FIELD,
-        help="uniform H, cotangent H, angle-deficit K, or principal k1/k2 (default cotan)",
+        choices=METHODS,
+        default=None,
+        help="uniform H, cotangent H, angle-deficit K, or principal k1/k2 (default cotan); "
+        "with --estimator: k1, k2, H (default), K or abs_max",
     )
+    p.add_argument(
+        "--estimator",
+        choices=CURVATURE_ESTIMATORS,
+        help="principal curvatures by this estimator (k1 >= k2, H > 0 on spheres): cotan "
+        "(Meyer 2003), quadric (libigl), rusinkiewicz (2004), jet (robust to noise)",
+    )
+    p.add_argument(
+        "--radius",
+        type=float,
+        help="the estimator's scale: quadric edge rings (default 5), jet world units "
+        "(default automatic, from the edge length and the estimated noise)",
+    )
+    p.add_argument("--directions", help="with an estimator: write d1, d2 as (n, 2, 3) .npy")
     p.add_argument(
         "--area",
         choices=AREA_KINDS,
-        default=DEFAULT_AREA,
-        help="vertex area (default barycentric, as in the course; voronoi converges)",
+        default=CURVATURE_AREA,
+        help="vertex area (default voronoi, the mixed area that converges; barycentric: the "
+        "course's)",
     )
     p.add_argument(
         "--boundary",
@@ -57,8 +87,26 @@ def run(args: argparse.Namespace) -> int:
     out = Path(args.out) if args.out is not None else None
     if out is not None:  # checked first: a doomed run fails at once and writes nothing
         check_output_path(out, overwrite_inputs=(args.mesh,), suffixes=OUT_SUFFIXES)
+    dirs = Path(args.directions) if args.directions else None
+    if dirs is not None:
+        check_output_path(dirs, overwrite_inputs=(args.mesh,), suffixes=(".npy",))
     mesh = load_mesh(args.mesh)
-    values = curvature_field(mesh.V, mesh.F, args.method, args.area, args.boundary)
+    result = None
+    if args.method is None:
+        args.method = DEFAULT_CURVATURE_FIELD if args.estimator is None else "H"
+    if args.estimator is not None or args.method not in CURVATURE_METHODS:
+        args.estimator = args.estimator or "cotan"
+        if args.method not in PRINCIPAL_FIELDS:
+            raise MeshError(
+                f"an estimator gives {', '.join(PRINCIPAL_FIELDS)}, not {args.method!r}",
+                "--method",
+            )
+        result = estimate_curvature(mesh.V, mesh.F, args.estimator, **_options(args))
+        values = result.field(args.method)
+    else:
+        if args.radius is not None or dirs is not None:
+            raise MeshError("--radius and --directions need --estimator", "--estimator")
+        values = curvature_field(mesh.V, mesh.F, args.method, args.area, args.boundary)
     if not np.isfinite(values).all():  # never write or summarize a broken field
         bad = int(np.count_nonzero(~np.isfinite(values)))
         raise MeshError(f"the {args.method} curvature is not finite at {bad} vertices", args.mesh)
@@ -68,12 +116,16 @@ def run(args: argparse.Namespace) -> int:
             save_mesh(out, mesh.V, mesh.F, scalars=values, overwrite_inputs=(args.mesh,))
         else:
             save_scalars(out, values, overwrite_inputs=(args.mesh,))
+    if dirs is not None and result is not None:
+        with atomic_write(dirs, "wb", overwrite_inputs=(args.mesh,)) as f:
+            np.save(f, np.stack([result.d1, result.d2], axis=1))
     stats = summary_stats(values)
     if args.json:
         emit_json(
             {
                 "file": str(args.mesh),
                 "method": args.method,
+                "estimator": args.estimator,
                 "area": args.area,
                 "boundary": args.boundary,
                 "n_vertices": len(values),
@@ -84,12 +136,33 @@ def run(args: argparse.Namespace) -> int:
             }
         )
     else:
-        print(
-            f"{args.method} curvature ({args.area} area, boundary rule {args.boundary}) "
-            f"on {len(values)} vertices"
+        how = (
+            f"{args.estimator} estimator"
+            if args.estimator
+            else f"{args.area} area, boundary rule {args.boundary}"
         )
+        print(f"{args.method} curvature ({how}) on {len(values)} vertices")
         for k, v in stats.items():
             print(f"  {k:<7}{v: .6g}")
         if out is not None:
             print(f"wrote {out}")
     return 0
+
+
+def _options(args: argparse.Namespace) -> dict[str, object]:
+    """The estimator's keyword options from the flags."""
+    if args.estimator == "cotan":
+        if args.radius is not None:
+            raise MeshError("the cotan estimator has no radius", "--radius")
+        return {"area": args.area, "boundary": args.boundary}
+    if args.radius is None:
+        return {}
+    if args.estimator == "quadric":
+        if args.radius != int(args.radius) or args.radius < 1:
+            raise MeshError(
+                f"quadric: a whole number of edge rings >= 1, got {args.radius}", "--radius"
+            )
+        return {"radius": int(args.radius)}
+    if args.estimator == "jet":
+        return {"radius": args.radius}
+    raise MeshError(f"the {args.estimator} estimator has no radius", "--radius")

@@ -7,7 +7,7 @@ import argparse
 from ..errors import MeshError
 from ..inspector import format_inspection, inspect_vertex
 from ..io import load_mesh
-from ..options import AREA_KINDS, BOUNDARY_RULES, DEFAULT_AREA, DEFAULT_BOUNDARY
+from ..options import AREA_KINDS, BOUNDARY_RULES, CURVATURE_AREA, DEFAULT_BOUNDARY
 from ._common import add_json_flag, emit_json, print_report
 
 
@@ -23,8 +23,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--area",
         choices=AREA_KINDS,
-        default=DEFAULT_AREA,
-        help=f"the A_i that Δ_cotan and K divide by (default {DEFAULT_AREA})",
+        default=CURVATURE_AREA,
+        help=f"the A_i that Δ_cotan and K divide by (default {CURVATURE_AREA})",
     )
     p.add_argument(
         "--boundary",

@@ -21,8 +21,8 @@ one CSV per table in ``tables/``:
 Sign conventions. Every Laplacian is negative semidefinite (``Δx = −2Hn``, so the core's mean
 curvature ``H = −½ Δx · n`` is positive on a sphere with outward normals); eigenvalues shown are
 the non-negative frequencies of ``−Δ``. :mod:`meshlap_core.surfaces` measures the second
-fundamental form against ``n = p_u × p_v`` with do Carmo's sign (``e = p_uu · n``), so its ``H``
-is the **negative** of the core's for the same normal; section 3 says so where both appear.
+fundamental form against ``n = p_u × p_v`` with the same sign (``e = −p_uu · n``), so its ``H``
+is the core's for the same normal.
 
 This package is headless: it never imports polyscope nor the viewer. Mesh pictures come from a
 screenshot function the caller passes (:class:`~meshlap_core.study.shots.Screenshot`; the

@@ -302,7 +302,7 @@ def _head(
         "",
         "Sign convention: every Laplacian is negative semidefinite, Δx = −2Hn (H > 0 on a "
         "sphere with outward normals); eigenvalues shown are the frequencies λ ≥ 0 of −Δ. "
-        "`meshlap_core.surfaces` (section 3) uses do Carmo's sign, so its H is the negative of "
+        "`meshlap_core.surfaces` (section 3) uses the same sign (II = −p_uu · n), so its H is "
         "the mesh H for the same normal.",
         "",
     ]

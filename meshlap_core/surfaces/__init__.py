@@ -11,7 +11,7 @@ A :class:`ParametricSurface` is a map ``p`` on a parameter rectangle ``[u0,u1] �
 At any ``(u, v)`` this module computes the partial derivatives, the unit normal
 ``n = (p_u × p_v) / |p_u × p_v|`` (always this orientation), the first fundamental form
 ``I = [[E, F], [F, G]]``, the second fundamental form ``II = [[e, f], [f, g]]`` with
-``e = p_uu · n, f = p_uv · n, g = p_vv · n``, the Gaussian curvature
+``e = −p_uu · n, f = −p_uv · n, g = −p_vv · n``, the Gaussian curvature
 ``K = (eg − f²)/(EG − F²)``, the mean curvature ``H = (eG − 2fF + gE) / (2(EG − F²))``, the
 principal curvatures ``κ₁ ≥ κ₂`` and directions, the normal curvature
 ``κₙ(θ) = II(w, w) / I(w, w)`` for ``w = (cos θ, sin θ)`` and the point classification.
@@ -19,12 +19,13 @@ It also triangulates the parameter rectangle (:func:`mesh_surface`) and measures
 discrete estimators of :mod:`meshlap_core.curvature` converge to the exact values
 (:func:`convergence_study`).
 
-Sign conventions. ``II`` is measured against ``n = p_u × p_v / |…|``: ``κₙ < 0`` where the
-surface bends away from ``n``. Every shipped closed surface has ``n`` pointing outwards, so the
-unit sphere has ``κ₁ = κ₂ = H = −1`` here (the textbook sign of do Carmo). The discrete core uses
-``Δx = −2 H n`` (negative semidefinite Laplacian), whose ``H`` is **minus** this one for the
-same normal (``+1`` on the unit sphere). :func:`convergence_study` therefore compares the core's
-``H`` with ``−H``; ``K`` does not depend on the sign.
+Sign conventions (one convention for the whole project). The normal is
+``n = p_u × p_v / |…|``, outward on every shipped closed surface, and ``II`` is measured so that
+``κₙ > 0`` where the surface bends **away** from ``n``: ``e = −p_uu · n = p_u · n_u`` (do Carmo's
+``II`` negated). The unit sphere has ``κ₁ = κ₂ = H = +1`` here, the same sign as the discrete
+core's ``Δx = −2 H n`` (negative semidefinite Laplacian) with outward normals from
+counter-clockwise faces, so :func:`convergence_study` compares ``H`` directly; ``K`` does not
+depend on the sign. ``κ₁ ≥ κ₂`` always.
 
 Derivatives. A surface may carry its exact derivatives; otherwise (and in the tests, to check
 them) they are computed numerically: first derivatives by the complex step

@@ -115,8 +115,8 @@ def helicoid(c: float = 1.0) -> ParametricSurface:
     """Helicoid ``p(u,v) = (u cos v, u sin v, c v)``, ``u ∈ [0,1]``, ``v ∈ [0,2π]``.
 
     A minimal surface (``H = 0``) with ``K = −c²/(c² + u²)²``. For ``c = 1``: ``E = 1, F = 0,
-    G = 1 + u², e = g = 0, f = −1/√(1+u²)``, ``κ = ±1/(1+u²)``, and at the origin
-    ``κₙ(θ) = −sin 2θ``.
+    G = 1 + u², e = g = 0, f = 1/√(1+u²)``, ``κ = ±1/(1+u²)``, and at the origin
+    ``κₙ(θ) = sin 2θ``.
 
     ``c = 0`` degenerates to the flat unit disc in polar coordinates: closed in ``v``, with a
     pole at its centre ``u = 0`` (declared, so meshes collapse it and the point is singular);
@@ -154,7 +154,7 @@ def sphere(r: float = 1.0) -> ParametricSurface:
     """Sphere ``p(u,v) = r (sin u cos v, sin u sin v, cos u)``, polar angle ``u ∈ [0,π]``,
     azimuth ``v ∈ [0,2π]`` (closed in ``v``, poles at ``u = 0`` and ``u = π``).
 
-    ``n`` points outwards; ``K = 1/r²`` and every point is umbilic with ``κ₁ = κ₂ = −1/r``.
+    ``n`` points outwards; ``K = 1/r²`` and every point is umbilic with ``κ₁ = κ₂ = 1/r``.
     """
     r = _positive(r, "r")
 
@@ -252,7 +252,8 @@ def catenoid(c: float = 1.0) -> ParametricSurface:
 def saddle(a: float = 1.0) -> ParametricSurface:
     """Hyperbolic paraboloid ``p(u,v) = (u, v, a (u² − v²))`` on ``[−1,1]²`` (``n`` upwards).
 
-    At the origin ``κ₁ = 2a, κ₂ = −2a`` along the axes, ``K = −4a²``.
+    At the origin ``κ₁ = 2a`` along ``v`` and ``κ₂ = −2a`` along ``u`` (for ``a > 0``; the
+    surface bends towards ``n`` along ``u``), ``K = −4a²``.
     """
     a = _finite(a, "a")
 
@@ -314,7 +315,8 @@ def monkey_saddle(a: float = 1.0) -> ParametricSurface:
 def cylinder(r: float = 1.0, height: float = 2.0) -> ParametricSurface:
     """Cylinder ``p(u,v) = (r cos u, r sin u, v)``, ``u ∈ [0,2π]`` (closed), ``v ∈ [0,height]``.
 
-    ``n`` points outwards; ``K = 0``, ``κ₁ = 0`` (along the axis), ``κ₂ = −1/r``: parabolic.
+    ``n`` points outwards; ``K = 0``, ``κ₁ = 1/r`` (around the axis), ``κ₂ = 0`` (along it):
+    parabolic.
     """
     r, height = _positive(r, "r"), _positive(height, "height")
 

@@ -115,7 +115,7 @@ class ConvergenceStudy:
         where = "interior vertices" + (" except poles" if self.exclude_poles else "")
         lines = [
             f"{self.surface}, {self.mesher} meshes: |discrete - exact| at {where}",
-            f"(exact H in the core's sign, Δx = −2Hn; max|H| = {self.ref_scale['H']:.4g}, "
+            f"(H > 0 on spheres, Δx = −2Hn; max|H| = {self.ref_scale['H']:.4g}, "
             f"max|K| = {self.ref_scale['K']:.4g}; order = log-log slope against h)",
             f"{'estimator':<22}{'res':>5}{'vertices':>10}{'h':>11}{'max err':>12}{'order':>7}"
             f"{'mean err':>12}{'order':>7}",
@@ -144,7 +144,7 @@ class _Level:
     V: FloatArray
     F: IntArray
     compare: BoolArray  # vertices compared
-    H: FloatArray  # exact H, core sign
+    H: FloatArray  # exact H (positive on spheres)
     K: FloatArray
     uv: FloatArray | None
     pole: BoolArray
@@ -187,7 +187,7 @@ def _study(
 def exact_curvature_at(
     surface: ParametricSurface | str, uv: Any, pole: Any = None
 ) -> tuple[FloatArray, FloatArray]:
-    """Exact ``H`` (in the **core's** sign, i.e. ``−H`` of this module) and ``K`` at mesh vertices.
+    """Exact ``H`` and ``K`` at mesh vertices (``H > 0`` on a sphere, the core's sign).
 
     Parameters
     ----------
@@ -219,7 +219,7 @@ def exact_curvature_at(
                 at = pole & (np.abs(uv[:, col] - surface.domain[EDGES.index(edge)]) <= tol)
                 uv[at, col] = inside
     cf = surface_curvature_fields(surface, uv[:, 0], uv[:, 1])
-    return -cf.H, cf.K
+    return cf.H, cf.K
 
 
 def convergence_study(
@@ -255,9 +255,9 @@ def convergence_study(
     Estimators (:data:`ESTIMATORS`): uniform ``H = −½ L_u x · n``; cotangent
     ``H = −½ M⁻¹C x · n`` and angle-deficit ``K = (2π − Σθ)/A`` with the Voronoi (mixed) and
     the barycentric vertex area ``A``. Only interior vertices are compared (boundary vertices
-    have one-sided stencils); the exact ``H`` is taken in the core's sign (``−H`` of this
-    module). The observed order is the slope of ``log(error)`` against ``log(h)``, ``h`` the
-    mean edge length: 2 means the error shrinks 4× when ``h`` halves, 0 that it stalls.
+    have one-sided stencils); the exact ``H`` has the core's sign (positive on spheres). The
+    observed order is the slope of ``log(error)`` against ``log(h)``, ``h`` the mean edge
+    length: 2 means the error shrinks 4× when ``h`` halves, 0 that it stalls.
 
     What it shows (unit sphere, default torus R = 3, r = 1; max errors):
 

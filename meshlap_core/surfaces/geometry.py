@@ -1,5 +1,6 @@
 """Fundamental forms, curvature fields, normal curvature, point classification and the
-geometry of one point of a parametric surface (do Carmo, ch. 3; signs in the package notes).
+geometry of one point of a parametric surface (do Carmo, ch. 3, with ``II`` negated so that a
+sphere with its outward normal has ``H > 0``: the signs are in the package notes).
 """
 
 from __future__ import annotations
@@ -63,7 +64,9 @@ def surface_curvature_fields(
 
     Notes
     -----
-    ``K = (eg − f²)/(EG − F²)`` and ``H = (eG − 2fF + gE)/(2(EG − F²))`` as in do Carmo. The
+    ``e = −p_uu · n, f = −p_uv · n, g = −p_vv · n`` (``= p_u · n_u, …``: positive where the
+    surface bends away from ``n``), ``K = (eg − f²)/(EG − F²)`` and
+    ``H = (eG − 2fF + gE)/(2(EG − F²))`` as in do Carmo. The
     principal curvatures are the eigenvalues of the shape operator ``I⁻¹II``, computed stably
     as those of the symmetric ``L⁻¹ II L⁻ᵀ`` (``I = LLᵀ``, Cholesky), so that ``κ₁ − κ₂`` is
     accurate to rounding even at umbilics; the principal parameter directions are
@@ -76,7 +79,8 @@ def surface_curvature_fields(
     singular = singular_mask(surface, u, v, N)
     n = np.divide(N, nn[..., None], out=np.full_like(N, np.nan), where=~singular[..., None])
     E, F, G = _dot(D.p_u, D.p_u), _dot(D.p_u, D.p_v), _dot(D.p_v, D.p_v)
-    e, f, g = _dot(D.p_uu, n), _dot(D.p_uv, n), _dot(D.p_vv, n)
+    # II against the outward normal with the sign that makes a sphere positive (package notes)
+    e, f, g = -_dot(D.p_uu, n), -_dot(D.p_uv, n), -_dot(D.p_vv, n)
     with np.errstate(invalid="ignore", divide="ignore"):
         det = np.where(singular, np.nan, E * G - F * F)
         K = (e * g - f * f) / det
@@ -203,7 +207,7 @@ class PointGeometry:
     n : (3,) float
         ``(p_u × p_v) / |p_u × p_v|``.
     E, F, G, e, f, g : float
-        First and second fundamental forms.
+        First and second fundamental forms (``e = −p_uu · n``: positive on a sphere).
     K, H, k1, k2 : float
         Gaussian, mean and principal curvatures (``k1 ≥ k2``, ``H = (k1 + k2)/2``).
     dir1_uv, dir2_uv : (2,) float
@@ -291,7 +295,7 @@ def point_geometry(
     --------
     >>> g = point_geometry("helicoid", 0.0, 0.0)
     >>> round(g.f, 12), round(g.K, 12), g.classification
-    (-1.0, -1.0, 'hyperbolic')
+    (1.0, -1.0, 'hyperbolic')
     """
     surface = get_surface(surface)
     u = surface.default_uv[0] if u is None else u

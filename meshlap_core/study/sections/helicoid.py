@@ -1,6 +1,7 @@
 """Section 3: the helicoid at the origin (fundamental forms, normal curvature, principal
-curvatures, in do Carmo's sign) and the convergence of the discrete H and K on meshed helicoid,
-sphere and torus against their closed forms."""
+curvatures, in the project's sign: positive where the surface bends away from n) and the
+convergence of the discrete H and K on meshed helicoid, sphere and torus against their closed
+forms."""
 
 from __future__ import annotations
 
@@ -29,18 +30,19 @@ def _origin(ctx: Context, sec: Section) -> None:
     geo = surfaces.point_geometry("helicoid", 0.0, 0.0)
     sec.p(
         "Helicoid p(u, v) = (u cos v, u sin v, v) (c = 1) at the origin (u, v) = (0, 0). "
-        "Signs here are do Carmo's, as in `meshlap_core.surfaces`: n = p_u × p_v / |p_u × p_v| "
-        "and e = p_uu · n, f = p_uv · n, g = p_vv · n. **The mesh code uses the opposite sign "
-        "for H** (Δx = −2Hn), so for the same normal H(core) = −H(surfaces); K does not change. "
-        "The closed forms below are the textbook ones for c = 1: E = 1, F = 0, G = 1 + u², "
-        "e = g = 0, f = −1/√(1+u²), K = −1/(1+u²)², κ = ±1/(1+u²), κₙ(θ) = −sin 2θ at u = 0."
+        "Signs are the project's, the same in `meshlap_core.surfaces` and on meshes: "
+        "n = p_u × p_v / |p_u × p_v| and e = −p_uu · n, f = −p_uv · n, g = −p_vv · n (do "
+        "Carmo's II negated), so a sphere with its outward normal has H > 0, as the mesh "
+        "code's Δx = −2Hn; K does not depend on the sign. "
+        "The closed forms below for c = 1: E = 1, F = 0, G = 1 + u², "
+        "e = g = 0, f = 1/√(1+u²), K = −1/(1+u²)², κ = ±1/(1+u²), κₙ(θ) = sin 2θ at u = 0."
     )
     exact = {
         "E": 1.0,
         "F": 0.0,
         "G": 1.0,
         "e": 0.0,
-        "f": -1.0,
+        "f": 1.0,
         "g": 0.0,
         "K": -1.0,
         "H": 0.0,
@@ -52,21 +54,21 @@ def _origin(ctx: Context, sec: Section) -> None:
         [
             "theta_max (deg)",
             math.degrees(geo.theta_max),
-            135.0,
-            abs(math.degrees(geo.theta_max) - 135.0),
+            45.0,
+            abs(math.degrees(geo.theta_max) - 45.0),
         ],
         [
             "theta_min (deg)",
             math.degrees(geo.theta_min),
-            45.0,
-            abs(math.degrees(geo.theta_min) - 45.0),
+            135.0,
+            abs(math.degrees(geo.theta_min) - 135.0),
         ],
     ]
     sec.add(
         ctx.table(
             "helicoid_origin",
             "First and second fundamental forms and curvatures of the helicoid at the "
-            "origin (do Carmo's sign), computed against the closed forms.",
+            "origin (H > 0 on spheres), computed against the closed forms.",
             ["quantity", "computed", "closed_form", "abs_difference"],
             rows,
         )
@@ -75,16 +77,16 @@ def _origin(ctx: Context, sec: Section) -> None:
     sec.p(
         f"Measured: at the origin the point is {geo.classification} with κ₁ = {num(geo.k1)} "
         f"at θ = {math.degrees(geo.theta_max):.1f}° and κ₂ = {num(geo.k2)} at "
-        f"θ = {math.degrees(geo.theta_min):.1f}°; the sampled κₙ(θ) differs from −sin 2θ by at "
+        f"θ = {math.degrees(geo.theta_min):.1f}°; the sampled κₙ(θ) differs from sin 2θ by at "
         f"most {num(dev)} over 721 angles."
     )
     _origin_figures(ctx, sec)
 
 
 def _principal(ctx: Context, sec: Section) -> float:
-    """The principal-curvature table at three points; returns max |κₙ(θ) + sin 2θ| at 0."""
+    """The principal-curvature table at three points; returns max |κₙ(θ) − sin 2θ| at 0."""
     theta, kn = surfaces.normal_curvature_curve("helicoid", 0.0, 0.0, 721)
-    dev = float(np.abs(kn + np.sin(2 * theta)).max())
+    dev = float(np.abs(kn - np.sin(2 * theta)).max())
     pts = []
     for u, v in ((0.0, 0.0), (0.5, 1.0), (1.0, 2.0)):
         g = surfaces.point_geometry("helicoid", u, v)
@@ -100,14 +102,14 @@ def _principal(ctx: Context, sec: Section) -> float:
                 g.K,
                 -1.0 / (1 + u * u) ** 2,
                 g.H,
-                -g.H,
+                g.H,  # one convention: the mesh code's H is the surface's
                 g.classification,
             ]
         )
     sec.add(
         ctx.table(
             "helicoid_principal",
-            "Principal curvatures along the helicoid (κ₁ ≥ κ₂; H_core = −H_surfaces).",
+            "Principal curvatures along the helicoid (κ₁ ≥ κ₂; H_core = H_surfaces).",
             [
                 "u",
                 "v",
@@ -135,13 +137,13 @@ def _origin_figures(ctx: Context, sec: Section) -> None:
     f1 = Fig(
         ctx.rel(path),
         "Normal curvature κₙ(θ) of the helicoid at the origin, with κ₁, "
-        "κ₂ and their directions (do Carmo's sign).",
+        "κ₂ and their directions (positive where it bends away from n).",
     )
     ctx.progress.step("helicoid at the origin")
     f2 = ctx.shot(
         "helicoid_viewer",
         "The viewer's surfaces panel: the helicoid and the point "
-        "(u, v) = (0, 0) with I, II, K, H (do Carmo's sign) and κₙ(θ).",
+        "(u, v) = (0, 0) with I, II, K, H (H > 0 on spheres) and κₙ(θ).",
         panel="surfaces",
     )
     ctx.progress.step("screenshot")
@@ -171,8 +173,8 @@ def _convergence(ctx: Context, sec: Section) -> None:
         ctx.progress.step(f"convergence {surf} {mesher}")
     sec.p(
         "Convergence: meshes of the parameter rectangle (`grid`) or subdivided icospheres, "
-        "errors |discrete − exact| over interior vertices, with the exact H taken in the core's "
-        "sign (−H of `surfaces`). order = log-log slope of the error against the mean edge "
+        "errors |discrete − exact| over interior vertices (one sign convention: H > 0 on "
+        "spheres for both). order = log-log slope of the error against the mean edge "
         "length h between consecutive levels (2: the error shrinks 4× when h halves; 0: it "
         "stalls)."
     )

@@ -1,0 +1,319 @@
+"""Curvature lab state: an estimator's principal curvatures and directions on a parametric
+surface's mesh (with its error against the exact surface, under resolution, noise and jitter)
+or on the loaded mesh (with the estimators' disagreement). No polyscope import."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from meshlap_core.curvature_estimators import disagreement, estimate_curvature
+from meshlap_core.curvature_study import curvature_study, exact_principal, perturbed_mesh
+from meshlap_core.errors import MeshError
+from meshlap_core.options import (
+    CURVATURE_ESTIMATORS,
+    LAB_SHOWS,
+    LAB_SOURCES,
+    PRINCIPAL_FIELDS,
+    check_choice,
+)
+from meshlap_core.principal import PrincipalCurvatures, tangent_frames
+from meshlap_core.surfaces import SURFACES
+from meshlap_core.types import FloatArray, IntArray
+
+MAX_RES = 256
+"""Largest lab resolution (cells per direction; the torus gets twice as many around)."""
+MAX_NOISE = 0.02
+"""Largest normal noise, a fraction of the bounding-box diagonal."""
+MAX_JITTER = 0.45
+"""Largest parameter jitter, a fraction of a cell."""
+
+
+def make_state() -> CurvatureLabState:
+    """The lab's initial state (the torus at 32 cells, cotan, H)."""
+    return CurvatureLabState()
+
+
+@dataclass
+class LabResult:
+    """What the lab shows, computed off the UI thread.
+
+    Attributes
+    ----------
+    V : (n,3) float
+    F : (m,3) int
+    values : (n,) float
+        The coloured field (0 where an error is not measured: boundary and poles).
+    label : str
+    principal : PrincipalCurvatures
+        The estimate (``k1 ≥ k2``, directions ``d1``, ``d2``).
+    exact_d1 : (n,3) float or None
+        The exact direction of ``k1`` (parametric surfaces).
+    summary : str
+        One line: the RMS error (surface) or the largest disagreement (mesh).
+    convergence : list of dict
+        On a surface with ``show == "error"``: the :func:`~meshlap_core.curvature_study.
+        curvature_study` rows of this estimator at a quarter, half and the full resolution
+        (``h``, ``H_rel``, ``K_rel``, ``H_order``, ...): the log-log plot of error against h.
+    """
+
+    V: FloatArray
+    F: IntArray
+    values: FloatArray
+    label: str
+    principal: PrincipalCurvatures
+    exact_d1: FloatArray | None
+    summary: str
+    convergence: list[dict[str, Any]] = field(default_factory=list)
+    exact: tuple[FloatArray, FloatArray] | None = None  # exact (k1, k2) on a parametric mesh
+
+
+def _exact(m: Any) -> tuple[PrincipalCurvatures, np.ndarray]:
+    ex = exact_principal(m, m.surface)
+    zero = np.zeros_like(ex.d1)
+    pc = PrincipalCurvatures(ex.k1, ex.k2, ex.d1, ex.d2, zero, "exact")
+    return pc, ex.compared
+
+
+@dataclass
+class CurvatureLabState:
+    """The lab's choices and its last result (``inputs()`` names what the result is for)."""
+
+    source: str = "surface"
+    estimator: str = "cotan"
+    quantity: str = "H"
+    show: str = "error"
+    crosses: bool = True
+    surface: str = "torus"
+    res: int = 32
+    noise: float = 0.0
+    jitter: float = 0.0
+    flips: float = 0.0
+    result: LabResult | None = None
+    computed_for: tuple[Any, ...] = field(default=())
+    vertex: int = -1  # the picked vertex of the result's mesh (-1: none)
+
+    def inputs(self, mesh_version: int) -> tuple[Any, ...]:
+        """Everything the result depends on (the mesh version only for the loaded mesh)."""
+        base = (self.source, self.estimator, self.quantity, self.show)
+        if self.source == "mesh":
+            return (*base, mesh_version)
+        return (*base, self.surface, self.res, self.noise, self.jitter, self.flips)
+
+    def set_choice(self, what: str, value: str) -> None:
+        """Set ``source``, ``estimator``, ``quantity``, ``show`` or ``surface`` (checked).
+
+        Raises
+        ------
+        MeshError
+            An unknown value (the previous one stays).
+        """
+        choices = {
+            "source": LAB_SOURCES,
+            "estimator": CURVATURE_ESTIMATORS,
+            "quantity": PRINCIPAL_FIELDS,
+            "show": LAB_SHOWS,
+            "surface": tuple(SURFACES),
+        }[what]
+        setattr(self, what, check_choice(value, choices, what))
+
+    def set_number(self, what: str, value: Any) -> None:
+        """Set ``res`` (3..MAX_RES), ``noise`` (0..MAX_NOISE), ``jitter`` (0..MAX_JITTER) or
+        ``flips`` (0..1, the fraction of edges flipped).
+
+        Raises
+        ------
+        MeshError
+            Not a finite number in range (the previous value stays).
+        """
+        lo, hi = {
+            "res": (3, MAX_RES),
+            "noise": (0.0, MAX_NOISE),
+            "jitter": (0.0, MAX_JITTER),
+            "flips": (0.0, 1.0),
+        }[what]
+        try:
+            x = float(value)
+        except (TypeError, ValueError):
+            raise MeshError(f"must be a number, got {value!r}", what) from None
+        if not math.isfinite(x) or not lo <= x <= hi:
+            raise MeshError(f"must be between {lo} and {hi}, got {value!r}", what)
+        setattr(self, what, int(x) if what == "res" else x)
+
+    def params(self) -> dict[str, Any]:
+        """The inputs as a plain dict for :meth:`compute` (picklable, for a child process)."""
+        return {
+            k: getattr(self, k)
+            for k in (
+                "source",
+                "estimator",
+                "quantity",
+                "show",
+                "surface",
+                "res",
+                "noise",
+                "jitter",
+                "flips",
+            )
+        }
+
+    @staticmethod
+    def compute(params: dict[str, Any], V: Any, F: Any, progress: Any = None) -> LabResult:
+        """The lab's result for ``params`` (any thread or a child process: touches no state);
+        ``V, F`` are the loaded mesh's (used when ``source`` is ``mesh``)."""
+        q, est = params["quantity"], params["estimator"]
+        if params["source"] == "surface":
+            n = int(params["res"])
+            res = (2 * n, n) if params["surface"] == "torus" else (n, n)
+            m, Vs = perturbed_mesh(
+                params["surface"], res, params["noise"], params["jitter"], flips=params["flips"]
+            )
+            r = estimate_curvature(Vs, m.F, est)
+            exact, compared = _exact(m)
+            if params["show"] == "error":
+                err = np.where(compared, r.field(q) - exact.field(q), np.nan)
+                values, label = np.nan_to_num(err), f"{q} error ({est} - exact)"
+                rms = float(np.sqrt(np.nanmean(err**2)))
+                scale = float(np.sqrt(np.nanmean(np.where(compared, exact.field(q), np.nan) ** 2)))
+                rel = f" ({100 * rms / scale:.3g} % of RMS |{q}|)" if scale > 0 else ""
+                summary = f"RMS error {rms:.4g}{rel} over {int(compared.sum())} vertices"
+            elif params["show"] == "disagreement":
+                values = _disagreement(Vs, m.F, q)
+                label, summary = f"{q} disagreement (max - min)", _dis_summary(values)
+            else:
+                values, label = r.field(q), f"{q} ({est})"
+                ex = exact.field(q)
+                summary = f"exact {q} in [{np.nanmin(ex):.4g}, {np.nanmax(ex):.4g}]"
+            conv = _convergence(params) if params["show"] == "error" else []
+            return LabResult(
+                Vs, m.F, values, label, r, exact.d1, summary, conv, (exact.k1, exact.k2)
+            )
+        V = np.asarray(V, dtype=np.float64)
+        F = np.asarray(F, dtype=np.int64)
+        r = estimate_curvature(V, F, est)
+        if params["show"] == "disagreement":
+            values = _disagreement(V, F, q)
+            return LabResult(
+                V, F, values, f"{q} disagreement (max - min)", r, None, _dis_summary(values)
+            )
+        note = (
+            "no exact surface for a loaded mesh: the estimate is shown"
+            if params["show"] == "error"
+            else ""
+        )
+        values = r.field(q)
+        summary = note or f"{q} in [{values.min():.4g}, {values.max():.4g}]"
+        return LabResult(V, F, values, f"{q} ({est})", r, None, summary)
+
+    def adopt(self, inputs: tuple[Any, ...], result: LabResult) -> None:
+        """Take ``result``, computed for ``inputs`` (a picked vertex stays if it exists)."""
+        self.result, self.computed_for = result, inputs
+        if self.vertex >= len(result.V):
+            self.vertex = -1
+
+    def pick(self, vertex: int) -> None:
+        """Pick a vertex of the shown mesh for the shape-operator readout.
+
+        Raises
+        ------
+        MeshError
+            No result yet, or ``vertex`` outside it.
+        """
+        if self.result is None or not 0 <= int(vertex) < len(self.result.V):
+            raise MeshError(f"no vertex {vertex} in the lab's mesh", "vertex")
+        self.vertex = int(vertex)
+
+    def shape_operator(self) -> dict[str, Any] | None:
+        """The picked vertex's discrete shape operator (see :func:`shape_operator_at`)."""
+        if self.result is None or self.vertex < 0:
+            return None
+        return shape_operator_at(self.result, self.vertex)
+
+
+def _convergence(params: dict[str, Any]) -> list[dict[str, Any]]:
+    """The estimator's errors at a quarter, half and the full resolution (at least 4 cells)."""
+    n = int(params["res"])
+    levels = sorted({max(4, n // 4), max(4, n // 2), n})
+    return curvature_study(
+        [params["surface"]],
+        [params["estimator"]],
+        levels,
+        params["noise"],
+        params["jitter"],
+        flips=params["flips"],
+    )
+
+
+def shape_operator_at(r: LabResult, i: int, n: int = 73) -> dict[str, Any]:
+    """The 2×2 shape operator of the estimate at vertex ``i`` in the tangent basis ``(t1, t2)``
+    of its normal, ``S = Σ k_j d_j d_jᵀ``, and Euler's formula
+    ``κn(θ) = k1 cos²θ + k2 sin²θ`` (θ from ``d1``) on ``n`` angles in ``[0°, 360°]``, beside the
+    exact one at the same vertex when the surface is known (the exact ``d1`` sits at the angle
+    ``φ`` from the estimate's, so the exact curve is ``k1* cos²(θ − φ) + k2* sin²(θ − φ)``).
+
+    Returns
+    -------
+    dict
+        ``S`` (2×2 list), ``t1``, ``t2`` (3-vectors), ``k1``, ``k2``, ``theta_deg`` and
+        ``kn`` ((n,) arrays), and ``exact_kn`` ((n,) or None).
+    """
+    p = r.principal
+    t1, t2 = tangent_frames(p.normal[i : i + 1])
+    c1 = np.array([p.d1[i] @ t1[0], p.d1[i] @ t2[0]])
+    c2 = np.array([p.d2[i] @ t1[0], p.d2[i] @ t2[0]])
+    S = p.k1[i] * np.outer(c1, c1) + p.k2[i] * np.outer(c2, c2)
+    th = np.radians(np.linspace(0.0, 360.0, n))
+    kn = p.k1[i] * np.cos(th) ** 2 + p.k2[i] * np.sin(th) ** 2
+    exact_kn = None
+    if r.exact_d1 is not None and r.exact is not None:
+        ek1, ek2 = float(r.exact[0][i]), float(r.exact[1][i])
+        if np.isfinite(ek1) and np.isfinite(ek2):
+            d = r.exact_d1[i]
+            phi = np.arctan2(d @ p.d2[i], d @ p.d1[i])
+            exact_kn = ek1 * np.cos(th - phi) ** 2 + ek2 * np.sin(th - phi) ** 2
+    return {
+        "S": S.tolist(),
+        "t1": t1[0],
+        "t2": t2[0],
+        "k1": float(p.k1[i]),
+        "k2": float(p.k2[i]),
+        "theta_deg": np.degrees(th),
+        "kn": kn,
+        "exact_kn": exact_kn,
+    }
+
+
+def _disagreement(V: FloatArray, F: IntArray, q: str) -> FloatArray:
+    return disagreement([estimate_curvature(V, F, e) for e in CURVATURE_ESTIMATORS], q)
+
+
+def _dis_summary(values: FloatArray) -> str:
+    return (
+        f"estimators disagree by up to {values.max():.4g} (median {np.median(values):.4g}): "
+        "large where no estimator can be trusted"
+    )
+
+
+def cross_field(
+    p: PrincipalCurvatures, which: int = 1
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """A principal direction as a 2-symmetric tangent line field for polyscope: the 2-D values
+    in the tangent basis ``(t1, t2)`` of ``p.normal``, scaled by ``|k| / max|k|``
+    (at least 0.2, so a flat direction still shows).
+
+    Returns
+    -------
+    values : (n,2) float
+    basis_x, basis_y : (n,3) float
+    """
+    d, k = (p.d1, p.k1) if which == 1 else (p.d2, p.k2)
+    N = p.normal
+    t1, t2 = tangent_frames(N)
+    a = np.abs(k)
+    top = float(np.percentile(a, 98)) or 1.0
+    s = np.clip(a / top, 0.2, 1.0)
+    values = np.stack([np.sum(d * t1, axis=1), np.sum(d * t2, axis=1)], axis=1) * s[:, None]
+    return values, t1, t2

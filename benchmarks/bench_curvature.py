@@ -1,0 +1,91 @@
+"""Time every principal-curvature estimator beside libigl's quadric fit (and pymeshlab's
+curvature filter when it is installed), on a 131k-vertex torus and on armadillo_igl.
+
+Run: ``python benchmarks/bench_curvature.py [--repeat 3] [--major 512 --minor 256]``.
+
+In one process, best of ``--repeat`` wall times. The baseline a user would write is libigl:
+``igl.principal_curvature(V, F, radius)`` (radius 2 and 5 edge rings) and
+``igl.cotmatrix + igl.massmatrix + igl.gaussian_curvature`` for cotangent H and K. The ratio
+column is our time over libigl's quadric fit at radius 5. The torus also reports the relative L2
+error of H against the exact value (its noise-free mesh; see tests/test_curvature_estimators.py
+for the noisy one). pymeshlab is not a dependency: its row is skipped when it is absent.
+"""
+
+from __future__ import annotations
+
+import argparse
+
+import igl
+import numpy as np
+from _util import best_of, print_table, shared_mesh
+
+from meshlap_core.curvature_estimators import estimate_curvature
+from meshlap_core.io import load_mesh
+from meshlap_core.options import CURVATURE_ESTIMATORS
+from meshlap_core.primitives import torus_mesh
+
+
+def libigl_cotan(V: np.ndarray, F: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """libigl's cotangent H and angle-deficit K, as its tutorial computes them."""
+    L = igl.cotmatrix(V, F)
+    M = igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_VORONOI)
+    Minv = 1.0 / M.diagonal()
+    HN = -(Minv[:, None] * (L @ V))
+    return 0.5 * np.linalg.norm(HN, axis=1), igl.gaussian_curvature(V, F) * Minv
+
+
+def pymeshlab_row(V: np.ndarray, F: np.ndarray, repeat: int) -> list[object] | None:
+    try:
+        import pymeshlab
+    except ImportError:
+        print("skip pymeshlab: not installed")
+        return None
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(V, F))
+    t, _ = best_of(lambda: ms.compute_curvature_principal_directions_per_vertex(), repeat)
+    return ["pymeshlab principal directions (default)", t]
+
+
+def run(name: str, V: np.ndarray, F: np.ndarray, repeat: int, H_exact: np.ndarray | None) -> None:
+    print(f"\n{name}: {len(V)} vertices, {len(F)} faces")
+    t_ref, _ = best_of(lambda: igl.principal_curvature(V, F, 5), repeat)
+    rows: list[list[object]] = []
+
+    def err(H: np.ndarray) -> str:
+        if H_exact is None:
+            return "-"
+        return f"{np.linalg.norm(H - H_exact) / np.linalg.norm(H_exact):.2e}"
+
+    t2, out2 = best_of(lambda: igl.principal_curvature(V, F, 2), repeat)
+    rows.append(["libigl principal_curvature r=2", t2, t2 / t_ref, err(0.5 * (out2[2] + out2[3]))])
+    _, out5 = best_of(lambda: igl.principal_curvature(V, F, 5), 1)
+    rows.append(["libigl principal_curvature r=5", t_ref, 1.0, err(0.5 * (out5[2] + out5[3]))])
+    tc, (Hc, _K) = best_of(lambda: libigl_cotan(V, F), repeat)
+    rows.append(["libigl cotmatrix + massmatrix + K", tc, tc / t_ref, err(Hc)])
+    for est in CURVATURE_ESTIMATORS:
+        t, r = best_of(lambda e=est: estimate_curvature(V, F, e), repeat)
+        rows.append([f"meshlap {est} (k1, k2, d1, d2)", t, t / t_ref, err(r.H)])
+    extra = pymeshlab_row(V, F, repeat)
+    if extra is not None:
+        rows.append([*extra, float(extra[1]) / t_ref, "-"])  # type: ignore[arg-type]
+    print_table(["estimator", "seconds", "x libigl quadric r=5", "H rel. L2 error"], rows)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--major", type=int, default=512)
+    ap.add_argument("--minor", type=int, default=256)
+    args = ap.parse_args()
+    V, F = torus_mesh(args.major, args.minor)
+    v = np.arctan2(V[:, 2], np.hypot(V[:, 0], V[:, 1]) - 3.0)
+    H = 0.5 * (1.0 + np.cos(v) / (3.0 + np.cos(v)))
+    run("torus R=3 r=1", V, F, args.repeat, H)
+    path = shared_mesh("armadillo_igl.obj")
+    if path is not None:
+        mesh = load_mesh(path)
+        run("armadillo_igl", mesh.V, mesh.F, args.repeat, None)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,219 @@
+"""The scale-aware curvature estimator: a weighted osculating jet over a ball in world units.
+
+At every vertex ``x_i`` the vertices within distance ``r`` (a world length, not a ring count)
+define a local frame: the normal is the weighted mean of their angle-weighted normals (so it
+follows the face orientation), and ``(t1, t2)`` span the plane orthogonal to it. The height
+``z`` of the neighbours above that plane is fitted in the weighted least-squares sense by the
+degree-2 jet ``z = c₀ + c₁x + c₂y + ½(a x² + 2b xy + c y²)`` with the compactly supported weights
+``w = (1 − d²/r²)²``, and the curvature of the fitted graph at ``(0, 0)`` (with its slope, so
+an imperfect frame does not bias it) gives ``κ₁ ≥ κ₂`` and their directions: the shape operator
+``I⁻¹ II`` with ``I = [[1 + c₁², c₁c₂], [c₁c₂, 1 + c₂²]]`` and ``II = −[[a, b], [b, c]] / W``,
+``W = √(1 + c₁² + c₂²)`` (the minus: positive where the graph bends away from its ``+z``
+normal, the project's sign).
+
+A ball of radius ``r`` averages the noise of ``~πr²ρ`` vertices (``ρ`` the vertex density): the
+noise in the curvature falls like ``σ/(r² √(πr²ρ))`` while the bias of the jet grows like
+``r²``, so a larger radius trades resolution for robustness. The automatic default
+:func:`default_jet_radius` estimates the noise and grows the radius with it.
+
+References
+----------
+F. Cazals & M. Pouget, "Estimating differential quantities using polynomial fitting of
+osculating jets", SGP 2003 (degree-2 jets, convergence of the fit).
+N. Amenta & Y. J. Kil / Yang & Qian, "Direct computing of surface curvatures for point-set
+surfaces", 2007 (fits over a world-radius ball, the scale the user chooses).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.spatial import cKDTree
+
+from .curvature import _face_geometry, _normals_from
+from .errors import MeshError
+from .noise import bbox_diagonal
+from .principal import PrincipalCurvatures, eig_sym2, tangent_frames
+from .topology import edges
+from .types import FloatArray, IntArray, as_mesh
+
+JET_RADIUS_EDGES = 3.0
+"""The automatic radius is at least this many mean edge lengths (enough neighbours to fit)."""
+JET_RADIUS_GAIN = 0.47
+"""``C`` of the automatic radius ``C (σ̂ h D³)^(1/5)`` (calibrated once on the torus R = 3,
+r = 1 with 32k vertices: 0.47 at 0.1 % and 0.75 at 1 % normal noise)."""
+MAX_PAIRS = 2_000_000
+"""Neighbour pairs processed at once (bounds the memory of one chunk to ~300 MB)."""
+
+
+def _mean_edge(V: FloatArray, F: IntArray) -> float:
+    E = edges(F)
+    if len(E) == 0:
+        raise MeshError("the jet fit needs a mesh with edges", "F")
+    return float(np.mean(np.linalg.norm(V[E[:, 0]] - V[E[:, 1]], axis=1)))
+
+
+def estimate_normal_noise(V: FloatArray, F: IntArray) -> float:
+    """Robust estimate ``σ̂`` of the noise along the normals (world units).
+
+    The offset of every vertex from its neighbours' centroid along its normal,
+    ``r_i = −(L_u x)_i · n_i``, has standard deviation ``σ √(1 + 1/d_i)`` for independent
+    noise ``N(0, σ²)`` along the normals at valence ``d_i`` (about ``1.08 σ`` at valence 6);
+    ``σ̂ = 1.4826 · median|r_i| / 1.08`` (the median absolute deviation, so that features do
+    not count as noise). On a clean mesh it is of the order ``h²κ``, not zero.
+    """
+    from .laplacian import uniform_laplacian
+
+    V, F = as_mesh(V, F)
+    fn, theta = _face_geometry(V, F)
+    N = _normals_from(F, len(V), fn, theta)
+    res = np.einsum("ij,ij->i", uniform_laplacian(F, len(V)) @ V, N)
+    used = np.zeros(len(V), dtype=bool)
+    used[F.ravel()] = True
+    return float(1.4826 * np.median(np.abs(res[used])) / 1.08) if used.any() else 0.0
+
+
+def default_jet_radius(V: FloatArray, F: IntArray) -> float:
+    """The automatic radius ``max(3 h, C (σ̂ h D³)^(1/5))``.
+
+    ``h`` the mean edge length, ``σ̂`` :func:`estimate_normal_noise`, ``D`` the bounding-box
+    diagonal (the length scale of the shape), ``C =`` :data:`JET_RADIUS_GAIN`. The power 1/5
+    balances the jet's bias (``∝ r²``) against the noise it averages (the curvature's standard
+    deviation ``∝ σ/(r² √(r²/h²))``): the optimum grows only like ``(σ h)^(1/5)``.
+    """
+    V, F = as_mesh(V, F)
+    h = _mean_edge(V, F)
+    sigma = estimate_normal_noise(V, F)
+    D = bbox_diagonal(V)
+    return max(JET_RADIUS_EDGES * h, JET_RADIUS_GAIN * (sigma * h * D**3) ** 0.2)
+
+
+def _sums(S: sp.csr_matrix, cols: list[np.ndarray]) -> np.ndarray:
+    """``S @ c`` for every column ``c`` (one contiguous sparse product each), ``(m, len(cols))``."""
+    out = np.empty((S.shape[0], len(cols)))
+    for k, c in enumerate(cols):
+        out[:, k] = S @ np.ascontiguousarray(c)
+    return out
+
+
+def _chunk(
+    X: list[np.ndarray], Nv: FloatArray, tree: cKDTree, idx: np.ndarray, r: float
+) -> tuple[FloatArray, ...]:
+    """The jet coefficients (slopes ``c1, c2``; second derivatives ``a, b, c``) and frames of
+    the centres ``idx``; ``X`` the three coordinate arrays of all vertices."""
+    P0 = np.stack([x[idx] for x in X], axis=1)
+    pairs = cKDTree(P0).sparse_distance_matrix(tree, r, output_type="ndarray")
+    i, j, d = pairs["i"].astype(np.int64), pairs["j"].astype(np.int64), pairs["v"]
+    keep = j != idx[i]  # the centre itself (distance 0) is not always listed: add it once
+    m = len(idx)
+    i = np.concatenate([i[keep], np.arange(m)])
+    j = np.concatenate([j[keep], idx])
+    d = np.concatenate([d[keep], np.zeros(m)])
+    w = (1.0 - (d / r) ** 2) ** 2
+    S = sp.csr_matrix((w, (i, np.arange(len(i)))), shape=(m, len(i)))
+    # frame normal: the weighted mean of the angle-weighted normals (the face orientation);
+    # the jet's slope terms absorb its tilt
+    nrm = _sums(S, [np.ascontiguousarray(Nv[j, k]) for k in range(3)])
+    ln = np.linalg.norm(nrm, axis=1, keepdims=True)
+    nrm = np.where(ln > 1e-12, nrm / np.maximum(ln, 1e-300), Nv[idx])
+    t1, t2 = tangent_frames(nrm)
+    D = [(X[k][j] - P0[i, k]) / r for k in range(3)]  # scaled for conditioning
+    x = D[0] * t1[i, 0] + D[1] * t1[i, 1] + D[2] * t1[i, 2]
+    y = D[0] * t2[i, 0] + D[1] * t2[i, 1] + D[2] * t2[i, 2]
+    z = D[0] * nrm[i, 0] + D[1] * nrm[i, 1] + D[2] * nrm[i, 2]
+    xx, xy, yy = 0.5 * x * x, x * y, 0.5 * y * y
+    basis = [None, x, y, xx, xy, yy]
+    cols = [x, y, xx, xy, yy]  # products with the constant 1
+    iu = [(a, b) for a in range(1, 6) for b in range(a, 6)]
+    cols += [basis[a] * basis[b] for a, b in iu]  # type: ignore[operator]
+    cols += [z] + [q * z for q in basis[1:]]  # type: ignore[operator]
+    sums = _sums(S, cols)
+    W = np.asarray(S.sum(axis=1)).ravel()
+    A = np.zeros((m, 6, 6))
+    A[:, 0, 0] = W
+    for k in range(5):
+        A[:, 0, k + 1] = A[:, k + 1, 0] = sums[:, k]
+    for k, (a, b) in enumerate(iu):
+        A[:, a, b] = A[:, b, a] = sums[:, 5 + k]
+    rhs = sums[:, 5 + len(iu) :]
+    A += 1e-10 * np.eye(6) * (np.trace(A, axis1=1, axis2=2)[:, None, None] + 1e-300)
+    cnt = np.bincount(i, minlength=m)
+    coef = np.linalg.solve(A, rhs[:, :, None])[:, :, 0]
+    coef[cnt < 6] = 0.0  # too few neighbours for a jet: report a flat point
+    c1, c2 = coef[:, 1], coef[:, 2]
+    a, b, c = coef[:, 3] / r, coef[:, 4] / r, coef[:, 5] / r  # back to world units
+    return c1, c2, a, b, c, t1, t2, nrm
+
+
+def _shape_operator(c1, c2, a, b, c, t1, t2, nrm) -> tuple[FloatArray, ...]:
+    Wn = np.sqrt(1.0 + c1 * c1 + c2 * c2)
+    E, Fm, G = 1.0 + c1 * c1, c1 * c2, 1.0 + c2 * c2
+    e, f, g = -a / Wn, -b / Wn, -c / Wn
+    # I = L Lᵀ (Cholesky); principal values are the eigenvalues of L⁻¹ II L⁻ᵀ
+    l11 = np.sqrt(E)
+    l21 = Fm / l11
+    l22 = np.sqrt(np.maximum(G - l21 * l21, 1e-300))
+    m11, m21, m22 = 1.0 / l11, -l21 / (l11 * l22), 1.0 / l22
+    s11 = m11 * m11 * e
+    s12 = m11 * (m21 * e + m22 * f)
+    s22 = m21 * m21 * e + 2 * m21 * m22 * f + m22 * m22 * g
+    k1, k2, co, si = eig_sym2(s11, s12, s22)
+    # parameter directions w = L⁻ᵀ y, then tangent vectors (1, 0, c1)·w₀ + (0, 1, c2)·w₁
+    pu = t1 + c1[:, None] * nrm
+    pv = t2 + c2[:, None] * nrm
+    dirs = []
+    for y0, y1 in ((co, si), (-si, co)):
+        w0, w1 = m11 * y0 + m21 * y1, m22 * y1
+        d = w0[:, None] * pu + w1[:, None] * pv
+        dirs.append(d / np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-300))
+    normal = (nrm - c1[:, None] * t1 - c2[:, None] * t2) / Wn[:, None]
+    return k1, k2, dirs[0], dirs[1], normal
+
+
+def jet_curvatures(V: FloatArray, F: IntArray, radius: float | None = None) -> PrincipalCurvatures:
+    """Principal curvatures and directions from a weighted degree-2 jet over a ball of world
+    radius ``radius`` around every vertex (Cazals & Pouget 2003; see the module notes).
+
+    Parameters
+    ----------
+    V : (n,3) float
+    F : (m,3) int
+        Used for the orientation (the angle-weighted normals) and the default radius only.
+    radius : float, optional
+        World units; ``None`` for :func:`default_jet_radius`. Larger is smoother and more
+        robust to noise, smaller follows finer detail.
+
+    Returns
+    -------
+    PrincipalCurvatures
+        ``normal`` is the fitted surface's normal at the vertex.
+
+    Raises
+    ------
+    MeshError
+        A radius that is not a positive finite number.
+    """
+    V, F = as_mesh(V, F)
+    r = default_jet_radius(V, F) if radius is None else float(radius)
+    if not np.isfinite(r) or r <= 0:
+        raise MeshError(f"the fit radius must be a positive number, got {radius!r}", "radius")
+    n = len(V)
+    fn, theta = _face_geometry(V, F)
+    Nv = _normals_from(F, n, fn, theta)
+    tree = cKDTree(V)
+    X = [np.ascontiguousarray(V[:, k]) for k in range(3)]
+    per = max(
+        1,
+        int(
+            tree.count_neighbors(cKDTree(V[:: max(1, n // 200)]), r)
+            / max(1, len(V[:: max(1, n // 200)]))
+        ),
+    )
+    step = max(1, MAX_PAIRS // per)
+    out = [np.zeros(n), np.zeros(n), np.zeros((n, 3)), np.zeros((n, 3)), np.zeros((n, 3))]
+    for s in range(0, n, step):
+        idx = np.arange(s, min(n, s + step))
+        res = _shape_operator(*_chunk(X, Nv, tree, idx, r))
+        for o, x in zip(out, res, strict=True):
+            o[idx] = x
+    return PrincipalCurvatures(out[0], out[1], out[2], out[3], out[4], "jet")

@@ -1,0 +1,303 @@
+"""Principal-curvature estimators against the exact curvature of parametric surfaces: the
+error at every vertex (the lab's error map) and the table of errors and observed orders under
+refinement (``meshlap curvature-study``).
+
+The meshes are :func:`meshlap_core.surfaces.mesh_surface` grids, optionally made irregular
+(``jitter``: every interior vertex moves in the parameter plane by up to ``jitter`` of a cell,
+and is evaluated on the surface there, so the exact values stay exact; ``flips``: a fraction of
+the edges flipped) and noisy (``noise``:
+Gaussian displacement along the normal of standard deviation ``noise × bounding-box
+diagonal``, the exact values being those of the clean point). Errors are measured at the
+vertices away from the boundary and the poles (one-sided stencils and sliver cells there), in
+the project's sign convention (``H > 0`` on a sphere, ``κ₁ ≥ κ₂``).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from .curvature_estimators import estimate_curvature
+from .errors import MeshError
+from .noise import add_noise
+from .options import CURVATURE_ESTIMATORS, check_choice
+from .principal import PrincipalCurvatures
+from .surfaces import (
+    ParametricSurface,
+    SurfaceMesh,
+    get_surface,
+    mesh_surface,
+    surface_curvature_fields,
+    surface_derivatives,
+)
+from .types import BoolArray, FloatArray, IntArray
+
+STUDY_COLUMNS: tuple[str, ...] = (
+    "surface",
+    "estimator",
+    "res",
+    "n_vertices",
+    "n_compared",
+    "h",
+    "H_rms",
+    "H_rel",
+    "H_order",
+    "K_rms",
+    "K_rel",
+    "K_order",
+    "k_max_err",
+    "angle_median_deg",
+    "angle_p95_deg",
+)
+"""Columns of :func:`curvature_study` rows (``*_rel``: RMS error over the RMS of the exact
+``max(|κ₁|, |κ₂|)`` (resp. its square for K); ``*_order``: log-log slope against ``h`` from the
+previous resolution, empty at the first; angles: ``d1`` against the exact direction where
+``|κ₁ − κ₂| > 10 %`` of ``max |κ|``)."""
+
+
+@dataclass(frozen=True)
+class ExactPrincipal:
+    """Exact curvature at the vertices of a surface mesh (NaN at singular points).
+
+    Attributes
+    ----------
+    k1, k2, H, K : (n,) float
+    d1, d2 : (n,3) float
+        Unit 3-D principal directions.
+    compared : (n,) bool
+        Vertices away from the boundary and the poles (where errors are measured).
+    """
+
+    k1: FloatArray
+    k2: FloatArray
+    H: FloatArray
+    K: FloatArray
+    d1: FloatArray
+    d2: FloatArray
+    compared: BoolArray
+
+
+def compared_vertices(m: SurfaceMesh, surface: ParametricSurface, margin: float = 0.1) -> BoolArray:
+    """Vertices at least ``margin`` of the domain from an open edge or a pole, ``(n,)`` bool."""
+    u, v = m.uv[:, 0], m.uv[:, 1]
+    u0, u1, v0, v1 = surface.domain
+    keep = ~m.pole & ~m.boundary
+    if not surface.closed_u or {"u0", "u1"} & set(surface.poles):
+        keep &= np.minimum(u - u0, u1 - u) > margin * (u1 - u0)
+    if not surface.closed_v or {"v0", "v1"} & set(surface.poles):
+        keep &= np.minimum(v - v0, v1 - v) > margin * (v1 - v0)
+    return keep
+
+
+def exact_principal(m: SurfaceMesh, surface: ParametricSurface | str) -> ExactPrincipal:
+    """The exact ``κ₁ ≥ κ₂``, ``H``, ``K`` and directions at the vertices of ``m``."""
+    s = get_surface(surface)
+    u, v = m.uv[:, 0], m.uv[:, 1]
+    cf = surface_curvature_fields(s, u, v)
+    D = surface_derivatives(s, u, v)
+    dirs = []
+    for w in (cf.w1, cf.w2):
+        d = w[:, :1] * D.p_u + w[:, 1:] * D.p_v
+        dirs.append(d / np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-300))
+    return ExactPrincipal(cf.k1, cf.k2, cf.H, cf.K, dirs[0], dirs[1], compared_vertices(m, s))
+
+
+def flip_edges(V: FloatArray, F: IntArray, fraction: float, seed: int = 0) -> IntArray:
+    """Flip a random ``fraction`` of the interior edges (an irregular triangulation of the same
+    vertices), vectorized: candidates whose two faces no other candidate touches, that stay
+    convex in their quad (both new triangles keep the orientation of the old normal) and do not
+    create an existing edge.
+
+    Returns
+    -------
+    F2 : (m,3) int
+        Same faces count and orientation; ``F`` is not modified.
+    """
+    if not 0.0 <= float(fraction) <= 1.0:
+        raise MeshError(f"must be between 0 and 1, got {fraction!r}", "flips")
+    F = np.asarray(F, dtype=np.int64)
+    n, m = len(V), len(F)
+    A, B = F.ravel(), np.roll(F, -1, axis=1).ravel()
+    C = np.roll(F, -2, axis=1).ravel()  # the corner opposite the half-edge A -> B
+    fid = np.repeat(np.arange(m), 3)
+    key = A * n + B
+    order = np.argsort(key)
+    sk = key[order]
+    pos = np.clip(np.searchsorted(sk, B * n + A), 0, len(sk) - 1)
+    twin = np.where(sk[pos] == B * n + A, order[pos], -1)
+    cand = np.flatnonzero((twin >= 0) & (A < B))
+    rng = np.random.default_rng(seed)
+    cand = cand[rng.random(len(cand)) < fraction]
+    f1, f2 = fid[cand], fid[twin[cand]]
+    used = np.bincount(np.concatenate([f1, f2]), minlength=m)
+    keep = (used[f1] == 1) & (used[f2] == 1)
+    h, a, b, c, d = cand[keep], A[cand[keep]], B[cand[keep]], C[cand[keep]], C[twin[cand[keep]]]
+    # the new edge c-d: refuse if it exists already or a new triangle turns over
+    exists = np.isin(c * n + d, key) | np.isin(d * n + c, key)
+    nrm = np.cross(V[b] - V[a], V[c] - V[a]) + np.cross(V[a] - V[b], V[d] - V[b])
+    # the quad a, d, b, c (counter-clockwise) gets the diagonal d-c: faces (a, d, c), (d, b, c)
+    t1 = np.cross(V[d] - V[a], V[c] - V[a])
+    t2 = np.cross(V[b] - V[d], V[c] - V[d])
+    ok = ~exists & (np.einsum("ij,ij->i", t1, nrm) > 0) & (np.einsum("ij,ij->i", t2, nrm) > 0)
+    F2 = F.copy()
+    F2[fid[h[ok]]] = np.stack([a[ok], d[ok], c[ok]], axis=1)
+    F2[fid[twin[h[ok]]]] = np.stack([d[ok], b[ok], c[ok]], axis=1)
+    return F2
+
+
+def perturbed_mesh(
+    surface: ParametricSurface | str,
+    res: int | Sequence[int],
+    noise: float = 0.0,
+    jitter: float = 0.0,
+    seed: int = 0,
+    flips: float = 0.0,
+) -> tuple[SurfaceMesh, FloatArray]:
+    """A surface mesh made irregular and noisy (see the module notes).
+
+    Parameters
+    ----------
+    surface : ParametricSurface or str
+    res : int or (nu, nv)
+    noise : float
+        Standard deviation of the normal displacement, a fraction of the bbox diagonal.
+    jitter : float
+        Largest parameter displacement of an interior vertex, a fraction of a cell (0 to 0.45).
+    seed : int
+    flips : float
+        Fraction of the interior edges to flip (:func:`flip_edges`), 0 to 1.
+
+    Returns
+    -------
+    mesh : SurfaceMesh
+        With the jittered ``uv`` (and clean ``V`` on the surface).
+    V : (n,3) float
+        The positions with the noise.
+    """
+    s = get_surface(surface)
+    if not (0.0 <= float(jitter) <= 0.45):
+        raise MeshError(f"must be between 0 and 0.45 of a cell, got {jitter!r}", "jitter")
+    m = mesh_surface(s, res)
+    if jitter > 0:
+        rng = np.random.default_rng(seed)
+        u0, u1, v0, v1 = s.domain
+        cell = np.array([(u1 - u0) / m.res[0], (v1 - v0) / m.res[1]])
+        free = ~m.pole & ~m.boundary
+        uv = m.uv.copy()
+        uv[free] += jitter * cell * rng.uniform(-1.0, 1.0, (int(free.sum()), 2))
+        uv[:, 0] = np.clip(uv[:, 0], u0, u1)
+        uv[:, 1] = np.clip(uv[:, 1], v0, v1)
+        V = m.V.copy()
+        V[free] = s(uv[free, 0], uv[free, 1])
+        m = SurfaceMesh(V, m.F, uv, m.pole, m.boundary, m.surface, m.res)
+    if flips > 0:
+        m = SurfaceMesh(
+            m.V, flip_edges(m.V, m.F, flips, seed), m.uv, m.pole, m.boundary, m.surface, m.res
+        )
+    V = add_noise(m.V, m.F, noise, mode="normal", seed=seed) if noise > 0 else m.V
+    return m, V
+
+
+def vertex_errors(result: PrincipalCurvatures, exact: ExactPrincipal) -> dict[str, FloatArray]:
+    """Per-vertex errors of an estimate (the error maps), each ``(n,)``, NaN where not compared:
+    ``H``, ``K``, ``k1``, ``k2`` (signed, estimate − exact) and ``angle`` (degrees between
+    ``d1`` and the exact direction, NaN near umbilics)."""
+    keep = exact.compared
+    gap = np.abs(exact.k1 - exact.k2) > 0.1 * np.maximum(np.abs(exact.k1), np.abs(exact.k2))
+    cos = np.abs(np.sum(result.d1 * exact.d1, axis=1))
+    out = {
+        "H": result.H - exact.H,
+        "K": result.K - exact.K,
+        "k1": result.k1 - exact.k1,
+        "k2": result.k2 - exact.k2,
+        "angle": np.where(gap, np.degrees(np.arccos(np.clip(cos, 0.0, 1.0))), np.nan),
+    }
+    return {k: np.where(keep, v, np.nan) for k, v in out.items()}
+
+
+def _rms(x: FloatArray) -> float:
+    x = x[np.isfinite(x)]
+    return float(np.sqrt(np.mean(x * x))) if x.size else math.nan
+
+
+def _order(e0: float, e1: float, h0: float, h1: float) -> float | None:
+    if e0 > 0 and e1 > 0 and h0 != h1 and math.isfinite(e0) and math.isfinite(e1):
+        return math.log(e0 / e1) / math.log(h0 / h1)
+    return None
+
+
+def curvature_study(
+    surfaces: Sequence[str] = ("sphere", "torus", "saddle", "helicoid"),
+    estimators: Sequence[str] = CURVATURE_ESTIMATORS,
+    levels: Sequence[int] = (16, 32, 64),
+    noise: float = 0.0,
+    jitter: float = 0.0,
+    seed: int = 0,
+    options: dict[str, dict[str, Any]] | None = None,
+    flips: float = 0.0,
+) -> list[dict[str, Any]]:
+    """Errors of every estimator on every surface at every resolution, with observed orders.
+
+    Parameters
+    ----------
+    surfaces : names of :data:`meshlap_core.surfaces.SURFACES`
+    estimators : names of :data:`~meshlap_core.options.CURVATURE_ESTIMATORS`
+    levels : cells per direction (the torus gets twice as many around its axis)
+    noise, jitter, seed, flips : see :func:`perturbed_mesh`
+    options : estimator name -> its keyword options (e.g. ``{"jet": {"radius": 0.2}}``)
+
+    Returns
+    -------
+    rows : list of dict
+        One per (surface, estimator, level), keys :data:`STUDY_COLUMNS`.
+    """
+    for e in estimators:
+        check_choice(e, CURVATURE_ESTIMATORS, "estimator")
+    if not levels or any(int(n) < 3 for n in levels):
+        raise MeshError(f"levels must be at least 3 cells, got {list(levels)}", "levels")
+    options = options or {}
+    rows: list[dict[str, Any]] = []
+    for name in surfaces:
+        s = get_surface(name)
+        meshes = []
+        for n in levels:
+            res = (2 * int(n), int(n)) if s.name == "torus" else (int(n), int(n))
+            m, V = perturbed_mesh(s, res, noise, jitter, seed, flips)
+            E = np.concatenate([m.F[:, [0, 1]], m.F[:, [1, 2]], m.F[:, [2, 0]]])
+            h = float(np.mean(np.linalg.norm(m.V[E[:, 0]] - m.V[E[:, 1]], axis=1)))
+            meshes.append((n, m, V, h, exact_principal(m, s)))
+        for est in estimators:
+            prev: dict[str, Any] | None = None
+            for n, m, V, h, ex in meshes:
+                r = estimate_curvature(V, m.F, est, **options.get(est, {}))  # type: ignore[arg-type]
+                err = vertex_errors(r, ex)
+                scale = _rms(np.maximum(np.abs(ex.k1), np.abs(ex.k2))[ex.compared])
+                row: dict[str, Any] = {
+                    "surface": s.name,
+                    "estimator": est,
+                    "res": int(n),
+                    "n_vertices": len(V),
+                    "n_compared": int(ex.compared.sum()),
+                    "h": h,
+                    "H_rms": _rms(err["H"]),
+                    "K_rms": _rms(err["K"]),
+                    "k_max_err": float(np.nanmax(np.abs(np.concatenate([err["k1"], err["k2"]])))),
+                    "angle_median_deg": float(np.nanmedian(err["angle"]))
+                    if np.isfinite(err["angle"]).any()
+                    else math.nan,
+                    "angle_p95_deg": float(np.nanpercentile(err["angle"], 95))
+                    if np.isfinite(err["angle"]).any()
+                    else math.nan,
+                }
+                row["H_rel"] = row["H_rms"] / scale if scale > 0 else math.nan
+                row["K_rel"] = row["K_rms"] / scale**2 if scale > 0 else math.nan
+                for key in ("H_order", "K_order"):
+                    rms = key.replace("order", "rms")
+                    row[key] = _order(prev[rms], row[rms], prev["h"], h) if prev else None
+                rows.append({c: row[c] for c in STUDY_COLUMNS})
+                prev = row
+    return rows

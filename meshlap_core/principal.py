@@ -1,0 +1,91 @@
+"""The result of every principal-curvature estimator (:class:`PrincipalCurvatures`) and the
+small linear algebra they share: tangent frames and closed-form 2×2 symmetric eigenpairs.
+
+The sign convention is the project's: outward normal from the face orientation, curvature
+positive where the surface bends away from it (``H > 0`` on a sphere), ``κ₁ ≥ κ₂``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .options import PRINCIPAL_FIELDS, check_choice
+from .types import FloatArray
+
+
+@dataclass(frozen=True)
+class PrincipalCurvatures:
+    """Principal curvatures and directions at every vertex.
+
+    Attributes
+    ----------
+    k1, k2 : (n,) float
+        ``k1 ≥ k2``; positive where the surface bends away from ``normal``.
+    d1, d2 : (n,3) float
+        Unit tangent directions of ``k1`` and ``k2`` (a line field: ``±d`` are the same); zero
+        where the estimator has none (an isolated vertex).
+    normal : (n,3) float
+        The unit normal the signs are measured against (outward for counter-clockwise faces).
+    estimator : str
+    """
+
+    k1: FloatArray
+    k2: FloatArray
+    d1: FloatArray
+    d2: FloatArray
+    normal: FloatArray
+    estimator: str
+
+    @property
+    def H(self) -> FloatArray:
+        """Mean curvature ``(k1 + k2)/2``, ``(n,)``."""
+        return 0.5 * (self.k1 + self.k2)
+
+    @property
+    def K(self) -> FloatArray:
+        """Gaussian curvature ``k1 k2``, ``(n,)``."""
+        return self.k1 * self.k2
+
+    def field(self, name: str) -> FloatArray:
+        """One of :data:`~meshlap_core.options.PRINCIPAL_FIELDS` (``k1``, ``k2``, ``H``, ``K``,
+        ``abs_max = max(|k1|, |k2|)``) as ``(n,)``."""
+        check_choice(name, PRINCIPAL_FIELDS, "field")
+        if name == "abs_max":
+            return np.maximum(np.abs(self.k1), np.abs(self.k2))
+        return np.asarray(getattr(self, name))
+
+
+def tangent_frames(N: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """An orthonormal tangent basis ``(t1, t2)`` per unit normal, ``t1 × t2 = n``.
+
+    Parameters
+    ----------
+    N : (n,3) float
+        Unit normals (zero rows give an arbitrary frame).
+
+    Returns
+    -------
+    t1, t2 : (n,3) float
+    """
+    a = np.zeros_like(N)
+    a[np.arange(len(N)), np.argmin(np.abs(N), axis=1)] = 1.0  # the axis least along n
+    t1 = np.cross(a, N)
+    t1 /= np.maximum(np.linalg.norm(t1, axis=1, keepdims=True), 1e-300)
+    return t1, np.cross(N, t1)
+
+
+def eig_sym2(a: FloatArray, b: FloatArray, c: FloatArray) -> tuple[FloatArray, ...]:
+    """Eigen-decomposition of the symmetric ``[[a, b], [b, c]]`` per row, in closed form.
+
+    Returns
+    -------
+    lam1, lam2 : (n,) float
+        ``lam1 ≥ lam2``.
+    cos, sin : (n,) float
+        The unit eigenvector of ``lam1`` is ``(cos, sin)`` (angle ``½ atan2(2b, a − c)``).
+    """
+    m, r = 0.5 * (a + c), np.hypot(0.5 * (a - c), b)
+    phi = 0.5 * np.arctan2(2.0 * b, a - c)
+    return m + r, m - r, np.cos(phi), np.sin(phi)

@@ -1,0 +1,157 @@
+"""The Curvature lab: its state headless (the error map is the error against the exact surface,
+disagreement is the max pairwise difference), and its widgets through the scripted UI on
+polyscope's ``openGL_mock`` (crosses uploaded as 2-symmetric tangent line fields)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from meshlap_app.state.curvature_lab import CurvatureLabState, cross_field
+
+from meshlap_core import curvature_estimators as ce
+from meshlap_core import primitives
+from meshlap_core.errors import MeshError
+
+
+def _compute(lab: CurvatureLabState, V=None, F=None):
+    return CurvatureLabState.compute(lab.params(), V, F)
+
+
+def test_error_map_is_estimate_minus_exact_and_shrinks_with_resolution():
+    lab = CurvatureLabState()  # torus, cotan, H, error
+    rms = []
+    for res in (16, 32):
+        lab.set_number("res", res)
+        r = _compute(lab)
+        assert r.V.shape == (2 * res * res, 3)
+        # exact H on the torus R = 3, r = 1
+        v = np.arctan2(r.V[:, 2], np.hypot(r.V[:, 0], r.V[:, 1]) - 3.0)
+        H = 0.5 * (1 + np.cos(v) / (3 + np.cos(v)))
+        np.testing.assert_allclose(r.values, r.principal.H - H, atol=1e-9)
+        rms.append(np.sqrt(np.mean(r.values**2)))
+        assert "RMS error" in r.summary
+    assert rms[1] < rms[0] / 3  # order 2: 4x per halving
+
+
+def test_noise_and_jitter_change_the_mesh_and_bad_values_are_refused():
+    lab = CurvatureLabState()
+    lab.set_number("res", 16)
+    clean = _compute(lab)
+    lab.set_number("noise", 0.002)
+    lab.set_number("jitter", 0.3)
+    noisy = _compute(lab)
+    assert np.abs(noisy.V - clean.V).max() > 0
+    assert np.sqrt(np.mean(noisy.values**2)) > 3 * np.sqrt(np.mean(clean.values**2))
+    for what, bad in (
+        ("noise", -0.1),
+        ("noise", "nan"),
+        ("jitter", 0.9),
+        ("res", 1e6),
+        ("res", "x"),
+    ):
+        with pytest.raises(MeshError, match=what):
+            lab.set_number(what, bad)
+    assert (lab.noise, lab.jitter, lab.res) == (0.002, 0.3, 16)  # unchanged
+    with pytest.raises(MeshError):
+        lab.set_choice("estimator", "magic")
+
+
+def test_disagreement_on_a_loaded_mesh():
+    V, F = primitives.bumpy_sphere(2)
+    lab = CurvatureLabState()
+    lab.set_choice("source", "mesh")
+    lab.set_choice("show", "disagreement")
+    r = _compute(lab, V, F)
+    H = np.stack([ce.estimate_curvature(V, F, e).H for e in ce.ESTIMATOR_FUNCTIONS])
+    np.testing.assert_allclose(r.values, H.max(0) - H.min(0), atol=1e-12)
+    assert "disagree" in r.summary
+
+
+def test_shape_operator_at_a_vertex_has_the_principal_values_and_euler_matches_exact():
+    lab = CurvatureLabState()  # the torus, cotan
+    lab.set_number("res", 32)
+    lab.adopt(lab.inputs(0), _compute(lab))
+    with pytest.raises(MeshError, match="vertex"):
+        lab.pick(10**6)
+    lab.pick(0)  # u = v = 0: the outer equator, k1 = 1 (around the tube), k2 = 1/4
+    so = lab.shape_operator()
+    S = np.array(so["S"])
+    np.testing.assert_allclose(S, S.T)
+    np.testing.assert_allclose(np.linalg.eigvalsh(S)[::-1], [so["k1"], so["k2"]], atol=1e-12)
+    assert (so["k1"], so["k2"]) == pytest.approx((1.0, 0.25), abs=2e-3)
+    # Euler's formula: the extremes of kn are k1 (θ = 0) and k2 (θ = 90°), close to exact
+    assert so["kn"][0] == pytest.approx(so["k1"]) and so["kn"].min() == pytest.approx(so["k2"])
+    np.testing.assert_allclose(so["kn"], so["exact_kn"], atol=3e-3)
+
+
+def test_cross_field_is_the_direction_in_the_tangent_basis():
+    V, F = primitives.torus_mesh(24, 12)
+    p = ce.estimate_curvature(V, F, "rusinkiewicz")
+    vals, bx, by = cross_field(p, 1)
+    d = vals[:, :1] * bx + vals[:, 1:] * by
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    np.testing.assert_allclose(np.abs(np.sum(d * p.d1, axis=1)), 1, atol=1e-9)
+    np.testing.assert_allclose(np.sum(bx * p.normal, axis=1), 0, atol=1e-12)
+
+
+# ---------------------------------------------------------------- widgets (openGL_mock)
+ps = pytest.importorskip("polyscope")
+
+import test_viewer_widgets as widgets  # noqa: E402
+
+drive = widgets.drive
+frames = widgets.frames
+mock = widgets.mock
+
+
+def drive_curvature_lab(viewer) -> None:
+    """Every lab widget with good and bad values (also run by the every-widget tour)."""
+    from meshlap_app.panels.curvature_lab import LAB
+
+    viewer.set_panel("curvature_lab")
+    frames(viewer, 2)
+    lab = viewer.panels["curvature_lab"].state
+    assert lab.result is not None and ps.has_surface_mesh(LAB)
+    drive(viewer, "resolution", 12)
+    assert lab.res == 12 and lab.result.V.shape[0] == 2 * 12 * 12
+    # the log-log plot of the error against h, with the fitted order in the legend
+    conv = lab.result.convergence
+    assert [row["res"] for row in conv] == [4, 6, 12]
+    order = conv[-1]["H_order"]
+    assert order == pytest.approx(2.0, abs=0.3)  # cotan on the regular torus grid
+    _kind, x, y = viewer.ui.plots[("curvature_lab", f"H, order {order:.2f}")]
+    np.testing.assert_allclose(x, np.log10([row["h"] for row in conv]))
+    assert len(x) == 3 and np.all(np.diff(x) < 0) and np.all(np.diff(y) < 0)  # finer: smaller
+    drive(viewer, "vertex", 5)
+    assert lab.vertex == 5
+    # what the Euler plot draws (the plot itself is clipped when the panel is long)
+    so = lab.shape_operator()
+    assert so["kn"][0] == pytest.approx(lab.result.principal.k1[5])
+    assert so["exact_kn"] is not None
+    drive(viewer, "vertex", 10**6)
+    assert lab.vertex == 5 and "vertex" in viewer.state.errors["curvature_lab"]
+    drive(viewer, "noise", 0.001)
+    drive(viewer, "jitter", 0.2)
+    drive(viewer, "edge flips", 0.1)
+    assert lab.computed_for[-3:] == (0.001, 0.2, 0.1)
+    drive(viewer, "noise", -1.0)
+    assert lab.noise == 0.001 and "noise" in viewer.state.errors["curvature_lab"]
+    drive(viewer, "estimator", "rusinkiewicz")
+    drive(viewer, "quantity", "k1")
+    drive(viewer, "show", "estimate")
+    assert lab.result.label == "k1 (rusinkiewicz)"
+    np.testing.assert_allclose(lab.result.values, lab.result.principal.k1)
+    drive(viewer, "lab surface", "saddle")
+    assert lab.result.V.shape[0] == 13 * 13
+    drive(viewer, "crosses", False)
+    drive(viewer, "crosses", True)
+    drive(viewer, "source", "mesh")
+    drive(viewer, "show", "disagreement")
+    assert lab.result.V.shape == viewer.state.mesh.V.shape
+    assert "disagree" in lab.result.summary
+    drive(viewer, "source", "surface")
+    drive(viewer, "show", "error")
+
+
+def test_curvature_lab_widgets(viewer):
+    drive_curvature_lab(viewer)
