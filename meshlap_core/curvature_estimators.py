@@ -42,7 +42,7 @@ from .curvature import (
 )
 from .curvature_fit import jet_curvatures
 from .errors import MeshError
-from .laplacian import vertex_areas
+from .laplacian import cotan_stiffness, vertex_areas
 from .options import (
     CURVATURE_AREA,
     CURVATURE_ESTIMATORS,
@@ -153,7 +153,7 @@ def cotan_curvatures(
     fn, theta = _face_geometry(V, F)
     N = _normals_from(F, n, fn, theta)
     A = vertex_areas(V, F, area)
-    H = _cotan_H(V, F, A, N)
+    H = _cotan_H(cotan_stiffness(V, F) @ V, A, N)
     d = _deficit_from(F, n, theta, boundary)
     K = np.divide(d, A, out=np.zeros_like(d), where=A > 0)
     r = np.sqrt(np.maximum(H * H - K, 0.0))

@@ -111,7 +111,7 @@ def drive_curvature_lab(viewer) -> None:
     viewer.set_panel("curvature_lab")
     frames(viewer, 2)
     lab = viewer.panels["curvature_lab"].state
-    assert lab.result is not None and ps.has_surface_mesh(LAB)
+    assert lab.result is not None and ps.has_surface_mesh(LAB), viewer.state.errors
     drive(viewer, "resolution", 12)
     assert lab.res == 12 and lab.result.V.shape[0] == 2 * 12 * 12
     # the log-log plot of the error against h, with the fitted order in the legend
