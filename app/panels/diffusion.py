@@ -44,7 +44,12 @@ class DiffusionPanel(Panel):
 
     title = "Diffusion"
     framed = (FILTERED, *HEAT_COPIES)
-    shortcuts = (("click", "diffusion: heat / distance source (add more with the checkbox)"),)
+    shortcuts = (
+        (
+            "mouse",
+            "diffusion: click a vertex for the heat / distance source (more: the checkbox)",
+        ),
+    )
 
     def __init__(self, name: str, state: DiffusionState) -> None:
         super().__init__(name, state)
