@@ -36,6 +36,7 @@ READER = CORE / "io" / "reader.py"
 ALLOWED = {
     ("linalg/slicing.py", "open"): "/proc/stat, the kernel's CPU counters (not a user's file)",
     ("io/atomic.py", "open"): "the output's directory, opened to fsync the rename",
+    ("exercises/sandbox.py", "open"): "/proc/self/statm, the worker's own size (not a user's file)",
 }
 # calls that read a file by name
 READ_CALLS = {"read_text", "read_bytes", "load", "loadtxt", "genfromtxt", "fromfile", "imread"}
