@@ -32,7 +32,7 @@ def test_every_panel_is_driven_and_usable(python_ok, tmp_path):
     failed = [r for r in rows if r[4] != "yes"]
     assert not failed, out
     spectral = next(r for r in rows if r[0] == "spectral")
-    assert "k = 12" in spectral[1]
+    assert "k = 12: computed" in spectral[1]
     steps = next(r for r in rows if r[1] == "3 implicit steps")
     assert len(re.findall(r"\d s", steps[5])) == 3  # each step's time is reported
     assert all(float(r[2]) >= 0 and int(r[3]) > 0 for r in rows)  # seconds, peak RSS
