@@ -149,6 +149,53 @@ def flip_edges(V: FloatArray, F: IntArray, fraction: float, seed: int = 0) -> In
     return F2
 
 
+def jittered_mesh(
+    surface: ParametricSurface | str, res: int | Sequence[int], jitter: float = 0.0, seed: int = 0
+) -> SurfaceMesh:
+    """The surface's grid mesh with every interior vertex moved in the parameter plane by up to
+    ``jitter`` of a cell (uniform, ``seed``) and evaluated on the surface there: the vertices
+    stay on the surface, so the exact values at them are exact (see :func:`perturbed_mesh`)."""
+    s = get_surface(surface)
+    if not (0.0 <= float(jitter) <= 0.45):
+        raise MeshError(f"must be between 0 and 0.45 of a cell, got {jitter!r}", "jitter")
+    m = mesh_surface(s, res)
+    if jitter > 0:
+        rng = np.random.default_rng(seed)
+        u0, u1, v0, v1 = s.domain
+        cell = np.array([(u1 - u0) / m.res[0], (v1 - v0) / m.res[1]])
+        free = ~m.pole & ~m.boundary
+        uv = m.uv.copy()
+        uv[free] += jitter * cell * rng.uniform(-1.0, 1.0, (int(free.sum()), 2))
+        uv[:, 0] = np.clip(uv[:, 0], u0, u1)
+        uv[:, 1] = np.clip(uv[:, 1], v0, v1)
+        V = m.V.copy()
+        V[free] = s(uv[free, 0], uv[free, 1])
+        m = SurfaceMesh(V, m.F, uv, m.pole, m.boundary, m.surface, m.res)
+    return m
+
+
+def flipped_and_noisy(
+    m: SurfaceMesh, noise: float = 0.0, seed: int = 0, flips: float = 0.0
+) -> tuple[SurfaceMesh, FloatArray]:
+    """``m`` with a fraction ``flips`` of its interior edges flipped (:func:`flip_edges`) and
+    its positions displaced along the normal by Gaussian noise of standard deviation
+    ``noise × bbox diagonal`` (the last two steps of :func:`perturbed_mesh`; ``m`` unchanged).
+
+    Returns
+    -------
+    mesh : SurfaceMesh
+        The flipped faces, the clean ``V`` and ``uv``.
+    V : (n,3) float
+        The positions with the noise.
+    """
+    if flips > 0:
+        m = SurfaceMesh(
+            m.V, flip_edges(m.V, m.F, flips, seed), m.uv, m.pole, m.boundary, m.surface, m.res
+        )
+    V = add_noise(m.V, m.F, noise, mode="normal", seed=seed) if noise > 0 else m.V
+    return m, V
+
+
 def perturbed_mesh(
     surface: ParametricSurface | str,
     res: int | Sequence[int],
@@ -157,7 +204,8 @@ def perturbed_mesh(
     seed: int = 0,
     flips: float = 0.0,
 ) -> tuple[SurfaceMesh, FloatArray]:
-    """A surface mesh made irregular and noisy (see the module notes).
+    """A surface mesh made irregular and noisy (see the module notes):
+    :func:`jittered_mesh` then :func:`flipped_and_noisy`.
 
     Parameters
     ----------
@@ -178,28 +226,7 @@ def perturbed_mesh(
     V : (n,3) float
         The positions with the noise.
     """
-    s = get_surface(surface)
-    if not (0.0 <= float(jitter) <= 0.45):
-        raise MeshError(f"must be between 0 and 0.45 of a cell, got {jitter!r}", "jitter")
-    m = mesh_surface(s, res)
-    if jitter > 0:
-        rng = np.random.default_rng(seed)
-        u0, u1, v0, v1 = s.domain
-        cell = np.array([(u1 - u0) / m.res[0], (v1 - v0) / m.res[1]])
-        free = ~m.pole & ~m.boundary
-        uv = m.uv.copy()
-        uv[free] += jitter * cell * rng.uniform(-1.0, 1.0, (int(free.sum()), 2))
-        uv[:, 0] = np.clip(uv[:, 0], u0, u1)
-        uv[:, 1] = np.clip(uv[:, 1], v0, v1)
-        V = m.V.copy()
-        V[free] = s(uv[free, 0], uv[free, 1])
-        m = SurfaceMesh(V, m.F, uv, m.pole, m.boundary, m.surface, m.res)
-    if flips > 0:
-        m = SurfaceMesh(
-            m.V, flip_edges(m.V, m.F, flips, seed), m.uv, m.pole, m.boundary, m.surface, m.res
-        )
-    V = add_noise(m.V, m.F, noise, mode="normal", seed=seed) if noise > 0 else m.V
-    return m, V
+    return flipped_and_noisy(jittered_mesh(surface, res, jitter, seed), noise, seed, flips)
 
 
 def vertex_errors(result: PrincipalCurvatures, exact: ExactPrincipal) -> dict[str, FloatArray]:
@@ -239,6 +266,7 @@ def curvature_study(
     seed: int = 0,
     options: dict[str, dict[str, Any]] | None = None,
     flips: float = 0.0,
+    progress: Any = None,
 ) -> list[dict[str, Any]]:
     """Errors of every estimator on every surface at every resolution, with observed orders.
 
@@ -249,6 +277,9 @@ def curvature_study(
     levels : cells per direction (the torus gets twice as many around its axis)
     noise, jitter, seed, flips : see :func:`perturbed_mesh`
     options : estimator name -> its keyword options (e.g. ``{"jet": {"radius": 0.2}}``)
+    progress : callable, optional
+        ``progress(fraction, message)`` before each estimate (a viewer job's reporter, which
+        stops the study when it is cancelled).
 
     Returns
     -------
@@ -261,6 +292,7 @@ def curvature_study(
         raise MeshError(f"levels must be at least 3 cells, got {list(levels)}", "levels")
     options = options or {}
     rows: list[dict[str, Any]] = []
+    total, done = len(surfaces) * len(estimators) * len(levels), 0
     for name in surfaces:
         s = get_surface(name)
         meshes = []
@@ -273,6 +305,9 @@ def curvature_study(
         for est in estimators:
             prev: dict[str, Any] | None = None
             for n, m, V, h, ex in meshes:
+                if progress is not None:
+                    progress(done / total, f"{s.name}, {est}, {n} cells")
+                done += 1
                 r = estimate_curvature(V, m.F, est, **options.get(est, {}))  # type: ignore[arg-type]
                 err = vertex_errors(r, ex)
                 scale = _rms(np.maximum(np.abs(ex.k1), np.abs(ex.k2))[ex.compared])

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from meshlap_app.state.curvature_lab import CurvatureLabState, cross_field
+from meshlap_app.state.curvature_lab import STUDY_LEVELS, CurvatureLabState, cross_field
 
 from meshlap_core import curvature_estimators as ce
 from meshlap_core import primitives
@@ -54,6 +54,27 @@ def test_noise_and_jitter_change_the_mesh_and_bad_values_are_refused():
     assert (lab.noise, lab.jitter, lab.res) == (0.002, 0.3, 16)  # unchanged
     with pytest.raises(MeshError):
         lab.set_choice("estimator", "magic")
+
+
+def test_noise_and_flips_reuse_the_cached_exact_surface():
+    lab = CurvatureLabState()
+    lab.set_number("res", 16)
+    first = _compute(lab)
+    lab.adopt(lab.inputs(0), first)
+    assert lab.base() is first.base
+    lab.set_number("noise", 0.003)
+    lab.set_number("flips", 0.2)
+    cached = CurvatureLabState.compute(lab.params(), None, None, lab.base())
+    assert cached.base is first.base  # the exact values were not recomputed
+    fresh = _compute(lab)  # the same result without the cache
+    np.testing.assert_array_equal(cached.values, fresh.values)
+    np.testing.assert_array_equal(cached.F, fresh.F)
+    assert not np.array_equal(cached.F, first.F)  # the flips are there
+    # a cache for other settings is never used by mistake
+    lab.set_number("jitter", 0.2)
+    assert lab.base() is None
+    moved = CurvatureLabState.compute(lab.params(), None, None, first.base)
+    assert moved.base is not first.base and moved.base.key == (lab.surface, 16, 0.2)
 
 
 def test_disagreement_on_a_loaded_mesh():
@@ -114,14 +135,21 @@ def drive_curvature_lab(viewer) -> None:
     assert lab.result is not None and ps.has_surface_mesh(LAB), viewer.state.errors
     drive(viewer, "resolution", 12)
     assert lab.res == 12 and lab.result.V.shape[0] == 2 * 12 * 12
-    # the log-log plot of the error against h, with the fitted order in the legend
-    conv = lab.result.convergence
-    assert [row["res"] for row in conv] == [4, 6, 12]
+    # the log-log plot of the error against h, with the fitted order in the legend: a
+    # second job, kept per (surface, estimator, noise, jitter, flips)
+    conv = lab.convergence()
+    assert [row["res"] for row in conv] == list(STUDY_LEVELS)
     order = conv[-1]["H_order"]
     assert order == pytest.approx(2.0, abs=0.3)  # cotan on the regular torus grid
     _kind, x, y = viewer.ui.plots[("curvature_lab", f"H, order {order:.2f}")]
     np.testing.assert_allclose(x, np.log10([row["h"] for row in conv]))
-    assert len(x) == 3 and np.all(np.diff(x) < 0) and np.all(np.diff(y) < 0)  # finer: smaller
+    assert len(x) == len(STUDY_LEVELS)
+    assert np.all(np.diff(x) < 0) and np.all(np.diff(y) < 0)  # finer: smaller
+    # a resolution move recomputes the error map, never the study (nor its figure)
+    drive(viewer, "resolution", 14)
+    assert lab.result.V.shape[0] == 2 * 14 * 14 and lab.convergence() is conv
+    assert len(lab.studies) == 1
+    drive(viewer, "resolution", 12)
     drive(viewer, "vertex", 5)
     assert lab.vertex == 5
     # what the Euler plot draws (the plot itself is clipped when the panel is long)

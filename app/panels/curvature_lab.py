@@ -23,6 +23,7 @@ from ..state.curvature_lab import (
     MAX_JITTER,
     MAX_NOISE,
     MAX_RES,
+    STUDY_LEVELS,
     CurvatureLabState,
     LabResult,
     cross_field,
@@ -47,6 +48,7 @@ class CurvatureLabPanel(Panel):
     def __init__(self, name: str, state: CurvatureLabState) -> None:
         super().__init__(name, state)
         self.state: CurvatureLabState = state
+        self._study_for: tuple[Any, ...] | None = None  # the study job's inputs
 
     def on_new_mesh(self, host: Host) -> None:
         self.watch.forget()
@@ -74,17 +76,35 @@ class CurvatureLabPanel(Panel):
         return True
 
     def sync(self, host: Host) -> None:
-        """Compute (a job in the window) when an input changed, upload when a result is new."""
+        """Compute (a job in the window) when an input changed, upload when a result is new;
+        the convergence study is a second job, started once the error map is applied and
+        kept per (surface, estimator, noise, jitter, flips): a resolution move skips it."""
         if host.active() is not self:
             return
-        lab, mesh = self.state, host.state.mesh
+        lab, mesh, jobs = self.state, host.state.mesh, host.state.jobs
         wanted = lab.inputs(mesh.version)
-        if lab.computed_for != wanted and host.state.jobs.running(self.name) is None:
+        if lab.computed_for != wanted and jobs.running(self.name) is None:
             self._start(host, wanted)
+        key = lab.study_key()
+        if jobs.running(self.study_owner) is not None and self._study_for != key:
+            jobs.cancel(self.study_owner)  # obsolete: the error map gets the cores
+        if (
+            key is not None
+            and key not in lab.studies
+            and lab.computed_for == wanted
+            and jobs.running(self.name) is None
+            and jobs.running(self.study_owner) is None
+        ):
+            self._start_study(host, key)
         r = lab.result
         if r is None or not self.watch.changed("uploaded", lab.computed_for, lab.crosses):
             return
         self._upload(host, r)
+
+    @property
+    def study_owner(self) -> str:
+        """The convergence study's job owner (one beside the error map's)."""
+        return f"{self.name} study"
 
     def _start(self, host: Host, wanted: tuple[Any, ...]) -> None:
         lab, jobs, mesh = self.state, host.state.jobs, host.state.mesh
@@ -100,8 +120,25 @@ class CurvatureLabPanel(Panel):
         jobs.start(
             self.name,
             f"curvature lab ({lab.estimator}, {lab.show})",
-            jobs.offload(lab.compute, params, mesh.V, mesh.F),
+            jobs.offload(lab.compute, params, mesh.V, mesh.F, lab.base()),
             apply,
+            fail,
+            background=bool(host.background),
+        )
+
+    def _start_study(self, host: Host, key: tuple[Any, ...]) -> None:
+        lab, jobs = self.state, host.state.jobs
+
+        def fail(message: str) -> None:
+            lab.adopt_study(key, [])  # not retried until an input changes
+            host.state.errors[self.name] = f"convergence study: {message}"
+
+        self._study_for = key
+        jobs.start(
+            self.study_owner,
+            f"convergence study ({lab.estimator}, {len(STUDY_LEVELS)} resolutions)",
+            jobs.offload(lab.study, lab.params()),
+            lambda rows: lab.adopt_study(key, rows),
             fail,
             background=bool(host.background),
         )
@@ -152,6 +189,7 @@ class CurvatureLabPanel(Panel):
         if not ui.header(self.title):
             return
         host.draw_job(self.name)
+        host.draw_job(self.study_owner)
         lab = self.state
         changed = False
         for what, items, tip in (
@@ -223,7 +261,7 @@ class CurvatureLabPanel(Panel):
             ui.text(lab.result.label)
             ui.text(lab.result.summary)
             self._draw_shape_operator(host)
-            self._draw_convergence(host, lab.result)
+            self._draw_convergence(host, lab.convergence())
 
     def _draw_shape_operator(self, host: Host) -> None:
         """The picked vertex's 2×2 tensor with its basis and Euler's κn(θ), exact beside it."""
@@ -249,9 +287,9 @@ class CurvatureLabPanel(Panel):
                     ui.plot_line("exact", so["theta_deg"], so["exact_kn"])
 
     @staticmethod
-    def _draw_convergence(host: Host, r: LabResult) -> None:
+    def _draw_convergence(host: Host, convergence: list[dict[str, Any]]) -> None:
         """log10(relative RMS error) against log10(h) for H and K, the order in the legend."""
-        rows = [row for row in r.convergence if row["H_rel"] > 0 and row["K_rel"] > 0]
+        rows = [row for row in convergence if row["H_rel"] > 0 and row["K_rel"] > 0]
         if len(rows) < 2:
             return
         x = np.log10([row["h"] for row in rows])

@@ -11,7 +11,13 @@ from typing import Any
 import numpy as np
 
 from meshlap_core.curvature_estimators import disagreement, estimate_curvature
-from meshlap_core.curvature_study import curvature_study, exact_principal, perturbed_mesh
+from meshlap_core.curvature_study import (
+    ExactPrincipal,
+    curvature_study,
+    exact_principal,
+    flipped_and_noisy,
+    jittered_mesh,
+)
 from meshlap_core.errors import MeshError
 from meshlap_core.options import (
     CURVATURE_ESTIMATORS,
@@ -30,6 +36,10 @@ MAX_NOISE = 0.02
 """Largest normal noise, a fraction of the bounding-box diagonal."""
 MAX_JITTER = 0.45
 """Largest parameter jitter, a fraction of a cell."""
+STUDY_LEVELS = (8, 16, 32, 64)
+"""Resolutions of the lab's convergence study (fixed: a resolution move keeps the plot)."""
+KEEP_BASES = 6
+"""Exact surfaces kept (per surface, resolution and jitter): a slider moved back is instant."""
 
 
 def make_state() -> CurvatureLabState:
@@ -54,10 +64,10 @@ class LabResult:
         The exact direction of ``k1`` (parametric surfaces).
     summary : str
         One line: the RMS error (surface) or the largest disagreement (mesh).
-    convergence : list of dict
-        On a surface with ``show == "error"``: the :func:`~meshlap_core.curvature_study.
-        curvature_study` rows of this estimator at a quarter, half and the full resolution
-        (``h``, ``H_rel``, ``K_rel``, ``H_order``, ...): the log-log plot of error against h.
+    exact : ((n,) float, (n,) float) or None
+        The exact ``(k1, k2)`` on a parametric mesh.
+    base : Base or None
+        The jittered mesh and its exact values, for the state's cache (parametric surfaces).
     """
 
     V: FloatArray
@@ -67,15 +77,31 @@ class LabResult:
     principal: PrincipalCurvatures
     exact_d1: FloatArray | None
     summary: str
-    convergence: list[dict[str, Any]] = field(default_factory=list)
-    exact: tuple[FloatArray, FloatArray] | None = None  # exact (k1, k2) on a parametric mesh
+    exact: tuple[FloatArray, FloatArray] | None = None
+    base: Base | None = None
 
 
-def _exact(m: Any) -> tuple[PrincipalCurvatures, np.ndarray]:
-    ex = exact_principal(m, m.surface)
-    zero = np.zeros_like(ex.d1)
-    pc = PrincipalCurvatures(ex.k1, ex.k2, ex.d1, ex.d2, zero, "exact")
-    return pc, ex.compared
+@dataclass(frozen=True)
+class Base:
+    """A lab surface before flips and noise: the jittered mesh and its exact curvature (what
+    a move of the noise or flips slider reuses; the exact values do not depend on them)."""
+
+    key: tuple[Any, ...]  # (surface, res, jitter)
+    mesh: Any  # SurfaceMesh
+    exact: ExactPrincipal
+
+
+def base_key(params: dict[str, Any]) -> tuple[Any, ...]:
+    """What the exact values depend on: ``(surface, res, jitter)``."""
+    return (params["surface"], int(params["res"]), float(params["jitter"]))
+
+
+def make_base(params: dict[str, Any]) -> Base:
+    """The jittered mesh of ``params`` and its exact curvature."""
+    n = int(params["res"])
+    res = (2 * n, n) if params["surface"] == "torus" else (n, n)
+    m = jittered_mesh(params["surface"], res, params["jitter"])
+    return Base(base_key(params), m, exact_principal(m, m.surface))
 
 
 @dataclass
@@ -95,6 +121,8 @@ class CurvatureLabState:
     result: LabResult | None = None
     computed_for: tuple[Any, ...] = field(default=())
     vertex: int = -1  # the picked vertex of the result's mesh (-1: none)
+    bases: dict[tuple[Any, ...], Base] = field(default_factory=dict)  # newest last
+    studies: dict[tuple[Any, ...], list[dict[str, Any]]] = field(default_factory=dict)
 
     def inputs(self, mesh_version: int) -> tuple[Any, ...]:
         """Everything the result depends on (the mesh version only for the loaded mesh)."""
@@ -160,39 +188,25 @@ class CurvatureLabState:
             )
         }
 
+    def base(self) -> Base | None:
+        """The cached exact surface for the current settings (``None``: not computed yet)."""
+        return self.bases.get(base_key(self.params()))
+
     @staticmethod
-    def compute(params: dict[str, Any], V: Any, F: Any, progress: Any = None) -> LabResult:
+    def compute(
+        params: dict[str, Any], V: Any, F: Any, base: Base | None = None, progress: Any = None
+    ) -> LabResult:
         """The lab's result for ``params`` (any thread or a child process: touches no state);
-        ``V, F`` are the loaded mesh's (used when ``source`` is ``mesh``)."""
-        q, est = params["quantity"], params["estimator"]
+        ``V, F`` are the loaded mesh's (used when ``source`` is ``mesh``); ``base`` the cached
+        exact surface for ``params`` (computed when ``None`` or for other settings). The
+        convergence study is separate (:meth:`study`)."""
         if params["source"] == "surface":
-            n = int(params["res"])
-            res = (2 * n, n) if params["surface"] == "torus" else (n, n)
-            m, Vs = perturbed_mesh(
-                params["surface"], res, params["noise"], params["jitter"], flips=params["flips"]
-            )
-            r = estimate_curvature(Vs, m.F, est)
-            exact, compared = _exact(m)
-            if params["show"] == "error":
-                err = np.where(compared, r.field(q) - exact.field(q), np.nan)
-                values, label = np.nan_to_num(err), f"{q} error ({est} - exact)"
-                rms = float(np.sqrt(np.nanmean(err**2)))
-                scale = float(np.sqrt(np.nanmean(np.where(compared, exact.field(q), np.nan) ** 2)))
-                rel = f" ({100 * rms / scale:.3g} % of RMS |{q}|)" if scale > 0 else ""
-                summary = f"RMS error {rms:.4g}{rel} over {int(compared.sum())} vertices"
-            elif params["show"] == "disagreement":
-                values = _disagreement(Vs, m.F, q)
-                label, summary = f"{q} disagreement (max - min)", _dis_summary(values)
-            else:
-                values, label = r.field(q), f"{q} ({est})"
-                ex = exact.field(q)
-                summary = f"exact {q} in [{np.nanmin(ex):.4g}, {np.nanmax(ex):.4g}]"
-            conv = _convergence(params) if params["show"] == "error" else []
-            return LabResult(
-                Vs, m.F, values, label, r, exact.d1, summary, conv, (exact.k1, exact.k2)
-            )
+            if base is None or base.key != base_key(params):
+                base = make_base(params)
+            return _surface_result(params, base)
         V = np.asarray(V, dtype=np.float64)
         F = np.asarray(F, dtype=np.int64)
+        q, est = params["quantity"], params["estimator"]
         r = estimate_curvature(V, F, est)
         if params["show"] == "disagreement":
             values = _disagreement(V, F, q)
@@ -208,9 +222,45 @@ class CurvatureLabState:
         summary = note or f"{q} in [{values.min():.4g}, {values.max():.4g}]"
         return LabResult(V, F, values, f"{q} ({est})", r, None, summary)
 
+    def study_key(self) -> tuple[Any, ...] | None:
+        """What the convergence study depends on, ``(surface, estimator, noise, jitter,
+        flips)``; ``None`` when no study is shown (the loaded mesh, or not the error map)."""
+        if self.source != "surface" or self.show != "error":
+            return None
+        return (self.surface, self.estimator, self.noise, self.jitter, self.flips)
+
+    @staticmethod
+    def study(params: dict[str, Any], progress: Any = None) -> list[dict[str, Any]]:
+        """The estimator's :func:`~meshlap_core.curvature_study.curvature_study` rows at
+        :data:`STUDY_LEVELS` (``h``, ``H_rel``, ``K_rel``, ``H_order``, ...): the log-log plot
+        of the error against h (any thread or a child process)."""
+        return curvature_study(
+            [params["surface"]],
+            [params["estimator"]],
+            STUDY_LEVELS,
+            params["noise"],
+            params["jitter"],
+            flips=params["flips"],
+            progress=progress,
+        )
+
+    def convergence(self) -> list[dict[str, Any]]:
+        """The study rows for the current settings (empty until computed or when not shown)."""
+        key = self.study_key()
+        return self.studies.get(key, []) if key is not None else []
+
+    def adopt_study(self, key: tuple[Any, ...], rows: list[dict[str, Any]]) -> None:
+        """Keep the study ``rows`` computed for ``key`` (a failed study keeps ``[]``)."""
+        self.studies[key] = rows
+
     def adopt(self, inputs: tuple[Any, ...], result: LabResult) -> None:
         """Take ``result``, computed for ``inputs`` (a picked vertex stays if it exists)."""
         self.result, self.computed_for = result, inputs
+        if result.base is not None:
+            self.bases.pop(result.base.key, None)
+            self.bases[result.base.key] = result.base
+            while len(self.bases) > KEEP_BASES:
+                self.bases.pop(next(iter(self.bases)))
         if self.vertex >= len(result.V):
             self.vertex = -1
 
@@ -233,18 +283,29 @@ class CurvatureLabState:
         return shape_operator_at(self.result, self.vertex)
 
 
-def _convergence(params: dict[str, Any]) -> list[dict[str, Any]]:
-    """The estimator's errors at a quarter, half and the full resolution (at least 4 cells)."""
-    n = int(params["res"])
-    levels = sorted({max(4, n // 4), max(4, n // 2), n})
-    return curvature_study(
-        [params["surface"]],
-        [params["estimator"]],
-        levels,
-        params["noise"],
-        params["jitter"],
-        flips=params["flips"],
-    )
+def _surface_result(params: dict[str, Any], base: Base) -> LabResult:
+    """The estimate on ``base``'s mesh after flips and noise, and the field shown."""
+    q, est = params["quantity"], params["estimator"]
+    m, Vs = flipped_and_noisy(base.mesh, params["noise"], flips=params["flips"])
+    r = estimate_curvature(Vs, m.F, est)
+    ex = base.exact
+    exact = PrincipalCurvatures(ex.k1, ex.k2, ex.d1, ex.d2, np.zeros_like(ex.d1), "exact")
+    compared = ex.compared
+    if params["show"] == "error":
+        err = np.where(compared, r.field(q) - exact.field(q), np.nan)
+        values, label = np.nan_to_num(err), f"{q} error ({est} - exact)"
+        rms = float(np.sqrt(np.nanmean(err**2)))
+        scale = float(np.sqrt(np.nanmean(np.where(compared, exact.field(q), np.nan) ** 2)))
+        rel = f" ({100 * rms / scale:.3g} % of RMS |{q}|)" if scale > 0 else ""
+        summary = f"RMS error {rms:.4g}{rel} over {int(compared.sum())} vertices"
+    elif params["show"] == "disagreement":
+        values = _disagreement(Vs, m.F, q)
+        label, summary = f"{q} disagreement (max - min)", _dis_summary(values)
+    else:
+        values, label = r.field(q), f"{q} ({est})"
+        exq = exact.field(q)
+        summary = f"exact {q} in [{np.nanmin(exq):.4g}, {np.nanmax(exq):.4g}]"
+    return LabResult(Vs, m.F, values, label, r, exact.d1, summary, (exact.k1, exact.k2), base)
 
 
 def shape_operator_at(r: LabResult, i: int, n: int = 73) -> dict[str, Any]:
