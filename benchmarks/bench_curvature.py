@@ -1,7 +1,14 @@
 """Time every principal-curvature estimator beside libigl's quadric fit (and pymeshlab's
 curvature filter when it is installed), on a 131k-vertex torus and on armadillo_igl.
 
-Run: ``python benchmarks/bench_curvature.py [--repeat 3] [--major 512 --minor 256]``.
+Run: ``python benchmarks/bench_curvature.py [--repeat 3] [--major 512 --minor 256]
+[--lab-res 128] [--only lab]``.
+
+The curvature lab's error map per slider move on the 32k-vertex torus (``--lab-res 128``:
+256 × 128 cells): what one move used to cost (the estimate, the exact surface and a three-level
+convergence study in one job) beside what it costs now (the error map alone, the exact surface
+taken from the cache unless the resolution or jitter moved; the study is a second job, kept per
+surface, estimator, noise, jitter and flips). The goal is < 100 ms per move.
 
 In one process, best of ``--repeat`` wall times. The baseline a user would write is libigl:
 ``igl.principal_curvature(V, F, radius)`` (radius 2 and 5 edge rings) and
@@ -20,6 +27,7 @@ import numpy as np
 from _util import best_of, print_table, shared_mesh
 
 from meshlap_core.curvature_estimators import estimate_curvature
+from meshlap_core.curvature_study import curvature_study
 from meshlap_core.io import load_mesh
 from meshlap_core.options import CURVATURE_ESTIMATORS
 from meshlap_core.primitives import torus_mesh
@@ -71,12 +79,59 @@ def run(name: str, V: np.ndarray, F: np.ndarray, repeat: int, H_exact: np.ndarra
     print_table(["estimator", "seconds", "x libigl quadric r=5", "H rel. L2 error"], rows)
 
 
+def lab_rows(res: int, repeat: int) -> None:
+    """The lab's error map per slider move, before and after the split (see the module notes)."""
+    from meshlap_app.state.curvature_lab import CurvatureLabState
+
+    lab = CurvatureLabState()  # the torus, H error
+    lab.set_number("res", res)
+    first = CurvatureLabState.compute(lab.params(), None, None)
+    lab.adopt(lab.inputs(0), first)
+    print(f"\ncurvature lab error map, torus {2 * res} x {res} cells: {len(first.V)} vertices")
+    rows: list[list[object]] = []
+    for est in ("cotan", "rusinkiewicz", "normal_cycle"):
+        lab.set_choice("estimator", est)
+        p = lab.params()
+        levels = sorted({max(4, res // 4), max(4, res // 2), res})
+
+        def before(p: dict = p, levels: list = levels) -> object:
+            CurvatureLabState.compute(p, None, None)  # no cache
+            return curvature_study([p["surface"]], [p["estimator"]], levels)
+
+        t_before, _ = best_of(before, 1)
+        t_res, _ = best_of(lambda p=p: CurvatureLabState.compute(p, None, None), repeat)
+        lab.set_number("noise", 0.001)
+        q = lab.params()
+        t_noise, _ = best_of(
+            lambda q=q: CurvatureLabState.compute(q, None, None, lab.base()), repeat
+        )
+        lab.set_number("noise", 0.0)
+        t_study, _ = best_of(lambda p=p: CurvatureLabState.study(p), 1)
+        rows.append([est, t_before, t_res, t_noise, t_before / t_noise, t_study])
+    print_table(
+        [
+            "estimator",
+            "before: one job (s)",
+            "resolution move (s)",
+            "noise / estimator move (s)",
+            "x faster",
+            "study job, separate (s)",
+        ],
+        rows,
+    )
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--major", type=int, default=512)
     ap.add_argument("--minor", type=int, default=256)
+    ap.add_argument("--lab-res", type=int, default=128, help="the lab's torus: 2N x N cells")
+    ap.add_argument("--only", choices=("all", "lab"), default="all")
     args = ap.parse_args()
+    lab_rows(args.lab_res, args.repeat)
+    if args.only == "lab":
+        return
     V, F = torus_mesh(args.major, args.minor)
     v = np.arctan2(V[:, 2], np.hypot(V[:, 0], V[:, 1]) - 3.0)
     H = 0.5 * (1.0 + np.cos(v) / (3.0 + np.cos(v)))

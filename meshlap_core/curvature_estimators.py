@@ -32,6 +32,7 @@ from collections.abc import Callable
 from typing import Any
 
 import numpy as np
+import scipy.sparse as sp
 
 from .curvature import (
     _cotan_H,
@@ -112,13 +113,14 @@ def _edge_tensor_fit(
         np.divide(co, r, out=np.zeros_like(co), where=r > 0),
         np.divide(si, r, out=np.zeros_like(si), where=r > 0),
     )
-    rows = np.stack([co * co, 2 * co * si, si * si], axis=1)
-    A = np.zeros((n, 3, 3))
-    rhs = np.zeros((n, 3))
-    for i in range(3):
-        rhs[:, i] = np.bincount(src, rows[:, i] * kappa, minlength=n)
-        for j in range(3):
-            A[:, i, j] = np.bincount(src, rows[:, i] * rows[:, j], minlength=n)
+    a, b, c = co * co, 2 * co * si, si * si
+    # the normal equations' 6 distinct entries and right-hand side summed per vertex in one
+    # sparse product (one pass over the half-edges instead of 12 bincounts)
+    W = np.stack([a * a, a * b, a * c, b * b, b * c, c * c, a * kappa, b * kappa, c * kappa], 1)
+    S = sp.csr_matrix((np.ones(len(src)), (src, np.arange(len(src)))), shape=(n, len(src)))
+    sums = np.asarray(S @ W)
+    A = sums[:, [0, 1, 2, 1, 3, 4, 2, 4, 5]].reshape(n, 3, 3)
+    rhs = sums[:, 6:]
     A += 1e-12 * np.eye(3) * (np.trace(A, axis1=1, axis2=2)[:, None, None] + 1e-300)
     x = np.linalg.solve(A, rhs[:, :, None])[:, :, 0]
     return x[:, 0], x[:, 1], x[:, 2]

@@ -23,7 +23,7 @@ import numpy as np
 
 from .curvature_estimators import estimate_curvature
 from .errors import MeshError
-from .noise import add_noise
+from .noise import add_noise, check_noise
 from .options import CURVATURE_ESTIMATORS, check_choice
 from .principal import PrincipalCurvatures
 from .surfaces import (
@@ -175,11 +175,20 @@ def jittered_mesh(
 
 
 def flipped_and_noisy(
-    m: SurfaceMesh, noise: float = 0.0, seed: int = 0, flips: float = 0.0
+    m: SurfaceMesh,
+    noise: float = 0.0,
+    seed: int = 0,
+    flips: float = 0.0,
+    normals: FloatArray | None = None,
 ) -> tuple[SurfaceMesh, FloatArray]:
     """``m`` with a fraction ``flips`` of its interior edges flipped (:func:`flip_edges`) and
     its positions displaced along the normal by Gaussian noise of standard deviation
     ``noise × bbox diagonal`` (the last two steps of :func:`perturbed_mesh`; ``m`` unchanged).
+
+    ``normals`` : (n,3) float, optional
+        The unit vertex normals of ``m`` (:func:`meshlap_core.curvature.vertex_normals`) when
+        already known (the lab caches them): used when no edge is flipped, the same noise as
+        :func:`meshlap_core.noise.add_noise` with ``mode="normal"`` without recomputing them.
 
     Returns
     -------
@@ -192,6 +201,10 @@ def flipped_and_noisy(
         m = SurfaceMesh(
             m.V, flip_edges(m.V, m.F, flips, seed), m.uv, m.pole, m.boundary, m.surface, m.res
         )
+    if noise > 0 and normals is not None and not flips > 0:
+        sigma = check_noise(m.V, noise)
+        z = np.random.default_rng(seed).standard_normal(len(m.V))
+        return m, m.V + (sigma * z)[:, None] * normals
     V = add_noise(m.V, m.F, noise, mode="normal", seed=seed) if noise > 0 else m.V
     return m, V
 

@@ -11,6 +11,7 @@ from meshlap_app.state.curvature_lab import STUDY_LEVELS, CurvatureLabState, cro
 from meshlap_core import curvature_estimators as ce
 from meshlap_core import primitives
 from meshlap_core.errors import MeshError
+from meshlap_core.noise import add_noise
 
 
 def _compute(lab: CurvatureLabState, V=None, F=None):
@@ -70,6 +71,13 @@ def test_noise_and_flips_reuse_the_cached_exact_surface():
     np.testing.assert_array_equal(cached.values, fresh.values)
     np.testing.assert_array_equal(cached.F, fresh.F)
     assert not np.array_equal(cached.F, first.F)  # the flips are there
+    # the cached normals give the noise of add_noise (without flips, where they are used)
+    lab.set_number("flips", 0.0)
+    cached = CurvatureLabState.compute(lab.params(), None, None, lab.base())
+    m = first.base.mesh
+    noisy = add_noise(m.V, m.F, 0.003, mode="normal", seed=0)
+    np.testing.assert_array_equal(cached.V, noisy)
+    np.testing.assert_array_equal(cached.values, _compute(lab).values)
     # a cache for other settings is never used by mistake
     lab.set_number("jitter", 0.2)
     assert lab.base() is None

@@ -10,6 +10,7 @@ from typing import Any
 
 import numpy as np
 
+from meshlap_core.curvature import vertex_normals
 from meshlap_core.curvature_estimators import disagreement, estimate_curvature
 from meshlap_core.curvature_study import (
     ExactPrincipal,
@@ -89,6 +90,7 @@ class Base:
     key: tuple[Any, ...]  # (surface, res, jitter)
     mesh: Any  # SurfaceMesh
     exact: ExactPrincipal
+    normals: FloatArray  # (n,3) unit vertex normals of the mesh (the noise's direction)
 
 
 def base_key(params: dict[str, Any]) -> tuple[Any, ...]:
@@ -101,7 +103,7 @@ def make_base(params: dict[str, Any]) -> Base:
     n = int(params["res"])
     res = (2 * n, n) if params["surface"] == "torus" else (n, n)
     m = jittered_mesh(params["surface"], res, params["jitter"])
-    return Base(base_key(params), m, exact_principal(m, m.surface))
+    return Base(base_key(params), m, exact_principal(m, m.surface), vertex_normals(m.V, m.F))
 
 
 @dataclass
@@ -286,7 +288,9 @@ class CurvatureLabState:
 def _surface_result(params: dict[str, Any], base: Base) -> LabResult:
     """The estimate on ``base``'s mesh after flips and noise, and the field shown."""
     q, est = params["quantity"], params["estimator"]
-    m, Vs = flipped_and_noisy(base.mesh, params["noise"], flips=params["flips"])
+    m, Vs = flipped_and_noisy(
+        base.mesh, params["noise"], flips=params["flips"], normals=base.normals
+    )
     r = estimate_curvature(Vs, m.F, est)
     ex = base.exact
     exact = PrincipalCurvatures(ex.k1, ex.k2, ex.d1, ex.d2, np.zeros_like(ex.d1), "exact")
