@@ -75,6 +75,19 @@ def non_default_session(mesh) -> Session:
             "gain": 3.0,
             "hks_scale": 2,
         },
+        "curvature_lab": {
+            "source": "mesh",
+            "estimator": "jet",
+            "quantity": "k1",
+            "show": "estimate",
+            "crosses": False,
+            "surface": "saddle",
+            "res": 20,
+            "noise": 0.001,
+            "jitter": 0.2,
+            "flips": 0.1,
+            "vertex": 40,
+        },
     }
     return s
 
@@ -158,6 +171,13 @@ WRONG_VALUES = [
     ("surfaces", "u", "nan"),
     ("surfaces", "theta", "30"),
     ("spectral", "play", "k"),
+    ("curvature_lab", "estimator", "magic"),
+    ("curvature_lab", "res", 2),
+    ("curvature_lab", "noise", 0.5),
+    ("curvature_lab", "jitter", -0.1),
+    ("curvature_lab", "flips", "0.1"),
+    ("curvature_lab", "crosses", 0),
+    ("curvature_lab", "vertex", -2),
 ]
 
 
@@ -721,3 +741,58 @@ def test_every_method_replays_lam_changes_exactly(
     assert st2.smoother.method == method and st2.lam == lams[1]
     assert np.array_equal(st2.V, st.V)
     assert st2.lam_steps == st.lam_steps
+
+
+def test_curvature_lab_vertex_must_exist_on_the_labs_mesh(tmp_path, sphere):
+    from meshlap_app.state.mesh import MeshState
+    from meshlap_app.state.session import check_session_mesh
+
+    mesh = MeshState()
+    assert mesh.load(sphere)
+    s = Session(mesh=sphere.resolve())
+    lab = s.settings["curvature_lab"]
+    lab.update(surface="saddle", res=8, vertex=80)  # a 9 x 9 grid: vertices 0..80
+    check_session_mesh(s, mesh, "x")
+    lab["vertex"] = 81
+    with pytest.raises(MeshError, match=r"curvature_lab.vertex.*0\.\.80"):
+        check_session_mesh(s, mesh, "x")
+    lab.update(source="mesh", vertex=161)  # the icosphere(2): 162 vertices
+    check_session_mesh(s, mesh, "x")
+    lab["vertex"] = 162
+    with pytest.raises(MeshError, match=r"0\.\.161"):
+        check_session_mesh(s, mesh, "x")
+
+
+def test_a_saved_session_reopens_the_curvature_lab(mock, tmp_path, sphere, monkeypatch):
+    from meshlap_app import session
+
+    monkeypatch.setenv("MESHLAP_CACHE_DIR", str(tmp_path / "cache"))
+    viewer = new_viewer(sphere)
+    panel = viewer.panels["curvature_lab"]
+    lab = panel.state
+    lab.set_choice("estimator", "rusinkiewicz")
+    lab.set_choice("quantity", "K")
+    lab.set_choice("surface", "catenoid")
+    lab.set_number("res", 10)
+    lab.set_number("noise", 0.002)
+    lab.set_number("jitter", 0.1)
+    lab.crosses = False
+    viewer.set_panel("curvature_lab")
+    tick(viewer)
+    assert lab.result is not None and lab.convergence(), viewer.state.errors
+    lab.pick(23)
+    tick(viewer)
+    values, conv = lab.result.values.copy(), lab.convergence()
+    path = session.save(viewer, tmp_path / "lab.json")
+    assert json.loads(path.read_text())["curvature_lab"]["vertex"] == 23
+
+    fresh = new_viewer(sphere)
+    session.load(fresh, path)
+    tick(fresh)
+    tick(fresh)
+    back = fresh.panels["curvature_lab"].state
+    assert fresh.state.panel == "curvature_lab"
+    assert back.settings() == lab.settings()
+    assert back.vertex == 23 and back.shape_operator()["k1"] == lab.shape_operator()["k1"]
+    np.testing.assert_array_equal(back.result.values, values)  # the same error map
+    assert back.convergence() == conv  # and the same study

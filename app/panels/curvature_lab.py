@@ -53,6 +53,13 @@ class CurvatureLabPanel(Panel):
     def on_new_mesh(self, host: Host) -> None:
         self.watch.forget()
 
+    def capture(self, host: Host) -> dict[str, Any]:
+        return self.state.settings()
+
+    def configure(self, host: Host, values: dict[str, Any]) -> None:
+        self.state.configure(values)
+        self.watch.forget()
+
     def show(self, host: Host, active: Panel) -> None:
         if active is self:
             self.sync(host)

@@ -28,8 +28,10 @@ from meshlap_core.options import (
     check_choice,
 )
 from meshlap_core.principal import PrincipalCurvatures, tangent_frames
-from meshlap_core.surfaces import SURFACES
+from meshlap_core.surfaces import SURFACES, mesh_surface
 from meshlap_core.types import FloatArray, IntArray
+
+from .checks import Schema, boolean, integer, number, one_of
 
 MAX_RES = 256
 """Largest lab resolution (cells per direction; the torus gets twice as many around)."""
@@ -41,6 +43,51 @@ STUDY_LEVELS = (8, 16, 32, 64)
 """Resolutions of the lab's convergence study (fixed: a resolution move keeps the plot)."""
 KEEP_BASES = 6
 """Exact surfaces kept (per surface, resolution and jitter): a slider moved back is instant."""
+
+
+SESSION: Schema = {
+    "source": ("surface", one_of(LAB_SOURCES)),
+    "estimator": ("cotan", one_of(CURVATURE_ESTIMATORS)),
+    "quantity": ("H", one_of(PRINCIPAL_FIELDS)),
+    "show": ("error", one_of(LAB_SHOWS)),
+    "crosses": (True, boolean),
+    "surface": ("torus", one_of(tuple(SURFACES))),
+    "res": (32, integer(3, MAX_RES)),
+    "noise": (0.0, number(0.0, MAX_NOISE)),
+    "jitter": (0.0, number(0.0, MAX_JITTER)),
+    "flips": (0.0, number(0.0, 1.0)),
+    "vertex": (-1, integer(-1)),
+}
+"""The Curvature lab's section of a saved session (:mod:`.session`): its choices, sliders and
+the picked vertex (of the lab's mesh: the parametric surface's at ``res``, or the loaded
+mesh)."""
+
+
+def lab_vertex_count(values: dict[str, Any], mesh: Any) -> int:
+    """Vertices of the lab's mesh for the session ``values`` (the loaded ``mesh``'s, or the
+    parametric surface's at ``res``: its grid, as :func:`make_base` meshes it)."""
+    if values["source"] == "mesh":
+        return len(mesh.V)
+    n = int(values["res"])
+    res = (2 * n, n) if values["surface"] == "torus" else (n, n)
+    return len(mesh_surface(values["surface"], res).V)
+
+
+def check_session(values: dict[str, Any], mesh: Any, source: Any) -> None:
+    """A saved picked vertex that the lab's mesh has.
+
+    Raises
+    ------
+    MeshError
+        ``vertex`` beyond the lab's mesh (named with its size).
+    """
+    v = values["vertex"]
+    if v >= 0:
+        n = lab_vertex_count(values, mesh)
+        if v >= n:
+            raise MeshError(
+                f'"curvature_lab.vertex" is {v}; the lab\'s mesh has vertices 0..{n - 1}', source
+            )
 
 
 def make_state() -> CurvatureLabState:
@@ -189,6 +236,24 @@ class CurvatureLabState:
                 "flips",
             )
         }
+
+    def settings(self) -> dict[str, Any]:
+        """Its section of a saved session (:data:`SESSION`'s keys)."""
+        out = self.params()
+        out["crosses"] = bool(self.crosses)
+        out["vertex"] = int(self.vertex)
+        return out
+
+    def configure(self, values: dict[str, Any]) -> None:
+        """Take a session's section (checked against :data:`SESSION` and by
+        :func:`check_session`); the result is recomputed for it, the picked vertex kept."""
+        for key in ("source", "estimator", "quantity", "show", "surface"):
+            self.set_choice(key, values[key])
+        for key in ("res", "noise", "jitter", "flips"):
+            self.set_number(key, values[key])
+        self.crosses = bool(values["crosses"])
+        self.result, self.computed_for = None, ()
+        self.vertex = int(values["vertex"])
 
     def base(self) -> Base | None:
         """The cached exact surface for the current settings (``None``: not computed yet)."""
