@@ -24,7 +24,7 @@ import numpy as np
 from .curvature_estimators import estimate_curvature
 from .errors import MeshError
 from .noise import add_noise, check_noise
-from .options import CURVATURE_ESTIMATORS, check_choice
+from .options import CURVATURE_ESTIMATORS, PRINCIPAL_FIELDS, check_choice
 from .principal import PrincipalCurvatures
 from .surfaces import (
     ParametricSurface,
@@ -57,6 +57,10 @@ STUDY_COLUMNS: tuple[str, ...] = (
 ``max(|κ₁|, |κ₂|)`` (resp. its square for K); ``*_order``: log-log slope against ``h`` from the
 previous resolution, empty at the first; angles: ``d1`` against the exact direction where
 ``|κ₁ − κ₂| > 10 %`` of ``max |κ|``)."""
+
+
+H_AND_K: tuple[str, ...] = PRINCIPAL_FIELDS[2:4]
+"""The two quantities whose orders are fitted and plotted (mean and Gaussian curvature)."""
 
 
 @dataclass(frozen=True)
@@ -349,3 +353,79 @@ def curvature_study(
                 rows.append({c: row[c] for c in STUDY_COLUMNS})
                 prev = row
     return rows
+
+
+def fitted_orders(rows: Sequence[dict[str, Any]]) -> dict[tuple[str, str], dict[str, float]]:
+    """The order of every (surface, estimator) of :func:`curvature_study` rows: the slope of
+    the least-squares line through ``(log h, log RMS error)`` over all its resolutions (for
+    ``H`` and ``K``; NaN with fewer than two positive finite errors).
+
+    Returns
+    -------
+    dict
+        ``(surface, estimator) -> {"H": order, "K": order}``.
+    """
+    groups: dict[tuple[str, str], list[dict[str, Any]]] = {}
+    for r in rows:
+        groups.setdefault((r["surface"], r["estimator"]), []).append(r)
+    out: dict[tuple[str, str], dict[str, float]] = {}
+    for key, group in groups.items():
+        h = np.array([r["h"] for r in group], dtype=np.float64)
+        orders = {}
+        for q in H_AND_K:
+            e = np.array([r[f"{q}_rms"] for r in group], dtype=np.float64)
+            ok = np.isfinite(e) & (e > 0) & (h > 0)
+            if np.unique(h[ok]).size < 2:
+                orders[q] = math.nan
+            else:
+                orders[q] = float(np.polyfit(np.log(h[ok]), np.log(e[ok]), 1)[0])
+        out[key] = orders
+    return out
+
+
+def write_study_figure(rows: Sequence[dict[str, Any]], path: Any) -> None:
+    """The log-log plot of the relative RMS error against the mean edge length ``h``, one line
+    per (surface, estimator), ``H`` left and ``K`` right, the :func:`fitted_orders` in the
+    legend; a PNG written atomically (matplotlib's Agg canvas, no pyplot).
+
+    Raises
+    ------
+    MeshError
+        ``path`` does not end in ``.png``, or no row to plot.
+    """
+    from pathlib import Path
+
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+    from matplotlib.ticker import NullFormatter
+
+    from .io import atomic_write
+
+    path = Path(path)
+    if path.suffix.lower() != ".png":
+        raise MeshError(f"the figure is written as PNG; got {path.suffix or 'no suffix'!r}", path)
+    if not rows:
+        raise MeshError("no rows to plot", path)
+    orders = fitted_orders(rows)
+    fig = Figure(figsize=(11.0, 4.8), dpi=110)
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(1, 2)
+    for ax, q in zip(axes, H_AND_K, strict=True):
+        for (surface, est), order in orders.items():
+            group = [r for r in rows if (r["surface"], r["estimator"]) == (surface, est)]
+            h = np.array([r["h"] for r in group], dtype=np.float64)
+            e = np.array([r[f"{q}_rel"] for r in group], dtype=np.float64)
+            ok = np.isfinite(e) & (e > 0)
+            if ok.any():
+                tag = f"{order[q]:.2f}" if math.isfinite(order[q]) else "-"
+                ax.loglog(h[ok], e[ok], "o-", ms=3, lw=1.2, label=f"{surface} {est}: {tag}")
+        ax.xaxis.set_minor_formatter(NullFormatter())  # minor labels overlap on short spans
+        ax.set_xlabel("mean edge length h")
+        ax.set_ylabel(f"relative RMS error of {q}")
+        ax.set_title(f"{q}: error against h (fitted order in the legend)", fontsize=10)
+        ax.grid(alpha=0.3, which="both")
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(fontsize=7, framealpha=0.9)
+    fig.tight_layout()
+    with atomic_write(path, "wb") as fh:
+        fig.savefig(fh, format="png")

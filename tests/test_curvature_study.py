@@ -20,6 +20,7 @@ from meshlap_core.curvature_study import (
     STUDY_COLUMNS,
     curvature_study,
     exact_principal,
+    fitted_orders,
     perturbed_mesh,
     vertex_errors,
 )
@@ -78,6 +79,46 @@ def test_cli_curvature_study_writes_the_csv(tmp_path, capsys):
     assert rows[0]["H_order"] == "" and float(rows[1]["H_order"]) > 1.0
     assert main(["curvature-study", "--estimators", "magic"]) == 2
     assert "--estimators" in capsys.readouterr().err
+
+
+def test_fitted_order_is_the_slope_of_an_exact_power_law():
+    # hand-made rows: H error 3 h², K error 0.5 h (+ a level without K), cotan and jet
+    rows = [
+        {"surface": "torus", "estimator": "cotan", "h": h, "H_rms": 3 * h**2, "K_rms": 0.5 * h}
+        for h in (0.4, 0.2, 0.1, 0.05)
+    ] + [
+        {"surface": "torus", "estimator": "jet", "h": 0.2, "H_rms": 1.0, "K_rms": 0.0},
+        {"surface": "torus", "estimator": "jet", "h": 0.1, "H_rms": 0.5, "K_rms": 0.0},
+    ]
+    orders = fitted_orders(rows)
+    assert orders[("torus", "cotan")] == pytest.approx({"H": 2.0, "K": 1.0})
+    assert orders[("torus", "jet")]["H"] == pytest.approx(1.0)
+    assert np.isnan(orders[("torus", "jet")]["K"])  # no positive error to fit
+
+
+def test_cli_curvature_study_writes_the_figure(tmp_path, capsys):
+    from PIL import Image
+
+    fig = tmp_path / "study.png"
+    args = ["curvature-study", "--surfaces", "torus", "--estimators", "cotan"]
+    args += ["--levels", "8,16,32"]
+    assert main([*args, "--figure", str(fig), "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["figure"] == str(fig)
+    with Image.open(fig) as im:
+        assert im.format == "PNG" and im.size[0] > im.size[1] > 300
+        pixels = np.asarray(im.convert("L"))
+    assert pixels.min() < 100  # something drawn, not a blank canvas
+    # the legend's order is the least-squares slope of the rows: ~2 for cotan on the torus
+    order = fitted_orders(out["rows"])[("torus", "cotan")]
+    assert order["H"] == pytest.approx(2.0, abs=0.3)
+    # a wrong suffix is refused before any work, and nothing is written
+    bad = tmp_path / "study.jpg"
+    assert main([*args, "--figure", str(bad)]) == 2
+    assert "png" in capsys.readouterr().err.lower() and not bad.exists()
+    # the figure is replaced atomically: no temporary file is left beside it
+    assert main([*args, "--figure", str(fig)]) == 0
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["study.png"]
 
 
 def test_cli_curvature_estimator_flags(tmp_path, capsys):

@@ -1,5 +1,6 @@
 """``meshlap curvature-study``: every curvature estimator against the exact curvature of the
-parametric surfaces under refinement, as a table of errors and observed orders (CSV)."""
+parametric surfaces under refinement, as a table of errors and observed orders (CSV) and a
+log-log figure of the error against h with the fitted orders (PNG)."""
 
 from __future__ import annotations
 
@@ -9,7 +10,7 @@ import io
 import math
 from pathlib import Path
 
-from ..curvature_study import STUDY_COLUMNS, curvature_study
+from ..curvature_study import STUDY_COLUMNS, curvature_study, write_study_figure
 from ..errors import MeshError
 from ..io import check_output_path
 from ..io.atomic import atomic_write
@@ -50,6 +51,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--flips", type=float, default=0.0, help="fraction of interior edges flipped")
     p.add_argument("--seed", type=int, default=0, help="noise, jitter and flips seed")
     p.add_argument("--csv", default=None, help="write the table as CSV here")
+    p.add_argument(
+        "--figure",
+        default=None,
+        help="write the log-log plot of error vs h (H and K, fitted orders) as PNG here",
+    )
     add_json_flag(p)
     p.set_defaults(func=run)
 
@@ -73,6 +79,9 @@ def run(args: argparse.Namespace) -> int:
     out = Path(args.csv) if args.csv else None
     if out is not None:
         check_output_path(out, suffixes=(".csv",))
+    figure = Path(args.figure) if args.figure else None
+    if figure is not None:
+        check_output_path(figure, suffixes=(".png",))
     surfaces = _names(args.surfaces, list(SURFACES), "--surfaces")
     estimators = _names(args.estimators, CURVATURE_ESTIMATORS, "--estimators")
     levels = parse_list(args.levels, int, "--levels")
@@ -92,8 +101,16 @@ def run(args: argparse.Namespace) -> int:
     if out is not None:
         with atomic_write(out) as f:
             f.write(buf.getvalue())
+    if figure is not None:
+        write_study_figure(rows, figure)
     if args.json:
-        emit_json({"rows": rows, "csv": str(out) if out else None})
+        emit_json(
+            {
+                "rows": rows,
+                "csv": str(out) if out else None,
+                "figure": str(figure) if figure else None,
+            }
+        )
         return 0
     show = ("surface", "estimator", "res", "n_vertices", "H_rel", "H_order", "K_rel", "K_order")
     print(" ".join(f"{c:>12}" for c in show) + f" {'angle_p95':>10}")
@@ -102,4 +119,6 @@ def run(args: argparse.Namespace) -> int:
         print(" ".join(f"{c:>12}" for c in cells))
     if out is not None:
         print(f"wrote {out}")
+    if figure is not None:
+        print(f"wrote {figure}")
     return 0
