@@ -35,15 +35,19 @@ import numpy as np
 import scipy.sparse as sp
 
 from .curvature import (
+    _areas_from,
+    _cotan_Cx,
     _cotan_H,
     _deficit_from,
+    _face_frame,
     _face_geometry,
+    _geometry_of,
     _normals_from,
     principal_curvature_quadric,
 )
 from .curvature_fit import jet_curvatures
 from .errors import MeshError
-from .laplacian import cotan_stiffness, vertex_areas
+from .laplacian import vertex_areas
 from .options import (
     CURVATURE_AREA,
     CURVATURE_ESTIMATORS,
@@ -152,10 +156,11 @@ def cotan_curvatures(
     """
     V, F = as_mesh(V, F)
     n = len(V)
-    fn, theta = _face_geometry(V, F)
+    fr = _face_frame(V, F)  # one pass over the faces for the normals, angles and C x
+    fn, theta = _geometry_of(fr)
     N = _normals_from(F, n, fn, theta)
-    A = vertex_areas(V, F, area)
-    H = _cotan_H(cotan_stiffness(V, F) @ V, A, N)
+    A = _areas_from(V, F, fr, area)
+    H = _cotan_H(_cotan_Cx(fr, F, n), A, N)  # C x without assembling C
     d = _deficit_from(F, n, theta, boundary)
     K = np.divide(d, A, out=np.zeros_like(d), where=A > 0)
     r = np.sqrt(np.maximum(H * H - K, 0.0))
