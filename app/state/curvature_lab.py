@@ -115,7 +115,8 @@ class LabResult:
     exact : ((n,) float, (n,) float) or None
         The exact ``(k1, k2)`` on a parametric mesh.
     base : Base or None
-        The jittered mesh and its exact values, for the state's cache (parametric surfaces).
+        The jittered mesh and its exact values when they were computed for this result, for the
+        state's cache (``None`` on the loaded mesh or when the cached one was used).
     """
 
     V: FloatArray
@@ -268,9 +269,11 @@ class CurvatureLabState:
         exact surface for ``params`` (computed when ``None`` or for other settings). The
         convergence study is separate (:meth:`study`)."""
         if params["source"] == "surface":
-            if base is None or base.key != base_key(params):
-                base = make_base(params)
-            return _surface_result(params, base)
+            if base is not None and base.key == base_key(params):
+                result = _surface_result(params, base)
+                result.base = None  # the state has it: not sent back from a child process
+                return result
+            return _surface_result(params, make_base(params))
         V = np.asarray(V, dtype=np.float64)
         F = np.asarray(F, dtype=np.int64)
         q, est = params["quantity"], params["estimator"]
