@@ -86,12 +86,14 @@ def drive_diffusion_widgets(viewer) -> None:
     assert 0 < st.exact_stats["mean"] < st.exact_stats["max"] < 1
     drive(viewer, "show error map", True)
     assert st.heat_field == "difference"
+    drive(viewer, "isolines", True)  # the error map's own setting (off at first)
+    assert panel.isolines.of("distance error").on and panel.isolines.of("distance").on
     drive(viewer, "show error map", False)
     drive(viewer, "isolines", False)
-    assert not st.isolines
+    assert not panel.isolines.of("distance").on
     drive(viewer, "isolines", True)
     drive(viewer, "isoline count", 5, 0, 10**6)
-    assert st.isoline_count == 200  # clamped
+    assert panel.isolines.of("distance").count == 200  # clamped
 
     # heat: Euler alone, then with the Spectral view's basis the two ways and their difference
     drive(viewer, "show", "heat")

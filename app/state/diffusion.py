@@ -127,8 +127,6 @@ class DiffusionState:
     heat_field: str = "euler"
     m: float = 1.0
     boundary: str = DEFAULT_HEAT_BOUNDARY
-    isolines: bool = True
-    isoline_count: int = 12
     filter: str = "low-pass"
     keep: int = 10
     gain: float = 2.0
@@ -334,16 +332,6 @@ class DiffusionState:
 
     def hks_time(self) -> float:
         return float(self._hks[2][self.hks_scale]) if self._hks is not None else float("nan")
-
-
-def isoline_period(values: FloatArray | None, count: int) -> float:
-    """The spacing of ``count`` isolines over the finite range of ``values``."""
-    if values is None:
-        return 1.0
-    v = np.asarray(values)
-    v = v[np.isfinite(v)]
-    span = float(v.max() - v.min()) if v.size else 0.0
-    return span / max(int(count), 1) if span > 0 else 1.0
 
 
 # ---------------------------------------------------------------- meshlap animate
