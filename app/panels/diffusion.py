@@ -381,6 +381,7 @@ class DiffusionPanel(Panel):
         )  # fmt: skip
         if ch:
             st.set_choice("show", show, SHOWS)
+            st.playing = False  # t plays in the heat view only
             self.recompute(host)
         ch, add = ui.checkbox(
             "add clicked vertices", st.add_sources, "on: a click adds a source; off: replaces"
@@ -409,6 +410,14 @@ class DiffusionPanel(Panel):
         )
         if ch:
             st.set_log_t(x)
+            self.recompute(host)
+        if ui.button(
+            "pause t" if st.playing else "play t",
+            "sweep t up its log scale, one step each time the last heat field has arrived",
+        ):
+            st.toggle_play()
+        # a step once the last field is shown: each t refactorizes M + tau K (a job)
+        if st.playing and host.state.jobs.running(self.name) is None and st.play_step():
             self.recompute(host)
         ch, steps = ui.input_int("Euler steps", st.steps, "(M + tau K) u' = M u, tau = t/steps")
         if ch:
