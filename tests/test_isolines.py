@@ -84,6 +84,8 @@ def _field(viewer, panel: str, suffix: str) -> str:
         return "eigenfunction" if suffix == " (mode)" else "error"
     if panel == "curvature_lab":
         return p.state.show
+    if panel in ("surfaces", "check"):
+        return {"surfaces": "Gaussian curvature", "check": "difference"}[panel]
     return p.iso_field()
 
 
@@ -124,6 +126,30 @@ def drive_isolines(viewer) -> None:
         frames(viewer)
         assert not _shown(ledger, MESH, "diffusion field").isolines  # off by default
         _toggle(viewer, ledger, "diffusion", MESH, "diffusion field")
+    drive_surface_isolines(viewer)
+
+
+def drive_surface_isolines(viewer) -> None:
+    """The parametric surface's exact K with its isolines."""
+    from meshlap_app.scene import SURFACE
+
+    with pytest.MonkeyPatch.context() as mp:
+        ledger = Ledger().install(mp)
+        viewer.set_panel("surfaces")
+        frames(viewer)
+        _toggle(viewer, ledger, "surfaces", SURFACE)
+
+
+def drive_check_isolines(viewer) -> None:
+    """The Check view's difference map (a check made on this mesh) with its isolines."""
+    from meshlap_app.panels.check import DIFF
+    from meshlap_app.scene import MESH
+
+    with pytest.MonkeyPatch.context() as mp:
+        ledger = Ledger().install(mp)
+        viewer.set_panel("check")
+        frames(viewer)
+        _toggle(viewer, ledger, "check", MESH, DIFF)
 
 
 def test_isolines_of_every_panel_reach_polyscope(viewer):
