@@ -154,3 +154,21 @@ def drive_check_isolines(viewer) -> None:
 
 def test_isolines_of_every_panel_reach_polyscope(viewer):
     drive_isolines(viewer)
+
+
+def test_heat_animation_frames_carry_the_distance_isolines(viewer, monkeypatch):
+    """``meshlap animate --heat``: each frame's field has the isolines of the view's setting,
+    the count over its range [0, peak]."""
+    ledger = Ledger().install(monkeypatch)
+    panel = viewer.panels["diffusion"]
+    viewer.set_panel("diffusion")
+    frames(viewer)
+    panel.isolines.of("distance", True).set_count(5)
+    opts = {"heat_vertex": 3, "heat_t": (-1.0, 1.0), "heat_frames": 2}
+    captions = list(panel.frames(viewer, opts))
+    assert len(captions) == 2 and "vertex 3" in captions[0]
+    q = ledger.quantities["mesh"]["diffusion field"]
+    assert q.isolines and q.isoline_period == pytest.approx(float(np.max(q.values)) / 5)
+    panel.isolines.of("distance").on = False
+    list(panel.frames(viewer, opts))
+    assert not ledger.quantities["mesh"]["diffusion field"].isolines
