@@ -15,7 +15,9 @@ import pytest
 
 from meshlap_core import curvature as cv
 from meshlap_core import laplacian as lap
+from meshlap_core.diffusion import mean_edge_length
 from meshlap_core.exercises import check_file, template
+from meshlap_core.exercises import geodesic_task as geo
 from meshlap_core.exercises.compare import COMPARE
 from meshlap_core.exercises.diagnose import DIAGNOSES, candidates, diagnose
 from meshlap_core.exercises.meshes import battery, case_named
@@ -58,6 +60,10 @@ WRONG = [  # (student file, task, the diagnosis it must get)
     ("wrong_ring_sorted", "one_ring", "unordered"),
     ("wrong_taubin_parallel", "taubin_step", "not_sequential"),
     ("wrong_eigen_negative", "eigenbasis", "sign_flip"),
+    ("wrong_heat_unnormalised", "heat_geodesic", "gradient_not_normalised"),
+    ("wrong_heat_sign", "heat_geodesic", "divergence_sign"),
+    ("wrong_heat_time", "heat_geodesic", "time_not_scaled"),
+    ("wrong_heat_shift", "heat_geodesic", "not_shifted"),
 ]
 RIGHT = ["right_vectorized", "right_loops", "right_dense", "right_other_order", "right_igl"]
 HOSTILE_TIMEOUT = 4.0
@@ -165,6 +171,23 @@ def _same(task, key, mistake) -> bool:
             if not COMPARE[task.kind](a, b, case, task.power).ok:
                 return False
     return True
+
+
+def test_the_heat_steps_without_a_mistake_are_the_reference():
+    """The mistakes of heat_geodesic are written with heat_steps: with no switch it must give
+    the lab's HeatGeodesic answer, and the distance must scale with the mesh (t = m·h²)."""
+    task = TASKS["heat_geodesic"]
+    answers = {}
+    for name in task.cases:
+        case = case_named(name)
+        ((_, args),) = task.calls(case)
+        ref = task.reference(case, args)
+        t = args[3] * mean_edge_length(case.V, case.F) ** 2
+        mine = geo.heat_steps(case.V, case.F, args[2], t)
+        np.testing.assert_allclose(mine, ref, rtol=0, atol=1e-10 * ref.max())
+        assert ref[args[2]] == 0 and ref.min() == 0 and ref.max() > 0
+        answers[name] = ref
+    np.testing.assert_allclose(answers["scaled"], 250.0 * answers["small_sphere"], rtol=1e-9)
 
 
 def test_every_diagnosis_has_a_sentence():

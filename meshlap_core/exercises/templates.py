@@ -162,6 +162,24 @@ def taubin_step(V, F, lam, mu):
     """
     raise NotImplementedError
 ''',
+    "heat_geodesic": '''
+def heat_geodesic(V, F, source, m):
+    """Geodesic distance from vertex ``source`` by the heat method (Crane, Weischedel &
+    Wardetzky, "Geodesics in heat", ACM TOG 2013), on a closed connected mesh.
+
+    K = −C (cotan_laplacian), M = mass_matrix (mixed Voronoi), h the mean edge length (each
+    edge once), t = m·h² (the time must scale with the mesh):
+    1. heat: solve (M + t K) u = δ, δ one at the source and zero elsewhere;
+    2. per face: X = −∇u / |∇u| (∇ the gradient of the piecewise-linear u; X = 0 where ∇u = 0);
+    3. Poisson: K φ = Gᵀ A X (G the (3m, n) face gradient, A the diagonal of face areas:
+       Gᵀ A X is minus the integrated divergence of X); K is singular (constants): pin one
+       vertex, e.g. φ_0 = 0, and solve for the others;
+    4. d = φ − φ[source].
+
+    Returns d : (n,), 0 at the source and increasing away from it (units of length).
+    """
+    raise NotImplementedError
+''',
 }
 
 
