@@ -16,7 +16,7 @@ import pytest
 from meshlap_core import curvature as cv
 from meshlap_core import laplacian as lap
 from meshlap_core.diffusion import mean_edge_length
-from meshlap_core.exercises import check_file, template
+from meshlap_core.exercises import check_file, guard, template
 from meshlap_core.exercises import geodesic_task as geo
 from meshlap_core.exercises.compare import COMPARE
 from meshlap_core.exercises.diagnose import DIAGNOSES, candidates, diagnose
@@ -301,6 +301,37 @@ def test_a_students_exception_shows_their_frames_only():
         and "multiprocessing" not in tb
         and "numpy" not in tb.split("IndexError")[0].replace("np.", "")
     )
+
+
+def test_a_file_importing_meshlap_is_refused_not_passed(checked):
+    """Returning meshlap's own answer must not pass: an import of meshlap is refused before
+    the file runs (every task, with the line), and a name built at run time is refused when
+    imported (that task's error, the student's line); the file's other tasks still run."""
+    r = checked("cheat_import")
+    assert [t.status for t in r.tasks] == ["import_error"] * 2 and not r.passed
+    for t in r.tasks:
+        assert t.message.startswith("line 3:") and "may not import meshlap" in t.message
+    r = checked("cheat_import_hidden")
+    for task in ("cotan_laplacian", "barycentric_areas"):
+        assert r[task].status == "error" and "may not import meshlap" in r[task].traceback
+        assert "cheat_import_hidden.py" in r[task].traceback
+    assert r["voronoi_areas"].status == "failed"  # numpy still works: only meshlap is refused
+
+
+def test_the_import_scan_reads_every_form_and_nothing_else(tmp_path):
+    cases = {
+        "import meshlap_core\n": 1,
+        "x = 1\ndef f():\n    from meshlap_app.state import check\n": 3,
+        "import importlib\nm = importlib.import_module('meshlap_core.laplacian')\n": 2,
+        "import meshlap\n": 1,
+        "import numpy as np\nimport meshlapx\nfrom . import meshlap_core\n": None,
+        "def broken(:\n": None,  # importing it reports the syntax error
+    }
+    for i, (text, line) in enumerate(cases.items()):
+        path = tmp_path / f"f{i}.py"
+        path.write_text(text)
+        got = guard.scan(str(path))
+        assert (got is None) if line is None else got.startswith(f"line {line}:"), text
 
 
 def test_a_file_that_does_not_parse_is_reported_for_every_task(tmp_path):

@@ -75,6 +75,7 @@ def non_default_session(mesh) -> Session:
             "gain": 3.0,
             "hks_scale": 2,
         },
+        "check": {"file": "hw/exercises.py", "task": "voronoi_areas", "vertex": 5, "checked": True},
     }
     return s
 

@@ -16,7 +16,8 @@ Conventions (the same as the lab's):
 - n = len(V) always: a vertex in no face still has its row (of zeros) and its entry.
 - Every Laplacian is NEGATIVE semidefinite: Δx = −2 H n, with H > 0 on a sphere (outward normals).
 - Matrices may be scipy.sparse or dense numpy arrays of shape (n, n).
-- Use numpy and scipy freely; do not import meshlap (that would be the answer).
+- Use numpy and scipy freely (libigl too); importing meshlap is refused by the checker (it
+  would be the answer).
 """
 
 import numpy as np
