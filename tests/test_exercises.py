@@ -15,12 +15,13 @@ import pytest
 
 from meshlap_core import curvature as cv
 from meshlap_core import laplacian as lap
+from meshlap_core import primitives
 from meshlap_core.diffusion import mean_edge_length
 from meshlap_core.exercises import check_file, guard, template
 from meshlap_core.exercises import geodesic_task as geo
 from meshlap_core.exercises.compare import COMPARE
 from meshlap_core.exercises.diagnose import DIAGNOSES, candidates, diagnose
-from meshlap_core.exercises.meshes import battery, case_named
+from meshlap_core.exercises.meshes import Case, battery, case_named
 from meshlap_core.exercises.tasks import TASKS
 from meshlap_core.options import EXERCISE_TASKS
 from meshlap_core.topology.rings import one_ring
@@ -188,6 +189,26 @@ def test_the_heat_steps_without_a_mistake_are_the_reference():
         assert ref[args[2]] == 0 and ref.min() == 0 and ref.max() > 0
         answers[name] = ref
     np.testing.assert_allclose(answers["scaled"], 250.0 * answers["small_sphere"], rtol=1e-9)
+
+
+def test_heat_reference_on_an_open_mesh_is_the_templates_neumann_step():
+    V, F = primitives.grid(9, 7, 2.0)
+    V[:, 2] = 0.1 * np.sin(3 * V[:, 0]) * V[:, 1]
+    case = Case("grid", V, F, "an open mesh like the viewer's")
+    ((_, args),) = geo.heat_calls(case)
+    ref = geo.heat_reference(case, args)
+    t = args[3] * mean_edge_length(V, F) ** 2
+    np.testing.assert_allclose(geo.heat_steps(V, F, args[2], t), ref, atol=1e-10 * ref.max())
+
+
+def test_an_unreachable_vertex_must_be_inf_in_the_answer_too():
+    """A distance of inf (a component without the source) never widens the tolerance: a
+    finite answer there fails, inf there passes, and the other vertices are still compared."""
+    case = case_named("one_triangle")
+    ref = np.array([0.0, 1.0, np.inf])
+    assert COMPARE["array"](ref.copy(), ref, case, 1).ok
+    assert not COMPARE["array"](np.array([0.0, 1.0, 5.0]), ref, case, 1).ok
+    assert not COMPARE["array"](np.array([0.0, 1.5, np.inf]), ref, case, 1).ok
 
 
 def test_every_diagnosis_has_a_sentence():

@@ -58,6 +58,18 @@ def test_state_rows_put_the_student_beside_the_reference():
     assert st.verdict()[0].startswith("cotan_laplacian") and "cot/2" in "\n".join(st.verdict())
 
 
+def test_heat_distance_on_the_mesh_on_screen():
+    """The heat-method task in the viewer: a missing shift is diagnosed, and its map is one
+    constant, φ[source] = −d[0] (the student pinned φ at vertex 0 and did not shift)."""
+    assert "heat_geodesic" in VIEWER_TASKS
+    V, F = primitives.icosphere(2)
+    check = CheckState.compute(STUDENTS / "wrong_heat_shift.py", "heat_geodesic", V, F)
+    assert check.result.tasks[0].diagnosis == "not_shifted" and check.signed
+    d = check.difference
+    assert np.ptp(d) < 1e-9 * np.abs(check.expected).max() and abs(d[0]) > 0.1
+    np.testing.assert_allclose(d[0], -check.expected[0], rtol=1e-9)  # φ pinned at vertex 0
+
+
 # ---------------------------------------------------------------- widgets (openGL_mock)
 ps = pytest.importorskip("polyscope")
 

@@ -43,8 +43,9 @@ def heat_calls(case: Case) -> list[tuple[str, tuple[Any, ...]]]:
 
 
 def heat_reference(case: Case, args: tuple[Any, ...]) -> np.ndarray:
-    """The lab's heat-method distance from ``args[2]`` with ``t = args[3]·h²``."""
-    return HeatGeodesic(case.V, case.F, m=args[3]).distance([args[2]])
+    """The lab's heat-method distance from ``args[2]`` with ``t = args[3]·h²``; on a mesh with
+    boundary (the viewer's) the heat step is the template's, zero flux (``"neumann"``)."""
+    return HeatGeodesic(case.V, case.F, m=args[3], boundary="neumann").distance([args[2]])
 
 
 def heat_steps(
