@@ -31,6 +31,9 @@ class Quantity:
     colorbar: bool
     vminmax: tuple[float, float] | None
     owner: str = ""  # the panel whose code added it ("" for the host)
+    isolines: bool = False  # ``isolines_enabled`` as passed
+    isoline_period: float | None = None  # ``isoline_period`` as passed (None: not passed)
+    values: Any = None  # the values uploaded (a scalar quantity)
 
 
 def _calling_panel() -> str:
@@ -90,6 +93,9 @@ class Ledger:
                 bool(kw.get("onscreen_colorbar_enabled", False)),
                 None if vm is None else (float(vm[0]), float(vm[1])),
             )
+            q.isolines = bool(kw.get("isolines_enabled", False))
+            q.isoline_period = kw.get("isoline_period")
+            q.values = values
             ledger._add(obj.get_name(), name, q)
             return out
 

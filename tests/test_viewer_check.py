@@ -105,6 +105,9 @@ def drive_check_widgets(viewer, tmp_path: Path) -> None:
         drive(viewer, "vertex", bad)
         assert st.vertex == 5 and "out of range" in viewer.state.errors["check"]
     drive(viewer, "vertex", 6)
+    from test_isolines import drive_check_isolines  # the map's isolines, while it is shown
+
+    drive_check_isolines(viewer)
     # a crashing student file: reported, the viewer and the last good map stay
     drive(viewer, "student file", str(STUDENTS / "hostile_crash.py"))
     drive(viewer, "task", "uniform_laplacian")

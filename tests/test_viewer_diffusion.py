@@ -51,6 +51,42 @@ def compute_basis(viewer, k: int = 40) -> None:
     assert st.basis is not None
 
 
+def drive_heat_play(viewer, hd: HeatDiffusion) -> None:
+    """Play t: one step of ``PLAY_STEP`` (log10 of t/h^2) each time the last heat field
+    arrived; pause holds t; at the top of the range play stops, and plays again from the
+    bottom. Leaves t at 10 h^2."""
+    from meshlap_app.state.diffusion import LOG_T_RANGE, PLAY_STEP
+
+    st = viewer.panels["diffusion"].state
+    h2 = mean_edge_length(viewer.state.mesh.V, viewer.state.mesh.F) ** 2
+    drive(viewer, "play t", True)
+    assert st.playing
+    for _ in range(3):
+        settle(viewer)
+    drive(viewer, "pause t", True)
+    assert not st.playing
+    settle(viewer)
+    x = st.log_t
+    steps = (x - 1.0) / PLAY_STEP
+    assert steps >= 2 and steps == pytest.approx(round(steps), abs=1e-9)  # whole steps up
+    frames(viewer, 3)
+    assert st.log_t == x  # paused: t holds
+    u = hd.euler(unit_heat(np.array(st.sources), hd.mass), 10.0**x * h2, st.steps)
+    np.testing.assert_allclose(st.heat["euler"], u, atol=1e-12)  # the field of the t shown
+    lo, hi = LOG_T_RANGE
+    drive(viewer, "log10 t/h^2", hi - PLAY_STEP / 2)
+    drive(viewer, "play t", True)
+    settle(viewer)
+    frames(viewer, 2)
+    assert not st.playing and st.log_t == hi  # stopped at the top
+    drive(viewer, "play t", True)  # again: from the bottom
+    assert lo <= st.log_t <= lo + 2 * PLAY_STEP
+    drive(viewer, "pause t", True)
+    settle(viewer)
+    drive(viewer, "log10 t/h^2", 1.0)
+    settle(viewer)
+
+
 def drive_diffusion_widgets(viewer) -> None:
     """Every widget of the Diffusion panel, with good and bad values."""
     mesh = viewer.state.mesh
@@ -86,12 +122,14 @@ def drive_diffusion_widgets(viewer) -> None:
     assert 0 < st.exact_stats["mean"] < st.exact_stats["max"] < 1
     drive(viewer, "show error map", True)
     assert st.heat_field == "difference"
+    drive(viewer, "isolines", True)  # the error map's own setting (off at first)
+    assert panel.isolines.of("distance error").on and panel.isolines.of("distance").on
     drive(viewer, "show error map", False)
     drive(viewer, "isolines", False)
-    assert not st.isolines
+    assert not panel.isolines.of("distance").on
     drive(viewer, "isolines", True)
     drive(viewer, "isoline count", 5, 0, 10**6)
-    assert st.isoline_count == 200  # clamped
+    assert panel.isolines.of("distance").count == 200  # clamped
 
     # heat: Euler alone, then with the Spectral view's basis the two ways and their difference
     drive(viewer, "show", "heat")
@@ -106,6 +144,7 @@ def drive_diffusion_widgets(viewer) -> None:
     np.testing.assert_allclose(st.heat["euler"], u, atol=1e-12)
     drive(viewer, "log10 t/h^2", float("nan"))
     assert st.log_t == 1.0
+    drive_heat_play(viewer, hd)
     compute_basis(viewer, k=len(V))  # the full basis: the two ways agree up to Euler's error
     viewer.set_panel("diffusion")
     drive(viewer, "Euler steps", 200)
@@ -251,3 +290,21 @@ def test_view_screenshot_on_a_clicked_vertex(tmp_path, sphere):
     line = img[int(0.25 * h) : int(0.7 * h), int(0.37 * w)].sum(axis=1)  # down the mesh
     jumps = np.count_nonzero(np.abs(np.diff(line)) > 40)  # the isoline bands' edges
     assert jumps >= 4, jumps  # (5 on this view: smooth shading changes by <= 3 a pixel)
+
+
+def test_play_moves_t_up_its_log_scale_and_stops_at_the_top():
+    """The play button's state, headless: whole steps up, a stop at the top, a restart."""
+    from meshlap_app.state.diffusion import LOG_T_RANGE, PLAY_STEP, DiffusionState
+
+    st = DiffusionState(log_t=0.0)
+    assert not st.play_step()  # not playing: t holds
+    st.toggle_play()
+    assert st.play_step() and st.play_step()
+    assert st.log_t == pytest.approx(2 * PLAY_STEP)
+    lo, hi = LOG_T_RANGE
+    st.log_t = hi - PLAY_STEP / 4
+    assert st.play_step() and st.log_t == hi and not st.playing
+    st.toggle_play()  # from the top: starts over at the bottom
+    assert st.playing and st.log_t == lo
+    st.clear()  # a new mesh stops it
+    assert not st.playing

@@ -515,6 +515,9 @@ def test_every_widget_is_driven(viewer, tmp_path, sphere):
     from test_curvature_lab import drive_curvature_lab  # the curvature lab's widgets
 
     drive_curvature_lab(viewer)
+    from test_isolines import drive_isolines  # every view's isoline toggle and count
+
+    drive_isolines(viewer)
     ui = viewer.ui
     undriven = sorted(set(ui.seen) - ui.driven)
     assert not undriven, f"widgets no test drives: {undriven}"

@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Any, ClassVar, Protocol
 
 import numpy as np
 
+from ..state.isolines import Isolines
 from ..state.watch import Watch
 
 if TYPE_CHECKING:
@@ -139,6 +140,7 @@ class Panel:
         self.name = name
         self.state = state  # this panel's slice of the AppState (None: it has none)
         self.watch = Watch()  # what was uploaded, and from which inputs
+        self.isolines = Isolines()  # isoline toggle and count of each scalar field it shows
 
     # -------------------------------------------------------------- every frame
     def draw(self, host: Host) -> None:

@@ -15,6 +15,7 @@ import polyscope as ps
 
 from meshlap_core.errors import MeshError
 
+from ..isolines import draw_isolines
 from ..scene import MESH, colorbar_at, picked_vertex, scalar_for_upload
 from ..state.check import VIEWER_TASKS, CheckState
 from ..ui import RED
@@ -53,7 +54,8 @@ class CheckPanel(Panel):
                 ps.get_surface_mesh(MESH).remove_quantity(DIFF)
                 self.watch.forget("map")
             return
-        if not self.watch.changed("map", mesh.version, id(st.check), host.state.ui_scale):
+        lines = repr(self.isolines)
+        if not self.watch.changed("map", mesh.version, id(st.check), host.state.ui_scale, lines):
             return
         d = np.asarray(st.check.difference, dtype=np.float64)
         r = float(np.abs(d).max()) if d.size else 0.0
@@ -69,6 +71,7 @@ class CheckPanel(Panel):
             enabled=True,
             onscreen_colorbar_enabled=True,
             onscreen_colorbar_location=colorbar_at(0, host.state.ui_scale),
+            **self.isolines.options("difference", values),
         )
 
     def capture(self, host: Host) -> dict[str, Any]:
@@ -154,6 +157,8 @@ class CheckPanel(Panel):
             ui.note("(checked on another mesh: check again)")
         if st.check is not None and st.current(host.state.mesh.version):
             self._draw_rows(host)
+            if st.check.difference is not None and draw_isolines(ui, self.isolines, "difference"):
+                self.sync(host)
 
     def _draw_rows(self, host: Host) -> None:
         ui, st = host.ui, self.state

@@ -10,6 +10,7 @@ import polyscope as ps
 from meshlap_core.options import AREA_KINDS as AREAS
 from meshlap_core.options import BOUNDARY_RULES, CURVATURE_FIELD_LABELS
 
+from ..isolines import draw_isolines
 from ..scene import MESH, MESH_B, colorbar_at, front_view, scalar_for_upload, side_offset
 from .base import Host, Panel
 
@@ -100,6 +101,7 @@ class CurvaturePanel(Panel):
             colorbar,
             host.active() is self,  # the copy (and its colour bar) only in this view
             host.state.ui_scale,
+            repr(self.isolines),
         )
         if not self.watch.changed("uploaded", *key):
             return
@@ -153,8 +155,9 @@ class CurvaturePanel(Panel):
         self._fields_job = (wanted, started)
         return False
 
-    @staticmethod
-    def _add_field(host: Host, sm: Any, name: str, colorbar: bool = False, slot: int = 0) -> None:
+    def _add_field(
+        self, host: Host, sm: Any, name: str, colorbar: bool = False, slot: int = 0
+    ) -> None:
         """Upload the field ``name`` on ``sm``: enabled with its colour bar (at ``slot``,
         :func:`.scene.colorbar_at`) when ``colorbar``, else uploaded but hidden."""
         curv = host.state.curv
@@ -170,6 +173,7 @@ class CurvaturePanel(Panel):
             enabled=colorbar,
             onscreen_colorbar_enabled=colorbar,
             onscreen_colorbar_location=colorbar_at(slot, host.state.ui_scale),
+            **self.isolines.options(name, values),
         )
 
     def draw(self, host: Host) -> None:
@@ -207,7 +211,8 @@ class CurvaturePanel(Panel):
             _, c.second_field = ui.combo(
                 "second field", c.second_field, names, "the field on the copy"
             )
-        if ch1 or ch2 or ch3 or ch4 or ch5:
+        ch6 = draw_isolines(ui, self.isolines, c.field_name)
+        if ch1 or ch2 or ch3 or ch4 or ch5 or ch6:
             self.sync(host)
             host.refresh()
         if ch5:

@@ -18,6 +18,7 @@ from meshlap_core.options import (
 )
 from meshlap_core.surfaces import SURFACES
 
+from ..isolines import draw_isolines
 from ..scene import COLORBAR_AT, picked_vertex
 from ..state.curvature_lab import (
     MAX_JITTER,
@@ -82,7 +83,8 @@ class CurvatureLabPanel(Panel):
         if lab.computed_for != wanted and host.state.jobs.running(self.name) is None:
             self._start(host, wanted)
         r = lab.result
-        if r is None or not self.watch.changed("uploaded", lab.computed_for, lab.crosses):
+        lines = repr(self.isolines)
+        if r is None or not self.watch.changed("uploaded", lab.computed_for, lab.crosses, lines):
             return
         self._upload(host, r)
 
@@ -120,6 +122,7 @@ class CurvatureLabPanel(Panel):
             enabled=True,
             onscreen_colorbar_enabled=True,
             onscreen_colorbar_location=COLORBAR_AT,
+            **self.isolines.options(self.state.show, v),
         )
         if not self.state.crosses:
             return
@@ -224,6 +227,8 @@ class CurvatureLabPanel(Panel):
             ui.text(lab.result.summary)
             self._draw_shape_operator(host)
             self._draw_convergence(host, lab.result)
+        if draw_isolines(ui, self.isolines, lab.show):  # last: the plots above stay in view
+            self.sync(host)
 
     def _draw_shape_operator(self, host: Host) -> None:
         """The picked vertex's 2×2 tensor with its basis and Euler's κn(θ), exact beside it."""

@@ -15,6 +15,7 @@ from meshlap_core.diffusion import HeatGeodesic, exact_distance, mean_edge_lengt
 from meshlap_core.options import FILTER_KINDS, HEAT_BOUNDARIES, SMOOTHING_METHODS
 
 from .. import scene
+from ..isolines import draw_isolines
 from ..scene import MESH, front_view, picked_vertex, side_offset
 from ..state.diffusion import (
     HEAT_FIELDS,
@@ -23,7 +24,6 @@ from ..state.diffusion import (
     SHOWS,
     DiffusionState,
     find_basis,
-    isoline_period,
     symmetric_range,
 )
 from .base import ExportItem, Host, Panel
@@ -37,6 +37,9 @@ INLINE_DISTANCE_MAX = 100_000
 """Up to this many vertices a new source's distance is solved on the UI thread (about 40 ms
 at 43k once factorized); above, as a job."""
 NEEDS_BASIS = "needs an eigenbasis: compute one in the Spectral view first"
+ISOLINES_ON = ("distance", "hks")
+"""Fields whose isolines start shown (heat is ~0 over most of the mesh: its level 0 would
+blacken it)."""
 
 
 class DiffusionPanel(Panel):
@@ -198,12 +201,21 @@ class DiffusionPanel(Panel):
             return f, None, "viridis"
         return None, None, "viridis"
 
+    def iso_field(self) -> str | None:
+        """The isoline settings' name of the field on the mesh (``None``: no field)."""
+        st = self.state
+        if st.show == "filter":
+            return None
+        error = st.heat_field == "difference" and st.show in ("heat", "distance")
+        return f"{st.show} error" if error else st.show
+
     def push(self, host: Host, force: bool = False) -> None:
         """Upload the shown field (with isolines), the sources and the filtered copy."""
         if host.active() is not self or not ps.has_surface_mesh(MESH):
             return
-        st = self.state
-        key = (st.version, st.show, st.heat_field, st.isolines, st.isoline_count)
+        st, name = self.state, self.iso_field()
+        lines = self.isolines.of(name, name in ISOLINES_ON) if name else None
+        key = (st.version, st.show, st.heat_field, lines and (lines.on, lines.count))
         if not self.watch.changed("field", *key) and not force:
             return
         f, vr, cmap = self._field()
@@ -217,20 +229,15 @@ class DiffusionPanel(Panel):
             # unreachable vertices (another component) and undefined errors take the top
             # colour: polyscope refuses non-finite values
             shown = np.where(np.isfinite(f), f, vr[1])
-            lines = st.isolines and st.show in ("distance", "hks")
-            # (heat is ~0 over most of the mesh: its level 0 would blacken it); the period is
-            # only passed with isolines on: setting it turns polyscope's on
-            iso = {"isoline_period": isoline_period(f, st.isoline_count)}
             sm.add_scalar_quantity(
                 FIELD,
                 shown,
                 cmap=cmap,
                 vminmax=vr,
                 enabled=True,
-                isolines_enabled=lines,
                 onscreen_colorbar_enabled=True,
                 onscreen_colorbar_location=scene.COLORBAR_AT,
-                **(iso if lines else {}),
+                **self.isolines.options(str(name), f, name in ISOLINES_ON),
             )
         self._push_sources(host)
         self._push_filtered(host)
@@ -329,8 +336,8 @@ class DiffusionPanel(Panel):
             "heat_field": st.heat_field,
             "m": float(st.m),
             "boundary": st.boundary,
-            "isolines": bool(st.isolines),
-            "isoline_count": int(st.isoline_count),
+            "isolines": bool(self.isolines.of("distance", True).on),
+            "isoline_count": int(self.isolines.of("distance", True).count),
             "filter": st.filter,
             "keep": int(st.keep),
             "gain": float(st.gain),
@@ -339,8 +346,13 @@ class DiffusionPanel(Panel):
 
     def configure(self, host: Host, values: dict[str, Any]) -> None:
         st = self.state
+        lines = self.isolines.of("distance", True)  # the session keeps the distance's
         for key, value in values.items():
-            if key != "sources":
+            if key == "isolines":
+                lines.on = bool(value)
+            elif key == "isoline_count":
+                lines.set_count(value)
+            elif key != "sources":
                 setattr(st, key, value)
 
     def restore(self, host: Host, values: dict[str, Any], active: bool) -> None:
@@ -369,6 +381,7 @@ class DiffusionPanel(Panel):
         )  # fmt: skip
         if ch:
             st.set_choice("show", show, SHOWS)
+            st.playing = False  # t plays in the heat view only
             self.recompute(host)
         ch, add = ui.checkbox(
             "add clicked vertices", st.add_sources, "on: a click adds a source; off: replaces"
@@ -384,18 +397,8 @@ class DiffusionPanel(Panel):
         {"heat": self._draw_heat, "distance": self._draw_distance}.get(
             st.show, self._draw_spectral
         )(host, basis)
-        if st.show in ("distance", "hks"):
-            self._draw_isolines(host)
-
-    def _draw_isolines(self, host: Host) -> None:
-        ui, st = host.ui, self.state
-        ch, on = ui.checkbox("isolines", st.isolines, "level curves of the field on the mesh")
-        if ch:
-            st.isolines = on
-            self.push(host)
-        ch, count = ui.input_int("isoline count", st.isoline_count, "curves over the range")
-        if ch:
-            st.isoline_count = int(min(max(count, 1), 200))
+        name = self.iso_field()
+        if name is not None and draw_isolines(ui, self.isolines, name, name in ISOLINES_ON):
             self.push(host)
 
     def _draw_heat(self, host: Host, basis: Any) -> None:
@@ -407,6 +410,14 @@ class DiffusionPanel(Panel):
         )
         if ch:
             st.set_log_t(x)
+            self.recompute(host)
+        if ui.button(
+            "pause t" if st.playing else "play t",
+            "sweep t up its log scale, one step each time the last heat field has arrived",
+        ):
+            st.toggle_play()
+        # a step once the last field is shown: each t refactorizes M + tau K (a job)
+        if st.playing and host.state.jobs.running(self.name) is None and st.play_step():
             self.recompute(host)
         ch, steps = ui.input_int("Euler steps", st.steps, "(M + tau K) u' = M u, tau = t/steps")
         if ch:
@@ -550,8 +561,8 @@ class DiffusionPanel(Panel):
             top = float(f.max()) or 1.0
             ps.get_surface_mesh(MESH).add_scalar_quantity(
                 FIELD, f, cmap="viridis", vminmax=(0.0, top), enabled=True,
-                isolines_enabled=st.isolines, isoline_period=top / st.isoline_count,
                 onscreen_colorbar_enabled=True, onscreen_colorbar_location=scene.COLORBAR_AT,
+                **self.isolines.options("distance", np.array([0.0, top]), True),
             )  # fmt: skip
             self._push_sources(host)
             yield f"heat from vertex {source}: t = {st.t(h):.3g} = 10^{x:.2f} h^2, peak {top:.3g}"

@@ -13,6 +13,7 @@ import polyscope as ps
 from meshlap_core.errors import MeshError
 
 from .. import scene
+from ..isolines import draw_isolines
 from ..record import Recorder, draw_record
 from ..scene import COLORBAR_AT, EIGEN, MESH, RECON, front_view, side_offset
 from ..state.spectral import ANIMATION, PLAY_KINDS, SCREENSHOT_K, SpectralState
@@ -80,7 +81,9 @@ class SpectralPanel(Panel):
         st = self.state
         if st.basis is None:
             return
-        if not self.watch.changed("mode", st.mode, id(st.basis)) and not force:
+        lines = self.isolines.of("eigenfunction")
+        key = (st.mode, id(st.basis), lines.on, lines.count)
+        if not self.watch.changed("mode", *key) and not force:
             return
         f, _ = st.eigenfunction()
         r = float(np.abs(f).max()) or 1.0
@@ -92,13 +95,15 @@ class SpectralPanel(Panel):
             enabled=True,
             onscreen_colorbar_enabled=True,
             onscreen_colorbar_location=COLORBAR_AT,
+            **self.isolines.options("eigenfunction", f),
         )
 
     def push_k(self, host: Host, force: bool = False) -> None:
         st = self.state
         if st.basis is None:
             return
-        if not self.watch.changed("k", st.k, id(st.basis)) and not force:
+        lines = self.isolines.of("error")
+        if not self.watch.changed("k", st.k, id(st.basis), lines.on, lines.count) and not force:
             return
         X = host.state.display.points(st.reconstruction) + self._offset(host)
         if not ps.has_surface_mesh(RECON):
@@ -118,6 +123,7 @@ class SpectralPanel(Panel):
             enabled=True,
             onscreen_colorbar_enabled=host.active() is self,  # below the eigenfunction's
             onscreen_colorbar_location=scene.colorbar_at(1, host.state.ui_scale),
+            **self.isolines.options("error", st.vertex_error),
         )
 
     def points(self, host: Host, name: str) -> np.ndarray | None:
@@ -252,6 +258,8 @@ class SpectralPanel(Panel):
         if ch:
             st.set_mode(mode)
             self.push_mode(host)
+        if draw_isolines(ui, self.isolines, "eigenfunction", suffix=" (mode)"):
+            self.push_mode(host)
         _, lam = st.eigenfunction()
         ui.text(f"lambda_{st.mode} = {lam:.6g}  (frequency of -Laplacian, >= 0)")
         ch, k = ui.slider_int(
@@ -263,6 +271,8 @@ class SpectralPanel(Panel):
         )
         if ch:
             st.set_k(k)
+            self.push_k(host)
+        if draw_isolines(ui, self.isolines, "error", suffix=" (error)"):
             self.push_k(host)
         e = st.errors
         ui.text(

@@ -13,6 +13,7 @@ import polyscope as ps
 from meshlap_core.errors import MeshError
 
 from .. import scene
+from ..isolines import draw_isolines
 from ..record import Recorder, draw_record
 from ..scene import (
     COLORBAR_AT,
@@ -95,7 +96,7 @@ class SurfacesPanel(Panel):
         sm = surf.mesh
         if sm is None:
             return
-        if self.watch.changed("surface", surf.version):
+        if self.watch.changed("surface", surf.version, repr(self.isolines)):
             s = ps.register_surface_mesh(SURFACE, sm.V, sm.F, smooth_shade=True)
             s.set_transform(Z_TO_Y)
             from meshlap_core.surfaces import surface_curvature_fields as surface_curvature
@@ -111,6 +112,7 @@ class SurfacesPanel(Panel):
                 enabled=True,
                 onscreen_colorbar_enabled=True,
                 onscreen_colorbar_location=COLORBAR_AT,
+                **self.isolines.options("Gaussian curvature", K),
             )
         self.push_point(host)
 
@@ -174,6 +176,8 @@ class SurfacesPanel(Panel):
         ch, res = ui.input_int("resolution", s.res, "cells per parameter direction; Enter applies")
         if ch:
             s.set_resolution(res)
+            self.push(host)
+        if draw_isolines(ui, self.isolines, "Gaussian curvature"):
             self.push(host)
         u0, u1, v0, v1 = s.domain
         ch1, u = ui.slider_float("u", s.u, u0, u1, "%.3f", "first parameter of the point")

@@ -49,6 +49,8 @@ HEAT_FIELDS: tuple[str, ...] = (*HEAT_METHODS, "difference")
 """The heat field on the mesh: backward Euler, the eigen-expansion, or spectral − Euler."""
 LOG_T_RANGE = (-3.0, 4.0)
 """The t slider's range, as log10 of t relative to the mesh's h² (t = 10^x · h²)."""
+PLAY_STEP = 0.05
+"""How far the play button moves t per heat field shown (log10 of t/h²: a decade in 20)."""
 HKS_SCALES = 16
 """Times of the heat kernel signature (log-spaced, Sun et al. 2009)."""
 
@@ -123,12 +125,11 @@ class DiffusionState:
     sources: list[int] = field(default_factory=list)
     add_sources: bool = False  # a click adds a source instead of replacing them
     log_t: float = 0.0  # t = 10^log_t · h²
+    playing: bool = False  # t sweeps up its log scale (the play button)
     steps: int = 1
     heat_field: str = "euler"
     m: float = 1.0
     boundary: str = DEFAULT_HEAT_BOUNDARY
-    isolines: bool = True
-    isoline_count: int = 12
     filter: str = "low-pass"
     keep: int = 10
     gain: float = 2.0
@@ -170,6 +171,7 @@ class DiffusionState:
         self._heat_solver = self._geodesic = self._geodesic_key = None
         self._filter = self._hks = None
         self.error = self.message = ""
+        self.playing = False
         self.version += 1
 
     def t(self, h: float) -> float:
@@ -198,6 +200,24 @@ class DiffusionState:
         if not math.isfinite(value):
             raise MeshError(f"must be a number between {lo:g} and {hi:g}", "log10 t/h^2")
         self.log_t = float(min(max(value, lo), hi))
+
+    def toggle_play(self) -> None:
+        """Play or pause the sweep of t; played from the top of the range, it starts over."""
+        self.playing = not self.playing
+        if self.playing and self.log_t >= LOG_T_RANGE[1]:
+            self.log_t = LOG_T_RANGE[0]
+
+    def play_step(self) -> bool:
+        """Move ``log_t`` up by :data:`PLAY_STEP` while playing (stopping at the top of
+        :data:`LOG_T_RANGE`); True when t moved."""
+        if not self.playing:
+            return False
+        hi = LOG_T_RANGE[1]
+        x = min(self.log_t + PLAY_STEP, hi)
+        self.playing = x < hi
+        moved = x != self.log_t
+        self.log_t = float(x)
+        return moved
 
     def set_m(self, value: float) -> None:
         if not (math.isfinite(value) and value > 0):
@@ -334,16 +354,6 @@ class DiffusionState:
 
     def hks_time(self) -> float:
         return float(self._hks[2][self.hks_scale]) if self._hks is not None else float("nan")
-
-
-def isoline_period(values: FloatArray | None, count: int) -> float:
-    """The spacing of ``count`` isolines over the finite range of ``values``."""
-    if values is None:
-        return 1.0
-    v = np.asarray(values)
-    v = v[np.isfinite(v)]
-    span = float(v.max() - v.min()) if v.size else 0.0
-    return span / max(int(count), 1) if span > 0 else 1.0
 
 
 # ---------------------------------------------------------------- meshlap animate
