@@ -240,6 +240,7 @@ ExerciseTask = Literal[
     "explicit_step",
     "implicit_step",
     "taubin_step",
+    "heat_geodesic",
 ]
 EXERCISE_TASKS: tuple[str, ...] = get_args(ExerciseTask)
 """The exercises of ``meshlap exercises init`` / ``meshlap check --task``, in template order."""

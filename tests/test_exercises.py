@@ -15,10 +15,13 @@ import pytest
 
 from meshlap_core import curvature as cv
 from meshlap_core import laplacian as lap
-from meshlap_core.exercises import check_file, template
+from meshlap_core import primitives
+from meshlap_core.diffusion import mean_edge_length
+from meshlap_core.exercises import check_file, guard, template
+from meshlap_core.exercises import geodesic_task as geo
 from meshlap_core.exercises.compare import COMPARE
 from meshlap_core.exercises.diagnose import DIAGNOSES, candidates, diagnose
-from meshlap_core.exercises.meshes import battery, case_named
+from meshlap_core.exercises.meshes import Case, battery, case_named
 from meshlap_core.exercises.tasks import TASKS
 from meshlap_core.options import EXERCISE_TASKS
 from meshlap_core.topology.rings import one_ring
@@ -58,6 +61,10 @@ WRONG = [  # (student file, task, the diagnosis it must get)
     ("wrong_ring_sorted", "one_ring", "unordered"),
     ("wrong_taubin_parallel", "taubin_step", "not_sequential"),
     ("wrong_eigen_negative", "eigenbasis", "sign_flip"),
+    ("wrong_heat_unnormalised", "heat_geodesic", "gradient_not_normalised"),
+    ("wrong_heat_sign", "heat_geodesic", "divergence_sign"),
+    ("wrong_heat_time", "heat_geodesic", "time_not_scaled"),
+    ("wrong_heat_shift", "heat_geodesic", "not_shifted"),
 ]
 RIGHT = ["right_vectorized", "right_loops", "right_dense", "right_other_order", "right_igl"]
 HOSTILE_TIMEOUT = 4.0
@@ -165,6 +172,43 @@ def _same(task, key, mistake) -> bool:
             if not COMPARE[task.kind](a, b, case, task.power).ok:
                 return False
     return True
+
+
+def test_the_heat_steps_without_a_mistake_are_the_reference():
+    """The mistakes of heat_geodesic are written with heat_steps: with no switch it must give
+    the lab's HeatGeodesic answer, and the distance must scale with the mesh (t = m·h²)."""
+    task = TASKS["heat_geodesic"]
+    answers = {}
+    for name in task.cases:
+        case = case_named(name)
+        ((_, args),) = task.calls(case)
+        ref = task.reference(case, args)
+        t = args[3] * mean_edge_length(case.V, case.F) ** 2
+        mine = geo.heat_steps(case.V, case.F, args[2], t)
+        np.testing.assert_allclose(mine, ref, rtol=0, atol=1e-10 * ref.max())
+        assert ref[args[2]] == 0 and ref.min() == 0 and ref.max() > 0
+        answers[name] = ref
+    np.testing.assert_allclose(answers["scaled"], 250.0 * answers["small_sphere"], rtol=1e-9)
+
+
+def test_heat_reference_on_an_open_mesh_is_the_templates_neumann_step():
+    V, F = primitives.grid(9, 7, 2.0)
+    V[:, 2] = 0.1 * np.sin(3 * V[:, 0]) * V[:, 1]
+    case = Case("grid", V, F, "an open mesh like the viewer's")
+    ((_, args),) = geo.heat_calls(case)
+    ref = geo.heat_reference(case, args)
+    t = args[3] * mean_edge_length(V, F) ** 2
+    np.testing.assert_allclose(geo.heat_steps(V, F, args[2], t), ref, atol=1e-10 * ref.max())
+
+
+def test_an_unreachable_vertex_must_be_inf_in_the_answer_too():
+    """A distance of inf (a component without the source) never widens the tolerance: a
+    finite answer there fails, inf there passes, and the other vertices are still compared."""
+    case = case_named("one_triangle")
+    ref = np.array([0.0, 1.0, np.inf])
+    assert COMPARE["array"](ref.copy(), ref, case, 1).ok
+    assert not COMPARE["array"](np.array([0.0, 1.0, 5.0]), ref, case, 1).ok
+    assert not COMPARE["array"](np.array([0.0, 1.5, np.inf]), ref, case, 1).ok
 
 
 def test_every_diagnosis_has_a_sentence():
@@ -278,6 +322,37 @@ def test_a_students_exception_shows_their_frames_only():
         and "multiprocessing" not in tb
         and "numpy" not in tb.split("IndexError")[0].replace("np.", "")
     )
+
+
+def test_a_file_importing_meshlap_is_refused_not_passed(checked):
+    """Returning meshlap's own answer must not pass: an import of meshlap is refused before
+    the file runs (every task, with the line), and a name built at run time is refused when
+    imported (that task's error, the student's line); the file's other tasks still run."""
+    r = checked("cheat_import")
+    assert [t.status for t in r.tasks] == ["import_error"] * 2 and not r.passed
+    for t in r.tasks:
+        assert t.message.startswith("line 3:") and "may not import meshlap" in t.message
+    r = checked("cheat_import_hidden")
+    for task in ("cotan_laplacian", "barycentric_areas"):
+        assert r[task].status == "error" and "may not import meshlap" in r[task].traceback
+        assert "cheat_import_hidden.py" in r[task].traceback
+    assert r["voronoi_areas"].status == "failed"  # numpy still works: only meshlap is refused
+
+
+def test_the_import_scan_reads_every_form_and_nothing_else(tmp_path):
+    cases = {
+        "import meshlap_core\n": 1,
+        "x = 1\ndef f():\n    from meshlap_app.state import check\n": 3,
+        "import importlib\nm = importlib.import_module('meshlap_core.laplacian')\n": 2,
+        "import meshlap\n": 1,
+        "import numpy as np\nimport meshlapx\nfrom . import meshlap_core\n": None,
+        "def broken(:\n": None,  # importing it reports the syntax error
+    }
+    for i, (text, line) in enumerate(cases.items()):
+        path = tmp_path / f"f{i}.py"
+        path.write_text(text)
+        got = guard.scan(str(path))
+        assert (got is None) if line is None else got.startswith(f"line {line}:"), text
 
 
 def test_a_file_that_does_not_parse_is_reported_for_every_task(tmp_path):

@@ -88,6 +88,7 @@ def non_default_session(mesh) -> Session:
             "flips": 0.1,
             "vertex": 40,
         },
+        "check": {"file": "hw/exercises.py", "task": "voronoi_areas", "vertex": 5, "checked": True},
     }
     return s
 

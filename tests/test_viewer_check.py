@@ -58,6 +58,18 @@ def test_state_rows_put_the_student_beside_the_reference():
     assert st.verdict()[0].startswith("cotan_laplacian") and "cot/2" in "\n".join(st.verdict())
 
 
+def test_heat_distance_on_the_mesh_on_screen():
+    """The heat-method task in the viewer: a missing shift is diagnosed, and its map is one
+    constant, φ[source] = −d[0] (the student pinned φ at vertex 0 and did not shift)."""
+    assert "heat_geodesic" in VIEWER_TASKS
+    V, F = primitives.icosphere(2)
+    check = CheckState.compute(STUDENTS / "wrong_heat_shift.py", "heat_geodesic", V, F)
+    assert check.result.tasks[0].diagnosis == "not_shifted" and check.signed
+    d = check.difference
+    assert np.ptp(d) < 1e-9 * np.abs(check.expected).max() and abs(d[0]) > 0.1
+    np.testing.assert_allclose(d[0], -check.expected[0], rtol=1e-9)  # φ pinned at vertex 0
+
+
 # ---------------------------------------------------------------- widgets (openGL_mock)
 ps = pytest.importorskip("polyscope")
 
@@ -133,3 +145,38 @@ def test_a_click_selects_the_vertex_in_this_view_only(viewer):
     )
     assert not panel.pick(viewer, hit, viewer.panels["curvature"])
     assert panel.pick(viewer, hit, panel) and panel.state.vertex == 9
+
+
+def test_a_saved_session_reopens_the_check(viewer, tmp_path):
+    """Saved with a check shown, a session runs it again on load (file, task, vertex, map);
+    a student file missing on this machine is said in red and the session still opens."""
+    from meshlap_app import session
+
+    viewer.set_panel("check")
+    drive(viewer, "student file", str(STUDENTS / "wrong_cotan_full.py"))
+    drive(viewer, "check", True)
+    drive(viewer, "vertex", 5)
+    saved = session.capture(viewer)
+    assert saved.settings["check"] == {
+        "file": str(STUDENTS / "wrong_cotan_full.py"),
+        "task": "cotan_laplacian",
+        "vertex": 5,
+        "checked": True,
+    }
+    path = session.save(viewer, tmp_path / "lesson.json")
+    st = viewer.panels["check"].state
+    st.file, st.check, st.vertex = "", None, -1
+    session.load(viewer, path)
+    widgets.frames(viewer, 2)
+    assert st.check is not None and st.current(viewer.state.mesh.version)
+    assert st.check.result.tasks[0].diagnosis == "cot_not_half" and st.vertex == 5
+    assert st.rows() and session.capture(viewer).settings["check"] == saved.settings["check"]
+
+    moved = saved.settings["check"] | {"file": str(tmp_path / "gone.py")}
+    other = session.Session(
+        mesh=saved.mesh, panel="check", settings=saved.settings | {"check": moved}
+    )
+    session.apply(viewer, other, "moved.json", resize=False)
+    assert "does not exist" in viewer.state.errors["check"]
+    assert not st.current(viewer.state.mesh.version)
+    assert st.file == moved["file"] and st.vertex == 5

@@ -13,6 +13,8 @@ from typing import Any
 import numpy as np
 import polyscope as ps
 
+from meshlap_core.errors import MeshError
+
 from ..isolines import draw_isolines
 from ..scene import MESH, colorbar_at, picked_vertex, scalar_for_upload
 from ..state.check import VIEWER_TASKS, CheckState
@@ -71,6 +73,31 @@ class CheckPanel(Panel):
             onscreen_colorbar_location=colorbar_at(0, host.state.ui_scale),
             **self.isolines.options("difference", values),
         )
+
+    def capture(self, host: Host) -> dict[str, Any]:
+        st = self.state
+        return {
+            "file": st.file,
+            "task": st.task,
+            "vertex": int(st.vertex),
+            "checked": st.current(host.state.mesh.version),
+        }
+
+    def configure(self, host: Host, values: dict[str, Any]) -> None:
+        self.state.file = values["file"]
+        self.state.set_task(values["task"])
+
+    def restore(self, host: Host, values: dict[str, Any], active: bool) -> None:
+        """The clicked vertex, and the check run again when one was shown (a job in the
+        window); a student file missing here is said in red, the session still opens."""
+        self.configure(host, values)
+        self.state.vertex = values["vertex"]
+        if not values["checked"]:
+            return
+        try:
+            self.start_check(host)
+        except MeshError as exc:
+            host.state.errors[self.name] = str(exc)
 
     def pick(self, host: Host, hit: Any, active: Panel) -> bool:
         """A click on the mesh in this view selects the vertex whose rows are shown."""

@@ -20,6 +20,8 @@ from meshlap_core.exercises.check import MeshCheck, check_on_mesh
 from meshlap_core.exercises.tasks import TASKS
 from meshlap_core.options import EXERCISE_TASKS, check_choice
 
+from .checks import Schema, boolean, integer, one_of
+
 VIEWER_TASKS: tuple[str, ...] = tuple(
     name for name in EXERCISE_TASKS if TASKS[name].kind in ("matrix", "array", "ring")
     and name != "spectral_reconstruction"
@@ -28,9 +30,47 @@ VIEWER_TASKS: tuple[str, ...] = tuple(
 need a small closed mesh: ``meshlap check`` covers them)."""
 
 
+def _file(x: Any) -> str | None:
+    """What is wrong with a saved student file: a string (``""``: none typed), one line."""
+    if not isinstance(x, str):
+        return f"must be a string, got {type(x).__name__}"
+    if len(x) > 4096 or any(c in x for c in "\x00\n\r"):
+        return "must be one file path (at most 4096 characters, one line)"
+    return None
+
+
+SESSION: Schema = {
+    "file": ("", _file),
+    "task": ("cotan_laplacian", one_of(VIEWER_TASKS)),
+    "vertex": (-1, integer(-1)),
+    "checked": (False, boolean),
+}
+"""The Check panel's section of a saved session (:mod:`.session`): the student file as typed
+(relative: in the viewer's folder), the task, the clicked vertex, and whether a check was shown
+(``checked``: loading the session runs it again, as a job, on the session's mesh). A student
+file missing on this machine does not refuse the session: the panel says so in red."""
+QUIET: dict[str, Any] = {"checked": False}
+"""Restored for another panel's animation: no student code run."""
+
+
+def check_session(values: dict[str, Any], mesh: Any, source: Any) -> None:
+    """A saved vertex the session's mesh has (``-1``: none).
+
+    Raises
+    ------
+    MeshError
+        ``check.vertex`` beyond the mesh's vertices.
+    """
+    if values["vertex"] >= len(mesh.V):
+        raise MeshError(
+            f'"check.vertex" {values["vertex"]} is out of range (the mesh has '
+            f"{len(mesh.V)} vertices)",
+            source,
+        )
+
+
 def make_state() -> CheckState:
-    """The Check panel's slice of the :class:`~.app.AppState` (no session section: a student
-    file's path belongs to one machine, and a check is re-run in a second)."""
+    """The Check panel's slice of the :class:`~.app.AppState`."""
     return CheckState()
 
 

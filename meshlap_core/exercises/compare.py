@@ -117,14 +117,19 @@ def compare_array(got: Any, ref: np.ndarray, case: Case, power: int) -> Comparis
         g = g.reshape(ref.shape)  # an (n,1) column is the same answer
     if g.shape != ref.shape:
         return _bad(_shape_message(g.shape, ref.shape, case))
-    if not np.isfinite(g).all():
-        bad = int(np.flatnonzero(~np.isfinite(g.reshape(len(g), -1)).all(axis=1))[0])
+    finite = np.isfinite(ref)  # inf: a distance no path reaches (another component)
+    if not np.isfinite(g[finite]).all():
+        bad_g = np.where(finite, g, 0.0).reshape(len(g), -1)
+        bad = int(np.flatnonzero(~np.isfinite(bad_g).all(axis=1))[0])
         return _bad("NaN or inf in the answer (a division by zero?)", bad)
-    d = (g - ref).reshape(len(ref), -1)
+    d = np.where(finite, g - np.where(finite, ref, 0.0), np.where(g == ref, 0.0, np.inf))
+    d = d.reshape(len(ref), -1)
     rows = np.abs(d).max(axis=1) if d.size else np.zeros(len(ref))
-    tol = _tolerance(float(np.abs(ref).max(initial=0.0)), case, power, EXERCISE_RTOL)
+    top = float(np.abs(ref[finite]).max(initial=0.0))
+    tol = _tolerance(top, case, power, EXERCISE_RTOL)
     i = int(np.argmax(rows)) if len(rows) else 0
     diff = d[:, 0] if ref.ndim == 1 else rows
+    diff = np.where(np.isfinite(diff), diff, top)  # the map shows an unmatched inf as the top
     show = (lambda a: float(a[i])) if ref.ndim == 1 else (lambda a: [float(x) for x in a[i]])
     ok = bool(rows.max(initial=0.0) <= tol)
     return Comparison(ok, i, show(ref), show(g), float(rows.max(initial=0.0)), tol, diff)

@@ -62,6 +62,14 @@ DIAGNOSES: dict[str, str] = {
     "lambda_only": "only the λ step: Taubin applies a μ step after it",
     "not_sequential": "both steps from the old positions: the μ step applies L to the λ "
     "step's result",
+    "gradient_not_normalised": "the heat gradient is not normalised: X = −∇u/|∇u| per face "
+    "(a distance grows at unit speed, whatever the amount of heat)",
+    "time_not_scaled": "the heat time is not scaled with the mesh: t = m·h² (h the mean edge "
+    "length), not t = m; a mesh scaled by 250 must give 250 times the distance",
+    "divergence_sign": "wrong sign of the divergence (or of X): the distance decreases away "
+    "from the source; X = −∇u/|∇u| points away from it and K φ = Gᵀ A X",
+    "not_shifted": "not shifted: the distance must be 0 at the source (subtract φ[source]); "
+    "the Poisson solution is only defined up to a constant",
     "sized_by_faces": "the answer is sized by F.max()+1: a vertex in no face (the last one here) "
     "still has its row; use n = len(V)",
     "slow_loop": "correct, but {seconds:.1f} s on {n} vertices, about {ratio:.0f}× the "
@@ -106,6 +114,8 @@ def _matches(task: Task, mistake: Mistake, case: Case, args: Args, got: Any) -> 
         same = np.array_equal(np.asarray(wrong), np.asarray(expected))
     if same:  # the mistake makes no difference on this call: it cannot explain a failure
         return False
+    if mistake.fits is not None:
+        return mistake.fits(got, expected, case)
     if task.kind == "eigen":
         return _eigen_matches(mistake.key, got, wrong)
     return COMPARE[task.kind](got, wrong, case, task.power).ok

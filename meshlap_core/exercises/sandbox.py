@@ -9,7 +9,8 @@ checker's process never runs student code, so nothing the student does can break
 - a 50 GB allocation: the worker's address space is limited (``resource.setrlimit(RLIMIT_AS)``,
   the worker's own size plus a budget), the allocation raises ``MemoryError``: ``memory``;
 - a crash (``os._exit``, a segfault in an extension): ``crashed``, then the next task;
-- an exception: ``error`` with the traceback frames of the student's file only.
+- an exception: ``error`` with the traceback frames of the student's file only;
+- an import of meshlap itself (which would return the reference): refused (:mod:`.guard`).
 
 The answers are compared with the reference in the checker's process (:mod:`.check`).
 """
@@ -30,7 +31,11 @@ from typing import Any
 
 from ..errors import Cancel, check_cancel
 from ..options import EXERCISE_MEMORY_MB, EXERCISE_TIMEOUT
+from . import guard
 from .meshes import Case, battery
+
+STUDENT_MODULE = "student_exercises"
+"""The module name the student's file is imported as in the worker."""
 
 
 @dataclass
@@ -92,7 +97,7 @@ def _limit_memory(budget_mb: int) -> None:
 
 
 def _import_student(path: str) -> Any:
-    spec = importlib.util.spec_from_file_location("student_exercises", path)
+    spec = importlib.util.spec_from_file_location(STUDENT_MODULE, path)
     if spec is None or spec.loader is None:
         raise ImportError(f"cannot import {path}")
     module = importlib.util.module_from_spec(spec)
@@ -174,6 +179,11 @@ def _worker(
     _limit_memory(budget_mb)
     all_cases = {c.name: c for c in battery()}
     sys.stdout = sys.stderr  # the student's prints must not mix with the checker's output
+    refused = guard.scan(path)  # a file calling meshlap itself would check nothing
+    if refused:
+        conn.send(("import_error", refused))
+        return
+    guard.install(STUDENT_MODULE, path)
     try:
         module = _import_student(path)
     except BaseException as exc:  # SystemExit, SyntaxError: the student's

@@ -23,6 +23,7 @@ from .. import curvature as cv
 from .. import laplacian as lap
 from ..options import BOUNDARY_RULES, EXERCISE_TASKS, MASS_AREA
 from ..topology.rings import one_ring
+from . import geodesic_task as geo
 from .meshes import Case
 
 Output = Any
@@ -46,10 +47,14 @@ STEP_CASES = ("tetrahedron", "obtuse_fan", "boundary_fan", "cube_corner", "scale
 @dataclass(frozen=True)
 class Mistake:
     """A classic mistake: its diagnosis key (see :data:`.diagnose.DIAGNOSES`) and the wrong
-    answer it gives, ``wrong(case, args)`` (``None`` where it makes no difference)."""
+    answer it gives, ``wrong(case, args)`` (``None`` where it makes no difference).
+
+    ``fits(got, expected, case)``, when given, recognises a mistake whose wrong answer is a
+    family (the distance up to an additive constant): ``wrong`` is then one member of it."""
 
     key: str
     wrong: Callable[[Case, Args], Output]
+    fits: Callable[[Any, Output, Case], bool] | None = None
 
 
 @dataclass(frozen=True)
@@ -408,6 +413,13 @@ def _table() -> dict[str, Task]:
             (M("mu_sign", _taubin("mu_sign")), M("lambda_only", _taubin("lambda_only")),
              M("not_sequential", _taubin("not_sequential"))),
             generic=False,
+        ),
+        Task(
+            "heat_geodesic", "array", 1, geo.HEAT_CASES, geo.heat_calls, geo.heat_reference,
+            (M("gradient_not_normalised", geo.heat_unnormalised),
+             M("time_not_scaled", geo.heat_time_not_scaled),
+             M("divergence_sign", geo.heat_negated, geo.fits_negated),
+             M("not_shifted", geo.heat_unshifted, geo.fits_shifted)),
         ),
     ]  # fmt: skip
     table = {t.name: t for t in tasks}

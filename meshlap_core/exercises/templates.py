@@ -16,7 +16,8 @@ Conventions (the same as the lab's):
 - n = len(V) always: a vertex in no face still has its row (of zeros) and its entry.
 - Every Laplacian is NEGATIVE semidefinite: Δx = −2 H n, with H > 0 on a sphere (outward normals).
 - Matrices may be scipy.sparse or dense numpy arrays of shape (n, n).
-- Use numpy and scipy freely; do not import meshlap (that would be the answer).
+- Use numpy and scipy freely (libigl too); importing meshlap is refused by the checker (it
+  would be the answer).
 """
 
 import numpy as np
@@ -159,6 +160,24 @@ def taubin_step(V, F, lam, mu):
     V′ = V₁ + μ L V₁ (μ < 0 is given).
 
     Returns V′ : (n,3).
+    """
+    raise NotImplementedError
+''',
+    "heat_geodesic": '''
+def heat_geodesic(V, F, source, m):
+    """Geodesic distance from vertex ``source`` by the heat method (Crane, Weischedel &
+    Wardetzky, "Geodesics in heat", ACM TOG 2013), on a closed connected mesh.
+
+    K = −C (cotan_laplacian), M = mass_matrix (mixed Voronoi), h the mean edge length (each
+    edge once), t = m·h² (the time must scale with the mesh):
+    1. heat: solve (M + t K) u = δ, δ one at the source and zero elsewhere;
+    2. per face: X = −∇u / |∇u| (∇ the gradient of the piecewise-linear u; X = 0 where ∇u = 0);
+    3. Poisson: K φ = Gᵀ A X (G the (3m, n) face gradient, A the diagonal of face areas:
+       Gᵀ A X is minus the integrated divergence of X); K is singular (constants): pin one
+       vertex, e.g. φ_0 = 0, and solve for the others;
+    4. d = φ − φ[source].
+
+    Returns d : (n,), 0 at the source and increasing away from it (units of length).
     """
     raise NotImplementedError
 ''',

@@ -86,3 +86,28 @@ def implicit_step(V, F, lam):
 
 def explicit_step(V, F, lam):
     return V + lam * _uniform_dense(V, F) @ V
+
+
+def heat_geodesic(V, F, source, m):
+    """Dense throughout; the singular Poisson system solved by least squares (minimum norm)."""
+    n = len(V)
+    K = -cotan_laplacian(V, F)
+    lengths = {}
+    for f in F:
+        for a, b in ((f[0], f[1]), (f[1], f[2]), (f[2], f[0])):
+            lengths[(min(a, b), max(a, b))] = np.linalg.norm(V[a] - V[b])
+    t = m * np.mean(list(lengths.values())) ** 2
+    u = np.linalg.solve(np.diag(_voronoi(V, F)) + t * K, np.eye(n)[source])
+    div = np.zeros(n)
+    for f in F:
+        p = V[f]
+        normal = np.cross(p[1] - p[0], p[2] - p[0])
+        area = 0.5 * np.linalg.norm(normal)
+        normal /= 2 * area
+        hats = [np.cross(normal, p[(c + 2) % 3] - p[(c + 1) % 3]) / (2 * area) for c in range(3)]
+        g = sum(u[f[c]] * hats[c] for c in range(3))
+        x = -g / np.linalg.norm(g)
+        for c in range(3):
+            div[f[c]] += area * hats[c] @ x
+    phi = np.linalg.lstsq(K, div, rcond=None)[0]
+    return phi - phi[source]

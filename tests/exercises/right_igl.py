@@ -50,3 +50,20 @@ def eigenbasis(V, F, k):
 def implicit_step(V, F, lam):
     M = mass_matrix(V, F)
     return spla.spsolve((M - lam * cotan_laplacian(V, F)).tocsc(), M @ V)
+
+
+def heat_geodesic(V, F, source, m):
+    K = -igl.cotmatrix(V, F)
+    M = igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_VORONOI)
+    t = m * igl.avg_edge_length(V, F) ** 2
+    delta = np.zeros(len(V))
+    delta[source] = 1.0
+    u = spla.splu((M + t * K).tocsc()).solve(delta)
+    G = igl.grad(V, F)
+    g = (G @ u).reshape(3, -1)
+    X = -g / np.linalg.norm(g, axis=0)
+    area = np.tile(0.5 * igl.doublearea(V, F).ravel(), 3)
+    b = G.T @ (area * X.ravel())
+    phi = np.zeros(len(V))
+    phi[1:] = spla.splu(K[1:, 1:].tocsc()).solve(b[1:])  # vertex 0 pinned
+    return phi - phi[source]

@@ -173,3 +173,36 @@ def taubin_step(V, F, lam, mu):
     L = uniform_laplacian(V, F)
     V1 = V + lam * (L @ V)
     return V1 + mu * (L @ V1)
+
+
+def _face_gradient_basis(V, F):
+    """(m,3,3): row c is the gradient of the hat function of corner c on each face, N×e/(2A)."""
+    P = V[F]
+    N = np.cross(P[:, 1] - P[:, 0], P[:, 2] - P[:, 0])
+    twice_area = np.linalg.norm(N, axis=1)
+    N = N / twice_area[:, None]
+    out = np.zeros((len(F), 3, 3))
+    for c in range(3):
+        e = P[:, (c + 2) % 3] - P[:, (c + 1) % 3]  # the edge opposite corner c, ccw
+        out[:, c] = np.cross(N, e) / twice_area[:, None]
+    return out, 0.5 * twice_area
+
+
+def heat_geodesic(V, F, source, m):
+    n = len(V)
+    K = -cotan_laplacian(V, F)
+    e = np.unique(np.sort(_edges(F), axis=1), axis=0)
+    h = np.linalg.norm(V[e[:, 0]] - V[e[:, 1]], axis=1).mean()
+    delta = np.zeros(n)
+    delta[source] = 1.0
+    u = spla.spsolve((mass_matrix(V, F) + m * h * h * K).tocsc(), delta)
+    B, area = _face_gradient_basis(V, F)
+    grad = np.einsum("fcx,fc->fx", B, u[F])
+    X = -grad / np.linalg.norm(grad, axis=1, keepdims=True)
+    div = np.bincount(
+        F.ravel(), (area[:, None] * np.einsum("fcx,fx->fc", B, X)).ravel(), minlength=n
+    )
+    keep = np.arange(n - 1)  # pin the last vertex
+    phi = np.zeros(n)
+    phi[keep] = spla.spsolve(K[keep][:, keep].tocsc(), div[keep])
+    return phi - phi[source]

