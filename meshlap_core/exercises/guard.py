@@ -29,6 +29,9 @@ import sys
 from collections.abc import Callable
 from typing import Any
 
+from ..errors import MeshError
+from ..io.reader import read_input
+
 FORBIDDEN = ("meshlap_core", "meshlap_app", "meshlap")
 """Top-level package names a student's file may not import."""
 WHY = (
@@ -55,9 +58,9 @@ def scan(path: str) -> str | None:
     """What is refused in the student file ``path`` (the first meshlap import, with its line),
     or ``None`` (also when the file does not parse: importing it reports that)."""
     try:
-        with open(path, encoding="utf-8") as f:
-            tree = ast.parse(f.read(), filename=path)
-    except (OSError, SyntaxError, UnicodeDecodeError, ValueError):
+        source = read_input(path, what="student file").decode("utf-8")
+        tree = ast.parse(source, filename=path)
+    except (MeshError, OSError, SyntaxError, UnicodeDecodeError, ValueError):
         return None
     for node in ast.walk(tree):
         names: list[str] = []
