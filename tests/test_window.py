@@ -381,9 +381,11 @@ def onering(s: Session) -> None:
     s.settled((0, 0, *s.size))
 
 
-def spectral(s: Session) -> None:
+def spectral(s: Session, to: float = 1 / 3) -> None:
     """Key 3; "compute eigenbasis": eigenmode and k sliders, the reconstruction beside the
-    mesh; drag k (the last slider): the reconstruction changes."""
+    mesh; drag k (the last slider) to the fraction ``to`` of its range: the reconstruction
+    changes (a later call drags elsewhere: a new basis keeps the k shown before, so a drag to
+    the same place could leave the reconstruction as it was)."""
     layout = s.goto(3, "Spectral")
     row = layout.find(1, "buttons", 0)
     s.click(((row.buttons[0][0] + row.buttons[0][1]) // 2, row.center[1]))
@@ -407,7 +409,7 @@ def spectral(s: Session) -> None:
         pressed = s.until(
             lambda img: changed_fraction(before, img, knob) > 0.01, 10, "k = 1 on the slider"
         )
-        s.x.xdotool("mousemove", str(slider.x0 + (slider.x1 - slider.x0) // 3), str(y))
+        s.x.xdotool("mousemove", str(slider.x0 + int((slider.x1 - slider.x0) * to)), str(y))
         s.until(
             lambda img: changed_fraction(pressed, img, knob) > 0.01, 10, "k following the mouse"
         )
@@ -449,7 +451,7 @@ def second_mesh_spectral(s: Session) -> None:
     assert s.app is not None
     if s.app.title() != TITLE + name:
         raise AssertionError(f"window title {s.app.title()!r} after opening {name}")
-    spectral(s)
+    spectral(s, to=2 / 3)
 
 
 def smoothing(s: Session) -> None:
