@@ -458,7 +458,16 @@ def smoothing(s: Session) -> None:
     """Key 4; type λ = 0.25 in the third field: nothing applies until Enter (the keys 2 and 5
     typed go to the field, not to the panel shortcuts), Enter changes the g(μ) plot; space
     plays (the smoothed copy moves), space pauses (it stops)."""
-    layout = s.goto(4, "Smoothing")
+    s.goto(4, "Smoothing")
+
+    def both_shown(img: np.ndarray) -> bool:  # the stepper is built as a job on a first visit
+        try:
+            return len(subjects(img, parse(img))) >= 2
+        except LookupError:
+            return False
+
+    s.until(both_shown, 30, "the input and its smoothed copy once the stepper is built")
+    layout = parse(s.settled((0, 0, *s.size)))
     s.subject_ok(layout, 2, "input and smoothed copy")
     plot = layout.find(1, "plot", 0)
     plot_box = (plot.x0, plot.y0, plot.x1, plot.y1)
