@@ -58,6 +58,7 @@ SECOND_MESH = ROOT / "assets" / "torus.obj"
 MESH_LIST = ("bumpy.obj", "cube.obj", "grid.obj", "icosphere.obj", "torus.obj")  # assets/, sorted
 TITLE = "meshlap — "  # the window title: meshlap — <file>
 STILL = 3e-5  # fraction of changed pixels that is no change (a blinking text cursor)
+WAIT = 30.0  # seconds a change shown after an input may take (only a failure waits it out)
 FRAME_TIMEOUT = 30.0  # seconds the viewer may take to draw the frames after one input event
 
 
@@ -157,7 +158,7 @@ class Session:
                 raise AssertionError(f"after {timeout:.0f} s still no {what}")
             time.sleep(0.1)
 
-    def settled(self, box: tuple[int, int, int, int], timeout: float = 10) -> np.ndarray:
+    def settled(self, box: tuple[int, int, int, int], timeout: float = WAIT) -> np.ndarray:
         """Wait until ``box`` is the same on two screenshots in a row (up to a text cursor's
         blink: 3e-5 of its pixels)."""
         prev, calm = [self.screenshot()], [0]
@@ -228,19 +229,20 @@ class Session:
             seen.append(found)
             return done
 
-        self.until(opened, 10, f"list of at least {entry + 1} entries under the combo")
+        self.until(opened, WAIT, f"list of at least {entry + 1} entries under the combo")
         self.click(seen[-1][entry])
-        self.until(lambda img: len(popup_lines(img, combo)) < 2, 10, "closed list after a pick")
+        self.until(lambda img: len(popup_lines(img, combo)) < 2, WAIT, "closed list after a pick")
 
     def goto(self, number: int, header: str) -> Layout:
         """Press the panel's shortcut (1–5); wait until the panel's section changed."""
         before = self.layout()
-        head = before.sections[1][0]
-        box = (head.x0, head.y0, head.x1, head.y1)
+        # the whole panel below the mesh section: two headers alone can differ by < 1 % of
+        # their pixels ("Curvature lab" → "Curvature")
+        box = panel_box(self, before)
         old = self.img
         self.key(str(number))
         if self.panel != number:
-            self.until(lambda img: changed_fraction(old, img, box) > 0.01, 10, f"{header} panel")
+            self.until(lambda img: changed_fraction(old, img, box) > 0.01, WAIT, f"{header} panel")
         self.panel = number
         return parse(self.settled((0, 0, *self.size)))
 
@@ -335,7 +337,7 @@ def curvature(s: Session) -> None:
             len(subjects(img, parse(img))) >= 2
             and sum(it.kind == "combo" for it in parse(img).sections[1]) > n
         ),
-        10,
+        WAIT,
         "second mesh and second-field combo after 'side by side'",
     )
     layout = parse(s.settled((0, 0, *s.size)))
@@ -361,7 +363,7 @@ def onering(s: Session) -> None:
         lambda img: (
             pixels(before, img, panel) > 200 and pixels(before, img, scene_box(s, layout)) > 200
         ),
-        10,
+        WAIT,
         f"vertex in the panel and its one-ring drawn after a click at {point}",
     )
     layout = parse(s.settled((0, 0, *s.size)))
@@ -375,7 +377,7 @@ def onering(s: Session) -> None:
     below = (layout.left, field.y1 + 4, layout.right, s.size[1])
     s.until(
         lambda img: pixels(typed, img, below) > 100,
-        10,
+        WAIT,
         "vertex 12 in the panel after typing 12 and Enter",
     )
     s.settled((0, 0, *s.size))
@@ -407,11 +409,11 @@ def spectral(s: Session, to: float = 1 / 3) -> None:
     s.x.xdotool("mousedown", "1")
     try:
         pressed = s.until(
-            lambda img: changed_fraction(before, img, knob) > 0.01, 10, "k = 1 on the slider"
+            lambda img: changed_fraction(before, img, knob) > 0.01, WAIT, "k = 1 on the slider"
         )
         s.x.xdotool("mousemove", str(slider.x0 + int((slider.x1 - slider.x0) * to)), str(y))
         s.until(
-            lambda img: changed_fraction(pressed, img, knob) > 0.01, 10, "k following the mouse"
+            lambda img: changed_fraction(pressed, img, knob) > 0.01, WAIT, "k following the mouse"
         )
     finally:
         s.x.xdotool("mouseup", "1")
@@ -424,7 +426,7 @@ def spectral(s: Session, to: float = 1 / 3) -> None:
             changed_fraction(before, img, scene_box(s, layout)) > 0.002
             and len(subjects(img, parse(img))) >= 2
         ),
-        10,
+        WAIT,
         "change of the reconstruction after dragging k, the mesh and the reconstruction shown",
     )
     s.subject_ok(parse(s.settled((0, 0, *s.size))), 2, "after dragging k")
@@ -481,14 +483,14 @@ def smoothing(s: Session) -> None:
     if len(parse(typed).sections[1]) != len(layout.sections[1]):
         raise AssertionError("typing 0.25 into λ changed the panel (a shortcut fired?)")
     s.key("Return")
-    s.until(lambda img: pixels(typed, img, scene) > 20, 10, "new caption (λ = 0.25) after Enter")
+    s.until(lambda img: pixels(typed, img, scene) > 20, WAIT, "new caption (λ = 0.25) after Enter")
     box = scene_box(s, layout)
     row = layout.find(1, "buttons", 0)  # step / play / reset: "play" reads "pause" while playing
     row_box = (row.x0, row.y0, min(row.x1 + 60, layout.right), row.y1)
     a = s.settled(box)
     s.key("space")
     playing = s.until(
-        lambda img: changed_fraction(a, img, row_box) > 0.01, 10, "'pause' on the play button"
+        lambda img: changed_fraction(a, img, row_box) > 0.01, WAIT, "'pause' on the play button"
     )
     # a loaded machine draws a playing frame (one step) in up to ~2 s: give the copy time
     s.until(lambda img: changed_fraction(a, img, box) > 0.002, 30, "smoothed copy moving (space)")
@@ -497,10 +499,10 @@ def smoothing(s: Session) -> None:
     # few pixels): first the button says the pause took effect, then the copy must be still
     s.until(
         lambda img: changed_fraction(playing, img, row_box) > 0.01,
-        10,
+        WAIT,
         "'play' on the button again after space",
     )
-    c = s.settled(box, timeout=10)
+    c = s.settled(box)
     s.drawn(6)  # playing, each of these frames would step the copy
     if changed_fraction(c, s.screenshot(), box) > STILL:
         raise AssertionError("space again: the smoothed copy still moves")
@@ -521,7 +523,7 @@ def surfaces(s: Session) -> None:
     s.drag((slider.x0 + 20, y), (slider.x1 - 30, y))
     s.until(
         lambda img: changed_fraction(before, img, section_box(layout, 1)) > 0.002,
-        10,
+        WAIT,
         "new (u, v) figures after dragging u",
     )
     s.settled((0, 0, *s.size))
@@ -588,19 +590,19 @@ def help_pane(s: Session) -> None:
         s.click(layout.sections[-2][0].center)
         s.until(
             lambda img: not any(it.kind == "buttons" for it in parse(img).sections[-2]),
-            10,
+            WAIT,
             "closed Export section",
         )
     before, box = s.img, (layout.left, 0, layout.right, s.size[1])
     s.key("h")
-    s.until(lambda img: changed_fraction(before, img, box) > 0.001, 10, "the panel grown after H")
+    s.until(lambda img: changed_fraction(before, img, box) > 0.001, WAIT, "the panel grown after H")
     scroll_to_end(s)
 
     def shown(img: np.ndarray) -> bool:
         kinds = {it.kind for it in parse(img).sections[-1]}
         return {"input", "buttons"} <= kinds and bool(kinds & {"checkbox", "slider"})
 
-    s.until(shown, 10, "the Help pane's widgets after H (session file, buttons, UI scale)")
+    s.until(shown, WAIT, "the Help pane's widgets after H (session file, buttons, UI scale)")
     s.settled((0, 0, *s.size))
 
 
@@ -635,11 +637,11 @@ def record_turn(s: Session) -> None:
     layout = scroll_to_end(s)
     if len(layout.sections[-1]) > 1:  # the Help pane is open: H closes it
         s.key("h")
-        s.until(lambda img: len(parse(img).sections[-1]) == 1, 10, "Help closed after H")
+        s.until(lambda img: len(parse(img).sections[-1]) == 1, WAIT, "Help closed after H")
         layout = scroll_to_end(s)
     if not record_buttons(s.img):
         s.click(layout.sections[surfaces_section(layout) + 1][0].center)
-        s.until(record_buttons, 10, "the record button under the opened record header")
+        s.until(record_buttons, WAIT, "the record button under the opened record header")
     layout = parse(s.settled((0, 0, *s.size)))
     i = surfaces_section(layout)
     row = layout.find(i + 1, "buttons", 0)
@@ -647,7 +649,7 @@ def record_turn(s: Session) -> None:
     row_box = (layout.left, row.y0, layout.right, row.y1)
     before, gifs = s.img, set(s.tmp.rglob("*.gif"))
     s.click(button)
-    s.until(lambda img: pixels(before, img, row_box) > 20, 10, "'stop' in record's place")
+    s.until(lambda img: pixels(before, img, row_box) > 20, WAIT, "'stop' in record's place")
     theta = layout.find(i, "slider", -1)
     if not theta.buttons:
         raise AssertionError("no turn button right of the θ slider")

@@ -16,7 +16,7 @@ from types import SimpleNamespace
 import pytest
 from imgui_screen import changed_fraction, parse
 from test_issue23 import readme_keys
-from test_window import Session, keep_shots, scene_box, spectral
+from test_window import WAIT, Session, keep_shots, scene_box, spectral
 from xwindow import missing_tools
 
 XDOTOOL = {"right": "Right", "left": "Left", "space": "space"}
@@ -55,7 +55,7 @@ def press_and_see(s: Session, key: str, what: str) -> str | None:
     before = s.settled((0, 0, *s.size))
     s.key(XDOTOOL.get(key, key))
     try:
-        s.until(lambda img: changed_fraction(before, img, (0, 0, *s.size)) > CHANGED, 10, what)
+        s.until(lambda img: changed_fraction(before, img, (0, 0, *s.size)) > CHANGED, WAIT, what)
     except AssertionError as exc:
         return f"{key!r}: {exc}"
     return None
