@@ -133,7 +133,7 @@ frames = widgets.frames
 mock = widgets.mock
 
 
-def drive_curvature_lab(viewer) -> None:
+def drive_panel_curvature_lab(viewer, tmp_path=None) -> None:
     """Every lab widget with good and bad values (also run by the every-widget tour)."""
     from meshlap_app.panels.curvature_lab import LAB
 
@@ -190,4 +190,4 @@ def drive_curvature_lab(viewer) -> None:
 
 
 def test_curvature_lab_widgets(viewer):
-    drive_curvature_lab(viewer)
+    drive_panel_curvature_lab(viewer)

@@ -1,6 +1,6 @@
 """The Check panel: its state headless, its widgets through the UI adapter (openGL_mock).
 
-:func:`drive_check_widgets` is also part of the every-widget tour of ``test_viewer_widgets.py``.
+:func:`drive_panel_check` is also part of the every-widget tour of ``test_viewer_widgets.py``.
 """
 
 from __future__ import annotations
@@ -81,7 +81,7 @@ mock = widgets.mock  # `sphere` and `viewer` come from conftest
 drive = widgets.drive
 
 
-def drive_check_widgets(viewer, tmp_path: Path) -> None:
+def drive_panel_check(viewer, tmp_path: Path) -> None:
     """Every Check widget with good and bad values (also run by the every-widget tour)."""
     viewer.set_panel("check")
     st = viewer.panels["check"].state
@@ -117,7 +117,7 @@ def drive_check_widgets(viewer, tmp_path: Path) -> None:
 
 
 def test_check_widgets(viewer, tmp_path):
-    drive_check_widgets(viewer, tmp_path)
+    drive_panel_check(viewer, tmp_path)
 
 
 def test_difference_map_has_its_colour_bar_only_in_this_view(viewer, monkeypatch):

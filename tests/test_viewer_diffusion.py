@@ -1,5 +1,5 @@
 """The Diffusion panel through its widgets (ScriptedUI on polyscope's openGL_mock) and its
-polyscope-free state. ``drive_diffusion_widgets`` is also part of the widget tour of
+polyscope-free state. ``drive_panel_diffusion`` is also part of the widget tour of
 ``tests/test_viewer_widgets.py`` (every widget driven)."""
 
 from __future__ import annotations
@@ -87,7 +87,7 @@ def drive_heat_play(viewer, hd: HeatDiffusion) -> None:
     settle(viewer)
 
 
-def drive_diffusion_widgets(viewer) -> None:
+def drive_panel_diffusion(viewer, tmp_path=None) -> None:
     """Every widget of the Diffusion panel, with good and bad values."""
     mesh = viewer.state.mesh
     V, F = mesh.V, mesh.F
@@ -199,7 +199,7 @@ def drive_diffusion_widgets(viewer) -> None:
 
 
 def test_diffusion_widgets(viewer):
-    drive_diffusion_widgets(viewer)
+    drive_panel_diffusion(viewer)
     ui = viewer.ui
     mine = {k for k in ui.seen if k[0] == "diffusion"}
     assert mine and not sorted(mine - ui.driven)

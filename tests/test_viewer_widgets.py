@@ -5,12 +5,17 @@ calls the real ``polyscope.imgui`` each frame and lets a test say what a widget 
 frame ("combo ``field`` returns ``gaussian``", "field ``lambda`` receives ``0``, then ``0.5``").
 Each widget gets good values and bad ones (empty, 0, negative, NaN, 1e309, out of range): the
 session never ends, bad input is shown in red in its panel and the last good state stays.
-``test_every_widget_is_driven`` fails when a panel draws a widget that no test here drives.
+``test_every_widget_is_driven`` runs ``drive_panel_<name>(viewer, tmp_path)`` of every registered
+panel (each panel's test module defines its own) and fails when a panel draws a widget that no
+driver drives.
 """
 
 from __future__ import annotations
 
+import importlib
 import time
+from collections.abc import Callable
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -21,7 +26,8 @@ from meshlap_app.ui import EXPECTED, UIApiMismatch, check_return  # noqa: E402
 from meshlap_app.viewer import Viewer  # noqa: E402
 from scripted_ui import parse_number  # noqa: E402
 
-from meshlap_core.io import load_mesh  # noqa: E402
+from meshlap_core import primitives  # noqa: E402
+from meshlap_core.io import load_mesh, save_mesh  # noqa: E402
 
 BAD_NUMBERS = ["", "0", "-1", "nan", "1e309", "abc"]
 
@@ -480,44 +486,91 @@ def test_captions_name_what_is_side_by_side(viewer):
 
 
 # ---------------------------------------------------------------- coverage
-def test_every_widget_is_driven(viewer, tmp_path, sphere):
-    """Run the whole tour on one adapter: every widget label drawn must have been scripted."""
-    test_mesh_panel_list_path_and_bad_files(viewer, tmp_path, sphere)
+def panel_drivers() -> dict[str, Callable[..., None]]:
+    """``drive_panel_<name>(viewer, tmp_path)`` of every registered panel, found in the test
+    module that defines it (``tests/test_*.py``): a new panel brings its driver in its own test
+    file and this tour runs it, without a line here. KeyError names a panel without one."""
+    from meshlap_app.registry import REGISTRY
+
+    sources = {p.stem: p.read_text() for p in sorted(Path(__file__).parent.glob("test_*.py"))}
+    drivers: dict[str, Callable[..., None]] = {}
+    for entry in REGISTRY:
+        name = f"drive_panel_{entry.name}"
+        homes = [stem for stem, text in sources.items() if f"\ndef {name}(" in text]
+        if len(homes) != 1:
+            raise KeyError(f"{entry.name}: {name} is defined in {homes or 'no test module'}")
+        drivers[entry.name] = getattr(importlib.import_module(homes[0]), name)
+    return drivers
+
+
+def test_every_panel_has_one_driver():
+    from meshlap_app.registry import REGISTRY
+
+    assert list(panel_drivers()) == [e.name for e in REGISTRY]
+
+
+def sphere_file(folder: Path) -> Path:
+    """An icosphere (level 2) written to ``folder`` (the ``sphere`` fixture's mesh)."""
+    path = folder / "sphere.obj"
+    if not path.is_file():
+        save_mesh(path, *primitives.icosphere(2))
+    return path
+
+
+def drive_panel_mesh_info(viewer, tmp_path: Path) -> None:
+    """The mesh section: the list, the path field and bad files."""
+    test_mesh_panel_list_path_and_bad_files(viewer, tmp_path, sphere_file(tmp_path))
+
+
+def drive_panel_curvature(viewer, tmp_path: Path) -> None:
     test_view_combo_switches_every_panel(viewer)
     test_curvature_widgets(viewer)
+
+
+def drive_panel_onering(viewer, tmp_path: Path) -> None:
     test_onering_widgets(viewer)
-    test_spectral_widgets(viewer)
-    test_smoothing_widgets(viewer)
-    test_smoothing_lambda_typed_keeps_the_mesh(viewer)
-    test_surfaces_widgets(viewer)
-    test_export_writes_what_is_on_screen(viewer, tmp_path)
-    test_help_widgets(viewer)
-    test_shortcuts(viewer)
-    test_click_and_drop(viewer, tmp_path, sphere)
     from test_viewer_inspector import drive_inspector  # the inspector's widgets
 
     drive_inspector(viewer)
 
+
+def drive_panel_spectral(viewer, tmp_path: Path) -> None:
+    test_spectral_widgets(viewer)
+
+
+def drive_panel_smoothing(viewer, tmp_path: Path) -> None:
+    test_smoothing_widgets(viewer)
+    test_smoothing_lambda_typed_keeps_the_mesh(viewer)
+
+
+def drive_panel_surfaces(viewer, tmp_path: Path) -> None:
+    test_surfaces_widgets(viewer)
+
+
+def drive_panel_export(viewer, tmp_path: Path) -> None:
+    test_export_writes_what_is_on_screen(viewer, tmp_path)
+
+
+def drive_panel_help(viewer, tmp_path: Path) -> None:
+    test_help_widgets(viewer)
+    test_shortcuts(viewer)
     from test_session import drive_session_widgets  # the session widgets (Help and window)
 
     drive_session_widgets(viewer, tmp_path)
 
+
+def test_every_widget_is_driven(viewer, tmp_path):
+    """Run every registered panel's driver on one adapter, then the widgets every panel shares
+    (play/record, isolines): every widget label drawn must have been scripted."""
+    for drive in panel_drivers().values():
+        drive(viewer, tmp_path)
     from test_viewer_record import drive_record_widgets  # play, θ and record widgets
 
     drive_record_widgets(viewer, tmp_path)
-
-    from test_viewer_check import drive_check_widgets  # the Check panel's widgets
-
-    drive_check_widgets(viewer, tmp_path)
-    from test_viewer_diffusion import drive_diffusion_widgets  # the Diffusion panel
-
-    drive_diffusion_widgets(viewer)
-    from test_curvature_lab import drive_curvature_lab  # the curvature lab's widgets
-
-    drive_curvature_lab(viewer)
     from test_isolines import drive_isolines  # every view's isoline toggle and count
 
     drive_isolines(viewer)
+    test_click_and_drop(viewer, tmp_path, sphere_file(tmp_path))  # a pick, a dropped file
     ui = viewer.ui
     undriven = sorted(set(ui.seen) - ui.driven)
     assert not undriven, f"widgets no test drives: {undriven}"
