@@ -14,7 +14,8 @@ from meshlap_app.state.check import VIEWER_TASKS, CheckState
 
 from meshlap_core import primitives
 from meshlap_core.errors import MeshError
-from meshlap_core.laplacian import cotan_stiffness
+from meshlap_core.laplacian import cotan_stiffness, mass_matrix, vertex_areas
+from meshlap_core.options import EXERCISE_TASKS
 
 STUDENTS = Path(__file__).parent / "exercises"
 
@@ -32,9 +33,9 @@ def test_state_checks_the_file_the_task_and_the_vertex(tmp_path):
     with pytest.raises(MeshError, match="not a Python file"):
         st.student_path(tmp_path)
     with pytest.raises(MeshError, match="eigenbasis"):
-        st.set_task("eigenbasis")  # no answer per vertex of any mesh: meshlap check covers it
+        st.set_task("eigenbase")  # the message lists the choices
     assert st.task == "cotan_laplacian"
-    assert "eigenbasis" not in VIEWER_TASKS and "one_ring" in VIEWER_TASKS
+    assert VIEWER_TASKS == EXERCISE_TASKS  # the panel shows every task meshlap check checks
     with pytest.raises(MeshError, match="out of range"):
         st.select(10, 10)
     assert st.rows() == [] and st.verdict() == []
@@ -70,6 +71,63 @@ def test_heat_distance_on_the_mesh_on_screen():
     np.testing.assert_allclose(d[0], -check.expected[0], rtol=1e-9)  # φ pinned at vertex 0
 
 
+def _generalized_pairs(V, F, k):
+    """Dense ``K u = λ M u`` from the core's operators (the test's own reference)."""
+    import scipy.linalg as sla
+
+    K = -cotan_stiffness(V, F).toarray()
+    lam, U = sla.eigh(K, mass_matrix(V, F, "voronoi").toarray())
+    return lam[:k], U[:, :k]
+
+
+def test_eigenbasis_on_the_mesh_on_screen():
+    """The eigenbasis in the viewer (642 vertices: above the dense size, so the reference is the
+    lab's sparse solver): the ordinary eigenproblem is diagnosed, the rows put λ_j and u_j[i]
+    beside the reference's, and the map is |u_j − u_ref,j| with the basis aligned; a right file
+    gets the same rows as the reference (its basis of the triple λ = 2 rotated onto ours)."""
+    V, F = primitives.icosphere(3)
+    lam, _ = _generalized_pairs(V, F, 6)
+    wrong = CheckState.compute(STUDENTS / "wrong_spectral.py", "eigenbasis", V, F)
+    assert wrong.result.tasks[0].diagnosis == "ordinary_eigenproblem" and not wrong.signed
+    st = CheckState()
+    st.adopt(wrong, (0, "f", "eigenbasis"))
+    st.select(7, len(V))
+    rows = st.rows()
+    assert [r[0] for r in rows[:4]] == ["λ0", "u0[7]", "λ1", "u1[7]"]
+    np.testing.assert_allclose([float(r[2]) for r in rows[::2]], lam, rtol=1e-5, atol=1e-5)
+    # the student's λ are those of K u = λ u: the Euclidean problem's
+    import scipy.linalg as sla
+
+    plain = sla.eigvalsh(-cotan_stiffness(V, F).toarray())[:6]
+    np.testing.assert_allclose([float(r[1]) for r in rows[::2]], plain, rtol=1e-5, atol=1e-9)
+    d = wrong.difference
+    assert d.shape == (len(V),) and d.min() > 0.05  # u0 is constant: 1/√area vs 1/√n
+    right = CheckState.compute(STUDENTS / "right_igl.py", "eigenbasis", V, F)
+    assert right.result.passed
+    # u0..u3: whole eigenspaces (λ = 0, and λ = 2 three times); u4, u5 are two of the five
+    # of the next λ, whose choice no alignment can undo
+    mine = np.array([float(r[1]) for r in right.rows(7)[1:8:2]])
+    np.testing.assert_allclose(mine, [float(r[2]) for r in right.rows(7)[1:8:2]], atol=1e-5)
+    m = vertex_areas(V, F, "voronoi")
+    assert abs(float(right.rows(7)[1][2])) == pytest.approx(1 / np.sqrt(m.sum()), rel=1e-5)
+
+
+def test_reconstruction_on_the_mesh_on_screen():
+    """Uᵀ X instead of Uᵀ M X in the viewer: diagnosed, and the map is the row's largest
+    |student − reference|, computed here from the test's own dense basis."""
+    V, F = primitives.icosphere(2)
+    check = CheckState.compute(STUDENTS / "wrong_spectral.py", "spectral_reconstruction", V, F)
+    t = check.result.tasks[0]
+    assert t.diagnosis == "projection_without_mass"
+    _, U = _generalized_pairs(V, F, 10)
+    M = mass_matrix(V, F, "voronoi")
+    ref, mine = U @ (U.T @ (M @ V)), U @ (U.T @ V)
+    np.testing.assert_allclose(check.difference, np.abs(mine - ref).max(axis=1), rtol=1e-6)
+    rows = check.rows(4)
+    assert [r[0] for r in rows] == ["x", "y", "z"]
+    np.testing.assert_allclose([float(r[2]) for r in rows], ref[4], rtol=1e-5, atol=1e-9)
+
+
 # ---------------------------------------------------------------- widgets (openGL_mock)
 ps = pytest.importorskip("polyscope")
 
@@ -88,7 +146,7 @@ def drive_panel_check(viewer, tmp_path: Path) -> None:
     drive(viewer, "check", True)  # nothing typed: said in red, nothing checked
     assert "student file" in viewer.state.errors["check"] and st.check is None
     drive(viewer, "student file", str(STUDENTS / "wrong_cotan_full.py"))
-    for bad in ("eigenbasis", "nonsense"):
+    for bad in ("eigenbase", "nonsense"):
         drive(viewer, "task", bad)
         assert st.task == "cotan_laplacian" and "check" in viewer.state.errors
     drive(viewer, "task", "cotan_laplacian")

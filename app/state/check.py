@@ -17,17 +17,14 @@ import numpy as np
 
 from meshlap_core.errors import MeshError
 from meshlap_core.exercises.check import MeshCheck, check_on_mesh
-from meshlap_core.exercises.tasks import TASKS
 from meshlap_core.options import EXERCISE_TASKS, check_choice
 
 from .checks import Schema, boolean, integer, one_of
 
-VIEWER_TASKS: tuple[str, ...] = tuple(
-    name for name in EXERCISE_TASKS if TASKS[name].kind in ("matrix", "array", "ring")
-    and name != "spectral_reconstruction"
-)  # fmt: skip
-"""The tasks with an answer per vertex of any mesh (the eigenproblem and the reconstruction
-need a small closed mesh: ``meshlap check`` covers them)."""
+VIEWER_TASKS: tuple[str, ...] = EXERCISE_TASKS
+"""Every task ``meshlap check`` checks: each has a difference map per vertex of the mesh on
+screen (the eigenbasis: ``|u_j − u_ref,j|`` with signs aligned, or the residual; the
+reconstruction: the row's largest component) and rows at a vertex."""
 
 
 def _file(x: Any) -> str | None:

@@ -17,15 +17,17 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import MeshError
+from ..laplacian import vertex_areas
 from ..options import (
     EXERCISE_MEMORY_MB,
     EXERCISE_SLOW_MIN_SECONDS,
     EXERCISE_SLOW_RATIO,
     EXERCISE_TASKS,
     EXERCISE_TIMEOUT,
+    MASS_AREA,
     check_choice,
 )
-from .compare import COMPARE, Comparison, as_matrix
+from .compare import COMPARE, Comparison, aligned_columns, as_matrix
 from .diagnose import describe, diagnose
 from .meshes import Case, battery
 from .result import CheckResult, TaskResult
@@ -180,9 +182,26 @@ def _cell(value: Any) -> str:
     return "—" if value is None else f"{value:.6g}"
 
 
+def _eigen_rows(expected: Any, got: Any, i: int) -> list[tuple[str, str, str]]:
+    """Per eigenpair ``j``: ``λ_j`` and ``u_j[i]``, student beside reference."""
+    lam_r, U_r = expected
+    lam_g = U_g = None
+    with contextlib.suppress(TypeError, ValueError):
+        lam_g, U_g = (np.asarray(x, dtype=float) for x in got)
+    if lam_g is None or U_g is None or lam_g.shape != lam_r.shape or U_g.shape != U_r.shape:
+        lam_g = U_g = None
+    out = []
+    for j in range(len(lam_r)):
+        out.append((f"λ{j}", _cell(None if lam_g is None else lam_g[j]), _cell(lam_r[j])))
+        out.append((f"u{j}[{i}]", _cell(None if U_g is None else U_g[i, j]), _cell(U_r[i, j])))
+    return out
+
+
 def vertex_rows(expected: Any, got: Any, i: int) -> list[tuple[str, str, str]]:
     """The terms of vertex ``i``'s row: matrix entries ``[i,j]`` (the union of both rows'
-    non-zeros), vector components, or ring positions."""
+    non-zeros), vector components, ring positions, or each eigenpair's ``λ_j`` and ``u_j[i]``."""
+    if isinstance(expected, tuple):  # an eigenbasis (λ, U)
+        return _eigen_rows(expected, got, i)
     if sp.issparse(expected):
         E = sp.csr_matrix(expected)
         G = None
@@ -244,4 +263,20 @@ def check_on_mesh(
         cmp = COMPARE[t.kind](got, expected, case, t.power)
         difference = cmp.difference
         signed = t.kind == "array" and np.ndim(expected) == 1
+        if t.kind == "eigen":
+            got = _aligned_eigen(got, expected, case)
     return MeshCheck(result, expected, got, difference, signed)
+
+
+def _aligned_eigen(got: Any, expected: tuple[np.ndarray, np.ndarray], case: Case) -> Any:
+    """The student's ``(λ, U)`` with U turned towards the reference's basis (signs, and
+    rotations inside repeated eigenvalues: :func:`~.compare.aligned_columns`), so that the rows
+    differ only where the vectors do; unchanged when it is not such a pair."""
+    try:
+        lam, U = (np.asarray(x, dtype=float) for x in got)
+    except (TypeError, ValueError):
+        return got
+    if U.shape != expected[1].shape:
+        return got
+    m = vertex_areas(case.V, case.F, MASS_AREA)
+    return lam, aligned_columns(U, expected[1], m, expected[0])

@@ -179,18 +179,20 @@ def compare_eigen(
     if not (np.isfinite(lam).all() and np.isfinite(U).all()):
         return _bad("NaN or inf in the answer")
     tol = _tolerance(float(np.abs(lam_ref).max()), case, power, EXERCISE_EIGEN_RTOL)
+    m = vertex_areas(case.V, case.F, MASS_AREA)
     if np.abs(lam - lam_ref).max() > tol:
         j = int(np.argmax(np.abs(lam - lam_ref)))
         err = float(np.abs(lam - lam_ref).max())
-        return Comparison(False, None, lam_ref.tolist(), lam.tolist(), err, tol,
+        diff = eigen_difference(U, ref[1], m, lam_ref)
+        return Comparison(False, None, lam_ref.tolist(), lam.tolist(), err, tol, diff,
                           message=f"eigenvalue {j} differs")  # fmt: skip
-    m = vertex_areas(case.V, case.F, MASS_AREA)
     G = U.T @ (m[:, None] * U)
     ortho = float(np.abs(G - np.eye(k)).max())
     if ortho > 1e-5:
         got = f"max |UᵀMU − I| = {ortho:.3g}"
         why = "eigenvectors not M-orthonormal"
-        return Comparison(False, None, "UᵀMU = I", got, ortho, 1e-5, message=why)
+        diff = eigen_difference(U, ref[1], m, lam_ref)
+        return Comparison(False, None, "UᵀMU = I", got, ortho, 1e-5, diff, message=why)
     K = -cotan_stiffness(case.V, case.F)
     R = (K @ U) - m[:, None] * U * lam_ref
     # K is dimensionless (cot weights), U has units 1/length: the residual is relative to |K||U|
@@ -200,6 +202,37 @@ def compare_eigen(
     ok = bool(rows[i] <= rtol)
     why = "" if ok else "the columns of U are not eigenvectors (K u ≠ λ M u)"
     return Comparison(ok, i, 0.0, float(rows[i]), float(rows[i]), rtol, rows, why)
+
+
+def aligned_columns(
+    U: np.ndarray, U_ref: np.ndarray, m: np.ndarray, lam_ref: np.ndarray | None = None
+) -> np.ndarray:
+    """``U`` turned towards the reference's basis: an eigenvector is defined up to its sign, and
+    inside a repeated eigenvalue's space (``lam_ref`` equal within ``EXERCISE_EIGEN_RTOL``) up
+    to a rotation, so each group of columns is multiplied by the orthogonal ``Q`` closest to
+    ``U_gᵀ M U_ref,g`` (its polar factor, orthogonal Procrustes); a single column gets the sign
+    of ``u_jᵀ M u_ref,j``. Neither choice is then shown as a mistake."""
+    k = U.shape[1]
+    lam = np.arange(k, dtype=float) if lam_ref is None else np.asarray(lam_ref, dtype=float)
+    gap = EXERCISE_EIGEN_RTOL * max(float(np.abs(lam).max(initial=0.0)), 1.0) * 10
+    out = np.array(U, dtype=float)
+    start = 0
+    for j in range(1, k + 1):
+        if j < k and abs(lam[j] - lam[j - 1]) <= gap:
+            continue
+        g = slice(start, j)
+        P, _, Wt = np.linalg.svd(U[:, g].T @ (m[:, None] * U_ref[:, g]))
+        out[:, g] = U[:, g] @ (P @ Wt)
+        start = j
+    return out
+
+
+def eigen_difference(
+    U: np.ndarray, U_ref: np.ndarray, m: np.ndarray, lam_ref: np.ndarray | None = None
+) -> np.ndarray:
+    """Per vertex, the largest ``|u_j − u_ref,j|`` over the columns after
+    :func:`aligned_columns`: the difference map of a wrong eigenbasis."""
+    return np.abs(aligned_columns(U, U_ref, m, lam_ref) - U_ref).max(axis=1)
 
 
 COMPARE = {
