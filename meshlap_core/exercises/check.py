@@ -75,7 +75,7 @@ def evaluate(task: Task, run: TaskRun, cases: dict[str, Case]) -> TaskResult:
             task.name, "failed", case.name, label, cmp.vertex, cmp.expected, cmp.got,
             cmp.error, cmp.tol, key, describe(key), cmp.message,
             n_failed=len(failures), n_calls=len(run.calls), difference=cmp.difference,
-            picture=_picture(failures),
+            picture=_picture(failures, task),
         )  # fmt: skip
     ratio, seconds, n = _speed(task, run, cases)
     if ratio is not None and ratio >= EXERCISE_SLOW_RATIO and seconds >= EXERCISE_SLOW_MIN_SECONDS:
@@ -87,13 +87,15 @@ def evaluate(task: Task, run: TaskRun, cases: dict[str, Case]) -> TaskResult:
     return TaskResult(task.name, "passed", n_calls=len(run.calls), speed_ratio=ratio)
 
 
-def _picture(failures: list[tuple[Case, Any, Any, Comparison, str]]) -> tuple | None:
-    """(V, F, difference, mesh name) of the largest failing mesh with a difference map."""
+def _picture(failures: list[tuple[Case, Any, Any, Comparison, str]], task: Task) -> tuple | None:
+    """(V, F, difference, mesh name, signed) of the largest failing mesh with a difference
+    map (``signed``: a scalar per vertex, student − reference)."""
     shown = [(c, cm) for c, _, _, cm, _ in failures if cm.difference is not None]
     if not shown:
         return None
     case, cmp = max(shown, key=lambda s: len(s[0].V))
-    return case.V, case.F, cmp.difference, case.name
+    signed = task.kind == "array" and np.ndim(cmp.expected) == 0
+    return case.V, case.F, cmp.difference, case.name, signed
 
 
 def _speed(task: Task, run: TaskRun, cases: dict[str, Case]) -> tuple[float | None, float, int]:

@@ -1,5 +1,8 @@
 """The result of a check: per task passed or why not, as text, JSON, JUnit XML, and for
-notebooks an HTML table (``_repr_html_``) and a small picture (``_repr_png_``, matplotlib)."""
+notebooks an HTML table (``_repr_html_``) and a small picture (``_repr_png_``): the task cells
+(matplotlib) beside the difference map on the failing mesh, drawn by the viewer's EGL snapshot
+renderer (the ``meshlap.check_picture`` entry point; the core never imports the viewer), or by
+matplotlib with the reason written under it when EGL is unavailable."""
 
 from __future__ import annotations
 
@@ -7,7 +10,7 @@ import html
 import io
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 
@@ -47,8 +50,9 @@ class TaskResult:
         Student time / reference time on the large mesh (speed-checked tasks).
     difference : (n,) float or None
         Student − reference per vertex of ``case`` (the difference map).
-    picture : (V, F, difference, mesh name) or None
-        The largest failing mesh and its difference map (the notebook picture).
+    picture : (V, F, difference, mesh name, signed) or None
+        The largest failing mesh and its difference map (the notebook picture); ``signed``:
+        a scalar per vertex (coolwarm around 0), else a magnitude (viridis from 0).
     """
 
     task: str
@@ -200,8 +204,30 @@ class CheckResult:
         )
 
     def _repr_png_(self) -> bytes:
-        """A small picture: one cell per task (green passed, red failed, grey not done), and
-        the first failure's largest failing mesh coloured by |student − reference|."""
+        """The notebook picture (:meth:`picture`, EGL when it can)."""
+        return self.picture().png
+
+    def picture(self, renderer: Literal["auto", "egl", "matplotlib"] = "auto") -> Picture:
+        """A small picture: one cell per task (green passed, red failed, grey not done) and the
+        first failure's largest failing mesh coloured by its difference map.
+
+        Parameters
+        ----------
+        renderer : {"auto", "egl", "matplotlib"}
+            ``"auto"``: the viewer's EGL snapshot renderer (``meshlap.check_picture`` entry
+            point), and matplotlib's 3D plot if it is not installed or EGL cannot render (the
+            picture and :attr:`Picture.reason` say why); ``"egl"`` raises instead of falling
+            back.
+
+        Returns
+        -------
+        Picture
+
+        Raises
+        ------
+        RuntimeError
+            ``renderer="egl"`` and EGL did not render.
+        """
         import matplotlib
 
         matplotlib.use("Agg", force=False)
@@ -216,13 +242,90 @@ class CheckResult:
             ax.text(0.03, n - 1 - k, f"{t.task}: {t.status}", va="center", fontsize=7, color="w")
         ax.set_axis_off()
         fail = next((t for t in self.tasks if t.picture is not None and not t.passed), None)
+        used, reason = "none", ""
         if fail is None:
             fig.text(0.72, 0.5, f"{self.n_passed}/{n} passed", ha="center", fontsize=12)
         else:
-            _draw_difference(fig, fail)
+            image = None
+            if renderer != "matplotlib":
+                try:
+                    image = _egl_image(fail)
+                except RuntimeError as exc:
+                    if renderer == "egl":
+                        raise
+                    reason = str(exc)
+            if image is not None:
+                used = "egl"
+                _show_image(fig, fail, image)
+            else:
+                used = "matplotlib"
+                _draw_difference(fig, fail)
+                if reason:
+                    fig.text(0.72, 0.02, _short("EGL unavailable: " + reason, 70),
+                             ha="center", fontsize=6, color="#57606a")  # fmt: skip
         buf = io.BytesIO()
         fig.savefig(buf, format="png")
-        return buf.getvalue()
+        return Picture(buf.getvalue(), used, reason)
+
+
+@dataclass(frozen=True)
+class Picture:
+    """A check result's picture.
+
+    Attributes
+    ----------
+    png : bytes
+    renderer : {"egl", "matplotlib", "none"}
+        What drew the difference map (``"none"``: no failure with a map to draw).
+    reason : str
+        Why EGL was not used (``""`` when it was, or was not asked).
+    """
+
+    png: bytes
+    renderer: str
+    reason: str = ""
+
+
+PICTURE_GROUP = "meshlap.check_picture"
+"""Entry-point group of the difference-map renderer: ``f(V, F, difference, signed) -> PNG``."""
+
+
+def _egl_image(t: TaskResult) -> np.ndarray:
+    """The failing mesh's difference map as an RGBA image, rendered by the viewer's EGL
+    snapshot renderer (the first ``meshlap.check_picture`` entry point).
+
+    Raises
+    ------
+    RuntimeError
+        No renderer installed, or it failed (its message).
+    """
+    from importlib.metadata import entry_points
+
+    found = list(entry_points(group=PICTURE_GROUP))
+    if not found:
+        raise RuntimeError("the viewer (meshlap_app) is not installed")
+    V, F, d, _name, signed = t.picture
+    try:
+        png = found[0].load()(V, F, d, signed)
+    except ImportError as exc:
+        raise RuntimeError(f"the viewer does not import: {exc}") from exc
+    import matplotlib.image as mpimg
+
+    return mpimg.imread(io.BytesIO(png), format="png")
+
+
+def _show_image(fig: Any, t: TaskResult, image: np.ndarray) -> None:
+    ax = fig.add_axes((0.5, 0.05, 0.45, 0.8))
+    ax.imshow(image)
+    ax.set_axis_off()
+    _caption(fig, t)
+
+
+def _caption(fig: Any, t: TaskResult) -> None:
+    _V, _F, d, name, _signed = t.picture
+    top = float(np.abs(np.asarray(d, dtype=float)).max()) or 1.0
+    fig.text(0.72, 0.92, f"{t.task} on {name}: |student − reference| ≤ {top:.3g}",
+             ha="center", fontsize=7)  # fmt: skip
 
 
 CELL_COLOURS = {
@@ -237,7 +340,7 @@ def _draw_difference(fig: Any, t: TaskResult) -> None:
     """The mesh in 3D, each face coloured by its vertices' mean |student − reference|."""
     from matplotlib import colormaps
 
-    V, F, d, name = t.picture
+    V, F, d, _name, _signed = t.picture
     ax = fig.add_axes((0.5, 0.05, 0.45, 0.8), projection="3d")
     face = np.abs(np.asarray(d, dtype=float))[F].mean(axis=1)
     top = float(face.max()) or 1.0
@@ -247,8 +350,7 @@ def _draw_difference(fig: Any, t: TaskResult) -> None:
     ax.set_axis_off()
     extent = np.ptp(V, axis=0)
     ax.set_box_aspect(np.maximum(extent, 0.05 * max(float(extent.max()), 1e-300)))
-    fig.text(0.72, 0.92, f"{t.task} on {name}: |student − reference| ≤ {top:.3g}",
-             ha="center", fontsize=7)  # fmt: skip
+    _caption(fig, t)
 
 
 def junit_document(results: list[CheckResult]) -> str:
