@@ -238,3 +238,99 @@ def test_a_saved_session_reopens_the_check(viewer, tmp_path):
     assert "does not exist" in viewer.state.errors["check"]
     assert not st.current(viewer.state.mesh.version)
     assert st.file == moved["file"] and st.vertex == 5
+
+
+# ---------------------------------------------------------------- real pixels (EGL)
+ONE_VERTEX_WRONG = '''
+import numpy as np
+
+
+def barycentric_areas(V, F):
+    """A third of each face, and a mistake at vertex {target} only."""
+    P = V[F]
+    A = 0.5 * np.linalg.norm(np.cross(P[:, 1] - P[:, 0], P[:, 2] - P[:, 0]), axis=1)
+    a = np.bincount(F.ravel(), np.repeat(A / 3.0, 3), minlength=len(V))
+    if len(V) > {target}:
+        a[{target}] += 2.0 * a.max()
+    return a
+'''
+
+EGL_CHECK_SCRIPT = """
+import json, sys, time
+from pathlib import Path
+
+import numpy as np
+import polyscope as ps
+from meshlap_app.camera import project_to_screen
+from meshlap_app.scene import save_screenshot
+from meshlap_app.state import AppState, MeshState
+from meshlap_app.viewer import Viewer, init_polyscope
+
+if __name__ == "__main__":
+    mesh = MeshState(); mesh.load(None)
+    init_polyscope("openGL3_egl")
+    viewer = Viewer(AppState(mesh=mesh, panel="check"))
+    viewer.sync_mesh()
+    ps.set_user_callback(viewer.callback)
+    ps.reset_camera_to_home_view()
+    panel = viewer.panels["check"]
+    panel.state.file = sys.argv[1]
+    panel.state.set_task("barycentric_areas")
+    panel.start_check(viewer)  # outside the window: inline
+    for _ in range(3):
+        ps.frame_tick()
+    save_screenshot(Path(sys.argv[2]))
+    target = int(sys.argv[3])
+    params = ps.get_view_camera_parameters()
+    w, h = ps.get_window_size()
+    xy, front = project_to_screen(viewer.state.display.points(mesh.V[[target]]),
+                                  params.get_view_mat(), params.get_fov_vertical_deg(), w, h)
+    t = panel.state.check.result.tasks[0]
+    print(json.dumps({"xy": xy[0].tolist(), "front": bool(front[0]), "size": [w, h],
+                      "status": t.status, "vertex": t.vertex}))
+"""
+
+
+def _facing_vertex() -> int:
+    """A vertex of the bundled mesh near the middle of the default view, facing the camera
+    (which looks along +z from −z), as in test_viewer's picking test."""
+    from meshlap_app.state import MeshState
+
+    from meshlap_core.curvature import vertex_normals
+
+    mesh = MeshState()
+    mesh.load(None)
+    N = vertex_normals(mesh.V, mesh.F)
+    return int(np.argmin(N[:, 2] + 0.2 * np.abs(mesh.V[:, 1]) + 0.2 * np.abs(mesh.V[:, 0])))
+
+
+@pytest.mark.egl
+def test_egl_difference_map_is_coloured_where_the_mistake_is(tmp_path, python_ok):
+    """A wrong student file loaded in the Check panel, rendered by EGL: the difference map is
+    red (coolwarm's positive end) around the wrong vertex's projection and nowhere else in the
+    3D view; the rest of the mesh is at the colour of 0."""
+    import json
+
+    import matplotlib.image as mpimg
+
+    target = _facing_vertex()
+    student = tmp_path / "one_wrong.py"
+    student.write_text(ONE_VERTEX_WRONG.replace("{target}", str(target)))
+    script = tmp_path / "egl_check.py"
+    script.write_text(EGL_CHECK_SCRIPT)
+    out = tmp_path / "check.png"
+    res = python_ok(script, student, out, target, timeout=600)
+    info = json.loads(res.stdout.strip().splitlines()[-1])
+    assert info["status"] == "failed" and info["front"]
+    img = mpimg.imread(out)[..., :3]
+    scale = img.shape[1] / info["size"][0]  # framebuffer pixels per window pixel
+    view = img[:, : int(0.55 * img.shape[1])]  # the 3D view (the panel is on the right)
+    red = (view[..., 0] - view[..., 2] > 0.2) & (view[..., 0] > 0.45)
+    bg = np.abs(view - view[0, 0]).sum(axis=2) > 0.05
+    assert bg.mean() > 0.05 and red.sum() > 10
+    ys, xs = np.nonzero(red)
+    x0, y0 = (np.array(info["xy"]) * scale).tolist()
+    # every red pixel is near the wrong vertex: the map is coloured there and only there
+    dist = np.hypot(xs - x0, ys - y0)
+    assert dist.max() < 0.08 * view.shape[0], (dist.max(), x0, y0)
+    assert red.sum() < 0.02 * bg.sum()
