@@ -44,16 +44,23 @@ def _cases(extra: Sequence[Case]) -> dict[str, Case]:
     return {c.name: c for c in [*battery(), *extra]}
 
 
-def evaluate(task: Task, run: TaskRun, cases: dict[str, Case]) -> TaskResult:
-    """Turn the worker's report of one task into a :class:`TaskResult` (compare, diagnose)."""
+def evaluate(
+    task: Task, run: TaskRun, cases: dict[str, Case], kept: dict[str, Any] | None = None
+) -> TaskResult:
+    """Turn the worker's report of one task into a :class:`TaskResult` (compare, diagnose);
+    ``kept`` receives the reference answer of every call by mesh name (the viewer's mesh's is
+    then not computed twice)."""
     if run.status != "ran":
+        shows_traceback = ("error", "memory", "import_error", "refused")
         return TaskResult(
             task.name,
             run.status,
             case=run.case if run.status not in _STOPPED else "",
             label=run.label if run.status not in _STOPPED else "",
+            diagnosis=run.diagnosis,
+            diagnosis_text=describe(run.diagnosis),
             message=_STOPPED.get(run.status, run.message),
-            traceback=run.message if run.status in ("error", "memory", "import_error") else "",
+            traceback=run.message if run.status in shows_traceback else "",
         )
     failures: list[tuple[Case, Any, Any, Comparison, str]] = []
     first_fail: Comparison | None = None
@@ -61,6 +68,8 @@ def evaluate(task: Task, run: TaskRun, cases: dict[str, Case]) -> TaskResult:
         case = cases[case_name]
         args = dict(task.calls(case))[label]
         ref = task.reference(case, args)
+        if kept is not None:
+            kept[case_name] = ref
         cmp = COMPARE[task.kind](answer, ref, case, task.power)
         if not cmp.ok:
             failures.append((case, args, answer, cmp, label))
@@ -256,9 +265,10 @@ def check_on_mesh(
     case = Case("your_mesh", np.asarray(V, float), np.asarray(F, np.int64), "the mesh on screen")
     t = TASKS[task]
     runs = run_student(path, [task], [case], timeout=timeout, memory_mb=memory_mb, cancel=cancel)
-    result = CheckResult(os.fspath(path), [evaluate(t, runs[task], _cases([case]))])
+    kept: dict[str, Any] = {}
+    result = CheckResult(os.fspath(path), [evaluate(t, runs[task], _cases([case]), kept)])
     (_, args), *_ = t.calls(case)
-    expected = t.reference(case, args)
+    expected = kept[case.name] if case.name in kept else t.reference(case, args)
     got = next((a for c, _, a, _ in runs[task].calls if c == case.name), None)
     difference, signed = None, False
     if got is not None:

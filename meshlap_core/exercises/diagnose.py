@@ -72,6 +72,17 @@ DIAGNOSES: dict[str, str] = {
     "the Poisson solution is only defined up to a constant",
     "sized_by_faces": "the answer is sized by F.max()+1: a vertex in no face (the last one here) "
     "still has its row; use n = len(V)",
+    "opens_window": "opens a window (polyscope, a GUI toolkit, an X/GL library): the checker "
+    'runs without a screen; keep viewers and plots under `if __name__ == "__main__":`',
+    "spawns_process": "starts a process (subprocess, os.system, multiprocessing, fork): a "
+    "check runs your functions only",
+    "outside_folder": "opens a file outside the exercises file's folder (another submission, "
+    "the reference, the system): a check reads and writes only beside your file",
+    "hangs_at_import": "the file never finishes importing (a loop, a sleep or input() at "
+    'module level?): put work inside the functions or under `if __name__ == "__main__":`',
+    "too_slow": "far slower than the reference on this mesh (a time limit scaled to the "
+    "reference's own time on the same mesh, on the same machine, was passed): a Python loop "
+    "per entry, or dense matrices on a big mesh?",
     "slow_loop": "correct, but {seconds:.1f} s on {n} vertices, about {ratio:.0f}× the "
     "reference's time: a Python loop per vertex or per entry? build from arrays (np.bincount, "
     "COO triplets)",

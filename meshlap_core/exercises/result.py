@@ -24,6 +24,7 @@ STATUS_WORDS = {
     "missing": "missing",
     "not_implemented": "not implemented",
     "import_error": "ERROR (the file does not import)",
+    "refused": "REFUSED (the sandbox stopped it)",
 }
 
 

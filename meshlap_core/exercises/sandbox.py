@@ -10,7 +10,10 @@ checker's process never runs student code, so nothing the student does can break
   the worker's own size plus a budget), the allocation raises ``MemoryError``: ``memory``;
 - a crash (``os._exit``, a segfault in an extension): ``crashed``, then the next task;
 - an exception: ``error`` with the traceback frames of the student's file only;
-- an import of meshlap itself (which would return the reference): refused (:mod:`.guard`).
+- an import of meshlap itself (which would return the reference): refused (:mod:`.guard`);
+- a window opened, a process started, a file opened outside the student's folder: stopped by
+  :class:`.guard.Fence` and reported ``refused`` with its diagnosis (the rest still checked);
+- an import that never ends: ``timeout`` with the diagnosis ``hangs_at_import``.
 
 The answers are compared with the reference in the checker's process (:mod:`.check`).
 """
@@ -46,7 +49,7 @@ class TaskRun:
     ----------
     status : str
         ``"ran"`` (every call returned), ``"missing"``, ``"not_implemented"``, ``"error"``,
-        ``"timeout"``, ``"memory"``, ``"crashed"`` or ``"import_error"``.
+        ``"timeout"``, ``"memory"``, ``"crashed"``, ``"refused"`` or ``"import_error"``.
     calls : list of (case name, label, answer, seconds)
     message : str
         The student's traceback (their file's frames only) or what stopped the task.
@@ -55,6 +58,8 @@ class TaskRun:
     speed : (float, float) or None
         Student and reference seconds on the large case, measured side by side in the worker
         (:func:`_speed`).
+    diagnosis : str or None
+        Why the sandbox stopped the task (a :data:`.guard.FENCE_WHY` key, ``hangs_at_import``).
     """
 
     status: str = "ran"
@@ -63,6 +68,7 @@ class TaskRun:
     case: str = ""
     label: str = ""
     speed: tuple[float, float] | None = None
+    diagnosis: str | None = None
 
 
 def student_traceback(exc: BaseException, path: str) -> str:
@@ -125,7 +131,9 @@ def _seconds(fn: Any, *args: Any) -> float:
     return time.perf_counter() - t0
 
 
-def _speed(task: Any, func: Any, case: Case) -> tuple[float, float]:
+def _speed(
+    task: Any, func: Any, case: Case, fence: guard.Fence, conn: Connection
+) -> tuple[float, float]:
     """(student seconds, reference seconds) on ``case``, from the round most favourable to the
     student: each round times the reference (best of 3) and then the student, side by side, so
     that a burst of load on a shared machine hits both; a correct answer is never called slow
@@ -133,8 +141,11 @@ def _speed(task: Any, func: Any, case: Case) -> tuple[float, float]:
     (_label, args), *_ = task.calls(case)
     best: tuple[float, float] | None = None
     for _round in range(SPEED_ROUNDS):
-        ref = min(_seconds(task.reference, case, args) for _ in range(3))
-        mine = _seconds(func, *args)
+        refs = [_seconds(task.reference, case, args) for _ in range(3)]
+        conn.send(("budget", task.name, case.name, max(refs)))
+        ref = min(refs)
+        with fence.student():
+            mine = _seconds(func, *args)
         if best is None or mine / max(ref, 1e-9) < best[0] / max(best[1], 1e-9):
             best = (mine, ref)
         if mine > 2.0:
@@ -143,17 +154,39 @@ def _speed(task: Any, func: Any, case: Case) -> tuple[float, float]:
 
 
 SPEED_ROUNDS = 4
+TIME_FACTOR = 2000.0
+"""A call on a mesh of :data:`BUDGET_MIN_VERTICES` or more may take this many times the
+reference's time on the same mesh, measured in the worker just before the call (side by side:
+a loaded machine slows both), when that is more than the task's time limit: a right answer
+written with dense matrices (O(n³), about 200× the sparse reference on the 2562-vertex mesh)
+is never stopped as an infinite loop because the machine was busy, nor on a big scan."""
+BUDGET_MIN_VERTICES = 1000
+"""Below this the reference takes milliseconds: the task's time limit alone applies."""
 
 
-def _run_task(conn: Connection, task: Any, func: Any, cases: list[Case], path: str) -> None:
+def _run_task(
+    conn: Connection, task: Any, func: Any, cases: list[Case], path: str, fence: guard.Fence
+) -> None:
     for case in cases:
         for label, args in task.calls(case):
             where = ("call", task.name, case.name, label)
+            if len(case.V) >= BUDGET_MIN_VERTICES:  # the reference here, now: the call's time
+                ref = _seconds(task.reference, case, args)
+                conn.send(("budget", task.name, case.name, ref))
             try:
                 t0 = time.perf_counter()
-                answer = func(*args)
+                with fence.student():
+                    answer = func(*args)
                 seconds = time.perf_counter() - t0
+                refused = fence.take()
+                if refused is not None:  # caught by the student: still refused
+                    raise refused
                 conn.send((*where, _portable(answer, task.kind), seconds))
+            except guard.Refused as exc:
+                fence.take()
+                text = student_traceback(exc, path)
+                conn.send(("stop", task.name, "refused", case.name, label, text, exc.key))
+                return
             except NotImplementedError:
                 conn.send(("stop", task.name, "not_implemented", case.name, label, ""))
                 return
@@ -167,7 +200,12 @@ def _run_task(conn: Connection, task: Any, func: Any, cases: list[Case], path: s
                 return
     if task.speed and any("speed" in c.tags for c in cases):
         big = next(c for c in cases if "speed" in c.tags)
-        conn.send(("speed", task.name, *_speed(task, func, big)))
+        try:
+            conn.send(("speed", task.name, *_speed(task, func, big, fence, conn)))
+        except guard.Refused as exc:  # only now (the speed call): refused all the same
+            fence.take()
+            text = student_traceback(exc, path)
+            conn.send(("stop", task.name, "refused", big.name, "speed", text, exc.key))
 
 
 def _worker(
@@ -184,10 +222,18 @@ def _worker(
         conn.send(("import_error", refused))
         return
     guard.install(STUDENT_MODULE, path)
+    fence = guard.Fence(path)
+    fence.install()
     try:
-        module = _import_student(path)
+        with fence.student():
+            module = _import_student(path)
+        refused = fence.take()
+        if refused is not None:  # caught by the student: still refused
+            raise refused
     except BaseException as exc:  # SystemExit, SyntaxError: the student's
-        conn.send(("import_error", student_traceback(exc, path)))
+        refused = fence.take()  # the first refused attempt, even if another error followed
+        key = refused.key if refused is not None else getattr(exc, "key", None)
+        conn.send(("import_error", student_traceback(exc, path), key))
         return
     for name in names:
         conn.send(("start", name))
@@ -197,7 +243,7 @@ def _worker(
             conn.send(("stop", name, "missing", "", "", ""))
             continue
         cases = [all_cases[c] for c in task.cases] + list(extra)
-        _run_task(conn, task, func, cases, path)
+        _run_task(conn, task, func, cases, path, fence)
         conn.send(("done", name))
     conn.send(("finished",))
 
@@ -210,6 +256,7 @@ def _receive(conn: Connection, runs: dict[str, TaskRun], msg: tuple) -> str | No
     elif kind == "stop":
         run = runs[msg[1]]
         run.status, run.case, run.label, run.message = msg[2], msg[3], msg[4], msg[5]
+        run.diagnosis = msg[6] if len(msg) > 6 else None
     elif kind == "speed":
         runs[msg[1]].speed = (msg[2], msg[3])
     return None
@@ -276,6 +323,7 @@ def _drive(
     started = False
     done: set[str] = set()
     deadline = time.monotonic() + timeout
+    budget: tuple[str, float] | None = None  # (mesh, reference seconds) of the call running
     try:
         while True:
             left = deadline - time.monotonic()
@@ -293,11 +341,16 @@ def _drive(
             if msg[0] == "import_error":
                 for n in todo:
                     runs[n].status, runs[n].message = "import_error", msg[1]
+                    runs[n].diagnosis = msg[2] if len(msg) > 2 else None
                 return []
             if msg[0] == "finished":
                 return []
+            if msg[0] == "budget":  # a call on a big mesh: TIME_FACTOR × the reference there
+                budget = (msg[2], msg[3])
+                deadline = max(deadline, time.monotonic() + TIME_FACTOR * msg[3])
+                continue
             if msg[0] == "start":
-                current, deadline = msg[1], time.monotonic() + timeout
+                current, deadline, budget = msg[1], time.monotonic() + timeout, None
                 started = True
                 done.update(todo[: todo.index(msg[1])])
             elif msg[0] == "done":
@@ -318,8 +371,18 @@ def _drive(
     if not started:  # the import itself never finished: every task is lost
         for n in todo:
             runs[n].status, runs[n].message = status, f"while importing your file: {why}"
+            runs[n].diagnosis = "hangs_at_import" if status == "timeout" else None
         return []
     if current is None:  # died between two tasks: the next one had not started
         return [n for n in todo if n not in done]
+    diagnosis = None
+    if status == "timeout" and budget is not None and TIME_FACTOR * budget[1] > timeout:
+        mesh, ref = budget
+        why = (
+            f"stopped on mesh {mesh}: over {TIME_FACTOR:g}× the reference's {ref:.3g} s there "
+            "(measured just before, on this machine)"
+        )
+        diagnosis = "too_slow"
     runs[current].status, runs[current].message = status, why
+    runs[current].diagnosis = diagnosis
     return todo[todo.index(current) + 1 :]

@@ -1,0 +1,140 @@
+"""The sandbox's fences (:class:`meshlap_core.exercises.guard.Fence`): a student file that
+opens a window, starts a process, opens a file outside its folder, or never finishes importing
+is stopped and reported with its diagnosis, and the checker (and the file's other tasks) go on.
+Each case has its hostile student file in ``tests/exercises/``."""
+
+from __future__ import annotations
+
+import multiprocessing
+from pathlib import Path
+
+import pytest
+
+from meshlap_core.exercises import check_file
+from meshlap_core.exercises.diagnose import DIAGNOSES
+
+STUDENTS = Path(__file__).parent / "exercises"
+
+FENCED = [  # (student file, task, status, diagnosis, the line of the file named in its traceback)
+    ("hostile_window", "uniform_laplacian", "import_error", "opens_window", "import polyscope"),
+    ("hostile_window", "one_ring", "import_error", "opens_window", "import polyscope"),
+    ("hostile_spawn", "uniform_laplacian", "refused", "spawns_process", "subprocess.run"),
+    ("hostile_spawn", "barycentric_areas", "refused", "spawns_process", ".Pool(2)"),
+    ("hostile_read_outside", "barycentric_areas", "refused", "outside_folder", "conftest.py"),
+]
+
+
+@pytest.fixture(scope="module")
+def fenced():
+    """Each hostile file checked once on the tasks it defines."""
+    tasks = {
+        "hostile_window": ["uniform_laplacian", "one_ring"],
+        "hostile_spawn": ["uniform_laplacian", "barycentric_areas", "one_ring"],
+        "hostile_read_outside": ["barycentric_areas", "mean_curvature_normal"],
+    }
+    return {name: check_file(STUDENTS / f"{name}.py", t) for name, t in tasks.items()}
+
+
+@pytest.mark.parametrize(("name", "task", "status", "diagnosis", "line"), FENCED)
+def test_a_fenced_action_is_stopped_and_diagnosed(fenced, name, task, status, diagnosis, line):
+    result = fenced[name][task]
+    assert result.status == status, result.lines()
+    assert result.diagnosis == diagnosis, result.lines()
+    text = "\n".join(result.lines())
+    assert DIAGNOSES[diagnosis].split(":")[0] in text
+    assert f"{name}.py" in result.traceback and line in result.traceback
+    frames = [ln for ln in result.traceback.splitlines() if ln.strip().startswith("File ")]
+    assert frames and all(f"{name}.py" in ln for ln in frames)  # the student's frames only
+
+
+def test_the_fences_stop_only_what_they_must(fenced):
+    """The same files' other tasks pass: a right answer beside a refused one (one_ring), and a
+    task reading a file inside its own folder (its source) is not refused."""
+    assert fenced["hostile_spawn"]["one_ring"].passed
+    assert fenced["hostile_read_outside"]["mean_curvature_normal"].passed
+
+
+def test_a_caught_refusal_is_still_refused(fenced):
+    """hostile_spawn's barycentric_areas catches the PermissionError and returns right areas:
+    the attempt was made, the task is refused all the same."""
+    r = fenced["hostile_spawn"]["barycentric_areas"]
+    assert r.status == "refused" and r.n_calls == 0
+
+
+def test_a_file_that_hangs_at_import_is_stopped_and_diagnosed():
+    result = check_file(
+        STUDENTS / "hostile_import_hang.py", ["uniform_laplacian", "one_ring"], timeout=4.0
+    )
+    for t in result.tasks:
+        assert t.status == "timeout" and t.diagnosis == "hangs_at_import", t.lines()
+        assert "while importing your file" in t.message
+    assert not multiprocessing.active_children()
+
+
+def test_a_right_file_is_not_fenced(tmp_path):
+    """A right file in another folder that reads a data file beside it, imports scipy's
+    submodules lazily inside the call and writes a scratch file in its folder: nothing is
+    refused."""
+    (tmp_path / "factor.txt").write_text("1.0\n")
+    (tmp_path / "mine.py").write_text(
+        "import os\nimport numpy as np\n\n"
+        "HERE = os.path.dirname(os.path.abspath(__file__))\n\n"
+        "def barycentric_areas(V, F):\n"
+        "    import scipy.sparse.csgraph  # a lazy import: the library's own files\n"
+        "    with open(os.path.join(HERE, 'factor.txt')) as f:\n"
+        "        s = float(f.read())\n"
+        "    np.save(os.path.join(HERE, 'scratch.npy'), V)\n"
+        "    P = V[F]\n"
+        "    A = 0.5 * np.linalg.norm(np.cross(P[:, 1] - P[:, 0], P[:, 2] - P[:, 0]), axis=1)\n"
+        "    return s * np.bincount(F.ravel(), np.repeat(A / 3.0, 3), minlength=len(V))\n"
+    )
+    result = check_file(tmp_path / "mine.py", ["barycentric_areas"])
+    assert result.passed, result.format_text()
+    assert (tmp_path / "scratch.npy").is_file()
+
+
+# ---- time limits in proportion to the reference on the same mesh ---------------------------
+
+RIGHT_HEAT = (STUDENTS / "right_igl.py").read_text()
+
+
+def _slow_student(tmp_path: Path, body: str) -> Path:
+    """right_igl.py with its heat_geodesic wrapped: ``body`` runs first on meshes of 1000
+    vertices or more (the battery's large sphere)."""
+    path = tmp_path / "slow.py"
+    path.write_text(
+        RIGHT_HEAT.replace("def heat_geodesic(", "def _heat(")
+        + "\n\ndef heat_geodesic(V, F, source, m):\n"
+        + "    import time\n\n"
+        + "    if len(V) >= 1000:\n"
+        + "".join(f"        {line}\n" for line in body.splitlines())
+        + "    return _heat(V, F, source, m)\n"
+    )
+    return path
+
+
+def test_a_right_answer_slower_than_the_time_limit_on_a_big_mesh_passes(tmp_path):
+    """The call on the large sphere takes longer than the task's time limit (here 4 s): it is
+    given TIME_FACTOR × the reference's time on that mesh, measured just before in the same
+    worker, and passes (right_dense.py's dense heat method took 82 s there with the machine's
+    load at 14 and was stopped as an infinite loop at 60 s)."""
+    path = _slow_student(tmp_path, "time.sleep(6.0)")
+    result = check_file(path, ["heat_geodesic"], timeout=4.0)
+    assert result.passed, result.format_text()
+
+
+def test_an_endless_call_on_a_big_mesh_is_stopped_at_its_budget(tmp_path, monkeypatch):
+    """An endless call on the large sphere is stopped when it passes its budget (TIME_FACTOR
+    lowered to 100 here, to keep the test short) and diagnosed as far slower than the
+    reference on that mesh; the budget's mesh and reference time are in the message."""
+    from meshlap_core.exercises import sandbox
+
+    monkeypatch.setattr(sandbox, "TIME_FACTOR", 100.0)
+    path = _slow_student(tmp_path, "while True:\n    time.sleep(0.01)")
+    t = check_file(path, ["heat_geodesic"], timeout=4.0)["heat_geodesic"]
+    assert t.status == "timeout", t.lines()
+    if t.diagnosis is None:  # the reference took under 40 ms: the 4 s limit came first
+        assert "infinite loop" in t.message
+    else:
+        assert t.diagnosis == "too_slow" and "on mesh large" in t.message
+        assert "100× the reference's" in t.message
