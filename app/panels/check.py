@@ -248,12 +248,13 @@ def _egl_main() -> None:
     from pathlib import Path
 
     from ..scene import write_png
-    from ..viewer import init_polyscope
 
     data = np.load(sys.argv[1])
     size, signed = int(data["size"]), bool(data["signed"])
     d = np.asarray(data["d"], dtype=np.float64)
-    init_polyscope("openGL3_egl")
+    ps.set_allow_headless_backends(True)
+    ps.set_use_prefs_file(False)
+    ps.init("openGL3_egl")  # a panel never imports the viewer: polyscope started here
     ps.set_ground_plane_mode("none")
     ps.set_window_size(size, size)
     mesh = ps.register_surface_mesh("mesh", data["V"], data["F"], smooth_shade=True)
