@@ -166,6 +166,15 @@ def drive_panel_check(viewer, tmp_path: Path) -> None:
     from test_isolines import drive_check_isolines  # the map's isolines, while it is shown
 
     drive_check_isolines(viewer)
+    # the eigenbasis on the mesh on screen: its rows are λ_j and u_j[i], the map is shown
+    drive(viewer, "student file", str(STUDENTS / "wrong_spectral.py"))
+    drive(viewer, "task", "eigenbasis")
+    drive(viewer, "check", True)
+    assert st.check.result.tasks[0].diagnosis == "ordinary_eigenproblem"
+    drive(viewer, "vertex", 3)
+    rows = viewer.ui.tables[("check", "check rows")].rows
+    assert [r[0] for r in rows[:2]] == ["λ0", "u0[3]"] and len(rows) == 12
+    assert st.check.difference is not None and st.check.difference.max() > 0
     # a crashing student file: reported, the viewer and the last good map stay
     drive(viewer, "student file", str(STUDENTS / "hostile_crash.py"))
     drive(viewer, "task", "uniform_laplacian")
