@@ -8,6 +8,7 @@ from __future__ import annotations
 import multiprocessing
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from meshlap_core.exercises import check_file
@@ -138,3 +139,49 @@ def test_an_endless_call_on_a_big_mesh_is_stopped_at_its_budget(tmp_path, monkey
     else:
         assert t.diagnosis == "too_slow" and "on mesh large" in t.message
         assert "100× the reference's" in t.message
+
+
+def _tube(rings: int, around: int = 6) -> tuple[np.ndarray, np.ndarray]:
+    """A closed tube (capped), rings 0.87 apart with unit edges around: ``rings`` long."""
+    k, j = np.meshgrid(np.arange(rings), np.arange(around), indexing="ij")
+    angle = 2 * np.pi * (j + 0.5 * k) / around
+    r = 1.0 / (2 * np.sin(np.pi / around))
+    ring = np.stack([r * np.cos(angle), r * np.sin(angle), 0.87 * k], axis=-1).reshape(-1, 3)
+    top = 0.87 * (rings - 1)
+    V = np.vstack([ring, [[0.0, 0.0, -0.5], [0.0, 0.0, top + 0.5]]])
+    a = (k[:-1] * around + j[:-1]).ravel()
+    b = (k[:-1] * around + (j[:-1] + 1) % around).ravel()
+    quads = np.concatenate(
+        [np.stack([a, b, a + around], 1), np.stack([b, b + around, a + around], 1)]
+    )
+    s, e, last = len(V) - 2, len(V) - 1, (rings - 1) * around
+    jj = np.arange(around)
+    caps = np.concatenate([
+        np.stack([np.full(around, s), (jj + 1) % around, jj], 1),
+        np.stack([np.full(around, e), last + jj, last + (jj + 1) % around], 1),
+    ])  # fmt: skip
+    return V, np.concatenate([quads, caps]).astype(np.int64)
+
+
+def test_a_mesh_where_the_heat_underflows_does_not_judge_the_heat_method():
+    """On a tube 2400 rings long the heat of t = h² underflows to 0 far from the source (it
+    decays like exp(−d/√t)): a right heat file written from the template (right_igl.py) is NaN
+    there (−∇u/|∇u| = 0/0), through no mistake of its own. That mesh is not held against it: it
+    passes on the battery, with a note naming the mesh and the share of faces; a wrong file
+    still fails on the battery."""
+    from meshlap_core.diffusion import HeatGeodesic
+    from meshlap_core.exercises import geodesic_task as geo
+    from meshlap_core.exercises.check import check_on_mesh
+    from meshlap_core.exercises.meshes import Case
+
+    V, F = _tube(2400)
+    case = Case("tube", V, F, "")
+    (_, args), *_ = geo.heat_calls(case)
+    u = HeatGeodesic(V, F, m=1.0, boundary="neumann").heat([args[2]])
+    assert np.min(np.abs(u)) == 0.0  # the heat underflowed: the premise of the test
+    right = check_on_mesh(STUDENTS / "right_igl.py", "heat_geodesic", V, F)
+    t = right.result.tasks[0]
+    assert t.passed, t.lines()
+    assert "not judged on mesh your_mesh" in t.note and "underflows" in "\n".join(t.lines())
+    wrong = check_on_mesh(STUDENTS / "wrong_heat_time.py", "heat_geodesic", V, F)
+    assert wrong.result.tasks[0].diagnosis == "time_not_scaled"

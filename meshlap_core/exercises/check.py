@@ -64,6 +64,7 @@ def evaluate(
         )
     failures: list[tuple[Case, Any, Any, Comparison, str]] = []
     first_fail: Comparison | None = None
+    notes: list[str] = []
     for case_name, label, answer, _seconds in run.calls:
         case = cases[case_name]
         args = dict(task.calls(case))[label]
@@ -71,7 +72,10 @@ def evaluate(
         if kept is not None:
             kept[case_name] = ref
         cmp = COMPARE[task.kind](answer, ref, case, task.power)
-        if not cmp.ok:
+        reason = None if cmp.ok or task.not_judged is None else task.not_judged(case, args)
+        if reason is not None:
+            notes.append(reason)
+        elif not cmp.ok:
             failures.append((case, args, answer, cmp, label))
             first_fail = first_fail or cmp
     if failures:
@@ -84,16 +88,18 @@ def evaluate(
             task.name, "failed", case.name, label, cmp.vertex, cmp.expected, cmp.got,
             cmp.error, cmp.tol, key, describe(key), cmp.message,
             n_failed=len(failures), n_calls=len(run.calls), difference=cmp.difference,
-            picture=_picture(failures, task),
+            picture=_picture(failures, task), note="; ".join(notes),
         )  # fmt: skip
     ratio, seconds, n = _speed(task, run, cases)
     if ratio is not None and ratio >= EXERCISE_SLOW_RATIO and seconds >= EXERCISE_SLOW_MIN_SECONDS:
         return TaskResult(
             task.name, "failed", "large", diagnosis="slow_loop",
             diagnosis_text=describe("slow_loop", ratio=ratio, n=n, seconds=seconds),
-            n_calls=len(run.calls), speed_ratio=ratio,
+            n_calls=len(run.calls), speed_ratio=ratio, note="; ".join(notes),
         )  # fmt: skip
-    return TaskResult(task.name, "passed", n_calls=len(run.calls), speed_ratio=ratio)
+    return TaskResult(
+        task.name, "passed", n_calls=len(run.calls), speed_ratio=ratio, note="; ".join(notes)
+    )
 
 
 def _picture(failures: list[tuple[Case, Any, Any, Comparison, str]], task: Task) -> tuple | None:

@@ -48,6 +48,31 @@ def heat_reference(case: Case, args: tuple[Any, ...]) -> np.ndarray:
     return HeatGeodesic(case.V, case.F, m=args[3], boundary="neumann").distance([args[2]])
 
 
+UNDERFLOW = 1e-290
+"""A face whose three corners' heat is below this times the largest heat has underflowed
+(0 or denormal): its gradient has no direction in double precision."""
+
+
+def heat_not_judged(case: Case, args: tuple[Any, ...]) -> str | None:
+    """Why a failing call on ``case`` is not held against the student, or ``None``.
+
+    The heat of ``t = m·h²`` decays like ``exp(−d/√t)``: beyond about 700 edge lengths from the
+    source (a big scan, a long tube) it underflows to 0, and the template's ``−∇u/|∇u|`` is
+    0/0 there; a right answer written from the template is then NaN, or noise, on such a mesh.
+    The lab's reference takes those faces' direction from a longer time's heat, which the
+    template does not ask for, so such a mesh cannot judge the student (the battery does)."""
+    u = HeatGeodesic(case.V, case.F, m=args[3], boundary="neumann").heat([args[2]])
+    a = np.abs(u)
+    lost = a[case.F].max(axis=1) <= UNDERFLOW * float(a.max(initial=0.0))
+    if not lost.any():
+        return None
+    return (
+        f"not judged on mesh {case.name}: the heat of t = m·h² underflows to 0 on "
+        f"{100 * lost.mean():.2g} % of its faces (far from the source), where −∇u/|∇u| has no "
+        "direction; the battery's meshes judge the task"
+    )
+
+
 def heat_steps(
     V: np.ndarray,
     F: np.ndarray,

@@ -51,6 +51,8 @@ class TaskResult:
         Student time / reference time on the large mesh (speed-checked tasks).
     difference : (n,) float or None
         Student − reference per vertex of ``case`` (the difference map).
+    note : str
+        Calls a mesh could not judge, and why (:attr:`.tasks.Task.not_judged`).
     picture : (V, F, difference, mesh name, signed) or None
         The largest failing mesh and its difference map (the notebook picture); ``signed``:
         a scalar per vertex (coolwarm around 0), else a magnitude (viridis from 0).
@@ -74,6 +76,7 @@ class TaskResult:
     speed_ratio: float | None = None
     difference: np.ndarray | None = field(default=None, repr=False)
     picture: tuple | None = field(default=None, repr=False)
+    note: str = ""
 
     @property
     def passed(self) -> bool:
@@ -90,7 +93,7 @@ class TaskResult:
         head = f"{self.task:<24} {STATUS_WORDS.get(self.status, self.status)}"
         if self.passed:
             speed = f", {self.speed_ratio:.0f}× the reference's time" if self.speed_ratio else ""
-            return [f"{head} ({self.n_calls} calls{speed})"]
+            return [f"{head} ({self.n_calls} calls{speed})", *self._note()]
         out = [head]
         if self.case:
             where = f"  on mesh {self.case}" + (f" ({self.label})" if self.label else "")
@@ -109,7 +112,10 @@ class TaskResult:
             out.append(f"  {self.message}")
         if self.traceback:
             out.extend("  " + line for line in self.traceback.splitlines())
-        return out
+        return out + self._note()
+
+    def _note(self) -> list[str]:
+        return [f"  note: {self.note}"] if self.note else []
 
 
 def _short(value: Any, limit: int = 160) -> str:

@@ -82,6 +82,9 @@ class Task:
         Also try the generic mistakes (sign, factor 2, factor ½).
     speed : bool
         Time the student against the reference on the large case.
+    not_judged : callable or None
+        ``not_judged(case, args) -> reason or None``: a failing call that the mesh cannot
+        judge (the reason is reported as a note, the call is not counted as failed).
     """
 
     name: str
@@ -93,6 +96,7 @@ class Task:
     mistakes: tuple[Mistake, ...] = ()
     generic: bool = True
     speed: bool = False
+    not_judged: Callable[[Case, Args], str | None] | None = None
 
 
 def _vf(case: Case) -> list[tuple[str, Args]]:
@@ -434,6 +438,7 @@ def _table() -> dict[str, Task]:
              M("time_not_scaled", geo.heat_time_not_scaled),
              M("divergence_sign", geo.heat_negated, geo.fits_negated),
              M("not_shifted", geo.heat_unshifted, geo.fits_shifted)),
+            not_judged=geo.heat_not_judged,
         ),
     ]  # fmt: skip
     table = {t.name: t for t in tasks}
