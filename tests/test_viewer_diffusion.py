@@ -30,11 +30,13 @@ def mock(polyscope_mock):
 
 
 def settle(viewer, owner: str = "diffusion") -> None:
-    """Wait for the panel's job and let the host apply it."""
+    """Wait for the panel's jobs (worker threads when ``viewer.background``) and let the host
+    apply them (an applied job may start the next one)."""
     t0 = time.monotonic()
     while viewer.state.jobs.running(owner) is not None:
         assert time.monotonic() - t0 < 120, "the diffusion job never finished"
-        time.sleep(0.02)
+        viewer.state.jobs.wait(owner, 1.0)
+        frames(viewer, 1)
     frames(viewer, 2)
 
 
@@ -308,3 +310,44 @@ def test_play_moves_t_up_its_log_scale_and_stops_at_the_top():
     assert st.playing and st.log_t == lo
     st.clear()  # a new mesh stops it
     assert not st.playing
+
+
+def test_distance_view_factorizes_before_the_first_click_which_only_solves(viewer, monkeypatch):
+    """As on a scan (solves as jobs, the window's worker threads): showing the distance view
+    starts the heat method's factorizations; a click while they run waits for them (the job is
+    not restarted) and is answered when they end; later clicks reuse them (no factorization)."""
+    import meshlap_app.panels.diffusion as mod
+
+    monkeypatch.setattr(mod, "INLINE_DISTANCE_MAX", 0)
+    viewer.background = True
+    panel, jobs = viewer.panels["diffusion"], viewer.state.jobs
+    st = panel.state
+    built: list[float] = []
+
+    class Counted(HeatGeodesic):
+        def __init__(self, *args, **kwargs):
+            time.sleep(0.3)  # long enough for a click to arrive meanwhile
+            super().__init__(*args, **kwargs)
+            built.append(self.m)
+
+    monkeypatch.setattr(mod, "HeatGeodesic", Counted)
+    viewer.set_panel("diffusion")
+    drive(viewer, "show", "distance")
+    job = jobs.running("diffusion")
+    assert job is not None and job.title == mod.FACTORING and st.sources == []
+    assert panel.select(viewer, 11)  # a click during the factorization
+    assert jobs.running("diffusion") is job  # waited for, not restarted
+    settle(viewer)
+    V, F = viewer.state.mesh.V, viewer.state.mesh.F
+    np.testing.assert_allclose(st.distance, HeatGeodesic(V, F).distance([11]), atol=1e-12)
+    assert built == [1.0]
+    assert panel.select(viewer, 30)
+    job = jobs.running("diffusion")
+    assert job is None or job.title == mod.SOLVING
+    settle(viewer)
+    np.testing.assert_allclose(st.distance, HeatGeodesic(V, F).distance([30]), atol=1e-12)
+    assert built == [1.0]  # the click only back-substituted
+    drive(viewer, "m (t = m h^2)", "2")  # a new m: factorized again, once
+    settle(viewer)
+    assert built == [1.0, 2.0]
+    np.testing.assert_allclose(st.distance, HeatGeodesic(V, F, m=2).distance([30]), atol=1e-12)

@@ -36,6 +36,9 @@ HEAT_COPIES = ("heat (second way)", "heat (third field)")
 INLINE_DISTANCE_MAX = 100_000
 """Up to this many vertices a new source's distance is solved on the UI thread (about 40 ms
 at 43k once factorized); above, as a job."""
+FACTORING = "heat method: factorizing"
+SOLVING = "heat method: distance"
+"""The titles of the distance's two jobs (a click during the first waits for it)."""
 NEEDS_BASIS = "needs an eigenbasis: compute one in the Spectral view first"
 ISOLINES_ON = ("distance", "hks")
 """Fields whose isolines start shown (heat is ~0 over most of the mesh: its level 0 would
@@ -57,6 +60,7 @@ class DiffusionPanel(Panel):
     def __init__(self, name: str, state: DiffusionState) -> None:
         super().__init__(name, state)
         self.state: DiffusionState = state
+        self._factoring: Any = None  # the geodesic key of the last factorization started
 
     # ------------------------------------------------------------------ the scene
     def on_new_mesh(self, host: Host) -> None:
@@ -74,6 +78,10 @@ class DiffusionPanel(Panel):
             if ps.has_surface_mesh(name):
                 ps.get_surface_mesh(name).set_enabled(mine)
         if mine:
+            if self.state.show == "distance" and not self.state.geodesic_ready(
+                host.state.mesh.version
+            ):
+                self.precompute(host)  # factorized before the first click
             self.push(host, force=True)
         elif self.watch.seen("field") is not None and ps.has_surface_mesh(MESH):
             ps.get_surface_mesh(MESH).remove_quantity(FIELD)
@@ -106,15 +114,12 @@ class DiffusionPanel(Panel):
 
     def recompute(self, host: Host) -> None:
         """Compute the field of the current view (a precomputation runs as a job)."""
-        st, mesh = self.state, host.state.mesh
+        st = self.state
         basis = self._basis(host)
         if st.show == "heat":
             self.start_heat(host, basis)
         elif st.show == "distance":
-            if st.geodesic_ready(mesh.version) and len(mesh.V) <= INLINE_DISTANCE_MAX:
-                st.compute_distance()
-            elif st.sources:
-                self.precompute(host)
+            self.distance(host)
         elif basis is not None and st.show == "filter":
             st.compute_filter(basis)
         elif basis is not None and st.show == "hks":
@@ -138,30 +143,54 @@ class DiffusionPanel(Panel):
             self._failed(host), background=host.background,
         )  # fmt: skip
 
-    def precompute(self, host: Host) -> None:
-        """The heat method's distance as a job: its two factorizations first when the mesh,
-        ``m`` or the boundary rule changed (about a second at 43k vertices), then the solve
-        (inline instead for meshes up to :data:`INLINE_DISTANCE_MAX` vertices once
-        factorized)."""
+    def distance(self, host: Host) -> None:
+        """The heat method's distance from the sources: its factorizations first (a job, once
+        per mesh, ``m`` and boundary rule), then per click only back-substitutions (inline up
+        to :data:`INLINE_DISTANCE_MAX` vertices, else a job: 0.3–0.6 s at 692k)."""
         st, mesh = self.state, host.state.mesh
-        key = st.geodesic_key(mesh.version)
-        V, F, m, rule = mesh.V, mesh.F, st.m, st.boundary
-        known = st._geodesic if st.geodesic_ready(mesh.version) else None
-        sources = list(st.sources)
+        if not st.geodesic_ready(mesh.version):
+            self.precompute(host)
+            return
+        if not st.sources:
+            return
+        if len(mesh.V) <= INLINE_DISTANCE_MAX:
+            st.compute_distance()
+            return
+        solver, sources = st._geodesic, list(st.sources)
 
-        def work(reporter: Any) -> tuple[HeatGeodesic, np.ndarray]:
-            solver = known if known is not None else HeatGeodesic(V, F, m=m, boundary=rule)
-            return solver, solver.distance(sources)
-
-        def apply(result: tuple[HeatGeodesic, np.ndarray]) -> None:
-            st.adopt_geodesic(result[0], key)
-            st.adopt_distance(result[1])
+        def apply(d: np.ndarray) -> None:
+            st.adopt_distance(d)
             self.push(host)
 
-        title = "heat method: distance" if known else "heat method: factorizing"
         host.state.jobs.start(
-            self.name, title, work, apply, self._failed(host), background=host.background
-        )
+            self.name, SOLVING, lambda reporter: solver.distance(sources), apply,
+            self._failed(host), background=host.background,
+        )  # fmt: skip
+
+    def precompute(self, host: Host) -> None:
+        """The heat method's factorizations as a job (about a second at 43k vertices, 10–30 s
+        at 692k), started as soon as the distance view shows a mesh, so the first click only
+        back-substitutes; clicks meanwhile wait for it (it is not restarted), and it answers
+        the sources of its end."""
+        st, mesh, jobs = self.state, host.state.mesh, host.state.jobs
+        if len(mesh.V) == 0 or len(mesh.F) == 0:
+            return
+        key = st.geodesic_key(mesh.version)
+        job = jobs.running(self.name)
+        if job is not None and job.title == FACTORING and self._factoring == key:
+            return  # under way: it answers the sources when done
+        V, F, m, rule = mesh.V, mesh.F, st.m, st.boundary
+
+        def apply(solver: HeatGeodesic) -> None:
+            st.adopt_geodesic(solver, key)
+            if st.show == "distance" and st.sources:
+                self.recompute(host)
+
+        self._factoring = key
+        jobs.start(
+            self.name, FACTORING, lambda reporter: HeatGeodesic(V, F, m=m, boundary=rule),
+            apply, self._failed(host), background=host.background,
+        )  # fmt: skip
 
     def start_exact(self, host: Host) -> None:
         """The exact polyhedral distance as a cancellable job (a child process when the
