@@ -5,6 +5,7 @@ polyscope-free state. ``drive_panel_diffusion`` is also part of the widget tour 
 from __future__ import annotations
 
 import time
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -38,6 +39,24 @@ def settle(viewer, owner: str = "diffusion") -> None:
         viewer.state.jobs.wait(owner, 1.0)
         frames(viewer, 1)
     frames(viewer, 2)
+
+
+def click(viewer, vertex: int, *held: str) -> None:
+    """A scripted click on the scene (with the modifier keys ``held``) that polyscope's pick
+    answers with the mesh's ``vertex``."""
+    hit = SimpleNamespace(
+        is_hit=True,
+        structure_name="mesh",
+        structure_data={"element_type": "vertex", "index": vertex},
+        position=np.zeros(3),
+    )
+    real = ps.pick
+    ps.pick = lambda screen_coords: hit
+    try:
+        viewer.ui.script("click", (10.0, 10.0, *held))
+        frames(viewer, 1)
+    finally:
+        ps.pick = real
 
 
 def compute_basis(viewer, k: int = 40) -> None:
@@ -102,12 +121,16 @@ def drive_panel_diffusion(viewer, tmp_path=None) -> None:
     settle(viewer)
     np.testing.assert_allclose(st.distance, HeatGeodesic(V, F).distance([7]), atol=1e-12)
     assert ps.get_surface_mesh("mesh").get_quantity_buffer  # the field is on the mesh
-    drive(viewer, "add clicked vertices", True)
-    assert panel.select(viewer, 40)
+    click(viewer, 40, "shift")  # a shift-click adds a source
     settle(viewer)
     assert st.sources == [7, 40]
     np.testing.assert_allclose(st.distance, HeatGeodesic(V, F).distance([7, 40]), atol=1e-12)
-    drive(viewer, "add clicked vertices", False)
+    click(viewer, 3)  # a plain click replaces them
+    assert st.sources == [3]
+    click(viewer, 7)
+    click(viewer, 40, "shift")
+    click(viewer, 40, "shift")  # twice the same: once
+    assert st.sources == [7, 40]
     drive(viewer, "m (t = m h^2)", "4")
     settle(viewer)
     np.testing.assert_allclose(st.distance, HeatGeodesic(V, F, m=4).distance([7, 40]), atol=1e-12)

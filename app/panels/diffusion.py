@@ -53,7 +53,7 @@ class DiffusionPanel(Panel):
     shortcuts = (
         (
             "mouse",
-            "diffusion: click a vertex for the heat / distance source (more: the checkbox)",
+            "diffusion: click a vertex for the heat / distance source; shift-click adds one",
         ),
     )
 
@@ -93,11 +93,12 @@ class DiffusionPanel(Panel):
         idx = picked_vertex(hit, host.mesh_points(), host.state.mesh.F)
         if idx is None:
             return False
-        return self.select(host, idx)
+        return self.select(host, idx, add="shift" in getattr(hit, "modifiers", ()))
 
-    def select(self, host: Host, vertex: int) -> bool:
-        """Make ``vertex`` a source and recompute what is shown."""
-        if not self.state.select(len(host.state.mesh.V), vertex):
+    def select(self, host: Host, vertex: int, add: bool = False) -> bool:
+        """Make ``vertex`` the source (``add``: one more, a shift-click) and recompute what is
+        shown."""
+        if not self.state.select(len(host.state.mesh.V), vertex, add):
             return False
         self.recompute(host)
         return True
@@ -412,16 +413,14 @@ class DiffusionPanel(Panel):
             st.set_choice("show", show, SHOWS)
             st.playing = False  # t plays in the heat view only
             self.recompute(host)
-        ch, add = ui.checkbox(
-            "add clicked vertices", st.add_sources, "on: a click adds a source; off: replaces"
-        )
-        if ch:
-            st.add_sources = add
         if ui.button("clear sources", "forget the clicked vertices"):
             st.sources = []
             st.version += 1
             self.push(host)
-        ui.text(f"sources: {', '.join(map(str, st.sources)) or 'click a vertex'}")
+        ui.text(
+            f"sources: {', '.join(map(str, st.sources)) or 'click a vertex'}"
+            + (" (shift-click adds one)" if st.sources else "")
+        )
         basis = self._basis(host)
         {"heat": self._draw_heat, "distance": self._draw_distance}.get(
             st.show, self._draw_spectral
@@ -573,7 +572,7 @@ class DiffusionPanel(Panel):
         Euler, t swept on a log scale; each frame coloured from 0 to its own maximum (the
         caption gives it: the peak falls as the heat spreads)."""
         st, mesh = self.state, host.state.mesh
-        st.show, st.heat_field, st.add_sources = "heat", "euler", False
+        st.show, st.heat_field = "heat", "euler"
         source = int(options["heat_vertex"])
         if source < 0:
             P = mesh.V - mesh.V.mean(axis=0)

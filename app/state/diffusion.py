@@ -123,7 +123,6 @@ class DiffusionState:
 
     show: str = "distance"
     sources: list[int] = field(default_factory=list)
-    add_sources: bool = False  # a click adds a source instead of replacing them
     log_t: float = 0.0  # t = 10^log_t · h²
     playing: bool = False  # t sweeps up its log scale (the play button)
     steps: int = 1
@@ -179,13 +178,13 @@ class DiffusionState:
         return float(10.0**self.log_t * h * h)
 
     # ------------------------------------------------------------------ sources
-    def select(self, n: int, vertex: int) -> bool:
-        """Make ``vertex`` the source (or add it, with :attr:`add_sources`); False when out of
-        range (nothing changes)."""
+    def select(self, n: int, vertex: int, add: bool = False) -> bool:
+        """Make ``vertex`` the source (``add``: one more source, as a shift-click does); False
+        when out of range (nothing changes)."""
         if not 0 <= int(vertex) < n:
             return False
         v = int(vertex)
-        if self.add_sources:
+        if add:
             if v not in self.sources:
                 self.sources = [*self.sources, v]
         else:
