@@ -13,6 +13,7 @@ from meshlap_core.diffusion import (
     HeatGeodesic,
     SpectralFilter,
     boundary_vertices,
+    curve_gain,
     exact_distance,
     heat_kernel_column,
     heat_kernel_signature,
@@ -399,3 +400,12 @@ def test_face_gradients_are_the_rows_of_igl_grad(mesh):
     assert area[0] == 0.5
     hat, area = face_gradients(np.array([[0.0, 0, 0], [1, 0, 0], [2, 0, 0]]), np.array([[0, 1, 2]]))
     assert area[0] == 0 and np.all(hat == 0)  # a face of no area: no gradient
+
+
+def test_a_drawn_transfer_function_is_linear_between_its_points():
+    lam = np.array([0.0, 0.5, 1.0, 1.5, 2.0, 3.0])
+    knots = [(0.0, 1.0), (1.0, 0.0), (2.0, 2.0)]
+    np.testing.assert_allclose(curve_gain(lam, knots), [1.0, 0.5, 0.0, 1.0, 2.0, 2.0])
+    for bad in ([(0.0, 1.0)], [(1.0, 0.0), (0.0, 1.0)], [(0.0, np.nan), (1.0, 1.0)], [1, 2]):
+        with pytest.raises(MeshError, match="curve"):
+            curve_gain(lam, bad)

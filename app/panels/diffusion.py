@@ -12,7 +12,7 @@ import numpy as np
 import polyscope as ps
 
 from meshlap_core.diffusion import HeatGeodesic, exact_distance, mean_edge_length
-from meshlap_core.options import FILTER_KINDS, HEAT_BOUNDARIES, SMOOTHING_METHODS
+from meshlap_core.options import HEAT_BOUNDARIES, SMOOTHING_METHODS
 
 from .. import scene
 from ..isolines import draw_isolines
@@ -21,6 +21,7 @@ from ..state.diffusion import (
     HEAT_FIELDS,
     HKS_SCALES,
     LOG_T_RANGE,
+    PANEL_FILTERS,
     SHOWS,
     DiffusionState,
     find_basis,
@@ -514,12 +515,13 @@ class DiffusionPanel(Panel):
     def _draw_filter(self, host: Host, basis: Any) -> None:
         ui, st = host.ui, self.state
         ch, kind = ui.combo(
-            "filter", st.filter, FILTER_KINDS,
+            "filter", st.filter, PANEL_FILTERS,
             "low-pass: first modes; band: gain on modes; explicit/implicit/taubin: the "
-            "smoothers' transfer functions (1 - s lam)^n, (1 + s lam)^-n, ...",
+            "smoothers' transfer functions (1 - s lam)^n, (1 + s lam)^-n, ...; drawn: drag "
+            "the curve's points in the plot",
         )  # fmt: skip
         if ch:
-            st.set_choice("filter", kind, FILTER_KINDS)
+            st.set_choice("filter", kind, PANEL_FILTERS)
         ch, keep = ui.slider_int("modes kept", st.keep, 0, basis.k_max, "low-pass / band end")
         if ch:
             st.keep = int(min(max(keep, 0), basis.k_max))
@@ -553,6 +555,27 @@ class DiffusionPanel(Panel):
                     ui.plot_line("h(lambda)", basis.eigenvalues, st.gains)
                     if st.measured is not None:
                         ui.plot_line("measured", basis.eigenvalues, st.measured)
+                    if st.filter == "drawn":
+                        self._drag_curve(host, basis)
+        if st.filter == "drawn":
+            ui.text("drag the points: U h(Lambda) U^T M X follows")
+
+    def _drag_curve(self, host: Host, basis: Any) -> None:
+        """The drawn curve's control points, each dragged in the plot; the filtered copy
+        follows every move (the projection is kept: one product per drag)."""
+        ui, st = host.ui, self.state
+        P = st.curve_points(basis)
+        ui.plot_line("drawn curve", P[:, 0], P[:, 1])
+        lam_max = float(basis.eigenvalues[-1])
+        for i, (x, y) in enumerate(P):
+            moved, nx, ny = ui.plot_drag_point(
+                f"curve point {i}", i, x, y,
+                "drag: lambda between its neighbours (the ends stay), h the gain of those modes",
+            )  # fmt: skip
+            if moved:
+                st.move_knot(i, nx, ny, lam_max)
+                st.compute_filter(basis)
+                self.push(host)
 
     def start_measure(self, host: Host, basis: Any) -> None:
         """Run the smoother and project (a job: the implicit one factorizes)."""

@@ -21,6 +21,7 @@ from meshlap_core.diffusion import (
     HeatDiffusion,
     HeatGeodesic,
     SpectralFilter,
+    curve_gain,
     heat_kernel_signature,
     heat_spectral,
     hks_distance,
@@ -51,6 +52,14 @@ LOG_T_RANGE = (-3.0, 4.0)
 """The t slider's range, as log10 of t relative to the mesh's h² (t = 10^x · h²)."""
 PLAY_STEP = 0.05
 """How far the play button moves t per heat field shown (log10 of t/h²: a decade in 20)."""
+PANEL_FILTERS: tuple[str, ...] = (*FILTER_KINDS, "drawn")
+"""The filter editor's kinds: the core's, and a curve the user drags (:func:`curve_gain`)."""
+DEFAULT_KNOTS: tuple[tuple[float, float], ...] = (
+    (0.0, 1.0), (0.1, 1.0), (0.25, 0.5), (0.5, 0.0), (1.0, 0.0),
+)  # fmt: skip
+"""The drawn curve's control points ``(λ / λ_max, h)``: a soft low-pass."""
+GAIN_RANGE = (-2.0, 5.0)
+"""The gains a drawn point may take (as the band gain's slider)."""
 HKS_SCALES = 16
 """Times of the heat kernel signature (log-spaced, Sun et al. 2009)."""
 
@@ -64,7 +73,7 @@ SESSION: Schema = {
     "boundary": (DEFAULT_HEAT_BOUNDARY, one_of(HEAT_BOUNDARIES)),
     "isolines": (True, boolean),
     "isoline_count": (12, integer(1, 200)),
-    "filter": ("low-pass", one_of(FILTER_KINDS)),
+    "filter": ("low-pass", one_of(PANEL_FILTERS)),
     "keep": (10, integer(0)),
     "gain": (2.0, number(-100.0, 100.0)),
     "hks_scale": (8, integer(0, HKS_SCALES - 1)),
@@ -133,6 +142,7 @@ class DiffusionState:
     keep: int = 10
     gain: float = 2.0
     band: tuple[int, int] = (1, 10)
+    knots: list[tuple[float, float]] = field(default_factory=lambda: list(DEFAULT_KNOTS))
     step: float = 0.0  # smoother step; 0: 0.5 / λ_max of the basis
     iters: int = 10
     residual: bool = False
@@ -316,8 +326,38 @@ class DiffusionState:
         extra = {"taubin_nu": nu} if self.filter == "taubin" else {}
         return smoother_transfer(basis, self.filter, step, self.iters, **extra)[1]
 
+    def curve_points(self, basis: SpectralBasis) -> FloatArray:
+        """The drawn curve's control points ``(p,2)`` in ``λ`` of the basis (its knots are
+        kept relative to the largest eigenvalue, so they survive a new basis)."""
+        P = np.array(self.knots, dtype=np.float64)
+        P[:, 0] *= float(basis.eigenvalues[-1]) or 1.0
+        return P
+
+    def move_knot(self, index: int, lam: float, gain: float, lam_max: float) -> None:
+        """Drag control point ``index`` to ``(λ, h)``: ``λ`` kept between its neighbours (the
+        two ends stay at 0 and ``λ_max``), ``h`` in :data:`GAIN_RANGE`.
+
+        Raises
+        ------
+        MeshError
+            A non-finite value (the point stays).
+        """
+        if not (math.isfinite(lam) and math.isfinite(gain)):
+            raise MeshError(f"a point must be finite, got ({lam!r}, {gain!r})", "drawn curve")
+        knots = list(self.knots)
+        last = len(knots) - 1
+        x = min(max(lam / (lam_max or 1.0), 0.0), 1.0)
+        if index in (0, last):
+            x = float(knots[index][0])
+        else:
+            x = min(max(x, knots[index - 1][0]), knots[index + 1][0])
+        knots[index] = (float(x), float(min(max(gain, GAIN_RANGE[0]), GAIN_RANGE[1])))
+        self.knots = knots
+
     def filter_gains(self, basis: SpectralBasis) -> FloatArray:
         lam = basis.eigenvalues
+        if self.filter == "drawn":
+            return curve_gain(lam, self.curve_points(basis))
         step, nu = self.smoother_step(basis)
         return transfer(
             self.filter,  # type: ignore[arg-type]

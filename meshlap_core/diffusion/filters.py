@@ -45,6 +45,33 @@ def band_gain(eigenvalues: FloatArray, lo: int, hi: int, gain: float) -> FloatAr
     return h
 
 
+def curve_gain(eigenvalues: FloatArray, knots: Any) -> FloatArray:
+    """A drawn transfer function: ``h(λ)`` linear between control points ``(λ_j, h_j)`` and
+    constant beyond the first and the last (``np.interp``).
+
+    Parameters
+    ----------
+    eigenvalues : (k,) float
+    knots : (p,2) float
+        Control points, ``p ≥ 2``, ``λ_j`` non-decreasing, all finite.
+
+    Returns
+    -------
+    h : (k,) float
+
+    Raises
+    ------
+    MeshError
+        Fewer than two points, a non-finite value or ``λ_j`` out of order.
+    """
+    P = np.asarray(knots, dtype=np.float64)
+    if P.ndim != 2 or P.shape[1] != 2 or len(P) < 2:
+        raise MeshError(f"needs two or more (lambda, h) points, got shape {P.shape}", "curve")
+    if not np.all(np.isfinite(P)) or np.any(np.diff(P[:, 0]) < 0):
+        raise MeshError("the points must be finite, lambda non-decreasing", "curve")
+    return np.interp(np.asarray(eigenvalues, dtype=np.float64), P[:, 0], P[:, 1])
+
+
 def transfer(
     kind: FilterKind,
     eigenvalues: FloatArray,
