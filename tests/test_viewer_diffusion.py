@@ -402,3 +402,55 @@ def test_distance_view_factorizes_before_the_first_click_which_only_solves(viewe
     settle(viewer)
     assert built == [1.0, 2.0]
     np.testing.assert_allclose(st.distance, HeatGeodesic(V, F, m=2).distance([30]), atol=1e-12)
+
+
+def test_a_session_keeps_the_isolines_of_every_field_and_the_heat_copies_show_them(
+    viewer, tmp_path, monkeypatch
+):
+    """The distance's toggle and count (``isolines`` / ``isoline_count``) and every other
+    field's that differs from a new field's (``isoline_fields``) are saved and restored; the
+    two heat copies beside the mesh carry the isolines of the field they show."""
+    import json
+
+    from legend_ledger import Ledger
+    from meshlap_app import session
+    from meshlap_app.state.isolines import Isolines
+
+    ledger = Ledger().install(monkeypatch)
+    panel = viewer.panels["diffusion"]
+    compute_basis(viewer, k=30)
+    viewer.set_panel("diffusion")
+    drive(viewer, "show", "distance")
+    click(viewer, 5)
+    settle(viewer)
+    drive(viewer, "isoline count", 30)
+    drive(viewer, "show", "heat")
+    settle(viewer)
+    drive(viewer, "isolines", True)  # the heat's: off by default
+    drive(viewer, "isoline count", 4)
+    drive(viewer, "heat field", "difference")
+    drive(viewer, "isoline count", 9)  # the difference's own setting (still off)
+    drive(viewer, "heat field", "euler")
+    frames(viewer, 2)
+    st = panel.state
+    for copy, which in (("heat (second way)", "spectral"), ("heat (third field)", "difference")):
+        q = ledger.quantities[copy][which]
+        if which == "spectral":  # the heat's setting: on, 4 curves over its own range
+            v = st.heat[which]
+            assert q.isolines and q.isoline_period == pytest.approx((v.max() - v.min()) / 4)
+        else:  # the difference's: off
+            assert not q.isolines
+    path = session.save(viewer, tmp_path / "iso.json")
+    saved = json.loads(path.read_text())["diffusion"]
+    assert saved["isolines"] is True and saved["isoline_count"] == 30
+    assert saved["isoline_fields"] == {
+        "heat": {"on": True, "count": 4},
+        "heat error": {"on": False, "count": 9},
+    }
+    panel.isolines = Isolines()  # forgotten
+    session.load(viewer, path)
+    frames(viewer, 2)
+    assert (panel.isolines.of("distance").on, panel.isolines.of("distance").count) == (True, 30)
+    assert (panel.isolines.of("heat").on, panel.isolines.of("heat").count) == (True, 4)
+    assert panel.isolines.of("heat error").count == 9 and not panel.isolines.of("heat error").on
+    assert not panel.isolines.of("distance error").on and panel.isolines.of("hks").on

@@ -20,6 +20,7 @@ from ..scene import MESH, front_view, picked_vertex, side_offset
 from ..state.diffusion import (
     HEAT_FIELDS,
     HKS_SCALES,
+    ISO_FIELDS,
     LOG_T_RANGE,
     PANEL_FILTERS,
     SHOWS,
@@ -27,6 +28,7 @@ from ..state.diffusion import (
     find_basis,
     symmetric_range,
 )
+from ..state.isolines import DEFAULT_COUNT
 from .base import ExportItem, Host, Panel
 
 FIELD = "diffusion field"
@@ -322,9 +324,11 @@ class DiffusionPanel(Panel):
             else:
                 ps.register_surface_mesh(name, X, F, smooth_shade=True)
                 host.request_frame()
+            iso = "heat error" if which == "difference" else "heat"
             ps.get_surface_mesh(name).add_scalar_quantity(
-                which, self.state.heat[which], cmap="coolwarm", vminmax=vr, enabled=True
-            )
+                which, self.state.heat[which], cmap="coolwarm", vminmax=vr, enabled=True,
+                **self.isolines.options(iso, self.state.heat[which], iso in ISOLINES_ON),
+            )  # fmt: skip
 
     def points(self, host: Host, name: str) -> np.ndarray | None:
         if name == FILTERED and self.state.filtered is not None:
@@ -369,11 +373,21 @@ class DiffusionPanel(Panel):
             "boundary": st.boundary,
             "isolines": bool(self.isolines.of("distance", True).on),
             "isoline_count": int(self.isolines.of("distance", True).count),
+            "isoline_fields": self._iso_changed(),
             "filter": st.filter,
             "keep": int(st.keep),
             "gain": float(st.gain),
             "hks_scale": int(st.hks_scale),
         }
+
+    def _iso_changed(self) -> dict[str, dict[str, Any]]:
+        """The isoline settings of :data:`ISO_FIELDS` that differ from a new field's."""
+        out = {}
+        for name in ISO_FIELDS:
+            s = self.isolines.fields.get(name)
+            if s is not None and (s.on != (name in ISOLINES_ON) or s.count != DEFAULT_COUNT):
+                out[name] = {"on": bool(s.on), "count": int(s.count)}
+        return out
 
     def configure(self, host: Host, values: dict[str, Any]) -> None:
         st = self.state
@@ -383,6 +397,12 @@ class DiffusionPanel(Panel):
                 lines.on = bool(value)
             elif key == "isoline_count":
                 lines.set_count(value)
+            elif key == "isoline_fields":
+                for name in ISO_FIELDS:  # a field not saved is at its defaults
+                    field = self.isolines.of(name, name in ISOLINES_ON)
+                    saved = value.get(name, {"on": name in ISOLINES_ON, "count": DEFAULT_COUNT})
+                    field.on = bool(saved["on"])
+                    field.set_count(saved["count"])
             elif key != "sources":
                 setattr(st, key, value)
 

@@ -63,6 +63,26 @@ GAIN_RANGE = (-2.0, 5.0)
 HKS_SCALES = 16
 """Times of the heat kernel signature (log-spaced, Sun et al. 2009)."""
 
+ISO_FIELDS: tuple[str, ...] = ("heat", "heat error", "distance error", "hks")
+"""The fields whose isoline settings a session keeps in ``isoline_fields`` (the distance's
+are ``isolines`` / ``isoline_count``): the heat (its two copies too), the heat difference, the
+distance's error map, the heat kernel signature."""
+
+
+def check_isoline_fields(x: Any) -> str | None:
+    """``{field: {"on": bool, "count": int}}`` over :data:`ISO_FIELDS`."""
+    if not isinstance(x, dict):
+        return "must be an object of fields"
+    for name, v in x.items():
+        if name not in ISO_FIELDS:
+            return f"has {name!r}; fields are {', '.join(ISO_FIELDS)}"
+        if not (isinstance(v, dict) and set(v) == {"on", "count"}):
+            return f'{name!r} must be {{"on": true/false, "count": N}}'
+        if boolean(v["on"]) or integer(1, 200)(v["count"]):
+            return f"{name!r}: on must be true/false, count 1..200"
+    return None
+
+
 SESSION: Schema = {
     "show": ("distance", one_of(SHOWS)),
     "sources": ([], lambda x: None if isinstance(x, list) else "must be a list of vertices"),
@@ -73,6 +93,7 @@ SESSION: Schema = {
     "boundary": (DEFAULT_HEAT_BOUNDARY, one_of(HEAT_BOUNDARIES)),
     "isolines": (True, boolean),
     "isoline_count": (12, integer(1, 200)),
+    "isoline_fields": ({}, check_isoline_fields),
     "filter": ("low-pass", one_of(PANEL_FILTERS)),
     "keep": (10, integer(0)),
     "gain": (2.0, number(-100.0, 100.0)),
