@@ -251,15 +251,6 @@ class HeatGeodesic:
             return u
         return ud if self.rule == "dirichlet" else 0.5 * (u + ud)
 
-    def _gradient(self, u: FloatArray, faces: IntArray | None = None) -> FloatArray:
-        """``∇u`` per face ``(3, m)`` (or on ``faces`` only, ``(3, len(faces))``)."""
-        hat = self._hat if faces is None else self._hat[:, :, faces]
-        c0, c1, c2 = self._corners if faces is None else (c[faces] for c in self._corners)
-        g = u[c0] * hat[0]
-        g += u[c1] * hat[1]
-        g += u[c2] * hat[2]
-        return g
-
     def _directions(
         self, u: FloatArray, faces: IntArray | None = None
     ) -> tuple[FloatArray, np.ndarray, np.ndarray]:
@@ -267,19 +258,25 @@ class HeatGeodesic:
         face's own heat has no direction: a face at constant heat, e.g. opposite the source on
         a tetrahedron), where it is trusted ``(m,)``, and where the heat underflowed ``(m,)``
         (below :data:`_UNDERFLOW` of the largest: denormal or 0, its gradient meaningless).
-        With ``faces``, on those faces only."""
-        c0, c1, c2 = self._corners if faces is None else (c[faces] for c in self._corners)
-        a = np.abs(u)
-        top = np.maximum(np.maximum(a[c0], a[c1]), a[c2])  # the face's largest heat
+        With ``faces``, on those faces only (``(3, len(faces))``, ...)."""
+        corners = self._corners if faces is None else [c[faces] for c in self._corners]
+        hat = self._hat if faces is None else self._hat[:, :, faces]
+        uc = [u[c] for c in corners]  # the heat at each corner, (m,) each
+        g = uc[0] * hat[0]  # ∇u = Σ_i u_i ∇φ_i
+        g += uc[1] * hat[1]
+        g += uc[2] * hat[2]
+        top = np.abs(uc[0])  # the face's largest heat
+        np.maximum(top, np.abs(uc[1]), out=top)
+        np.maximum(top, np.abs(uc[2]), out=top)
         # ∇u relative to the face's own heat: no underflow when squared (a gradient of 1e-161
         # would), and the round-off test is one comparison
-        g = self._gradient(u, faces)
         g /= np.where(top > 0, top, 1.0)
         norm = np.sqrt(np.einsum("kf,kf->f", g, g))
         known = norm > _ROUNDOFF / self.h
         # a face whose heat underflowed (not one at constant heat by symmetry) waits for a
         # longer time's direction
-        lost = top <= _UNDERFLOW * float(a.max(initial=0.0))
+        peak = max(float(u.max(initial=0.0)), -float(u.min(initial=0.0)))
+        lost = top <= _UNDERFLOW * peak
         g *= np.where(known, -1.0 / np.where(known, norm, 1.0), 0.0)
         return g, known & ~lost, lost
 
