@@ -409,3 +409,19 @@ def test_a_drawn_transfer_function_is_linear_between_its_points():
     for bad in ([(0.0, 1.0)], [(1.0, 0.0), (0.0, 1.0)], [(0.0, np.nan), (1.0, 1.0)], [1, 2]):
         with pytest.raises(MeshError, match="curve"):
             curve_gain(lam, bad)
+
+
+def test_the_pieces_of_a_drawn_curve_sum_to_its_filter(full_basis):
+    """``Σ_j y_j G_j`` (each hat's filtered geometry, precomputed) equals ``U h(Λ) Uᵀ M X``
+    for the curve through the gains ``y``; gains all 1 give X back (the full basis)."""
+    f = SpectralFilter(full_basis)
+    top = float(full_basis.eigenvalues[-1])
+    xs = np.array([0.0, 0.1, 0.3, 1.0]) * top
+    G = f.pieces(xs)
+    assert G.shape == (4, *full_basis.V.shape)
+    y = np.array([1.0, -0.5, 2.0, 0.25])
+    h = curve_gain(full_basis.eigenvalues, np.column_stack([xs, y]))
+    np.testing.assert_allclose(np.tensordot(y, G, axes=1), f.apply(h), atol=1e-12)
+    np.testing.assert_allclose(G.sum(axis=0), full_basis.V, atol=1e-9)
+    with pytest.raises(MeshError, match="curve"):
+        f.pieces([1.0, 0.0])

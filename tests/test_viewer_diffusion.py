@@ -109,30 +109,39 @@ def drive_heat_play(viewer, hd: HeatDiffusion) -> None:
 
 
 def drive_drawn_curve(viewer, basis) -> None:
-    """The drawn transfer function: every control point dragged in the plot, the filtered
-    copy ``U h(Λ) Uᵀ M X`` following each move; the ends keep λ = 0 and λ_max, inner points
-    stay between their neighbours; a non-finite drag is refused."""
+    """The drawn transfer function: every control point dragged in the plot (its gain; its λ
+    stays), the filtered copy ``U h(Λ) Uᵀ M X`` following each move; gains clamped to the
+    band gain's range; a non-finite drag is refused."""
+    from meshlap_app.state.diffusion import DEFAULT_KNOTS
+
     st = viewer.panels["diffusion"].state
     V = viewer.state.mesh.V
     drive(viewer, "filter", "drawn")
     lam = basis.eigenvalues
     top = float(lam[-1])
+    xs = [x for x, _ in DEFAULT_KNOTS]
     for i in range(len(st.knots)):
-        drive(viewer, f"curve point {i}", (0.5 * top, 1.0))
-    assert [x for x, _ in st.knots] == [0.0, 0.25, 0.5, 0.5, 1.0]  # ends fixed, inner clamped
+        drive(viewer, f"curve point {i}", (0.5 * top, 1.0))  # dragged sideways too: λ stays
+    assert [x for x, _ in st.knots] == xs and [y for _, y in st.knots] == [1.0] * len(xs)
     np.testing.assert_allclose(st.gains, 1.0)
     np.testing.assert_allclose(st.filtered, V, atol=1e-9)  # h ≡ 1 on the full basis: X
-    drive(viewer, "curve point 3", (0.75 * top, 0.0))  # a notch: 1 up to λmax/2, 0 at 3/4
+    drive(viewer, "curve point 3", (xs[3] * top, 0.0))  # a notch at λ_3, by hand:
     s = lam / top
-    h = np.where(s <= 0.5, 1.0, np.where(s <= 0.75, (0.75 - s) / 0.25, (s - 0.75) / 0.25))
+    h = 1.0 - np.clip(
+        1.0 - np.abs(s - xs[3]) / np.where(s < xs[3], xs[3] - xs[2], xs[4] - xs[3]), 0, 1
+    )
     np.testing.assert_allclose(st.gains, h, atol=1e-12)
     U, M = basis.vectors, basis.mass
     np.testing.assert_allclose(st.filtered, U @ (h[:, None] * (U.T @ (M[:, None] * V))), atol=1e-9)
     drive(viewer, "curve point 1", (0.1 * top, 99.0))  # the gain clamped to the slider's range
-    assert st.knots[1] == (0.1, 5.0)
+    assert st.knots[1] == (xs[1], 5.0)
     before = list(st.knots)
-    drive(viewer, "curve point 2", (float("nan"), 1.0))
+    drive(viewer, "curve point 2", (0.2, float("nan")))
     assert st.knots == before and "drawn curve" in viewer.state.errors["diffusion"]
+    drive(viewer, "keep residual", True)  # with the residual: X − U Uᵀ M X added back
+    ref = SpectralFilter(basis).apply(st.gains, residual=True)
+    np.testing.assert_allclose(st.filtered, ref, atol=1e-9)
+    drive(viewer, "keep residual", False)
 
 
 def drive_panel_diffusion(viewer, tmp_path=None) -> None:

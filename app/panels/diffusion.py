@@ -578,7 +578,7 @@ class DiffusionPanel(Panel):
                     if st.filter == "drawn":
                         self._drag_curve(host, basis)
         if st.filter == "drawn":
-            ui.text("drag the points: U h(Lambda) U^T M X follows")
+            ui.text("drag the points up or down: U h(Lambda) U^T M X follows")
 
     def _drag_curve(self, host: Host, basis: Any) -> None:
         """The drawn curve's control points, each dragged in the plot; the filtered copy
@@ -586,14 +586,13 @@ class DiffusionPanel(Panel):
         ui, st = host.ui, self.state
         P = st.curve_points(basis)
         ui.plot_line("drawn curve", P[:, 0], P[:, 1])
-        lam_max = float(basis.eigenvalues[-1])
         for i, (x, y) in enumerate(P):
-            moved, nx, ny = ui.plot_drag_point(
+            moved, _, ny = ui.plot_drag_point(
                 f"curve point {i}", i, x, y,
-                "drag: lambda between its neighbours (the ends stay), h the gain of those modes",
+                f"drag up or down: the gain h at lambda = {x:.3g} (linear between the points)",
             )  # fmt: skip
             if moved:
-                st.move_knot(i, nx, ny, lam_max)
+                st.move_knot(i, ny)
                 st.compute_filter(basis)
                 self.push(host)
 

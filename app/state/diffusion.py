@@ -55,9 +55,11 @@ PLAY_STEP = 0.05
 PANEL_FILTERS: tuple[str, ...] = (*FILTER_KINDS, "drawn")
 """The filter editor's kinds: the core's, and a curve the user drags (:func:`curve_gain`)."""
 DEFAULT_KNOTS: tuple[tuple[float, float], ...] = (
-    (0.0, 1.0), (0.1, 1.0), (0.25, 0.5), (0.5, 0.0), (1.0, 0.0),
+    (0.0, 1.0), (0.05, 1.0), (0.1, 1.0), (0.2, 0.5), (0.35, 0.0), (0.6, 0.0), (1.0, 0.0),
 )  # fmt: skip
-"""The drawn curve's control points ``(λ / λ_max, h)``: a soft low-pass."""
+"""The drawn curve's control points ``(λ / λ_max, h)``: a soft low-pass. Their λ are fixed
+(an equalizer's bands, denser at low frequencies); a drag moves a gain, so the filtered shape
+is a sum of precomputed pieces (:meth:`SpectralFilter.pieces`)."""
 GAIN_RANGE = (-2.0, 5.0)
 """The gains a drawn point may take (as the band gain's slider)."""
 HKS_SCALES = 16
@@ -188,6 +190,7 @@ class DiffusionState:
     _geodesic: Any = None
     _geodesic_key: Any = None
     _filter: Any = None
+    _pieces: Any = None  # (the drawn curve's λ (p,), its pieces G (p,n,c))
     _hks: Any = None  # (basis id, H (n,s), times (s,))
 
     # ------------------------------------------------------------------ lifetime
@@ -199,7 +202,7 @@ class DiffusionState:
         self.exact_stats = {}
         self.filtered = self.gains = self.hks = self.hks_dist = self.measured = None
         self._heat_solver = self._geodesic = self._geodesic_key = None
-        self._filter = self._hks = None
+        self._filter = self._hks = self._pieces = None
         self.error = self.message = ""
         self.playing = False
         self.version += 1
@@ -354,25 +357,20 @@ class DiffusionState:
         P[:, 0] *= float(basis.eigenvalues[-1]) or 1.0
         return P
 
-    def move_knot(self, index: int, lam: float, gain: float, lam_max: float) -> None:
-        """Drag control point ``index`` to ``(λ, h)``: ``λ`` kept between its neighbours (the
-        two ends stay at 0 and ``λ_max``), ``h`` in :data:`GAIN_RANGE`.
+    def move_knot(self, index: int, gain: float) -> None:
+        """Drag control point ``index`` to the gain ``h`` (kept in :data:`GAIN_RANGE`; its λ
+        stays).
 
         Raises
         ------
         MeshError
-            A non-finite value (the point stays).
+            A non-finite gain (the point stays).
         """
-        if not (math.isfinite(lam) and math.isfinite(gain)):
-            raise MeshError(f"a point must be finite, got ({lam!r}, {gain!r})", "drawn curve")
+        if not math.isfinite(gain):
+            raise MeshError(f"a gain must be finite, got {gain!r}", "drawn curve")
         knots = list(self.knots)
-        last = len(knots) - 1
-        x = min(max(lam / (lam_max or 1.0), 0.0), 1.0)
-        if index in (0, last):
-            x = float(knots[index][0])
-        else:
-            x = min(max(x, knots[index - 1][0]), knots[index + 1][0])
-        knots[index] = (float(x), float(min(max(gain, GAIN_RANGE[0]), GAIN_RANGE[1])))
+        h = float(min(max(gain, GAIN_RANGE[0]), GAIN_RANGE[1]))
+        knots[index] = (float(knots[index][0]), h)
         self.knots = knots
 
     def filter_gains(self, basis: SpectralBasis) -> FloatArray:
@@ -396,8 +394,16 @@ class DiffusionState:
         per basis)."""
         if self._filter is None or self._filter.basis is not basis:
             self._filter = SpectralFilter(basis)
+            self._pieces = None
         self.gains = self.filter_gains(basis)
-        self.filtered = self._filter.apply(self.gains, residual=self.residual)
+        if self.filter == "drawn":  # Σ_j y_j G_j: a drag costs a few axpys
+            P = self.curve_points(basis)
+            if self._pieces is None or not np.array_equal(self._pieces[0], P[:, 0]):
+                self._pieces = (P[:, 0].copy(), self._filter.pieces(P[:, 0]))
+            out = np.tensordot(P[:, 1], self._pieces[1], axes=1)
+            self.filtered = out + self._filter.residual if self.residual else out
+        else:
+            self.filtered = self._filter.apply(self.gains, residual=self.residual)
         self.version += 1
 
     # ------------------------------------------------------------------ HKS
