@@ -11,12 +11,13 @@ The heat method (Crane, Weischedel & Wardetzky, "Geodesics in heat", ACM TOG 201
    ``A`` the face areas; ``K = Gᵀ A G``), one vertex pinned per connected component;
 4. ``d = φ − mean(φ[γ])`` in each component holding a source.
 
-The matrices are factorized once (:class:`HeatGeodesic`); a new source costs two or three
-pairs of triangular solves and a few vectorized products per face (MEASURE at 692k vertices,
-``benchmarks/bench_diffusion.py``). The heat decays like ``exp(−d/√t)``, so beyond about
-``575 √t`` from the sources it underflows (below 1e-250 of its peak: 1.3 % to 23 % of the 692k
-armadillo with ``t = h²``, by source): those faces take the direction of the heat of a longer
-time, ``t·100ʲ`` (``j = 1 … 4``; the levels the mesh's size calls for factorized with the
+The matrices are factorized once (:class:`HeatGeodesic`); a new source costs two or three pairs
+of triangular solves and a few vectorized products per face (median 1.3 s at 692k vertices
+against ``igl.heat_geodesics_solve``'s 1.25 s side by side at load 7, of which the three solves
+~0.85 s; ``benchmarks/bench_diffusion.py``). The heat decays like ``exp(−d/√t)``, so beyond
+about ``575 √t`` from the sources it underflows (below 1e-250 of its peak: 1.3 % to 23 % of the
+692k armadillo with ``t = h²``, by source): those faces take the direction of the heat of a
+longer time, ``t·100ʲ`` (``j = 1 … 4``; the levels the mesh's size calls for factorized with the
 others, any other when first needed). Measured on the 692k scan (one ``igl.upsample`` of the
 173k ``armadillo_loop``, whose vertices it keeps): our distance there differs from ours on the
 173k mesh by 0.4 % on average (1.0 % at most), potpourri3d's from its own 173k answer by 7.4 %
