@@ -81,10 +81,11 @@ class DiffusionPanel(Panel):
             if ps.has_surface_mesh(name):
                 ps.get_surface_mesh(name).set_enabled(mine)
         if mine:
-            if self.state.show == "distance" and not self.state.geodesic_ready(
-                host.state.mesh.version
-            ):
-                self.precompute(host)  # factorized before the first click
+            # the window factorizes before the first click (a headless render or animation
+            # computes what it shows right away instead)
+            ready = self.state.geodesic_ready(host.state.mesh.version)
+            if host.background and self.state.show == "distance" and not ready:
+                self.precompute(host)
             self.push(host, force=True)
         elif self.watch.seen("field") is not None and ps.has_surface_mesh(MESH):
             ps.get_surface_mesh(MESH).remove_quantity(FIELD)
