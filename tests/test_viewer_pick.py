@@ -56,7 +56,7 @@ def test_every_panel_is_handed_the_modifier_keys_of_a_click(viewer, monkeypatch,
         assert isinstance(hit, Pick)
         assert hit.modifiers == held and hit.shift == ("shift" in held)
         assert hit.structure_name == "mesh" and hit.structure_data["index"] == 4
-        np.testing.assert_array_equal(hit.position, [0.1, 0.2, 0.3])
+        assert hit.position == (0.1, 0.2, 0.3)
 
 
 def test_a_panel_that_ignores_modifiers_still_answers_a_modified_click(viewer, monkeypatch):
@@ -72,5 +72,6 @@ def test_pick_of_polyscope_result_copies_it():
     hit = Pick.of(res, ["shift"])
     assert hit == Pick("mesh", {"index": 2}, hit.position, frozenset({"shift"}))
     res.structure_data["index"] = 5  # a copy: polyscope's result may be reused
-    assert hit.structure_data["index"] == 2 and hit.position.dtype == np.float64
+    assert hit.structure_data["index"] == 2 and hit.position == (1.0, 2.0, 3.0)
+    assert Pick.of(res, ["shift"]) != hit  # compared by value: the hit changed
     assert not Pick("mesh").shift and Pick("mesh").modifiers == frozenset()

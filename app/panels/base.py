@@ -42,8 +42,8 @@ class Pick:
     structure_data : dict
         polyscope's per-structure data (``element_type``, ``index``, barycentric
         coordinates ...).
-    position : (3,) float
-        The 3D point hit, in display coordinates.
+    position : tuple of 3 float
+        The 3D point hit, in display coordinates (a tuple: picks compare by value).
     modifiers : frozenset of str
         The keys held during the click: a subset of ``{"shift", "ctrl", "alt"}``
         (:data:`meshlap_app.ui.MODIFIERS`).
@@ -51,7 +51,7 @@ class Pick:
 
     structure_name: str
     structure_data: dict[str, Any] = field(default_factory=dict)
-    position: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    position: tuple[float, float, float] = (0.0, 0.0, 0.0)
     modifiers: frozenset[str] = frozenset()
 
     @classmethod
@@ -60,7 +60,7 @@ class Pick:
         return cls(
             str(hit.structure_name),
             dict(getattr(hit, "structure_data", {}) or {}),
-            np.asarray(getattr(hit, "position", np.zeros(3)), dtype=np.float64),
+            tuple(float(x) for x in getattr(hit, "position", (0.0, 0.0, 0.0))),  # type: ignore[arg-type]
             frozenset(modifiers),
         )
 
