@@ -42,6 +42,9 @@ GREY = (0.7, 0.7, 0.7, 1.0)
 HIGHLIGHT = (0.95, 0.75, 0.2, 0.35)  # the background of a highlighted table row
 TABLE_ROWS = ((0.11, 0.11, 0.12, 0.94), (0.17, 0.17, 0.19, 0.94))  # opaque: readable over 3D
 
+MODIFIERS = ("shift", "ctrl", "alt")
+"""The modifier keys a scene click reports (:meth:`UI.scene_click`), by these names."""
+
 RGBA = tuple[float, float, float, float]
 
 
@@ -135,8 +138,9 @@ class UI(FieldErrors, Plots):
         None or value
             ``None``: what the user did this frame stands (here, always). Otherwise a value
             that replaces it: for a button, header or key whether it was pressed; for a
-            checkbox, combo, drop-down, slider or field the new value; for a click or hover the
-            window position ``(x, y)``.
+            checkbox, combo, drop-down, slider or field the new value; for a hover the window
+            position ``(x, y)``; for a click ``(x, y)`` followed by the modifier keys held
+            (``"shift"``, ``"ctrl"``, ``"alt"``), if any.
         """
         return None
 
@@ -483,16 +487,19 @@ class UI(FieldErrors, Plots):
             return False
         return bool(self.im.IsKeyPressed(getattr(self.im, code), False))
 
-    def scene_click(self) -> tuple[float, float] | None:
-        """Window position of a left click on the 3D view this frame (not on a panel), or
-        ``None``. The hook sees it as the label ``"click"``."""
+    def scene_click(self) -> tuple[tuple[float, float], frozenset[str]] | None:
+        """A left click on the 3D view this frame (not on a panel): its window position and
+        the modifier keys held (a subset of :data:`MODIFIERS`), or ``None``. The hook sees it
+        as the label ``"click"`` (a scripted ``(x, y, "shift")`` is a shift-click)."""
         v = self._record("click", "click", "")
         if v is not None:
-            return tuple(v)
+            return (float(v[0]), float(v[1])), frozenset(str(m) for m in v[2:])
         io = self.im.GetIO()
         if io.WantCaptureMouse or not self.im.IsMouseClicked(0):
             return None
-        return tuple(io.MousePos)
+        held = (bool(io.KeyShift), bool(io.KeyCtrl), bool(io.KeyAlt))
+        mods = frozenset(m for m, down in zip(MODIFIERS, held, strict=True) if down)
+        return (float(io.MousePos[0]), float(io.MousePos[1])), mods
 
     def hover(self) -> tuple[float, float] | None:
         """Window position of the mouse over the 3D view this frame (``None`` over a panel).
@@ -537,4 +544,4 @@ class UI(FieldErrors, Plots):
         """Hook called after :meth:`overlay_text` drew ``text`` at window pixel ``pos``."""
 
 
-__all__ = ["EXPECTED", "RGBA", "UI", "UIApiMismatch", "check_return"]
+__all__ = ["EXPECTED", "MODIFIERS", "RGBA", "UI", "UIApiMismatch", "check_return"]

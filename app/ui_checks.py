@@ -19,6 +19,7 @@ EXPECTED: dict[str, tuple[type, ...]] = {
     "InputInt": (bool, int),
     "InputText": (bool, str),
     "BeginPlot": (bool,),
+    "DragPoint": (bool, float, float),
     "BeginTable": (bool,),
 }
 

@@ -107,6 +107,26 @@ class Plots:
             self.ip.SetNextFillStyle(tuple(float(t) for t in c))
             self.ip.PlotBars(label if i == 0 else f"##{label}{i}", _f64([xi]), _f64([yi]), width)
 
+    def plot_drag_point(
+        self, label: str, index: int, x: float, y: float, tooltip: str
+    ) -> tuple[bool, float, float]:
+        """A point of the open plot the user drags (ImPlot's ``DragPoint``, id ``index``):
+        ``(moved, x, y)``. The hook sees it as the widget ``label`` of kind ``drag`` (drawn
+        with ``(x, y)``; a scripted ``(x, y)`` moves it there)."""
+        moved, nx, ny = check_return(
+            "DragPoint",
+            self.ip.DragPoint(
+                int(index), float(x), float(y), (0.85, 0.2, 0.1, 1.0), 5 * self.scale
+            ),
+        )
+        if moved and tooltip:
+            self.im.SetTooltip(tooltip)
+        v = self._record(label, "drag", tooltip, (float(x), float(y)))  # type: ignore[attr-defined]
+        if v is not None:
+            moved, nx, ny = True, float(v[0]), float(v[1])
+        self._changed(moved)  # type: ignore[attr-defined]
+        return bool(moved), float(nx), float(ny)
+
     def plot_vlines(self, label: str, x: Any) -> None:
         self.ip.PlotInfLines(label, _f64(x))
         self._plotted(label, "vlines", x, None)

@@ -30,7 +30,7 @@ from meshlap_core.options import UP_AXES, check_choice
 from . import scene, window
 from .jobs import Job, Reporter, prefer_gil_free_solvers, warm_up
 from .pacing import Pacer
-from .panels.base import Panel
+from .panels.base import Panel, Pick
 from .registry import REGISTRY, VIEWS
 from .scene import MESH
 from .state.app import AppState
@@ -196,18 +196,22 @@ class Viewer:
 
     # ------------------------------------------------------------------ input
     def handle_click(self) -> None:
-        xy = self.ui.scene_click()
-        if xy is not None:
-            self.pick_at(xy)
+        click = self.ui.scene_click()
+        if click is not None:
+            self.pick_at(*click)
 
-    def pick_at(self, screen_xy: tuple[float, float]) -> bool:
-        """Pick at window coordinates; the active view first, then the others, may use it."""
+    def pick_at(
+        self, screen_xy: tuple[float, float], modifiers: frozenset[str] = frozenset()
+    ) -> bool:
+        """Pick at window coordinates (``modifiers``: the keys held, see :class:`Pick`); the
+        active view first, then the others, may use it."""
         res = ps.pick(screen_coords=screen_xy)
         if not res.is_hit:
             return False
+        hit = Pick.of(res, modifiers)
         active = self.active()
         others = [p for p in self.panels.values() if p is not active]
-        return any(p.pick(self, res, active) for p in (active, *others))
+        return any(p.pick(self, hit, active) for p in (active, *others))
 
     def handle_keys(self) -> None:
         """The shortcuts: a number selects a view; other keys go to the active view, then to

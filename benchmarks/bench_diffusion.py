@@ -2,11 +2,13 @@
 peers a user would otherwise call, in one process.
 
     python benchmarks/bench_diffusion.py [--mesh armadillo_igl.obj] [--scan] [--exact]
-                                         [--filter-k 300] [--repeat 3]
+                                         [--filter-k 300] [--repeat 3] [--clicks 6]
 
-* precompute (factorizations) and one solve of :class:`meshlap_core.diffusion.HeatGeodesic`
-  against ``igl.heat_geodesics_precompute`` / ``_solve`` and, when installed (not a
-  dependency), ``potpourri3d.MeshHeatMethodDistanceSolver``; all with ``t = h²``;
+* precompute (factorizations) of :class:`meshlap_core.diffusion.HeatGeodesic` against
+  ``igl.heat_geodesics_precompute`` and, when installed (not a dependency),
+  ``potpourri3d.MeshHeatMethodDistanceSolver``; all with ``t = h²``; then a new source per
+  click (``--clicks`` sources spread over the mesh, vertex 0 first; the solvers alternating
+  on each) against ``igl.heat_geodesics_solve`` / ``compute_distance``: median and worst;
 * ``--exact``: ``igl.exact_geodesic`` from one source (18–39 s at 43k) and the heat method's
   relative error against it;
 * ``igl.isolines`` with 10 levels of the distance;
@@ -32,6 +34,7 @@ from _util import best_of, print_table, shared_mesh
 from meshlap_core.diffusion import (
     HeatGeodesic,
     SpectralFilter,
+    curve_gain,
     exact_distance,
     isoline_values,
     isolines,
@@ -52,48 +55,77 @@ def _igl_precompute(V: np.ndarray, F: np.ndarray):
     return data
 
 
-def heat_rows(V: np.ndarray, F: np.ndarray, repeat: int, src: int) -> tuple[list, np.ndarray]:
-    """Precompute and solve times of ours and the peers, alternating (ours, libigl,
-    potpourri3d, ours, ...), best of ``repeat``; our distance."""
+def click_sources(n: int, clicks: int) -> np.ndarray:
+    """``clicks`` vertices spread over the mesh (fixed seed), vertex 0 first."""
+    rng = np.random.default_rng(24)
+    return np.unique(np.concatenate([[0], rng.choice(n, clicks - 1, replace=False)]))[:clicks]
+
+
+def heat_rows(
+    V: np.ndarray, F: np.ndarray, repeat: int, clicks: int
+) -> tuple[list, np.ndarray, list]:
+    """Precompute times of ours and the peers, alternating (ours, libigl, potpourri3d, ours,
+    ...), best of ``repeat``; then, on the precomputed solvers, a new source per click from
+    ``clicks`` sources spread over the mesh, the solvers alternating on each source (median
+    and worst per solver); our distance from vertex 0; the per-click table."""
     have_pp = importlib.util.find_spec("potpourri3d") is not None
     if not have_pp:
         print("potpourri3d not installed: its row is skipped (pip install potpourri3d)")
     names = ["meshlap HeatGeodesic", "igl heat_geodesics"] + (["potpourri3d"] if have_pp else [])
-    best = {n: [np.inf, np.inf] for n in names}
-    dist: dict[str, np.ndarray] = {}
+    pre = dict.fromkeys(names, np.inf)
+    solvers: dict[str, object] = {}
     for _ in range(repeat):
         for name in names:
             if name.startswith("meshlap"):
-                tp, hg = _timed(lambda: HeatGeodesic(V, F))
-                ts, d = _timed(lambda: hg.distance([src]))  # noqa: B023
+                tp, solvers[name] = _timed(lambda: HeatGeodesic(V, F))
             elif name.startswith("igl"):
-                tp, data = _timed(lambda: _igl_precompute(V, F))
-                ts, d = _timed(lambda: igl.heat_geodesics_solve(data, np.array([src])))  # noqa: B023
+                tp, solvers[name] = _timed(lambda: _igl_precompute(V, F))
             else:
                 import potpourri3d as pp3d
 
-                tp, solver = _timed(lambda: pp3d.MeshHeatMethodDistanceSolver(V, F))
-                ts, d = _timed(lambda: solver.compute_distance(src))  # noqa: B023
-            best[name] = [min(best[name][0], tp), min(best[name][1], ts)]
-            dist[name] = np.asarray(d)
-    ours = dist[names[0]]
-    t0, s0 = best[names[0]]
+                tp, solvers[name] = _timed(lambda: pp3d.MeshHeatMethodDistanceSolver(V, F))
+            pre[name] = min(pre[name], tp)
+
+    def click(name: str, src: int) -> np.ndarray:
+        s = solvers[name]
+        if name.startswith("meshlap"):
+            return s.distance([src])  # type: ignore[attr-defined]
+        if name.startswith("igl"):
+            return np.asarray(igl.heat_geodesics_solve(s, np.array([src])))
+        return np.asarray(s.compute_distance(src))  # type: ignore[attr-defined]
+
+    per_click: dict[str, list[float]] = {n: [] for n in names}
+    first: dict[str, np.ndarray] = {}
+    sources = click_sources(len(V), clicks)
+    for src in sources:
+        for name in names:
+            ts, d = _timed(lambda: click(name, int(src)))  # noqa: B023
+            per_click[name].append(ts)
+            if src == sources[0]:
+                first[name] = d
+    ours = first[names[0]]
+    t0 = pre[names[0]]
+    c0 = float(np.median(per_click[names[0]]))
     rows = [
-        [n, best[n][0], best[n][1], best[n][0] / t0, best[n][1] / s0,
-         float(np.abs(ours - dist[n]).max() / ours.max())]
+        [n, pre[n], float(np.median(per_click[n])), float(np.max(per_click[n])), pre[n] / t0,
+         float(np.median(per_click[n])) / c0, float(np.abs(ours - first[n]).max() / ours.max())]
         for n in names
     ]  # fmt: skip
-    return rows, ours
+    clicks_table = [[int(src), *(per_click[n][i] for n in names)] for i, src in enumerate(sources)]
+    return rows, ours, [["source", *names], clicks_table]
 
 
 def run_mesh(name: str, V: np.ndarray, F: np.ndarray, args: argparse.Namespace) -> None:
     print(f"\n## {name}: {len(V)} vertices, {len(F)} faces")
     src = 0
-    rows, d = heat_rows(V, F, args.repeat, src)
+    rows, d, (head, per_click) = heat_rows(V, F, args.repeat, args.clicks)
     print_table(
-        ["solver", "precompute s", "solve s", "precompute ratio", "solve ratio", "max |Δd|/max d"],
+        ["solver", "precompute s", "click s (median)", "click s (worst)", "precompute ratio",
+         "click ratio", "max |Δd|/max d (source 0)"],
         rows,
-    )
+    )  # fmt: skip
+    print(f"\na new source per click, {len(per_click)} sources, seconds (solvers alternating):")
+    print_table(head, per_click)
     t_iso, (_, E, _) = best_of(lambda: isolines(V, F, d, isoline_values(d, 10)), args.repeat)
     t_iso_raw, _ = best_of(lambda: igl.isolines(V, F, d, isoline_values(d, 10)), args.repeat)
     print(
@@ -143,6 +175,26 @@ def run_mesh(name: str, V: np.ndarray, F: np.ndarray, args: argparse.Namespace) 
             f"drag update (one mode changed) {1000 * t_drag:.2f} ms (goal < 16 ms); "
             f"ratio {t_full / t_drag:.0f}"
         )
+        top = float(basis.eigenvalues[-1])
+        xs = np.array([0.0, 0.05, 0.1, 0.2, 0.35, 0.6, 1.0]) * top  # the panel's drawn curve
+        y = np.array([1.0, 1.0, 1.0, 0.5, 0.0, 0.0, 0.0])
+        t_pieces, G = best_of(lambda: f.pieces(xs), args.repeat)
+
+        def curve_drag():  # a gain of the drawn curve moved: the panel's Σ_j y_j G_j
+            y[3] = 0.6 if y[3] == 0.5 else 0.5
+            return np.tensordot(y, G, axes=1)
+
+        def curve_full():  # the same move through U h(Λ) Uᵀ M X (most gains change)
+            y[3] = 0.6 if y[3] == 0.5 else 0.5
+            return f.apply(curve_gain(basis.eigenvalues, np.column_stack([xs, y])))
+
+        t_curve, _ = best_of(curve_drag, max(args.repeat, 5))
+        t_curve_full, _ = best_of(curve_full, max(args.repeat, 5))
+        print(
+            f"drawn curve at k={k} (7 points): its pieces {1000 * t_pieces:.1f} ms once per "
+            f"basis; a drag {1000 * t_curve:.2f} ms (goal < 16 ms) against "
+            f"{1000 * t_curve_full:.1f} ms through the product over U"
+        )
 
 
 def main() -> None:
@@ -152,6 +204,7 @@ def main() -> None:
     ap.add_argument("--exact", action="store_true", help="igl.exact_geodesic too (slow)")
     ap.add_argument("--filter-k", type=int, default=0, help="time the filter drag at this k")
     ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--clicks", type=int, default=6, help="new sources timed per solver")
     args = ap.parse_args()
     path = shared_mesh(args.mesh)
     if path is not None:
@@ -161,7 +214,7 @@ def main() -> None:
         src = shared_mesh("armadillo_loop.obj")
         if src is not None:
             mesh = load_mesh(src)
-            V, F = igl.upsample(mesh.V, mesh.F)
+            V, F = igl.upsample(mesh.V, mesh.F)  # = /tmp/scans/armadillo_692k.obj
             scan = argparse.Namespace(**{**vars(args), "exact": False, "filter_k": 0})
             run_mesh("armadillo 692k (upsampled armadillo_loop)", V, F, scan)
 

@@ -1,12 +1,15 @@
 """Regenerate the README screenshots of every viewer panel (headless, EGL).
 
-Run: ``python docs/make_screenshots.py``. Uses ../shared/meshes/armadillo.obj for the spectral
-panel when present, the bundled assets otherwise. The inspector shot is taken on a perturbed grid
+Run: ``python docs/make_screenshots.py [NAME ...]`` (names: the keys of :data:`SHOTS`,
+``inspector``, ``diffusion_distance``, ``diffusion_heat``; all when none). Uses
+../shared/meshes/armadillo.obj for the spectral panel when present, the bundled assets
+otherwise. The inspector shot is taken on a perturbed grid
 (:func:`perturbed_grid`, seeded) at a vertex whose ring has a negative cotangent weight.
 """
 
 from __future__ import annotations
 
+import json
 import subprocess
 import sys
 import tempfile
@@ -37,6 +40,34 @@ SHOTS = {
 }
 
 
+DIFFUSION_VERTEX = 2259
+"""A vertex of ``assets/bumpy.obj`` up and left of the one facing the camera: the distance's
+isolines and the heat's spread both in view."""
+
+
+def heat_session(folder: Path) -> Path:
+    """A session of the Diffusion view showing heat two ways on the bumpy sphere: 60 modes
+    computed, a unit of heat at :data:`DIFFUSION_VERTEX`, t = 10 h², 10 backward Euler steps,
+    the eigen-expansion and their difference on copies beside it, isolines of the heat on."""
+    path = folder / "heat.json"
+    session = {
+        "format": "meshlap-session",
+        "version": 1,
+        "mesh": str(ROOT / "assets" / "bumpy.obj"),
+        "panel": "diffusion",
+        "spectral": {"computed": True, "k_request": 60, "k": 60},
+        "diffusion": {
+            "show": "heat",
+            "sources": [DIFFUSION_VERTEX],
+            "log_t": 1.0,
+            "steps": 10,
+            "isoline_fields": {"heat": {"on": True, "count": 10}},
+        },
+    }
+    path.write_text(json.dumps(session))
+    return path
+
+
 INSPECT_VERTEX = 54
 """A vertex of :func:`perturbed_grid` near the centre with a negative weight (w = -0.50)."""
 
@@ -59,6 +90,11 @@ def main() -> None:
         save_mesh(grid, *perturbed_grid())
         shots = dict(SHOTS)
         shots["inspector"] = [str(grid), "--panel", "onering", "--vertex", str(INSPECT_VERTEX)]
+        bumpy = str(ROOT / "assets" / "bumpy.obj")
+        shots["diffusion_distance"] = [
+            bumpy, "--panel", "diffusion", "--vertex", str(DIFFUSION_VERTEX),
+        ]  # fmt: skip
+        shots["diffusion_heat"] = ["--session", str(heat_session(Path(tmp)))]
         only = sys.argv[1:]  # names of the shots to take (all when none)
         for name, args in shots.items():
             if only and name not in only:

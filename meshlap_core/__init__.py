@@ -72,6 +72,16 @@ _PUBLIC: dict[str, str | tuple[str, str]] = {
     "smooth": "smoothing",
     "add_noise": "noise",
     "rmse": "metrics",
+    # heat, geodesic distance, spectral filters (meshlap_core.diffusion)
+    "HeatDiffusion": "diffusion",
+    "heat_spectral": "diffusion",
+    "HeatGeodesic": "diffusion",
+    "exact_distance": "diffusion",
+    "SpectralFilter": "diffusion",
+    "transfer_function": ("diffusion", "transfer"),
+    "heat_kernel_signature": "diffusion",
+    "isolines": "diffusion",
+    "save_polylines": "diffusion",
     # parametric surfaces
     "get_surface": "surfaces",
     "mesh_surface": "surfaces",

@@ -80,6 +80,37 @@ def test_heat_euler_and_spectral(capsys, sphere_obj):
     assert r["total_heat"] == pytest.approx(1.0) and 0 < r["truncation_bound"] < 1
 
 
+def test_heat_writes_the_level_curves_of_u(capsys, tmp_path):
+    """``meshlap heat --isolines N --curves FILE``: N levels evenly spaced inside u's range
+    (u − min)/(max − min) = i/(N+1), every curve point on its level (u linear on each edge)."""
+    path = tmp_path / "grid.obj"
+    V, F = primitives.grid(21, 21)
+    save_mesh(path, V, F)
+    curves = tmp_path / "u_curves.obj"
+    out = tmp_path / "u.npy"
+    code, text, err = run_cli(
+        capsys, "heat", path, "--vertex", 220, "--t", "0.01", "--out", out,
+        "--isolines", 3, "--curves", curves, "--json",
+    )  # fmt: skip
+    assert code == 0, err
+    r = json.loads(text)
+    u = np.load(out)
+    lines = curves.read_text().splitlines()
+    P = np.array([[float(x) for x in ln.split()[1:]] for ln in lines if ln.startswith("v ")])
+    assert r["curves"] == str(curves) and r["curve_segments"] == sum(
+        ln.startswith("l ") for ln in lines
+    )
+    assert r["curve_segments"] > 0
+    # u at each curve point, interpolated on the mesh (barycentric in its face)
+    import igl
+
+    _, face, _ = igl.point_mesh_squared_distance(P, V, F)
+    B = igl.barycentric_coordinates(P, *(V[F[face, i]] for i in range(3)))
+    at = np.einsum("pi,pi->p", B, u[F[face]])
+    levels = u.min() + (u.max() - u.min()) * np.arange(1, 4) / 4
+    assert np.all(np.min(np.abs(at[:, None] - levels[None, :]), axis=1) < 1e-9 * u.max())
+
+
 def test_filter_unit_gain_band_returns_the_mesh(capsys, sphere_obj, tmp_path):
     out = tmp_path / "f.obj"
     n = len(load_mesh(sphere_obj).V)
@@ -104,6 +135,12 @@ def test_filter_unit_gain_band_returns_the_mesh(capsys, sphere_obj, tmp_path):
         (["geodesic", "{m}", "--vertex", "1", "--out", "{m}"], "refusing to overwrite"),
         (["geodesic", "{m}", "--vertex", "1", "--out", "d.txt"], "unsupported output"),
         (["heat", "{m}", "--vertex", "1", "--t", "nan"], "--t"),
+        (["heat", "{m}", "--vertex", "1", "--t", "1", "--curves", "c.obj"], "--isolines"),
+        (["heat", "{m}", "--vertex", "1", "--t", "1", "--isolines", "-1"], "--isolines"),
+        (
+            ["heat", "{m}", "--vertex", "1", "--t", "1", "--isolines", "2", "--curves", "c.ply"],
+            "unsupported output",
+        ),
         (["heat", "{m}", "--vertex", "1", "--t", "1", "--method", "spectral"], "--k"),
         (["filter", "{m}", "--k", "10", "--band", "x", "--out", "f.obj"], "--band"),
         (["filter", "{m}", "--k", "10", "--taubin", "1", "a", "2", "--out", "f.obj"], "--taubin"),

@@ -13,6 +13,7 @@ from meshlap_core.diffusion import (
     HeatGeodesic,
     SpectralFilter,
     boundary_vertices,
+    curve_gain,
     exact_distance,
     heat_kernel_column,
     heat_kernel_signature,
@@ -29,6 +30,7 @@ from meshlap_core.diffusion import (
     truncation_bound,
     unit_heat,
 )
+from meshlap_core.diffusion.geodesic import face_gradients, far_levels
 from meshlap_core.errors import MeshError
 from meshlap_core.primitives import bumpy_sphere, grid, icosphere
 from meshlap_core.spectral.basis import SpectralBasis
@@ -361,3 +363,65 @@ def test_heat_method_survives_underflow_on_a_long_strip():
     hs = HeatGeodesic(V2, F2)
     hs.distance([0])
     assert hs._far == {}
+
+
+def test_the_longer_times_a_long_mesh_needs_are_factorized_with_the_precomputation():
+    """On the strip the heat of t = h² reaches about 575 √t = 0.29 of its length 1 (exp(−d/√t)
+    down to 1e-250), so t·100 (reach 2.9, over twice the diagonal) is factorized up front
+    and a click only back-substitutes; on the sphere (reach ≈ 40 radii) none is."""
+    V, F = grid(2000, 3)
+    V = V * np.array([1.0, 2.0 / 1999.0, 1.0])
+    hg = HeatGeodesic(V, F)
+    assert far_levels(V, hg.t) == 1 and set(hg._far) == {1}
+    built = dict(hg._far)
+    hg.distance([0])
+    hg.distance([1000])
+    assert hg._far == built  # nothing factorized per click
+    V2, _ = icosphere(3)
+    assert far_levels(V2, mean_edge_length(*icosphere(3)) ** 2) == 0
+    assert far_levels(V * 1e6, hg.t) == 4  # at most _FAR_LEVELS
+
+
+@pytest.mark.parametrize("mesh", ["sphere", "grid", "bumpy"])
+def test_face_gradients_are_the_rows_of_igl_grad(mesh):
+    import igl
+
+    V, F = {"sphere": icosphere(2), "grid": grid(7, 5), "bumpy": bumpy_sphere(2)}[mesh]
+    hat, area = face_gradients(V, F)
+    G = igl.grad(V, F).toarray().reshape(3, len(F), len(V))  # rows: x of each face, y, z
+    for i in range(3):
+        np.testing.assert_allclose(
+            hat[i], G[:, np.arange(len(F)), F[:, i]], atol=1e-12 * np.abs(G).max()
+        )
+    np.testing.assert_allclose(area, 0.5 * igl.doublearea(V, F).ravel(), rtol=1e-14)
+    # hand check: the right triangle (0,0), (1,0), (0,1): ∇φ₀ = (−1,−1), ∇φ₁ = (1,0), ∇φ₂ = (0,1)
+    hat, area = face_gradients(np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0]]), np.array([[0, 1, 2]]))
+    np.testing.assert_allclose(hat[:, :, 0], [[-1, -1, 0], [1, 0, 0], [0, 1, 0]], atol=1e-15)
+    assert area[0] == 0.5
+    hat, area = face_gradients(np.array([[0.0, 0, 0], [1, 0, 0], [2, 0, 0]]), np.array([[0, 1, 2]]))
+    assert area[0] == 0 and np.all(hat == 0)  # a face of no area: no gradient
+
+
+def test_a_drawn_transfer_function_is_linear_between_its_points():
+    lam = np.array([0.0, 0.5, 1.0, 1.5, 2.0, 3.0])
+    knots = [(0.0, 1.0), (1.0, 0.0), (2.0, 2.0)]
+    np.testing.assert_allclose(curve_gain(lam, knots), [1.0, 0.5, 0.0, 1.0, 2.0, 2.0])
+    for bad in ([(0.0, 1.0)], [(1.0, 0.0), (0.0, 1.0)], [(0.0, np.nan), (1.0, 1.0)], [1, 2]):
+        with pytest.raises(MeshError, match="curve"):
+            curve_gain(lam, bad)
+
+
+def test_the_pieces_of_a_drawn_curve_sum_to_its_filter(full_basis):
+    """``Σ_j y_j G_j`` (each hat's filtered geometry, precomputed) equals ``U h(Λ) Uᵀ M X``
+    for the curve through the gains ``y``; gains all 1 give X back (the full basis)."""
+    f = SpectralFilter(full_basis)
+    top = float(full_basis.eigenvalues[-1])
+    xs = np.array([0.0, 0.1, 0.3, 1.0]) * top
+    G = f.pieces(xs)
+    assert G.shape == (4, *full_basis.V.shape)
+    y = np.array([1.0, -0.5, 2.0, 0.25])
+    h = curve_gain(full_basis.eigenvalues, np.column_stack([xs, y]))
+    np.testing.assert_allclose(np.tensordot(y, G, axes=1), f.apply(h), atol=1e-12)
+    np.testing.assert_allclose(G.sum(axis=0), full_basis.V, atol=1e-9)
+    with pytest.raises(MeshError, match="curve"):
+        f.pieces([1.0, 0.0])

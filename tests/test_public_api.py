@@ -36,3 +36,25 @@ def test_import_loads_no_numerics_until_a_name_is_used():
     )
     res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert res.returncode == 0, res.stderr
+
+
+def test_diffusion_names_are_the_diffusion_modules():
+    """Heat, geodesic distance and spectral filters from the top level: the same objects as
+    ``meshlap_core.diffusion``; the heat method on the unit sphere reaches the antipode at
+    about π (great circle)."""
+    import numpy as np
+
+    from meshlap_core import diffusion
+
+    for name, there in [
+        ("HeatDiffusion", "HeatDiffusion"), ("heat_spectral", "heat_spectral"),
+        ("HeatGeodesic", "HeatGeodesic"), ("exact_distance", "exact_distance"),
+        ("SpectralFilter", "SpectralFilter"), ("transfer_function", "transfer"),
+        ("heat_kernel_signature", "heat_kernel_signature"), ("isolines", "isolines"),
+        ("save_polylines", "save_polylines"),
+    ]:  # fmt: skip
+        assert getattr(meshlap_core, name) is getattr(diffusion, there)
+    V, F = meshlap_core.icosphere(3)
+    d = meshlap_core.HeatGeodesic(V, F).distance([0])
+    far = int(np.argmin(V @ V[0]))
+    assert abs(d[far] - np.pi) < 0.05 * np.pi

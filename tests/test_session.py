@@ -70,6 +70,7 @@ def non_default_session(mesh) -> Session:
             "boundary": "neumann",
             "isolines": False,
             "isoline_count": 7,
+            "isoline_fields": {"heat": {"on": True, "count": 5}},
             "filter": "band",
             "keep": 12,
             "gain": 3.0,

@@ -5,6 +5,7 @@ polyscope-free state. ``drive_panel_diffusion`` is also part of the widget tour 
 from __future__ import annotations
 
 import time
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -30,12 +31,32 @@ def mock(polyscope_mock):
 
 
 def settle(viewer, owner: str = "diffusion") -> None:
-    """Wait for the panel's job and let the host apply it."""
+    """Wait for the panel's jobs (worker threads when ``viewer.background``) and let the host
+    apply them (an applied job may start the next one)."""
     t0 = time.monotonic()
     while viewer.state.jobs.running(owner) is not None:
         assert time.monotonic() - t0 < 120, "the diffusion job never finished"
-        time.sleep(0.02)
+        viewer.state.jobs.wait(owner, 1.0)
+        frames(viewer, 1)
     frames(viewer, 2)
+
+
+def click(viewer, vertex: int, *held: str) -> None:
+    """A scripted click on the scene (with the modifier keys ``held``) that polyscope's pick
+    answers with the mesh's ``vertex``."""
+    hit = SimpleNamespace(
+        is_hit=True,
+        structure_name="mesh",
+        structure_data={"element_type": "vertex", "index": vertex},
+        position=np.zeros(3),
+    )
+    real = ps.pick
+    ps.pick = lambda screen_coords: hit
+    try:
+        viewer.ui.script("click", (10.0, 10.0, *held))
+        frames(viewer, 1)
+    finally:
+        ps.pick = real
 
 
 def compute_basis(viewer, k: int = 40) -> None:
@@ -87,6 +108,42 @@ def drive_heat_play(viewer, hd: HeatDiffusion) -> None:
     settle(viewer)
 
 
+def drive_drawn_curve(viewer, basis) -> None:
+    """The drawn transfer function: every control point dragged in the plot (its gain; its λ
+    stays), the filtered copy ``U h(Λ) Uᵀ M X`` following each move; gains clamped to the
+    band gain's range; a non-finite drag is refused."""
+    from meshlap_app.state.diffusion import DEFAULT_KNOTS
+
+    st = viewer.panels["diffusion"].state
+    V = viewer.state.mesh.V
+    drive(viewer, "filter", "drawn")
+    lam = basis.eigenvalues
+    top = float(lam[-1])
+    xs = [x for x, _ in DEFAULT_KNOTS]
+    for i in range(len(st.knots)):
+        drive(viewer, f"curve point {i}", (0.5 * top, 1.0))  # dragged sideways too: λ stays
+    assert [x for x, _ in st.knots] == xs and [y for _, y in st.knots] == [1.0] * len(xs)
+    np.testing.assert_allclose(st.gains, 1.0)
+    np.testing.assert_allclose(st.filtered, V, atol=1e-9)  # h ≡ 1 on the full basis: X
+    drive(viewer, "curve point 3", (xs[3] * top, 0.0))  # a notch at λ_3, by hand:
+    s = lam / top
+    h = 1.0 - np.clip(
+        1.0 - np.abs(s - xs[3]) / np.where(s < xs[3], xs[3] - xs[2], xs[4] - xs[3]), 0, 1
+    )
+    np.testing.assert_allclose(st.gains, h, atol=1e-12)
+    U, M = basis.vectors, basis.mass
+    np.testing.assert_allclose(st.filtered, U @ (h[:, None] * (U.T @ (M[:, None] * V))), atol=1e-9)
+    drive(viewer, "curve point 1", (0.1 * top, 99.0))  # the gain clamped to the slider's range
+    assert st.knots[1] == (xs[1], 5.0)
+    before = list(st.knots)
+    drive(viewer, "curve point 2", (0.2, float("nan")))
+    assert st.knots == before and "drawn curve" in viewer.state.errors["diffusion"]
+    drive(viewer, "keep residual", True)  # with the residual: X − U Uᵀ M X added back
+    ref = SpectralFilter(basis).apply(st.gains, residual=True)
+    np.testing.assert_allclose(st.filtered, ref, atol=1e-9)
+    drive(viewer, "keep residual", False)
+
+
 def drive_panel_diffusion(viewer, tmp_path=None) -> None:
     """Every widget of the Diffusion panel, with good and bad values."""
     mesh = viewer.state.mesh
@@ -100,12 +157,16 @@ def drive_panel_diffusion(viewer, tmp_path=None) -> None:
     settle(viewer)
     np.testing.assert_allclose(st.distance, HeatGeodesic(V, F).distance([7]), atol=1e-12)
     assert ps.get_surface_mesh("mesh").get_quantity_buffer  # the field is on the mesh
-    drive(viewer, "add clicked vertices", True)
-    assert panel.select(viewer, 40)
+    click(viewer, 40, "shift")  # a shift-click adds a source
     settle(viewer)
     assert st.sources == [7, 40]
     np.testing.assert_allclose(st.distance, HeatGeodesic(V, F).distance([7, 40]), atol=1e-12)
-    drive(viewer, "add clicked vertices", False)
+    click(viewer, 3)  # a plain click replaces them
+    assert st.sources == [3]
+    click(viewer, 7)
+    click(viewer, 40, "shift")
+    click(viewer, 40, "shift")  # twice the same: once
+    assert st.sources == [7, 40]
     drive(viewer, "m (t = m h^2)", "4")
     settle(viewer)
     np.testing.assert_allclose(st.distance, HeatGeodesic(V, F, m=4).distance([7, 40]), atol=1e-12)
@@ -188,6 +249,7 @@ def drive_panel_diffusion(viewer, tmp_path=None) -> None:
     np.testing.assert_allclose(st.gains, 1.0)  # no step: identity
     drive(viewer, "keep residual", True)
     drive(viewer, "keep residual", False)
+    drive_drawn_curve(viewer, basis)
 
     # heat kernel signature
     drive(viewer, "show", "hks")
@@ -308,3 +370,96 @@ def test_play_moves_t_up_its_log_scale_and_stops_at_the_top():
     assert st.playing and st.log_t == lo
     st.clear()  # a new mesh stops it
     assert not st.playing
+
+
+def test_distance_view_factorizes_before_the_first_click_which_only_solves(viewer, monkeypatch):
+    """As on a scan (solves as jobs, the window's worker threads): showing the distance view
+    starts the heat method's factorizations; a click while they run waits for them (the job is
+    not restarted) and is answered when they end; later clicks reuse them (no factorization)."""
+    import meshlap_app.panels.diffusion as mod
+
+    monkeypatch.setattr(mod, "INLINE_DISTANCE_MAX", 0)
+    viewer.background = True
+    panel, jobs = viewer.panels["diffusion"], viewer.state.jobs
+    st = panel.state
+    built: list[float] = []
+
+    class Counted(HeatGeodesic):
+        def __init__(self, *args, **kwargs):
+            time.sleep(0.3)  # long enough for a click to arrive meanwhile
+            super().__init__(*args, **kwargs)
+            built.append(self.m)
+
+    monkeypatch.setattr(mod, "HeatGeodesic", Counted)
+    viewer.set_panel("diffusion")
+    drive(viewer, "show", "distance")
+    job = jobs.running("diffusion")
+    assert job is not None and job.title == mod.FACTORING and st.sources == []
+    assert panel.select(viewer, 11)  # a click during the factorization
+    assert jobs.running("diffusion") is job  # waited for, not restarted
+    settle(viewer)
+    V, F = viewer.state.mesh.V, viewer.state.mesh.F
+    np.testing.assert_allclose(st.distance, HeatGeodesic(V, F).distance([11]), atol=1e-12)
+    assert built == [1.0]
+    assert panel.select(viewer, 30)
+    job = jobs.running("diffusion")
+    assert job is None or job.title == mod.SOLVING
+    settle(viewer)
+    np.testing.assert_allclose(st.distance, HeatGeodesic(V, F).distance([30]), atol=1e-12)
+    assert built == [1.0]  # the click only back-substituted
+    drive(viewer, "m (t = m h^2)", "2")  # a new m: factorized again, once
+    settle(viewer)
+    assert built == [1.0, 2.0]
+    np.testing.assert_allclose(st.distance, HeatGeodesic(V, F, m=2).distance([30]), atol=1e-12)
+
+
+def test_a_session_keeps_the_isolines_of_every_field_and_the_heat_copies_show_them(
+    viewer, tmp_path, monkeypatch
+):
+    """The distance's toggle and count (``isolines`` / ``isoline_count``) and every other
+    field's that differs from a new field's (``isoline_fields``) are saved and restored; the
+    two heat copies beside the mesh carry the isolines of the field they show."""
+    import json
+
+    from legend_ledger import Ledger
+    from meshlap_app import session
+    from meshlap_app.state.isolines import Isolines
+
+    ledger = Ledger().install(monkeypatch)
+    panel = viewer.panels["diffusion"]
+    compute_basis(viewer, k=30)
+    viewer.set_panel("diffusion")
+    drive(viewer, "show", "distance")
+    click(viewer, 5)
+    settle(viewer)
+    drive(viewer, "isoline count", 30)
+    drive(viewer, "show", "heat")
+    settle(viewer)
+    drive(viewer, "isolines", True)  # the heat's: off by default
+    drive(viewer, "isoline count", 4)
+    drive(viewer, "heat field", "difference")
+    drive(viewer, "isoline count", 9)  # the difference's own setting (still off)
+    drive(viewer, "heat field", "euler")
+    frames(viewer, 2)
+    st = panel.state
+    for copy, which in (("heat (second way)", "spectral"), ("heat (third field)", "difference")):
+        q = ledger.quantities[copy][which]
+        if which == "spectral":  # the heat's setting: on, 4 curves over its own range
+            v = st.heat[which]
+            assert q.isolines and q.isoline_period == pytest.approx((v.max() - v.min()) / 4)
+        else:  # the difference's: off
+            assert not q.isolines
+    path = session.save(viewer, tmp_path / "iso.json")
+    saved = json.loads(path.read_text())["diffusion"]
+    assert saved["isolines"] is True and saved["isoline_count"] == 30
+    assert saved["isoline_fields"] == {
+        "heat": {"on": True, "count": 4},
+        "heat error": {"on": False, "count": 9},
+    }
+    panel.isolines = Isolines()  # forgotten
+    session.load(viewer, path)
+    frames(viewer, 2)
+    assert (panel.isolines.of("distance").on, panel.isolines.of("distance").count) == (True, 30)
+    assert (panel.isolines.of("heat").on, panel.isolines.of("heat").count) == (True, 4)
+    assert panel.isolines.of("heat error").count == 9 and not panel.isolines.of("heat error").on
+    assert not panel.isolines.of("distance error").on and panel.isolines.of("hks").on

@@ -93,16 +93,21 @@ def test_installed_polyscope_returns_what_the_adapter_expects(mock):
         "InputText": lambda: psim.InputText("it", "x"),
         "BeginPlot": lambda: psimplot.BeginPlot("p"),
         "BeginTable": lambda: psim.BeginTable("t", 2),
+        # inside the plot (ImPlot refuses it elsewhere): called in BeginPlot's branch
+        "DragPoint": lambda: psimplot.DragPoint(0, 0.5, 0.5, (1.0, 0.0, 0.0, 1.0)),
     }
     assert set(calls) == set(EXPECTED)
     results = {}
 
     def callback():
         for name, call in calls.items():
+            if name == "DragPoint":
+                continue
             results[name] = call()
             if name == "BeginCombo" and results[name]:
                 psim.EndCombo()
             if name == "BeginPlot" and results[name]:
+                results["DragPoint"] = calls["DragPoint"]()
                 psimplot.EndPlot()
             if name == "BeginTable" and results[name]:
                 psim.EndTable()

@@ -10,7 +10,8 @@ A panel never imports the viewer; it types against :class:`Host`.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar, Protocol
 
@@ -26,6 +27,47 @@ if TYPE_CHECKING:
 ExportItem = tuple[str, "np.ndarray | None", "np.ndarray | None", "np.ndarray | None"]
 """(file name, V or ``None``, F or ``None``, per-vertex scalars or ``None``): a mesh (PLY with
 the scalars) when V is given, else the scalars alone (CSV)."""
+
+
+@dataclass(frozen=True)
+class Pick:
+    """A click on the 3D view as a panel's :meth:`Panel.pick` sees it: what polyscope's pick
+    found there, and the modifier keys held (every panel gets them; e.g. shift-click adds a
+    source in the Diffusion view).
+
+    Attributes
+    ----------
+    structure_name : str
+        The structure hit (polyscope's name).
+    structure_data : dict
+        polyscope's per-structure data (``element_type``, ``index``, barycentric
+        coordinates ...).
+    position : tuple of 3 float
+        The 3D point hit, in display coordinates (a tuple: picks compare by value).
+    modifiers : frozenset of str
+        The keys held during the click: a subset of ``{"shift", "ctrl", "alt"}``
+        (:data:`meshlap_app.ui.MODIFIERS`).
+    """
+
+    structure_name: str
+    structure_data: dict[str, Any] = field(default_factory=dict)
+    position: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    modifiers: frozenset[str] = frozenset()
+
+    @classmethod
+    def of(cls, hit: Any, modifiers: Iterable[str] = ()) -> Pick:
+        """From polyscope's pick result ``hit`` and the keys held."""
+        return cls(
+            str(hit.structure_name),
+            dict(getattr(hit, "structure_data", {}) or {}),
+            tuple(float(x) for x in getattr(hit, "position", (0.0, 0.0, 0.0))),  # type: ignore[arg-type]
+            frozenset(modifiers),
+        )
+
+    @property
+    def shift(self) -> bool:
+        """Shift was held."""
+        return "shift" in self.modifiers
 
 
 HOST_SHORTCUTS: tuple[tuple[str, str], ...] = (
@@ -169,7 +211,8 @@ class Panel:
         return False
 
     def pick(self, host: Host, hit: Any, active: Panel) -> bool:
-        """Handle a click on the 3D view (``hit``: polyscope's pick result); True if used."""
+        """Handle a click on the 3D view (``hit``: a :class:`Pick`, polyscope's pick result
+        with the modifier keys held); True if used."""
         return False
 
     def captions(self, host: Host) -> dict[str, str]:

@@ -12,7 +12,7 @@ import numpy as np
 import polyscope as ps
 
 from meshlap_core.diffusion import HeatGeodesic, exact_distance, mean_edge_length
-from meshlap_core.options import FILTER_KINDS, HEAT_BOUNDARIES, SMOOTHING_METHODS
+from meshlap_core.options import HEAT_BOUNDARIES, SMOOTHING_METHODS
 
 from .. import scene
 from ..isolines import draw_isolines
@@ -20,12 +20,15 @@ from ..scene import MESH, front_view, picked_vertex, side_offset
 from ..state.diffusion import (
     HEAT_FIELDS,
     HKS_SCALES,
+    ISO_FIELDS,
     LOG_T_RANGE,
+    PANEL_FILTERS,
     SHOWS,
     DiffusionState,
     find_basis,
     symmetric_range,
 )
+from ..state.isolines import DEFAULT_COUNT
 from .base import ExportItem, Host, Panel
 
 FIELD = "diffusion field"
@@ -36,6 +39,9 @@ HEAT_COPIES = ("heat (second way)", "heat (third field)")
 INLINE_DISTANCE_MAX = 100_000
 """Up to this many vertices a new source's distance is solved on the UI thread (about 40 ms
 at 43k once factorized); above, as a job."""
+FACTORING = "heat method: factorizing"
+SOLVING = "heat method: distance"
+"""The titles of the distance's two jobs (a click during the first waits for it)."""
 NEEDS_BASIS = "needs an eigenbasis: compute one in the Spectral view first"
 ISOLINES_ON = ("distance", "hks")
 """Fields whose isolines start shown (heat is ~0 over most of the mesh: its level 0 would
@@ -50,13 +56,14 @@ class DiffusionPanel(Panel):
     shortcuts = (
         (
             "mouse",
-            "diffusion: click a vertex for the heat / distance source (more: the checkbox)",
+            "diffusion: click a vertex for the heat / distance source; shift-click adds one",
         ),
     )
 
     def __init__(self, name: str, state: DiffusionState) -> None:
         super().__init__(name, state)
         self.state: DiffusionState = state
+        self._factoring: Any = None  # the geodesic key of the last factorization started
 
     # ------------------------------------------------------------------ the scene
     def on_new_mesh(self, host: Host) -> None:
@@ -74,6 +81,11 @@ class DiffusionPanel(Panel):
             if ps.has_surface_mesh(name):
                 ps.get_surface_mesh(name).set_enabled(mine)
         if mine:
+            # the window factorizes before the first click (a headless render or animation
+            # computes what it shows right away instead)
+            ready = self.state.geodesic_ready(host.state.mesh.version)
+            if host.background and self.state.show == "distance" and not ready:
+                self.precompute(host)
             self.push(host, force=True)
         elif self.watch.seen("field") is not None and ps.has_surface_mesh(MESH):
             ps.get_surface_mesh(MESH).remove_quantity(FIELD)
@@ -85,11 +97,12 @@ class DiffusionPanel(Panel):
         idx = picked_vertex(hit, host.mesh_points(), host.state.mesh.F)
         if idx is None:
             return False
-        return self.select(host, idx)
+        return self.select(host, idx, add="shift" in getattr(hit, "modifiers", ()))
 
-    def select(self, host: Host, vertex: int) -> bool:
-        """Make ``vertex`` a source and recompute what is shown."""
-        if not self.state.select(len(host.state.mesh.V), vertex):
+    def select(self, host: Host, vertex: int, add: bool = False) -> bool:
+        """Make ``vertex`` the source (``add``: one more, a shift-click) and recompute what is
+        shown."""
+        if not self.state.select(len(host.state.mesh.V), vertex, add):
             return False
         self.recompute(host)
         return True
@@ -106,15 +119,12 @@ class DiffusionPanel(Panel):
 
     def recompute(self, host: Host) -> None:
         """Compute the field of the current view (a precomputation runs as a job)."""
-        st, mesh = self.state, host.state.mesh
+        st = self.state
         basis = self._basis(host)
         if st.show == "heat":
             self.start_heat(host, basis)
         elif st.show == "distance":
-            if st.geodesic_ready(mesh.version) and len(mesh.V) <= INLINE_DISTANCE_MAX:
-                st.compute_distance()
-            elif st.sources:
-                self.precompute(host)
+            self.distance(host)
         elif basis is not None and st.show == "filter":
             st.compute_filter(basis)
         elif basis is not None and st.show == "hks":
@@ -138,30 +148,54 @@ class DiffusionPanel(Panel):
             self._failed(host), background=host.background,
         )  # fmt: skip
 
-    def precompute(self, host: Host) -> None:
-        """The heat method's distance as a job: its two factorizations first when the mesh,
-        ``m`` or the boundary rule changed (about a second at 43k vertices), then the solve
-        (inline instead for meshes up to :data:`INLINE_DISTANCE_MAX` vertices once
-        factorized)."""
+    def distance(self, host: Host) -> None:
+        """The heat method's distance from the sources: its factorizations first (a job, once
+        per mesh, ``m`` and boundary rule), then per click only back-substitutions (inline up
+        to :data:`INLINE_DISTANCE_MAX` vertices, else a job: 0.3–0.6 s at 692k)."""
         st, mesh = self.state, host.state.mesh
-        key = st.geodesic_key(mesh.version)
-        V, F, m, rule = mesh.V, mesh.F, st.m, st.boundary
-        known = st._geodesic if st.geodesic_ready(mesh.version) else None
-        sources = list(st.sources)
+        if not st.geodesic_ready(mesh.version):
+            self.precompute(host)
+            return
+        if not st.sources:
+            return
+        if len(mesh.V) <= INLINE_DISTANCE_MAX:
+            st.compute_distance()
+            return
+        solver, sources = st._geodesic, list(st.sources)
 
-        def work(reporter: Any) -> tuple[HeatGeodesic, np.ndarray]:
-            solver = known if known is not None else HeatGeodesic(V, F, m=m, boundary=rule)
-            return solver, solver.distance(sources)
-
-        def apply(result: tuple[HeatGeodesic, np.ndarray]) -> None:
-            st.adopt_geodesic(result[0], key)
-            st.adopt_distance(result[1])
+        def apply(d: np.ndarray) -> None:
+            st.adopt_distance(d)
             self.push(host)
 
-        title = "heat method: distance" if known else "heat method: factorizing"
         host.state.jobs.start(
-            self.name, title, work, apply, self._failed(host), background=host.background
-        )
+            self.name, SOLVING, lambda reporter: solver.distance(sources), apply,
+            self._failed(host), background=host.background,
+        )  # fmt: skip
+
+    def precompute(self, host: Host) -> None:
+        """The heat method's factorizations as a job (about a second at 43k vertices, 10–30 s
+        at 692k), started as soon as the distance view shows a mesh, so the first click only
+        back-substitutes; clicks meanwhile wait for it (it is not restarted), and it answers
+        the sources of its end."""
+        st, mesh, jobs = self.state, host.state.mesh, host.state.jobs
+        if len(mesh.V) == 0 or len(mesh.F) == 0:
+            return
+        key = st.geodesic_key(mesh.version)
+        job = jobs.running(self.name)
+        if job is not None and job.title == FACTORING and self._factoring == key:
+            return  # under way: it answers the sources when done
+        V, F, m, rule = mesh.V, mesh.F, st.m, st.boundary
+
+        def apply(solver: HeatGeodesic) -> None:
+            st.adopt_geodesic(solver, key)
+            if st.show == "distance" and st.sources:
+                self.recompute(host)
+
+        self._factoring = key
+        jobs.start(
+            self.name, FACTORING, lambda reporter: HeatGeodesic(V, F, m=m, boundary=rule),
+            apply, self._failed(host), background=host.background,
+        )  # fmt: skip
 
     def start_exact(self, host: Host) -> None:
         """The exact polyhedral distance as a cancellable job (a child process when the
@@ -291,9 +325,11 @@ class DiffusionPanel(Panel):
             else:
                 ps.register_surface_mesh(name, X, F, smooth_shade=True)
                 host.request_frame()
+            iso = "heat error" if which == "difference" else "heat"
             ps.get_surface_mesh(name).add_scalar_quantity(
-                which, self.state.heat[which], cmap="coolwarm", vminmax=vr, enabled=True
-            )
+                which, self.state.heat[which], cmap="coolwarm", vminmax=vr, enabled=True,
+                **self.isolines.options(iso, self.state.heat[which], iso in ISOLINES_ON),
+            )  # fmt: skip
 
     def points(self, host: Host, name: str) -> np.ndarray | None:
         if name == FILTERED and self.state.filtered is not None:
@@ -338,11 +374,21 @@ class DiffusionPanel(Panel):
             "boundary": st.boundary,
             "isolines": bool(self.isolines.of("distance", True).on),
             "isoline_count": int(self.isolines.of("distance", True).count),
+            "isoline_fields": self._iso_changed(),
             "filter": st.filter,
             "keep": int(st.keep),
             "gain": float(st.gain),
             "hks_scale": int(st.hks_scale),
         }
+
+    def _iso_changed(self) -> dict[str, dict[str, Any]]:
+        """The isoline settings of :data:`ISO_FIELDS` that differ from a new field's."""
+        out = {}
+        for name in ISO_FIELDS:
+            s = self.isolines.fields.get(name)
+            if s is not None and (s.on != (name in ISOLINES_ON) or s.count != DEFAULT_COUNT):
+                out[name] = {"on": bool(s.on), "count": int(s.count)}
+        return out
 
     def configure(self, host: Host, values: dict[str, Any]) -> None:
         st = self.state
@@ -352,6 +398,12 @@ class DiffusionPanel(Panel):
                 lines.on = bool(value)
             elif key == "isoline_count":
                 lines.set_count(value)
+            elif key == "isoline_fields":
+                for name in ISO_FIELDS:  # a field not saved is at its defaults
+                    field = self.isolines.of(name, name in ISOLINES_ON)
+                    saved = value.get(name, {"on": name in ISOLINES_ON, "count": DEFAULT_COUNT})
+                    field.on = bool(saved["on"])
+                    field.set_count(saved["count"])
             elif key != "sources":
                 setattr(st, key, value)
 
@@ -383,16 +435,14 @@ class DiffusionPanel(Panel):
             st.set_choice("show", show, SHOWS)
             st.playing = False  # t plays in the heat view only
             self.recompute(host)
-        ch, add = ui.checkbox(
-            "add clicked vertices", st.add_sources, "on: a click adds a source; off: replaces"
-        )
-        if ch:
-            st.add_sources = add
         if ui.button("clear sources", "forget the clicked vertices"):
             st.sources = []
             st.version += 1
             self.push(host)
-        ui.text(f"sources: {', '.join(map(str, st.sources)) or 'click a vertex'}")
+        ui.text(
+            f"sources: {', '.join(map(str, st.sources)) or 'click a vertex'}"
+            + (" (shift-click adds one)" if st.sources else "")
+        )
         basis = self._basis(host)
         {"heat": self._draw_heat, "distance": self._draw_distance}.get(
             st.show, self._draw_spectral
@@ -486,12 +536,13 @@ class DiffusionPanel(Panel):
     def _draw_filter(self, host: Host, basis: Any) -> None:
         ui, st = host.ui, self.state
         ch, kind = ui.combo(
-            "filter", st.filter, FILTER_KINDS,
+            "filter", st.filter, PANEL_FILTERS,
             "low-pass: first modes; band: gain on modes; explicit/implicit/taubin: the "
-            "smoothers' transfer functions (1 - s lam)^n, (1 + s lam)^-n, ...",
+            "smoothers' transfer functions (1 - s lam)^n, (1 + s lam)^-n, ...; drawn: drag "
+            "the curve's points in the plot",
         )  # fmt: skip
         if ch:
-            st.set_choice("filter", kind, FILTER_KINDS)
+            st.set_choice("filter", kind, PANEL_FILTERS)
         ch, keep = ui.slider_int("modes kept", st.keep, 0, basis.k_max, "low-pass / band end")
         if ch:
             st.keep = int(min(max(keep, 0), basis.k_max))
@@ -525,6 +576,26 @@ class DiffusionPanel(Panel):
                     ui.plot_line("h(lambda)", basis.eigenvalues, st.gains)
                     if st.measured is not None:
                         ui.plot_line("measured", basis.eigenvalues, st.measured)
+                    if st.filter == "drawn":
+                        self._drag_curve(host, basis)
+        if st.filter == "drawn":
+            ui.text("drag the points up or down: U h(Lambda) U^T M X follows")
+
+    def _drag_curve(self, host: Host, basis: Any) -> None:
+        """The drawn curve's control points, each dragged in the plot; the filtered copy
+        follows every move (the projection is kept: one product per drag)."""
+        ui, st = host.ui, self.state
+        P = st.curve_points(basis)
+        ui.plot_line("drawn curve", P[:, 0], P[:, 1])
+        for i, (x, y) in enumerate(P):
+            moved, _, ny = ui.plot_drag_point(
+                f"curve point {i}", i, x, y,
+                f"drag up or down: the gain h at lambda = {x:.3g} (linear between the points)",
+            )  # fmt: skip
+            if moved:
+                st.move_knot(i, ny)
+                st.compute_filter(basis)
+                self.push(host)
 
     def start_measure(self, host: Host, basis: Any) -> None:
         """Run the smoother and project (a job: the implicit one factorizes)."""
@@ -544,7 +615,7 @@ class DiffusionPanel(Panel):
         Euler, t swept on a log scale; each frame coloured from 0 to its own maximum (the
         caption gives it: the peak falls as the heat spreads)."""
         st, mesh = self.state, host.state.mesh
-        st.show, st.heat_field, st.add_sources = "heat", "euler", False
+        st.show, st.heat_field = "heat", "euler"
         source = int(options["heat_vertex"])
         if source < 0:
             P = mesh.V - mesh.V.mean(axis=0)

@@ -21,6 +21,7 @@ from meshlap_core.diffusion import (
     HeatDiffusion,
     HeatGeodesic,
     SpectralFilter,
+    curve_gain,
     heat_kernel_signature,
     heat_spectral,
     hks_distance,
@@ -51,8 +52,38 @@ LOG_T_RANGE = (-3.0, 4.0)
 """The t slider's range, as log10 of t relative to the mesh's h² (t = 10^x · h²)."""
 PLAY_STEP = 0.05
 """How far the play button moves t per heat field shown (log10 of t/h²: a decade in 20)."""
+PANEL_FILTERS: tuple[str, ...] = (*FILTER_KINDS, "drawn")
+"""The filter editor's kinds: the core's, and a curve the user drags (:func:`curve_gain`)."""
+DEFAULT_KNOTS: tuple[tuple[float, float], ...] = (
+    (0.0, 1.0), (0.05, 1.0), (0.1, 1.0), (0.2, 0.5), (0.35, 0.0), (0.6, 0.0), (1.0, 0.0),
+)  # fmt: skip
+"""The drawn curve's control points ``(λ / λ_max, h)``: a soft low-pass. Their λ are fixed
+(an equalizer's bands, denser at low frequencies); a drag moves a gain, so the filtered shape
+is a sum of precomputed pieces (:meth:`SpectralFilter.pieces`)."""
+GAIN_RANGE = (-2.0, 5.0)
+"""The gains a drawn point may take (as the band gain's slider)."""
 HKS_SCALES = 16
 """Times of the heat kernel signature (log-spaced, Sun et al. 2009)."""
+
+ISO_FIELDS: tuple[str, ...] = ("heat", "heat error", "distance error", "hks")
+"""The fields whose isoline settings a session keeps in ``isoline_fields`` (the distance's
+are ``isolines`` / ``isoline_count``): the heat (its two copies too), the heat difference, the
+distance's error map, the heat kernel signature."""
+
+
+def check_isoline_fields(x: Any) -> str | None:
+    """``{field: {"on": bool, "count": int}}`` over :data:`ISO_FIELDS`."""
+    if not isinstance(x, dict):
+        return "must be an object of fields"
+    for name, v in x.items():
+        if name not in ISO_FIELDS:
+            return f"has {name!r}; fields are {', '.join(ISO_FIELDS)}"
+        if not (isinstance(v, dict) and set(v) == {"on", "count"}):
+            return f'{name!r} must be {{"on": true/false, "count": N}}'
+        if boolean(v["on"]) or integer(1, 200)(v["count"]):
+            return f"{name!r}: on must be true/false, count 1..200"
+    return None
+
 
 SESSION: Schema = {
     "show": ("distance", one_of(SHOWS)),
@@ -64,7 +95,8 @@ SESSION: Schema = {
     "boundary": (DEFAULT_HEAT_BOUNDARY, one_of(HEAT_BOUNDARIES)),
     "isolines": (True, boolean),
     "isoline_count": (12, integer(1, 200)),
-    "filter": ("low-pass", one_of(FILTER_KINDS)),
+    "isoline_fields": ({}, check_isoline_fields),
+    "filter": ("low-pass", one_of(PANEL_FILTERS)),
     "keep": (10, integer(0)),
     "gain": (2.0, number(-100.0, 100.0)),
     "hks_scale": (8, integer(0, HKS_SCALES - 1)),
@@ -123,7 +155,6 @@ class DiffusionState:
 
     show: str = "distance"
     sources: list[int] = field(default_factory=list)
-    add_sources: bool = False  # a click adds a source instead of replacing them
     log_t: float = 0.0  # t = 10^log_t · h²
     playing: bool = False  # t sweeps up its log scale (the play button)
     steps: int = 1
@@ -134,6 +165,7 @@ class DiffusionState:
     keep: int = 10
     gain: float = 2.0
     band: tuple[int, int] = (1, 10)
+    knots: list[tuple[float, float]] = field(default_factory=lambda: list(DEFAULT_KNOTS))
     step: float = 0.0  # smoother step; 0: 0.5 / λ_max of the basis
     iters: int = 10
     residual: bool = False
@@ -158,6 +190,7 @@ class DiffusionState:
     _geodesic: Any = None
     _geodesic_key: Any = None
     _filter: Any = None
+    _pieces: Any = None  # (the drawn curve's λ (p,), its pieces G (p,n,c))
     _hks: Any = None  # (basis id, H (n,s), times (s,))
 
     # ------------------------------------------------------------------ lifetime
@@ -169,7 +202,7 @@ class DiffusionState:
         self.exact_stats = {}
         self.filtered = self.gains = self.hks = self.hks_dist = self.measured = None
         self._heat_solver = self._geodesic = self._geodesic_key = None
-        self._filter = self._hks = None
+        self._filter = self._hks = self._pieces = None
         self.error = self.message = ""
         self.playing = False
         self.version += 1
@@ -179,13 +212,13 @@ class DiffusionState:
         return float(10.0**self.log_t * h * h)
 
     # ------------------------------------------------------------------ sources
-    def select(self, n: int, vertex: int) -> bool:
-        """Make ``vertex`` the source (or add it, with :attr:`add_sources`); False when out of
-        range (nothing changes)."""
+    def select(self, n: int, vertex: int, add: bool = False) -> bool:
+        """Make ``vertex`` the source (``add``: one more source, as a shift-click does); False
+        when out of range (nothing changes)."""
         if not 0 <= int(vertex) < n:
             return False
         v = int(vertex)
-        if self.add_sources:
+        if add:
             if v not in self.sources:
                 self.sources = [*self.sources, v]
         else:
@@ -317,8 +350,33 @@ class DiffusionState:
         extra = {"taubin_nu": nu} if self.filter == "taubin" else {}
         return smoother_transfer(basis, self.filter, step, self.iters, **extra)[1]
 
+    def curve_points(self, basis: SpectralBasis) -> FloatArray:
+        """The drawn curve's control points ``(p,2)`` in ``λ`` of the basis (its knots are
+        kept relative to the largest eigenvalue, so they survive a new basis)."""
+        P = np.array(self.knots, dtype=np.float64)
+        P[:, 0] *= float(basis.eigenvalues[-1]) or 1.0
+        return P
+
+    def move_knot(self, index: int, gain: float) -> None:
+        """Drag control point ``index`` to the gain ``h`` (kept in :data:`GAIN_RANGE`; its λ
+        stays).
+
+        Raises
+        ------
+        MeshError
+            A non-finite gain (the point stays).
+        """
+        if not math.isfinite(gain):
+            raise MeshError(f"a gain must be finite, got {gain!r}", "drawn curve")
+        knots = list(self.knots)
+        h = float(min(max(gain, GAIN_RANGE[0]), GAIN_RANGE[1]))
+        knots[index] = (float(knots[index][0]), h)
+        self.knots = knots
+
     def filter_gains(self, basis: SpectralBasis) -> FloatArray:
         lam = basis.eigenvalues
+        if self.filter == "drawn":
+            return curve_gain(lam, self.curve_points(basis))
         step, nu = self.smoother_step(basis)
         return transfer(
             self.filter,  # type: ignore[arg-type]
@@ -336,8 +394,16 @@ class DiffusionState:
         per basis)."""
         if self._filter is None or self._filter.basis is not basis:
             self._filter = SpectralFilter(basis)
+            self._pieces = None
         self.gains = self.filter_gains(basis)
-        self.filtered = self._filter.apply(self.gains, residual=self.residual)
+        if self.filter == "drawn":  # Σ_j y_j G_j: a drag costs a few axpys
+            P = self.curve_points(basis)
+            if self._pieces is None or not np.array_equal(self._pieces[0], P[:, 0]):
+                self._pieces = (P[:, 0].copy(), self._filter.pieces(P[:, 0]))
+            out = np.tensordot(P[:, 1], self._pieces[1], axes=1)
+            self.filtered = out + self._filter.residual if self.residual else out
+        else:
+            self.filtered = self._filter.apply(self.gains, residual=self.residual)
         self.version += 1
 
     # ------------------------------------------------------------------ HKS

@@ -13,14 +13,14 @@ import argparse
 
 import numpy as np
 
-from ..diffusion import HeatGeodesic, exact_distance, igl_heat_distance, isoline_values, isolines
+from ..diffusion import HeatGeodesic, exact_distance, igl_heat_distance
 from ..diffusion.geodesic import check_time_factor
-from ..diffusion.isolines import save_polylines
 from ..errors import MeshError
 from ..io import load_mesh, save_mesh, save_scalars
 from ..options import DEFAULT_HEAT_BOUNDARY, GEODESIC_METHODS, HEAT_BOUNDARIES
 from ..progress import Progress
 from ._common import add_json_flag, emit_json, print_report, summary_stats
+from ._curves import add_curve_flags, curves_path, write_curves
 from ._sources import add_vertex_flag, output, vertices
 
 OUT_SUFFIXES = (".npy", ".csv", ".ply")
@@ -50,8 +50,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         help=f"heat-step boundary condition on open meshes (default {DEFAULT_HEAT_BOUNDARY})",
     )
     p.add_argument("--out", help="write one distance per vertex: .npy, .csv or .ply")
-    p.add_argument("--isolines", type=int, default=0, help="number of level curves (with --curves)")
-    p.add_argument("--curves", help="write the level curves as an OBJ of polylines")
+    add_curve_flags(p, "distance")
     add_json_flag(p)
     p.set_defaults(func=run)
 
@@ -80,11 +79,7 @@ def _distance(args: argparse.Namespace, V: np.ndarray, F: np.ndarray, src: np.nd
 
 def run(args: argparse.Namespace) -> int:
     out = output(args.out, args.mesh, OUT_SUFFIXES, "--out")
-    curves = output(args.curves, args.mesh, (".obj",), "--curves")
-    if args.isolines < 0:
-        raise MeshError(f"must be 0 or more, got {args.isolines}", "--isolines")
-    if (args.isolines > 0) != (curves is not None):
-        raise MeshError("--isolines N and --curves FILE go together", "--isolines")
+    curves = curves_path(args)
     check_time_factor(args.m, "--m")
     mesh = load_mesh(args.mesh)
     V, F = mesh.V, mesh.F
@@ -110,12 +105,8 @@ def run(args: argparse.Namespace) -> int:
             save_mesh(out, V, F, scalars=d, overwrite_inputs=(args.mesh,))
         else:
             save_scalars(out, d, overwrite_inputs=(args.mesh,))
-    if curves is not None:
-        P, E, _ = isolines(V, F, d, isoline_values(d, args.isolines))
-        save_polylines(curves, P, E, overwrite_inputs=(args.mesh,))
-        result["curve_segments"] = len(E)
+    write_curves(args, curves, V, F, d, result)
     result["out"] = str(out) if out else None
-    result["curves"] = str(curves) if curves else None
     if args.json:
         emit_json(result)
     else:

@@ -1,4 +1,5 @@
-"""``meshlap heat MESH --vertex V --t T``: heat at time ``t`` from a unit of heat at vertices.
+"""``meshlap heat MESH --vertex V --t T``: heat at time ``t`` from a unit of heat at vertices
+(``--isolines N --curves FILE``: its level curves as OBJ polylines).
 
 ``u_t = Δu`` with ``Δ = M⁻¹C`` (negative semidefinite): ``--method euler`` takes ``--steps``
 backward Euler steps ``(M + τK) u = M u_prev`` (``K = −C``, ``τ = t/steps``); ``--method
@@ -16,6 +17,7 @@ from ..errors import MeshError
 from ..io import load_mesh, save_mesh, save_scalars
 from ..options import HEAT_METHODS, MASS_AREA
 from ._common import add_json_flag, emit_json, print_report, summary_stats
+from ._curves import add_curve_flags, curves_path, write_curves
 from ._sources import add_vertex_flag, output, vertices
 
 OUT_SUFFIXES = (".npy", ".csv", ".ply")
@@ -34,6 +36,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--k", type=int, default=None, help="eigenmodes of --method spectral")
     p.add_argument("--no-cache", action="store_true", help="do not read or write the basis cache")
     p.add_argument("--out", help="write u: .npy, .csv or .ply")
+    add_curve_flags(p, "heat u")
     add_json_flag(p)
     p.set_defaults(func=run, laplacian="cotan", area=MASS_AREA)
 
@@ -41,6 +44,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     t = check_time(args.t, "--t")
     out = output(args.out, args.mesh, OUT_SUFFIXES, "--out")
+    curves = curves_path(args)
     if args.method == "spectral" and args.k is None:
         raise MeshError("--method spectral needs --k (the number of eigenmodes)", "--k")
     if args.steps < 1:
@@ -77,6 +81,7 @@ def run(args: argparse.Namespace) -> int:
             save_mesh(out, V, F, scalars=u, overwrite_inputs=(args.mesh,))
         else:
             save_scalars(out, u, overwrite_inputs=(args.mesh,))
+    write_curves(args, curves, V, F, u, result)
     result["out"] = str(out) if out else None
     if args.json:
         emit_json(result)
@@ -89,6 +94,7 @@ def run(args: argparse.Namespace) -> int:
         print(
             f"  truncation bound exp(-λ_(k-1) t) = {result['truncation_bound']:.3g} at k = {args.k}"
         )
-    if out is not None:
-        print(f"wrote {out}")
+    for path in (out, curves):
+        if path is not None:
+            print(f"wrote {path}")
     return 0

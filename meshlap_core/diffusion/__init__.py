@@ -17,7 +17,7 @@ Modules
 ``isolines``
     Level curves of a per-vertex field (``igl.isolines``) and their OBJ polyline file.
 ``filters``
-    Spectral filters ``U h(Λ) Uᵀ M X`` and the smoothers' transfer functions.
+    Spectral filters ``U h(Λ) Uᵀ M X``, the smoothers' transfer functions and a drawn one.
 ``hks``
     The heat kernel signature (Sun et al. 2009).
 """
@@ -25,6 +25,7 @@ Modules
 from .filters import (
     SpectralFilter,
     band_gain,
+    curve_gain,
     low_pass,
     measured_amplification,
     smoother_transfer,
@@ -49,6 +50,7 @@ __all__ = [
     "band_gain",
     "boundary_vertices",
     "check_sources",
+    "curve_gain",
     "exact_distance",
     "heat_kernel_column",
     "heat_kernel_signature",

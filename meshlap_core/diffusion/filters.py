@@ -45,6 +45,33 @@ def band_gain(eigenvalues: FloatArray, lo: int, hi: int, gain: float) -> FloatAr
     return h
 
 
+def curve_gain(eigenvalues: FloatArray, knots: Any) -> FloatArray:
+    """A drawn transfer function: ``h(λ)`` linear between control points ``(λ_j, h_j)`` and
+    constant beyond the first and the last (``np.interp``).
+
+    Parameters
+    ----------
+    eigenvalues : (k,) float
+    knots : (p,2) float
+        Control points, ``p ≥ 2``, ``λ_j`` non-decreasing, all finite.
+
+    Returns
+    -------
+    h : (k,) float
+
+    Raises
+    ------
+    MeshError
+        Fewer than two points, a non-finite value or ``λ_j`` out of order.
+    """
+    P = np.asarray(knots, dtype=np.float64)
+    if P.ndim != 2 or P.shape[1] != 2 or len(P) < 2:
+        raise MeshError(f"needs two or more (lambda, h) points, got shape {P.shape}", "curve")
+    if not np.all(np.isfinite(P)) or np.any(np.diff(P[:, 0]) < 0):
+        raise MeshError("the points must be finite, lambda non-decreasing", "curve")
+    return np.interp(np.asarray(eigenvalues, dtype=np.float64), P[:, 0], P[:, 1])
+
+
 def transfer(
     kind: FilterKind,
     eigenvalues: FloatArray,
@@ -140,6 +167,26 @@ class SpectralFilter:
             raise MeshError(f"needs one gain per mode ({self.k}), got shape {h.shape}", "h")
         out = self._filtered(h)
         return out + self.residual if residual else out
+
+    def pieces(self, lam_knots: Any) -> FloatArray:
+        """The filtered geometry of each hat of a drawn curve with control points at
+        ``lam_knots (p,)``: ``G_j = U diag(b_j(Λ)) C``, ``b_j`` the piecewise-linear hat that is 1
+        at ``λ_j`` and 0 at the other points (``np.interp``'s, constant beyond the ends), so
+        the curve through gains ``y`` filters to ``Σ_j y_j G_j`` (:func:`curve_gain` is linear
+        in ``y``): a drag of a gain is ``p`` axpys of ``(n,c)``, not a product over ``U``.
+
+        Returns
+        -------
+        G : (p, n, c) float
+        """
+        xs = np.asarray(lam_knots, dtype=np.float64)
+        curve_gain(self.eigenvalues, np.column_stack([xs, np.zeros_like(xs)]))  # checks them
+        eye = np.eye(len(xs))
+        B = np.stack([np.interp(self.eigenvalues, xs, e) for e in eye])  # (p, k)
+        W = B[:, :, None] * self.coefficients[None]  # (p, k, c): each hat's coefficients
+        p, k, c = W.shape
+        G = self.U @ W.transpose(1, 0, 2).reshape(k, p * c)  # one pass over U: (n, p·c)
+        return np.ascontiguousarray(G.reshape(len(G), p, c).transpose(1, 0, 2))
 
     def _filtered(self, h: FloatArray) -> FloatArray:
         """``U diag(h) C``, from the last result when only a few gains changed."""

@@ -6,21 +6,24 @@ The heat method (Crane, Weischedel & Wardetzky, "Geodesics in heat", ACM TOG 201
 1. heat for a short time ``t = m·h²`` (``h`` the mean edge length, ``m`` default 1) by one
    backward Euler step ``(M + tK) u = δ_γ`` (``δ_γ`` one at each source);
 2. the unit field ``X = −∇u / |∇u|`` per face (``∇`` the piecewise-linear gradient,
-   ``igl.grad``);
+   ``igl.grad``, here per face: :func:`face_gradients`);
 3. the Poisson problem ``Δφ = ∇·X``, in weak form ``K φ = Gᵀ A X`` (``G`` the gradient,
    ``A`` the face areas; ``K = Gᵀ A G``), one vertex pinned per connected component;
 4. ``d = φ − mean(φ[γ])`` in each component holding a source.
 
-Both matrices are factorized once (:class:`HeatGeodesic`); a new source costs two or three
-triangular solves and two sparse products. The heat decays like ``exp(−d/√t)``, so beyond
-about ``700 √t`` from the sources it underflows to 0 and has no direction (1.3 % of the 692k
-armadillo with ``t = h²``): those faces take the direction of the heat of a longer time,
-``t·100ʲ`` (``j = 1 … 4``, each factorized when first needed). Measured on the 692k scan
-(one ``igl.upsample`` of the 173k ``armadillo_loop``, whose vertices it keeps): our distance
-there differs from ours on the 173k mesh by 0.4 % on average (1.0 % at most), potpourri3d's
-from its own 173k answer by 7.4 % (36 % at most). On a mesh with boundary the heat step takes the
-paper's boundary condition (``"neumann"``, ``"dirichlet"`` or their ``"average"``, sec.
-3.2.4). Vertices in components without a source get ``inf`` (no path reaches them).
+The matrices are factorized once (:class:`HeatGeodesic`); a new source costs two or three pairs
+of triangular solves and a few vectorized products per face (median 1.3 s at 692k vertices
+against ``igl.heat_geodesics_solve``'s 1.25 s side by side at load 7, of which the three solves
+~0.85 s; ``benchmarks/bench_diffusion.py``). The heat decays like ``exp(−d/√t)``, so beyond
+about ``575 √t`` from the sources it underflows (below 1e-250 of its peak: 1.3 % to 23 % of the
+692k armadillo with ``t = h²``, by source): those faces take the direction of the heat of a
+longer time, ``t·100ʲ`` (``j = 1 … 4``; the levels the mesh's size calls for factorized with the
+others, any other when first needed). Measured on the 692k scan (one ``igl.upsample`` of the
+173k ``armadillo_loop``, whose vertices it keeps): our distance there differs from ours on the
+173k mesh by 0.4 % on average (1.0 % at most), potpourri3d's from its own 173k answer by 7.4 %
+(36 % at most). On a mesh with boundary the heat step takes the paper's boundary condition
+(``"neumann"``, ``"dirichlet"`` or their ``"average"``, sec. 3.2.4). Vertices in components
+without a source get ``inf`` (no path reaches them).
 
 :func:`exact_distance` is the exact polyhedral distance of Mitchell, Mount & Papadimitriou
 (``igl.exact_geodesic``), run per component (libigl answers 0 across components).
@@ -56,6 +59,9 @@ _UNDERFLOW = 1e-250
 """A face whose largest heat is below this times the largest heat anywhere has underflowed."""
 _FAR_LEVELS = 4
 """Longer heat times tried where the heat underflowed: t·100 … t·100⁴ (reach ×10 each)."""
+_REACH = float(-np.log(_UNDERFLOW))
+"""The heat of time ``t`` falls below :data:`_UNDERFLOW` of its peak about this many ``√t``
+from the sources (it decays like ``exp(−d/√t)``)."""
 
 
 def edge_counts(F: IntArray, n: int) -> sp.csr_matrix:
@@ -89,6 +95,51 @@ def boundary_vertices(F: IntArray, n: int) -> IntArray:
     rows = np.repeat(np.arange(n), np.diff(count.indptr))
     once = count.data == 1
     return np.unique(np.concatenate([rows[once], count.indices[once]])).astype(np.int64)
+
+
+def face_gradients(V: FloatArray, F: IntArray) -> tuple[FloatArray, FloatArray]:
+    """The gradient of each corner's hat function on each face, and the face areas.
+
+    On the face ``(p₀, p₁, p₂)`` with unit normal ``n`` and area ``A``,
+    ``∇φ_i = n × (p_k − p_j) / (2A)`` for ``(i, j, k)`` cyclic: the rows of ``igl.grad``,
+    stored per corner, so ``∇u = Σ_i u_i ∇φ_i`` is three products (no sparse matrix).
+
+    Parameters
+    ----------
+    V : (n,3) float
+    F : (m,3) int
+
+    Returns
+    -------
+    hat : (3, 3, m) float
+        ``hat[i, :, f]`` the gradient of corner ``i``'s hat on face ``f`` (0 on a face of
+        zero area).
+    area : (m,) float
+    """
+    P = [V[F[:, i]] for i in range(3)]
+    N = np.cross(P[1] - P[0], P[2] - P[0])
+    double = np.linalg.norm(N, axis=1)
+    ok = double > 0
+    inv = np.divide(1.0, double, out=np.zeros_like(double), where=ok)
+    unit = N * inv[:, None]
+    hat = np.empty((3, 3, len(F)))
+    for i in range(3):
+        j, k = (i + 1) % 3, (i + 2) % 3
+        hat[i] = (np.cross(unit, P[k] - P[j]) * inv[:, None]).T
+    return hat, 0.5 * double
+
+
+def far_levels(V: FloatArray, t: float) -> int:
+    """How many longer heat times (``t·100ʲ``) the farthest faces of the mesh will need: the
+    smallest ``j`` whose reach ``575·10ʲ·√t`` (:data:`_REACH`) covers twice the bounding box's
+    diagonal (a surface path is longer than the chord), at most :data:`_FAR_LEVELS`."""
+    if len(V) == 0 or t <= 0:
+        return 0
+    span = 2.0 * float(np.linalg.norm(np.ptp(V, axis=0)))
+    reach = _REACH * np.sqrt(t)
+    if span <= reach:
+        return 0
+    return int(min(np.ceil(np.log10(span / reach)), _FAR_LEVELS))
 
 
 def check_time_factor(m: float, name: str = "m") -> float:
@@ -168,9 +219,9 @@ class HeatGeodesic:
                 sub = A[self._interior][:, self._interior]
                 self._heat_dirichlet = SPDSolver(sub, backend)
         self._corners = [np.ascontiguousarray(self.F[:, i]) for i in range(3)]
-        self._grad = igl.grad(self.V, self.F).tocsr()  # (3m, n): x rows, then y, then z
-        self._div = self._grad.T.tocsr()  # Gᵀ, stored for the divergence
-        self._area3 = np.tile(0.5 * igl.doublearea(self.V, self.F).ravel(), 3)
+        # ∇ of each corner's hat function per face (3 corners, 3 coordinates, m), and the face
+        # areas: ∇u and the divergence Gᵀ A X from them (half igl.grad's product time)
+        self._hat, self._area = face_gradients(self.V, self.F)
         self.n_components, self.labels = components(K)
         self._K = K
         self._face_label = self.labels[self.F[:, 0]] if len(self.F) else np.zeros(0, np.int64)
@@ -182,6 +233,10 @@ class HeatGeodesic:
         self._free = np.flatnonzero(free)
         poisson = K[self._free][:, self._free].tocsr()
         self._poisson = SPDSolver(poisson, backend) if len(self._free) else None
+        # the longer times the sources' farthest faces will need, factorized now: a click then
+        # only back-substitutes (the 692k scan needs t·100; an unforeseen one is built lazily)
+        for level in range(1, far_levels(self.V, self.t) + 1):
+            self._far_solver(level)
 
     def heat(self, sources: IntArray) -> FloatArray:
         """The heat step ``u`` (before normalization) for checked ``sources``."""
@@ -197,35 +252,57 @@ class HeatGeodesic:
             return u
         return ud if self.rule == "dirichlet" else 0.5 * (u + ud)
 
-    def _directions(self, u: FloatArray) -> tuple[FloatArray, np.ndarray, np.ndarray]:
+    def _directions(
+        self, u: FloatArray, faces: IntArray | None = None
+    ) -> tuple[FloatArray, np.ndarray, np.ndarray]:
         """``X = −∇u/|∇u|`` per face ``(3,m)`` (0 where a gradient at the round-off of the
         face's own heat has no direction: a face at constant heat, e.g. opposite the source on
         a tetrahedron), where it is trusted ``(m,)``, and where the heat underflowed ``(m,)``
-        (below :data:`_UNDERFLOW` of the largest: denormal or 0, its gradient meaningless)."""
-        g = (self._grad @ u).reshape(3, -1)
-        # |g| scaled by its largest component: squaring a gradient of 1e-161 would underflow
-        big = np.abs(g).max(axis=0)
-        unit = np.divide(g, big, out=np.zeros_like(g), where=big > 0)
-        norm = big * np.sqrt(np.sum(unit * unit, axis=0))
-        a = np.abs(u)
-        c0, c1, c2 = self._corners
-        noise = (_ROUNDOFF / self.h) * np.maximum(np.maximum(a[c0], a[c1]), a[c2])
-        known = (norm > noise) & (norm > 0)
+        (below :data:`_UNDERFLOW` of the largest: denormal or 0, its gradient meaningless).
+        With ``faces``, on those faces only (``(3, len(faces))``, ...)."""
+        corners = self._corners if faces is None else [c[faces] for c in self._corners]
+        hat = self._hat if faces is None else self._hat[:, :, faces]
+        uc = [u[c] for c in corners]  # the heat at each corner, (m,) each
+        g = uc[0] * hat[0]  # ∇u = Σ_i u_i ∇φ_i
+        g += uc[1] * hat[1]
+        g += uc[2] * hat[2]
+        top = np.abs(uc[0])  # the face's largest heat
+        np.maximum(top, np.abs(uc[1]), out=top)
+        np.maximum(top, np.abs(uc[2]), out=top)
+        # ∇u relative to the face's own heat: no underflow when squared (a gradient of 1e-161
+        # would), and the round-off test is one comparison
+        g /= np.where(top > 0, top, 1.0)
+        norm = np.sqrt(np.einsum("kf,kf->f", g, g))
+        known = norm > _ROUNDOFF / self.h
         # a face whose heat underflowed (not one at constant heat by symmetry) waits for a
         # longer time's direction
-        top = np.maximum(np.maximum(a[c0], a[c1]), a[c2])
-        lost = top <= _UNDERFLOW * float(a.max(initial=0.0))
-        return np.divide(-g, norm, out=np.zeros_like(g), where=known), known & ~lost, lost
+        peak = max(float(u.max(initial=0.0)), -float(u.min(initial=0.0)))
+        lost = top <= _UNDERFLOW * peak
+        g *= np.where(known, -1.0 / np.where(known, norm, 1.0), 0.0)
+        return g, known & ~lost, lost
 
-    def _far_heat(self, level: int, sources: IntArray) -> FloatArray:
-        """The Neumann heat at ``t·100^level`` from the sources (its factorization cached)."""
+    def _far_solver(self, level: int) -> SPDSolver:
+        """The Neumann heat step's factorization at ``t·100^level`` (built once)."""
         solver = self._far.get(level)
         if solver is None:
             A = (sp.diags(self.mass) + (self.t * 100.0**level) * self._K).tocsr()
             solver = self._far[level] = SPDSolver(A, self._backend)
+        return solver
+
+    def _far_heat(self, level: int, sources: IntArray) -> FloatArray:
+        """The Neumann heat at ``t·100^level`` from the sources."""
         delta = np.zeros(len(self.V))
         delta[sources] = 1.0
-        return solver.solve(delta)
+        return self._far_solver(level).solve(delta)
+
+    def _divergence(self, X: FloatArray) -> FloatArray:
+        """``Gᵀ A X`` ``(n,)``: each face's area times ``⟨∇φ_i, X⟩`` summed at its corners
+        ``i`` (the weak divergence of the unit field ``X (3,m)``)."""
+        n = len(self.V)
+        b = np.zeros(n)
+        for corner, hat in zip(self._corners, self._hat, strict=True):
+            b += np.bincount(corner, self._area * np.einsum("kf,kf->f", hat, X), minlength=n)
+        return b
 
     def distance(self, sources: int | IntArray) -> FloatArray:
         """Approximate geodesic distance to the nearest source.
@@ -245,19 +322,19 @@ class HeatGeodesic:
         src = check_sources(sources, n)
         X, known, lost = self._directions(self.heat(src))
         # far from the sources the heat of t = m·h² underflows to 0 (it decays like
-        # exp(−d/√t): beyond about 700 √t): those faces take the direction of the heat of a
-        # longer time, t·100, t·100², ... (each factorized once, when first needed)
+        # exp(−d/√t): beyond about 575 √t): those faces take the direction of the heat of a
+        # longer time, t·100, t·100², ... (factorized once, with the precomputation when the
+        # mesh's size calls for them), on those faces only
         wanted = np.bincount(self.labels[src], minlength=self.n_components)[self._face_label] > 0
         redo = wanted & (lost | ~known) if np.any(wanted & lost) else np.zeros_like(lost)
         level = 0
         while np.any(redo) and level < _FAR_LEVELS:
             level += 1
-            X2, known2, _ = self._directions(self._far_heat(level, src))
-            fill = redo & known2
-            X[:, fill] = X2[:, fill]
-            redo &= ~fill
-        X = X.ravel()
-        b = self._div @ (self._area3 * X)
+            faces = np.flatnonzero(redo)
+            X2, known2, _ = self._directions(self._far_heat(level, src), faces)
+            X[:, faces[known2]] = X2[:, known2]
+            redo[faces[known2]] = False
+        b = self._divergence(X)
         phi = np.zeros(n)
         if self._poisson is not None:
             phi[self._free] = self._poisson.solve(b[self._free])
