@@ -51,6 +51,7 @@ class SmoothingState:
     version: int = 0  # bumped when the stepper is rebuilt (connectivity may need re-upload)
     lam_steps: list[list[Any]] = field(default_factory=list)  # [[λ, steps], ...] of this run
     last_move: float | None = None  # RMS displacement of the last step *play* took
+    asked_at: int = 0  # iteration when a child-process stepper was last asked for a step
 
     def toggle_play(self) -> None:
         """*play* / *pause* (the button and ``space``)."""
@@ -64,6 +65,9 @@ class SmoothingState:
         that step stays on screen and the run counts as diverged (``smoother.diverged``: a
         smaller ``λ`` goes on from there, as after any divergence).
 
+        With a stepper in a child process (:mod:`meshlap_app.smoother_process`) the step is
+        only asked for here (unless one is on its way); :meth:`poll` takes it and checks it.
+
         Returns
         -------
         bool
@@ -72,10 +76,20 @@ class SmoothingState:
         s = self.smoother
         if s is None:
             return False
+        if self.asynchronous:
+            self.advance()
+            return self.playing
         before = np.array(s.V, dtype=float)
         if not self.step():
             return False
         move = float(np.sqrt(np.mean(np.sum((np.asarray(s.V) - before) ** 2, axis=1))))
+        return self._check_growth(move)
+
+    def _check_growth(self, move: float) -> bool:
+        """*play*'s rule after a step that moved the vertices ``move`` (RMS): go on, or stop
+        beyond the stable λ when the move grew (see :meth:`play_step`)."""
+        s = self.smoother
+        assert s is not None
         stab = s.stability
         if stab.stable or self.last_move is None or move <= self.last_move:
             self.last_move = move
@@ -91,6 +105,60 @@ class SmoothingState:
             "(or use implicit) to go on, or press reset"
         )
         return False
+
+    @property
+    def asynchronous(self) -> bool:
+        """The stepper runs in a child process and takes steps asked for ahead
+        (:meth:`advance`, :meth:`poll`)."""
+        return bool(getattr(self.smoother, "asynchronous", False))
+
+    def advance(self) -> None:
+        """One step from the window (the *step* button, ``right``, *play*): asked for from a
+        child-process stepper (taken by :meth:`poll`, the window keeps drawing meanwhile),
+        else done at once (:meth:`step`)."""
+        s = self.smoother
+        if s is None:
+            return
+        if not self.asynchronous:
+            self.step()
+        elif not s.diverged:
+            self.asked_at = s.iteration
+            try:
+                s.request_step()
+            except MeshError as exc:
+                self.error, self.playing = str(exc), False
+
+    def poll(self) -> bool:
+        """Take the step a child-process stepper finished, if any (never waits): count it,
+        stop on divergence, and apply *play*'s rule beyond the stable λ. True when the
+        positions changed."""
+        s = self.smoother
+        if s is None or not self.asynchronous:
+            return False
+        try:
+            arrived = s.poll()
+        except MeshError as exc:
+            self.error, self.playing = str(exc), False
+            return False
+        if not arrived:
+            return False
+        stepped = s.iteration > self.asked_at
+        self.asked_at = s.iteration
+        if stepped:
+            self._count_step(s.lam)
+        if s.diverged:
+            self.playing = False
+            self.error = f"{s.divergence_message()}; press reset"
+        elif stepped and self.playing:
+            move = s.history[-1].get("step_rms", 0.0) if s.history else 0.0
+            self._check_growth(float(move))
+        return stepped
+
+    def drop(self) -> None:
+        """Forget the stepper (a new mesh); a child process's ends."""
+        old, self.smoother, self.playing = self.smoother, None, False
+        if hasattr(old, "close"):
+            old.close()
 
     def rebuild(self, V: FloatArray, F: IntArray) -> bool:
         """Build the stepper for the current options from the clean mesh ``V`` (+ noise).
@@ -143,8 +211,11 @@ class SmoothingState:
         return smoother
 
     def adopt(self, smoother: Smoother) -> None:
-        """Step ``smoother`` from now on (built by :meth:`build`, maybe in a job)."""
-        self.smoother = smoother
+        """Step ``smoother`` from now on (built by :meth:`build`, maybe in a job, maybe in a
+        child process); the one it replaces is closed (its child process ends)."""
+        old, self.smoother = self.smoother, smoother
+        if old is not smoother and hasattr(old, "close"):
+            old.close()
         self.error = ""
         self.version += 1
         self.lam_steps = []
