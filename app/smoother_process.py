@@ -113,8 +113,9 @@ def _serve(
     normals: bool,
 ) -> None:
     """Body of the child: build the stepper (reporting each phase), then answer commands
-    (``step``, ``reset``, ``set_lam``, ``diverge``, ``close``) until ``close`` or the pipe ends;
-    after each one the positions (and normals) are in the shared block and a snapshot is sent."""
+    (``step`` with a count, ``reset``, ``set_lam``, ``diverge``, ``close``) until ``close`` or
+    the pipe ends; after each one the positions (and normals) are in the shared block and a
+    snapshot is sent."""
     from .state.smoothing import SmoothingState
 
     shm = shared_memory.SharedMemory(name=name)  # the fork server's children share the
@@ -133,8 +134,11 @@ def _serve(
             if cmd == "close":
                 return
             try:
-                if cmd == "step":
-                    sm.step()
+                if cmd == "step":  # args: how many (stops at a divergence)
+                    for _ in range(args[0] if args else 1):
+                        sm.step()
+                        if sm.diverged:
+                            break
                 elif cmd == "reset":
                     sm.reset()
                 elif cmd == "set_lam":
@@ -367,11 +371,12 @@ class RemoteSmoother:
         """A step was asked for and its answer has not been read."""
         return self._pending
 
-    def request_step(self) -> bool:
-        """Ask for one step and return at once (False: one is already on its way)."""
+    def request_step(self, count: int = 1) -> bool:
+        """Ask for ``count`` steps (shown together) and return at once (False: a request is
+        already on its way)."""
         if self._pending:
             return False
-        self._send(("step",))
+        self._send(("step", max(1, int(count))))
         self._pending = True
         return True
 

@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import time
 from collections.abc import Iterator
 from typing import Any
 
@@ -44,6 +45,7 @@ class SmoothingPanel(Panel):
         super().__init__(name, state)
         self.state: SmoothingState = state
         self.recorder = Recorder(f"{name}.gif")
+        self._shown_at: float | None = None  # when push last uploaded new steps
 
     def on_new_mesh(self, host: Host) -> None:
         self.state.drop()  # a stepper in a child process: the process ends
@@ -133,6 +135,7 @@ class SmoothingPanel(Panel):
             mesh = ps.get_surface_mesh(SMOOTHED)
             P = d.points(st.V) + self._shift(host)
             N = getattr(st.smoother, "normals", None)
+            self._shown_at = time.perf_counter()
             if N is None:
                 mesh.update_vertex_positions(P)
             else:  # the child computed the normals: two buffers, no geometry re-derived here
@@ -291,6 +294,8 @@ class SmoothingPanel(Panel):
         if ui.button("reset", "back to the (noisy) input, iteration 0"):
             st.reset()
             self.push(host, force=True)
+        if self._shown_at is not None:  # the frame that showed new steps has been drawn
+            st.show_s, self._shown_at = time.perf_counter() - self._shown_at, None
         st.poll()  # a step a child process finished (never waits)
         if st.playing:
             st.play_step()

@@ -20,6 +20,9 @@ from meshlap_core.types import FloatArray, IntArray
 from .animation import Animation, Option
 from .checks import Schema, integer, number, one_of
 
+MAX_BATCH = 8
+"""Most steps *play* asks a child-process stepper for at once
+(:meth:`SmoothingState.play_batch`)."""
 MAX_FRAMES_ITERS = 5000
 """Most smoothing iterations an animation renders (one frame each), and the most a session may
 hold (``smoothing.iterations``): opening a session replays every step before the first frame,
@@ -52,6 +55,7 @@ class SmoothingState:
     lam_steps: list[list[Any]] = field(default_factory=list)  # [[λ, steps], ...] of this run
     last_move: float | None = None  # RMS displacement of the last step *play* took
     asked_at: int = 0  # iteration when a child-process stepper was last asked for a step
+    show_s: float = 0.0  # how long the window's last frame showing a new step took
 
     def toggle_play(self) -> None:
         """*play* / *pause* (the button and ``space``)."""
@@ -77,7 +81,7 @@ class SmoothingState:
         if s is None:
             return False
         if self.asynchronous:
-            self.advance()
+            self.advance(self.play_batch())
             return self.playing
         before = np.array(s.V, dtype=float)
         if not self.step():
@@ -112,10 +116,22 @@ class SmoothingState:
         (:meth:`advance`, :meth:`poll`)."""
         return bool(getattr(self.smoother, "asynchronous", False))
 
-    def advance(self) -> None:
-        """One step from the window (the *step* button, ``right``, *play*): asked for from a
-        child-process stepper (taken by :meth:`poll`, the window keeps drawing meanwhile),
-        else done at once (:meth:`step`)."""
+    def play_batch(self) -> int:
+        """Steps *play* asks a child-process stepper for at once: as many as it solves while
+        the window draws the last ones (:attr:`show_s` over the last step's own time, at most
+        :data:`MAX_BATCH`), so neither side waits for the other on a big mesh; 1 when drawing
+        is quicker than a step."""
+        s = self.smoother
+        last = s.history[-1] if s is not None and s.history else {}
+        step_s = float(last.get("time_ms") or 0.0) / 1e3
+        if step_s <= 0.0 or self.show_s <= step_s:
+            return 1
+        return int(min(MAX_BATCH, round(self.show_s / step_s)))
+
+    def advance(self, count: int = 1) -> None:
+        """``count`` steps from the window (the *step* button, ``right``, *play*): asked for
+        from a child-process stepper (taken by :meth:`poll`, the window keeps drawing
+        meanwhile), else one done at once (:meth:`step`)."""
         s = self.smoother
         if s is None:
             return
@@ -124,7 +140,7 @@ class SmoothingState:
         elif not s.diverged:
             self.asked_at = s.iteration
             try:
-                s.request_step()
+                s.request_step(count)
             except MeshError as exc:
                 self.error, self.playing = str(exc), False
 
@@ -143,9 +159,9 @@ class SmoothingState:
         if not arrived:
             return False
         stepped = s.iteration > self.asked_at
-        self.asked_at = s.iteration
-        if stepped:
+        for _ in range(s.iteration - self.asked_at):
             self._count_step(s.lam)
+        self.asked_at = s.iteration
         if s.diverged:
             self.playing = False
             self.error = f"{s.divergence_message()}; press reset"
