@@ -107,8 +107,7 @@ def _snapshot(sm: Any) -> dict[str, Any]:
 def _serve(
     conn: Any,
     name: str,
-    V: FloatArray,
-    F: IntArray,
+    inputs: tuple[str, int, int],
     options: tuple[str, str, float, float, int],
     normals: bool,
 ) -> None:
@@ -118,6 +117,7 @@ def _serve(
     snapshot is sent."""
     from .state.smoothing import SmoothingState
 
+    V, F = _read_inputs(*inputs)
     shm = shared_memory.SharedMemory(name=name)  # the fork server's children share the
     # parent's resource tracker: only the parent's unlink unregisters the block
     cur, start, nrm = _blocks(shm.buf, len(V))
@@ -156,6 +156,34 @@ def _serve(
         del cur, start, nrm
         shm.close()
         conn.close()
+
+
+def _write_inputs(V: FloatArray, F: IntArray) -> shared_memory.SharedMemory:
+    """``V`` and ``F`` in a new shared block (read once by the child: pickling 50 MB to the
+    fork server held the GIL, and so the window, for a second on a loaded machine)."""
+    shm = shared_memory.SharedMemory(create=True, size=max(1, 24 * len(V) + 24 * len(F)))
+    np.ndarray(V.shape, np.float64, shm.buf)[...] = V
+    np.ndarray(F.shape, np.int64, shm.buf, offset=24 * len(V))[...] = F
+    return shm
+
+
+def _read_inputs(name: str, n: int, m: int) -> tuple[FloatArray, IntArray]:
+    """Copies of ``V (n,3)`` and ``F (m,3)`` from the block :func:`_write_inputs` made."""
+    shm = shared_memory.SharedMemory(name=name)
+    try:
+        V = np.array(np.ndarray((n, 3), np.float64, shm.buf))
+        F = np.array(np.ndarray((m, 3), np.int64, shm.buf, offset=24 * n))
+    finally:
+        shm.close()
+    return V, F
+
+
+def _free(shm: shared_memory.SharedMemory) -> None:
+    shm.close()
+    try:
+        shm.unlink()
+    except FileNotFoundError:
+        pass
 
 
 def _send(conn: Any, message: tuple[Any, ...]) -> None:
@@ -261,16 +289,18 @@ class RemoteSmoother:
         V = np.asarray(V, dtype=np.float64)
         F = np.asarray(F, dtype=np.int64)
         shm = shared_memory.SharedMemory(create=True, size=_block_bytes(len(V)))
+        inputs = _write_inputs(V, F)
         try:
             ctx = _context()
             here, there = ctx.Pipe(duplex=True)
+            where = (inputs.name, len(V), len(F))
             proc = ctx.Process(
-                target=_serve, args=(there, shm.name, V, F, options, normals), daemon=True
+                target=_serve, args=(there, shm.name, where, options, normals), daemon=True
             )
             proc.start()
         except BaseException:
-            shm.close()
-            shm.unlink()
+            _free(shm)
+            _free(inputs)
             raise
         there.close()
         proxy = cls(proc, here, shm, V, F, options, normals)
@@ -279,6 +309,8 @@ class RemoteSmoother:
         except BaseException:
             proxy.close()
             raise
+        finally:
+            _free(inputs)  # read by the child as it started
         proxy.V0 = np.array(proxy._start)
         proxy.V0.flags.writeable = False
         return proxy

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from meshlap_app.jobs import Cancelled, Jobs, Reporter
 from meshlap_app.smoother_process import RemoteSmoother, build, vertex_normals
-from meshlap_app.state.smoothing import SmoothingState
+from meshlap_app.state.smoothing import MAX_BATCH, SmoothingState
 
 from meshlap_core.errors import MeshError
 from meshlap_core.primitives import bumpy_sphere
@@ -149,6 +149,31 @@ def test_a_failed_build_says_why_and_ends_the_child(mesh):
         RemoteSmoother.start(V, F, ("implicit", "bogus", 0.01, 0.0, 0), reporter())
 
 
+def test_steps_asked_for_together_count_each_step(mesh):
+    """*play* on a big mesh asks for several steps at once (as many as the stepper solves
+    while the window draws): each is counted at its λ, the positions are the same."""
+    V, F = mesh
+    st = SmoothingState(method="implicit", laplacian="cotan", lam=0.01)
+    st.adopt(RemoteSmoother.start(V, F, st.options(), reporter()))
+    try:
+        local = SmoothingState.build(V, F, st.options())
+        st.show_s = 1e9  # drawing far slower than a step
+        assert st.play_batch() == 1  # the step's own time is not known before the first one
+        st.advance(st.play_batch())
+        wait_for(st.poll)
+        st.advance(st.play_batch())  # now the largest batch
+        wait_for(st.poll)
+        for _ in range(1 + MAX_BATCH):
+            local.step()
+        assert st.smoother.iteration == 1 + MAX_BATCH
+        assert st.lam_steps == [[0.01, 1 + MAX_BATCH]]
+        assert np.abs(st.V - local.V).max() <= 1e-10
+        st.show_s = 0.0  # drawing quicker than a step: one at a time
+        assert st.play_batch() == 1
+    finally:
+        st.drop()
+
+
 def test_a_dropped_stepper_ends_its_process(mesh):
     V, F = mesh
     remote = RemoteSmoother.start(V, F, OPTIONS, reporter())
@@ -215,5 +240,10 @@ def test_the_panel_steps_a_child_process_stepper(viewer):
         shown = host_values(pos, len(st.V))
         shift = shown[0] - d.points(st.V[:1])[0]
         assert np.abs(shown - (d.points(local.V) + shift)).max() <= 1e-5
+        from meshlap_app.scene import SMOOTH_INPUT
+
+        normals = ps.get_surface_mesh(SMOOTH_INPUT).get_buffer("vertexNormals")
+        expected = vertex_normals(d.points(st.V_start), st.F)  # what polyscope would derive
+        assert np.abs(host_values(normals, len(st.V)) - expected).max() <= 1e-5
     finally:
         panel.on_new_mesh(viewer)

@@ -129,6 +129,12 @@ class SmoothingPanel(Panel):
                 SMOOTHED, d.points(st.V) + self._shift(host), st.F, smooth_shade=True
             )
             sm.set_color(SMOOTHED_COLOR)
+            N = getattr(st.smoother, "normals", None)
+            if N is not None:  # polyscope then skips deriving them at the first draw
+                N = N @ d.rotation.T.astype(np.float32)
+                sm.get_buffer("vertexNormals").update_data(N)
+                if st.smoother.iteration == 0:  # the input's own normals
+                    inp.get_buffer("vertexNormals").update_data(N)
             self.watch.changed("iteration", st.smoother.iteration)
             host.request_frame()  # a new copy: frame it
         elif self.watch.changed("iteration", st.smoother.iteration) or force:
