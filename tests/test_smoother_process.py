@@ -247,3 +247,30 @@ def test_the_panel_steps_a_child_process_stepper(viewer):
         assert np.abs(host_values(normals, len(st.V)) - expected).max() <= 1e-5
     finally:
         panel.on_new_mesh(viewer)
+
+
+def test_a_rebuild_moves_the_shown_copies_to_the_new_stepper(viewer):
+    """A new stepper of the same mesh (new noise) is shown by moving the two copies already
+    registered: the input shows the new noisy positions, the smoothed copy the new stepper's."""
+    import polyscope as ps
+    from meshlap_app.scene import SMOOTH_INPUT, SMOOTHED
+
+    panel = viewer.panels["smoothing"]
+    st = panel.state
+    viewer.set_panel("smoothing")
+    ps.frame_tick()
+    assert st.smoother is not None and st.noise_alpha == 0.0
+    panel.start_build(viewer, noise_alpha=0.01)
+    ps.frame_tick()
+    assert st.noise_alpha == 0.01
+    d = viewer.state.display
+    n = len(st.V)
+    shown_in = host_values(ps.get_surface_mesh(SMOOTH_INPUT).get_buffer("vertexPositions"), n)
+    assert np.abs(shown_in - d.points(st.V_start)).max() <= 1e-5
+    assert np.abs(st.V_start - viewer.state.mesh.V).max() > 1e-4  # the noise is there
+    st.step()
+    panel.push(viewer)
+    shown = host_values(ps.get_surface_mesh(SMOOTHED).get_buffer("vertexPositions"), n)
+    shift = shown[0] - d.points(st.V[:1])[0]
+    assert np.abs(shown - (d.points(st.V) + shift)).max() <= 1e-5
+    panel.on_new_mesh(viewer)

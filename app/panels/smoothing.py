@@ -120,21 +120,7 @@ class SmoothingPanel(Panel):
             return
         d = host.state.display
         if self.watch.changed("registered", st.version, id(st.smoother)):
-            # the input (with its noise) stays put; the smoothed copy moves beside it
-            inp = ps.register_surface_mesh(
-                SMOOTH_INPUT, d.points(st.V_start), st.F, smooth_shade=True
-            )
-            inp.set_color(INPUT_COLOR)
-            sm = ps.register_surface_mesh(
-                SMOOTHED, d.points(st.V) + self._shift(host), st.F, smooth_shade=True
-            )
-            sm.set_color(SMOOTHED_COLOR)
-            N = getattr(st.smoother, "normals", None)
-            if N is not None:  # polyscope then skips deriving them at the first draw
-                N = N @ d.rotation.T.astype(np.float32)
-                sm.get_buffer("vertexNormals").update_data(N)
-                if st.smoother.iteration == 0:  # the input's own normals
-                    inp.get_buffer("vertexNormals").update_data(N)
+            self._register(host)
             self.watch.changed("iteration", st.smoother.iteration)
             host.request_frame()  # a new copy: frame it
         elif self.watch.changed("iteration", st.smoother.iteration) or force:
@@ -146,6 +132,39 @@ class SmoothingPanel(Panel):
                 mesh.update_vertex_positions(P)
             else:  # the child computed the normals: two buffers, no geometry re-derived here
                 upload_positions(mesh, P, N @ d.rotation.T.astype(np.float32))
+
+    def _register(self, host: Host) -> None:
+        """Show a new stepper: the input (with its noise) stays put, the smoothed copy moves
+        beside it. The two structures of the previous stepper of this mesh (same faces) get
+        new positions instead of being registered again (0.5–1 s each at 692k vertices)."""
+        st, d = self.state, host.state.display
+        assert st.smoother is not None
+        P_in = d.points(st.V_start)
+        P = d.points(st.V) + self._shift(host)
+        N = getattr(st.smoother, "normals", None)
+        N = None if N is None else N @ d.rotation.T.astype(np.float32)
+        N_in = N if st.smoother.iteration == 0 else None  # V is V0: the input's normals
+        if all(
+            ps.has_surface_mesh(name)
+            and ps.get_surface_mesh(name).n_vertices() == len(P)
+            and ps.get_surface_mesh(name).n_faces() == len(st.F)
+            for name in (SMOOTH_INPUT, SMOOTHED)
+        ):
+            for name, points, normals in ((SMOOTH_INPUT, P_in, N_in), (SMOOTHED, P, N)):
+                mesh = ps.get_surface_mesh(name)
+                if normals is None:
+                    mesh.update_vertex_positions(points)
+                else:
+                    upload_positions(mesh, points, normals)
+            return
+        inp = ps.register_surface_mesh(SMOOTH_INPUT, P_in, st.F, smooth_shade=True)
+        inp.set_color(INPUT_COLOR)
+        sm = ps.register_surface_mesh(SMOOTHED, P, st.F, smooth_shade=True)
+        sm.set_color(SMOOTHED_COLOR)
+        if N is not None:  # polyscope then skips deriving them at the first draw
+            sm.get_buffer("vertexNormals").update_data(N)
+            if N_in is not None:
+                inp.get_buffer("vertexNormals").update_data(N_in)
 
     def points(self, host: Host, name: str) -> np.ndarray | None:
         """Display positions of a structure this panel registered (for camera framing)."""
