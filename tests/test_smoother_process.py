@@ -240,11 +240,10 @@ def test_the_panel_steps_a_child_process_stepper(viewer):
         shown = host_values(pos, len(st.V))
         shift = shown[0] - d.points(st.V[:1])[0]
         assert np.abs(shown - (d.points(local.V) + shift)).max() <= 1e-5
-        from meshlap_app.scene import SMOOTH_INPUT
-
-        normals = ps.get_surface_mesh(SMOOTH_INPUT).get_buffer("vertexNormals")
-        expected = vertex_normals(d.points(st.V_start), st.F)  # what polyscope would derive
+        normals = ps.get_surface_mesh(SMOOTHED).get_buffer("vertexNormals")
+        expected = vertex_normals(d.points(local.V), st.F)  # what polyscope would derive
         assert np.abs(host_values(normals, len(st.V)) - expected).max() <= 1e-5
+        assert not st.error and not any(viewer.state.errors.values()), viewer.state.errors
     finally:
         panel.on_new_mesh(viewer)
 
@@ -270,6 +269,7 @@ def test_a_rebuild_moves_the_shown_copies_to_the_new_stepper(viewer):
     assert np.abs(st.V_start - viewer.state.mesh.V).max() > 1e-4  # the noise is there
     st.step()
     panel.push(viewer)
+    assert not any(viewer.state.errors.values()), viewer.state.errors
     shown = host_values(ps.get_surface_mesh(SMOOTHED).get_buffer("vertexPositions"), n)
     shift = shown[0] - d.points(st.V[:1])[0]
     assert np.abs(shown - (d.points(st.V) + shift)).max() <= 1e-5

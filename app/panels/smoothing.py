@@ -160,11 +160,8 @@ class SmoothingPanel(Panel):
         inp = ps.register_surface_mesh(SMOOTH_INPUT, P_in, st.F, smooth_shade=True)
         inp.set_color(INPUT_COLOR)
         sm = ps.register_surface_mesh(SMOOTHED, P, st.F, smooth_shade=True)
-        sm.set_color(SMOOTHED_COLOR)
-        if N is not None:  # polyscope then skips deriving them at the first draw
-            sm.get_buffer("vertexNormals").update_data(N)
-            if N_in is not None:
-                inp.get_buffer("vertexNormals").update_data(N_in)
+        sm.set_color(SMOOTHED_COLOR)  # (their normals are derived at their first draw: a
+        # buffer that polyscope has not filled yet refuses data)
 
     def points(self, host: Host, name: str) -> np.ndarray | None:
         """Display positions of a structure this panel registered (for camera framing)."""
@@ -417,8 +414,12 @@ def upload_positions(mesh: Any, P: np.ndarray, N: np.ndarray) -> None:
     (:func:`meshlap_app.smoother_process.vertex_normals`, polyscope's own formula) written
     into the mesh's two vertex buffers: ``update_vertex_positions`` would re-derive face
     normals, areas and vertex normals on the UI thread (0.2–0.6 s at 692k vertices)."""
+    normals = mesh.get_buffer("vertexNormals")
+    if not normals.has_data():  # not drawn yet: polyscope fills it at the first draw
+        mesh.update_vertex_positions(P)
+        return
     mesh.get_buffer("vertexPositions").update_data(np.asarray(P, dtype=np.float64))
-    mesh.get_buffer("vertexNormals").update_data(np.asarray(N, dtype=np.float32))
+    normals.update_data(np.asarray(N, dtype=np.float32))
     ps.request_redraw()
 
 
