@@ -274,3 +274,23 @@ def test_a_rebuild_moves_the_shown_copies_to_the_new_stepper(viewer):
     shift = shown[0] - d.points(st.V[:1])[0]
     assert np.abs(shown - (d.points(st.V) + shift)).max() <= 1e-5
     panel.on_new_mesh(viewer)
+
+
+def test_without_child_processes_the_stepper_is_built_here(mesh, monkeypatch):
+    """Where no child process can start, the job builds the stepper in its own thread (the
+    pure in-process path): the same stepper."""
+    from meshlap_app import smoother_process
+
+    from meshlap_core.smoothing import Smoother
+
+    def refuse() -> None:
+        raise OSError("no processes here")
+
+    monkeypatch.setattr(smoother_process, "_context", refuse)
+    V, F = mesh
+    got = build(V, F, OPTIONS, reporter(), SmoothingState.build)
+    assert isinstance(got, Smoother)
+    got.step()
+    local = SmoothingState.build(V, F, OPTIONS)
+    local.step()
+    assert np.abs(got.V - local.V).max() <= 1e-10
