@@ -447,6 +447,10 @@ class RemoteSmoother:
         arrived, self._arrived = self._arrived, False
         return arrived
 
+    def finish(self) -> None:
+        """Wait for the steps on their way (:meth:`poll` then reports them)."""
+        self._drain()
+
     def _drain(self) -> None:
         """Wait for the step on its way (a synchronous call comes after it)."""
         if self._pending:

@@ -170,6 +170,12 @@ def test_steps_asked_for_together_count_each_step(mesh):
         assert np.abs(st.V - local.V).max() <= 1e-10
         st.show_s = 0.0  # drawing quicker than a step: one at a time
         assert st.play_batch() == 1
+        st.advance(2)
+        st.set_lam(0.02)  # the steps on their way count at the λ they were taken with
+        local.step()
+        local.step()
+        assert st.lam_steps == [[0.01, 3 + MAX_BATCH]] and st.smoother.lam == 0.02
+        assert np.abs(st.V - local.V).max() <= 1e-10
     finally:
         st.drop()
 

@@ -280,6 +280,9 @@ class SmoothingState:
             ``λ`` is not a finite number > 0 (the state keeps the previous ``λ``).
         """
         lam = check_lam(lam, "lambda")
+        if self.asynchronous:  # steps on their way were taken at the old λ: counted first
+            self.smoother.finish()  # type: ignore[union-attr]
+            self.poll()
         if self.smoother is not None:
             self.smoother.set_lam(lam)
         self.lam = lam
