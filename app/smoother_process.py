@@ -13,6 +13,9 @@ come back through one :class:`multiprocessing.shared_memory.SharedMemory` block:
 
     [ V current (n,3) float64 | V0, the noisy input (n,3) float64 | normals (n,3) float32 ]
 
+(the mesh itself reaches the child through a second, transient block, read once at its start).
+*play* may ask for several steps at once (:meth:`RemoteSmoother.request_step` with a count).
+
 Besides the synchronous calls (a session's replay, ``meshlap animate``), a step can be asked
 for and collected later (:meth:`RemoteSmoother.request_step`, :meth:`RemoteSmoother.poll`):
 the window asks, keeps drawing, and uploads the positions when they arrive. The child also
