@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import time
 from collections.abc import Iterator
 from typing import Any
 
@@ -12,7 +13,7 @@ import polyscope as ps
 from meshlap_core.errors import MeshError
 from meshlap_core.options import LAPLACIAN_KINDS, SMOOTHING_METHODS
 
-from .. import scene
+from .. import scene, smoother_process
 from ..record import Recorder, draw_record
 from ..scene import INPUT_COLOR, SMOOTH_INPUT, SMOOTHED, SMOOTHED_COLOR, front_view, side_offset
 from ..state.smoothing import (
@@ -44,10 +45,10 @@ class SmoothingPanel(Panel):
         super().__init__(name, state)
         self.state: SmoothingState = state
         self.recorder = Recorder(f"{name}.gif")
+        self._shown_at: float | None = None  # when push last uploaded new steps
 
     def on_new_mesh(self, host: Host) -> None:
-        self.state.smoother = None
-        self.state.playing = False
+        self.state.drop()  # a stepper in a child process: the process ends
         for name in (SMOOTHED, SMOOTH_INPUT):
             scene.remove_structure(name)
         self.watch.forget()
@@ -86,10 +87,21 @@ class SmoothingPanel(Panel):
                 raise MeshError(message)
             st.error, st.playing = message, False
 
-        host.state.jobs.start(
+        jobs = host.state.jobs
+        if jobs.processes and host.background:
+            # the window: the stepper lives in a child process (CHOLMOD holds the GIL while
+            # it factorizes, which froze the window for seconds from a thread)
+            def work(reporter: Any) -> Any:
+                return smoother_process.build(V, F, options, reporter, st.build)
+        else:
+
+            def work(reporter: Any) -> Any:
+                return st.build(V, F, options, reporter)
+
+        jobs.start(
             self.name,
             f"building the {options[0]} {options[1]} smoother",
-            lambda reporter: st.build(V, F, options, reporter),
+            work,
             apply,
             fail,
             background=host.background,
@@ -108,21 +120,48 @@ class SmoothingPanel(Panel):
             return
         d = host.state.display
         if self.watch.changed("registered", st.version, id(st.smoother)):
-            # the input (with its noise) stays put; the smoothed copy moves beside it
-            inp = ps.register_surface_mesh(
-                SMOOTH_INPUT, d.points(st.V_start), st.F, smooth_shade=True
-            )
-            inp.set_color(INPUT_COLOR)
-            sm = ps.register_surface_mesh(
-                SMOOTHED, d.points(st.V) + self._shift(host), st.F, smooth_shade=True
-            )
-            sm.set_color(SMOOTHED_COLOR)
+            self._register(host)
             self.watch.changed("iteration", st.smoother.iteration)
             host.request_frame()  # a new copy: frame it
         elif self.watch.changed("iteration", st.smoother.iteration) or force:
-            ps.get_surface_mesh(SMOOTHED).update_vertex_positions(
-                d.points(st.V) + self._shift(host)
-            )
+            mesh = ps.get_surface_mesh(SMOOTHED)
+            P = d.points(st.V) + self._shift(host)
+            N = getattr(st.smoother, "normals", None)
+            self._shown_at = time.perf_counter()
+            if N is None:
+                mesh.update_vertex_positions(P)
+            else:  # the child computed the normals: two buffers, no geometry re-derived here
+                upload_positions(mesh, P, N @ d.rotation.T.astype(np.float32))
+
+    def _register(self, host: Host) -> None:
+        """Show a new stepper: the input (with its noise) stays put, the smoothed copy moves
+        beside it. The two structures of the previous stepper of this mesh (same faces) get
+        new positions instead of being registered again (0.5–1 s each at 692k vertices)."""
+        st, d = self.state, host.state.display
+        assert st.smoother is not None
+        P_in = d.points(st.V_start)
+        P = d.points(st.V) + self._shift(host)
+        N = getattr(st.smoother, "normals", None)
+        N = None if N is None else N @ d.rotation.T.astype(np.float32)
+        N_in = N if st.smoother.iteration == 0 else None  # V is V0: the input's normals
+        if all(
+            ps.has_surface_mesh(name)
+            and ps.get_surface_mesh(name).n_vertices() == len(P)
+            and ps.get_surface_mesh(name).n_faces() == len(st.F)
+            for name in (SMOOTH_INPUT, SMOOTHED)
+        ):
+            for name, points, normals in ((SMOOTH_INPUT, P_in, N_in), (SMOOTHED, P, N)):
+                mesh = ps.get_surface_mesh(name)
+                if normals is None:
+                    mesh.update_vertex_positions(points)
+                else:
+                    upload_positions(mesh, points, normals)
+            return
+        inp = ps.register_surface_mesh(SMOOTH_INPUT, P_in, st.F, smooth_shade=True)
+        inp.set_color(INPUT_COLOR)
+        sm = ps.register_surface_mesh(SMOOTHED, P, st.F, smooth_shade=True)
+        sm.set_color(SMOOTHED_COLOR)  # (their normals are derived at their first draw: a
+        # buffer that polyscope has not filled yet refuses data)
 
     def points(self, host: Host, name: str) -> np.ndarray | None:
         """Display positions of a structure this panel registered (for camera framing)."""
@@ -156,7 +195,7 @@ class SmoothingPanel(Panel):
         if key == "space":
             st.toggle_play()
         elif key == "right":
-            st.step()
+            st.advance()
         elif key == "r":
             st.reset()
             self.push(host, force=True)
@@ -183,7 +222,7 @@ class SmoothingPanel(Panel):
         st = self.state
         st.method, st.laplacian = values["method"], values["laplacian"]
         st.lam, st.noise_alpha, st.seed = values["lam"], values["noise_alpha"], values["seed"]
-        st.smoother, st.playing = None, False
+        st.drop()
 
     def restore(self, host: Host, values: dict[str, Any], active: bool) -> None:
         """When the run had steps (or this view is shown), rebuild and replay them, each run of
@@ -265,7 +304,7 @@ class SmoothingPanel(Panel):
         if ch:
             self.start_build(host, seed=seed)
         if ui.button("step", "one iteration"):
-            st.step()
+            st.advance()
         ui.same_line()
         if ui.button(
             "pause" if st.playing else "play",
@@ -277,6 +316,9 @@ class SmoothingPanel(Panel):
         if ui.button("reset", "back to the (noisy) input, iteration 0"):
             st.reset()
             self.push(host, force=True)
+        if self._shown_at is not None:  # the frame that showed new steps has been drawn
+            st.show_s, self._shown_at = time.perf_counter() - self._shown_at, None
+        st.poll()  # a step a child process finished (never waits)
         if st.playing:
             st.play_step()
         self.push(host)
@@ -365,6 +407,20 @@ class SmoothingPanel(Panel):
                     raise MeshError(st.error or "the smoothing stopped", "--lam")
             self.push(host)
             yield caption(st, iters)
+
+
+def upload_positions(mesh: Any, P: np.ndarray, N: np.ndarray) -> None:
+    """New vertex positions ``P (n,3)`` with their smooth-shading normals ``N (n,3)``
+    (:func:`meshlap_app.smoother_process.vertex_normals`, polyscope's own formula) written
+    into the mesh's two vertex buffers: ``update_vertex_positions`` would re-derive face
+    normals, areas and vertex normals on the UI thread (0.2–0.6 s at 692k vertices)."""
+    normals = mesh.get_buffer("vertexNormals")
+    if not normals.has_data():  # not drawn yet: polyscope fills it at the first draw
+        mesh.update_vertex_positions(P)
+        return
+    mesh.get_buffer("vertexPositions").update_data(np.asarray(P, dtype=np.float64))
+    normals.update_data(np.asarray(N, dtype=np.float32))
+    ps.request_redraw()
 
 
 PANEL = SmoothingPanel

@@ -20,6 +20,9 @@ from meshlap_core.types import FloatArray, IntArray
 from .animation import Animation, Option
 from .checks import Schema, integer, number, one_of
 
+MAX_BATCH = 8
+"""Most steps *play* asks a child-process stepper for at once
+(:meth:`SmoothingState.play_batch`)."""
 MAX_FRAMES_ITERS = 5000
 """Most smoothing iterations an animation renders (one frame each), and the most a session may
 hold (``smoothing.iterations``): opening a session replays every step before the first frame,
@@ -51,6 +54,8 @@ class SmoothingState:
     version: int = 0  # bumped when the stepper is rebuilt (connectivity may need re-upload)
     lam_steps: list[list[Any]] = field(default_factory=list)  # [[λ, steps], ...] of this run
     last_move: float | None = None  # RMS displacement of the last step *play* took
+    asked_at: int = 0  # iteration when a child-process stepper was last asked for a step
+    show_s: float = 0.0  # how long the window's last frame showing a new step took
 
     def toggle_play(self) -> None:
         """*play* / *pause* (the button and ``space``)."""
@@ -64,6 +69,9 @@ class SmoothingState:
         that step stays on screen and the run counts as diverged (``smoother.diverged``: a
         smaller ``λ`` goes on from there, as after any divergence).
 
+        With a stepper in a child process (:mod:`meshlap_app.smoother_process`) the step is
+        only asked for here (unless one is on its way); :meth:`poll` takes it and checks it.
+
         Returns
         -------
         bool
@@ -72,10 +80,20 @@ class SmoothingState:
         s = self.smoother
         if s is None:
             return False
+        if self.asynchronous:
+            self.advance(self.play_batch())
+            return self.playing
         before = np.array(s.V, dtype=float)
         if not self.step():
             return False
         move = float(np.sqrt(np.mean(np.sum((np.asarray(s.V) - before) ** 2, axis=1))))
+        return self._check_growth(move)
+
+    def _check_growth(self, move: float) -> bool:
+        """*play*'s rule after a step that moved the vertices ``move`` (RMS): go on, or stop
+        beyond the stable λ when the move grew (see :meth:`play_step`)."""
+        s = self.smoother
+        assert s is not None
         stab = s.stability
         if stab.stable or self.last_move is None or move <= self.last_move:
             self.last_move = move
@@ -91,6 +109,72 @@ class SmoothingState:
             "(or use implicit) to go on, or press reset"
         )
         return False
+
+    @property
+    def asynchronous(self) -> bool:
+        """The stepper runs in a child process and takes steps asked for ahead
+        (:meth:`advance`, :meth:`poll`)."""
+        return bool(getattr(self.smoother, "asynchronous", False))
+
+    def play_batch(self) -> int:
+        """Steps *play* asks a child-process stepper for at once: as many as it solves while
+        the window draws the last ones (:attr:`show_s` over the last step's own time, at most
+        :data:`MAX_BATCH`), so neither side waits for the other on a big mesh; 1 when drawing
+        is quicker than a step."""
+        s = self.smoother
+        last = s.history[-1] if s is not None and s.history else {}
+        step_s = float(last.get("time_ms") or 0.0) / 1e3
+        if step_s <= 0.0 or self.show_s <= step_s:
+            return 1
+        return int(min(MAX_BATCH, round(self.show_s / step_s)))
+
+    def advance(self, count: int = 1) -> None:
+        """``count`` steps from the window (the *step* button, ``right``, *play*): asked for
+        from a child-process stepper (taken by :meth:`poll`, the window keeps drawing
+        meanwhile), else one done at once (:meth:`step`)."""
+        s = self.smoother
+        if s is None:
+            return
+        if not self.asynchronous:
+            self.step()
+        elif not s.diverged:
+            self.asked_at = s.iteration
+            try:
+                s.request_step(count)
+            except MeshError as exc:
+                self.error, self.playing = str(exc), False
+
+    def poll(self) -> bool:
+        """Take the step a child-process stepper finished, if any (never waits): count it,
+        stop on divergence, and apply *play*'s rule beyond the stable λ. True when the
+        positions changed."""
+        s = self.smoother
+        if s is None or not self.asynchronous:
+            return False
+        try:
+            arrived = s.poll()
+        except MeshError as exc:
+            self.error, self.playing = str(exc), False
+            return False
+        if not arrived:
+            return False
+        stepped = s.iteration > self.asked_at
+        for _ in range(s.iteration - self.asked_at):
+            self._count_step(s.lam)
+        self.asked_at = s.iteration
+        if s.diverged:
+            self.playing = False
+            self.error = f"{s.divergence_message()}; press reset"
+        elif stepped and self.playing:
+            move = s.history[-1].get("step_rms", 0.0) if s.history else 0.0
+            self._check_growth(float(move))
+        return stepped
+
+    def drop(self) -> None:
+        """Forget the stepper (a new mesh); a child process's ends."""
+        old, self.smoother, self.playing = self.smoother, None, False
+        if hasattr(old, "close"):
+            old.close()
 
     def rebuild(self, V: FloatArray, F: IntArray) -> bool:
         """Build the stepper for the current options from the clean mesh ``V`` (+ noise).
@@ -143,8 +227,11 @@ class SmoothingState:
         return smoother
 
     def adopt(self, smoother: Smoother) -> None:
-        """Step ``smoother`` from now on (built by :meth:`build`, maybe in a job)."""
-        self.smoother = smoother
+        """Step ``smoother`` from now on (built by :meth:`build`, maybe in a job, maybe in a
+        child process); the one it replaces is closed (its child process ends)."""
+        old, self.smoother = self.smoother, smoother
+        if old is not smoother and hasattr(old, "close"):
+            old.close()
         self.error = ""
         self.version += 1
         self.lam_steps = []
@@ -193,6 +280,9 @@ class SmoothingState:
             ``λ`` is not a finite number > 0 (the state keeps the previous ``λ``).
         """
         lam = check_lam(lam, "lambda")
+        if self.asynchronous:  # steps on their way were taken at the old λ: counted first
+            self.smoother.finish()  # type: ignore[union-attr]
+            self.poll()
         if self.smoother is not None:
             self.smoother.set_lam(lam)
         self.lam = lam

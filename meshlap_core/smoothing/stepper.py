@@ -274,6 +274,7 @@ class Smoother:
             self._K_fp = K[:, :0].tocsr()
         self._recompute_mass = self.mass_update == "recompute" and self.laplacian == "cotan"
         self._stability: Stability | None = None
+        self._mu_min: tuple[float, bool] | None = None  # W and K are frozen: kept across λ
         self.n_factorizations = 0
         self._solver: SPDSolver | None = None
         self._solver_key: tuple[float, int] | None = None
@@ -293,7 +294,9 @@ class Smoother:
     def stability(self) -> Stability:
         """Stability figures of this smoother on the input mesh (computed once, on first use)."""
         if self._stability is None:
-            mu_min, exact = most_negative_eigenvalue(self._W0, self._K)
+            if self._mu_min is None:  # one eigensolve per stepper, whatever λ becomes
+                self._mu_min = most_negative_eigenvalue(self._W0, self._K)
+            mu_min, exact = self._mu_min
             self._stability = _stability_from_mu(
                 self.method,
                 self.laplacian,

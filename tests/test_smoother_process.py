@@ -1,0 +1,302 @@
+"""The smoothing stepper in a child process (:mod:`meshlap_app.smoother_process`, issue 21):
+the same positions as the stepper in this process, steps asked for and collected later,
+Cancel and failures that leave the state as it was, the normals polyscope would compute, and
+the panel stepping a child-process stepper in the window's way."""
+
+from __future__ import annotations
+
+import gc
+import threading
+import time
+
+import numpy as np
+import pytest
+from meshlap_app.jobs import Cancelled, Jobs, Reporter
+from meshlap_app.smoother_process import RemoteSmoother, build, vertex_normals
+from meshlap_app.state.smoothing import MAX_BATCH, SmoothingState
+
+from meshlap_core.errors import MeshError
+from meshlap_core.primitives import bumpy_sphere
+
+OPTIONS = ("implicit", "cotan", 0.01, 0.01, 3)  # method, Laplacian, λ, noise α, seed
+
+
+@pytest.fixture(scope="module")
+def mesh():
+    return bumpy_sphere(3)
+
+
+def reporter() -> Reporter:
+    return Reporter(threading.Event())
+
+
+def host_values(buf, n: int) -> np.ndarray:
+    """A polyscope vertex buffer's host values ``(n,3)``."""
+    return np.array([buf.get_value(i).as_tuple() for i in range(n)])
+
+
+def wait_for(poll, timeout: float = 120.0) -> None:
+    end = time.monotonic() + timeout
+    while not poll():
+        assert time.monotonic() < end, "no answer from the child process"
+        time.sleep(0.01)
+
+
+@pytest.mark.parametrize("options", [OPTIONS, ("taubin", "uniform", 0.5, 0.0, 0)])
+def test_child_stepper_matches_the_stepper_in_this_process(mesh, options, spd_backend):
+    V, F = mesh
+    remote = RemoteSmoother.start(V, F, options, reporter())
+    local = SmoothingState.build(V, F, options)
+    try:
+        assert np.abs(remote.V0 - local.V0).max() <= 1e-10  # the same noise (same seed)
+        assert np.abs(remote.V - local.V).max() <= 1e-10
+        for _ in range(3):
+            remote.step()
+            local.step()
+        assert remote.iteration == local.iteration == 3
+        assert np.abs(remote.V - local.V).max() <= 1e-10
+        assert remote.history[-1]["rmse"] == pytest.approx(local.history[-1]["rmse"], abs=1e-12)
+        # (ARPACK starts from a random vector: μ_min agrees to its tolerance)
+        assert remote.stability.mu_min == pytest.approx(local.stability.mu_min, rel=1e-6)
+        assert remote.stability.stable == local.stability.stable
+        remote.set_lam(2 * options[2])  # λ changed mid-run: the implicit system refactorized
+        local.set_lam(2 * options[2])
+        remote.step()
+        local.step()
+        assert np.abs(remote.V - local.V).max() <= 1e-10
+        assert remote.n_factorizations == local.n_factorizations
+        remote.reset()
+        assert remote.iteration == 0 and np.array_equal(remote.V, remote.V0)
+    finally:
+        remote.close()
+
+
+def test_a_step_asked_for_arrives_later_with_its_normals(mesh):
+    V, F = mesh
+    remote = RemoteSmoother.start(V, F, OPTIONS, reporter())
+    local = SmoothingState.build(V, F, OPTIONS)
+    try:
+        assert remote.request_step() and not remote.request_step()  # one on its way at a time
+        wait_for(remote.poll)
+        local.step()
+        assert remote.iteration == 1 and np.abs(remote.V - local.V).max() <= 1e-10
+        assert np.abs(remote.normals - vertex_normals(local.V, local.F)).max() <= 1e-6
+        assert not remote.poll()  # collected once
+        remote.request_step()
+        remote.set_lam(0.02)  # a synchronous call waits for the step on its way first
+        assert remote.iteration == 2 and remote.lam == 0.02 and remote.poll()
+    finally:
+        remote.close()
+
+
+def test_vertex_normals_are_polyscopes_smooth_shading_normals(polyscope_mock, mesh):
+    """polyscope's own normals after ``update_vertex_positions`` (its host buffer) equal
+    :func:`vertex_normals`; the panel's two-buffer upload leaves the same buffers."""
+    from meshlap_app.panels.smoothing import upload_positions
+
+    ps = polyscope_mock
+    V, F = mesh
+    W = V + 0.05 * np.sin(7 * V[:, [1, 2, 0]])  # some other shape
+    m = ps.register_surface_mesh("normals_check", V, F, smooth_shade=True)
+    try:
+        m.update_vertex_positions(W)
+        ps.frame_tick()
+        buf = m.get_buffer("vertexNormals")
+        theirs = host_values(buf, len(V))
+        assert np.abs(theirs - vertex_normals(W, F)).max() <= 1e-5
+        upload_positions(m, V, vertex_normals(V, F))
+        ps.frame_tick()
+        pos = m.get_buffer("vertexPositions")
+        assert np.abs(host_values(pos, len(V)) - V).max() <= 1e-6
+        got = host_values(buf, len(V))
+        assert np.abs(got - vertex_normals(V, F)).max() <= 1e-6
+    finally:
+        ps.remove_surface_mesh("normals_check")
+
+
+def test_vertex_normals_hand_computed():
+    """Two triangles folded at a right angle along the x axis: the shared vertices' normal is
+    the normalized sum of the two faces' area-weighted normals."""
+    V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.0]])
+    F = np.array([[0, 1, 2], [0, 3, 1]])  # normals +z and +y, areas 1/2 each
+    N = vertex_normals(V, F)
+    s = 1 / np.sqrt(2)
+    assert np.allclose(N, [[0, s, s], [0, s, s], [0, 0, 1], [0, 1, 0]], atol=1e-7)
+
+
+def test_cancel_ends_the_child_and_leaves_the_state(mesh):
+    V, F = mesh
+    st = SmoothingState()
+    st.rebuild(V, F)
+    before = st.smoother
+    rep = reporter()
+    rep.cancel.set()
+    with pytest.raises(Cancelled):
+        RemoteSmoother.start(V, F, OPTIONS, rep)
+    jobs = Jobs()
+    job = jobs.start(
+        "smoothing", "build", lambda r: build(V, F, OPTIONS, r, st.build), st.adopt, None
+    )
+    jobs.cancel("smoothing")
+    job.thread.join(60)
+    jobs.poll()
+    assert not job.thread.is_alive() and st.smoother is before and st.error == ""
+
+
+def test_a_failed_build_says_why_and_ends_the_child(mesh):
+    V, F = mesh
+    with pytest.raises(MeshError, match="laplacian"):
+        RemoteSmoother.start(V, F, ("implicit", "bogus", 0.01, 0.0, 0), reporter())
+
+
+def test_steps_asked_for_together_count_each_step(mesh):
+    """*play* on a big mesh asks for several steps at once (as many as the stepper solves
+    while the window draws): each is counted at its λ, the positions are the same."""
+    V, F = mesh
+    st = SmoothingState(method="implicit", laplacian="cotan", lam=0.01)
+    st.adopt(RemoteSmoother.start(V, F, st.options(), reporter()))
+    try:
+        local = SmoothingState.build(V, F, st.options())
+        st.show_s = 1e9  # drawing far slower than a step
+        assert st.play_batch() == 1  # the step's own time is not known before the first one
+        st.advance(st.play_batch())
+        wait_for(st.poll)
+        st.advance(st.play_batch())  # now the largest batch
+        wait_for(st.poll)
+        for _ in range(1 + MAX_BATCH):
+            local.step()
+        assert st.smoother.iteration == 1 + MAX_BATCH
+        assert st.lam_steps == [[0.01, 1 + MAX_BATCH]]
+        assert np.abs(st.V - local.V).max() <= 1e-10
+        st.show_s = 0.0  # drawing quicker than a step: one at a time
+        assert st.play_batch() == 1
+        st.advance(2)
+        st.set_lam(0.02)  # the steps on their way count at the λ they were taken with
+        local.step()
+        local.step()
+        assert st.lam_steps == [[0.01, 3 + MAX_BATCH]] and st.smoother.lam == 0.02
+        assert np.abs(st.V - local.V).max() <= 1e-10
+    finally:
+        st.drop()
+
+
+def test_a_dropped_stepper_ends_its_process(mesh):
+    V, F = mesh
+    remote = RemoteSmoother.start(V, F, OPTIONS, reporter())
+    proc = remote._proc
+    st = SmoothingState()
+    st.adopt(remote)
+    st.drop()
+    proc.join(10)
+    assert not proc.is_alive()
+    remote = RemoteSmoother.start(V, F, OPTIONS, reporter())
+    proc = remote._proc
+    del remote
+    gc.collect()
+    proc.join(10)
+    assert not proc.is_alive()
+
+
+def test_state_counts_asynchronous_steps_and_play_goes_on(mesh):
+    V, F = mesh
+    st = SmoothingState(method="implicit", laplacian="cotan", lam=0.01)
+    st.adopt(RemoteSmoother.start(V, F, st.options(), reporter()))
+    try:
+        local = SmoothingState.build(V, F, st.options())
+        st.advance()
+        wait_for(st.poll)
+        st.toggle_play()
+        while st.smoother.iteration < 4:
+            assert st.play_step()
+            st.poll()
+            time.sleep(0.005)
+        wait_for(lambda: st.poll() or not st.smoother.pending)
+        n = st.smoother.iteration
+        for _ in range(n):
+            local.step()
+        assert st.lam_steps == [[0.01, n]] and st.playing
+        assert np.abs(st.V - local.V).max() <= 1e-10
+    finally:
+        st.drop()
+
+
+def test_the_panel_steps_a_child_process_stepper(viewer):
+    """The window's way: the panel's build job starts a child-process stepper, the *step*
+    button asks for a step, a later frame shows it (positions uploaded with their normals)."""
+    import polyscope as ps
+    from meshlap_app.scene import SMOOTHED
+
+    viewer.background = True
+    viewer.state.jobs.processes = True
+    panel = viewer.panels["smoothing"]
+    st = panel.state
+    st.method, st.laplacian, st.lam = "implicit", "cotan", 0.01
+    try:
+        viewer.set_panel("smoothing")
+        wait_for(lambda: (ps.frame_tick(), st.smoother is not None)[1])
+        assert isinstance(st.smoother, RemoteSmoother)
+        panel.on_key(viewer, "right")
+        wait_for(lambda: (ps.frame_tick(), st.smoother.iteration == 1)[1])
+        ps.frame_tick()
+        local = SmoothingState.build(viewer.state.mesh.V, viewer.state.mesh.F, st.options())
+        local.step()
+        assert np.abs(st.V - local.V).max() <= 1e-10
+        d = viewer.state.display
+        pos = ps.get_surface_mesh(SMOOTHED).get_buffer("vertexPositions")
+        shown = host_values(pos, len(st.V))
+        shift = shown[0] - d.points(st.V[:1])[0]
+        assert np.abs(shown - (d.points(local.V) + shift)).max() <= 1e-5
+        normals = ps.get_surface_mesh(SMOOTHED).get_buffer("vertexNormals")
+        expected = vertex_normals(d.points(local.V), st.F)  # what polyscope would derive
+        assert np.abs(host_values(normals, len(st.V)) - expected).max() <= 1e-5
+        assert not st.error and not any(viewer.state.errors.values()), viewer.state.errors
+    finally:
+        panel.on_new_mesh(viewer)
+
+
+def test_a_rebuild_moves_the_shown_copies_to_the_new_stepper(viewer):
+    """A new stepper of the same mesh (new noise) is shown by moving the two copies already
+    registered: the input shows the new noisy positions, the smoothed copy the new stepper's."""
+    import polyscope as ps
+    from meshlap_app.scene import SMOOTH_INPUT, SMOOTHED
+
+    panel = viewer.panels["smoothing"]
+    st = panel.state
+    viewer.set_panel("smoothing")
+    ps.frame_tick()
+    assert st.smoother is not None and st.noise_alpha == 0.0
+    panel.start_build(viewer, noise_alpha=0.01)
+    ps.frame_tick()
+    assert st.noise_alpha == 0.01
+    d = viewer.state.display
+    n = len(st.V)
+    shown_in = host_values(ps.get_surface_mesh(SMOOTH_INPUT).get_buffer("vertexPositions"), n)
+    assert np.abs(shown_in - d.points(st.V_start)).max() <= 1e-5
+    assert np.abs(st.V_start - viewer.state.mesh.V).max() > 1e-4  # the noise is there
+    st.step()
+    panel.push(viewer)
+    assert not any(viewer.state.errors.values()), viewer.state.errors
+    shown = host_values(ps.get_surface_mesh(SMOOTHED).get_buffer("vertexPositions"), n)
+    shift = shown[0] - d.points(st.V[:1])[0]
+    assert np.abs(shown - (d.points(st.V) + shift)).max() <= 1e-5
+    panel.on_new_mesh(viewer)
+
+
+def test_without_child_processes_the_stepper_is_built_here(mesh, monkeypatch):
+    """Where no child process can start, the job builds the stepper in its own thread (the
+    pure in-process path): the same stepper."""
+    from meshlap_app import smoother_process
+
+    from meshlap_core.smoothing import Smoother
+
+    def refuse() -> None:
+        raise OSError("no processes here")
+
+    monkeypatch.setattr(smoother_process, "_context", refuse)
+    V, F = mesh
+    got = build(V, F, OPTIONS, reporter(), SmoothingState.build)
+    assert isinstance(got, Smoother)
+    got.step()
+    local = SmoothingState.build(V, F, OPTIONS)
+    local.step()
+    assert np.abs(got.V - local.V).max() <= 1e-10
