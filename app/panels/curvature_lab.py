@@ -27,7 +27,6 @@ from ..state.curvature_lab import (
     STUDY_LEVELS,
     CurvatureLabState,
     LabResult,
-    cross_field,
 )
 from .base import Host, Panel
 
@@ -50,6 +49,7 @@ class CurvatureLabPanel(Panel):
         super().__init__(name, state)
         self.state: CurvatureLabState = state
         self._study_for: tuple[Any, ...] | None = None  # the study job's inputs
+        self._field: str | None = None  # the scalar quantity on the lab's mesh
 
     def on_new_mesh(self, host: Host) -> None:
         self.watch.forget()
@@ -66,7 +66,7 @@ class CurvatureLabPanel(Panel):
             self.sync(host)
         elif ps.has_surface_mesh(LAB):  # hidden, its colour bar would stay on screen
             ps.remove_surface_mesh(LAB)
-            self.watch.forget("uploaded")
+            self.watch.forget("uploaded", "shape")
 
     def points(self, host: Host, name: str) -> np.ndarray | None:
         r = self.state.result
@@ -106,9 +106,16 @@ class CurvatureLabPanel(Panel):
             self._start_study(host, key)
         r = lab.result
         lines = repr(self.isolines)
-        if r is None or not self.watch.changed("uploaded", lab.computed_for, lab.crosses, lines):
+        if r is None:
             return
-        self._upload(host, r)
+        # the mesh and its crosses only when the estimate changed; a quantity or show move
+        # (the same estimate) re-colours the mesh on screen
+        shape = (r.estimate_key or lab.computed_for, lab.crosses)
+        if self.watch.changed("shape", shape) or not ps.has_surface_mesh(LAB):
+            self.watch.forget("uploaded")
+            self._upload_shape(r)
+        if self.watch.changed("uploaded", lab.computed_for, lines):
+            self._upload_field(r)
 
     @property
     def study_owner(self) -> str:
@@ -126,13 +133,20 @@ class CurvatureLabPanel(Panel):
             lab.computed_for = wanted  # not retried until an input changes
             host.state.errors[self.name] = message
 
+        base, estimate = lab.base(), lab.estimate()
+        if lab.light():  # a thread (or inline when only the colours change): no child process
+            work = lambda reporter: lab.compute(  # noqa: E731
+                params, mesh.V, mesh.F, base, reporter, estimate
+            )
+        else:
+            work = jobs.offload(lab.compute, params, mesh.V, mesh.F, base)
         jobs.start(
             self.name,
             f"curvature lab ({lab.estimator}, {lab.show})",
-            jobs.offload(lab.compute, params, mesh.V, mesh.F, lab.base()),
+            work,
             apply,
             fail,
-            background=bool(host.background),
+            background=bool(host.background) and (estimate is None or lab.show == "disagreement"),
         )
 
     def _start_study(self, host: Host, key: tuple[Any, ...]) -> None:
@@ -152,8 +166,30 @@ class CurvatureLabPanel(Panel):
             background=bool(host.background),
         )
 
-    def _upload(self, host: Host, r: LabResult) -> None:
+    def _upload_shape(self, r: LabResult) -> None:
+        """The lab's mesh and its crosses (red k1, blue k2; the exact k1 hidden)."""
         sm = ps.register_surface_mesh(LAB, r.V, r.F, smooth_shade=True)
+        self._field = None
+        c = r.crosses
+        if not self.state.crosses or c is None:
+            return
+        for name, vals, color, on in (
+            ("k1 direction (max)", c.k1, K1_COLOR, True),
+            ("k2 direction (min)", c.k2, K2_COLOR, True),
+            ("exact k1 direction", c.exact, EXACT_COLOR, False),
+        ):
+            if vals is not None:
+                sm.add_tangent_vector_quantity(
+                    name, vals, c.basis_x, c.basis_y, n_sym=2, enabled=on, color=color,
+                    radius=0.0015,
+                )  # fmt: skip
+
+    def _upload_field(self, r: LabResult) -> None:
+        """The coloured field (the previous one removed: one scalar quantity at a time)."""
+        sm = ps.get_surface_mesh(LAB)
+        if self._field is not None and self._field != r.label:
+            sm.remove_quantity(self._field)
+        self._field = r.label
         v = np.asarray(r.values, dtype=np.float64)
         top = float(np.percentile(np.abs(v), 98)) if v.size else 1.0
         top = top if top > 0 else 1.0
@@ -168,31 +204,6 @@ class CurvatureLabPanel(Panel):
             onscreen_colorbar_location=COLORBAR_AT,
             **self.isolines.options(self.state.show, v),
         )
-        if not self.state.crosses:
-            return
-        for which, name, color in (
-            (1, "k1 direction (max)", K1_COLOR),
-            (2, "k2 direction (min)", K2_COLOR),
-        ):
-            vals, bx, by = cross_field(r.principal, which)
-            sm.add_tangent_vector_quantity(
-                name, vals, bx, by, n_sym=2, enabled=True, color=color, radius=0.0015
-            )
-        if r.exact_d1 is not None:
-            vals, bx, by = cross_field(
-                type(r.principal)(
-                    r.principal.k1,
-                    r.principal.k2,
-                    r.exact_d1,
-                    r.exact_d1,
-                    r.principal.normal,
-                    "exact",
-                ),
-                1,
-            )
-            sm.add_tangent_vector_quantity(
-                "exact k1 direction", vals, bx, by, n_sym=2, enabled=False, color=EXACT_COLOR
-            )
 
     def draw(self, host: Host) -> None:
         ui = host.ui
