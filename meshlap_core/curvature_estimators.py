@@ -353,6 +353,52 @@ def estimate_curvature(
         ) from None
 
 
+PATCH_RINGS = {"cotan": 3, "rusinkiewicz": 3, "normal_cycle": 3, "quadric": None}
+"""Edge rings of the patch :func:`curvature_at_vertex` estimates on: the vertex's value
+depends on its 2-ring (normals of its neighbours, dihedral angles at its edges), libigl's
+quadric on ``radius + 2`` rings (``None``: from its ``radius``)."""
+
+
+def curvature_at_vertex(
+    V: FloatArray, F: IntArray, vertex: int, estimator: CurvatureEstimator = "cotan", **options: Any
+) -> tuple[PrincipalCurvatures, int]:
+    """The estimator at one vertex from a patch of rings around it (what an inspector needs
+    on a big scan, in milliseconds): the same values as :func:`estimate_curvature` on the
+    whole mesh at that vertex (tested), for the estimators of :data:`PATCH_RINGS` (the jet's
+    automatic radius depends on the whole mesh: it is refused here).
+
+    Returns
+    -------
+    PrincipalCurvatures
+        On the patch.
+    int
+        The vertex's index in the patch.
+
+    Raises
+    ------
+    MeshError
+        An unknown estimator or one without a patch rule, or a vertex out of range.
+    """
+    V, F = as_mesh(V, F)
+    check_choice(estimator, CURVATURE_ESTIMATORS, "estimator")
+    if estimator not in PATCH_RINGS:
+        raise MeshError(f"the {estimator} estimator needs the whole mesh", "estimator")
+    if not 0 <= int(vertex) < len(V):
+        raise MeshError(f"vertex {vertex} is out of range (the mesh has {len(V)})", "vertex")
+    rings = PATCH_RINGS[estimator] or int(options.get("radius", 5)) + 2
+    mark = np.zeros(len(V), dtype=bool)
+    mark[int(vertex)] = True
+    faces = np.zeros(len(F), dtype=bool)
+    for _ in range(rings):
+        faces = mark[F].any(axis=1)
+        mark[F[faces]] = True
+    keep = np.flatnonzero(mark)
+    local = np.full(len(V), -1, dtype=np.int64)
+    local[keep] = np.arange(len(keep))
+    p = estimate_curvature(V[keep], local[F[faces]], estimator, **options)
+    return p, int(local[int(vertex)])
+
+
 def disagreement(results: list[PrincipalCurvatures], field: str = "H") -> FloatArray:
     """Max pairwise difference of ``field`` among estimators at every vertex, ``(n,)``: where it
     is large, no estimator can be trusted (noise, sharp features, bad triangles)."""

@@ -17,6 +17,7 @@ import pytest
 from meshlap_core import curvature_estimators as ce
 from meshlap_core import primitives
 from meshlap_core.curvature_fit import default_jet_radius, estimate_normal_noise, jet_curvatures
+from meshlap_core.curvature_study import perturbed_mesh
 from meshlap_core.errors import MeshError
 from meshlap_core.noise import add_noise, bbox_diagonal
 from meshlap_core.options import CURVATURE_ESTIMATORS
@@ -287,10 +288,37 @@ def test_mixed_voronoi_areas_from_the_face_frame_equal_libigls_massmatrix() -> N
     """The cotan and normal-cycle estimators take the mixed Voronoi areas from their one pass
     over the faces (obtuse triangles included: a jittered, flipped saddle)."""
     from meshlap_core.curvature import _areas_from, _face_frame
-    from meshlap_core.curvature_study import perturbed_mesh
 
     m, V = perturbed_mesh("saddle", 20, 0.0, jitter=0.4, flips=0.3)
     theta = igl.internal_angles(V, m.F)
     assert (theta > np.pi / 2).any()  # the obtuse rule is exercised
     ref = igl.massmatrix(V, m.F, igl.MASSMATRIX_TYPE_VORONOI).diagonal()
     np.testing.assert_allclose(_areas_from(V, m.F, _face_frame(V, m.F), "voronoi"), ref, rtol=1e-12)
+
+
+@pytest.mark.parametrize("name", ["cotan", "rusinkiewicz", "normal_cycle", "quadric"])
+def test_curvature_at_vertex_is_the_whole_meshs_value_there(name: str) -> None:
+    m, V = perturbed_mesh("torus", (48, 24), 0.002, jitter=0.3)
+    whole = ce.estimate_curvature(V, m.F, name)
+    for i in (0, 100, 250):
+        p, j = ce.curvature_at_vertex(V, m.F, i, name)
+        assert len(p.k1) < len(V) / 2  # a patch, not the mesh
+        np.testing.assert_allclose([p.k1[j], p.k2[j]], [whole.k1[i], whole.k2[i]], atol=1e-9)
+        S, _, _ = p.shape_operator(j)
+        Sw, _, _ = whole.shape_operator(i)
+        np.testing.assert_allclose(S, Sw, atol=1e-9)
+    with pytest.raises(MeshError, match="whole mesh"):
+        ce.curvature_at_vertex(V, m.F, 0, "jet")
+    with pytest.raises(MeshError, match="out of range"):
+        ce.curvature_at_vertex(V, m.F, len(V), name)
+
+
+def test_shape_operator_has_the_principal_pairs_as_eigenpairs() -> None:
+    V, F = primitives.torus_mesh(32, 16)
+    p = ce.estimate_curvature(V, F, "cotan")
+    for i in (0, 7, 300):
+        S, t1, t2 = p.shape_operator(i)
+        np.testing.assert_allclose(np.cross(t1, t2), p.normal[i], atol=1e-12)
+        c1 = np.array([p.d1[i] @ t1, p.d1[i] @ t2])
+        np.testing.assert_allclose(S @ c1, p.k1[i] * c1, atol=1e-12)
+        np.testing.assert_allclose(np.linalg.eigvalsh(S)[::-1], [p.k1[i], p.k2[i]], atol=1e-12)

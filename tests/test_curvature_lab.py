@@ -240,3 +240,43 @@ def drive_panel_curvature_lab(viewer, tmp_path=None) -> None:
 
 def test_curvature_lab_widgets(viewer):
     drive_panel_curvature_lab(viewer)
+
+
+def drive_curvature_estimator(viewer) -> None:
+    """The Curvature view's estimator combo (k1, k2 from the chosen estimator, a bad name
+    refused) and the One-ring view's shape-operator row at a vertex (run by
+    ``drive_panel_curvature`` of the every-widget tour)."""
+    from meshlap_app.state.curvature import ESTIMATOR_HELP
+
+    viewer.set_panel("curvature")
+    c, mesh = viewer.state.curv, viewer.state.mesh
+    assert all(f"{e}:" in ESTIMATOR_HELP for e in ce.ESTIMATOR_FUNCTIONS)  # each with its paper
+    assert "Rusinkiewicz 2004" in ESTIMATOR_HELP and "Meyer et al. 2003" in ESTIMATOR_HELP
+    drive(viewer, "field", "k1")
+    drive(viewer, "estimator", "rusinkiewicz")
+    ref = ce.estimate_curvature(mesh.V, mesh.F, "rusinkiewicz")
+    np.testing.assert_allclose(c.values("k1"), ref.k1, atol=1e-12)
+    np.testing.assert_allclose(c.values("k2"), ref.k2, atol=1e-12)
+    assert c.summary("k1")["max"] == pytest.approx(ref.k1.max())
+    with pytest.raises(MeshError, match="estimator"):
+        c.set_estimator("magic")
+    assert c.estimator == "rusinkiewicz"
+    # the One-ring view's row: the estimator's 2x2 tensor at the vertex, in its basis
+    drive(viewer, "vertex", 7, panel="onering")
+    so = c.shape_operator(mesh, 7)
+    S, t1, _ = ref.shape_operator(7)
+    np.testing.assert_allclose(so["S"], S, atol=1e-12)
+    np.testing.assert_allclose(so["t1"], t1)
+    assert so["k1"] == pytest.approx(ref.k1[7]) and so["estimator"] == "rusinkiewicz"
+    drive(viewer, "estimator", "jet", panel="curvature")  # the whole mesh's run (inline here)
+    assert c.principal_current(mesh) and c.principal.estimator == "jet"
+    viewer.set_panel("onering")
+    frames(viewer, 1)
+    np.testing.assert_allclose(c.shape_operator(mesh, 7)["k1"], c.principal.k1[7])
+    drive(viewer, "estimator", "cotan", panel="curvature")
+    np.testing.assert_array_equal(c.values("k1"), c.fields["k1"])  # cotan: the course fields
+    drive(viewer, "field", "cotan")
+
+
+def test_curvature_estimator_widgets(viewer):
+    drive_curvature_estimator(viewer)

@@ -508,10 +508,7 @@ def shape_operator_at(r: LabResult, i: int, n: int = 73) -> dict[str, Any]:
         ``kn`` ((n,) arrays), and ``exact_kn`` ((n,) or None).
     """
     p = r.principal
-    t1, t2 = tangent_frames(p.normal[i : i + 1])
-    c1 = np.array([p.d1[i] @ t1[0], p.d1[i] @ t2[0]])
-    c2 = np.array([p.d2[i] @ t1[0], p.d2[i] @ t2[0]])
-    S = p.k1[i] * np.outer(c1, c1) + p.k2[i] * np.outer(c2, c2)
+    S, t1, t2 = p.shape_operator(i)
     th = np.radians(np.linspace(0.0, 360.0, n))
     kn = p.k1[i] * np.cos(th) ** 2 + p.k2[i] * np.sin(th) ** 2
     exact_kn = None
@@ -523,8 +520,8 @@ def shape_operator_at(r: LabResult, i: int, n: int = 73) -> dict[str, Any]:
             exact_kn = ek1 * np.cos(th - phi) ** 2 + ek2 * np.sin(th - phi) ** 2
     return {
         "S": S.tolist(),
-        "t1": t1[0],
-        "t2": t2[0],
+        "t1": t1,
+        "t2": t2,
         "k1": float(p.k1[i]),
         "k2": float(p.k2[i]),
         "theta_deg": np.degrees(th),
