@@ -47,6 +47,7 @@ def non_default_session(mesh) -> Session:
             "clip": 7.5,
             "side_by_side": True,
             "second_field": "k1",
+            "estimator": "rusinkiewicz",
         },
         "onering": {"vertex": 17, "reverse": True},
         "spectral": {"computed": True, "k_request": 24, "k": 9, "mode": 4, "play": "modes"},
