@@ -228,6 +228,9 @@ def drive_panel_curvature_lab(viewer, tmp_path=None) -> None:
     np.testing.assert_allclose(lab.result.values, lab.result.principal.k1)
     drive(viewer, "lab surface", "saddle")
     assert lab.result.V.shape[0] == 13 * 13
+    drive(viewer, "lab surface", "ellipsoid")  # its exact curvature is the closed form
+    assert lab.result.exact is not None and np.all(np.isfinite(lab.result.exact[0]))
+    drive(viewer, "lab surface", "saddle")
     drive(viewer, "crosses", False)
     drive(viewer, "crosses", True)
     drive(viewer, "source", "mesh")
