@@ -229,7 +229,8 @@ def drive_panel_curvature_lab(viewer, tmp_path=None) -> None:
     drive(viewer, "lab surface", "saddle")
     assert lab.result.V.shape[0] == 13 * 13
     drive(viewer, "lab surface", "ellipsoid")  # its exact curvature is the closed form
-    assert lab.result.exact is not None and np.all(np.isfinite(lab.result.exact[0]))
+    k1 = lab.result.exact[0]
+    assert np.isfinite(k1).sum() == len(k1) - 2  # all but the two poles
     drive(viewer, "lab surface", "saddle")
     drive(viewer, "crosses", False)
     drive(viewer, "crosses", True)

@@ -8,7 +8,12 @@ import numpy as np
 import polyscope as ps
 
 from meshlap_core.options import AREA_KINDS as AREAS
-from meshlap_core.options import BOUNDARY_RULES, CURVATURE_ESTIMATORS, CURVATURE_FIELD_LABELS
+from meshlap_core.options import (
+    BOUNDARY_RULES,
+    CURVATURE_ESTIMATORS,
+    CURVATURE_FIELD_LABELS,
+    PRINCIPAL_FIELDS,
+)
 
 from ..isolines import draw_isolines
 from ..scene import MESH, MESH_B, colorbar_at, front_view, scalar_for_upload, side_offset
@@ -171,7 +176,7 @@ class CurvaturePanel(Panel):
         label, signed = CURVATURE_FIELD_LABELS[name]
         label += " [1/length^2]" if name == "gaussian" else " [1/length]"
         values, (lo, hi), factor = scalar_for_upload(curv.values(name), curv.color_range(name))
-        if name in ("k1", "k2") and curv.estimator != "cotan":
+        if name in PRINCIPAL_FIELDS[:2] and curv.estimator != "cotan":
             label += f" ({curv.estimator})"
         sm.add_scalar_quantity(
             label + factor,

@@ -32,9 +32,9 @@ from .base import Host, Panel
 
 LAB = "curvature lab"
 """The lab's surface mesh (the parametric surface's, or a copy of the loaded mesh)."""
-K1_COLOR = (0.85, 0.15, 0.1)
-K2_COLOR = (0.1, 0.3, 0.85)
-EXACT_COLOR = (0.1, 0.1, 0.1)
+K1_COLOR = (0.05, 0.05, 0.05)  # not in the coolwarm / viridis maps under them
+K2_COLOR = (0.0, 0.6, 0.25)
+EXACT_COLOR = (0.85, 0.1, 0.85)
 
 
 class CurvatureLabPanel(Panel):
@@ -167,7 +167,7 @@ class CurvatureLabPanel(Panel):
         )
 
     def _upload_shape(self, r: LabResult) -> None:
-        """The lab's mesh and its crosses (red k1, blue k2; the exact k1 hidden)."""
+        """The lab's mesh and its crosses (black k1, green k2; the exact k1 hidden)."""
         sm = ps.register_surface_mesh(LAB, r.V, r.F, smooth_shade=True)
         self._field = None
         c = r.crosses
@@ -180,8 +180,8 @@ class CurvatureLabPanel(Panel):
         ):
             if vals is not None:
                 sm.add_tangent_vector_quantity(
-                    name, vals, c.basis_x, c.basis_y, n_sym=2, enabled=on, color=color,
-                    radius=0.0015,
+                    name, vals, c.basis_x, c.basis_y, n_sym=2, vectortype="ambient",
+                    enabled=on, color=color, radius=0.0012,
                 )  # fmt: skip
 
     def _upload_field(self, r: LabResult) -> None:
@@ -239,42 +239,12 @@ class CurvatureLabPanel(Panel):
         ch, lab.crosses = ui.checkbox(
             "crosses",
             lab.crosses,
-            "principal directions: red k1 (max), blue k2 (min), length by |k|",
+            "principal directions: black k1 (max), green k2 (min), length by |k| "
+            "(the exact k1 in magenta, off by default)",
         )
         changed |= ch
         if lab.source == "surface":
-            ch, value = ui.combo(
-                "lab surface", lab.surface, tuple(SURFACES), "the parametric surface"
-            )
-            if ch:
-                lab.set_choice("surface", value)
-                changed = True
-            for what, lo, hi, tip in (
-                ("resolution", 3, MAX_RES, "cells per direction (the torus: twice around)"),
-            ):
-                ch, value = ui.slider_int(what, lab.res, lo, hi, tip)
-                if ch:
-                    lab.set_number("res", value)
-                    changed = True
-            for what, key, hi, tip in (
-                (
-                    "noise",
-                    "noise",
-                    MAX_NOISE,
-                    "normal noise, a fraction of the bounding-box diagonal",
-                ),
-                (
-                    "jitter",
-                    "jitter",
-                    MAX_JITTER,
-                    "parameter jitter of interior vertices, a fraction of a cell",
-                ),
-                ("edge flips", "flips", 1.0, "fraction of the interior edges flipped"),
-            ):
-                ch, value = ui.slider_float(what, getattr(lab, key), 0.0, hi, "%.4f", tip)
-                if ch:
-                    lab.set_number(key, value)
-                    changed = True
+            changed |= self._draw_surface_sliders(host)
         if changed:
             self.sync(host)
             host.refresh()
@@ -285,6 +255,43 @@ class CurvatureLabPanel(Panel):
             self._draw_convergence(host, lab.convergence())
         if draw_isolines(ui, self.isolines, lab.show):  # last: the plots above stay in view
             self.sync(host)
+
+    def _draw_surface_sliders(self, host: Host) -> bool:
+        """The parametric surface, its resolution, noise, jitter and edge flips; True when
+        one changed."""
+        ui, lab = host.ui, self.state
+        changed = False
+        ch, value = ui.combo("lab surface", lab.surface, tuple(SURFACES), "the parametric surface")
+        if ch:
+            lab.set_choice("surface", value)
+            changed = True
+        for what, lo, hi, tip in (
+            ("resolution", 3, MAX_RES, "cells per direction (the torus: twice around)"),
+        ):
+            ch, value = ui.slider_int(what, lab.res, lo, hi, tip)
+            if ch:
+                lab.set_number("res", value)
+                changed = True
+        for what, key, hi, tip in (
+            (
+                "noise",
+                "noise",
+                MAX_NOISE,
+                "normal noise, a fraction of the bounding-box diagonal",
+            ),
+            (
+                "jitter",
+                "jitter",
+                MAX_JITTER,
+                "parameter jitter of interior vertices, a fraction of a cell",
+            ),
+            ("edge flips", "flips", 1.0, "fraction of the interior edges flipped"),
+        ):
+            ch, value = ui.slider_float(what, getattr(lab, key), 0.0, hi, "%.4f", tip)
+            if ch:
+                lab.set_number(key, value)
+                changed = True
+        return changed
 
     def _draw_shape_operator(self, host: Host) -> None:
         """The picked vertex's 2×2 tensor with its basis and Euler's κn(θ), exact beside it."""

@@ -22,6 +22,7 @@ from meshlap_core.options import (
     CURVATURE_ESTIMATORS,
     CURVATURE_FIELD_LABELS,
     CURVATURE_FIELDS,
+    PRINCIPAL_FIELDS,
     check_choice,
 )
 from meshlap_core.principal import PrincipalCurvatures
@@ -178,7 +179,7 @@ class CurvatureState:
         """The field ``name`` as shown: ``k1`` and ``k2`` from the chosen estimator (once
         computed; the cotan fields' until then and for ``cotan``), the others as computed."""
         p, mesh_version = self.principal, self._key[:1]
-        if name in ("k1", "k2") and self.estimator != "cotan" and p is not None:
+        if name in PRINCIPAL_FIELDS[:2] and self.estimator != "cotan" and p is not None:
             if self._pkey[:2] == (*mesh_version, self.estimator):
                 return p.k1 if name == "k1" else p.k2
         return self.fields[name]

@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 
 from meshlap_core.curvature import vertex_normals
-from meshlap_core.curvature_estimators import disagreement, estimate_curvature
+from meshlap_core.curvature_estimators import PATCH_RINGS, disagreement, estimate_curvature
 from meshlap_core.curvature_study import (
     ExactPrincipal,
     curvature_study,
@@ -46,10 +46,11 @@ KEEP_BASES = 6
 KEEP_ESTIMATES = 8
 """Estimates kept (per surface, resolution, jitter, noise, flips and estimator): a quantity or
 *show* move, or a slider moved back, recolours without re-running the estimator."""
-LIGHT_ESTIMATORS = ("cotan", "rusinkiewicz", "normal_cycle")
-"""The tensor estimators (about 0.1 s at 32k vertices): the lab runs them in a thread, not a
-child process, whose start, imports and 13 MB of pickles cost ~1 s per move (the window's
-``Jobs.processes``; measured in ``benchmarks/bench_curvature.py --only lab``)."""
+LIGHT_ESTIMATORS = tuple(e for e, rings in PATCH_RINGS.items() if rings is not None)
+"""The tensor estimators (cotan, Rusinkiewicz, normal cycle: a fixed patch of rings, about
+0.1 s at 32k vertices): the lab runs them in a thread, not a child process, whose start,
+imports and 13 MB of pickles cost 0.3-1 s per move (the window's ``Jobs.processes``; measured
+in ``benchmarks/bench_curvature.py --only window``)."""
 LIGHT_RES = 128
 """Largest resolution run in a thread (the torus: 32,768 vertices; numpy releases the GIL,
 the window's longest gap measured 0.02-0.12 s under load)."""
@@ -362,7 +363,7 @@ class CurvatureLabState:
         F = np.asarray(F, dtype=np.int64)
         q, est = params["quantity"], params["estimator"]
         r = estimate_curvature(V, F, est)
-        crosses = crosses_of(r)
+        crosses = crosses_of(r, None, cross_length(V, F))
         if params["show"] == "disagreement":
             values = _disagreement(V, F, q)
             label = f"{q} disagreement (max - min)"
@@ -461,7 +462,7 @@ def _surface_result(
         Fs = m.F
         r = estimate_curvature(Vs, Fs, est)
     if crosses is None:
-        crosses = crosses_of(r, base.exact.d1)
+        crosses = crosses_of(r, base.exact.d1, cross_length(Vs, Fs))
     ex = base.exact
     exact = PrincipalCurvatures(ex.k1, ex.k2, ex.d1, ex.d2, np.zeros_like(ex.d1), "exact")
     compared = ex.compared
@@ -567,9 +568,23 @@ def cross_field(
     return _in_basis(d, k, t1, t2), t1, t2
 
 
-def crosses_of(p: PrincipalCurvatures, exact_d1: FloatArray | None = None) -> Crosses:
+def crosses_of(
+    p: PrincipalCurvatures, exact_d1: FloatArray | None = None, length: float = 1.0
+) -> Crosses:
     """Both principal directions (and the exact ``d1`` when given) as :func:`cross_field`
-    gives them, sharing one tangent basis."""
+    gives them, sharing one tangent basis, times ``length`` (the world length of a cross arm
+    at the largest ``|k|``: drawn as ambient vectors, a cross stays inside its vertex's cell
+    on a coarse or a fine mesh alike)."""
     t1, t2 = tangent_frames(p.normal)
-    exact = None if exact_d1 is None else _in_basis(exact_d1, p.k1, t1, t2)
-    return Crosses(t1, t2, _in_basis(p.d1, p.k1, t1, t2), _in_basis(p.d2, p.k2, t1, t2), exact)
+    exact = None if exact_d1 is None else length * _in_basis(exact_d1, p.k1, t1, t2)
+    k1, k2 = _in_basis(p.d1, p.k1, t1, t2), _in_basis(p.d2, p.k2, t1, t2)
+    return Crosses(t1, t2, length * k1, length * k2, exact)
+
+
+def cross_length(V: FloatArray, F: IntArray) -> float:
+    """A cross arm's world length: 0.4 of the mean edge length (one cross per vertex, no
+    overlap with the neighbours')."""
+    if len(F) == 0:
+        return 1.0
+    e = V[F[:, [1, 2, 0]]] - V[F]
+    return 0.4 * float(np.sqrt(np.einsum("ijk,ijk->ij", e, e)).mean())

@@ -419,12 +419,12 @@ def _positive(x: float, name: str) -> float:
 SURFACES: Mapping[str, Callable[..., ParametricSurface]] = {
     "helicoid": helicoid,
     "sphere": sphere,
-    "ellipsoid": ellipsoid,
     "torus": torus,
     "catenoid": catenoid,
     "saddle": saddle,
     "monkey_saddle": monkey_saddle,
     "cylinder": cylinder,
+    "ellipsoid": ellipsoid,
 }
 """Factories of the shipped surfaces by name; ``helicoid`` is the default."""
 
