@@ -320,9 +320,9 @@ class CurvatureLabState:
         return self.bases.get(base_key(self.params()))
 
     def estimate(self) -> Estimate | None:
-        """The cached estimate for the current settings (``None``: not computed yet, or the
-        loaded mesh)."""
-        if self.source != "surface":
+        """The cached estimate for the current settings (``None``: not computed yet, its exact
+        surface no longer cached, or the loaded mesh)."""
+        if self.source != "surface" or self.base() is None:  # its exact values are needed
             return None
         return self.estimates.get(estimate_key(self.params()))
 
