@@ -41,6 +41,9 @@ SESSION: Schema = {
     "estimator": ("cotan", one_of(CURVATURE_ESTIMATORS)),
 }
 """The Curvature panel's section of a saved session (:mod:`.session`)."""
+SESSION_ADDED = ("estimator",)
+"""Keys newer than the first session files: written only when not the default (cotan), so a
+session that does not need it stays readable by an older meshlap."""
 
 ESTIMATOR_HELP = "\n".join(f"{k}: {v}" for k, v in CURVATURE_ESTIMATOR_LABELS.items())
 """The estimator combo's tooltip: every estimator with its paper."""
