@@ -626,6 +626,7 @@ def test_added_keys_are_written_only_when_they_say_something(tmp_path, sphere):
         ("smoothing", "lam_steps"): [[0.5, 2], [0.25, 3]],
         ("spectral", "play"): "modes",
         ("surfaces", "theta"): 30.0,
+        ("curvature", "estimator"): "rusinkiewicz",
     }
     assert read_session(tmp_path / "all.json") == s
 
