@@ -23,6 +23,7 @@ from meshlap_core.io import save_mesh
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "docs" / "img"
 ARMADILLO = ROOT.parent / "shared" / "meshes" / "armadillo.obj"
+SCAN = ROOT.parent / "shared" / "meshes" / "armadillo_igl.obj"
 
 SHOTS = {
     "curvature": [str(ROOT / "assets" / "bumpy.obj"), "--panel", "curvature", "--field", "cotan"],
@@ -83,6 +84,56 @@ def perturbed_grid(seed: int = 3) -> tuple[np.ndarray, np.ndarray]:
     return V, F
 
 
+def directions_session(folder: Path) -> Path | None:
+    """A session opening the curvature lab on the armadillo_igl scan: the Rusinkiewicz
+    estimator's H with its principal directions as crosses (black k1, green k2)."""
+    if not SCAN.is_file():
+        return None
+    from meshlap_app.state.session import Session, write_session
+
+    s = Session(mesh=SCAN, panel="curvature_lab", camera=closeup_camera(folder))
+    s.settings["curvature_lab"].update(
+        {"source": "mesh", "estimator": "rusinkiewicz", "quantity": "H", "show": "estimate"}
+    )
+    return write_session(folder / "directions.json", s)
+
+
+CLOSEUP = """
+import json, sys
+import numpy as np
+import polyscope as ps
+from meshlap_app.state.camera import captured
+from meshlap_app.viewer import init_polyscope
+from meshlap_core.io import load_mesh
+m = load_mesh(sys.argv[1])
+init_polyscope("openGL3_egl")
+ps.register_surface_mesh("m", m.V, m.F)
+lo, hi = m.V.min(0), m.V.max(0)
+c = 0.5 * (lo + hi)
+top = (m.V[:, 1] > lo[1] + 0.7 * (hi[1] - lo[1])) & (abs(m.V[:, 0] - c[0]) < 0.12 * (hi[0] - lo[0]))
+d = np.linalg.norm(hi - lo)
+head = m.V[top].mean(0) + np.array([0.09, 0.0, 0.0]) * d  # the head left of the panel
+ps.look_at(head + np.array([-0.1, 0.05, 0.42]) * d, head)
+print(json.dumps(captured(json.loads(ps.get_view_as_json()))))
+"""
+"""Run in a child process (EGL): the camera looking at the scan's head (the middle of its top
+third, between the raised hands) from the front."""
+
+
+def closeup_camera(folder: Path) -> dict:
+    """polyscope's view of :data:`SCAN`'s head (a session's camera, :data:`CLOSEUP`)."""
+    import json
+
+    out = subprocess.run(
+        [sys.executable, "-c", CLOSEUP, str(SCAN)],
+        check=True,
+        cwd=folder,
+        capture_output=True,
+        text=True,
+    )
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
 def main() -> None:
     OUT.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory() as tmp:  # polyscope writes .ini files into the cwd
@@ -95,6 +146,9 @@ def main() -> None:
             bumpy, "--panel", "diffusion", "--vertex", str(DIFFUSION_VERTEX),
         ]  # fmt: skip
         shots["diffusion_heat"] = ["--session", str(heat_session(Path(tmp)))]
+        session = directions_session(Path(tmp))
+        if session is not None:  # principal directions on a scan
+            shots["curvature_directions"] = ["--session", str(session)]
         only = sys.argv[1:]  # names of the shots to take (all when none)
         for name, args in shots.items():
             if only and name not in only:

@@ -121,21 +121,26 @@ def _chunk(
     x = D[0] * t1[i, 0] + D[1] * t1[i, 1] + D[2] * t1[i, 2]
     y = D[0] * t2[i, 0] + D[1] * t2[i, 1] + D[2] * t2[i, 2]
     z = D[0] * nrm[i, 0] + D[1] * nrm[i, 1] + D[2] * nrm[i, 2]
-    xx, xy, yy = 0.5 * x * x, x * y, 0.5 * y * y
-    basis = [None, x, y, xx, xy, yy]
-    cols = [x, y, xx, xy, yy]  # products with the constant 1
-    iu = [(a, b) for a in range(1, 6) for b in range(a, 6)]
-    cols += [basis[a] * basis[b] for a, b in iu]  # type: ignore[operator]
-    cols += [z] + [q * z for q in basis[1:]]  # type: ignore[operator]
-    sums = _sums(S, cols)
-    W = np.asarray(S.sum(axis=1)).ravel()
-    A = np.zeros((m, 6, 6))
-    A[:, 0, 0] = W
-    for k in range(5):
-        A[:, 0, k + 1] = A[:, k + 1, 0] = sums[:, k]
-    for k, (a, b) in enumerate(iu):
-        A[:, a, b] = A[:, b, a] = sums[:, 5 + k]
-    rhs = sums[:, 5 + len(iu) :]
+    # the normal equations of the basis (1, x, y, x²/2, xy, y²/2) hold the weighted moments
+    # Σ w xᵖ yᵠ for p + q ≤ 4: 14 distinct ones (not the 20 products of basis pairs)
+    x2, xy, y2 = x * x, x * y, y * y
+    mono = {(1, 0): x, (0, 1): y, (2, 0): x2, (1, 1): xy, (0, 2): y2}
+    mono |= {(3, 0): x2 * x, (2, 1): x2 * y, (1, 2): x * y2, (0, 3): y2 * y}
+    mono |= {(4, 0): x2 * x2, (3, 1): x2 * xy, (2, 2): x2 * y2, (1, 3): xy * y2, (0, 4): y2 * y2}
+    powers = list(mono)
+    zs = [z, x * z, y * z, 0.5 * x2 * z, xy * z, 0.5 * y2 * z]
+    sums = _sums(S, [mono[k] for k in powers] + zs)
+    moment = {k: sums[:, c] for c, k in enumerate(powers)}
+    moment[(0, 0)] = np.asarray(S.sum(axis=1)).ravel()
+    # basis function k is coef[k] · x^px y^py
+    exps = [(0, 0), (1, 0), (0, 1), (2, 0), (1, 1), (0, 2)]
+    coefs = [1.0, 1.0, 1.0, 0.5, 1.0, 0.5]
+    A = np.empty((m, 6, 6))
+    for a in range(6):
+        for b in range(a, 6):
+            e = (exps[a][0] + exps[b][0], exps[a][1] + exps[b][1])
+            A[:, a, b] = A[:, b, a] = coefs[a] * coefs[b] * moment[e]
+    rhs = sums[:, len(powers) :]
     A += 1e-10 * np.eye(6) * (np.trace(A, axis1=1, axis2=2)[:, None, None] + 1e-300)
     cnt = np.bincount(i, minlength=m)
     coef = np.linalg.solve(A, rhs[:, :, None])[:, :, 0]

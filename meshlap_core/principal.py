@@ -56,6 +56,25 @@ class PrincipalCurvatures:
             return np.maximum(np.abs(self.k1), np.abs(self.k2))
         return np.asarray(getattr(self, name))
 
+    def shape_operator(self, i: int) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """The discrete shape operator at vertex ``i`` as a symmetric 2×2 tensor
+        ``S = k1 c1 c1ᵀ + k2 c2 c2ᵀ`` in the tangent basis ``(t1, t2)`` of its normal
+        (:func:`tangent_frames`; ``c1``, ``c2`` are ``d1``, ``d2`` in that basis): its
+        eigenvalues are ``k1 ≥ k2`` and Euler's formula reads ``κn(θ) = uᵀ S u`` for the unit
+        tangent ``u = (cos θ, sin θ)``.
+
+        Returns
+        -------
+        S : (2,2) float
+        t1, t2 : (3,) float
+            The basis, ``t1 × t2 = normal[i]``.
+        """
+        t1, t2 = tangent_frames(self.normal[i : i + 1])
+        c1 = np.array([self.d1[i] @ t1[0], self.d1[i] @ t2[0]])
+        c2 = np.array([self.d2[i] @ t1[0], self.d2[i] @ t2[0]])
+        S = self.k1[i] * np.outer(c1, c1) + self.k2[i] * np.outer(c2, c2)
+        return S, t1[0], t2[0]
+
 
 def tangent_frames(N: FloatArray) -> tuple[FloatArray, FloatArray]:
     """An orthonormal tangent basis ``(t1, t2)`` per unit normal, ``t1 × t2 = n``.

@@ -6,7 +6,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from meshlap_app.state.curvature_lab import STUDY_LEVELS, CurvatureLabState, cross_field
+from meshlap_app.state.curvature_lab import (
+    STUDY_LEVELS,
+    CurvatureLabState,
+    cross_field,
+    crosses_of,
+)
 
 from meshlap_core import curvature_estimators as ce
 from meshlap_core import primitives
@@ -123,6 +128,48 @@ def test_cross_field_is_the_direction_in_the_tangent_basis():
     np.testing.assert_allclose(np.sum(bx * p.normal, axis=1), 0, atol=1e-12)
 
 
+def test_a_quantity_move_recolours_the_cached_estimate():
+    """The estimate is kept per (surface, res, jitter, noise, flips, estimator): a quantity or
+    show move gives the same values as a fresh computation without running the estimator."""
+    lab = CurvatureLabState()
+    lab.set_number("res", 12)
+    lab.set_number("noise", 0.002)
+    assert lab.estimate() is None and lab.light()  # cotan: a thread of the window
+    lab.adopt(lab.inputs(0), _compute(lab))
+    est = lab.estimate()
+    assert est is not None and est.principal is lab.result.principal
+    lab.set_choice("quantity", "K")
+    cached = CurvatureLabState.compute(lab.params(), None, None, lab.base(), None, est)
+    assert cached.principal is est.principal and cached.crosses is est.crosses
+    np.testing.assert_array_equal(cached.values, _compute(lab).values)
+    # an estimate for other settings is never used by mistake
+    lab.set_number("noise", 0.001)
+    assert lab.estimate() is None
+    other = CurvatureLabState.compute(lab.params(), None, None, lab.base(), None, est)
+    assert other.principal is not est.principal
+    np.testing.assert_array_equal(other.values, _compute(lab).values)
+    # the slow estimators and the disagreement of all of them stay in a child process
+    lab.set_choice("estimator", "jet")
+    assert not lab.light()
+    lab.set_choice("estimator", "cotan")
+    lab.set_choice("show", "disagreement")
+    assert not lab.light()
+
+
+def test_crosses_share_one_basis_and_equal_cross_field():
+    V, F = primitives.torus_mesh(24, 12)
+    p = ce.estimate_curvature(V, F, "cotan")
+    c = crosses_of(p, p.d2)
+    for which, vals in ((1, c.k1), (2, c.k2)):
+        ref, bx, by = cross_field(p, which)
+        np.testing.assert_allclose(vals, ref, atol=1e-12)
+        np.testing.assert_allclose(c.basis_x, bx)
+        np.testing.assert_allclose(c.basis_y, by)
+    # the exact direction (d2 here) is scaled as k1's cross and orthogonal to it
+    np.testing.assert_allclose(np.linalg.norm(c.exact, axis=1), np.linalg.norm(c.k1, axis=1))
+    np.testing.assert_allclose(np.sum(c.exact * c.k1, axis=1), 0, atol=1e-12)
+
+
 # ---------------------------------------------------------------- widgets (openGL_mock)
 ps = pytest.importorskip("polyscope")
 
@@ -173,12 +220,18 @@ def drive_panel_curvature_lab(viewer, tmp_path=None) -> None:
     drive(viewer, "noise", -1.0)
     assert lab.noise == 0.001 and "noise" in viewer.state.errors["curvature_lab"]
     drive(viewer, "estimator", "rusinkiewicz")
+    principal = lab.result.principal
     drive(viewer, "quantity", "k1")
+    assert lab.result.principal is principal  # recoloured, the estimator not run again
     drive(viewer, "show", "estimate")
     assert lab.result.label == "k1 (rusinkiewicz)"
     np.testing.assert_allclose(lab.result.values, lab.result.principal.k1)
     drive(viewer, "lab surface", "saddle")
     assert lab.result.V.shape[0] == 13 * 13
+    drive(viewer, "lab surface", "ellipsoid")  # its exact curvature is the closed form
+    k1 = lab.result.exact[0]
+    assert np.isfinite(k1).sum() == len(k1) - 2  # all but the two poles
+    drive(viewer, "lab surface", "saddle")
     drive(viewer, "crosses", False)
     drive(viewer, "crosses", True)
     drive(viewer, "source", "mesh")
@@ -191,3 +244,43 @@ def drive_panel_curvature_lab(viewer, tmp_path=None) -> None:
 
 def test_curvature_lab_widgets(viewer):
     drive_panel_curvature_lab(viewer)
+
+
+def drive_curvature_estimator(viewer) -> None:
+    """The Curvature view's estimator combo (k1, k2 from the chosen estimator, a bad name
+    refused) and the One-ring view's shape-operator row at a vertex (run by
+    ``drive_panel_curvature`` of the every-widget tour)."""
+    from meshlap_app.state.curvature import ESTIMATOR_HELP
+
+    viewer.set_panel("curvature")
+    c, mesh = viewer.state.curv, viewer.state.mesh
+    assert all(f"{e}:" in ESTIMATOR_HELP for e in ce.ESTIMATOR_FUNCTIONS)  # each with its paper
+    assert "Rusinkiewicz 2004" in ESTIMATOR_HELP and "Meyer et al. 2003" in ESTIMATOR_HELP
+    drive(viewer, "field", "k1")
+    drive(viewer, "estimator", "rusinkiewicz")
+    ref = ce.estimate_curvature(mesh.V, mesh.F, "rusinkiewicz")
+    np.testing.assert_allclose(c.values("k1"), ref.k1, atol=1e-12)
+    np.testing.assert_allclose(c.values("k2"), ref.k2, atol=1e-12)
+    assert c.summary("k1")["max"] == pytest.approx(ref.k1.max())
+    with pytest.raises(MeshError, match="estimator"):
+        c.set_estimator("magic")
+    assert c.estimator == "rusinkiewicz"
+    # the One-ring view's row: the estimator's 2x2 tensor at the vertex, in its basis
+    drive(viewer, "vertex", 7, panel="onering")
+    so = c.shape_operator(mesh, 7)
+    S, t1, _ = ref.shape_operator(7)
+    np.testing.assert_allclose(so["S"], S, atol=1e-12)
+    np.testing.assert_allclose(so["t1"], t1)
+    assert so["k1"] == pytest.approx(ref.k1[7]) and so["estimator"] == "rusinkiewicz"
+    drive(viewer, "estimator", "jet", panel="curvature")  # the whole mesh's run (inline here)
+    assert c.principal_current(mesh) and c.principal.estimator == "jet"
+    viewer.set_panel("onering")
+    frames(viewer, 1)
+    np.testing.assert_allclose(c.shape_operator(mesh, 7)["k1"], c.principal.k1[7])
+    drive(viewer, "estimator", "cotan", panel="curvature")
+    np.testing.assert_array_equal(c.values("k1"), c.fields["k1"])  # cotan: the course fields
+    drive(viewer, "field", "cotan")
+
+
+def test_curvature_estimator_widgets(viewer):
+    drive_curvature_estimator(viewer)

@@ -47,6 +47,7 @@ def non_default_session(mesh) -> Session:
             "clip": 7.5,
             "side_by_side": True,
             "second_field": "k1",
+            "estimator": "rusinkiewicz",
         },
         "onering": {"vertex": 17, "reverse": True},
         "spectral": {"computed": True, "k_request": 24, "k": 9, "mode": 4, "play": "modes"},
@@ -626,6 +627,7 @@ def test_added_keys_are_written_only_when_they_say_something(tmp_path, sphere):
         ("smoothing", "lam_steps"): [[0.5, 2], [0.25, 3]],
         ("spectral", "play"): "modes",
         ("surfaces", "theta"): 30.0,
+        ("curvature", "estimator"): "rusinkiewicz",
     }
     assert read_session(tmp_path / "all.json") == s
 

@@ -547,8 +547,9 @@ def test_cli_plot_mesh_and_convergence(tmp_path, capsys) -> None:
 
 def _expected_singular(name: str, u: np.ndarray, v: np.ndarray) -> np.ndarray:
     """Where each catalogue surface (default parameters) degenerates, worked out by hand:
-    only the sphere's two poles (|p_u × p_v| = r² sin u)."""
-    if name == "sphere":
+    only the sphere's and the ellipsoid's two poles (|p_u × p_v| = r² sin u, resp.
+    sin u · |(bc sin u cos v, ac sin u sin v, ab cos u)|)."""
+    if name in ("sphere", "ellipsoid"):
         return (u == 0.0) | (u == np.pi)
     return np.zeros(np.broadcast(u, v).shape, dtype=bool)
 

@@ -530,6 +530,9 @@ def drive_panel_mesh_info(viewer, tmp_path: Path) -> None:
 def drive_panel_curvature(viewer, tmp_path: Path) -> None:
     test_view_combo_switches_every_panel(viewer)
     test_curvature_widgets(viewer)
+    from test_curvature_lab import drive_curvature_estimator  # estimator, shape operator
+
+    drive_curvature_estimator(viewer)
 
 
 def drive_panel_onering(viewer, tmp_path: Path) -> None:

@@ -8,10 +8,16 @@ import numpy as np
 import polyscope as ps
 
 from meshlap_core.options import AREA_KINDS as AREAS
-from meshlap_core.options import BOUNDARY_RULES, CURVATURE_FIELD_LABELS
+from meshlap_core.options import (
+    BOUNDARY_RULES,
+    CURVATURE_ESTIMATORS,
+    CURVATURE_FIELD_LABELS,
+    PRINCIPAL_FIELDS,
+)
 
 from ..isolines import draw_isolines
 from ..scene import MESH, MESH_B, colorbar_at, front_view, scalar_for_upload, side_offset
+from ..state.curvature import ESTIMATOR_HELP, PRINCIPAL_JOB
 from .base import Host, Panel
 
 FIELD_HELP = (
@@ -68,6 +74,7 @@ class CurvaturePanel(Panel):
             "clip": float(c.percentile),
             "side_by_side": bool(c.side_by_side),
             "second_field": c.second_field,
+            "estimator": c.estimator,
         }
 
     def configure(self, host: Host, values: dict[str, Any]) -> None:
@@ -75,6 +82,7 @@ class CurvaturePanel(Panel):
         c.field_name, c.area, c.boundary = values["field"], values["area"], values["boundary"]
         c.set_percentile(values["clip"])
         c.side_by_side, c.second_field = values["side_by_side"], values["second_field"]
+        c.set_estimator(values["estimator"])
 
     def start(self, host: Host, options: dict[str, Any], shown: bool, screenshot: bool) -> None:
         if options.get("field") is not None:
@@ -90,6 +98,8 @@ class CurvaturePanel(Panel):
             return
         if not self.fields_ready(host):
             return  # a job computes them: the map on screen stays until they arrive
+        if curv.estimator != "cotan":  # k1, k2 stay cotan's until the estimator's arrive
+            curv.want_principal(mesh, host.state.jobs, bool(host.background))
         key = (
             mesh.version,
             curv.area,
@@ -102,6 +112,8 @@ class CurvaturePanel(Panel):
             host.active() is self,  # the copy (and its colour bar) only in this view
             host.state.ui_scale,
             repr(self.isolines),
+            curv.estimator,
+            curv.principal_inputs(mesh) if curv.principal_current(mesh) else None,
         )
         if not self.watch.changed("uploaded", *key):
             return
@@ -163,7 +175,9 @@ class CurvaturePanel(Panel):
         curv = host.state.curv
         label, signed = CURVATURE_FIELD_LABELS[name]
         label += " [1/length^2]" if name == "gaussian" else " [1/length]"
-        values, (lo, hi), factor = scalar_for_upload(curv.fields[name], curv.color_range(name))
+        values, (lo, hi), factor = scalar_for_upload(curv.values(name), curv.color_range(name))
+        if name in PRINCIPAL_FIELDS[:2] and curv.estimator != "cotan":
+            label += f" ({curv.estimator})"
         sm.add_scalar_quantity(
             label + factor,
             values,
@@ -181,9 +195,20 @@ class CurvaturePanel(Panel):
         if not ui.header(self.title):
             return
         host.draw_job(self.name)  # new area or boundary rule: the fields' progress, Cancel
+        host.draw_job(PRINCIPAL_JOB)  # the estimator's run (k1, k2 and directions)
         c = host.state.curv
         names = tuple(CURVATURE_FIELD_LABELS)
         ch1, c.field_name = ui.combo("field", c.field_name, names, FIELD_HELP)
+        ch7, estimator = ui.combo(
+            "estimator",
+            c.estimator,
+            CURVATURE_ESTIMATORS,
+            "k1, k2 (and the One-ring view's shape operator) by:\n" + ESTIMATOR_HELP,
+        )
+        if ch7:
+            c.set_estimator(estimator)
+        if c.principal_error:
+            ui.error(f"{c.estimator}: {c.principal_error}")
         ch2, c.area = ui.combo(
             "area", c.area, AREAS, "vertex area A_i: barycentric (1/3 of each face) or Voronoi"
         )
@@ -212,7 +237,7 @@ class CurvaturePanel(Panel):
                 "second field", c.second_field, names, "the field on the copy"
             )
         ch6 = draw_isolines(ui, self.isolines, c.field_name)
-        if ch1 or ch2 or ch3 or ch4 or ch5 or ch6:
+        if ch1 or ch2 or ch3 or ch4 or ch5 or ch6 or ch7:
             self.sync(host)
             host.refresh()
         if ch5:

@@ -27,15 +27,14 @@ from ..state.curvature_lab import (
     STUDY_LEVELS,
     CurvatureLabState,
     LabResult,
-    cross_field,
 )
 from .base import Host, Panel
 
 LAB = "curvature lab"
 """The lab's surface mesh (the parametric surface's, or a copy of the loaded mesh)."""
-K1_COLOR = (0.85, 0.15, 0.1)
-K2_COLOR = (0.1, 0.3, 0.85)
-EXACT_COLOR = (0.1, 0.1, 0.1)
+K1_COLOR = (0.05, 0.05, 0.05)  # not in the coolwarm / viridis maps under them
+K2_COLOR = (0.0, 0.6, 0.25)
+EXACT_COLOR = (0.85, 0.1, 0.85)
 
 
 class CurvatureLabPanel(Panel):
@@ -50,6 +49,7 @@ class CurvatureLabPanel(Panel):
         super().__init__(name, state)
         self.state: CurvatureLabState = state
         self._study_for: tuple[Any, ...] | None = None  # the study job's inputs
+        self._field: str | None = None  # the scalar quantity on the lab's mesh
 
     def on_new_mesh(self, host: Host) -> None:
         self.watch.forget()
@@ -66,7 +66,7 @@ class CurvatureLabPanel(Panel):
             self.sync(host)
         elif ps.has_surface_mesh(LAB):  # hidden, its colour bar would stay on screen
             ps.remove_surface_mesh(LAB)
-            self.watch.forget("uploaded")
+            self.watch.forget("uploaded", "shape")
 
     def points(self, host: Host, name: str) -> np.ndarray | None:
         r = self.state.result
@@ -106,9 +106,16 @@ class CurvatureLabPanel(Panel):
             self._start_study(host, key)
         r = lab.result
         lines = repr(self.isolines)
-        if r is None or not self.watch.changed("uploaded", lab.computed_for, lab.crosses, lines):
+        if r is None:
             return
-        self._upload(host, r)
+        # the mesh and its crosses only when the estimate changed; a quantity or show move
+        # (the same estimate) re-colours the mesh on screen
+        shape = (r.estimate_key or lab.computed_for, lab.crosses)
+        if self.watch.changed("shape", shape) or not ps.has_surface_mesh(LAB):
+            self.watch.forget("uploaded")
+            self._upload_shape(r)
+        if self.watch.changed("uploaded", lab.computed_for, lines):
+            self._upload_field(r)
 
     @property
     def study_owner(self) -> str:
@@ -126,13 +133,20 @@ class CurvatureLabPanel(Panel):
             lab.computed_for = wanted  # not retried until an input changes
             host.state.errors[self.name] = message
 
+        base, estimate = lab.base(), lab.estimate()
+        if lab.light():  # a thread (or inline when only the colours change): no child process
+            work = lambda reporter: lab.compute(  # noqa: E731
+                params, mesh.V, mesh.F, base, reporter, estimate
+            )
+        else:
+            work = jobs.offload(lab.compute, params, mesh.V, mesh.F, base)
         jobs.start(
             self.name,
             f"curvature lab ({lab.estimator}, {lab.show})",
-            jobs.offload(lab.compute, params, mesh.V, mesh.F, lab.base()),
+            work,
             apply,
             fail,
-            background=bool(host.background),
+            background=bool(host.background) and (estimate is None or lab.show == "disagreement"),
         )
 
     def _start_study(self, host: Host, key: tuple[Any, ...]) -> None:
@@ -152,8 +166,30 @@ class CurvatureLabPanel(Panel):
             background=bool(host.background),
         )
 
-    def _upload(self, host: Host, r: LabResult) -> None:
+    def _upload_shape(self, r: LabResult) -> None:
+        """The lab's mesh and its crosses (black k1, green k2; the exact k1 hidden)."""
         sm = ps.register_surface_mesh(LAB, r.V, r.F, smooth_shade=True)
+        self._field = None
+        c = r.crosses
+        if not self.state.crosses or c is None:
+            return
+        for name, vals, color, on in (
+            ("k1 direction (max)", c.k1, K1_COLOR, True),
+            ("k2 direction (min)", c.k2, K2_COLOR, True),
+            ("exact k1 direction", c.exact, EXACT_COLOR, False),
+        ):
+            if vals is not None:
+                sm.add_tangent_vector_quantity(
+                    name, vals, c.basis_x, c.basis_y, n_sym=2, vectortype="ambient",
+                    enabled=on, color=color, radius=0.0012,
+                )  # fmt: skip
+
+    def _upload_field(self, r: LabResult) -> None:
+        """The coloured field (the previous one removed: one scalar quantity at a time)."""
+        sm = ps.get_surface_mesh(LAB)
+        if self._field is not None and self._field != r.label:
+            sm.remove_quantity(self._field)
+        self._field = r.label
         v = np.asarray(r.values, dtype=np.float64)
         top = float(np.percentile(np.abs(v), 98)) if v.size else 1.0
         top = top if top > 0 else 1.0
@@ -168,31 +204,6 @@ class CurvatureLabPanel(Panel):
             onscreen_colorbar_location=COLORBAR_AT,
             **self.isolines.options(self.state.show, v),
         )
-        if not self.state.crosses:
-            return
-        for which, name, color in (
-            (1, "k1 direction (max)", K1_COLOR),
-            (2, "k2 direction (min)", K2_COLOR),
-        ):
-            vals, bx, by = cross_field(r.principal, which)
-            sm.add_tangent_vector_quantity(
-                name, vals, bx, by, n_sym=2, enabled=True, color=color, radius=0.0015
-            )
-        if r.exact_d1 is not None:
-            vals, bx, by = cross_field(
-                type(r.principal)(
-                    r.principal.k1,
-                    r.principal.k2,
-                    r.exact_d1,
-                    r.exact_d1,
-                    r.principal.normal,
-                    "exact",
-                ),
-                1,
-            )
-            sm.add_tangent_vector_quantity(
-                "exact k1 direction", vals, bx, by, n_sym=2, enabled=False, color=EXACT_COLOR
-            )
 
     def draw(self, host: Host) -> None:
         ui = host.ui
@@ -228,42 +239,12 @@ class CurvatureLabPanel(Panel):
         ch, lab.crosses = ui.checkbox(
             "crosses",
             lab.crosses,
-            "principal directions: red k1 (max), blue k2 (min), length by |k|",
+            "principal directions: black k1 (max), green k2 (min), length by |k| "
+            "(the exact k1 in magenta, off by default)",
         )
         changed |= ch
         if lab.source == "surface":
-            ch, value = ui.combo(
-                "lab surface", lab.surface, tuple(SURFACES), "the parametric surface"
-            )
-            if ch:
-                lab.set_choice("surface", value)
-                changed = True
-            for what, lo, hi, tip in (
-                ("resolution", 3, MAX_RES, "cells per direction (the torus: twice around)"),
-            ):
-                ch, value = ui.slider_int(what, lab.res, lo, hi, tip)
-                if ch:
-                    lab.set_number("res", value)
-                    changed = True
-            for what, key, hi, tip in (
-                (
-                    "noise",
-                    "noise",
-                    MAX_NOISE,
-                    "normal noise, a fraction of the bounding-box diagonal",
-                ),
-                (
-                    "jitter",
-                    "jitter",
-                    MAX_JITTER,
-                    "parameter jitter of interior vertices, a fraction of a cell",
-                ),
-                ("edge flips", "flips", 1.0, "fraction of the interior edges flipped"),
-            ):
-                ch, value = ui.slider_float(what, getattr(lab, key), 0.0, hi, "%.4f", tip)
-                if ch:
-                    lab.set_number(key, value)
-                    changed = True
+            changed |= self._draw_surface_sliders(host)
         if changed:
             self.sync(host)
             host.refresh()
@@ -274,6 +255,43 @@ class CurvatureLabPanel(Panel):
             self._draw_convergence(host, lab.convergence())
         if draw_isolines(ui, self.isolines, lab.show):  # last: the plots above stay in view
             self.sync(host)
+
+    def _draw_surface_sliders(self, host: Host) -> bool:
+        """The parametric surface, its resolution, noise, jitter and edge flips; True when
+        one changed."""
+        ui, lab = host.ui, self.state
+        changed = False
+        ch, value = ui.combo("lab surface", lab.surface, tuple(SURFACES), "the parametric surface")
+        if ch:
+            lab.set_choice("surface", value)
+            changed = True
+        for what, lo, hi, tip in (
+            ("resolution", 3, MAX_RES, "cells per direction (the torus: twice around)"),
+        ):
+            ch, value = ui.slider_int(what, lab.res, lo, hi, tip)
+            if ch:
+                lab.set_number("res", value)
+                changed = True
+        for what, key, hi, tip in (
+            (
+                "noise",
+                "noise",
+                MAX_NOISE,
+                "normal noise, a fraction of the bounding-box diagonal",
+            ),
+            (
+                "jitter",
+                "jitter",
+                MAX_JITTER,
+                "parameter jitter of interior vertices, a fraction of a cell",
+            ),
+            ("edge flips", "flips", 1.0, "fraction of the interior edges flipped"),
+        ):
+            ch, value = ui.slider_float(what, getattr(lab, key), 0.0, hi, "%.4f", tip)
+            if ch:
+                lab.set_number(key, value)
+                changed = True
+        return changed
 
     def _draw_shape_operator(self, host: Host) -> None:
         """The picked vertex's 2×2 tensor with its basis and Euler's κn(θ), exact beside it."""

@@ -413,6 +413,7 @@ class OneRingPanel(Panel):
         kind = "boundary vertex (open fan)" if r.boundary else "interior vertex (closed cycle)"
         ui.text(f"vertex {r.vertex}: {kind}, valence {r.valence}")
         ui.text(f"H (cotan) = {r.H + 0.0:.5g}   K (angle deficit) = {r.K + 0.0:.5g}")
+        self.draw_shape_operator(host)
         if not r.ordered:
             ui.error("not a disk: neighbours listed by index, not in order")
         ui.text("order: " + " -> ".join(str(j) for j in r.neighbors[:40]))
@@ -421,6 +422,27 @@ class OneRingPanel(Panel):
                 ui.error(r.inspection_error)
             return
         self.draw_inspection(host, r.inspection)
+
+    def draw_shape_operator(self, host: Host) -> None:
+        """The shape operator row: the Curvature view's estimator's 2×2 tensor at the vertex
+        with its tangent basis (a patch around the vertex, or the whole mesh's estimate)."""
+        ui, c, mesh = host.ui, host.state.curv, host.state.mesh
+        so = self.watch.cached(
+            "shape operator",
+            (mesh.version, self.state.vertex, c.principal_inputs(mesh), c.principal_current(mesh)),
+            lambda: c.shape_operator(mesh, self.state.vertex),
+        )
+        if so is None:  # the jet: its radius needs the whole mesh (a job)
+            c.want_principal(mesh, host.state.jobs, bool(host.background))
+            ui.note(f"shape operator ({c.estimator}): computed for the whole mesh ...")
+            return
+        (a, b), (_, d) = so["S"]
+        fmt = lambda t: f"({t[0]:.3f}, {t[1]:.3f}, {t[2]:.3f})"  # noqa: E731
+        ui.text(
+            f"shape operator ({so['estimator']}): S = [[{a:.4g}, {b:.4g}], [{b:.4g}, {d:.4g}]]"
+            f"  (k1 = {so['k1']:.4g}, k2 = {so['k2']:.4g})"
+        )
+        ui.note(f"in the tangent basis t1 = {fmt(so['t1'])}, t2 = {fmt(so['t2'])}")
 
     def draw_inspection(self, host: Host, ins: VertexInspection) -> None:
         """The inspector's tables and formulas, and the legend of its 3D drawings."""

@@ -8,15 +8,24 @@ from typing import Any
 import numpy as np
 
 from meshlap_core.curvature import all_curvature_fields
+from meshlap_core.curvature_estimators import (
+    PATCH_RINGS,
+    curvature_at_vertex,
+    estimate_curvature,
+)
 from meshlap_core.errors import MeshError
 from meshlap_core.options import (
     AREA_KINDS,
     BOUNDARY_RULES,
     CURVATURE_AREA,
+    CURVATURE_ESTIMATOR_LABELS,
+    CURVATURE_ESTIMATORS,
     CURVATURE_FIELD_LABELS,
     CURVATURE_FIELDS,
+    PRINCIPAL_FIELDS,
     check_choice,
 )
+from meshlap_core.principal import PrincipalCurvatures
 from meshlap_core.types import FloatArray
 
 from .checks import Schema, boolean, number, one_of
@@ -29,8 +38,17 @@ SESSION: Schema = {
     "clip": (2.0, number(0.0, 49.0)),
     "side_by_side": (False, boolean),
     "second_field": ("uniform", one_of(CURVATURE_FIELDS)),
+    "estimator": ("cotan", one_of(CURVATURE_ESTIMATORS)),
 }
 """The Curvature panel's section of a saved session (:mod:`.session`)."""
+SESSION_ADDED = ("estimator",)
+"""Keys newer than the first session files: written only when not the default (cotan), so a
+session that does not need it stays readable by an older meshlap."""
+
+ESTIMATOR_HELP = "\n".join(f"{k}: {v}" for k, v in CURVATURE_ESTIMATOR_LABELS.items())
+"""The estimator combo's tooltip: every estimator with its paper."""
+PRINCIPAL_JOB = "principal curvatures"
+"""The job owner of the estimator's run (the Curvature and One-ring views both start it)."""
 
 
 def check_view_options(options: dict[str, Any], state: Any) -> None:
@@ -87,6 +105,12 @@ class CurvatureState:
     percentile: float = 2.0
     side_by_side: bool = False
     second_field: str = "uniform"
+    estimator: str = "cotan"
+    principal: PrincipalCurvatures | None = None  # the estimator's, for ``_pkey``
+    principal_error: str = ""  # the last failed estimator run's message
+    _pkey: tuple[Any, ...] = ()
+    _pjob: tuple[Any, ...] = ()  # the inputs of the estimator job started last
+    _pfailed: tuple[Any, ...] = ()  # the inputs whose run failed (not retried)
     _key: tuple[Any, ...] = ()
     fields: dict[str, FloatArray] = field(default_factory=dict)
     _summaries: dict[tuple[Any, ...], dict[str, Any]] = field(default_factory=dict)
@@ -119,6 +143,112 @@ class CurvatureState:
         self.fields = fields
         self._key = (mesh.version, self.area, self.boundary)
 
+    def set_estimator(self, name: str) -> None:
+        """The estimator of the ``k1``, ``k2`` fields and of the shape operator
+        (:data:`~meshlap_core.options.CURVATURE_ESTIMATORS`).
+
+        Raises
+        ------
+        MeshError
+            An unknown name (the previous one stays).
+        """
+        self.estimator = check_choice(name, CURVATURE_ESTIMATORS, "estimator")
+
+    def principal_inputs(self, mesh: MeshState) -> tuple[Any, ...]:
+        """What the estimate depends on: the mesh, the estimator, and for ``cotan`` the area
+        and the boundary rule."""
+        rules = (self.area, self.boundary) if self.estimator == "cotan" else ()
+        return (mesh.version, self.estimator, *rules)
+
+    def principal_current(self, mesh: MeshState) -> bool:
+        """:attr:`principal` is the estimator's on ``mesh`` with the current rules."""
+        return self.principal is not None and self._pkey == self.principal_inputs(mesh)
+
+    @staticmethod
+    def estimate(
+        V: FloatArray, F: Any, estimator: str, area: str, boundary: str, progress: Any = None
+    ) -> PrincipalCurvatures:
+        """The estimator's principal curvatures and directions (any thread or a child
+        process; ``area`` and ``boundary`` are cotan's)."""
+        options = {"area": area, "boundary": boundary} if estimator == "cotan" else {}
+        return estimate_curvature(V, F, estimator, **options)
+
+    def adopt_principal(self, inputs: tuple[Any, ...], p: PrincipalCurvatures) -> None:
+        """Take the estimate ``p`` computed for ``inputs`` (:meth:`principal_inputs`)."""
+        self.principal, self._pkey = p, inputs
+        self._summaries.clear()
+
+    def values(self, name: str) -> FloatArray:
+        """The field ``name`` as shown: ``k1`` and ``k2`` from the chosen estimator (once
+        computed; the cotan fields' until then and for ``cotan``), the others as computed."""
+        p, mesh_version = self.principal, self._key[:1]
+        if name in PRINCIPAL_FIELDS[:2] and self.estimator != "cotan" and p is not None:
+            if self._pkey[:2] == (*mesh_version, self.estimator):
+                return p.k1 if name == "k1" else p.k2
+        return self.fields[name]
+
+    def want_principal(self, mesh: MeshState, jobs: Any, background: bool) -> bool:
+        """Bring :attr:`principal` up to date for ``mesh``: right here outside the window, a
+        job (:data:`PRINCIPAL_JOB`, a child process) in it. True when it is current; a failed
+        run is not retried until an input changes (its message in :attr:`principal_error`)."""
+        wanted = self.principal_inputs(mesh)
+        if self.principal_current(mesh):
+            return True
+        if self._pfailed == wanted or (
+            jobs.running(PRINCIPAL_JOB) is not None and self._pjob == wanted
+        ):
+            return False
+
+        def apply(p: PrincipalCurvatures) -> None:
+            if self.principal_inputs(mesh) == wanted:
+                self.adopt_principal(wanted, p)
+
+        def fail(message: str) -> None:
+            self._pfailed, self.principal_error = wanted, message
+
+        self._pjob, self.principal_error = wanted, ""
+        args = (mesh.V, mesh.F, self.estimator, self.area, self.boundary)
+        jobs.start(
+            PRINCIPAL_JOB,
+            f"principal curvatures ({self.estimator})",
+            jobs.offload(self.estimate, *args),
+            apply,
+            fail,
+            background=background,
+        )
+        return self.principal_current(mesh)
+
+    def shape_operator(self, mesh: MeshState, vertex: int) -> dict[str, Any] | None:
+        """The estimator's 2×2 shape operator at ``vertex`` in its tangent basis
+        (:meth:`~meshlap_core.principal.PrincipalCurvatures.shape_operator`): ``S``, ``t1``,
+        ``t2``, ``k1``, ``k2`` and ``estimator``. From the whole mesh's estimate when it is
+        current, else from a patch around the vertex (milliseconds on a big scan:
+        :func:`~meshlap_core.curvature_estimators.curvature_at_vertex`); ``None`` for the jet
+        until its whole-mesh estimate is there (:meth:`want_principal`)."""
+        if not 0 <= vertex < len(mesh.V):
+            return None
+        p, i = self.principal, vertex
+        if p is None or not self.principal_current(mesh):
+            if self.estimator not in PATCH_RINGS:
+                return None
+            options = {"area": self.area, "boundary": self.boundary}
+            p, i = curvature_at_vertex(
+                mesh.V,
+                mesh.F,
+                vertex,
+                self.estimator,
+                **(options if self.estimator == "cotan" else {}),
+            )
+        S, t1, t2 = p.shape_operator(i)
+        return {
+            "S": S,
+            "t1": t1,
+            "t2": t2,
+            "k1": float(p.k1[i]),
+            "k2": float(p.k2[i]),
+            "estimator": self.estimator,
+        }
+
     def set_percentile(self, percentile: float) -> None:
         """Clip percentage of the colour range, in ``[0, 49]``.
 
@@ -140,10 +270,10 @@ class CurvatureState:
         """Range, min/max and histogram of a field, cached until the field or the clip
         percentage changes (the panel reads it every frame)."""
         name = name or self.field_name
-        key = (self._key, name, self.percentile, bins)
+        key = (self._key, name, self.percentile, bins, self.estimator, self._pkey)
         cached = self._summaries.get(key)
         if cached is None:
-            values = self.fields[name]
+            values = self.values(name)
             lo, hi = robust_range(values, CURVATURE_FIELD_LABELS[name][1], self.percentile)
             counts, edges = np.histogram(np.clip(values, lo, hi), bins=bins, range=(lo, hi))
             cached = {

@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 
 from meshlap_core.curvature import vertex_normals
-from meshlap_core.curvature_estimators import disagreement, estimate_curvature
+from meshlap_core.curvature_estimators import PATCH_RINGS, disagreement, estimate_curvature
 from meshlap_core.curvature_study import (
     ExactPrincipal,
     curvature_study,
@@ -43,6 +43,17 @@ STUDY_LEVELS = (8, 16, 32, 64)
 """Resolutions of the lab's convergence study (fixed: a resolution move keeps the plot)."""
 KEEP_BASES = 6
 """Exact surfaces kept (per surface, resolution and jitter): a slider moved back is instant."""
+KEEP_ESTIMATES = 8
+"""Estimates kept (per surface, resolution, jitter, noise, flips and estimator): a quantity or
+*show* move, or a slider moved back, recolours without re-running the estimator."""
+LIGHT_ESTIMATORS = tuple(e for e, rings in PATCH_RINGS.items() if rings is not None)
+"""The tensor estimators (cotan, Rusinkiewicz, normal cycle: a fixed patch of rings, about
+0.1 s at 32k vertices): the lab runs them in a thread, not a child process, whose start,
+imports and 13 MB of pickles cost 0.3-1 s per move (the window's ``Jobs.processes``; measured
+in ``benchmarks/bench_curvature.py --only window``)."""
+LIGHT_RES = 128
+"""Largest resolution run in a thread (the torus: 32,768 vertices; numpy releases the GIL,
+the window's longest gap measured 0.02-0.12 s under load)."""
 
 
 SESSION: Schema = {
@@ -128,6 +139,42 @@ class LabResult:
     summary: str
     exact: tuple[FloatArray, FloatArray] | None = None
     base: Base | None = None
+    estimate_key: tuple[Any, ...] | None = None
+    crosses: Crosses | None = None
+
+
+@dataclass(frozen=True)
+class Crosses:
+    """The principal directions as 2-symmetric tangent line fields for polyscope, made once
+    per estimate off the UI thread (:func:`crosses_of`).
+
+    Attributes
+    ----------
+    basis_x, basis_y : (n,3) float
+        The tangent basis of the estimate's normals.
+    k1, k2 : (n,2) float
+        ``d1``, ``d2`` in that basis, scaled by ``|k| / max|k|`` (at least 0.2).
+    exact : (n,2) float or None
+        The exact ``d1`` in that basis (parametric surfaces), scaled as ``k1``.
+    """
+
+    basis_x: FloatArray
+    basis_y: FloatArray
+    k1: FloatArray
+    k2: FloatArray
+    exact: FloatArray | None
+
+
+@dataclass(frozen=True)
+class Estimate:
+    """An estimator's output on a lab surface after flips and noise (what a quantity or *show*
+    move reuses: only the coloured field changes)."""
+
+    key: tuple[Any, ...]  # (surface, res, jitter, noise, flips, estimator)
+    V: FloatArray  # (n,3) the noisy positions
+    F: IntArray  # (m,3) the flipped faces
+    principal: PrincipalCurvatures
+    crosses: Crosses | None = None
 
 
 @dataclass(frozen=True)
@@ -144,6 +191,17 @@ class Base:
 def base_key(params: dict[str, Any]) -> tuple[Any, ...]:
     """What the exact values depend on: ``(surface, res, jitter)``."""
     return (params["surface"], int(params["res"]), float(params["jitter"]))
+
+
+def estimate_key(params: dict[str, Any]) -> tuple[Any, ...]:
+    """What an estimate on a lab surface depends on: the base's key, noise, flips and the
+    estimator."""
+    return (
+        *base_key(params),
+        float(params["noise"]),
+        float(params["flips"]),
+        params["estimator"],
+    )
 
 
 def make_base(params: dict[str, Any]) -> Base:
@@ -173,6 +231,7 @@ class CurvatureLabState:
     vertex: int = -1  # the picked vertex of the result's mesh (-1: none)
     bases: dict[tuple[Any, ...], Base] = field(default_factory=dict)  # newest last
     studies: dict[tuple[Any, ...], list[dict[str, Any]]] = field(default_factory=dict)
+    estimates: dict[tuple[Any, ...], Estimate] = field(default_factory=dict)  # newest last
 
     def inputs(self, mesh_version: int) -> tuple[Any, ...]:
         """Everything the result depends on (the mesh version only for the loaded mesh)."""
@@ -260,29 +319,55 @@ class CurvatureLabState:
         """The cached exact surface for the current settings (``None``: not computed yet)."""
         return self.bases.get(base_key(self.params()))
 
+    def estimate(self) -> Estimate | None:
+        """The cached estimate for the current settings (``None``: not computed yet, its exact
+        surface no longer cached, or the loaded mesh)."""
+        if self.source != "surface" or self.base() is None:  # its exact values are needed
+            return None
+        return self.estimates.get(estimate_key(self.params()))
+
+    def light(self) -> bool:
+        """The next result is cheap enough for a thread of the window (see
+        :data:`LIGHT_ESTIMATORS`): a lab surface up to :data:`LIGHT_RES`, one tensor estimator
+        (or an estimate already cached), not the disagreement of all the estimators."""
+        if self.source != "surface" or self.show == "disagreement":
+            return False
+        return self.estimate() is not None or (
+            self.estimator in LIGHT_ESTIMATORS and self.res <= LIGHT_RES
+        )
+
     @staticmethod
     def compute(
-        params: dict[str, Any], V: Any, F: Any, base: Base | None = None, progress: Any = None
+        params: dict[str, Any],
+        V: Any,
+        F: Any,
+        base: Base | None = None,
+        progress: Any = None,
+        estimate: Estimate | None = None,
     ) -> LabResult:
         """The lab's result for ``params`` (any thread or a child process: touches no state);
         ``V, F`` are the loaded mesh's (used when ``source`` is ``mesh``); ``base`` the cached
-        exact surface for ``params`` (computed when ``None`` or for other settings). The
-        convergence study is separate (:meth:`study`)."""
+        exact surface for ``params`` (computed when ``None`` or for other settings);
+        ``estimate`` the cached estimate for ``params`` (the estimator is not run again: a
+        quantity or *show* move only recolours). The convergence study is separate
+        (:meth:`study`)."""
         if params["source"] == "surface":
+            if estimate is not None and estimate.key != estimate_key(params):
+                estimate = None
             if base is not None and base.key == base_key(params):
-                result = _surface_result(params, base)
+                result = _surface_result(params, base, estimate)
                 result.base = None  # the state has it: not sent back from a child process
                 return result
-            return _surface_result(params, make_base(params))
+            return _surface_result(params, make_base(params), estimate)
         V = np.asarray(V, dtype=np.float64)
         F = np.asarray(F, dtype=np.int64)
         q, est = params["quantity"], params["estimator"]
         r = estimate_curvature(V, F, est)
+        crosses = crosses_of(r, None, cross_length(V, F))
         if params["show"] == "disagreement":
             values = _disagreement(V, F, q)
-            return LabResult(
-                V, F, values, f"{q} disagreement (max - min)", r, None, _dis_summary(values)
-            )
+            label = f"{q} disagreement (max - min)"
+            return LabResult(V, F, values, label, r, None, _dis_summary(values), crosses=crosses)
         note = (
             "no exact surface for a loaded mesh: the estimate is shown"
             if params["show"] == "error"
@@ -290,7 +375,7 @@ class CurvatureLabState:
         )
         values = r.field(q)
         summary = note or f"{q} in [{values.min():.4g}, {values.max():.4g}]"
-        return LabResult(V, F, values, f"{q} ({est})", r, None, summary)
+        return LabResult(V, F, values, f"{q} ({est})", r, None, summary, crosses=crosses)
 
     def study_key(self) -> tuple[Any, ...] | None:
         """What the convergence study depends on, ``(surface, estimator, noise, jitter,
@@ -331,6 +416,14 @@ class CurvatureLabState:
             self.bases[result.base.key] = result.base
             while len(self.bases) > KEEP_BASES:
                 self.bases.pop(next(iter(self.bases)))
+        key = result.estimate_key
+        if key is not None:
+            self.estimates.pop(key, None)
+            self.estimates[key] = Estimate(
+                key, result.V, result.F, result.principal, result.crosses
+            )
+            while len(self.estimates) > KEEP_ESTIMATES:
+                self.estimates.pop(next(iter(self.estimates)))
         if self.vertex >= len(result.V):
             self.vertex = -1
 
@@ -353,13 +446,23 @@ class CurvatureLabState:
         return shape_operator_at(self.result, self.vertex)
 
 
-def _surface_result(params: dict[str, Any], base: Base) -> LabResult:
-    """The estimate on ``base``'s mesh after flips and noise, and the field shown."""
+def _surface_result(
+    params: dict[str, Any], base: Base, estimate: Estimate | None = None
+) -> LabResult:
+    """The estimate on ``base``'s mesh after flips and noise (``estimate`` when cached), and
+    the field shown."""
     q, est = params["quantity"], params["estimator"]
-    m, Vs = flipped_and_noisy(
-        base.mesh, params["noise"], flips=params["flips"], normals=base.normals
-    )
-    r = estimate_curvature(Vs, m.F, est)
+    crosses = None
+    if estimate is not None:
+        Vs, Fs, r, crosses = estimate.V, estimate.F, estimate.principal, estimate.crosses
+    else:
+        m, Vs = flipped_and_noisy(
+            base.mesh, params["noise"], flips=params["flips"], normals=base.normals
+        )
+        Fs = m.F
+        r = estimate_curvature(Vs, Fs, est)
+    if crosses is None:
+        crosses = crosses_of(r, base.exact.d1, cross_length(Vs, Fs))
     ex = base.exact
     exact = PrincipalCurvatures(ex.k1, ex.k2, ex.d1, ex.d2, np.zeros_like(ex.d1), "exact")
     compared = ex.compared
@@ -371,13 +474,25 @@ def _surface_result(params: dict[str, Any], base: Base) -> LabResult:
         rel = f" ({100 * rms / scale:.3g} % of RMS |{q}|)" if scale > 0 else ""
         summary = f"RMS error {rms:.4g}{rel} over {int(compared.sum())} vertices"
     elif params["show"] == "disagreement":
-        values = _disagreement(Vs, m.F, q)
+        values = _disagreement(Vs, Fs, q)
         label, summary = f"{q} disagreement (max - min)", _dis_summary(values)
     else:
         values, label = r.field(q), f"{q} ({est})"
         exq = exact.field(q)
         summary = f"exact {q} in [{np.nanmin(exq):.4g}, {np.nanmax(exq):.4g}]"
-    return LabResult(Vs, m.F, values, label, r, exact.d1, summary, (exact.k1, exact.k2), base)
+    return LabResult(
+        Vs,
+        Fs,
+        values,
+        label,
+        r,
+        exact.d1,
+        summary,
+        (exact.k1, exact.k2),
+        base,
+        estimate_key(params),
+        crosses,
+    )
 
 
 def shape_operator_at(r: LabResult, i: int, n: int = 73) -> dict[str, Any]:
@@ -394,10 +509,7 @@ def shape_operator_at(r: LabResult, i: int, n: int = 73) -> dict[str, Any]:
         ``kn`` ((n,) arrays), and ``exact_kn`` ((n,) or None).
     """
     p = r.principal
-    t1, t2 = tangent_frames(p.normal[i : i + 1])
-    c1 = np.array([p.d1[i] @ t1[0], p.d1[i] @ t2[0]])
-    c2 = np.array([p.d2[i] @ t1[0], p.d2[i] @ t2[0]])
-    S = p.k1[i] * np.outer(c1, c1) + p.k2[i] * np.outer(c2, c2)
+    S, t1, t2 = p.shape_operator(i)
     th = np.radians(np.linspace(0.0, 360.0, n))
     kn = p.k1[i] * np.cos(th) ** 2 + p.k2[i] * np.sin(th) ** 2
     exact_kn = None
@@ -409,8 +521,8 @@ def shape_operator_at(r: LabResult, i: int, n: int = 73) -> dict[str, Any]:
             exact_kn = ek1 * np.cos(th - phi) ** 2 + ek2 * np.sin(th - phi) ** 2
     return {
         "S": S.tolist(),
-        "t1": t1[0],
-        "t2": t2[0],
+        "t1": t1,
+        "t2": t2,
         "k1": float(p.k1[i]),
         "k2": float(p.k2[i]),
         "theta_deg": np.degrees(th),
@@ -430,6 +542,15 @@ def _dis_summary(values: FloatArray) -> str:
     )
 
 
+def _in_basis(d: FloatArray, k: FloatArray, t1: FloatArray, t2: FloatArray) -> FloatArray:
+    """``d`` (n,3) in the basis ``(t1, t2)``, scaled by ``|k| / max|k|`` (at least 0.2, so a
+    flat direction still shows), ``(n,2)``."""
+    a = np.abs(k)
+    top = float(np.percentile(a, 98)) if a.size else 1.0
+    s = np.clip(a / (top or 1.0), 0.2, 1.0)
+    return np.stack([np.einsum("ij,ij->i", d, t1), np.einsum("ij,ij->i", d, t2)], 1) * s[:, None]
+
+
 def cross_field(
     p: PrincipalCurvatures, which: int = 1
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
@@ -443,10 +564,27 @@ def cross_field(
     basis_x, basis_y : (n,3) float
     """
     d, k = (p.d1, p.k1) if which == 1 else (p.d2, p.k2)
-    N = p.normal
-    t1, t2 = tangent_frames(N)
-    a = np.abs(k)
-    top = float(np.percentile(a, 98)) or 1.0
-    s = np.clip(a / top, 0.2, 1.0)
-    values = np.stack([np.sum(d * t1, axis=1), np.sum(d * t2, axis=1)], axis=1) * s[:, None]
-    return values, t1, t2
+    t1, t2 = tangent_frames(p.normal)
+    return _in_basis(d, k, t1, t2), t1, t2
+
+
+def crosses_of(
+    p: PrincipalCurvatures, exact_d1: FloatArray | None = None, length: float = 1.0
+) -> Crosses:
+    """Both principal directions (and the exact ``d1`` when given) as :func:`cross_field`
+    gives them, sharing one tangent basis, times ``length`` (the world length of a cross arm
+    at the largest ``|k|``: drawn as ambient vectors, a cross stays inside its vertex's cell
+    on a coarse or a fine mesh alike)."""
+    t1, t2 = tangent_frames(p.normal)
+    exact = None if exact_d1 is None else length * _in_basis(exact_d1, p.k1, t1, t2)
+    k1, k2 = _in_basis(p.d1, p.k1, t1, t2), _in_basis(p.d2, p.k2, t1, t2)
+    return Crosses(t1, t2, length * k1, length * k2, exact)
+
+
+def cross_length(V: FloatArray, F: IntArray) -> float:
+    """A cross arm's world length: 0.4 of the mean edge length (one cross per vertex, no
+    overlap with the neighbours')."""
+    if len(F) == 0:
+        return 1.0
+    e = V[F[:, [1, 2, 0]]] - V[F]
+    return 0.4 * float(np.sqrt(np.einsum("ijk,ijk->ij", e, e)).mean())

@@ -1,4 +1,4 @@
-"""The catalogue of parametric surfaces: :class:`ParametricSurface` and the seven shipped ones.
+"""The catalogue of parametric surfaces: :class:`ParametricSurface` and the eight shipped ones.
 
 ``meshlap_core.surfaces.torus`` here is the *parametric* torus (a :class:`ParametricSurface`,
 exact geometry at any ``(u, v)``); :func:`meshlap_core.primitives.torus_mesh` is the *triangle
@@ -185,6 +185,62 @@ def sphere(r: float = 1.0) -> ParametricSurface:
     )
 
 
+def ellipsoid(a: float = 1.5, b: float = 1.0, c: float = 0.75) -> ParametricSurface:
+    """Ellipsoid ``p(u,v) = (a sin u cos v, b sin u sin v, c cos u)`` with semi-axes
+    ``a, b, c``, polar angle ``u ∈ [0,π]``, azimuth ``v ∈ [0,2π]`` (closed in ``v``, poles at
+    ``u = 0`` and ``u = π``, like :func:`sphere`).
+
+    ``n`` points outwards. With ``h = √(x²/a⁴ + y²/b⁴ + z²/c⁴)`` at the point ``(x, y, z)``:
+    ``K = 1 / (a²b²c² h⁴)`` and ``H = (a² + b² + c² − x² − y² − z²) / (2 a²b²c² h³)`` (both
+    reduce to ``1/r²`` and ``1/r`` on a sphere). With distinct axes it has four umbilics (in
+    the plane of the largest and smallest axes); elsewhere ``κ₁ > κ₂ > 0``.
+    """
+    a, b, c = _positive(a, "a"), _positive(b, "b"), _positive(c, "c")
+
+    def p(u: np.ndarray, v: np.ndarray) -> np.ndarray:
+        return _xyz(a * np.sin(u) * np.cos(v), b * np.sin(u) * np.sin(v), c * np.cos(u))
+
+    def d(u: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, ...]:
+        su, cu, sv, cv = np.sin(u), np.cos(u), np.sin(v), np.cos(v)
+        z = np.zeros_like(u * v)
+        return (
+            _xyz(a * cu * cv, b * cu * sv, -c * su),
+            _xyz(-a * su * sv, b * su * cv, z),
+            _xyz(-a * su * cv, -b * su * sv, -c * cu),
+            _xyz(-a * cu * sv, b * cu * cv, z),
+            _xyz(-a * su * cv, -b * su * sv, z),
+        )
+
+    return ParametricSurface(
+        "ellipsoid",
+        p,
+        (0.0, np.pi, 0.0, 2 * np.pi),
+        closed_v=True,
+        poles=("u0", "u1"),
+        derivatives=d,
+        default_uv=(np.pi / 3, np.pi / 4),
+        description="ellipsoid with semi-axes a, b, c; elliptic, four umbilics",
+        params={"a": a, "b": b, "c": c},
+    )
+
+
+def ellipsoid_curvature(
+    a: float, b: float, c: float, X: FloatArray
+) -> tuple[FloatArray, FloatArray]:
+    """The closed-form ``H`` and ``K`` of the ellipsoid ``x²/a² + y²/b² + z²/c² = 1`` at its
+    points ``X`` (n,3) (outward normal, ``H > 0``): see :func:`ellipsoid`.
+
+    Returns
+    -------
+    H, K : (n,) float
+    """
+    X = np.asarray(X, dtype=np.float64)
+    h = np.sqrt((X[:, 0] / a**2) ** 2 + (X[:, 1] / b**2) ** 2 + (X[:, 2] / c**2) ** 2)
+    abc2 = (a * b * c) ** 2
+    H = (a * a + b * b + c * c - np.einsum("ij,ij->i", X, X)) / (2.0 * abc2 * h**3)
+    return H, 1.0 / (abc2 * h**4)
+
+
 def torus(R: float = 3.0, r: float = 1.0) -> ParametricSurface:
     """Parametric torus ``p(u,v) = ((R + r cos v) cos u, (R + r cos v) sin u, r sin v)`` on
     ``[0,2π]²`` (a :class:`ParametricSurface`, not a mesh).
@@ -368,6 +424,7 @@ SURFACES: Mapping[str, Callable[..., ParametricSurface]] = {
     "saddle": saddle,
     "monkey_saddle": monkey_saddle,
     "cylinder": cylinder,
+    "ellipsoid": ellipsoid,
 }
 """Factories of the shipped surfaces by name; ``helicoid`` is the default."""
 
