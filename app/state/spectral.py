@@ -35,6 +35,24 @@ MODES_PER_SECOND = 1.5
 per frame."""
 
 
+def _finish_basis(basis: SpectralBasis, k: int, progress: Any) -> tuple[SpectralBasis, Any]:
+    """The errors for every k and the slider's checkpoints of a new basis (off the UI
+    thread); ``(basis, errors)``."""
+    if progress is not None:
+        progress.phase_only("reconstruction errors for every k")
+    errors = basis.errors()  # every k at once (cumulative sums)
+    basis.reconstruct(max(1, k // 2))  # builds the slider's checkpoints
+    return basis, errors
+
+
+def solve_basis(V: FloatArray, F: IntArray, k: int, progress: Any = None) -> tuple[Any, Any]:
+    """The eigenbasis job's work in a child process (:func:`meshlap_app.jobs.in_child`, which
+    ends the process on Cancel): ``k`` eigenpairs, the errors for every k and the slider's
+    checkpoints, as ``(basis, errors)``, sent back pickled. Module level, so it pickles."""
+    basis = SpectralBasis.compute(V, F, k, progress=progress)
+    return _finish_basis(basis, k, progress)
+
+
 @dataclass
 class SpectralState:
     """Basis, selected eigenmode ``mode`` and reconstruction order ``k``."""
@@ -81,16 +99,11 @@ class SpectralState:
         cancel handed to the core where it takes them)."""
         from ..jobs import call_hooked
 
-        report = progress if progress is not None else self._progress
         if progress is not None:
             basis = call_hooked(SpectralBasis.compute, V, F, k, reporter=progress)
         else:
-            basis = SpectralBasis.compute(V, F, k, progress=report)
-        if progress is not None:
-            progress.phase_only("reconstruction errors for every k")
-        errors = basis.errors()  # every k at once (cumulative sums)
-        basis.reconstruct(max(1, k // 2))  # builds the slider's checkpoints off the UI thread
-        return basis, errors
+            basis = SpectralBasis.compute(V, F, k, progress=self._progress)
+        return _finish_basis(basis, k, progress)
 
     def _failed(self, message: str) -> None:
         self.error, self.message = message, ""
@@ -116,10 +129,19 @@ class SpectralState:
         if jobs is None:
             jobs = self._jobs if self._jobs is not None else Jobs()
         self._jobs = jobs
+        if getattr(jobs, "processes", False):
+            # (the window: a child process, where the eigensolver may use CHOLMOD, which
+            # holds the GIL, with METIS ordering; in a thread it would freeze the frames, so
+            # there it keeps to QDLDL: 147 s instead of about 60 s at 692k vertices)
+            from ..jobs import in_child
+
+            work = in_child(solve_basis, V, F, k)
+        else:
+            work = lambda reporter: self.solve(V, F, k, reporter)  # noqa: E731
         self._job = jobs.start(
             owner,
             f"eigenbasis ({k} modes)",
-            lambda reporter: self.solve(V, F, k, reporter),
+            work,
             self._adopt,
             self._failed,
             background=background,

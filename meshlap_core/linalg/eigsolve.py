@@ -56,6 +56,7 @@ from .common import (
     with_cancel,
 )
 from .components import component_scales, components, null_space, scale_groups, solve_by_groups
+from .factor import ldl_backend
 from .slicing import SlicedLanczos, default_workers
 
 # Dense solver below this many vertices (or when k is a large fraction of n).
@@ -479,7 +480,9 @@ def _sparse_eigenpairs(
         else:  # (one slice below ~60 modes: no need to sample the machine's load)
             nw = 1 if k < 60 else default_workers(n, max(slice_size, first_slice))
         nb = 1 if blas_threads_ is None else max(1, int(blas_threads_))
-        info.messages.append(f"{nw} slice worker(s), {nb} BLAS thread(s)")
+        info.messages.append(
+            f"{nw} slice worker(s), {nb} BLAS thread(s), LDLT by {ldl_backend(n)}"
+        )
         rho = float(density) if density else float(m.sum() / (4 * np.pi))
         try:
             with limit_blas_threads(nb):

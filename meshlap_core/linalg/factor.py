@@ -186,6 +186,17 @@ run on a busy machine), which pays off from the second factorization of the penc
 (0.10 + 0.12 s against 0.55 + 0.19 s at 43k)."""
 
 
+def ldl_backend(n: int) -> str:
+    """The ``LDLᵀ`` back end :class:`ShiftInvert` tries first for ``n`` unknowns, with its
+    ordering: ``"CHOLMOD (METIS)"``, ``"CHOLMOD (AMD)"`` or ``"QDLDL (AMD)"`` (SuperLU only if
+    QDLDL fails)."""
+    from .spd import eigen_backend
+
+    if eigen_backend() == "cholmod":
+        return f"CHOLMOD ({'METIS' if n >= METIS_MIN_N else 'AMD'})"
+    return "QDLDL (AMD)"
+
+
 class CholmodLDLFactor:
     """CHOLMOD's simplicial ``LDLᵀ`` (scikit-sparse) of a symmetric matrix, with its inertia;
     see :func:`cholmod_inertia`. Solves a block of right-hand sides in one call."""
