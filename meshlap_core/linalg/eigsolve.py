@@ -480,9 +480,7 @@ def _sparse_eigenpairs(
         else:  # (one slice below ~60 modes: no need to sample the machine's load)
             nw = 1 if k < 60 else default_workers(n, max(slice_size, first_slice))
         nb = 1 if blas_threads_ is None else max(1, int(blas_threads_))
-        info.messages.append(
-            f"{nw} slice worker(s), {nb} BLAS thread(s), LDLT by {ldl_backend(n)}"
-        )
+        info.messages.append(f"{nw} slice worker(s), {nb} BLAS thread(s), LDLT by {ldl_backend(n)}")
         rho = float(density) if density else float(m.sum() / (4 * np.pi))
         try:
             with limit_blas_threads(nb):
