@@ -143,13 +143,19 @@ def lowdin(Y: FloatArray, helper: Any | None = None) -> float:
 
 
 def fix_signs(U: FloatArray) -> None:
-    """Deterministic sign: the entry of largest magnitude of each column is positive."""
-    if U.shape[1] == 0:
+    """Deterministic sign: the entry of largest magnitude of each column is positive.
+
+    Column by column on an F-ordered ``U`` (no ``n × k`` temporary: 550 MB at 692k vertices
+    and k = 100), and only the columns that change sign are rewritten."""
+    k = U.shape[1]
+    if k == 0:
         return
-    idx = np.argmax(np.abs(U), axis=0)
-    s = np.sign(U[idx, np.arange(U.shape[1])])
-    s[s == 0] = 1.0
-    U *= s[None, :]
+    if U.flags.f_contiguous:
+        idx = np.array([int(np.argmax(np.abs(U[:, j]))) for j in range(k)], dtype=np.int64)
+    else:
+        idx = np.argmax(np.abs(U), axis=0)
+    for j in np.flatnonzero(U[idx, np.arange(k)] < 0):
+        U[:, j] *= -1.0
 
 
 def pencil_eigenpairs(
