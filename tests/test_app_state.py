@@ -179,6 +179,65 @@ def test_spectral_state_background_thread(tmp_path, monkeypatch):
     assert s.basis.k_max == 10 and not s.busy
 
 
+def test_spectral_state_in_a_child_process_matches_the_thread(tmp_path, monkeypatch):
+    """The window (``jobs.processes``) computes the eigenbasis in a child process (where the
+    eigensolver may use CHOLMOD, which holds the GIL): the basis that comes back pickled is
+    the one computed here, M-orthonormal, with its errors, and still extends in place."""
+    import pickle
+    import time
+
+    from meshlap_app.jobs import Jobs
+    from meshlap_app.state.spectral import SpectralState
+
+    monkeypatch.setenv("MESHLAP_CACHE_DIR", str(tmp_path))
+    V, F = primitives.icosphere(3)
+    here = SpectralState(k_request=12)
+    here.start(V, F, background=False)
+    jobs = Jobs()
+    jobs.processes = True
+    s = SpectralState(k_request=12)
+    s.start(V, F, jobs=jobs)
+    t0 = time.monotonic()
+    while not s.poll():
+        assert time.monotonic() - t0 < 120, "child never finished"
+        time.sleep(0.02)
+    b, ref = s.basis, here.basis
+    assert b is not None and b.k_max == 12 and not s.busy and not s.error
+    assert b.vectors.flags.f_contiguous  # (mapped from the child's shared-memory file)
+    np.testing.assert_allclose(b.eigenvalues, ref.eigenvalues, rtol=1e-8, atol=1e-10)
+    G = b.vectors.T @ (b.mass[:, None] * b.vectors)
+    np.testing.assert_allclose(G, np.eye(12), atol=1e-9)
+    np.testing.assert_allclose(s.errors.mean, here.errors.mean, rtol=1e-6, atol=1e-12)
+    s.set_k(7)
+    np.testing.assert_allclose(s.reconstruction, here.basis.reconstruct(7), atol=1e-9)
+    again = pickle.loads(pickle.dumps(b))  # locks and BLAS controller rebuilt
+    again.ensure(16)
+    assert again.k_max == 16 and again.eigenvalues[:12] == pytest.approx(b.eigenvalues)
+
+
+def test_shared_vectors_carry_the_eigenvectors_and_leave_no_file():
+    """The eigenvectors travel from the child as a file in shared memory: mapped back equal
+    (F-ordered), the file unlinked once opened, and unlinked too when a copy is dropped
+    unopened (a cancelled job)."""
+    import os
+    import pickle
+
+    from meshlap_app.state.spectral import SharedVectors
+
+    U = np.asfortranarray(np.random.default_rng(3).standard_normal((1000, 7)))
+    sent = SharedVectors(U)
+    got = pickle.loads(pickle.dumps(sent)).open()
+    assert got.flags.f_contiguous and got.shape == (1000, 7)
+    np.testing.assert_array_equal(got, U)
+    assert not os.path.exists(sent.path)
+    lost = pickle.loads(pickle.dumps(SharedVectors(U[:, :3])))
+    assert os.path.exists(lost.path)
+    lost.maker = -1  # as in the window: made by another process, never opened
+    path = lost.path
+    del lost
+    assert not os.path.exists(path)
+
+
 def test_smoothing_state_steps_and_reports(tmp_path):
     from meshlap_app.state.smoothing import SmoothingState
 

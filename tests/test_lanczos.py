@@ -254,3 +254,41 @@ def test_scaled_pencil_equals_the_two_diagonal_products():
     np.testing.assert_allclose(A.toarray(), ref, rtol=1e-15, atol=0)
     assert A.nnz == K.nnz and np.array_equal(A.indices, K.indices)
     np.testing.assert_allclose(A.toarray(), A.toarray().T)  # symmetric stays symmetric
+
+
+def test_cholmod_analysis_is_done_once_per_pencil_across_threads(spd_backend, monkeypatch):
+    """Two slice workers factor shifts of one pencil: CHOLMOD's symbolic analysis (the
+    ordering) is computed once and copied by the other thread; every factor still counts
+    the inertia right and the eigenvalues are the dense solver's."""
+    if spd_backend != "cholmod":
+        pytest.skip("CHOLMOD only")
+    import sksparse.cholmod as cm
+
+    calls = []
+    real = cm.analyze
+
+    def counting(*args, **kwargs):
+        calls.append(1)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(cm, "analyze", counting)
+    V, F = bumpy_sphere(3)
+    lam, _, info = S.laplacian_eigenpairs(
+        V, F, 90, method="sparse", slice_size=24, first_slice=24, workers=2
+    )
+    assert len(calls) == 1 and len(info.shifts) >= 2 and info.n_factorizations >= 3
+    K, m = S.spectral_operators(V, F)
+    d = 1 / np.sqrt(m)
+    ref = np.linalg.eigvalsh((K.toarray() * d[:, None]) * d[None, :])[:90]
+    np.testing.assert_allclose(lam, ref, rtol=1e-9, atol=1e-9 * ref.max())
+    # and with a shared ordering, a shift of the same pattern counts its negative eigenvalues
+    A = S.spectral_operators(V, F)[0].multiply(d[:, None]).multiply(d[None, :]).tocsr()
+    ordering = factor.SymbolicOrdering(A.shape[0])
+    eye = sp.identity(A.shape[0], format="csr")
+    rng = np.random.default_rng(1)
+    first, _ = factor.cholmod_inertia((A - 5.0 * eye).tocsr(), rng, None, ordering)
+    second, neg = factor.cholmod_inertia((A - 40.0 * eye).tocsr(), rng, None, ordering)
+    assert second.factor is not first.factor and len(calls) == 2
+    assert neg == np.count_nonzero(ref < 40.0) + np.count_nonzero(
+        np.linalg.eigvalsh(A.toarray())[90:] < 40.0
+    )

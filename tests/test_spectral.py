@@ -334,6 +334,40 @@ def test_agrees_with_scipy_eigsh():
     assert sv.min() > 1 - 1e-6
 
 
+@pytest.mark.parametrize("gil_free", [False, True])
+def test_both_ldl_back_ends_give_the_eigsh_pairs(spd_backend, gil_free, monkeypatch):
+    """CHOLMOD (scikit-sparse) and QDLDL (the pure-wheel fallback, also the one a thread of
+    the window uses: ``prefer_gil_free``) give the same eigenpairs as scipy's eigsh: equal
+    eigenvalues, M-orthonormal vectors with small residuals ``‖Ku − λMu‖``."""
+    from meshlap_core.linalg import spd
+
+    monkeypatch.setattr(spd, "_GIL_FREE", {"eigen": gil_free})
+    V, F = torus_mesh(48, 20)
+    K, m = S.spectral_operators(V, F)
+    ref = np.sort(spla.eigsh(K, 30, M=sp.diags(m).tocsc(), sigma=-1e-3, which="LM")[0])
+    lam, U, info = S.pencil_eigenpairs(K, m, 30, method="sparse", workers=1)
+    want = "CHOLMOD" if spd_backend == "cholmod" and not gil_free else "QDLDL"
+    assert any(f"LDLT by {want}" in msg for msg in info.messages), info.messages
+    np.testing.assert_allclose(lam[1:], ref[1:], rtol=1e-9)
+    assert abs(lam[0]) < 1e-12
+    np.testing.assert_allclose(U.T @ (m[:, None] * U), np.eye(30), atol=1e-10)
+    R = K @ U - (m[:, None] * U) * lam
+    assert np.linalg.norm(R / np.sqrt(m)[:, None], axis=0).max() <= 1e-6 * lam.max()
+    idx = np.argmax(np.abs(U), axis=0)
+    assert np.all(U[idx, np.arange(30)] > 0)
+
+
+def test_fix_signs_makes_the_largest_entry_positive_in_any_layout():
+    from meshlap_core.linalg.eigsolve import fix_signs
+
+    A = np.array([[1.0, -3.0, 0.0], [-2.0, 1.0, 0.0], [0.5, 2.0, 0.0]])
+    want = np.array([[-1.0, 3.0, 0.0], [2.0, -1.0, 0.0], [-0.5, -2.0, 0.0]])
+    for order in "CF":
+        X = np.array(A, order=order)
+        fix_signs(X)
+        np.testing.assert_array_equal(X, want)
+
+
 # ----------------------------------------------------------------------------- bad input
 
 

@@ -8,6 +8,9 @@ the previous k.
 
 from __future__ import annotations
 
+import contextlib
+import os
+import tempfile
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -33,6 +36,89 @@ SCREENSHOT_K = 30
 MODES_PER_SECOND = 1.5
 """Pace of the eigenmodes played on screen (a mode must be readable); the k sweep is one k
 per frame."""
+
+
+def _finish_basis(basis: SpectralBasis, k: int, progress: Any) -> tuple[SpectralBasis, Any]:
+    """The errors for every k and the slider's checkpoints of a new basis (off the UI
+    thread); ``(basis, errors)``."""
+    if progress is not None:
+        progress.phase_only("reconstruction errors for every k")
+    errors = basis.errors()  # every k at once (cumulative sums)
+    basis.reconstruct(max(1, k // 2))  # builds the slider's checkpoints
+    return basis, errors
+
+
+SHARED_PREFIX = "meshlap-basis-"
+"""Name prefix of the files that carry eigenvectors from the child process to the window."""
+
+
+class SharedVectors:
+    """The eigenvectors of a basis computed in a child process, handed to the window as a file
+    in shared memory (``/dev/shm``) instead of inside the pickled result: unpickling 550 MB
+    (692k vertices, k = 100) holds the GIL for a second under load, and the window's frames
+    stop meanwhile; mapping the file takes a millisecond and copies nothing.
+
+    Made in the child (the ``(n, k)`` F-ordered array written as raw float64, column after
+    column); :meth:`open` in the window maps it (``np.memmap``) and unlinks the file at once
+    (the mapping stays valid). A copy that is never opened (the job was cancelled or
+    superseded) unlinks the file when it is collected; files left by a child that was ended
+    while it sent are removed by the next child.
+    """
+
+    def __init__(self, U: FloatArray) -> None:
+        folder = "/dev/shm" if os.path.isdir("/dev/shm") else tempfile.gettempdir()
+        _remove_stale(folder)
+        fd, self.path = tempfile.mkstemp(prefix=f"{SHARED_PREFIX}{os.getpid()}-", dir=folder)
+        with os.fdopen(fd, "wb") as f:
+            np.asfortranarray(U, dtype=np.float64).T.tofile(f)
+        self.shape = (int(U.shape[0]), int(U.shape[1]))
+        self.maker = os.getpid()
+        self.opened = False
+
+    def open(self) -> FloatArray:
+        """The ``(n, k)`` F-ordered eigenvectors, mapped from the file (then unlinked)."""
+        n, k = self.shape
+        try:
+            mm = np.memmap(self.path, dtype=np.float64, mode="r+", shape=(k, n))
+        finally:
+            self.opened = True
+            with contextlib.suppress(OSError):
+                os.unlink(self.path)
+        return np.asarray(mm).T if k else np.zeros((n, 0), order="F")
+
+    def __del__(self) -> None:
+        if not getattr(self, "opened", True) and getattr(self, "maker", None) != os.getpid():
+            with contextlib.suppress(OSError):
+                os.unlink(self.path)
+
+
+def _remove_stale(folder: str) -> None:
+    """Remove the files of :class:`SharedVectors` whose maker process has ended."""
+    with contextlib.suppress(OSError):
+        for name in os.listdir(folder):
+            if not name.startswith(SHARED_PREFIX):
+                continue
+            try:
+                pid = int(name[len(SHARED_PREFIX) :].split("-", 1)[0])
+                os.kill(pid, 0)
+            except ProcessLookupError:
+                with contextlib.suppress(OSError):
+                    os.unlink(os.path.join(folder, name))
+            except (ValueError, OSError):
+                continue
+
+
+def solve_basis(V: FloatArray, F: IntArray, k: int, progress: Any = None) -> tuple[Any, ...]:
+    """The eigenbasis job's work in a child process (:func:`meshlap_app.jobs.in_child`, which
+    ends the process on Cancel): ``k`` eigenpairs, the errors for every k and the slider's
+    checkpoints, as ``(basis, errors, shared)``: the basis is sent back pickled without its
+    eigenvectors, which travel in ``shared`` (:class:`SharedVectors`). Module level, so it
+    pickles."""
+    basis = SpectralBasis.compute(V, F, k, progress=progress)
+    basis, errors = _finish_basis(basis, k, progress)
+    shared = SharedVectors(basis.vectors)
+    basis.vectors = np.zeros((basis.vectors.shape[0], 0), order="F")
+    return basis, errors, shared
 
 
 @dataclass
@@ -81,16 +167,11 @@ class SpectralState:
         cancel handed to the core where it takes them)."""
         from ..jobs import call_hooked
 
-        report = progress if progress is not None else self._progress
         if progress is not None:
             basis = call_hooked(SpectralBasis.compute, V, F, k, reporter=progress)
         else:
-            basis = SpectralBasis.compute(V, F, k, progress=report)
-        if progress is not None:
-            progress.phase_only("reconstruction errors for every k")
-        errors = basis.errors()  # every k at once (cumulative sums)
-        basis.reconstruct(max(1, k // 2))  # builds the slider's checkpoints off the UI thread
-        return basis, errors
+            basis = SpectralBasis.compute(V, F, k, progress=self._progress)
+        return _finish_basis(basis, k, progress)
 
     def _failed(self, message: str) -> None:
         self.error, self.message = message, ""
@@ -116,10 +197,19 @@ class SpectralState:
         if jobs is None:
             jobs = self._jobs if self._jobs is not None else Jobs()
         self._jobs = jobs
+        if getattr(jobs, "processes", False):
+            # (the window: a child process, where the eigensolver may use CHOLMOD, which
+            # holds the GIL, with METIS ordering; in a thread it would freeze the frames, so
+            # there it keeps to QDLDL: 147 s instead of about 60 s at 692k vertices)
+            from ..jobs import in_child
+
+            work = in_child(solve_basis, V, F, k)
+        else:
+            work = lambda reporter: self.solve(V, F, k, reporter)  # noqa: E731
         self._job = jobs.start(
             owner,
             f"eigenbasis ({k} modes)",
-            lambda reporter: self.solve(V, F, k, reporter),
+            work,
             self._adopt,
             self._failed,
             background=background,
@@ -141,8 +231,10 @@ class SpectralState:
         fresh, self._fresh = self._fresh, False
         return fresh
 
-    def _adopt(self, result: tuple[SpectralBasis, Any]) -> None:
-        basis, self.errors = result
+    def _adopt(self, result: tuple[Any, ...]) -> None:
+        basis, self.errors = result[:2]
+        if len(result) > 2:  # from a child process: the eigenvectors were sent apart
+            basis.vectors = result[2].open()
         self._job = None
         self.basis = basis
         self._fresh = True

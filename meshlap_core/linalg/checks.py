@@ -78,7 +78,7 @@ def orthogonality(U: FloatArray, m: FloatArray) -> float:
     idx = np.unique(
         np.r_[0, kk // 3, (2 * kk) // 3, kk - 1, np.random.default_rng(kk).integers(0, kk, 4)]
     )
-    G = U[:, idx].T @ (m[:, None] * U)
+    G = (U[:, idx] * m[:, None]).T @ U  # (no n × k temporary: M applied to the sample)
     E = np.zeros_like(G)
     E[np.arange(len(idx)), idx] = 1.0
     norms = np.einsum("ij,ij,i->j", U, U, m)

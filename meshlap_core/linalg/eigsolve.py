@@ -56,6 +56,7 @@ from .common import (
     with_cancel,
 )
 from .components import component_scales, components, null_space, scale_groups, solve_by_groups
+from .factor import ldl_backend
 from .slicing import SlicedLanczos, default_workers
 
 # Dense solver below this many vertices (or when k is a large fraction of n).
@@ -142,13 +143,19 @@ def lowdin(Y: FloatArray, helper: Any | None = None) -> float:
 
 
 def fix_signs(U: FloatArray) -> None:
-    """Deterministic sign: the entry of largest magnitude of each column is positive."""
-    if U.shape[1] == 0:
+    """Deterministic sign: the entry of largest magnitude of each column is positive.
+
+    Column by column on an F-ordered ``U`` (no ``n × k`` temporary: 550 MB at 692k vertices
+    and k = 100), and only the columns that change sign are rewritten."""
+    k = U.shape[1]
+    if k == 0:
         return
-    idx = np.argmax(np.abs(U), axis=0)
-    s = np.sign(U[idx, np.arange(U.shape[1])])
-    s[s == 0] = 1.0
-    U *= s[None, :]
+    if U.flags.f_contiguous:
+        idx = np.array([int(np.argmax(np.abs(U[:, j]))) for j in range(k)], dtype=np.int64)
+    else:
+        idx = np.argmax(np.abs(U), axis=0)
+    for j in np.flatnonzero(U[idx, np.arange(k)] < 0):
+        U[:, j] *= -1.0
 
 
 def pencil_eigenpairs(
@@ -479,7 +486,7 @@ def _sparse_eigenpairs(
         else:  # (one slice below ~60 modes: no need to sample the machine's load)
             nw = 1 if k < 60 else default_workers(n, max(slice_size, first_slice))
         nb = 1 if blas_threads_ is None else max(1, int(blas_threads_))
-        info.messages.append(f"{nw} slice worker(s), {nb} BLAS thread(s)")
+        info.messages.append(f"{nw} slice worker(s), {nb} BLAS thread(s), LDLT by {ldl_backend(n)}")
         rho = float(density) if density else float(m.sum() / (4 * np.pi))
         try:
             with limit_blas_threads(nb):

@@ -311,7 +311,9 @@ class SlicedLanczos:
             self.known_X if (i == 0 and known is not None) else None,
             count,
             check_below=lo > 0 and not (i == 0 and self.known_X is not None and self.near_all),
-            check_top=self.workers >= 2 and i == self.n_total - 1,
+            # (the top slice factors for the check above λ_k while it computes its Ritz
+            # vectors; with two workers it also overlaps the other slice)
+            check_top=i == self.n_total - 1,
         )
 
     def absorb(self, r: SliceResult) -> None:

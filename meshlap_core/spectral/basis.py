@@ -138,6 +138,20 @@ class SpectralBasis:
         self._threads = thread_controller()
         self._reset_reconstruction()
 
+    def __getstate__(self) -> dict[str, Any]:
+        """Pickled without its locks and BLAS controller (a basis computed in a child process
+        is sent back to the window whole: arrays, info and the slider's checkpoints)."""
+        state = self.__dict__.copy()
+        for name in ("_lock", "_extend_lock", "_threads"):
+            state.pop(name, None)
+        return state
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__dict__.update(state)
+        self._lock = threading.RLock()
+        self._extend_lock = threading.Lock()
+        self._threads = thread_controller()
+
     # ---- construction ------------------------------------------------------------------
 
     @classmethod
