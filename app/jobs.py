@@ -337,7 +337,14 @@ def call_hooked(fn: Callable[..., Any], *args: Any, reporter: Reporter, **kwargs
 
 
 # ---------------------------------------------------------------------- child processes
-CHILD_PRELOAD = ("numpy", "scipy.sparse", "meshlap_core.io", "meshlap_core.curvature")
+CHILD_PRELOAD = (
+    "numpy",
+    "scipy.sparse",
+    "meshlap_core.io",
+    "meshlap_core.curvature",
+    "meshlap_core.spectral",  # the eigenbasis job (app/state/spectral.py)
+    "meshlap_core.smoothing",  # the stepper process (app/smoother_process.py)
+)
 """Modules the fork server imports once, so each child starts in milliseconds."""
 
 
