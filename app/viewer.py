@@ -14,6 +14,7 @@ changed), hands clicks and keys to the panels, and frames the scene when asked. 
 
 from __future__ import annotations
 
+import copy
 import os
 import sys
 import traceback
@@ -34,6 +35,7 @@ from .panels.base import Panel
 from .registry import REGISTRY, VIEWS
 from .scene import MESH
 from .state.app import AppState
+from .state.preview import PREVIEW_LABEL, MeshPreview
 from .state.watch import Watch
 from .ui import UI
 
@@ -113,6 +115,9 @@ class Viewer:
         self.watch = Watch()
         self._logged: set[tuple[str, str]] = set()
         self._caption_boxes: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+        self.preview: MeshPreview | None = None  # a mesh being opened, shown as parsed
+        self._preview_fit: tuple[Any, ...] = ()  # the display fit its points were made with
+        self.no_shadow = False  # the ground's shadow is off for a big mesh (scene.shadow_for)
 
     # ------------------------------------------------------------------ Host
     def active(self) -> Panel:
@@ -163,13 +168,60 @@ class Viewer:
                 self.forget_errors(view)
             scene.remove_structure(MESH)
             self.state.display.fit(mesh.V, self.state.up_for(mesh.name))
-            ps.register_surface_mesh(MESH, self.mesh_points(), mesh.F, smooth_shade=True)
+            self.no_shadow = scene.shadow_for(len(mesh.F), self.no_shadow)
+            if not self._keep_preview(mesh):
+                scene.remove_structure(MESH)
+                ps.register_surface_mesh(MESH, self.mesh_points(), mesh.F, smooth_shade=True)
             window.set_title(window.window_title(mesh.name, True))  # the window's, if any
             for p in self.panels.values():
                 p.on_new_mesh(self)
         for p in self.panels.values():
             p.sync(self)
         self.refresh()
+
+    def show_preview(self, preview: MeshPreview) -> None:
+        """Show a mesh being opened as parsed (the Mesh job's partial result) in place of the
+        mesh, coloured by its preview field; the views' own structures are hidden meanwhile.
+        The state is untouched: the validated mesh replaces it (:meth:`_keep_preview`), or a
+        failed or cancelled job brings the mesh back (:meth:`restore_mesh`)."""
+        display = copy.deepcopy(self.state.display)
+        display.fit(preview.V, self.state.up_for(preview.name))
+        points = display.points(preview.V)
+        label, scale = PREVIEW_LABEL, self.state.ui_scale
+        self.no_shadow = scene.shadow_for(len(preview.F), self.no_shadow)
+        scene.show_preview(points, preview.F, preview.field, preview.vminmax, label, scale)
+        self.preview, self._preview_fit = preview, _fit_of(display)
+        section = self.panels[REGISTRY[0].name]  # no view: each hides its structures
+        for p in self.panels.values():
+            p.show(self, section)
+        window.set_title(window.window_title(preview.name, True))
+
+    def _keep_preview(self, mesh: Any) -> bool:
+        """The structure registered for the preview already shows ``mesh`` (validation left
+        the geometry as parsed): keep it, without its preview colours; True when kept."""
+        preview, self.preview = self.preview, None
+        if preview is None or not ps.has_surface_mesh(MESH) or preview.name != mesh.name:
+            return False
+        if self._preview_fit != _fit_of(self.state.display):
+            return False
+        if not preview.same_geometry(mesh.V, mesh.F):
+            return False
+        ps.get_surface_mesh(MESH).remove_quantity(PREVIEW_LABEL)
+        return True
+
+    def restore_mesh(self) -> None:
+        """Show the current mesh again after a preview whose job failed or was cancelled:
+        registered anew, every panel's uploads redone from its unchanged state."""
+        self.preview = None
+        mesh = self.state.mesh
+        self.no_shadow = scene.shadow_for(len(mesh.F), self.no_shadow)
+        scene.remove_structure(MESH)
+        ps.register_surface_mesh(MESH, self.mesh_points(), mesh.F, smooth_shade=True)
+        for p in self.panels.values():
+            p.watch.forget()
+        window.set_title(window.window_title(mesh.name, True))
+        self.refresh()
+        self.reframe = True
 
     def forget_errors(self, section: str) -> None:
         """Drop the refused-value errors of ``section`` (its context changed)."""
@@ -196,6 +248,8 @@ class Viewer:
 
     # ------------------------------------------------------------------ input
     def handle_click(self) -> None:
+        if self.preview is not None:  # the picture is not the mesh the panels know
+            return
         xy = self.ui.scene_click()
         if xy is not None:
             self.pick_at(xy)
@@ -291,6 +345,8 @@ class Viewer:
         """Apply what the finished jobs computed (here, on the UI thread)."""
         if self.state.jobs.poll():
             self.pacer.touch()  # a result to show: full rate for a moment
+        if self.preview is not None and self.state.jobs.running(REGISTRY[0].name) is None:
+            self.restore_mesh()  # its job failed or was cancelled: the mesh comes back
 
     def note_activity(self) -> None:
         """Input this frame (the UI's activity changed, or polyscope was asked to redraw: the
@@ -432,7 +488,13 @@ class Viewer:
 
         name = Path(path).name if path is not None else "the default mesh"
         job = state.jobs.start(
-            section, f"opening {name}", work, apply, fail, background=self.background
+            section,
+            f"opening {name}",
+            work,
+            apply,
+            fail,
+            background=self.background,
+            preview=self.show_preview,
         )
         assert job is not None
         return self.background or job.status == "done"
@@ -514,6 +576,11 @@ class Viewer:
             x = float(xy[:, 0].mean()) - 3.5 * len(text) * self.ui.scale
             y = float(min(xy[:, 1].max() + 8, h - 24))
             self.ui.overlay_text((x, y), text)
+
+
+def _fit_of(display: Any) -> tuple[Any, ...]:
+    """What the display positions of a mesh depend on besides its vertices."""
+    return (display.scale, *np.asarray(display.centre).tolist(), display.up)
 
 
 def opens_later(path: Path | None, shot: Path | None, saved: Any, options: dict[str, Any]) -> bool:

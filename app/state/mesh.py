@@ -106,14 +106,17 @@ def read_mesh(path: str | Path | None, progress: Any = None) -> LoadedMesh:
     """Read, validate and describe ``path`` (the bundled default when ``None``).
 
     ``progress`` is a job's reporter (:class:`meshlap_app.jobs.Reporter`): passed on to
-    ``load_mesh`` as ``progress=`` / ``cancel=`` when the core takes them, and told each phase.
+    ``load_mesh`` as ``progress=`` / ``cancel=`` when the core takes them, and told each phase;
+    a reporter with ``partial`` (a job's) is handed a :class:`~.preview.MeshPreview` as soon as
+    the file is parsed (before the validation), for the window to show at once.
 
     Raises
     ------
     MeshError, OSError
         The file is refused or unreadable.
     """
-    from ..jobs import call_hooked
+    from ..jobs import accepts, call_hooked
+    from .preview import make_preview
 
     def phase(message: str) -> None:
         if progress is not None:
@@ -132,7 +135,16 @@ def read_mesh(path: str | Path | None, progress: Any = None) -> LoadedMesh:
         name = Path(path).name
     phase(f"reading {name}")
     if progress is not None:
-        mesh = call_hooked(load_mesh, path, reporter=progress)
+        extra: dict[str, Any] = {}
+        partial = getattr(progress, "partial", None)
+        if partial is not None and accepts(load_mesh, "on_parsed"):
+
+            def show_parsed(V: FloatArray, F: IntArray) -> None:
+                phase("a preview of the geometry read")
+                partial(make_preview(name, V, F))
+
+            extra["on_parsed"] = show_parsed
+        mesh = call_hooked(load_mesh, path, reporter=progress, **extra)
     else:
         mesh = load_mesh(path)
     phase("describing the mesh")
