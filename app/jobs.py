@@ -74,6 +74,7 @@ class Reporter:
         self.reports = 0
         self.at = clock()
         self._partial: list[Any] = []  # the latest partial result not yet shown (0 or 1 item)
+        self.last_partial: Any = None  # the latest partial result, shown or not
 
     def __call__(self, fraction: float | None, message: str = "") -> None:
         """Report a phase (``message``, kept when empty) and a fraction in [0, 1] (``None``:
@@ -100,6 +101,7 @@ class Reporter:
         """Hand a partial result to the UI thread (the job's ``preview``, called in
         :meth:`Jobs.poll` while the job still runs; a newer one replaces one not yet shown)."""
         self.check()
+        self.last_partial = value
         self._partial[:] = [value]
         if self.on_report is not None:
             self.on_report()
@@ -371,6 +373,7 @@ class _ChildReporter:
     (which checks Cancel and ends the child)."""
 
     cancel = None  # the parent cancels by ending the process
+    remote = True  # what the function returns is sent to another process
 
     def __init__(self, conn: Any) -> None:
         self.conn = conn

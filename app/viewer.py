@@ -472,7 +472,11 @@ class Viewer:
         state = self.state
         curv = state.curv
         settings = (curv.area, curv.boundary)
-        work = state.jobs.offload(read_mesh_with_fields, path, *settings)  # a child process
+        read = state.jobs.offload(read_mesh_with_fields, path, *settings)  # a child process
+
+        def work(reporter: Reporter) -> Any:
+            loaded, fields = read(reporter)  # sent back without the geometry previewed
+            return loaded.with_geometry(reporter.last_partial), fields
 
         def apply(result: Any) -> None:
             loaded, fields = result

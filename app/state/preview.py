@@ -22,6 +22,8 @@ from .curvature import robust_range
 
 PREVIEW_LABEL = "preview: uniform H, curvature being computed [1/length]"
 """The colour map's name on the preview (said on screen: not the final field)."""
+PREVIEW_FACES = 100_000
+"""A mesh with fewer faces gets no preview (validated and coloured in well under a second)."""
 
 
 @dataclass
@@ -49,6 +51,8 @@ class MeshPreview:
 
     def same_geometry(self, V: FloatArray, F: IntArray) -> bool:
         """Whether the validated mesh ``(V, F)`` is exactly the geometry previewed."""
+        if self.V is V and self.F is F:
+            return True
         return (
             self.V.shape == np.shape(V)
             and self.F.shape == np.shape(F)
