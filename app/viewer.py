@@ -166,7 +166,6 @@ class Viewer:
         if self.watch.changed("mesh", mesh.version, id(mesh)):
             for view in VIEWS:  # a refused value of the last mesh's context
                 self.forget_errors(view)
-            scene.remove_structure(MESH)
             self.state.display.fit(mesh.V, self.state.up_for(mesh.name))
             self.no_shadow = scene.shadow_for(len(mesh.F), self.no_shadow)
             if not self._keep_preview(mesh):

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -15,7 +15,8 @@ from meshlap_core.io import load_mesh
 from meshlap_core.types import FloatArray, IntArray
 from meshlap_core.validate import validate_mesh
 
-from .preview import MeshPreview
+if TYPE_CHECKING:
+    from .preview import MeshPreview
 
 ROOT = Path(__file__).resolve().parents[2]  # the checkout (app/ sits beside assets/)
 ASSETS_DIR = ROOT / "assets"
