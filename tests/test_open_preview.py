@@ -25,13 +25,14 @@ import pytest
 from meshlap_app.jobs import Jobs, in_child
 from meshlap_app.state.mesh import read_mesh_with_fields
 from meshlap_app.state.preview import PREVIEW_LABEL, make_preview, preview_field
+from test_viewer_widgets import frames
+
 from meshlap_core import primitives
 from meshlap_core.curvature import all_curvature_fields, mean_curvature_uniform
 from meshlap_core.errors import MeshError
 from meshlap_core.io import load_mesh, save_mesh
 from meshlap_core.laplacian import uniform_laplacian
 from meshlap_core.options import CURVATURE_FIELD_LABELS
-from test_viewer_widgets import frames
 
 
 def test_preview_field_is_the_uniform_laplacian_against_the_normals_on_a_closed_mesh():
@@ -159,7 +160,7 @@ def test_a_child_sends_the_mesh_back_without_the_geometry_previewed(tmp_path, mo
     path = tmp_path / "ball.obj"
     save_mesh(path, V, F)
     reporter = RemoteReporter()
-    loaded, fields = read_mesh_with_fields(path, "voronoi", "pi", reporter)
+    loaded, _ = read_mesh_with_fields(path, "voronoi", "pi", reporter)
     assert loaded.mesh.V is None and loaded.mesh.F is None  # not sent twice
     p = reporter.last_partial
     mesh = load_mesh(path)
