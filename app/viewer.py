@@ -14,7 +14,6 @@ changed), hands clicks and keys to the panels, and frames the scene when asked. 
 
 from __future__ import annotations
 
-import copy
 import os
 import sys
 import traceback
@@ -28,14 +27,14 @@ import polyscope as ps
 from meshlap_core.errors import MeshError
 from meshlap_core.options import UP_AXES, check_choice
 
-from . import scene, window
+from . import opening, scene, window
 from .jobs import Job, Reporter, prefer_gil_free_solvers, warm_up
 from .pacing import Pacer
 from .panels.base import Panel
 from .registry import REGISTRY, VIEWS
 from .scene import MESH
 from .state.app import AppState
-from .state.preview import PREVIEW_LABEL, MeshPreview
+from .state.preview import MeshPreview
 from .state.watch import Watch
 from .ui import UI
 
@@ -116,7 +115,7 @@ class Viewer:
         self._logged: set[tuple[str, str]] = set()
         self._caption_boxes: dict[str, tuple[np.ndarray, np.ndarray]] = {}
         self.preview: MeshPreview | None = None  # a mesh being opened, shown as parsed
-        self._preview_fit: tuple[Any, ...] = ()  # the display fit its points were made with
+        self.preview_fit: tuple[Any, ...] = ()  # the display fit its points were made with
         self.no_shadow = False  # the ground's shadow is off for a big mesh (scene.shadow_for)
 
     # ------------------------------------------------------------------ Host
@@ -168,7 +167,7 @@ class Viewer:
                 self.forget_errors(view)
             self.state.display.fit(mesh.V, self.state.up_for(mesh.name))
             self.no_shadow = scene.shadow_for(len(mesh.F), self.no_shadow)
-            if not self._keep_preview(mesh):
+            if not opening.keep_preview(self, mesh):
                 scene.remove_structure(MESH)
                 ps.register_surface_mesh(MESH, self.mesh_points(), mesh.F, smooth_shade=True)
             window.set_title(window.window_title(mesh.name, True))  # the window's, if any
@@ -179,48 +178,12 @@ class Viewer:
         self.refresh()
 
     def show_preview(self, preview: MeshPreview) -> None:
-        """Show a mesh being opened as parsed (the Mesh job's partial result) in place of the
-        mesh, coloured by its preview field; the views' own structures are hidden meanwhile.
-        The state is untouched: the validated mesh replaces it (:meth:`_keep_preview`), or a
-        failed or cancelled job brings the mesh back (:meth:`restore_mesh`)."""
-        display = copy.deepcopy(self.state.display)
-        display.fit(preview.V, self.state.up_for(preview.name))
-        points = display.points(preview.V)
-        label, scale = PREVIEW_LABEL, self.state.ui_scale
-        self.no_shadow = scene.shadow_for(len(preview.F), self.no_shadow)
-        scene.show_preview(points, preview.F, preview.field, preview.vminmax, label, scale)
-        self.preview, self._preview_fit = preview, _fit_of(display)
-        section = self.panels[REGISTRY[0].name]  # no view: each hides its structures
-        for p in self.panels.values():
-            p.show(self, section)
-        window.set_title(window.window_title(preview.name, True))
-
-    def _keep_preview(self, mesh: Any) -> bool:
-        """The structure registered for the preview already shows ``mesh`` (validation left
-        the geometry as parsed): keep it, without its preview colours; True when kept."""
-        preview, self.preview = self.preview, None
-        if preview is None or not ps.has_surface_mesh(MESH) or preview.name != mesh.name:
-            return False
-        if self._preview_fit != _fit_of(self.state.display):
-            return False
-        if not preview.same_geometry(mesh.V, mesh.F):
-            return False
-        ps.get_surface_mesh(MESH).remove_quantity(PREVIEW_LABEL)
-        return True
+        """Show a mesh being opened as parsed (:func:`.opening.show_preview`)."""
+        opening.show_preview(self, preview)
 
     def restore_mesh(self) -> None:
-        """Show the current mesh again after a preview whose job failed or was cancelled:
-        registered anew, every panel's uploads redone from its unchanged state."""
-        self.preview = None
-        mesh = self.state.mesh
-        self.no_shadow = scene.shadow_for(len(mesh.F), self.no_shadow)
-        scene.remove_structure(MESH)
-        ps.register_surface_mesh(MESH, self.mesh_points(), mesh.F, smooth_shade=True)
-        for p in self.panels.values():
-            p.watch.forget()
-        window.set_title(window.window_title(mesh.name, True))
-        self.refresh()
-        self.reframe = True
+        """Show the current mesh again after a preview (:func:`.opening.restore_mesh`)."""
+        opening.restore_mesh(self)
 
     def forget_errors(self, section: str) -> None:
         """Drop the refused-value errors of ``section`` (its context changed)."""
@@ -462,45 +425,10 @@ class Viewer:
         """Load ``path``; on failure the error is shown in the Mesh section, the mesh stays.
 
         In the window (:attr:`background`) the file is read, validated and its curvature
-        fields computed as one job of the Mesh section (the last good mesh stays on screen
-        meanwhile; True: started); otherwise right here (True: loaded).
+        fields computed as one job of the Mesh section, a preview shown as soon as it is
+        parsed (:mod:`.opening`; True: started); otherwise right here (True: loaded).
         """
-        from .state.mesh import read_mesh_with_fields
-
-        section = REGISTRY[0].name  # the first section: the mesh's
-        state = self.state
-        curv = state.curv
-        settings = (curv.area, curv.boundary)
-        read = state.jobs.offload(read_mesh_with_fields, path, *settings)  # a child process
-
-        def work(reporter: Reporter) -> Any:
-            loaded, fields = read(reporter)  # sent back without the geometry previewed
-            return loaded.with_geometry(reporter.last_partial), fields
-
-        def apply(result: Any) -> None:
-            loaded, fields = result
-            state.jobs.cancel_all()  # what other panels computed belongs to the old mesh
-            state.mesh.adopt(loaded)
-            if (curv.area, curv.boundary) == settings:
-                curv.adopt(state.mesh, fields)
-            self.sync_mesh()
-            self.reframe = True
-
-        def fail(message: str) -> None:
-            state.mesh.error = message
-
-        name = Path(path).name if path is not None else "the default mesh"
-        job = state.jobs.start(
-            section,
-            f"opening {name}",
-            work,
-            apply,
-            fail,
-            background=self.background,
-            preview=self.show_preview,
-        )
-        assert job is not None
-        return self.background or job.status == "done"
+        return opening.open_mesh(self, path)
 
     # ------------------------------------------------------------------ framing, captions
     def framed_names(self) -> tuple[str, ...]:
@@ -579,11 +507,6 @@ class Viewer:
             x = float(xy[:, 0].mean()) - 3.5 * len(text) * self.ui.scale
             y = float(min(xy[:, 1].max() + 8, h - 24))
             self.ui.overlay_text((x, y), text)
-
-
-def _fit_of(display: Any) -> tuple[Any, ...]:
-    """What the display positions of a mesh depend on besides its vertices."""
-    return (display.scale, *np.asarray(display.centre).tolist(), display.up)
 
 
 def opens_later(path: Path | None, shot: Path | None, saved: Any, options: dict[str, Any]) -> bool:

@@ -18,8 +18,6 @@ import numpy as np
 
 from meshlap_core.types import FloatArray, IntArray
 
-from .curvature import robust_range
-
 PREVIEW_LABEL = "preview: uniform H, curvature being computed [1/length]"
 """The colour map's name on the preview (said on screen: not the final field)."""
 PREVIEW_FACES = 100_000
@@ -40,7 +38,8 @@ class MeshPreview:
     field : (n,) float64
         :func:`preview_field` of ``(V, F)``.
     vminmax : (float, float)
-        Its colour range (symmetric, 2 % clipped at each end, as the Curvature panel's).
+        Its colour range ``(−r, r)``, ``r`` the 98th percentile of ``|field|`` (one outlier
+        cannot wash the map out).
     """
 
     name: str
@@ -113,4 +112,6 @@ def preview_field(V: FloatArray, F: IntArray) -> FloatArray:
 def make_preview(name: str, V: FloatArray, F: IntArray) -> MeshPreview:
     """The :class:`MeshPreview` of a parsed mesh (run in the loading job)."""
     H = preview_field(V, F)
-    return MeshPreview(name, V, F, H, robust_range(H, signed=True))
+    r = float(np.percentile(np.abs(H), 98.0)) if len(H) else 0.0
+    r = r if np.isfinite(r) and r > 0 else 1.0
+    return MeshPreview(name, V, F, H, (-r, r))
