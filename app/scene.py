@@ -209,6 +209,12 @@ FRONT_VIEWS: dict[str, tuple[float, float, float]] = {
 OBLIQUE_VIEW = (0.55, 0.75, -1.0)
 
 
+def box_of(P: np.ndarray) -> np.ndarray:
+    """``[min, max]`` ``(2,3)`` of the points ``P (k,3)`` (``(0,3)`` when there are none): what
+    :func:`frame_points` reads of a structure (its bounding box's corners frame the same)."""
+    return np.array([P.min(axis=0), P.max(axis=0)]) if len(P) else np.zeros((0, 3))
+
+
 def frame_points(
     P: np.ndarray,
     toward_eye: tuple[float, float, float] = DEFAULT_VIEW,

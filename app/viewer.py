@@ -445,6 +445,18 @@ class Viewer:
                 return P
         return None
 
+    def structure_box(self, name: str) -> np.ndarray | None:
+        """The corners ``(2,3)`` (min, max) of a structure's display positions, ``(0,3)``
+        when it has none, ``None`` when unknown: all that framing and captions read (the
+        main mesh's is kept while its points are: two passes over millions of points less at
+        each re-frame)."""
+        if name == MESH:
+            d, mesh = self.state.display, self.state.mesh
+            key = (mesh.version, id(mesh.V), d.scale, *d.centre.tolist(), d.up)  # as the points'
+            return self.watch.cached("mesh box", key, lambda: scene.box_of(self.mesh_points()))
+        P = self.structure_points(name)
+        return None if P is None else scene.box_of(P)
+
     def view_direction(self) -> tuple[float, float, float]:
         """Where the camera looks from: the active view's own direction, else the mesh's
         front (:data:`.scene.FRONT_VIEWS`)."""
@@ -460,7 +472,7 @@ class Viewer:
         if strip is not None:
             if not self.keep_camera:
                 scene.frame_scene_left(
-                    self.framed_names(), self.structure_points, 0.95, self.view_direction(), strip
+                    self.framed_names(), self.structure_box, 0.95, self.view_direction(), strip
                 )
             return
         if not whole and self.active().focus(self):
@@ -470,13 +482,13 @@ class Viewer:
         fraction = max(scene.scene_fraction(w, self.state.ui_scale), 0.95 * (1 - pane / w))
         left = scene.COLORBAR_PX * self.state.ui_scale / max(w, 1)  # clear of the colour bar
         names = self.framed_names()
-        scene.frame_scene_left(names, self.structure_points, fraction, self.view_direction(), left)
+        scene.frame_scene_left(names, self.structure_box, fraction, self.view_direction(), left)
         self._caption_boxes = {}
         for name in names:
             if ps.has_surface_mesh(name) and ps.get_surface_mesh(name).is_enabled():
-                P = self.structure_points(name)
-                if P is not None and len(P):
-                    self._caption_boxes[name] = (P.min(axis=0), P.max(axis=0))
+                box = self.structure_box(name)
+                if box is not None and len(box):
+                    self._caption_boxes[name] = (box[0], box[1])
 
     def captions(self) -> dict[str, str]:
         """Caption of each structure the active view shows side by side."""
