@@ -147,9 +147,9 @@ def child(scan: Path, k: int, wait_basis: bool, out: Path) -> list[dict[str, Any
     ps.frame_tick()
     refused = said("spectral") or getattr(sp, "error", "") or ""
     if wait_basis and not refused:
-        while sp.busy:
+        while sp.busy:  # the job's result is applied in a frame (Jobs.poll)
             time.sleep(0.1)
-        ps.frame_tick()
+            ps.frame_tick()
         ps.frame_tick()
     ok = bool(refused) or sp.busy or sp.basis is not None
     said_ = "refused" if refused else ("computed" if sp.basis is not None else "computing")
