@@ -73,6 +73,8 @@ class Reporter:
         self.fraction: float | None = None
         self.reports = 0
         self.at = clock()
+        self._partial: list[Any] = []  # the latest partial result not yet shown (0 or 1 item)
+        self.last_partial: Any = None  # the latest partial result, shown or not
 
     def __call__(self, fraction: float | None, message: str = "") -> None:
         """Report a phase (``message``, kept when empty) and a fraction in [0, 1] (``None``:
@@ -95,6 +97,20 @@ class Reporter:
         if self.cancel.is_set():
             raise Cancelled("cancelled")
 
+    def partial(self, value: Any) -> None:
+        """Hand a partial result to the UI thread (the job's ``preview``, called in
+        :meth:`Jobs.poll` while the job still runs; a newer one replaces one not yet shown)."""
+        self.check()
+        self.last_partial = value
+        self._partial[:] = [value]
+        if self.on_report is not None:
+            self.on_report()
+
+    def take_partial(self) -> list[Any]:
+        """The partial result waiting to be shown (``[]``: none), forgotten once taken."""
+        taken, self._partial = self._partial, []
+        return taken
+
 
 @dataclass
 class Job:
@@ -108,6 +124,7 @@ class Job:
     reporter: Reporter
     started: float
     clock: Callable[[], float] = time.monotonic
+    preview: Callable[[Any], None] | None = None  # shows a partial result (UI thread)
     status: str = RUNNING  # until Jobs.poll handled it (or it was cancelled)
     outcome: str = RUNNING  # what the worker ended with: done, failed or cancelled
     result: Any = None
@@ -191,6 +208,7 @@ class Jobs:
         fail: Callable[[str], None] | None = None,
         replace: bool = True,
         background: bool | None = None,
+        preview: Callable[[Any], None] | None = None,
     ) -> Job | None:
         """Start ``work`` for ``owner``; ``apply(result)`` (or ``fail(message)``) runs later in
         :meth:`poll`.
@@ -202,6 +220,9 @@ class Jobs:
 
         ``background=False`` (default: the ``background`` given to the constructor) runs the
         job right here and applies it at once: the caller is on the UI thread.
+        ``preview(value)`` shows each partial result the work hands over
+        (:meth:`Reporter.partial`) while the job runs, in :meth:`poll`; a job run right here
+        applies its result at once and previews nothing.
         """
         old = self._jobs.get(owner)
         if old is not None and old.running:
@@ -209,7 +230,7 @@ class Jobs:
                 return None
             self.cancel(owner)
         reporter = Reporter(threading.Event(), self.clock, self._reported)
-        job = Job(owner, title, work, apply, fail, reporter, self.clock(), self.clock)
+        job = Job(owner, title, work, apply, fail, reporter, self.clock(), self.clock, preview)
         self._jobs[owner] = job
         if self.background if background is None else background:
             job.thread = threading.Thread(target=self._run, args=(job,), daemon=True)
@@ -255,10 +276,16 @@ class Jobs:
     def poll(self) -> list[Job]:
         """Apply the results of the jobs that finished (UI thread, once per frame): ``apply``
         for a result, ``fail`` for an error; a cancelled job changes nothing. Returns the jobs
-        handled."""
+        handled (a running job's partial result is shown by its ``preview`` after them; it
+        does not count as handled)."""
         with self._lock:
             finished, self._finished = self._finished, []
-        return [job for job in finished if self._settle(job)]
+        handled = [job for job in finished if self._settle(job)]
+        for job in list(self._jobs.values()):
+            if job.running and job.preview is not None and job.outcome == RUNNING:
+                for value in job.reporter.take_partial():
+                    job.preview(value)
+        return handled
 
     def _settle(self, job: Job) -> bool:
         """Apply a finished job's outcome (UI thread); False when it was superseded or
@@ -353,6 +380,7 @@ class _ChildReporter:
     (which checks Cancel and ends the child)."""
 
     cancel = None  # the parent cancels by ending the process
+    remote = True  # what the function returns is sent to another process
 
     def __init__(self, conn: Any) -> None:
         self.conn = conn
@@ -367,6 +395,10 @@ class _ChildReporter:
 
     def check(self) -> None:
         """Nothing to check here (the parent ends the process on Cancel)."""
+
+    def partial(self, value: Any) -> None:
+        """Send a partial result to the parent (its reporter's :meth:`Reporter.partial`)."""
+        self.conn.send(("partial", value))
 
 
 def _child_main(conn: Any, fn: Callable[..., Any], args: tuple[Any, ...]) -> None:
@@ -442,6 +474,8 @@ def in_child(fn: Callable[..., Any], *args: Any) -> Callable[[Reporter], Any]:
                         raise MeshError(message) from None
                     if kind == "progress":
                         reporter(*payload)
+                    elif kind == "partial":
+                        reporter.partial(payload[0])
                     elif kind == "result":
                         return payload[0]
                     else:

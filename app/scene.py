@@ -153,6 +153,52 @@ def remove_structure(name: str) -> None:
             remove(name)
 
 
+LARGE_MESH_FACES = 1_000_000
+"""Above this many faces the ground's shadow is off (:func:`shadow_for`): with Mesa's software
+OpenGL the shadow is a second render pass of the whole mesh, about half of each redraw of a
+1.4M-face scan (0.5 s of CPU)."""
+
+
+def shadow_for(n_faces: int, turned_off: bool) -> bool:
+    """Turn the ground's shadow off for a mesh of more than :data:`LARGE_MESH_FACES` faces,
+    back on for a smaller one when this rule turned it off (``turned_off``); returns whether
+    it is now off by this rule (a shadow turned off elsewhere, e.g. an animation's, stays
+    off)."""
+    if n_faces > LARGE_MESH_FACES:
+        ps.set_ground_plane_mode("none")
+        return True
+    if turned_off:
+        ps.set_ground_plane_mode("shadow_only")
+    return False
+
+
+def show_preview(
+    points: np.ndarray,
+    F: np.ndarray,
+    values: np.ndarray,
+    vminmax: tuple[float, float],
+    label: str,
+    ui_scale: float = 1.0,
+) -> Any:
+    """Register ``points (n,3)``, ``F (m,3)`` as the main mesh :data:`MESH` (replacing it),
+    coloured by ``values (n,)`` under ``label`` with its colour bar: the preview of a mesh
+    being opened (:mod:`meshlap_app.state.preview`). Returns the structure."""
+    remove_structure(MESH)
+    sm = ps.register_surface_mesh(MESH, points, F, smooth_shade=True)
+    sm.add_scalar_quantity(
+        label,
+        values,
+        defined_on="vertices",
+        cmap="coolwarm",
+        vminmax=vminmax,
+        enabled=True,
+        onscreen_colorbar_enabled=True,
+        onscreen_colorbar_location=colorbar_at(0, ui_scale),
+    )
+    sm.set_enabled(True)
+    return sm
+
+
 # the direction from a mesh towards the camera (y up): scans face -z; meshes known to face +z
 # get their front; the parametric surfaces (torus, helicoid, ...) are seen obliquely from above
 DEFAULT_VIEW = (0.0, 0.15, -1.0)
@@ -161,6 +207,12 @@ FRONT_VIEWS: dict[str, tuple[float, float, float]] = {
     "nefertiti.obj": (0.0, 0.15, 1.0),  # in display coordinates: z-up, turned (UP_BY_MESH)
 }
 OBLIQUE_VIEW = (0.55, 0.75, -1.0)
+
+
+def box_of(P: np.ndarray) -> np.ndarray:
+    """``[min, max]`` ``(2,3)`` of the points ``P (k,3)`` (``(0,3)`` when there are none): what
+    :func:`frame_points` reads of a structure (its bounding box's corners frame the same)."""
+    return np.array([P.min(axis=0), P.max(axis=0)]) if len(P) else np.zeros((0, 3))
 
 
 def frame_points(

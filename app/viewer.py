@@ -27,13 +27,14 @@ import polyscope as ps
 from meshlap_core.errors import MeshError
 from meshlap_core.options import UP_AXES, check_choice
 
-from . import scene, window
+from . import opening, scene, window
 from .jobs import Job, Reporter, prefer_gil_free_solvers, warm_up
 from .pacing import Pacer
 from .panels.base import Panel, Pick
 from .registry import REGISTRY, VIEWS
 from .scene import MESH
 from .state.app import AppState
+from .state.preview import MeshPreview
 from .state.watch import Watch
 from .ui import UI
 
@@ -113,6 +114,9 @@ class Viewer:
         self.watch = Watch()
         self._logged: set[tuple[str, str]] = set()
         self._caption_boxes: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+        self.preview: MeshPreview | None = None  # a mesh being opened, shown as parsed
+        self.preview_fit: tuple[Any, ...] = ()  # the display fit its points were made with
+        self.no_shadow = False  # the ground's shadow is off for a big mesh (scene.shadow_for)
 
     # ------------------------------------------------------------------ Host
     def active(self) -> Panel:
@@ -161,15 +165,25 @@ class Viewer:
         if self.watch.changed("mesh", mesh.version, id(mesh)):
             for view in VIEWS:  # a refused value of the last mesh's context
                 self.forget_errors(view)
-            scene.remove_structure(MESH)
             self.state.display.fit(mesh.V, self.state.up_for(mesh.name))
-            ps.register_surface_mesh(MESH, self.mesh_points(), mesh.F, smooth_shade=True)
+            self.no_shadow = scene.shadow_for(len(mesh.F), self.no_shadow)
+            if not opening.keep_preview(self, mesh):
+                scene.remove_structure(MESH)
+                ps.register_surface_mesh(MESH, self.mesh_points(), mesh.F, smooth_shade=True)
             window.set_title(window.window_title(mesh.name, True))  # the window's, if any
             for p in self.panels.values():
                 p.on_new_mesh(self)
         for p in self.panels.values():
             p.sync(self)
         self.refresh()
+
+    def show_preview(self, preview: MeshPreview) -> None:
+        """Show a mesh being opened as parsed (:func:`.opening.show_preview`)."""
+        opening.show_preview(self, preview)
+
+    def restore_mesh(self) -> None:
+        """Show the current mesh again after a preview (:func:`.opening.restore_mesh`)."""
+        opening.restore_mesh(self)
 
     def forget_errors(self, section: str) -> None:
         """Drop the refused-value errors of ``section`` (its context changed)."""
@@ -196,6 +210,8 @@ class Viewer:
 
     # ------------------------------------------------------------------ input
     def handle_click(self) -> None:
+        if self.preview is not None:  # the picture is not the mesh the panels know
+            return
         click = self.ui.scene_click()
         if click is not None:
             self.pick_at(*click)
@@ -295,6 +311,8 @@ class Viewer:
         """Apply what the finished jobs computed (here, on the UI thread)."""
         if self.state.jobs.poll():
             self.pacer.touch()  # a result to show: full rate for a moment
+        if self.preview is not None and self.state.jobs.running(REGISTRY[0].name) is None:
+            self.restore_mesh()  # its job failed or was cancelled: the mesh comes back
 
     def note_activity(self) -> None:
         """Input this frame (the UI's activity changed, or polyscope was asked to redraw: the
@@ -411,35 +429,10 @@ class Viewer:
         """Load ``path``; on failure the error is shown in the Mesh section, the mesh stays.
 
         In the window (:attr:`background`) the file is read, validated and its curvature
-        fields computed as one job of the Mesh section (the last good mesh stays on screen
-        meanwhile; True: started); otherwise right here (True: loaded).
+        fields computed as one job of the Mesh section, a preview shown as soon as it is
+        parsed (:mod:`.opening`; True: started); otherwise right here (True: loaded).
         """
-        from .state.mesh import read_mesh_with_fields
-
-        section = REGISTRY[0].name  # the first section: the mesh's
-        state = self.state
-        curv = state.curv
-        settings = (curv.area, curv.boundary)
-        work = state.jobs.offload(read_mesh_with_fields, path, *settings)  # a child process
-
-        def apply(result: Any) -> None:
-            loaded, fields = result
-            state.jobs.cancel_all()  # what other panels computed belongs to the old mesh
-            state.mesh.adopt(loaded)
-            if (curv.area, curv.boundary) == settings:
-                curv.adopt(state.mesh, fields)
-            self.sync_mesh()
-            self.reframe = True
-
-        def fail(message: str) -> None:
-            state.mesh.error = message
-
-        name = Path(path).name if path is not None else "the default mesh"
-        job = state.jobs.start(
-            section, f"opening {name}", work, apply, fail, background=self.background
-        )
-        assert job is not None
-        return self.background or job.status == "done"
+        return opening.open_mesh(self, path)
 
     # ------------------------------------------------------------------ framing, captions
     def framed_names(self) -> tuple[str, ...]:
@@ -456,6 +449,18 @@ class Viewer:
                 return P
         return None
 
+    def structure_box(self, name: str) -> np.ndarray | None:
+        """The corners ``(2,3)`` (min, max) of a structure's display positions, ``(0,3)``
+        when it has none, ``None`` when unknown: all that framing and captions read (the
+        main mesh's is kept while its points are: two passes over millions of points less at
+        each re-frame)."""
+        if name == MESH:
+            d, mesh = self.state.display, self.state.mesh
+            key = (mesh.version, id(mesh.V), d.scale, *d.centre.tolist(), d.up)  # as the points'
+            return self.watch.cached("mesh box", key, lambda: scene.box_of(self.mesh_points()))
+        P = self.structure_points(name)
+        return None if P is None else scene.box_of(P)
+
     def view_direction(self) -> tuple[float, float, float]:
         """Where the camera looks from: the active view's own direction, else the mesh's
         front (:data:`.scene.FRONT_VIEWS`)."""
@@ -471,7 +476,7 @@ class Viewer:
         if strip is not None:
             if not self.keep_camera:
                 scene.frame_scene_left(
-                    self.framed_names(), self.structure_points, 0.95, self.view_direction(), strip
+                    self.framed_names(), self.structure_box, 0.95, self.view_direction(), strip
                 )
             return
         if not whole and self.active().focus(self):
@@ -481,13 +486,13 @@ class Viewer:
         fraction = max(scene.scene_fraction(w, self.state.ui_scale), 0.95 * (1 - pane / w))
         left = scene.COLORBAR_PX * self.state.ui_scale / max(w, 1)  # clear of the colour bar
         names = self.framed_names()
-        scene.frame_scene_left(names, self.structure_points, fraction, self.view_direction(), left)
+        scene.frame_scene_left(names, self.structure_box, fraction, self.view_direction(), left)
         self._caption_boxes = {}
         for name in names:
             if ps.has_surface_mesh(name) and ps.get_surface_mesh(name).is_enabled():
-                P = self.structure_points(name)
-                if P is not None and len(P):
-                    self._caption_boxes[name] = (P.min(axis=0), P.max(axis=0))
+                box = self.structure_box(name)
+                if box is not None and len(box):
+                    self._caption_boxes[name] = (box[0], box[1])
 
     def captions(self) -> dict[str, str]:
         """Caption of each structure the active view shows side by side."""

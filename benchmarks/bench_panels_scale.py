@@ -13,11 +13,12 @@ its ``PYTHONPATH``, as pytest gives it to the tests), the same widgets
 ``tests/test_viewer_widgets.py`` drives on a small sphere:
 
 - open the scan with its curvature fields (the Mesh section's job, inline here), first frame;
-- curvature: the Gaussian field, then the Voronoi area (every field recomputed);
+- curvature: the Gaussian field, then the other vertex area (every field recomputed);
 - one-ring: vertex 7 typed into the field (its inspector), and vertex ``n`` refused;
 - spectral: ``--k`` modes asked for (default 100): computed, or refused with the message
-  naming the memory limit (``meshlap_core/spectral/budget.py``); only the refusal or the start
-  is waited for unless ``--wait-basis``;
+  naming the memory limit (``meshlap_core/spectral/budget.py``); the basis is a job here as in
+  the window (a thread), so only the refusal or the start is waited for unless
+  ``--wait-basis`` (else it is cancelled before the next panel);
 - smoothing: the default stepper built (its job, inline), 3 steps, the implicit cotan stepper
   built (its factorization, :meth:`~meshlap_core.smoothing.Smoother.prepare`) and 3 steps;
 - surfaces: the torus;
@@ -126,8 +127,9 @@ def child(scan: Path, k: int, wait_basis: bool, out: Path) -> list[dict[str, Any
     drive("field", "gaussian", "curvature")
     row("curvature", "field: gaussian", t, c.field_name == "gaussian", said("curvature"))
     t = time.perf_counter()
-    drive("area", "voronoi")
-    row("curvature", "area: voronoi (fields recomputed)", t, c.area == "voronoi")
+    other = "barycentric" if c.area != "barycentric" else "voronoi"  # not the one shown
+    drive("area", other)
+    row("curvature", f"area: {other} (fields recomputed)", t, c.area == other)
 
     ring = viewer.panels["onering"].state
     t = time.perf_counter()
@@ -139,14 +141,15 @@ def child(scan: Path, k: int, wait_basis: bool, out: Path) -> list[dict[str, Any
 
     sp = viewer.panels["spectral"].state
     t = time.perf_counter()
+    viewer.background = True  # the eigenbasis as the window starts it: a job (a thread here)
     drive("modes to compute", k, "spectral")
     drive("compute eigenbasis", True)
     ps.frame_tick()
     refused = said("spectral") or getattr(sp, "error", "") or ""
     if wait_basis and not refused:
-        while sp.busy:
+        while sp.busy:  # the job's result is applied in a frame (Jobs.poll)
             time.sleep(0.1)
-        ps.frame_tick()
+            ps.frame_tick()
         ps.frame_tick()
     ok = bool(refused) or sp.busy or sp.basis is not None
     said_ = "refused" if refused else ("computed" if sp.basis is not None else "computing")
@@ -158,6 +161,7 @@ def child(scan: Path, k: int, wait_basis: bool, out: Path) -> list[dict[str, Any
             time.sleep(0.1)
             ps.frame_tick()
         row("spectral", "cancelled", t, not sp.busy)
+    viewer.background = False
 
     sm = viewer.panels["smoothing"].state
     t = time.perf_counter()

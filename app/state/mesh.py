@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -14,6 +14,9 @@ from meshlap_core.errors import MeshError
 from meshlap_core.io import load_mesh
 from meshlap_core.types import FloatArray, IntArray
 from meshlap_core.validate import validate_mesh
+
+if TYPE_CHECKING:
+    from .preview import MeshPreview
 
 ROOT = Path(__file__).resolve().parents[2]  # the checkout (app/ sits beside assets/)
 ASSETS_DIR = ROOT / "assets"
@@ -100,20 +103,49 @@ class LoadedMesh:
     name: str
     path: Path | None
     info: dict[str, Any]
+    previewed: bool = False  # a preview was handed over with exactly this geometry
+    shared: bool = True  # mesh.V and mesh.F are here (False: sent without them, see below)
+
+    def without_geometry(self) -> LoadedMesh:
+        """Itself with ``mesh.V`` and ``mesh.F`` dropped when they are the preview's (what a
+        child process sends back: the window already holds them, :meth:`with_geometry`)."""
+        if self.previewed:
+            self.mesh.V = self.mesh.F = None
+            self.shared = False
+        return self
+
+    def with_geometry(self, preview: Any) -> LoadedMesh:
+        """Itself with the geometry of ``preview`` (the :class:`~.preview.MeshPreview` it
+        was sent without) put back.
+
+        Raises
+        ------
+        MeshError
+            The geometry was dropped and no preview is given.
+        """
+        if not self.shared:
+            if preview is None:
+                raise MeshError("the preview of the geometry was lost", self.name)
+            self.mesh.V, self.mesh.F, self.shared = preview.V, preview.F, True
+        return self
 
 
 def read_mesh(path: str | Path | None, progress: Any = None) -> LoadedMesh:
     """Read, validate and describe ``path`` (the bundled default when ``None``).
 
     ``progress`` is a job's reporter (:class:`meshlap_app.jobs.Reporter`): passed on to
-    ``load_mesh`` as ``progress=`` / ``cancel=`` when the core takes them, and told each phase.
+    ``load_mesh`` as ``progress=`` / ``cancel=`` when the core takes them, and told each phase;
+    a reporter with ``partial`` (a job's) is handed a :class:`~.preview.MeshPreview` as soon as
+    the file is parsed (before the validation), for the window to show at once.
 
     Raises
     ------
     MeshError, OSError
         The file is refused or unreadable.
     """
-    from ..jobs import call_hooked
+    from ..jobs import accepts, call_hooked
+    from . import preview
+    from .preview import make_preview
 
     def phase(message: str) -> None:
         if progress is not None:
@@ -132,12 +164,28 @@ def read_mesh(path: str | Path | None, progress: Any = None) -> LoadedMesh:
         name = Path(path).name
     phase(f"reading {name}")
     if progress is not None:
-        mesh = call_hooked(load_mesh, path, reporter=progress)
+        extra: dict[str, Any] = {}
+        partial = getattr(progress, "partial", None)
+        sent: list[MeshPreview] = []
+        if partial is not None and accepts(load_mesh, "on_parsed"):
+
+            def show_parsed(V: FloatArray, F: IntArray) -> None:
+                if len(F) < preview.PREVIEW_FACES:
+                    return
+                phase("a preview of the geometry read")
+                sent.append(make_preview(name, V, F))
+                partial(sent[-1])
+
+            extra["on_parsed"] = show_parsed
+        mesh = call_hooked(load_mesh, path, reporter=progress, **extra)
     else:
-        mesh = load_mesh(path)
+        mesh, sent = load_mesh(path), []
     phase("describing the mesh")
     info = mesh_info(mesh.V, mesh.F, mesh.report, label or name, table=mesh.edge_table)
-    return LoadedMesh(mesh, name, Path(path).resolve(), info)
+    previewed = bool(sent) and sent[-1].same_geometry(mesh.V, mesh.F)
+    if previewed:  # one copy of the arrays, the preview's (as the window holds them)
+        mesh.V, mesh.F = sent[-1].V, sent[-1].F
+    return LoadedMesh(mesh, name, Path(path).resolve(), info, previewed)
 
 
 def read_mesh_with_fields(
@@ -156,4 +204,6 @@ def read_mesh_with_fields(
     # the viewer asks nothing more of the edge table: not sent back from the child process
     # (about 140 MB of the 240 MB at 692k vertices) nor kept in the window's memory
     m.edge_table = None
+    if getattr(progress, "remote", False):  # a child process: the window has the preview's
+        loaded.without_geometry()
     return loaded, fields

@@ -6,8 +6,10 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from ..errors import MeshError, check_cancel
-from ..types import FloatArray
+from ..types import FloatArray, IntArray
 from ..validate import Mesh, validate_mesh
 from ._scan import Parsed
 from .atomic import PathLike
@@ -34,6 +36,7 @@ def load_mesh(
     repair: bool = True,
     progress: Callable[[float, str], None] | None = None,
     cancel: Any = None,
+    on_parsed: Callable[[FloatArray, IntArray], None] | None = None,
 ) -> Mesh:
     """Load an OBJ, OFF, PLY (ASCII / binary) or STL (ASCII / binary) triangle mesh.
 
@@ -51,6 +54,12 @@ def load_mesh(
     cancel : threading.Event or callable, optional
         Checked between the phases: once set (or returning ``True``) loading stops with
         :class:`~meshlap_core.errors.Cancelled`.
+    on_parsed : callable, optional
+        ``on_parsed(V, F)`` with the file's vertices ``(n,3) float64`` and triangles
+        ``(m,3) int64`` as parsed, before validation, when every face is a triangle with
+        in-range indices and every coordinate is finite (a viewer shows them at once while
+        the validation runs; validation may still repair or refuse them). The arrays are the
+        parser's: not to be modified.
 
     Returns
     -------
@@ -81,6 +90,8 @@ def load_mesh(
     phase(0.1, f"parsing {len(data) / 2**20:.0f} MB")
     parsed = _parse(p.suffix.lower(), data, src)
     del data  # the parsed arrays are copies: free the file's bytes before validating
+    if on_parsed is not None:
+        _hand_over(parsed, on_parsed)
     phase(0.5, f"validating {len(parsed.V):,} vertices")
     mesh = validate_mesh(
         parsed.V,
@@ -127,6 +138,18 @@ def load_vertex_scalars(path: PathLike, name: str = "quality") -> FloatArray:
         have = ", ".join(sorted(parsed.vertex_props)) or "none"
         raise MeshError(f"the vertex element has no property {name!r} (properties: {have})", src)
     return parsed.vertex_props[name]
+
+
+def _hand_over(parsed: Parsed, on_parsed: Callable[[FloatArray, IntArray], None]) -> None:
+    """Call ``on_parsed(V, F)`` when ``parsed`` is plain triangles, in range, finite."""
+    V, F = parsed.V, parsed.faces
+    if not (isinstance(F, np.ndarray) and F.ndim == 2 and F.shape[1] == 3 and len(F)):
+        return
+    if not (isinstance(V, np.ndarray) and V.ndim == 2 and V.shape[1] == 3 and len(V)):
+        return
+    if F.min() < 0 or F.max() >= len(V) or not np.isfinite(V).all():
+        return
+    on_parsed(V.astype(np.float64, copy=False), F.astype(np.int64, copy=False))
 
 
 def _read_input(path: PathLike) -> tuple[Path, str, bytes]:

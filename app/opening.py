@@ -1,0 +1,128 @@
+"""Opening a mesh in the viewer: one job of the Mesh section, and the preview of a big scan.
+
+In the window the file is read, validated and its curvature fields computed in a child
+process (:func:`meshlap_app.jobs.in_child`; the previous mesh stays on screen meanwhile). As
+soon as a big file is parsed, the job hands over a :class:`~.state.preview.MeshPreview` (its
+geometry and a quick uniform-H field, :mod:`.state.preview`), which :func:`show_preview`
+puts on screen in place of the mesh at once, on the UI thread, leaving the state untouched.
+When the validated mesh arrives, :func:`keep_preview` keeps the structure registered for the
+preview if validation left the geometry as parsed (no second registration and upload of
+millions of triangles; the child sends the mesh back without that geometry, the window holds
+it already), and the Curvature panel uploads the final colours. A job that fails or is
+cancelled after its preview brings the previous mesh back (:func:`restore_mesh`).
+
+Imports polyscope.
+"""
+
+from __future__ import annotations
+
+import copy
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import polyscope as ps
+
+from . import scene, window
+from .jobs import Reporter
+from .registry import REGISTRY
+from .scene import MESH
+from .state.preview import PREVIEW_LABEL, MeshPreview
+
+
+def open_mesh(viewer: Any, path: Path | None) -> bool:
+    """Load ``path`` into ``viewer`` (see :meth:`meshlap_app.viewer.Viewer.open`): a job of
+    the Mesh section (``viewer.background``; True: started) or right here (True: loaded);
+    a failure is kept in ``state.mesh.error`` and the mesh stays."""
+    from .state.mesh import read_mesh_with_fields
+
+    section = REGISTRY[0].name  # the first section: the mesh's
+    state = viewer.state
+    curv = state.curv
+    settings = (curv.area, curv.boundary)
+    read = state.jobs.offload(read_mesh_with_fields, path, *settings)  # a child process
+
+    def work(reporter: Reporter) -> Any:
+        loaded, fields = read(reporter)  # sent back without the geometry previewed
+        return loaded.with_geometry(reporter.last_partial), fields
+
+    def apply(result: Any) -> None:
+        loaded, fields = result
+        state.jobs.cancel_all()  # what other panels computed belongs to the old mesh
+        state.mesh.adopt(loaded)
+        if (curv.area, curv.boundary) == settings:
+            curv.adopt(state.mesh, fields)
+        viewer.sync_mesh()
+        viewer.reframe = True
+
+    def fail(message: str) -> None:
+        state.mesh.error = message
+
+    name = Path(path).name if path is not None else "the default mesh"
+    job = state.jobs.start(
+        section,
+        f"opening {name}",
+        work,
+        apply,
+        fail,
+        background=viewer.background,
+        preview=viewer.show_preview,
+    )
+    if job is None:  # start replaces a running job: never refused
+        raise RuntimeError("the opening job was refused")
+    return bool(viewer.background) or job.status == "done"
+
+
+def fit_of(display: Any) -> tuple[Any, ...]:
+    """What the display positions of a mesh depend on besides its vertices."""
+    return (display.scale, *np.asarray(display.centre).tolist(), display.up)
+
+
+def show_preview(viewer: Any, preview: MeshPreview) -> None:
+    """Show a mesh being opened as parsed (the Mesh job's partial result) in place of the
+    mesh, coloured by its preview field; the views' own structures are hidden meanwhile.
+    The state is untouched: the validated mesh replaces it (:func:`keep_preview`), or a
+    failed or cancelled job brings the mesh back (:func:`restore_mesh`)."""
+    state = viewer.state
+    display = copy.deepcopy(state.display)
+    display.fit(preview.V, state.up_for(preview.name))
+    points = display.points(preview.V)
+    viewer.no_shadow = scene.shadow_for(len(preview.F), viewer.no_shadow)
+    scene.show_preview(
+        points, preview.F, preview.field, preview.vminmax, PREVIEW_LABEL, state.ui_scale
+    )
+    viewer.preview, viewer.preview_fit = preview, fit_of(display)
+    section = viewer.panels[REGISTRY[0].name]  # no view: each hides its structures
+    for p in viewer.panels.values():
+        p.show(viewer, section)
+    window.set_title(window.window_title(preview.name, True))
+
+
+def keep_preview(viewer: Any, mesh: Any) -> bool:
+    """The structure registered for the preview already shows ``mesh`` (validation left the
+    geometry as parsed; the display fitted to it already): keep it, without its preview
+    colours. True when kept; the preview is forgotten either way."""
+    preview, viewer.preview = viewer.preview, None
+    if preview is None or not ps.has_surface_mesh(MESH) or preview.name != mesh.name:
+        return False
+    if viewer.preview_fit != fit_of(viewer.state.display):
+        return False
+    if not preview.same_geometry(mesh.V, mesh.F):
+        return False
+    ps.get_surface_mesh(MESH).remove_quantity(PREVIEW_LABEL)
+    return True
+
+
+def restore_mesh(viewer: Any) -> None:
+    """Show the current mesh again after a preview whose job failed or was cancelled:
+    registered anew, every panel's uploads redone from its unchanged state."""
+    viewer.preview = None
+    mesh = viewer.state.mesh
+    viewer.no_shadow = scene.shadow_for(len(mesh.F), viewer.no_shadow)
+    scene.remove_structure(MESH)
+    ps.register_surface_mesh(MESH, viewer.mesh_points(), mesh.F, smooth_shade=True)
+    for p in viewer.panels.values():
+        p.watch.forget()
+    window.set_title(window.window_title(mesh.name, True))
+    viewer.refresh()
+    viewer.reframe = True
