@@ -47,6 +47,10 @@ CALLS: dict[str, Callable[[Any, Any, Any], Any]] = {
     "smooth": lambda V, F, t: mc.smooth(V, F, iters=1),
     "add_noise": lambda V, F, t: mc.add_noise(V, F, 0.01, mode="normal"),
     "rmse": lambda V, F, t: mc.rmse(V, V0),
+    "HeatDiffusion": lambda V, F, t: mc.HeatDiffusion(V, F),
+    "HeatGeodesic": lambda V, F, t: mc.HeatGeodesic(V, F),
+    "exact_distance": lambda V, F, t: mc.exact_distance(V, F, [0]),
+    "isolines": lambda V, F, t: mc.isolines(V, F, np.linspace(0.0, 1.0, len(V0)), [0.5]),
 }
 # names that take no vertex / face arrays (files, generators, surfaces, records, the errors)
 NO_MESH_ARRAYS = {
@@ -66,6 +70,11 @@ NO_MESH_ARRAYS = {
     "get_surface",
     "mesh_surface",
     "point_geometry",
+    "SpectralFilter",  # built from a SpectralBasis (tests/test_diffusion.py)
+    "heat_spectral",  # a SpectralBasis and a field
+    "heat_kernel_signature",  # a SpectralBasis and times
+    "transfer_function",  # eigenvalues only
+    "save_polylines",  # a file of curves: tests/test_isolines.py
 }
 USES_V = {"rmse", "add_noise"} | {
     n for n in CALLS if n not in ("one_ring", "boundary_loops", "uniform_laplacian")
