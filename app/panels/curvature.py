@@ -247,10 +247,9 @@ class CurvaturePanel(Panel):
         st = c.summary()
         lo, hi = st["range"]
         ui.text(f"min {st['min']:.4g}  max {st['max']:.4g}  colour range [{lo:.4g}, {hi:.4g}]")
-        ui.text(CURVATURE_FIELD_LABELS[c.field_name][0])
-        with ui.plot(
+        with ui.plot(  # the field's name is the x axis's label (and the colour bar's title)
             "histogram (clipped to the colour range)",
-            160,
+            130,
             CURVATURE_FIELD_LABELS[c.field_name][0],
             "vertices",
         ) as shown:
