@@ -275,7 +275,7 @@ def test_every_plot_legend_covers_none_of_its_data(mock, viewer, panel):
         for _ in range(2):  # placed from the last frame's data: one more frame
             ps.frame_tick()
         where = viewer.ui.legend_at[title]
-        if where == OUTSIDE:
+        if where == OUTSIDE or not placer.labels.get(title):  # above the plot, or no legend
             continue
         items = placer.items[title]
         if title in placer.log_y:  # corners are boxes on screen: log10 y

@@ -260,7 +260,9 @@ class CurvaturePanel(Panel):
                     (id(st), lo, hi, signed),
                     lambda: _bar_colors(st["centers"], lo, hi, signed),
                 )
-                ui.plot_bars("vertices", st["centers"], st["counts"], st["width"], colors)
+                # one series, named by the y axis: no legend (it went above the plot, over
+                # every corner's bars, and took the plot's height)
+                ui.plot_bars("##vertices", st["centers"], st["counts"], st["width"], colors)
 
 
 def _bar_colors(centers: np.ndarray, lo: float, hi: float, signed: bool) -> np.ndarray:
