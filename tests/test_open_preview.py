@@ -311,3 +311,22 @@ def test_make_preview_range_is_symmetric():
     V, F = primitives.icosphere(2)
     lo, hi = make_preview("x", V, F).vminmax
     assert lo == -hi and hi > 0
+
+
+def test_after_a_cancelled_preview_the_next_mesh_opened_goes_to_the_recent_list(
+    viewer, held, ellipsoid, sphere
+):
+    """The restore after a cancelled preview forgets every panel's change tracking: the Mesh
+    section still knows the first mesh it showed, and lists the next one opened."""
+    open_until_preview(viewer, ellipsoid)
+    assert viewer.state.jobs.cancel("mesh_info")
+    frames(viewer, 2)
+    held.set()
+    frames(viewer, 2)
+    section = viewer.panels["mesh_info"]
+    assert section.recent == []  # nothing was opened: the first mesh is not "recent"
+    viewer.background = False
+    assert viewer.open(sphere)
+    frames(viewer, 2)
+    assert viewer.state.mesh.name == "sphere.obj"
+    assert section.recent == [sphere]

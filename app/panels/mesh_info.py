@@ -20,12 +20,17 @@ class MeshPanel(Panel):
         self.path_text = ""
         self.recent: list[Path] = []  # the last meshes opened, newest first
         self._listed: tuple[float, list[tuple[str, Path]]] = (-1e9, [])
+        # the version of the first mesh shown, kept apart from ``watch`` (which a preview's
+        # failed or cancelled job forgets: app/opening.py, restore_mesh)
+        self._first: int | None = None
 
     def on_new_mesh(self, host: Host) -> None:
         """A mesh opened after the first one goes to the top of the recent list."""
-        opened_before = self.watch.seen("mesh") is not None
-        self.watch.changed("mesh", host.state.mesh.version)
-        if opened_before and host.state.mesh.path is not None:
+        version = host.state.mesh.version
+        self.watch.changed("mesh", version)
+        if self._first is None:
+            self._first = version
+        elif version != self._first and host.state.mesh.path is not None:
             self.remember(host.state.mesh.path)
 
     def open_path(self, host: Host, path: Path) -> None:
