@@ -68,33 +68,6 @@ def _from_tensor(
     return l1, l2, d1, -si[:, None] * t1 + co[:, None] * t2
 
 
-def corner_mixed_areas(V: FloatArray, F: IntArray, theta: FloatArray) -> FloatArray:
-    """Each corner's share of the mixed Voronoi area (Meyer et al. 2003, Fig. 4), ``(m,3)``.
-
-    Non-obtuse triangle: ``⅛ (|e_ij|² cot θ_k + |e_ik|² cot θ_j)`` at corner ``i``; obtuse
-    triangle: half its area at the obtuse corner, a quarter at the others. The three sum to the
-    triangle's area, and their sum per vertex is ``vertex_areas(V, F, "voronoi")``.
-    """
-    P = [V[F[:, i]] for i in range(3)]
-    sq = [np.einsum("ij,ij->i", d, d) for d in (P[2] - P[1], P[0] - P[2], P[1] - P[0])]
-    area = 0.5 * np.linalg.norm(np.cross(P[1] - P[0], P[2] - P[0]), axis=1)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        cot = np.cos(theta) / np.sin(theta)
-    cot = np.nan_to_num(cot, nan=0.0, posinf=0.0, neginf=0.0)
-    # corner i: its two edges are the ones opposite the other two corners j, k
-    vor = np.stack(
-        [
-            (sq[(i + 2) % 3] * cot[:, (i + 2) % 3] + sq[(i + 1) % 3] * cot[:, (i + 1) % 3]) / 8
-            for i in range(3)
-        ],
-        axis=1,
-    )
-    obtuse = theta > 0.5 * np.pi
-    any_obtuse = obtuse.any(axis=1, keepdims=True)
-    mixed = np.where(obtuse, area[:, None] / 2, area[:, None] / 4)
-    return np.where(any_obtuse, mixed, vor)
-
-
 def _edge_tensor_fit(
     V: FloatArray, E: IntArray, N: FloatArray, t1: FloatArray, t2: FloatArray
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
@@ -234,7 +207,7 @@ def rusinkiewicz_curvatures(V: FloatArray, F: IntArray) -> PrincipalCurvatures:
             rhs += r * y[:, None]
     A += 1e-12 * np.eye(3) * (np.trace(A, axis1=1, axis2=2)[:, None, None] + 1e-300)
     abc = np.linalg.solve(A, rhs[:, :, None])[:, :, 0]
-    w = _mixed_corner_areas(fr)  # corner_mixed_areas from the frame
+    w = _mixed_corner_areas(fr)  # each corner's mixed Voronoi area (Meyer et al. 2003)
     t1, t2 = tangent_frames(N)
     acc = np.zeros((n, 3))
     for k in range(3):
