@@ -51,6 +51,10 @@ class Plots:
         area = (float(self.im.GetContentRegionAvail()[0]) - 70.0 * s, (height - 90.0) * s)
         return self.legends.place(title, size, area)
 
+    def _legend_row(self) -> float:
+        """Pixels of a one-row legend above a plot (a line of text, ImPlot's padding)."""
+        return float(self.im.GetTextLineHeight()) + 22.0 * self.scale
+
     def _plotted(self, label: str, kind: str, x: Any, y: Any) -> None:
         self.legends.add(kind, x, y, label)
         self._record_plot(label, kind, x, y)
@@ -66,7 +70,10 @@ class Plots:
         (self.legends.log_y.add if y_log else self.legends.log_y.discard)(title)
         where = self._legend_place(title, height)
         self._record_legend(title, where)
-        shown = check_return("BeginPlot", self.ip.BeginPlot(title, (-1, height * self.scale)))
+        # a legend above the plot takes a row of its height: the plot grows by that row, so
+        # the data keeps the height asked for (else a short plot's data area all but vanishes)
+        px = height * self.scale + (self._legend_row() if where == OUTSIDE else 0.0)
+        shown = check_return("BeginPlot", self.ip.BeginPlot(title, (-1, px)))
         self.legends.begin(title)
         ip = self.ip
         try:
