@@ -183,9 +183,7 @@ def _run_task(
                     raise refused
                 conn.send((*where, _portable(answer, task.kind), seconds))
             except guard.Refused as exc:
-                fence.take()
-                text = student_traceback(exc, path)
-                conn.send(("stop", task.name, "refused", case.name, label, text, exc.key))
+                _send_refused(conn, fence, exc, path, (task.name, case.name, label))
                 return
             except NotImplementedError:
                 conn.send(("stop", task.name, "not_implemented", case.name, label, ""))
@@ -203,9 +201,16 @@ def _run_task(
         try:
             conn.send(("speed", task.name, *_speed(task, func, big, fence, conn)))
         except guard.Refused as exc:  # only now (the speed call): refused all the same
-            fence.take()
-            text = student_traceback(exc, path)
-            conn.send(("stop", task.name, "refused", big.name, "speed", text, exc.key))
+            _send_refused(conn, fence, exc, path, (task.name, big.name, "speed"))
+
+
+def _send_refused(
+    conn: Connection, fence: guard.Fence, exc: guard.Refused, path: str, where: tuple[str, str, str]
+) -> None:
+    """Report a call the fence refused: ``where`` is (task, case, call label)."""
+    fence.take()  # the attempt is reported once, here
+    task, case, label = where
+    conn.send(("stop", task, "refused", case, label, student_traceback(exc, path), exc.key))
 
 
 def _worker(
