@@ -50,17 +50,18 @@ class MeshPanel(Panel):
         mesh = host.state.mesh
         info = mesh.info
         genus = info.get("genus")
+        # the name and sizes on their own line: a long file name never splits "genus = 0"
         ui.text(
-            f"{mesh.name}: {info.get('n_vertices', 0)} vertices, "
-            f"{info.get('n_faces', 0)} faces, chi = {info.get('euler_characteristic')}, "
+            f"{mesh.name}: {info.get('n_vertices', 0)} vertices, {info.get('n_faces', 0)} faces"
+        )
+        ui.text(
+            f"chi = {info.get('euler_characteristic')}, "
             + (f"genus = {genus}" if genus is not None else "genus undefined (see below)")
+            + f", boundary loops {info.get('n_boundary_loops')}, components "
+            f"{info.get('n_components')}, {'' if info.get('manifold') else 'non-'}manifold"
         )
         if genus is None:
             ui.note(genus_reason(info))
-        ui.text(
-            f"boundary loops {info.get('n_boundary_loops')}, components "
-            f"{info.get('n_components')}, manifold {'yes' if info.get('manifold') else 'no'}"
-        )
         for r in info.get("repairs", []):
             ui.text(f"repaired: {r}")
         entered, self.path_text = ui.input_text(
