@@ -38,10 +38,13 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import MeshError, check_cancel
+from ..laplacian import vertex_areas
 from ..linalg.common import ProgressCallback, report_progress
 from ..linalg.components import components
-from ..linalg.spd import SPDSolver, solver_backend
+from ..linalg.factor import SharedAnalysis, pinned_data
+from ..linalg.spd import solver_backend
 from ..options import (
+    AREA_KINDS,
     DEFAULT_HEAT_BOUNDARY,
     HEAT_BOUNDARIES,
     MASS_AREA,
@@ -49,7 +52,6 @@ from ..options import (
     HeatBoundary,
     check_choice,
 )
-from ..spectral.operators import spectral_operators
 from ..types import FloatArray, IntArray, as_mesh
 from .sources import check_sources
 
@@ -82,7 +84,11 @@ def mean_edge_length(V: FloatArray, F: IntArray) -> float:
     V, F = as_mesh(V, F)
     if len(F) == 0:
         return 0.0
-    count = edge_counts(F, len(V))
+    return _mean_length(V, edge_counts(F, len(V)))
+
+
+def _mean_length(V: FloatArray, count: sp.csr_matrix) -> float:
+    """The mean length of the edges of the table ``count`` (:func:`edge_counts`)."""
     i = np.repeat(np.arange(len(V)), np.diff(count.indptr))
     return float(np.mean(np.linalg.norm(V[i] - V[count.indices], axis=1)))
 
@@ -91,8 +97,12 @@ def boundary_vertices(F: IntArray, n: int) -> IntArray:
     """Vertices on a boundary edge (an edge of one face), sorted ``(b,)`` int."""
     if len(F) == 0:
         return np.zeros(0, dtype=np.int64)
-    count = edge_counts(F, n)
-    rows = np.repeat(np.arange(n), np.diff(count.indptr))
+    return _boundary(edge_counts(F, n))
+
+
+def _boundary(count: sp.csr_matrix) -> IntArray:
+    """The vertices of the edges held by one face in the table ``count`` (sorted)."""
+    rows = np.repeat(np.arange(count.shape[0]), np.diff(count.indptr))
     once = count.data == 1
     return np.unique(np.concatenate([rows[once], count.indices[once]])).astype(np.int64)
 
@@ -129,6 +139,41 @@ def face_gradients(V: FloatArray, F: IntArray) -> tuple[FloatArray, FloatArray]:
     return hat, 0.5 * double
 
 
+def gradient_stiffness(F: IntArray, hat: FloatArray, area: FloatArray, n: int) -> sp.csr_matrix:
+    """The stiffness ``K = Gᵀ A G`` (``G`` the piecewise-linear gradient, ``A`` the face
+    areas) from the per-face hat gradients of :func:`face_gradients`.
+
+    ``K_ij = Σ_f A_f ⟨∇φ_i, ∇φ_j⟩`` over the faces holding ``i`` and ``j``: for an edge
+    ``ij`` it is ``−½ (cot α_ij + cot β_ij)`` (so ``K = −C``, libigl's ``−cotmatrix``, to
+    round-off), and ``K_ii = −Σ_j K_ij``. Being ``Gᵀ A G``, it is positive semidefinite and
+    the exact adjoint of the divergence the heat method takes (a face of zero area adds
+    nothing). Every mesh edge and the whole diagonal are stored, zero or not, so matrices
+    built from its values keep its pattern.
+
+    Parameters
+    ----------
+    F : (m,3) int
+    hat : (3,3,m) float
+    area : (m,) float
+    n : int
+
+    Returns
+    -------
+    K : (n,n) scipy.sparse.csr_matrix
+        Symmetric, sorted indices, each entry once.
+    """
+    dot = [area * np.einsum("kf,kf->f", hat[(i + 1) % 3], hat[(i + 2) % 3]) for i in range(3)]
+    diag = [area * np.einsum("kf,kf->f", hat[i], hat[i]) for i in range(3)]
+    a = np.concatenate([F[:, 1], F[:, 2], F[:, 0]])  # the edge opposite corner i
+    b = np.concatenate([F[:, 2], F[:, 0], F[:, 1]])
+    off = np.concatenate(dot)
+    rows = np.concatenate([a, b, F[:, 0], F[:, 1], F[:, 2]])
+    cols = np.concatenate([b, a, F[:, 0], F[:, 1], F[:, 2]])
+    K = sp.coo_matrix((np.concatenate([off, off, *diag]), (rows, cols)), shape=(n, n)).tocsr()
+    K.sum_duplicates()  # sorts the indices; keeps explicit zeros
+    return K
+
+
 def far_levels(V: FloatArray, t: float) -> int:
     """How many longer heat times (``t·100ʲ``) the farthest faces of the mesh will need: the
     smallest ``j`` whose reach ``575·10ʲ·√t`` (:data:`_REACH`) covers twice the bounding box's
@@ -140,6 +185,16 @@ def far_levels(V: FloatArray, t: float) -> int:
     if span <= reach:
         return 0
     return int(min(np.ceil(np.log10(span / reach)), _FAR_LEVELS))
+
+
+def _diagonal_positions(K: sp.csr_matrix) -> IntArray:
+    """Where each diagonal entry ``K_ii`` sits in ``K.data`` ``(n,)`` (sorted CSR storing its
+    whole diagonal, as :func:`gradient_stiffness` does)."""
+    rows = np.repeat(np.arange(K.shape[0]), np.diff(K.indptr))
+    pos = np.flatnonzero(rows == K.indices)
+    if len(pos) != K.shape[0]:
+        raise ValueError("the matrix does not store its whole diagonal")
+    return pos
 
 
 def check_time_factor(m: float, name: str = "m") -> float:
@@ -199,44 +254,61 @@ class HeatGeodesic:
         self.V, self.F = as_mesh(V, F)
         self.rule = check_choice(boundary, HEAT_BOUNDARIES, "boundary condition", "boundary")
         self.m = check_time_factor(m)
-        K, self.mass = spectral_operators(self.V, self.F, "cotan", area)
+        check_choice(area, AREA_KINDS, "area")
         n = len(self.V)
-        self.h = mean_edge_length(self.V, self.F)
+        if n == 0 or len(self.F) == 0:
+            raise MeshError("the mesh has no faces; the heat method needs a surface", "F")
+        # ∇ of each corner's hat function per face (3 corners, 3 coordinates, m), and the face
+        # areas: ∇u, the divergence Gᵀ A X and K = Gᵀ A G from them (no igl.grad/cotmatrix)
+        self._hat, self._area = face_gradients(self.V, self.F)
+        self._corners = [np.ascontiguousarray(self.F[:, i]) for i in range(3)]
+        K = self._K = gradient_stiffness(self.F, self._hat, self._area, n)
+        self.mass = vertex_areas(self.V, self.F, area)
+        bad = np.flatnonzero(~(self.mass > 0))
+        if len(bad):
+            raise MeshError(
+                f"vertex {int(bad[0])} (and {len(bad) - 1} more) has zero area: it is "
+                "unreferenced or only in degenerate faces; remove unreferenced vertices and "
+                "degenerate faces first (meshlap's load_mesh does)",
+                "V",
+            )
+        count = edge_counts(self.F, n)  # one edge table: h and the boundary
+        self.h = _mean_length(self.V, count)
         self.t = self.m * self.h**2
-        A = (sp.diags(self.mass) + self.t * K).tocsr()
-        # two solves per source set: the factorization dominates, and CHOLMOD's supernodal
-        # one (when scikit-sparse is installed) is about twice cholespy's at 43k vertices
-        backend = self._backend = solver_backend()
-        self._heat = SPDSolver(A, backend)
-        self.boundary = boundary_vertices(self.F, n)
+        self.boundary = _boundary(count)
+        self.n_components, self.labels = components(K)
+        self._face_label = self.labels[self.F[:, 0]]
+        # every matrix below has K's pattern (pinned rows and columns kept as explicit
+        # zeros), so one symbolic analysis serves all their factorizations: M + tK, the
+        # pinned K, the Dirichlet M + tK and the longer times' M + t'K
+        self._diag = _diagonal_positions(K)
+        self._shared = SharedAnalysis(K.indptr, K.indices, solver_backend())
+        heat = self._heat_data(self.t)
+        self._heat = self._shared.factor(heat)
         self._interior: IntArray | None = None
-        self._heat_dirichlet: SPDSolver | None = None
-        if len(self.boundary) and self.rule != "neumann":
+        self._heat_dirichlet: Any = None
+        if len(self.boundary) and self.rule != "neumann" and len(self.boundary) < n:
             keep = np.ones(n, bool)
             keep[self.boundary] = False
-            self._interior = np.flatnonzero(keep)
-            if len(self._interior):
-                sub = A[self._interior][:, self._interior]
-                self._heat_dirichlet = SPDSolver(sub, backend)
-        self._corners = [np.ascontiguousarray(self.F[:, i]) for i in range(3)]
-        # ∇ of each corner's hat function per face (3 corners, 3 coordinates, m), and the face
-        # areas: ∇u and the divergence Gᵀ A X from them (half igl.grad's product time)
-        self._hat, self._area = face_gradients(self.V, self.F)
-        self.n_components, self.labels = components(K)
-        self._K = K
-        self._face_label = self.labels[self.F[:, 0]] if len(self.F) else np.zeros(0, np.int64)
-        self._far: dict[int, SPDSolver] = {}
+            self._interior = keep
+            self._heat_dirichlet = self._shared.factor(
+                pinned_data(K.indptr, K.indices, heat, self.boundary)
+            )
+        self._far: dict[int, Any] = {}
         first = np.full(self.n_components, n)
         np.minimum.at(first, self.labels, np.arange(n))
-        free = np.ones(n, bool)
-        free[first] = False  # one pinned vertex per component: K restricted is definite
-        self._free = np.flatnonzero(free)
-        poisson = K[self._free][:, self._free].tocsr()
-        self._poisson = SPDSolver(poisson, backend) if len(self._free) else None
+        self._pinned = first  # one pinned vertex per component: K without them is definite
+        self._poisson = self._shared.factor(pinned_data(K.indptr, K.indices, K.data, first))
         # the longer times the sources' farthest faces will need, factorized now: a click then
         # only back-substitutes (the 692k scan needs t·100; an unforeseen one is built lazily)
         for level in range(1, far_levels(self.V, self.t) + 1):
             self._far_solver(level)
+
+    def _heat_data(self, t: float) -> FloatArray:
+        """The values of ``M + tK`` on ``K``'s pattern."""
+        data = t * self._K.data
+        data[self._diag] += self.mass
+        return data
 
     def heat(self, sources: IntArray) -> FloatArray:
         """The heat step ``u`` (before normalization) for checked ``sources``."""
@@ -246,10 +318,11 @@ class HeatGeodesic:
         u = self._heat.solve(delta)
         if self._heat_dirichlet is None or self._interior is None:
             return u
-        ud = np.zeros(n)
-        ud[self._interior] = self._heat_dirichlet.solve(delta[self._interior])
-        if not np.any(ud):  # every source on the boundary: Dirichlet heat is zero
+        delta[~self._interior] = 0.0  # the boundary rows are pinned to 0
+        if not np.any(delta):  # every source on the boundary: Dirichlet heat is zero
             return u
+        ud = self._heat_dirichlet.solve(delta)
+        ud[~self._interior] = 0.0  # exactly 0 already (decoupled rows): stated
         return ud if self.rule == "dirichlet" else 0.5 * (u + ud)
 
     def _directions(
@@ -281,12 +354,11 @@ class HeatGeodesic:
         g *= np.where(known, -1.0 / np.where(known, norm, 1.0), 0.0)
         return g, known & ~lost, lost
 
-    def _far_solver(self, level: int) -> SPDSolver:
+    def _far_solver(self, level: int) -> Any:
         """The Neumann heat step's factorization at ``t·100^level`` (built once)."""
         solver = self._far.get(level)
         if solver is None:
-            A = (sp.diags(self.mass) + (self.t * 100.0**level) * self._K).tocsr()
-            solver = self._far[level] = SPDSolver(A, self._backend)
+            solver = self._far[level] = self._shared.factor(self._heat_data(self.t * 100.0**level))
         return solver
 
     def _far_heat(self, level: int, sources: IntArray) -> FloatArray:
@@ -335,9 +407,8 @@ class HeatGeodesic:
             X[:, faces[known2]] = X2[:, known2]
             redo[faces[known2]] = False
         b = self._divergence(X)
-        phi = np.zeros(n)
-        if self._poisson is not None:
-            phi[self._free] = self._poisson.solve(b[self._free])
+        b[self._pinned] = 0.0  # the pinned vertices' rows: φ = 0 there
+        phi = self._poisson.solve(b)
         count = np.bincount(self.labels[src], minlength=self.n_components)
         total = np.bincount(self.labels[src], weights=phi[src], minlength=self.n_components)
         has = count > 0
