@@ -145,7 +145,7 @@ def gradient_stiffness(F: IntArray, hat: FloatArray, area: FloatArray, n: int) -
 
     ``K_ij = Σ_f A_f ⟨∇φ_i, ∇φ_j⟩`` over the faces holding ``i`` and ``j``: for an edge
     ``ij`` it is ``−½ (cot α_ij + cot β_ij)`` (so ``K = −C``, libigl's ``−cotmatrix``, to
-    round-off), and ``K_ii = −Σ_j K_ij``. Being ``Gᵀ A G``, it is positive semidefinite and
+    round-off), and ``K_ii = −Σ_{j≠i} K_ij``. Being ``Gᵀ A G``, it is positive semidefinite and
     the exact adjoint of the divergence the heat method takes (a face of zero area adds
     nothing). Every mesh edge and the whole diagonal are stored, zero or not, so matrices
     built from its values keep its pattern.
@@ -162,14 +162,17 @@ def gradient_stiffness(F: IntArray, hat: FloatArray, area: FloatArray, n: int) -
     K : (n,n) scipy.sparse.csr_matrix
         Symmetric, sorted indices, each entry once.
     """
-    dot = [area * np.einsum("kf,kf->f", hat[(i + 1) % 3], hat[(i + 2) % 3]) for i in range(3)]
-    diag = [area * np.einsum("kf,kf->f", hat[i], hat[i]) for i in range(3)]
+    off = np.concatenate(
+        [area * np.einsum("kf,kf->f", hat[(i + 1) % 3], hat[(i + 2) % 3]) for i in range(3)]
+    )
     a = np.concatenate([F[:, 1], F[:, 2], F[:, 0]])  # the edge opposite corner i
     b = np.concatenate([F[:, 2], F[:, 0], F[:, 1]])
-    off = np.concatenate(dot)
-    rows = np.concatenate([a, b, F[:, 0], F[:, 1], F[:, 2]])
-    cols = np.concatenate([b, a, F[:, 0], F[:, 1], F[:, 2]])
-    K = sp.coo_matrix((np.concatenate([off, off, *diag]), (rows, cols)), shape=(n, n)).tocsr()
+    # Σ_j ∇φ_j = 0 on a face, so A⟨∇φ_i, ∇φ_i⟩ = −Σ_{j≠i} A⟨∇φ_i, ∇φ_j⟩: the diagonal is
+    # minus the row sums (K·1 = 0), n entries instead of 3m to sort
+    diag = -(np.bincount(a, off, minlength=n) + np.bincount(b, off, minlength=n))
+    ar = np.arange(n)
+    rows, cols = np.concatenate([a, b, ar]), np.concatenate([b, a, ar])
+    K = sp.coo_matrix((np.concatenate([off, off, diag]), (rows, cols)), shape=(n, n)).tocsr()
     K.sum_duplicates()  # sorts the indices; keeps explicit zeros
     return K
 
