@@ -11,19 +11,22 @@ The heat method (Crane, Weischedel & Wardetzky, "Geodesics in heat", ACM TOG 201
    ``A`` the face areas; ``K = Gᵀ A G``), one vertex pinned per connected component;
 4. ``d = φ − mean(φ[γ])`` in each component holding a source.
 
-The matrices are factorized once (:class:`HeatGeodesic`); a new source costs two or three pairs
-of triangular solves and a few vectorized products per face (median 1.3 s at 692k vertices
-against ``igl.heat_geodesics_solve``'s 1.25 s side by side at load 7, of which the three solves
-~0.85 s; ``benchmarks/bench_diffusion.py``). The heat decays like ``exp(−d/√t)``, so beyond
-about ``575 √t`` from the sources it underflows (below 1e-250 of its peak: 1.3 % to 23 % of the
-692k armadillo with ``t = h²``, by source): those faces take the direction of the heat of a
-longer time, ``t·100ʲ`` (``j = 1 … 4``; the levels the mesh's size calls for factorized with the
-others, any other when first needed). Measured on the 692k scan (one ``igl.upsample`` of the
-173k ``armadillo_loop``, whose vertices it keeps): our distance there differs from ours on the
-173k mesh by 0.4 % on average (1.0 % at most), potpourri3d's from its own 173k answer by 7.4 %
-(36 % at most). On a mesh with boundary the heat step takes the paper's boundary condition
-(``"neumann"``, ``"dirichlet"`` or their ``"average"``, sec. 3.2.4). Vertices in components
-without a source get ``inf`` (no path reaches them).
+The matrices are factorized once (:class:`HeatGeodesic`), all on the pattern of ``K`` (a pinned
+row and column kept as explicit zeros), so CHOLMOD's symbolic analysis is done once for all of
+them (:class:`~meshlap_core.linalg.factor.SharedAnalysis`); ``K`` itself is assembled from the
+per-face gradients the method needs anyway (:func:`gradient_stiffness`). A new source costs two
+or three pairs of triangular solves and a few vectorized products per face (median 1.3 s at
+692k vertices against ``igl.heat_geodesics_solve``'s 1.25 s side by side at load 7, of which
+the three solves ~0.85 s; ``benchmarks/bench_diffusion.py``). The heat decays like
+``exp(−d/√t)``, so beyond about ``575 √t`` from the sources it underflows (below 1e-250 of its
+peak: 1.3 % to 23 % of the 692k armadillo with ``t = h²``, by source): those faces take the
+direction of the heat of a longer time, ``t·100ʲ`` (``j = 1 … 4``; the levels the mesh's size
+calls for factorized with the others, any other when first needed). Measured on the 692k scan
+(one ``igl.upsample`` of the 173k ``armadillo_loop``, whose vertices it keeps): our distance
+there differs from ours on the 173k mesh by 0.4 % on average (1.0 % at most), potpourri3d's
+from its own 173k answer by 7.4 % (36 % at most). On a mesh with boundary the heat step takes
+the paper's boundary condition (``"neumann"``, ``"dirichlet"`` or their ``"average"``, sec.
+3.2.4). Vertices in components without a source get ``inf`` (no path reaches them).
 
 :func:`exact_distance` is the exact polyhedral distance of Mitchell, Mount & Papadimitriou
 (``igl.exact_geodesic``), run per component (libigl answers 0 across components).
@@ -61,6 +64,8 @@ _UNDERFLOW = 1e-250
 """A face whose largest heat is below this times the largest heat anywhere has underflowed."""
 _FAR_LEVELS = 4
 """Longer heat times tried where the heat underflowed: t·100 … t·100⁴ (reach ×10 each)."""
+SIMPLICIAL_MAX_N = 0
+"""Below this many vertices CHOLMOD factorizes the heat method's matrices simplicially."""
 _REACH = float(-np.log(_UNDERFLOW))
 """The heat of time ``t`` falls below :data:`_UNDERFLOW` of its peak about this many ``√t``
 from the sources (it decays like ``exp(−d/√t)``)."""
@@ -285,15 +290,12 @@ class HeatGeodesic:
         # zeros), so one symbolic analysis serves all their factorizations: M + tK, the
         # pinned K, the Dirichlet M + tK and the longer times' M + t'K
         self._diag = _diagonal_positions(K)
-        self._shared = SharedAnalysis(K.indptr, K.indices, solver_backend())
+        mode = "simplicial" if n < SIMPLICIAL_MAX_N else "supernodal"
+        self._shared = SharedAnalysis(K.indptr, K.indices, solver_backend(), mode)
         heat = self._heat_data(self.t)
         self._heat = self._shared.factor(heat)
-        self._interior: IntArray | None = None
-        self._heat_dirichlet: Any = None
+        self._heat_dirichlet: Any = None  # M + tK with the boundary rows pinned to u = 0
         if len(self.boundary) and self.rule != "neumann" and len(self.boundary) < n:
-            keep = np.ones(n, bool)
-            keep[self.boundary] = False
-            self._interior = keep
             self._heat_dirichlet = self._shared.factor(
                 pinned_data(K.indptr, K.indices, heat, self.boundary)
             )
@@ -319,13 +321,13 @@ class HeatGeodesic:
         delta = np.zeros(n)
         delta[sources] = 1.0
         u = self._heat.solve(delta)
-        if self._heat_dirichlet is None or self._interior is None:
+        if self._heat_dirichlet is None:
             return u
-        delta[~self._interior] = 0.0  # the boundary rows are pinned to 0
+        delta[self.boundary] = 0.0  # the boundary rows are pinned: u = 0 there
         if not np.any(delta):  # every source on the boundary: Dirichlet heat is zero
             return u
         ud = self._heat_dirichlet.solve(delta)
-        ud[~self._interior] = 0.0  # exactly 0 already (decoupled rows): stated
+        ud[self.boundary] = 0.0  # (0 already: those rows are decoupled)
         return ud if self.rule == "dirichlet" else 0.5 * (u + ud)
 
     def _directions(
