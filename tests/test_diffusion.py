@@ -20,6 +20,7 @@ from meshlap_core.diffusion import (
     boundary_vertices,
     curve_gain,
     exact_distance,
+    geodesic,
     heat_kernel_column,
     heat_kernel_signature,
     heat_spectral,
@@ -464,23 +465,26 @@ def test_pinned_data_decouples_rows_and_keeps_the_pattern():
     assert np.array_equal(A.data[:3], [4.0, 1, 2])  # the input is not modified
 
 
-@pytest.mark.parametrize("solver", ["cholmod", "fallback"])
+@pytest.mark.parametrize("solver", ["simplicial", "supernodal", "fallback"])
 @pytest.mark.parametrize("rule", ["neumann", "dirichlet", "average"])
 def test_shared_analysis_solves_equal_separate_factorizations(solver, rule, monkeypatch):
     """The heat step, the Dirichlet heat step and the pinned Poisson solve of one shared
     symbolic analysis (pinned rows kept as explicit zeros) equal SuperLU solves of the
     separately assembled matrices (libigl's cotmatrix and massmatrix, the restricted
-    systems) to round-off, on a mesh with boundary and two components."""
-    if solver == "cholmod" and importlib.util.find_spec("sksparse") is None:
+    systems) to round-off, on a mesh with boundary and two components: CHOLMOD's simplicial
+    and supernodal factorizations, and the pure-wheel fallback."""
+    if solver != "fallback" and importlib.util.find_spec("sksparse") is None:
         pytest.skip("scikit-sparse (CHOLMOD) is not installed")
-    monkeypatch.setenv("MESHLAP_SOLVER", solver)
+    monkeypatch.setenv("MESHLAP_SOLVER", "fallback" if solver == "fallback" else "cholmod")
+    monkeypatch.setattr(geodesic, "SIMPLICIAL_MAX_N", 0 if solver == "supernodal" else 10**9)
     V, F = wavy_grid_pair()
     n = len(V)
     hg = HeatGeodesic(V, F, boundary=rule)
-    backend = "cholmod" if solver == "cholmod" else "cholespy"
+    backend = "cholespy" if solver == "fallback" else "cholmod"
     factors = [hg._heat, hg._poisson] + ([hg._heat_dirichlet] if rule != "neumann" else [])
     assert all(f.backend == backend for f in factors)
-    if solver == "cholmod":
+    if solver != "fallback":
+        assert hg._shared.mode == solver
         assert all(isinstance(f, CholmodSPDFactor) for f in factors)
         order = hg._shared._base.P()  # one analysis: every factor has its ordering
         assert all(np.array_equal(f.factor.P(), order) for f in factors)
