@@ -516,8 +516,11 @@ def test_shared_analysis_solves_equal_separate_factorizations(solver, rule, monk
 def test_shared_analysis_refuses_an_indefinite_matrix_like_spdsolver(monkeypatch):
     monkeypatch.setenv("MESHLAP_SOLVER", "fallback")
     A = sp.csr_matrix(np.array([[1.0, 2.0], [2.0, 1.0]]))  # eigenvalues 3 and −1
-    for backend in ["cholmod", "cholespy"]:
+    for backend, mode in [("cholmod", "simplicial"), ("cholmod", "supernodal"), ("cholespy", "")]:
         if backend == "cholmod" and importlib.util.find_spec("sksparse") is None:
             continue
+        shared = SharedAnalysis(A.indptr, A.indices, backend, mode or "supernodal")
+        if backend == "cholmod":  # its own check refuses it (the LDLᵀ has a negative pivot)
+            assert shared._cholmod(shared.matrix(A.data)) is None
         with pytest.raises(np.linalg.LinAlgError):
-            SharedAnalysis(A.indptr, A.indices, backend).factor(A.data)
+            shared.factor(A.data)
