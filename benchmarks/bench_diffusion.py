@@ -18,7 +18,8 @@ peers a user would otherwise call, in one process.
   memory).
 
 The runs alternate (ours, peer, ...) and the best of ``--repeat`` is kept; the ratios are
-peer / ours (above 1: ours faster). Meshes missing from ``../shared/meshes`` are skipped.
+peer / ours (above 1: ours faster). Each alternation's precompute pair is printed too, as
+ours / peer (below 1: ours faster). Meshes missing from ``../shared/meshes`` are skipped.
 """
 
 from __future__ import annotations
@@ -72,7 +73,7 @@ def heat_rows(
     if not have_pp:
         print("potpourri3d not installed: its row is skipped (pip install potpourri3d)")
     names = ["meshlap HeatGeodesic", "igl heat_geodesics"] + (["potpourri3d"] if have_pp else [])
-    pre = dict.fromkeys(names, np.inf)
+    pre: dict[str, list[float]] = {name: [] for name in names}
     solvers: dict[str, object] = {}
     for _ in range(repeat):
         for name in names:
@@ -84,7 +85,7 @@ def heat_rows(
                 import potpourri3d as pp3d
 
                 tp, solvers[name] = _timed(lambda: pp3d.MeshHeatMethodDistanceSolver(V, F))
-            pre[name] = min(pre[name], tp)
+            pre[name].append(tp)
 
     def click(name: str, src: int) -> np.ndarray:
         s = solvers[name]
@@ -104,6 +105,10 @@ def heat_rows(
             if src == sources[0]:
                 first[name] = d
     ours = first[names[0]]
+    for name in names[1:]:  # each alternation's pair: how steady the ratio is
+        pairs = ", ".join(f"{a / b:.2f}" for a, b in zip(pre[names[0]], pre[name], strict=True))
+        print(f"precompute, ours / {name} per pair (ours first): {pairs}")
+    pre = {name: min(times) for name, times in pre.items()}  # the best of each
     t0 = pre[names[0]]
     c0 = float(np.median(per_click[names[0]]))
     rows = [

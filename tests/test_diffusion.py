@@ -4,8 +4,13 @@ Three tiers: hand-computed tiny cases, invariants, and references (the Legendre 
 sphere's heat kernel, great-circle and Euclidean distance, ``expm_multiply``, libigl).
 """
 
+import importlib.util
+
+import igl
 import numpy as np
 import pytest
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
 from scipy.special import eval_legendre
 
 from meshlap_core.diffusion import (
@@ -15,6 +20,7 @@ from meshlap_core.diffusion import (
     boundary_vertices,
     curve_gain,
     exact_distance,
+    geodesic,
     heat_kernel_column,
     heat_kernel_signature,
     heat_spectral,
@@ -30,8 +36,9 @@ from meshlap_core.diffusion import (
     truncation_bound,
     unit_heat,
 )
-from meshlap_core.diffusion.geodesic import face_gradients, far_levels
+from meshlap_core.diffusion.geodesic import face_gradients, far_levels, gradient_stiffness
 from meshlap_core.errors import MeshError
+from meshlap_core.linalg.factor import CholmodSPDFactor, SharedAnalysis, pinned_data
 from meshlap_core.primitives import bumpy_sphere, grid, icosphere
 from meshlap_core.spectral.basis import SpectralBasis
 
@@ -425,3 +432,95 @@ def test_the_pieces_of_a_drawn_curve_sum_to_its_filter(full_basis):
     np.testing.assert_allclose(G.sum(axis=0), full_basis.V, atol=1e-9)
     with pytest.raises(MeshError, match="curve"):
         f.pieces([1.0, 0.0])
+
+
+def wavy_grid_pair():
+    """Two components with boundary: a 15×12 grid lifted into a wave (obtuse and acute
+    angles, no symmetry) and a smaller tilted one beside it."""
+    V1, F1 = grid(15, 12)
+    V1[:, 2] = 0.15 * np.sin(5 * V1[:, 0]) * np.cos(3 * V1[:, 1] + 0.4)
+    V1[:, 0] += 0.02 * np.sin(17 * V1[:, 1])
+    V2, F2 = grid(6, 7, size=0.5)
+    V2 = V2 @ np.array([[1.0, 0, 0.3], [0, 1.0, 0.1], [0, 0, 1.0]]) + np.array([2.0, 0, 0])
+    return np.vstack([V1, V2]), np.vstack([F1, F2 + len(V1)])
+
+
+def test_gradient_stiffness_is_minus_libigl_cotmatrix():
+    V, F = wavy_grid_pair()
+    hat, area = face_gradients(V, F)
+    K = gradient_stiffness(F, hat, area, len(V))
+    C = igl.cotmatrix(V, F)
+    np.testing.assert_allclose(K.toarray(), -C.toarray(), atol=1e-12 * abs(C).max())
+    assert np.all(K.diagonal() > 0) and K.has_canonical_format
+
+
+def test_pinned_data_decouples_rows_and_keeps_the_pattern():
+    A = sp.csr_matrix(np.array([[4.0, 1, 0, 2], [1, 5, 1, 0], [0, 1, 6, 1], [2, 0, 1, 7]]))
+    out = pinned_data(A.indptr, A.indices, A.data, np.array([1]))
+    P = sp.csr_matrix((out, A.indices, A.indptr), shape=A.shape)
+    expected = A.toarray()
+    expected[1, [0, 2]] = expected[[0, 2], 1] = 0.0
+    np.testing.assert_array_equal(P.toarray(), expected)
+    assert P.nnz == A.nnz  # the removed entries are stored zeros
+    assert np.array_equal(A.data[:3], [4.0, 1, 2])  # the input is not modified
+
+
+@pytest.mark.parametrize("solver", ["simplicial", "supernodal", "fallback"])
+@pytest.mark.parametrize("rule", ["neumann", "dirichlet", "average"])
+def test_shared_analysis_solves_equal_separate_factorizations(solver, rule, monkeypatch):
+    """The heat step, the Dirichlet heat step and the pinned Poisson solve of one shared
+    symbolic analysis (pinned rows kept as explicit zeros) equal SuperLU solves of the
+    separately assembled matrices (libigl's cotmatrix and massmatrix, the restricted
+    systems) to round-off, on a mesh with boundary and two components: CHOLMOD's simplicial
+    and supernodal factorizations, and the pure-wheel fallback."""
+    if solver != "fallback" and importlib.util.find_spec("sksparse") is None:
+        pytest.skip("scikit-sparse (CHOLMOD) is not installed")
+    monkeypatch.setenv("MESHLAP_SOLVER", "fallback" if solver == "fallback" else "cholmod")
+    monkeypatch.setattr(geodesic, "SIMPLICIAL_MAX_N", 0 if solver == "supernodal" else 10**9)
+    V, F = wavy_grid_pair()
+    n = len(V)
+    hg = HeatGeodesic(V, F, boundary=rule)
+    backend = "cholespy" if solver == "fallback" else "cholmod"
+    factors = [hg._heat, hg._poisson] + ([hg._heat_dirichlet] if rule != "neumann" else [])
+    assert all(f.backend == backend for f in factors)
+    if solver != "fallback":
+        assert hg._shared.mode == solver
+        assert all(isinstance(f, CholmodSPDFactor) for f in factors)
+        order = hg._shared._base.P()  # one analysis: every factor has its ordering
+        assert all(np.array_equal(f.factor.P(), order) for f in factors)
+    K = -igl.cotmatrix(V, F).tocsc()
+    M = sp.diags(igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_VORONOI).diagonal())
+    A = (M + hg.t * K).tocsc()
+    boundary = np.unique(igl.boundary_facets(F)[0])
+    interior = np.setdiff1d(np.arange(n), boundary)
+    rng = np.random.default_rng(5)
+    src = np.array([20, 100, n - 3])  # an interior vertex of each component, one more
+    delta = np.zeros(n)
+    delta[src] = 1.0
+    u = spla.spsolve(A, delta)
+    ud = np.zeros(n)
+    ud[interior] = spla.spsolve(A[interior][:, interior], delta[interior])
+    expected = {"neumann": u, "dirichlet": ud, "average": 0.5 * (u + ud)}[rule]
+    np.testing.assert_allclose(hg.heat(src), expected, atol=1e-12 * np.abs(expected).max())
+    # the Poisson system: one pinned vertex per component (the first), K restricted
+    pinned = np.array([0, 15 * 12])
+    assert np.array_equal(np.sort(hg._pinned), pinned)
+    free = np.setdiff1d(np.arange(n), pinned)
+    b = rng.standard_normal(n)
+    b[pinned] = 0.0
+    phi = np.zeros(n)
+    phi[free] = spla.spsolve(K[free][:, free], b[free])
+    np.testing.assert_allclose(hg._poisson.solve(b), phi, atol=1e-10 * np.abs(phi).max())
+
+
+def test_shared_analysis_refuses_an_indefinite_matrix_like_spdsolver(monkeypatch):
+    monkeypatch.setenv("MESHLAP_SOLVER", "fallback")
+    A = sp.csr_matrix(np.array([[1.0, 2.0], [2.0, 1.0]]))  # eigenvalues 3 and −1
+    for backend, mode in [("cholmod", "simplicial"), ("cholmod", "supernodal"), ("cholespy", "")]:
+        if backend == "cholmod" and importlib.util.find_spec("sksparse") is None:
+            continue
+        shared = SharedAnalysis(A.indptr, A.indices, backend, mode or "supernodal")
+        if backend == "cholmod":  # its own check refuses it (the LDLᵀ has a negative pivot)
+            assert shared._cholmod(shared.matrix(A.data)) is None
+        with pytest.raises(np.linalg.LinAlgError):
+            shared.factor(A.data)

@@ -11,19 +11,22 @@ The heat method (Crane, Weischedel & Wardetzky, "Geodesics in heat", ACM TOG 201
    ``A`` the face areas; ``K = Gᵀ A G``), one vertex pinned per connected component;
 4. ``d = φ − mean(φ[γ])`` in each component holding a source.
 
-The matrices are factorized once (:class:`HeatGeodesic`); a new source costs two or three pairs
-of triangular solves and a few vectorized products per face (median 1.3 s at 692k vertices
-against ``igl.heat_geodesics_solve``'s 1.25 s side by side at load 7, of which the three solves
-~0.85 s; ``benchmarks/bench_diffusion.py``). The heat decays like ``exp(−d/√t)``, so beyond
-about ``575 √t`` from the sources it underflows (below 1e-250 of its peak: 1.3 % to 23 % of the
-692k armadillo with ``t = h²``, by source): those faces take the direction of the heat of a
-longer time, ``t·100ʲ`` (``j = 1 … 4``; the levels the mesh's size calls for factorized with the
-others, any other when first needed). Measured on the 692k scan (one ``igl.upsample`` of the
-173k ``armadillo_loop``, whose vertices it keeps): our distance there differs from ours on the
-173k mesh by 0.4 % on average (1.0 % at most), potpourri3d's from its own 173k answer by 7.4 %
-(36 % at most). On a mesh with boundary the heat step takes the paper's boundary condition
-(``"neumann"``, ``"dirichlet"`` or their ``"average"``, sec. 3.2.4). Vertices in components
-without a source get ``inf`` (no path reaches them).
+The matrices are factorized once (:class:`HeatGeodesic`), all on the pattern of ``K`` (a pinned
+row and column kept as explicit zeros), so CHOLMOD's symbolic analysis is done once for all of
+them (:class:`~meshlap_core.linalg.factor.SharedAnalysis`); ``K`` itself is assembled from the
+per-face gradients the method needs anyway (:func:`gradient_stiffness`). A new source costs two
+or three pairs of triangular solves and a few vectorized products per face (median 1.3 s at
+692k vertices against ``igl.heat_geodesics_solve``'s 1.25 s side by side at load 7, of which
+the three solves ~0.85 s; ``benchmarks/bench_diffusion.py``). The heat decays like
+``exp(−d/√t)``, so beyond about ``575 √t`` from the sources it underflows (below 1e-250 of its
+peak: 1.3 % to 23 % of the 692k armadillo with ``t = h²``, by source): those faces take the
+direction of the heat of a longer time, ``t·100ʲ`` (``j = 1 … 4``; the levels the mesh's size
+calls for factorized with the others, any other when first needed). Measured on the 692k scan
+(one ``igl.upsample`` of the 173k ``armadillo_loop``, whose vertices it keeps): our distance
+there differs from ours on the 173k mesh by 0.4 % on average (1.0 % at most), potpourri3d's
+from its own 173k answer by 7.4 % (36 % at most). On a mesh with boundary the heat step takes
+the paper's boundary condition (``"neumann"``, ``"dirichlet"`` or their ``"average"``, sec.
+3.2.4). Vertices in components without a source get ``inf`` (no path reaches them).
 
 :func:`exact_distance` is the exact polyhedral distance of Mitchell, Mount & Papadimitriou
 (``igl.exact_geodesic``), run per component (libigl answers 0 across components).
@@ -38,10 +41,13 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import MeshError, check_cancel
+from ..laplacian import vertex_areas
 from ..linalg.common import ProgressCallback, report_progress
 from ..linalg.components import components
-from ..linalg.spd import SPDSolver, solver_backend
+from ..linalg.factor import SharedAnalysis, pinned_data
+from ..linalg.spd import solver_backend
 from ..options import (
+    AREA_KINDS,
     DEFAULT_HEAT_BOUNDARY,
     HEAT_BOUNDARIES,
     MASS_AREA,
@@ -49,7 +55,6 @@ from ..options import (
     HeatBoundary,
     check_choice,
 )
-from ..spectral.operators import spectral_operators
 from ..types import FloatArray, IntArray, as_mesh
 from .sources import check_sources
 
@@ -59,6 +64,12 @@ _UNDERFLOW = 1e-250
 """A face whose largest heat is below this times the largest heat anywhere has underflowed."""
 _FAR_LEVELS = 4
 """Longer heat times tried where the heat underflowed: t·100 … t·100⁴ (reach ×10 each)."""
+SIMPLICIAL_MAX_N = 200_000
+"""Below this many vertices CHOLMOD factorizes the heat method's matrices simplicially
+(``LDLᵀ``, no BLAS), from it supernodally. Measured side by side in one process (2 cores,
+load 8; precompute, then the median click): 43k armadillo_igl 0.54 s / 22 ms simplicial
+against 0.67 s / 34 ms supernodal; 173k armadillo_loop 4.4 s / 99 ms against 4.3 s / 200 ms;
+the 692k scan 90 s / 0.52 s against 25 s / 0.68 s."""
 _REACH = float(-np.log(_UNDERFLOW))
 """The heat of time ``t`` falls below :data:`_UNDERFLOW` of its peak about this many ``√t``
 from the sources (it decays like ``exp(−d/√t)``)."""
@@ -82,7 +93,11 @@ def mean_edge_length(V: FloatArray, F: IntArray) -> float:
     V, F = as_mesh(V, F)
     if len(F) == 0:
         return 0.0
-    count = edge_counts(F, len(V))
+    return _mean_length(V, edge_counts(F, len(V)))
+
+
+def _mean_length(V: FloatArray, count: sp.csr_matrix) -> float:
+    """The mean length of the edges of the table ``count`` (:func:`edge_counts`)."""
     i = np.repeat(np.arange(len(V)), np.diff(count.indptr))
     return float(np.mean(np.linalg.norm(V[i] - V[count.indices], axis=1)))
 
@@ -91,8 +106,12 @@ def boundary_vertices(F: IntArray, n: int) -> IntArray:
     """Vertices on a boundary edge (an edge of one face), sorted ``(b,)`` int."""
     if len(F) == 0:
         return np.zeros(0, dtype=np.int64)
-    count = edge_counts(F, n)
-    rows = np.repeat(np.arange(n), np.diff(count.indptr))
+    return _boundary(edge_counts(F, n))
+
+
+def _boundary(count: sp.csr_matrix) -> IntArray:
+    """The vertices of the edges held by one face in the table ``count`` (sorted)."""
+    rows = np.repeat(np.arange(count.shape[0]), np.diff(count.indptr))
     once = count.data == 1
     return np.unique(np.concatenate([rows[once], count.indices[once]])).astype(np.int64)
 
@@ -129,6 +148,44 @@ def face_gradients(V: FloatArray, F: IntArray) -> tuple[FloatArray, FloatArray]:
     return hat, 0.5 * double
 
 
+def gradient_stiffness(F: IntArray, hat: FloatArray, area: FloatArray, n: int) -> sp.csr_matrix:
+    """The stiffness ``K = Gᵀ A G`` (``G`` the piecewise-linear gradient, ``A`` the face
+    areas) from the per-face hat gradients of :func:`face_gradients`.
+
+    ``K_ij = Σ_f A_f ⟨∇φ_i, ∇φ_j⟩`` over the faces holding ``i`` and ``j``: for an edge
+    ``ij`` it is ``−½ (cot α_ij + cot β_ij)`` (so ``K = −C``, libigl's ``−cotmatrix``, to
+    round-off), and ``K_ii = −Σ_{j≠i} K_ij``. Being ``Gᵀ A G``, it is positive semidefinite and
+    the exact adjoint of the divergence the heat method takes (a face of zero area adds
+    nothing). Every mesh edge and the whole diagonal are stored, zero or not, so matrices
+    built from its values keep its pattern.
+
+    Parameters
+    ----------
+    F : (m,3) int
+    hat : (3,3,m) float
+    area : (m,) float
+    n : int
+
+    Returns
+    -------
+    K : (n,n) scipy.sparse.csr_matrix
+        Symmetric, sorted indices, each entry once.
+    """
+    off = np.concatenate(
+        [area * np.einsum("kf,kf->f", hat[(i + 1) % 3], hat[(i + 2) % 3]) for i in range(3)]
+    )
+    a = np.concatenate([F[:, 1], F[:, 2], F[:, 0]])  # the edge opposite corner i
+    b = np.concatenate([F[:, 2], F[:, 0], F[:, 1]])
+    # Σ_j ∇φ_j = 0 on a face, so A⟨∇φ_i, ∇φ_i⟩ = −Σ_{j≠i} A⟨∇φ_i, ∇φ_j⟩: the diagonal is
+    # minus the row sums (K·1 = 0), n entries instead of 3m to sort
+    diag = -(np.bincount(a, off, minlength=n) + np.bincount(b, off, minlength=n))
+    ar = np.arange(n)
+    rows, cols = np.concatenate([a, b, ar]), np.concatenate([b, a, ar])
+    K = sp.coo_matrix((np.concatenate([off, off, diag]), (rows, cols)), shape=(n, n)).tocsr()
+    K.sum_duplicates()  # sorts the indices; keeps explicit zeros
+    return K
+
+
 def far_levels(V: FloatArray, t: float) -> int:
     """How many longer heat times (``t·100ʲ``) the farthest faces of the mesh will need: the
     smallest ``j`` whose reach ``575·10ʲ·√t`` (:data:`_REACH`) covers twice the bounding box's
@@ -140,6 +197,16 @@ def far_levels(V: FloatArray, t: float) -> int:
     if span <= reach:
         return 0
     return int(min(np.ceil(np.log10(span / reach)), _FAR_LEVELS))
+
+
+def _diagonal_positions(K: sp.csr_matrix) -> IntArray:
+    """Where each diagonal entry ``K_ii`` sits in ``K.data`` ``(n,)`` (sorted CSR storing its
+    whole diagonal, as :func:`gradient_stiffness` does)."""
+    rows = np.repeat(np.arange(K.shape[0]), np.diff(K.indptr))
+    pos = np.flatnonzero(rows == K.indices)
+    if len(pos) != K.shape[0]:
+        raise ValueError("the matrix does not store its whole diagonal")
+    return pos
 
 
 def check_time_factor(m: float, name: str = "m") -> float:
@@ -199,44 +266,58 @@ class HeatGeodesic:
         self.V, self.F = as_mesh(V, F)
         self.rule = check_choice(boundary, HEAT_BOUNDARIES, "boundary condition", "boundary")
         self.m = check_time_factor(m)
-        K, self.mass = spectral_operators(self.V, self.F, "cotan", area)
+        check_choice(area, AREA_KINDS, "area")
         n = len(self.V)
-        self.h = mean_edge_length(self.V, self.F)
-        self.t = self.m * self.h**2
-        A = (sp.diags(self.mass) + self.t * K).tocsr()
-        # two solves per source set: the factorization dominates, and CHOLMOD's supernodal
-        # one (when scikit-sparse is installed) is about twice cholespy's at 43k vertices
-        backend = self._backend = solver_backend()
-        self._heat = SPDSolver(A, backend)
-        self.boundary = boundary_vertices(self.F, n)
-        self._interior: IntArray | None = None
-        self._heat_dirichlet: SPDSolver | None = None
-        if len(self.boundary) and self.rule != "neumann":
-            keep = np.ones(n, bool)
-            keep[self.boundary] = False
-            self._interior = np.flatnonzero(keep)
-            if len(self._interior):
-                sub = A[self._interior][:, self._interior]
-                self._heat_dirichlet = SPDSolver(sub, backend)
-        self._corners = [np.ascontiguousarray(self.F[:, i]) for i in range(3)]
+        if n == 0 or len(self.F) == 0:
+            raise MeshError("the mesh has no faces; the heat method needs a surface", "F")
         # ∇ of each corner's hat function per face (3 corners, 3 coordinates, m), and the face
-        # areas: ∇u and the divergence Gᵀ A X from them (half igl.grad's product time)
+        # areas: ∇u, the divergence Gᵀ A X and K = Gᵀ A G from them (no igl.grad/cotmatrix)
         self._hat, self._area = face_gradients(self.V, self.F)
+        self._corners = [np.ascontiguousarray(self.F[:, i]) for i in range(3)]
+        K = self._K = gradient_stiffness(self.F, self._hat, self._area, n)
+        self.mass = vertex_areas(self.V, self.F, area)
+        bad = np.flatnonzero(~(self.mass > 0))
+        if len(bad):
+            raise MeshError(
+                f"vertex {int(bad[0])} (and {len(bad) - 1} more) has zero area: it is "
+                "unreferenced or only in degenerate faces; remove unreferenced vertices and "
+                "degenerate faces first (meshlap's load_mesh does)",
+                "V",
+            )
+        count = edge_counts(self.F, n)  # one edge table: h and the boundary
+        self.h = _mean_length(self.V, count)
+        self.t = self.m * self.h**2
+        self.boundary = _boundary(count)
         self.n_components, self.labels = components(K)
-        self._K = K
-        self._face_label = self.labels[self.F[:, 0]] if len(self.F) else np.zeros(0, np.int64)
-        self._far: dict[int, SPDSolver] = {}
+        self._face_label = self.labels[self.F[:, 0]]
+        # every matrix below has K's pattern (pinned rows and columns kept as explicit
+        # zeros), so one symbolic analysis serves all their factorizations: M + tK, the
+        # pinned K, the Dirichlet M + tK and the longer times' M + t'K
+        self._diag = _diagonal_positions(K)
+        mode = "simplicial" if n < SIMPLICIAL_MAX_N else "supernodal"
+        self._shared = SharedAnalysis(K.indptr, K.indices, solver_backend(), mode)
+        heat = self._heat_data(self.t)
+        self._heat = self._shared.factor(heat)
+        self._heat_dirichlet: Any = None  # M + tK with the boundary rows pinned to u = 0
+        if len(self.boundary) and self.rule != "neumann" and len(self.boundary) < n:
+            self._heat_dirichlet = self._shared.factor(
+                pinned_data(K.indptr, K.indices, heat, self.boundary)
+            )
+        self._far: dict[int, Any] = {}
         first = np.full(self.n_components, n)
         np.minimum.at(first, self.labels, np.arange(n))
-        free = np.ones(n, bool)
-        free[first] = False  # one pinned vertex per component: K restricted is definite
-        self._free = np.flatnonzero(free)
-        poisson = K[self._free][:, self._free].tocsr()
-        self._poisson = SPDSolver(poisson, backend) if len(self._free) else None
+        self._pinned = first  # one pinned vertex per component: K without them is definite
+        self._poisson = self._shared.factor(pinned_data(K.indptr, K.indices, K.data, first))
         # the longer times the sources' farthest faces will need, factorized now: a click then
         # only back-substitutes (the 692k scan needs t·100; an unforeseen one is built lazily)
         for level in range(1, far_levels(self.V, self.t) + 1):
             self._far_solver(level)
+
+    def _heat_data(self, t: float) -> FloatArray:
+        """The values of ``M + tK`` on ``K``'s pattern."""
+        data = t * self._K.data
+        data[self._diag] += self.mass
+        return data
 
     def heat(self, sources: IntArray) -> FloatArray:
         """The heat step ``u`` (before normalization) for checked ``sources``."""
@@ -244,12 +325,13 @@ class HeatGeodesic:
         delta = np.zeros(n)
         delta[sources] = 1.0
         u = self._heat.solve(delta)
-        if self._heat_dirichlet is None or self._interior is None:
+        if self._heat_dirichlet is None:
             return u
-        ud = np.zeros(n)
-        ud[self._interior] = self._heat_dirichlet.solve(delta[self._interior])
-        if not np.any(ud):  # every source on the boundary: Dirichlet heat is zero
+        delta[self.boundary] = 0.0  # the boundary rows are pinned: u = 0 there
+        if not np.any(delta):  # every source on the boundary: Dirichlet heat is zero
             return u
+        ud = self._heat_dirichlet.solve(delta)
+        ud[self.boundary] = 0.0  # (0 already: those rows are decoupled)
         return ud if self.rule == "dirichlet" else 0.5 * (u + ud)
 
     def _directions(
@@ -281,12 +363,11 @@ class HeatGeodesic:
         g *= np.where(known, -1.0 / np.where(known, norm, 1.0), 0.0)
         return g, known & ~lost, lost
 
-    def _far_solver(self, level: int) -> SPDSolver:
+    def _far_solver(self, level: int) -> Any:
         """The Neumann heat step's factorization at ``t·100^level`` (built once)."""
         solver = self._far.get(level)
         if solver is None:
-            A = (sp.diags(self.mass) + (self.t * 100.0**level) * self._K).tocsr()
-            solver = self._far[level] = SPDSolver(A, self._backend)
+            solver = self._far[level] = self._shared.factor(self._heat_data(self.t * 100.0**level))
         return solver
 
     def _far_heat(self, level: int, sources: IntArray) -> FloatArray:
@@ -335,9 +416,8 @@ class HeatGeodesic:
             X[:, faces[known2]] = X2[:, known2]
             redo[faces[known2]] = False
         b = self._divergence(X)
-        phi = np.zeros(n)
-        if self._poisson is not None:
-            phi[self._free] = self._poisson.solve(b[self._free])
+        b[self._pinned] = 0.0  # the pinned vertices' rows: φ = 0 there
+        phi = self._poisson.solve(b)
         count = np.bincount(self.labels[src], minlength=self.n_components)
         total = np.bincount(self.labels[src], weights=phi[src], minlength=self.n_components)
         has = count > 0

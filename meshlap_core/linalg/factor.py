@@ -4,7 +4,8 @@ Sylvester's law of inertia: for ``PAPᵀ = LDLᵀ`` (no pivoting, ``D`` diagonal
 negative eigenvalues of ``A`` is the number of negative entries of ``D``. Two back ends: QDLDL
 (AMD ordering, the factorization of the OSQP solver) and SuperLU in symmetric mode without
 pivoting as a fallback. Every factor is checked by a solve with a random right-hand side, so a
-tiny pivot (a shift on an eigenvalue) is detected and the shift moved.
+tiny pivot (a shift on an eigenvalue) is detected and the shift moved. :class:`SharedAnalysis`:
+positive definite matrices of one pattern factorized from one symbolic analysis.
 
 Mesh-free: matrices in, numbers out.
 """
@@ -339,3 +340,132 @@ class ShiftInvert:
 
     def __call__(self, Y: FloatArray, out: FloatArray) -> None:
         out[...] = self.factor.solve(Y)
+
+
+class SharedAnalysis:
+    """Cholesky factors of several symmetric positive definite matrices with one sparsity
+    pattern, from one symbolic analysis.
+
+    With CHOLMOD (scikit-sparse) the fill-reducing ordering and the pattern of ``L``
+    (``analyze``, a third to a half of a factorization) are computed once, on the first
+    :meth:`factor`, and each factor starts from a copy of that analysis
+    (``Factor.cholesky``): only the numeric factorization is repeated. A matrix with rows
+    and columns pinned to the identity keeps the pattern when its removed entries are stored
+    as explicit zeros (see :func:`pinned_data`). Other back ends (cholespy, SuperLU) factorize
+    each matrix with :class:`~meshlap_core.linalg.spd.SPDSolver`.
+
+    Parameters
+    ----------
+    indptr, indices : (n+1,) int, (nnz,) int
+        The CSR pattern of the symmetric matrices (both triangles, sorted, each entry once;
+        read as CSC it is the same matrix).
+    backend : {"cholmod", "cholespy", "superlu"}, optional
+        Default :func:`~meshlap_core.linalg.spd.solver_backend`.
+    mode : {"supernodal", "simplicial"}
+        CHOLMOD's factorization (supernodal ``LLᵀ`` or simplicial ``LDLᵀ``).
+    """
+
+    def __init__(
+        self,
+        indptr: IntArray,
+        indices: IntArray,
+        backend: str | None = None,
+        mode: str = "supernodal",
+    ) -> None:
+        from .spd import solver_backend
+
+        self.n = len(indptr) - 1
+        self.indptr, self.indices = indptr, indices
+        self.backend = solver_backend() if backend is None else backend
+        self.mode = mode
+        self._base: Any = None  # the analysed, never factored, CHOLMOD factor
+        self.lock = threading.Lock()
+
+    def matrix(self, data: FloatArray) -> sp.csr_matrix:
+        """The CSR matrix of this pattern with the values ``data`` ``(nnz,)`` (no copy)."""
+        return sp.csr_matrix((data, self.indices, self.indptr), shape=(self.n, self.n))
+
+    def factor(self, data: FloatArray) -> Any:
+        """A solver (``.solve(B)``, ``.backend``) for the matrix of this pattern with the
+        values ``data``: CHOLMOD from the shared analysis; if CHOLMOD refuses the matrix or
+        another back end is in use, :class:`~meshlap_core.linalg.spd.SPDSolver`.
+
+        Raises
+        ------
+        numpy.linalg.LinAlgError
+            The matrix is not numerically positive definite (as ``SPDSolver`` raises it).
+        """
+        from .spd import SPDSolver
+
+        A = self.matrix(data)
+        if self.backend == "cholmod":
+            factor = self._cholmod(A)
+            if factor is not None:
+                return CholmodSPDFactor(factor)
+        return SPDSolver(A, self.backend)
+
+    def _cholmod(self, A: sp.csr_matrix) -> Any:
+        """CHOLMOD's factor of ``A`` from the shared analysis, or ``None`` when refused."""
+        from sksparse.cholmod import CholmodError, CholmodWarning, analyze
+
+        from .spd import PIVOT_RATIO, surely_positive_definite
+
+        csc = sp.csc_matrix((A.data, A.indices, A.indptr), shape=A.shape)  # symmetric
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("error", CholmodWarning)
+                with self.lock:
+                    if self._base is None:
+                        self._base = analyze(csc, mode=self.mode)
+                    base = self._base
+                factor = base.cholesky(csc)
+        except (CholmodError, CholmodWarning):
+            return None
+        if not surely_positive_definite(A):
+            # a pivot at round-off of its own diagonal entry is refused, as SPDSolver does
+            # (the simplicial LDLᵀ does not stop at a negative one)
+            D = factor.D()
+            if not (np.all(np.isfinite(D)) and np.all(D > PIVOT_RATIO * A.diagonal()[factor.P()])):
+                return None
+        return factor
+
+
+class CholmodSPDFactor:
+    """A CHOLMOD factor of a positive definite matrix made by :class:`SharedAnalysis`."""
+
+    backend = "cholmod"
+
+    def __init__(self, factor: Any) -> None:
+        self.factor = factor
+
+    def solve(self, B: FloatArray) -> FloatArray:
+        """``X = A⁻¹ B`` for ``B`` of shape ``(n,)`` or ``(n,k)`` (``B`` is not modified)."""
+        return np.asarray(self.factor.solve_A(np.ascontiguousarray(B, dtype=np.float64)))
+
+
+def pinned_data(
+    indptr: IntArray, indices: IntArray, data: FloatArray, pinned: IntArray
+) -> FloatArray:
+    """The values of a symmetric CSR matrix with the rows and columns ``pinned`` decoupled:
+    their off-diagonal entries set to explicit zeros (the pattern kept, so one
+    :class:`SharedAnalysis` serves both), their diagonal entries kept. A solve with a
+    right-hand side that is 0 at ``pinned`` is 0 there and, elsewhere, the solve of the
+    matrix restricted to the other rows and columns (a Dirichlet condition).
+
+    Parameters
+    ----------
+    indptr, indices, data : the CSR arrays (sorted, the diagonal stored)
+    pinned : (p,) int
+
+    Returns
+    -------
+    data : (nnz,) float
+        A new array.
+    """
+    n = len(indptr) - 1
+    mask = np.zeros(n, bool)
+    mask[pinned] = True
+    rows = np.repeat(np.arange(n), np.diff(indptr))
+    out = np.array(data, dtype=np.float64)
+    out[(mask[rows] | mask[indices]) & (rows != indices)] = 0.0
+    return out
