@@ -46,6 +46,7 @@ from .curvature import (
     principal_curvature_quadric,
 )
 from .curvature_fit import jet_curvatures
+from .curvature_topology import CurvatureTopology, topology_for
 from .errors import MeshError
 from .options import (
     CURVATURE_AREA,
@@ -56,7 +57,6 @@ from .options import (
     check_choice,
 )
 from .principal import PrincipalCurvatures, eig_sym2, tangent_frames
-from .topology import EdgeTable
 from .types import FloatArray, IntArray, as_mesh
 
 
@@ -68,41 +68,69 @@ def _from_tensor(
     return l1, l2, d1, -si[:, None] * t1 + co[:, None] * t2
 
 
+def _columns(X: FloatArray) -> list[FloatArray]:
+    """The three coordinates of ``X`` (k,3) as contiguous ``(k,)`` arrays (gathers and
+    products on strided columns are about 3x slower)."""
+    return [np.ascontiguousarray(X[:, d]) for d in range(3)]
+
+
+def _solve3(S: list[FloatArray], rhs: list[FloatArray]) -> FloatArray:
+    """The symmetric 3×3 systems ``[[S0, S1, S2], [S1, S3, S4], [S2, S4, S5]] x = rhs`` per row,
+    regularised by ``1e-12 · trace`` (a vertex or face whose rows do not span the plane gets
+    the least-norm-like solution, not a singular matrix), ``(k,3)``."""
+    k = len(S[0])
+    A = np.empty((k, 3, 3))
+    for (i, j), s in zip(((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)), S, strict=True):
+        A[:, i, j] = s
+        A[:, j, i] = s
+    reg = 1e-12 * (S[0] + S[3] + S[5] + 1e-300)
+    for i in range(3):
+        A[:, i, i] += reg
+    return np.linalg.solve(A, np.stack(rhs, axis=1)[:, :, None])[:, :, 0]
+
+
 def _edge_tensor_fit(
-    V: FloatArray, E: IntArray, N: FloatArray, t1: FloatArray, t2: FloatArray
+    V: FloatArray, topo: CurvatureTopology, N: FloatArray, t1: FloatArray, t2: FloatArray
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Least-squares ``[[a, b], [b, c]]`` per vertex from the normal curvatures of the edges
-    ``E`` (e,2), ``κ_ij = 2 (x_i − x_j) · n_i / |x_i − x_j|²`` (Meyer et al. 2003, §5.3,
-    uniform weights)."""
+    (``topo.directed``, both directions), ``κ_ij = 2 (x_i − x_j) · n_i / |x_i − x_j|²``
+    (Meyer et al. 2003, §5.3, uniform weights)."""
     n = len(V)
-    src = np.concatenate([E[:, 0], E[:, 1]])
-    dst = np.concatenate([E[:, 1], E[:, 0]])
-    e = V[dst] - V[src]
-    en = np.einsum("ij,ij->i", e, N[src])
-    L2 = np.einsum("ij,ij->i", e, e)
+    src, dst = topo.directed
+    deg = np.bincount(src, minlength=n)
+    # the edges are sorted by source: the source's values are repeats, not gathers
+    e = [x[dst] - np.repeat(x, deg) for x in _columns(V)]
+
+    def along(B: FloatArray) -> FloatArray:
+        b = _columns(B)
+        return (
+            np.repeat(b[0], deg) * e[0] + np.repeat(b[1], deg) * e[1] + np.repeat(b[2], deg) * e[2]
+        )
+
+    en, co, si = along(N), along(t1), along(t2)
+    L2 = e[0] * e[0] + e[1] * e[1] + e[2] * e[2]
     kappa = np.divide(-2.0 * en, L2, out=np.zeros_like(en), where=L2 > 0)
     # the edge's direction in the tangent plane: t1, t2 are orthogonal to n, so the tangent
     # projection of e has the coordinates (e·t1, e·t2); its angle φ gives the row
     # (cos²φ, 2 cosφ sinφ, sin²φ) = (co², 2 co si, si²) / r²
-    co, si = np.einsum("ij,ij->i", e, t1[src]), np.einsum("ij,ij->i", e, t2[src])
     r2 = co * co + si * si
     inv = np.divide(1.0, r2, out=np.zeros_like(r2), where=r2 > 0)
     a, b, c = co * co * inv, 2.0 * co * si * inv, si * si * inv
     # the normal equations' 6 distinct entries and right-hand side summed per vertex
-    # (9 bincounts: faster than one sparse product with a stacked (2e, 9) matrix)
     sums = [
         np.bincount(src, weights=w, minlength=n)
         for w in (a * a, a * b, a * c, b * b, b * c, c * c, a * kappa, b * kappa, c * kappa)
     ]
-    A = np.stack([sums[i] for i in (0, 1, 2, 1, 3, 4, 2, 4, 5)], axis=1).reshape(n, 3, 3)
-    rhs = np.stack(sums[6:], axis=1)
-    A += 1e-12 * np.eye(3) * (np.trace(A, axis1=1, axis2=2)[:, None, None] + 1e-300)
-    x = np.linalg.solve(A, rhs[:, :, None])[:, :, 0]
+    x = _solve3(sums[:6], sums[6:])
     return x[:, 0], x[:, 1], x[:, 2]
 
 
 def cotan_curvatures(
-    V: FloatArray, F: IntArray, area: AreaKind = CURVATURE_AREA, boundary: str = DEFAULT_BOUNDARY
+    V: FloatArray,
+    F: IntArray,
+    area: AreaKind = CURVATURE_AREA,
+    boundary: str = DEFAULT_BOUNDARY,
+    topology: CurvatureTopology | None = None,
 ) -> PrincipalCurvatures:
     """Cotangent ``H`` and angle-deficit ``K`` (Meyer, Desbrun, Schröder & Barr 2003).
 
@@ -119,6 +147,9 @@ def cotan_curvatures(
     area : {"voronoi", "barycentric"}
     boundary : {"pi", "2pi", "zero"}
         Rule of the angle deficit at boundary vertices.
+    topology : CurvatureTopology, optional
+        ``F``'s edges built once (:class:`~meshlap_core.curvature_topology.CurvatureTopology`):
+        pass it again with every new ``V`` of the same faces.
 
     Returns
     -------
@@ -132,12 +163,12 @@ def cotan_curvatures(
     N = _normals_from(F, n, fn, theta)
     A = _areas_from(V, F, fr, area)
     H = _cotan_H(_cotan_Cx(fr, F, n), A, N)  # C x without assembling C
-    table = EdgeTable.from_faces(F, n)  # one sort for the edges and the boundary
-    d = _deficit_from(F, n, theta, boundary, table.boundary_vertex_mask())
+    topo = topology_for(F, n, topology)  # the edges and the boundary: one sort, kept
+    d = _deficit_from(F, n, theta, boundary, topo.on_boundary)
     K = np.divide(d, A, out=np.zeros_like(d), where=A > 0)
     r = np.sqrt(np.maximum(H * H - K, 0.0))
     t1, t2 = tangent_frames(N)
-    _, _, d1, d2 = _from_tensor(*_edge_tensor_fit(V, table.edges, N, t1, t2), t1, t2)
+    _, _, d1, d2 = _from_tensor(*_edge_tensor_fit(V, topo, N, t1, t2), t1, t2)
     return PrincipalCurvatures(H + r, H - r, d1, d2, N, "cotan")
 
 
@@ -160,17 +191,72 @@ def quadric_curvatures(V: FloatArray, F: IntArray, radius: int = 5) -> Principal
     return PrincipalCurvatures(k1, k2, d1, d2, _normals_from(F, len(V), fn, theta), "quadric")
 
 
-def _rotate_into(x: FloatArray, a: FloatArray, b: FloatArray) -> FloatArray:
-    """The rotation taking unit ``a`` to unit ``b`` about ``a × b`` applied to ``x`` (rows)."""
-    k = np.cross(a, b)
-    c = np.einsum("ij,ij->i", a, b)
-    kx = np.einsum("ij,ij->i", k, x)
-    kk = np.einsum("ij,ij->i", k, k)
-    s = np.where(c > -1 + 1e-12, 1.0 / (1.0 + c), 0.0)
-    return x + np.cross(k, x) + s[:, None] * (k * kx[:, None] - x * kk[:, None])
+def _cross(a: list[FloatArray], b: list[FloatArray]) -> list[FloatArray]:
+    """``a × b`` on coordinate columns."""
+    return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 
 
-def rusinkiewicz_curvatures(V: FloatArray, F: IntArray) -> PrincipalCurvatures:
+def _dot(a: list[FloatArray], b: list[FloatArray]) -> FloatArray:
+    """``a · b`` on coordinate columns."""
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def _face_tensors(
+    P: list[list[FloatArray]], NN: list[list[FloatArray]], u: list[FloatArray], v: list[FloatArray]
+) -> FloatArray:
+    """Rusinkiewicz's per-face ``(a, b, c)`` ``(m,3)``: the least-squares solution of
+    ``II (e·u, e·v)ᵀ = (Δn·u, Δn·v)ᵀ`` over the three edges (corner positions ``P[k]`` and
+    vertex normals ``NN[k]`` as coordinate columns); the 6 × 3 system's normal equations."""
+    zero = np.zeros_like(u[0])
+    S = [zero, zero, zero, zero, zero, zero]  # S00, S01, S02 (= 0), S11, S12, S22
+    rhs = [zero, zero, zero]
+    for i, j in ((0, 1), (1, 2), (2, 0)):
+        e = [P[j][d] - P[i][d] for d in range(3)]
+        dn = [NN[j][d] - NN[i][d] for d in range(3)]
+        eu, ev, nu, nv = _dot(e, u), _dot(e, v), _dot(dn, u), _dot(dn, v)
+        uu, uv, vv = eu * eu, eu * ev, ev * ev
+        # rows (eu, ev, 0) → nu and (0, eu, ev) → nv
+        S = [S[0] + uu, S[1] + uv, S[2], S[3] + vv + uu, S[4] + uv, S[5] + vv]
+        rhs = [rhs[0] + eu * nu, rhs[1] + ev * nu + eu * nv, rhs[2] + ev * nv]
+    return _solve3(S, rhs)
+
+
+def _in_face_plane(
+    n: list[FloatArray],
+    fn: list[FloatArray],
+    t1: list[FloatArray],
+    t2: list[FloatArray],
+    u: list[FloatArray],
+    v: list[FloatArray],
+) -> tuple[tuple[FloatArray, FloatArray], tuple[FloatArray, FloatArray]]:
+    """The vertex's tangent frame ``(t1, t2)`` rotated into the face's plane (the rotation
+    taking the vertex normal ``n`` to the face normal ``fn`` about ``n × fn``, Rodrigues'
+    formula), in the face's basis ``(u, v)``: ``((t1·u, t1·v), (t2·u, t2·v))`` after the
+    rotation. The rotation keeps ``t2 = n × t1``, so the image of ``t2`` is
+    ``fn × R t1``: its coordinates are ``(−y, x)`` for ``R t1 = (x, y)``."""
+    k = _cross(n, fn)
+    c = _dot(n, fn)
+    s = np.where(c > -1 + 1e-12, 1.0 / (1.0 + np.maximum(c, -1 + 1e-12)), 0.0)
+    kk = _dot(k, k)
+
+    def rotate(x: list[FloatArray]) -> list[FloatArray]:
+        kx, kdx = _cross(k, x), _dot(k, x)
+        return [x[d] + kx[d] + s * (k[d] * kdx - x[d] * kk) for d in range(3)]
+
+    r1 = rotate(t1)
+    c1 = (_dot(r1, u), _dot(r1, v))
+    c2 = (-c1[1], c1[0].copy())
+    flip = np.flatnonzero(s == 0.0)  # n opposite fn: the formula's rotation of t2 itself
+    if len(flip):
+        r2 = rotate(t2)
+        c2[0][flip] = _dot(r2, u)[flip]
+        c2[1][flip] = _dot(r2, v)[flip]
+    return c1, c2
+
+
+def rusinkiewicz_curvatures(
+    V: FloatArray, F: IntArray, topology: CurvatureTopology | None = None
+) -> PrincipalCurvatures:
     """Per-face curvature tensors averaged to the vertices (Rusinkiewicz, "Estimating curvatures
     and their derivatives on triangle meshes", 3DPVT 2004).
 
@@ -181,74 +267,60 @@ def rusinkiewicz_curvatures(V: FloatArray, F: IntArray) -> PrincipalCurvatures:
     vertex rotates its tangent frame into the face's plane (about ``n_i × n_f``), expresses the
     face tensor there, and averages with its corners' mixed Voronoi areas as weights.
 
+    Parameters
+    ----------
+    V : (n,3) float
+    F : (m,3) int
+    topology : CurvatureTopology, optional
+        Accepted for a common signature with the other tensor estimators (checked against
+        ``F``; this one needs no edges).
+
     Returns
     -------
     PrincipalCurvatures
     """
     V, F = as_mesh(V, F)
     n = len(V)
+    if topology is not None:
+        topology_for(F, n, topology)
     fr = _face_frame(V, F)
     fn, theta = _geometry_of(fr)
     N = _normals_from(F, n, fn, theta)
-    P = [V[F[:, i]] for i in range(3)]
-    u = P[1] - P[0]
-    u /= np.maximum(np.linalg.norm(u, axis=1, keepdims=True), 1e-300)
-    v = np.cross(fn, u)
-    # normal equations of the 6 x 3 system, one per face
-    A = np.zeros((len(F), 3, 3))
-    rhs = np.zeros((len(F), 3))
-    for i, j in ((0, 1), (1, 2), (2, 0)):
-        e, dn = P[j] - P[i], N[F[:, j]] - N[F[:, i]]
-        eu, ev = np.einsum("ij,ij->i", e, u), np.einsum("ij,ij->i", e, v)
-        nu, nv = np.einsum("ij,ij->i", dn, u), np.einsum("ij,ij->i", dn, v)
-        for row, y in (((eu, ev, 0 * eu), nu), ((0 * eu, eu, ev), nv)):
-            r = np.stack(row, axis=1)
-            A += r[:, :, None] * r[:, None, :]
-            rhs += r * y[:, None]
-    A += 1e-12 * np.eye(3) * (np.trace(A, axis1=1, axis2=2)[:, None, None] + 1e-300)
-    abc = np.linalg.solve(A, rhs[:, :, None])[:, :, 0]
+    corners = [np.ascontiguousarray(F[:, k]) for k in range(3)]
+    X, NC = _columns(V), _columns(N)
+    P = [[x[c] for x in X] for c in corners]
+    NN = [[x[c] for x in NC] for c in corners]
+    fnc = _columns(fn)
+    u = [P[1][d] - P[0][d] for d in range(3)]
+    inv = 1.0 / np.maximum(np.sqrt(_dot(u, u)), 1e-300)
+    u = [x * inv for x in u]
+    v = _cross(fnc, u)
+    abc = _face_tensors(P, NN, u, v)
+    a, b, c = abc[:, 0], abc[:, 1], abc[:, 2]
     w = _mixed_corner_areas(fr)  # each corner's mixed Voronoi area (Meyer et al. 2003)
     t1, t2 = tangent_frames(N)
-    acc = np.zeros((n, 3))
+    T1, T2 = _columns(t1), _columns(t2)
+    vals = np.empty((3, len(F), 3))  # (tensor entry, face, corner): the weighted forms
     for k in range(3):
-        vk = F[:, k]
-        r1 = _rotate_into(t1[vk], N[vk], fn)
-        r2 = _rotate_into(t2[vk], N[vk], fn)
-        c1 = (np.einsum("ij,ij->i", r1, u), np.einsum("ij,ij->i", r1, v))
-        c2 = (np.einsum("ij,ij->i", r2, u), np.einsum("ij,ij->i", r2, v))
-
-        def form(x: tuple[FloatArray, FloatArray], y: tuple[FloatArray, FloatArray]) -> FloatArray:
-            return (
-                abc[:, 0] * x[0] * y[0]
-                + abc[:, 1] * (x[0] * y[1] + x[1] * y[0])
-                + abc[:, 2] * x[1] * y[1]
-            )
-
-        for col, val in enumerate((form(c1, c1), form(c1, c2), form(c2, c2))):
-            acc[:, col] += np.bincount(vk, w[:, k] * val, minlength=n)
-    W = np.bincount(F.ravel(), w.ravel(), minlength=n)
+        ck = corners[k]
+        (x1, y1), (x2, y2) = _in_face_plane(
+            NN[k], fnc, [x[ck] for x in T1], [x[ck] for x in T2], u, v
+        )
+        vals[0, :, k] = a * x1 * x1 + 2.0 * b * x1 * y1 + c * y1 * y1
+        vals[1, :, k] = a * x1 * x2 + b * (x1 * y2 + y1 * x2) + c * y1 * y2
+        vals[2, :, k] = a * x2 * x2 + 2.0 * b * x2 * y2 + c * y2 * y2
+    vals *= w[None]
+    flat = F.ravel()
+    acc = np.stack([np.bincount(flat, vals[j].ravel(), minlength=n) for j in range(3)], axis=1)
+    W = np.bincount(flat, w.ravel(), minlength=n)
     acc = np.divide(acc, W[:, None], out=np.zeros_like(acc), where=W[:, None] > 0)
     k1, k2, d1, d2 = _from_tensor(acc[:, 0], acc[:, 1], acc[:, 2], t1, t2)
     return PrincipalCurvatures(k1, k2, d1, d2, N, "rusinkiewicz")
 
 
-def _interior_edges(F: IntArray, n: int) -> tuple[IntArray, IntArray, IntArray, IntArray]:
-    """Edges with two consistently oriented faces: ``(a, b, f1, f2)``, ``a → b`` in ``f1`` and
-    ``b → a`` in ``f2``."""
-    m = len(F)
-    A = F.ravel()
-    B = np.roll(F, -1, axis=1).ravel()
-    fid = np.repeat(np.arange(m), 3)
-    key = A * n + B
-    order = np.argsort(key, kind="stable")
-    sk = key[order]
-    rev = B * n + A
-    pos = np.clip(np.searchsorted(sk, rev), 0, len(sk) - 1)
-    found = (sk[pos] == rev) & (A < B)
-    return A[found], B[found], fid[found], fid[order[pos[found]]]
-
-
-def normal_cycle_curvatures(V: FloatArray, F: IntArray) -> PrincipalCurvatures:
+def normal_cycle_curvatures(
+    V: FloatArray, F: IntArray, topology: CurvatureTopology | None = None
+) -> PrincipalCurvatures:
     """The normal-cycle curvature tensor (Cohen-Steiner & Morvan, "Restricted Delaunay
     triangulations and normal cycle", SoCG 2003).
 
@@ -257,6 +329,13 @@ def normal_cycle_curvatures(V: FloatArray, F: IntArray) -> PrincipalCurvatures:
     angle (positive at convex edges, outward normals). Bending across an edge is curvature
     *orthogonal* to it, so the tangent part of ``T`` has the eigenvalue ``κ₁`` along the
     direction of ``κ₂`` and vice versa: ``d1`` is the eigenvector of the smaller eigenvalue.
+
+    Parameters
+    ----------
+    V : (n,3) float
+    F : (m,3) int
+    topology : CurvatureTopology, optional
+        ``F``'s interior edges built once (pass it again with every new ``V``).
 
     Returns
     -------
@@ -269,7 +348,7 @@ def normal_cycle_curvatures(V: FloatArray, F: IntArray) -> PrincipalCurvatures:
     fr = _face_frame(V, F)
     fn, theta = _geometry_of(fr)
     N = _normals_from(F, n, fn, theta)
-    a, b, f1, f2 = _interior_edges(F, n)
+    a, b, f1, f2 = topology_for(F, n, topology).interior
     e = V[b] - V[a]
     L = np.linalg.norm(e, axis=1)
     eh = e / np.maximum(L, 1e-300)[:, None]
@@ -325,6 +404,10 @@ def estimate_curvature(
             f"the {estimator} estimator does not take {sorted(options)}", "options"
         ) from None
 
+
+TOPOLOGY_ESTIMATORS = ("cotan", "rusinkiewicz", "normal_cycle")
+"""The estimators taking a ``topology`` (:class:`~meshlap_core.curvature_topology.
+CurvatureTopology`): its faces' edges built once, reused for every new ``V``."""
 
 PATCH_RINGS = {"cotan": 3, "rusinkiewicz": 3, "normal_cycle": 3, "quadric": None}
 """Edge rings of the patch :func:`curvature_at_vertex` estimates on: the vertex's value
