@@ -416,12 +416,22 @@ quadric on ``radius + 2`` rings (``None``: from its ``radius``)."""
 
 
 def curvature_at_vertex(
-    V: FloatArray, F: IntArray, vertex: int, estimator: CurvatureEstimator = "cotan", **options: Any
+    V: FloatArray,
+    F: IntArray,
+    vertex: int,
+    estimator: CurvatureEstimator = "cotan",
+    topology: CurvatureTopology | None = None,
+    **options: Any,
 ) -> tuple[PrincipalCurvatures, int]:
     """The estimator at one vertex from a patch of rings around it (what an inspector needs
     on a big scan, in milliseconds): the same values as :func:`estimate_curvature` on the
     whole mesh at that vertex (tested), for the estimators of :data:`PATCH_RINGS` (the jet's
     automatic radius depends on the whole mesh: it is refused here).
+
+    The patch grows ring by ring through the vertex–face adjacency
+    (:attr:`~meshlap_core.curvature_topology.CurvatureTopology.vertex_faces`, CSR): only the
+    faces near the vertex are read once it is built. Pass ``topology`` (of ``F``) to build it
+    once for many vertices; ``options`` go to the estimator on the patch.
 
     Returns
     -------
@@ -442,17 +452,15 @@ def curvature_at_vertex(
     if not 0 <= int(vertex) < len(V):
         raise MeshError(f"vertex {vertex} is out of range (the mesh has {len(V)})", "vertex")
     rings = PATCH_RINGS[estimator] or int(options.get("radius", 5)) + 2
-    mark = np.zeros(len(V), dtype=bool)
-    mark[int(vertex)] = True
-    faces = np.zeros(len(F), dtype=bool)
-    for _ in range(rings):
-        faces = mark[F].any(axis=1)
-        mark[F[faces]] = True
-    keep = np.flatnonzero(mark)
-    local = np.full(len(V), -1, dtype=np.int64)
-    local[keep] = np.arange(len(keep))
-    p = estimate_curvature(V[keep], local[F[faces]], estimator, **options)
-    return p, int(local[int(vertex)])
+    topo = topology_for(F, len(V), topology)
+    keep = np.array([int(vertex)], dtype=np.int64)  # sorted: the patch keeps the mesh's order
+    faces = np.zeros(0, dtype=np.int64)
+    for _ in range(rings):  # the faces touching the ring so far, then their vertices
+        faces = topo.faces_around(keep)
+        keep = np.union1d(keep, F[faces].ravel())
+    local = np.searchsorted(keep, F[faces])
+    p = estimate_curvature(V[keep], local, estimator, **options)
+    return p, int(np.searchsorted(keep, int(vertex)))
 
 
 def disagreement(results: list[PrincipalCurvatures], field: str = "H") -> FloatArray:

@@ -284,3 +284,26 @@ def drive_curvature_estimator(viewer) -> None:
 
 def test_curvature_estimator_widgets(viewer):
     drive_curvature_estimator(viewer)
+
+
+def test_the_flipped_triangulation_and_its_topology_are_kept_per_base():
+    """A noise move on a flipped mesh reuses the flips (the same faces, normals and topology as
+    flipped_and_noisy makes), and a base sent to a child process leaves them behind."""
+    import pickle
+
+    from meshlap_core.curvature_study import flipped_and_noisy
+
+    lab = CurvatureLabState()
+    lab.set_number("res", 12)
+    first = _compute(lab)
+    base = first.base
+    m, normals, topo = base.triangulation(0.3)
+    assert base.triangulation(0.3)[2] is topo  # kept
+    ref, Vn = flipped_and_noisy(base.mesh, 0.002, flips=0.3)
+    np.testing.assert_array_equal(m.F, ref.F)
+    np.testing.assert_array_equal(topo.F, ref.F)
+    _, V = flipped_and_noisy(m, 0.002, normals=normals)
+    np.testing.assert_array_equal(V, Vn)
+    assert base.triangulation(0.0)[0] is base.mesh
+    assert len(pickle.loads(pickle.dumps(base)).kept) == 0
+    assert len(base.kept) == 2
