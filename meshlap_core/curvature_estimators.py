@@ -77,16 +77,40 @@ def _columns(X: FloatArray) -> list[FloatArray]:
 def _solve3(S: list[FloatArray], rhs: list[FloatArray]) -> FloatArray:
     """The symmetric 3×3 systems ``[[S0, S1, S2], [S1, S3, S4], [S2, S4, S5]] x = rhs`` per row,
     regularised by ``1e-12 · trace`` (a vertex or face whose rows do not span the plane gets
-    the least-norm-like solution, not a singular matrix), ``(k,3)``."""
-    k = len(S[0])
-    A = np.empty((k, 3, 3))
-    for (i, j), s in zip(((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)), S, strict=True):
-        A[:, i, j] = s
-        A[:, j, i] = s
-    reg = 1e-12 * (S[0] + S[3] + S[5] + 1e-300)
-    for i in range(3):
-        A[:, i, i] += reg
-    return np.linalg.solve(A, np.stack(rhs, axis=1)[:, :, None])[:, :, 0]
+    a finite solution, not a singular matrix), ``(k,3)``.
+
+    In closed form (the adjugate over the determinant of the matrix scaled to unit trace: ten
+    times faster than ``np.linalg.solve`` on stacked 3×3 matrices); rows whose scaled
+    determinant is below ``1e-10`` (nearly singular: a boundary vertex with two edges) go to
+    ``np.linalg.solve``."""
+    tr = S[0] + S[3] + S[5]
+    inv = 1.0 / (tr + 1e-300)
+    reg = 1e-12 * (tr + 1e-300) * inv
+    a, b, c = S[0] * inv + reg, S[1] * inv, S[2] * inv
+    d, e, f = S[3] * inv + reg, S[4] * inv, S[5] * inv + reg
+    r0, r1, r2 = rhs[0] * inv, rhs[1] * inv, rhs[2] * inv
+    c00, c01, c02 = d * f - e * e, c * e - b * f, b * e - c * d
+    c11, c12, c22 = a * f - c * c, b * c - a * e, a * d - b * b
+    det = a * c00 + b * c01 + c * c02
+    good = det > 1e-10
+    with np.errstate(divide="ignore", invalid="ignore"):
+        idet = 1.0 / det
+    x = np.stack(
+        [
+            (c00 * r0 + c01 * r1 + c02 * r2) * idet,
+            (c01 * r0 + c11 * r1 + c12 * r2) * idet,
+            (c02 * r0 + c12 * r1 + c22 * r2) * idet,
+        ],
+        axis=1,
+    )
+    bad = np.flatnonzero(~good)
+    if len(bad):
+        A = np.empty((len(bad), 3, 3))
+        for (i, j), s in zip(((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)), S, strict=True):
+            A[:, i, j] = A[:, j, i] = s[bad]
+        A += (1e-12 * (tr[bad] + 1e-300))[:, None, None] * np.eye(3)
+        x[bad] = np.linalg.solve(A, np.stack([r[bad] for r in rhs], axis=1)[:, :, None])[:, :, 0]
+    return x
 
 
 def _edge_tensor_fit(

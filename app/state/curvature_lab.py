@@ -623,8 +623,13 @@ def crosses_of(
 
 def cross_length(V: FloatArray, F: IntArray) -> float:
     """A cross arm's world length: 0.4 of the mean edge length (one cross per vertex, no
-    overlap with the neighbours')."""
+    overlap with the neighbours'; the three edges of every face, on coordinate columns)."""
     if len(F) == 0:
         return 1.0
-    e = V[F[:, [1, 2, 0]]] - V[F]
-    return 0.4 * float(np.sqrt(np.einsum("ijk,ijk->ij", e, e)).mean())
+    X = [np.ascontiguousarray(V[:, d]) for d in range(3)]
+    P = [[x[np.ascontiguousarray(F[:, k])] for x in X] for k in range(3)]
+    total = 0.0
+    for i, j in ((0, 1), (1, 2), (2, 0)):
+        d = [P[j][c] - P[i][c] for c in range(3)]
+        total += float(np.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sum())
+    return 0.4 * total / (3 * len(F))
