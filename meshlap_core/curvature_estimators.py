@@ -29,6 +29,7 @@ Estimators (:data:`~meshlap_core.options.CURVATURE_ESTIMATORS`):
 from __future__ import annotations
 
 from collections.abc import Callable
+from inspect import signature
 from typing import Any
 
 import numpy as np
@@ -423,6 +424,13 @@ ESTIMATOR_FUNCTIONS: dict[str, Callable[..., PrincipalCurvatures]] = {
 }
 """Estimator name → function ``(V, F, **options) -> PrincipalCurvatures``."""
 
+TOPOLOGY_ESTIMATORS: tuple[str, ...] = tuple(
+    name for name, f in ESTIMATOR_FUNCTIONS.items() if "topology" in signature(f).parameters
+)
+"""The estimators taking a ``topology`` (:class:`~meshlap_core.curvature_topology.
+CurvatureTopology`): its faces' edges built once, reused for every new ``V`` (cotan,
+Rusinkiewicz, normal cycle)."""
+
 
 def estimate_curvature(
     V: FloatArray, F: IntArray, estimator: CurvatureEstimator = "cotan", **options: Any
@@ -447,10 +455,6 @@ def estimate_curvature(
             f"the {estimator} estimator does not take {sorted(options)}", "options"
         ) from None
 
-
-TOPOLOGY_ESTIMATORS = ("cotan", "rusinkiewicz", "normal_cycle")
-"""The estimators taking a ``topology`` (:class:`~meshlap_core.curvature_topology.
-CurvatureTopology`): its faces' edges built once, reused for every new ``V``."""
 
 PATCH_RINGS = {"cotan": 3, "rusinkiewicz": 3, "normal_cycle": 3, "quadric": None}
 """Edge rings of the patch :func:`curvature_at_vertex` estimates on: the vertex's value
