@@ -246,6 +246,38 @@ def test_curvature_lab_widgets(viewer):
     drive_panel_curvature_lab(viewer)
 
 
+def test_a_new_estimate_on_the_same_faces_moves_the_registered_vertices(viewer, monkeypatch):
+    """A noise or estimator move keeps the registered mesh (its vertices moved, its crosses
+    replaced or removed); new faces (a resolution move) register it again."""
+    from meshlap_app.panels.curvature_lab import LAB
+
+    viewer.set_panel("curvature_lab")
+    frames(viewer, 2)
+    drive(viewer, "resolution", 12)
+    lab = viewer.panels["curvature_lab"].state
+    registered = []
+    real = ps.register_surface_mesh
+    monkeypatch.setattr(
+        ps,
+        "register_surface_mesh",
+        lambda name, *a, **k: registered.append(name) or real(name, *a, **k),
+    )
+    before = lab.result
+    drive(viewer, "noise", 0.002)
+    drive(viewer, "estimator", "normal_cycle")
+    assert lab.result.F is before.F and not np.array_equal(lab.result.V, before.V)
+    assert registered == []
+    sm = ps.get_surface_mesh(LAB)
+    assert sm.n_vertices() == len(lab.result.V)
+    sm.remove_quantity("k1 direction (max)", error_if_absent=True)  # the crosses are there
+    drive(viewer, "crosses", False)
+    with pytest.raises(Exception, match="k2 direction"):  # and gone with the checkbox
+        ps.get_surface_mesh(LAB).remove_quantity("k2 direction (min)", error_if_absent=True)
+    drive(viewer, "crosses", True)
+    drive(viewer, "resolution", 13)
+    assert registered == [LAB] and ps.get_surface_mesh(LAB).n_vertices() == 2 * 13 * 13
+
+
 def drive_curvature_estimator(viewer) -> None:
     """The Curvature view's estimator combo (k1, k2 from the chosen estimator, a bad name
     refused) and the One-ring view's shape-operator row at a vertex (run by
