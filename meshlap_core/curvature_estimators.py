@@ -270,27 +270,23 @@ def _in_face_plane(
     v: list[FloatArray],
 ) -> tuple[tuple[FloatArray, FloatArray], tuple[FloatArray, FloatArray]]:
     """The vertex's tangent frame ``(t1, t2)`` rotated into the face's plane (the rotation
-    taking the vertex normal ``n`` to the face normal ``fn`` about ``n × fn``, Rodrigues'
-    formula), in the face's basis ``(u, v)``: ``((t1·u, t1·v), (t2·u, t2·v))`` after the
-    rotation. The rotation keeps ``t2 = n × t1``, so the image of ``t2`` is
-    ``fn × R t1``: its coordinates are ``(−y, x)`` for ``R t1 = (x, y)``."""
-    k = _cross(n, fn)
+    ``R`` taking the vertex normal ``n`` to the face normal ``fn`` about ``n × fn``), in the
+    face's basis ``(u, v)``: ``((t1·u, t1·v), (t2·u, t2·v))`` after the rotation.
+
+    For a tangent ``t ⊥ n`` Rodrigues' formula reduces to ``R t = t − (t·fn)/(1 + n·fn)
+    (n + fn)``, and ``u, v ⊥ fn``: ``R t · u = t·u − (t·fn)(n·u)/(1 + n·fn)``. The rotation
+    keeps ``t2 = n × t1``, so the image of ``t2`` is ``fn × R t1``: its coordinates are
+    ``(−y, x)`` for ``R t1 = (x, y)``. Where ``n`` is opposite ``fn`` no rotation is defined:
+    ``t1``, ``t2`` are projected as they are."""
     c = _dot(n, fn)
     s = np.where(c > -1 + 1e-12, 1.0 / (1.0 + np.maximum(c, -1 + 1e-12)), 0.0)
-    kk = _dot(k, k)
-
-    def rotate(x: list[FloatArray]) -> list[FloatArray]:
-        kx, kdx = _cross(k, x), _dot(k, x)
-        return [x[d] + kx[d] + s * (k[d] * kdx - x[d] * kk) for d in range(3)]
-
-    r1 = rotate(t1)
-    c1 = (_dot(r1, u), _dot(r1, v))
+    st = s * _dot(t1, fn)
+    c1 = (_dot(t1, u) - st * _dot(n, u), _dot(t1, v) - st * _dot(n, v))
     c2 = (-c1[1], c1[0].copy())
-    flip = np.flatnonzero(s == 0.0)  # n opposite fn: the formula's rotation of t2 itself
+    flip = np.flatnonzero(s == 0.0)
     if len(flip):
-        r2 = rotate(t2)
-        c2[0][flip] = _dot(r2, u)[flip]
-        c2[1][flip] = _dot(r2, v)[flip]
+        c2[0][flip] = _dot(t2, u)[flip]
+        c2[1][flip] = _dot(t2, v)[flip]
     return c1, c2
 
 
