@@ -24,6 +24,10 @@ Estimators (:data:`~meshlap_core.options.CURVATURE_ESTIMATORS`):
 - ``"jet"`` — :func:`meshlap_core.curvature_fit.jet_curvatures`: the scale-aware estimator, a
   weighted osculating-jet fit over a ball of a radius in world units (Cazals & Pouget 2003),
   robust to noise.
+
+Cotan, Rusinkiewicz and the normal cycle take a ``topology``
+(:class:`~meshlap_core.curvature_topology.CurvatureTopology`, :data:`TOPOLOGY_ESTIMATORS`): the
+faces' edges built once and reused while the vertices move (noise, a slider of the lab).
 """
 
 from __future__ import annotations

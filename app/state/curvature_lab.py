@@ -57,10 +57,10 @@ topology): a noise or estimator move on a flipped mesh does not flip again."""
 """Estimates kept (per surface, resolution, jitter, noise, flips and estimator): a quantity or
 *show* move, or a slider moved back, recolours without re-running the estimator."""
 LIGHT_ESTIMATORS = tuple(e for e, rings in PATCH_RINGS.items() if rings is not None)
-"""The tensor estimators (cotan, Rusinkiewicz, normal cycle: a fixed patch of rings, about
-0.1 s at 32k vertices): the lab runs them in a thread, not a child process, whose start,
-imports and 13 MB of pickles cost 0.3-1 s per move (the window's ``Jobs.processes``; measured
-in ``benchmarks/bench_curvature.py --only window``)."""
+"""The tensor estimators (cotan, Rusinkiewicz, normal cycle: a fixed patch of rings, 0.05-0.07 s
+of CPU at 32k vertices with the base's kept topology): the lab runs them in a thread, not a
+child process, whose start, imports and 13 MB of pickles cost 0.3-1 s per move (the window's
+``Jobs.processes``; measured in ``benchmarks/bench_curvature.py --only window``)."""
 LIGHT_RES = 128
 """Largest resolution run in a thread (the torus: 32,768 vertices; numpy releases the GIL,
 the window's longest gap measured 0.02-0.12 s under load)."""
