@@ -351,7 +351,9 @@ def rusinkiewicz_curvatures(
         vals[2, :, k] = a * x2 * x2 + 2.0 * b * x2 * y2 + c * y2 * y2
     vals *= w[None]
     flat = F.ravel()
-    acc = np.stack([np.bincount(flat, vals[j].ravel(), minlength=n) for j in range(3)], axis=1)
+    acc = np.zeros((n, 3))  # float even with no faces (an empty bincount is int)
+    for j in range(3):
+        acc[:, j] = np.bincount(flat, vals[j].ravel(), minlength=n)
     W = np.bincount(flat, w.ravel(), minlength=n)
     acc = np.divide(acc, W[:, None], out=np.zeros_like(acc), where=W[:, None] > 0)
     k1, k2, d1, d2 = _from_tensor(acc[:, 0], acc[:, 1], acc[:, 2], t1, t2)
@@ -403,9 +405,9 @@ def normal_cycle_curvatures(
     c1 = np.concatenate([_dot(eh, [x[v] for x in T1]) for v in (a, b)])
     c2 = np.concatenate([_dot(eh, [x[v] for x in T2]) for v in (a, b)])
     ww = np.concatenate([w, w])
-    acc = np.stack(
-        [np.bincount(ends, ww * val, minlength=n) for val in (c1 * c1, c1 * c2, c2 * c2)], axis=1
-    )
+    acc = np.zeros((n, 3))  # float even with no edges (an empty bincount is int)
+    for j, val in enumerate((c1 * c1, c1 * c2, c2 * c2)):
+        acc[:, j] = np.bincount(ends, ww * val, minlength=n)
     A = _areas_from(V, F, fr, "voronoi")
     acc = np.divide(acc, A[:, None], out=np.zeros_like(acc), where=A[:, None] > 0)
     l1, l2, co, si = eig_sym2(acc[:, 0], acc[:, 1], acc[:, 2])
