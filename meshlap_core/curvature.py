@@ -238,18 +238,31 @@ def _uniform_Lx(V: FloatArray, E: IntArray) -> FloatArray:
     return out
 
 
-def _mixed_corner_area(fr: _FaceFrame, i: int, any_obtuse: BoolArray) -> FloatArray:
+def _cot_weights(fr: _FaceFrame) -> list[FloatArray]:
+    """``|e_k|² cot θ_k`` for the three corners ``k`` of every face of a :class:`_FaceFrame`
+    (``cot θ = cosdbl / 2A``; 0 where the face has no area), three ``(m,)`` arrays: each
+    computed once, shared by the two corners whose Voronoi share uses it."""
+    out = []
+    for k in range(3):
+        e = fr.E[k]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            w = (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]) * fr.cosdbl[:, k] / fr.dbl
+        out.append(np.where(np.isfinite(w), w, 0.0))
+    return out
+
+
+def _mixed_corner_area(
+    fr: _FaceFrame, i: int, any_obtuse: BoolArray, cw: list[FloatArray] | None = None
+) -> FloatArray:
     """Corner ``i``'s share of the mixed Voronoi area (Meyer et al. 2003, Fig. 4) in every
     face of a :class:`_FaceFrame`, ``(m,)``: ``⅛ (|e_j|² cot θ_j + |e_k|² cot θ_k)`` in a
     non-obtuse triangle (``cot θ = cosdbl / 2A``, ``e_j`` opposite corner ``j``), else half
     the area at the obtuse corner (``cosdbl < 0``) and a quarter at the others. One column at
-    a time: no ``(m,3)`` temporaries on a big scan."""
-    vor = np.zeros(len(fr.dbl))
-    for k in ((i + 1) % 3, (i + 2) % 3):
-        e = fr.E[k]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            w = (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]) * fr.cosdbl[:, k] / fr.dbl
-        vor += np.where(np.isfinite(w), w, 0.0) / 8.0
+    a time: no ``(m,3)`` temporaries on a big scan (``cw``: :func:`_cot_weights`, when the
+    three corners are wanted)."""
+    if cw is None:
+        cw = _cot_weights(fr)
+    vor = cw[(i + 1) % 3] / 8.0 + cw[(i + 2) % 3] / 8.0
     quarter = fr.dbl / 8.0  # a quarter of the area A = dbl / 2
     mixed = np.where(fr.cosdbl[:, i] < 0, 2.0 * quarter, quarter)
     return np.where(any_obtuse, mixed, vor)
@@ -258,7 +271,8 @@ def _mixed_corner_area(fr: _FaceFrame, i: int, any_obtuse: BoolArray) -> FloatAr
 def _mixed_corner_areas(fr: _FaceFrame) -> FloatArray:
     """Every corner's share of the mixed Voronoi area, ``(m,3)`` (:func:`_mixed_corner_area`)."""
     any_obtuse = (fr.cosdbl < 0).any(axis=1)
-    return np.stack([_mixed_corner_area(fr, i, any_obtuse) for i in range(3)], axis=1)
+    cw = _cot_weights(fr)
+    return np.stack([_mixed_corner_area(fr, i, any_obtuse, cw) for i in range(3)], axis=1)
 
 
 def _areas_from(V: FloatArray, F: IntArray, fr: _FaceFrame, area: str) -> FloatArray:
@@ -272,9 +286,11 @@ def _areas_from(V: FloatArray, F: IntArray, fr: _FaceFrame, area: str) -> FloatA
         return np.bincount(F.ravel(), weights=np.repeat(fr.dbl / 6.0, 3), minlength=len(V))
     check_choice(area, AREA_KINDS, "area")
     any_obtuse = (fr.cosdbl < 0).any(axis=1)
+    cw = _cot_weights(fr)
     out = np.zeros(len(V))
     for i in range(3):
-        out += np.bincount(F[:, i], weights=_mixed_corner_area(fr, i, any_obtuse), minlength=len(V))
+        w = _mixed_corner_area(fr, i, any_obtuse, cw)
+        out += np.bincount(F[:, i], weights=w, minlength=len(V))
     return out
 
 

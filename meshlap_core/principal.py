@@ -88,11 +88,22 @@ def tangent_frames(N: FloatArray) -> tuple[FloatArray, FloatArray]:
     -------
     t1, t2 : (n,3) float
     """
-    a = np.zeros_like(N)
-    a[np.arange(len(N)), np.argmin(np.abs(N), axis=1)] = 1.0  # the axis least along n
-    t1 = np.cross(a, N)
+    ax = np.argmin(np.abs(N), axis=1)  # the axis least along n
+    x, y, z = (np.ascontiguousarray(N[:, d]) for d in range(3))
+    on0, on1 = ax == 0, ax == 1
+    # e_ax × n on coordinate columns: e0 × n = (0, −z, y), e1 × n = (z, 0, −x), e2 × n = (−y, x, 0)
+    zero = np.zeros_like(x)
+    t1 = np.empty_like(N)
+    t1[:, 0] = np.where(on0, zero, np.where(on1, z, -y))
+    t1[:, 1] = np.where(on0, -z, np.where(on1, zero, x))
+    t1[:, 2] = np.where(on0, y, np.where(on1, -x, zero))
     t1 /= np.maximum(np.linalg.norm(t1, axis=1, keepdims=True), 1e-300)
-    return t1, np.cross(N, t1)
+    a, b, c = t1[:, 0], t1[:, 1], t1[:, 2]
+    t2 = np.empty_like(N)
+    t2[:, 0] = y * c - z * b
+    t2[:, 1] = z * a - x * c
+    t2[:, 2] = x * b - y * a
+    return t1, t2
 
 
 def eig_sym2(a: FloatArray, b: FloatArray, c: FloatArray) -> tuple[FloatArray, ...]:

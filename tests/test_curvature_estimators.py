@@ -364,3 +364,62 @@ def test_mesh_estimators_converge_to_the_exact_ellipsoid(name: str) -> None:
         errs = [r[f"{q}_rel"] for r in rows]
         assert errs[0] > errs[1] > errs[2]
         assert rows[-1][f"{q}_order"] > 1.6
+
+
+def test_a_kept_topology_gives_the_same_estimate_for_new_positions() -> None:
+    """The faces' edges built once (CurvatureTopology) and reused as the vertices move: the same
+    values as without it; a topology of other faces is refused, as is one for the quadric."""
+    from meshlap_core.curvature_topology import CurvatureTopology
+
+    m, V0 = perturbed_mesh("torus", (24, 12), 0.0, jitter=0.3, flips=0.2)
+    topo = CurvatureTopology.of(m.F, len(V0))
+    for alpha in (0.001, 0.004):
+        V = add_noise(V0, m.F, alpha, mode="normal", seed=3)
+        for name in ce.TOPOLOGY_ESTIMATORS:
+            plain, kept = (
+                ce.estimate_curvature(V, m.F, name),
+                ce.estimate_curvature(V, m.F, name, topology=topo),
+            )
+            for f in ("k1", "k2", "d1", "d2", "normal"):
+                np.testing.assert_array_equal(getattr(plain, f), getattr(kept, f))
+    other = CurvatureTopology.of(np.roll(m.F, 1, axis=0), len(V0))
+    for name in ce.TOPOLOGY_ESTIMATORS:
+        with pytest.raises(MeshError, match="another mesh"):
+            ce.estimate_curvature(V0, m.F, name, topology=other)
+    with pytest.raises(MeshError, match="does not take"):
+        ce.estimate_curvature(V0, m.F, "quadric", topology=topo)
+
+
+def test_topology_adjacency_is_the_brute_force_one() -> None:
+    """Interior edges (two consistently oriented faces) and the vertex–face CSR against loops
+    over a hand-checkable mesh (an open strip of 4 triangles, a boundary everywhere)."""
+    from meshlap_core.curvature_topology import CurvatureTopology
+
+    F = np.array([[0, 1, 2], [1, 3, 2], [2, 3, 4], [3, 5, 4]])
+    topo = CurvatureTopology.of(F, 6)
+    a, b, f1, f2 = topo.interior
+    assert sorted(zip(a.tolist(), b.tolist(), f1.tolist(), f2.tolist(), strict=True)) == [
+        (1, 2, 0, 1),
+        (2, 3, 2, 1),
+        (3, 4, 2, 3),
+    ]
+    ptr, faces = topo.vertex_faces
+    for i in range(6):
+        assert faces[ptr[i] : ptr[i + 1]].tolist() == [f for f in range(4) if i in F[f]]
+    assert topo.faces_around(np.array([0, 5])).tolist() == [0, 3]
+    assert topo.on_boundary.all()
+    src, dst = topo.directed
+    assert np.all(np.diff(src) >= 0) and len(src) == 2 * len(topo.table.edges)
+    pairs = set(zip(src.tolist(), dst.tolist(), strict=True))
+    assert pairs == {(j, i) for i, j in pairs} and (0, 1) in pairs and (0, 3) not in pairs
+
+
+def test_curvature_at_vertex_takes_a_kept_topology() -> None:
+    from meshlap_core.curvature_topology import CurvatureTopology
+
+    m, V = perturbed_mesh("torus", (48, 24), 0.002, jitter=0.3)
+    topo = CurvatureTopology.of(m.F, len(V))
+    whole = ce.estimate_curvature(V, m.F, "rusinkiewicz")
+    for i in (7, 500):
+        p, j = ce.curvature_at_vertex(V, m.F, i, "rusinkiewicz", topology=topo)
+        np.testing.assert_allclose([p.k1[j], p.k2[j]], [whole.k1[i], whole.k2[i]], atol=1e-9)

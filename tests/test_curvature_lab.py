@@ -246,6 +246,38 @@ def test_curvature_lab_widgets(viewer):
     drive_panel_curvature_lab(viewer)
 
 
+def test_a_new_estimate_on_the_same_faces_moves_the_registered_vertices(viewer, monkeypatch):
+    """A noise or estimator move keeps the registered mesh (its vertices moved, its crosses
+    replaced or removed); new faces (a resolution move) register it again."""
+    from meshlap_app.panels.curvature_lab import LAB
+
+    viewer.set_panel("curvature_lab")
+    frames(viewer, 2)
+    drive(viewer, "resolution", 12)
+    lab = viewer.panels["curvature_lab"].state
+    registered = []
+    real = ps.register_surface_mesh
+    monkeypatch.setattr(
+        ps,
+        "register_surface_mesh",
+        lambda name, *a, **k: registered.append(name) or real(name, *a, **k),
+    )
+    before = lab.result
+    drive(viewer, "noise", 0.002)
+    drive(viewer, "estimator", "normal_cycle")
+    assert lab.result.F is before.F and not np.array_equal(lab.result.V, before.V)
+    assert registered == []
+    sm = ps.get_surface_mesh(LAB)
+    assert sm.n_vertices() == len(lab.result.V)
+    sm.remove_quantity("k1 direction (max)", error_if_absent=True)  # the crosses are there
+    drive(viewer, "crosses", False)
+    with pytest.raises(Exception, match="k2 direction"):  # and gone with the checkbox
+        ps.get_surface_mesh(LAB).remove_quantity("k2 direction (min)", error_if_absent=True)
+    drive(viewer, "crosses", True)
+    drive(viewer, "resolution", 13)
+    assert registered == [LAB] and ps.get_surface_mesh(LAB).n_vertices() == 2 * 13 * 13
+
+
 def drive_curvature_estimator(viewer) -> None:
     """The Curvature view's estimator combo (k1, k2 from the chosen estimator, a bad name
     refused) and the One-ring view's shape-operator row at a vertex (run by
@@ -284,3 +316,26 @@ def drive_curvature_estimator(viewer) -> None:
 
 def test_curvature_estimator_widgets(viewer):
     drive_curvature_estimator(viewer)
+
+
+def test_the_flipped_triangulation_and_its_topology_are_kept_per_base():
+    """A noise move on a flipped mesh reuses the flips (the same faces, normals and topology as
+    flipped_and_noisy makes), and a base sent to a child process leaves them behind."""
+    import pickle
+
+    from meshlap_core.curvature_study import flipped_and_noisy
+
+    lab = CurvatureLabState()
+    lab.set_number("res", 12)
+    first = _compute(lab)
+    base = first.base
+    m, normals, topo = base.triangulation(0.3)
+    assert base.triangulation(0.3)[2] is topo  # kept
+    ref, Vn = flipped_and_noisy(base.mesh, 0.002, flips=0.3)
+    np.testing.assert_array_equal(m.F, ref.F)
+    np.testing.assert_array_equal(topo.F, ref.F)
+    _, V = flipped_and_noisy(m, 0.002, normals=normals)
+    np.testing.assert_array_equal(V, Vn)
+    assert base.triangulation(0.0)[0] is base.mesh
+    assert len(pickle.loads(pickle.dumps(base)).kept) == 0
+    assert len(base.kept) == 2

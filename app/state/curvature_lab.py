@@ -11,14 +11,21 @@ from typing import Any
 import numpy as np
 
 from meshlap_core.curvature import vertex_normals
-from meshlap_core.curvature_estimators import PATCH_RINGS, disagreement, estimate_curvature
+from meshlap_core.curvature_estimators import (
+    PATCH_RINGS,
+    TOPOLOGY_ESTIMATORS,
+    disagreement,
+    estimate_curvature,
+)
 from meshlap_core.curvature_study import (
     ExactPrincipal,
     curvature_study,
     exact_principal,
+    flip_edges,
     flipped_and_noisy,
     jittered_mesh,
 )
+from meshlap_core.curvature_topology import CurvatureTopology
 from meshlap_core.errors import MeshError
 from meshlap_core.options import (
     CURVATURE_ESTIMATORS,
@@ -28,7 +35,7 @@ from meshlap_core.options import (
     check_choice,
 )
 from meshlap_core.principal import PrincipalCurvatures, tangent_frames
-from meshlap_core.surfaces import SURFACES, mesh_surface
+from meshlap_core.surfaces import SURFACES, SurfaceMesh, mesh_surface
 from meshlap_core.types import FloatArray, IntArray
 
 from .checks import Schema, boolean, integer, number, one_of
@@ -44,13 +51,16 @@ STUDY_LEVELS = (8, 16, 32, 64)
 KEEP_BASES = 6
 """Exact surfaces kept (per surface, resolution and jitter): a slider moved back is instant."""
 KEEP_ESTIMATES = 8
+KEEP_FLIPS = 3
+"""Flipped triangulations kept per exact surface (per ``flips`` value, with their normals and
+topology): a noise or estimator move on a flipped mesh does not flip again."""
 """Estimates kept (per surface, resolution, jitter, noise, flips and estimator): a quantity or
 *show* move, or a slider moved back, recolours without re-running the estimator."""
 LIGHT_ESTIMATORS = tuple(e for e, rings in PATCH_RINGS.items() if rings is not None)
-"""The tensor estimators (cotan, Rusinkiewicz, normal cycle: a fixed patch of rings, about
-0.1 s at 32k vertices): the lab runs them in a thread, not a child process, whose start,
-imports and 13 MB of pickles cost 0.3-1 s per move (the window's ``Jobs.processes``; measured
-in ``benchmarks/bench_curvature.py --only window``)."""
+"""The tensor estimators (cotan, Rusinkiewicz, normal cycle: a fixed patch of rings, 0.05-0.07 s
+of CPU at 32k vertices with the base's kept topology): the lab runs them in a thread, not a
+child process, whose start, imports and 13 MB of pickles cost 0.3-1 s per move (the window's
+``Jobs.processes``; measured in ``benchmarks/bench_curvature.py --only window``)."""
 LIGHT_RES = 128
 """Largest resolution run in a thread (the torus: 32,768 vertices; numpy releases the GIL,
 the window's longest gap measured 0.02-0.12 s under load)."""
@@ -180,12 +190,42 @@ class Estimate:
 @dataclass(frozen=True)
 class Base:
     """A lab surface before flips and noise: the jittered mesh and its exact curvature (what
-    a move of the noise or flips slider reuses; the exact values do not depend on them)."""
+    a move of the noise or flips slider reuses; the exact values do not depend on them), and
+    per ``flips`` value the flipped mesh, its normals and its
+    :class:`~meshlap_core.curvature_topology.CurvatureTopology` (the faces do not change with
+    the noise: the estimators' edge tables are built once per resolution, jitter and flips;
+    :meth:`triangulation`). The topologies are not pickled to or from a child process."""
 
     key: tuple[Any, ...]  # (surface, res, jitter)
     mesh: Any  # SurfaceMesh
     exact: ExactPrincipal
     normals: FloatArray  # (n,3) unit vertex normals of the mesh (the noise's direction)
+    kept: dict[float, tuple[Any, FloatArray, CurvatureTopology]] = field(
+        default_factory=dict, repr=False, compare=False
+    )
+
+    def triangulation(self, flips: float) -> tuple[SurfaceMesh, FloatArray, CurvatureTopology]:
+        """The mesh with a fraction ``flips`` of its edges flipped (seed 0, as
+        :func:`~meshlap_core.curvature_study.flipped_and_noisy`), its unit vertex normals and
+        its topology, made on first use and kept (the last :data:`KEEP_FLIPS` values; any
+        thread: the same values whoever makes them)."""
+        got = self.kept.get(float(flips))
+        if got is None:
+            m, normals = self.mesh, self.normals
+            if flips > 0:
+                F = flip_edges(m.V, m.F, flips, 0)
+                m = SurfaceMesh(m.V, F, m.uv, m.pole, m.boundary, m.surface, m.res)
+                normals = vertex_normals(m.V, F)
+            got = (m, normals, CurvatureTopology.of(m.F, len(m.V)))
+            self.kept[float(flips)] = got
+            while len(self.kept) > KEEP_FLIPS:
+                self.kept.pop(next(iter(self.kept)), None)
+        return got
+
+    def __getstate__(self) -> dict[str, Any]:
+        state = dict(self.__dict__)
+        state["kept"] = {}  # rebuilt where it is used: megabytes of indices otherwise
+        return state
 
 
 def base_key(params: dict[str, Any]) -> tuple[Any, ...]:
@@ -456,11 +496,11 @@ def _surface_result(
     if estimate is not None:
         Vs, Fs, r, crosses = estimate.V, estimate.F, estimate.principal, estimate.crosses
     else:
-        m, Vs = flipped_and_noisy(
-            base.mesh, params["noise"], flips=params["flips"], normals=base.normals
-        )
+        m, normals, topology = base.triangulation(params["flips"])
+        _, Vs = flipped_and_noisy(m, params["noise"], normals=normals)
         Fs = m.F
-        r = estimate_curvature(Vs, Fs, est)
+        options = {"topology": topology} if est in TOPOLOGY_ESTIMATORS else {}
+        r = estimate_curvature(Vs, Fs, est, **options)
     if crosses is None:
         crosses = crosses_of(r, base.exact.d1, cross_length(Vs, Fs))
     ex = base.exact
@@ -583,8 +623,13 @@ def crosses_of(
 
 def cross_length(V: FloatArray, F: IntArray) -> float:
     """A cross arm's world length: 0.4 of the mean edge length (one cross per vertex, no
-    overlap with the neighbours')."""
+    overlap with the neighbours'; the three edges of every face, on coordinate columns)."""
     if len(F) == 0:
         return 1.0
-    e = V[F[:, [1, 2, 0]]] - V[F]
-    return 0.4 * float(np.sqrt(np.einsum("ijk,ijk->ij", e, e)).mean())
+    X = [np.ascontiguousarray(V[:, d]) for d in range(3)]
+    P = [[x[np.ascontiguousarray(F[:, k])] for x in X] for k in range(3)]
+    total = 0.0
+    for i, j in ((0, 1), (1, 2), (2, 0)):
+        d = [P[j][c] - P[i][c] for c in range(3)]
+        total += float(np.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sum())
+    return 0.4 * total / (3 * len(F))
