@@ -38,6 +38,8 @@ from typing import Any
 from meshlap_core import errors as _errors
 from meshlap_core.errors import MeshError
 
+from .handover import pack, unpack
+
 Cancelled: type[Exception] = getattr(_errors, "Cancelled", None) or type(
     "Cancelled", (Exception,), {"__doc__": "A job stopped because it was cancelled."}
 )
@@ -397,8 +399,9 @@ class _ChildReporter:
         """Nothing to check here (the parent ends the process on Cancel)."""
 
     def partial(self, value: Any) -> None:
-        """Send a partial result to the parent (its reporter's :meth:`Reporter.partial`)."""
-        self.conn.send(("partial", value))
+        """Send a partial result to the parent (its reporter's :meth:`Reporter.partial`), its
+        large arrays through shared memory (:mod:`.handover`)."""
+        self.conn.send(("partial", pack(value)))
 
 
 def _child_main(conn: Any, fn: Callable[..., Any], args: tuple[Any, ...]) -> None:
@@ -414,7 +417,7 @@ def _child_main(conn: Any, fn: Callable[..., Any], args: tuple[Any, ...]) -> Non
     except BaseException as exc:  # reported to the parent, never lost
         conn.send(("error", f"{type(exc).__name__}: {exc}"))
     else:
-        conn.send(("result", result))
+        conn.send(("result", pack(result)))  # its large arrays through shared memory
     finally:
         conn.close()
 
@@ -475,9 +478,9 @@ def in_child(fn: Callable[..., Any], *args: Any) -> Callable[[Reporter], Any]:
                     if kind == "progress":
                         reporter(*payload)
                     elif kind == "partial":
-                        reporter.partial(payload[0])
+                        reporter.partial(unpack(payload[0]))
                     elif kind == "result":
-                        return payload[0]
+                        return unpack(payload[0])
                     else:
                         raise MeshError(payload[0])
                 elif not proc.is_alive() and not recv.poll():
