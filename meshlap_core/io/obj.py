@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import re
 from collections.abc import Iterator
+from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
 import numpy as np
@@ -43,6 +44,7 @@ from ._scan import (
 # a face corner: v, v/vt, v/vt/vn or v//vn (each an integer of the contract)
 _CORNER = re.compile(rb"([+-]?[0-9]+)(?:/[+-]?[0-9]+(?:/[+-]?[0-9]+)?|//[+-]?[0-9]+)?")
 _BLOCK = 1 << 24  # bytes of face or vertex lines parsed at a time on the bulk path
+_PARALLEL_BYTES = 1 << 23  # a file at least this big parses its vertices in a second thread
 _SEP = (9, 10, 11, 12, 13, 32)  # what may follow a keyword: whitespace or the line end
 _BLANK = (9, 11, 12, 32)  # a line starting with one of these is indented
 
@@ -95,12 +97,17 @@ def parse_obj_bulk(data: bytes) -> Parsed | None:
     nv, nf = int(is_v.sum()), int(is_f.sum())
     if nv == 0 or nf == 0:
         return None  # the general parser gives the precise error
-    V = _bulk_vertices(select_lines(data, arr, starts, ends, is_v), nv)
-    if V is None:
-        return None
+    vtext = select_lines(data, arr, starts, ends, is_v)
     ftext = select_lines(data, arr, starts, ends, is_f)
-    got = _bulk_faces(ftext, nf)
-    if got is None:
+    if len(data) < _PARALLEL_BYTES:
+        V, got = _bulk_vertices(vtext, nv), _bulk_faces(ftext, nf)
+    else:  # numpy's text parsing releases the GIL: vertices and faces on two cores
+        with ThreadPoolExecutor(1) as pool:
+            vertices = pool.submit(_bulk_vertices, vtext, nv)
+            got = _bulk_faces(ftext, nf)
+            V = vertices.result()
+    del vtext
+    if V is None or got is None:
         return None
     vals, sizes = got
     if b"-" in ftext and np.any(vals < 0):  # relative indices: -1 is the latest vertex
@@ -127,26 +134,26 @@ def _blocks(text: bytes) -> Iterator[bytes]:
         i = j
 
 
-def _keyword_blanked(block: bytes, keyword: bytes, chars: bytes) -> np.ndarray | None:
-    """``block`` as a writable array with each line's keyword byte blanked; None when a byte
-    outside ``chars`` (or a second keyword letter) occurs."""
+def _keyword_blanked(block: bytes, keyword: bytes, chars: bytes) -> bytes | None:
+    """``block`` (lines that each start with ``keyword``) with each line's keyword byte
+    blanked; None when a byte outside ``chars`` (or a second keyword letter) occurs.
+
+    With one keyword letter per line and every line starting with it, the letter occurs
+    nowhere else: one ``bytes.replace`` blanks exactly the first byte of every line."""
     n_lines = block.count(b"\n")
     if block.translate(None, chars + WHITESPACE + keyword) or block.count(keyword) != n_lines:
         return None
-    buf = np.frombuffer(block, dtype=np.uint8).copy()
-    buf[0] = 32
-    buf[np.flatnonzero(buf[:-1] == 10) + 1] = 32
-    return buf
+    return block.replace(keyword, b" ")
 
 
 def _bulk_vertices(vtext: bytes, nv: int) -> np.ndarray | None:
     """The ``3·nv`` coordinates of the ``v`` lines, or None (not exactly 3 literals per line)."""
     parts = []
     for block in _blocks(vtext):
-        buf = _keyword_blanked(block, b"v", FLOAT_CHARS)
-        if buf is None or not np.all(tokens_per_line(buf) == 3):
+        text = _keyword_blanked(block, b"v", FLOAT_CHARS)
+        if text is None or not np.all(tokens_per_line(np.frombuffer(text, np.uint8)) == 3):
             return None  # w coordinates, vertex colours, missing coordinates, other characters
-        vals = bulk_numbers(buf.tobytes(), np.float64)
+        vals = bulk_numbers(text, np.float64)
         if vals is None or vals.size != 3 * block.count(b"\n"):
             return None
         parts.append(vals)
@@ -158,13 +165,16 @@ def _bulk_faces(ftext: bytes, nf: int) -> tuple[IntArray, IntArray] | None:
     """The vertex indices (as written) and corner counts of the ``f`` lines, or None."""
     vals_parts, size_parts = [], []
     for block in _blocks(ftext):
-        buf = _keyword_blanked(block, b"f", INT_CHARS + b"/")
-        if buf is None or not _signs_ok(buf):
+        text = _keyword_blanked(block, b"f", INT_CHARS + b"/")
+        if text is None:
             return None
-        if b"/" in block and not _blank_after_slash(buf):
+        slashes = b"/" in block
+        buf = np.frombuffer(text, dtype=np.uint8)
+        buf = buf.copy() if slashes else buf  # _blank_after_slash writes into it
+        if not _signs_ok(buf) or (slashes and not _blank_after_slash(buf)):
             return None
         sizes = tokens_per_line(buf)
-        vals = bulk_numbers(buf.tobytes(), np.int64)
+        vals = bulk_numbers(buf.tobytes() if slashes else text, np.int64)
         if vals is None or vals.size != int(sizes.sum()):
             return None
         vals_parts.append(vals)
