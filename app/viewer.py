@@ -580,6 +580,8 @@ def run(
     shot = Path(screenshot).resolve() if screenshot is not None else None
     if shot is not None and not shot.parent.is_dir():
         raise MeshError(f"output directory {shot.parent} does not exist", shot)
+    if shot is None:  # the fork server of the window's jobs starts while the window opens
+        warm_up()
     state = AppState(folder=cwd)
     state.panel = state.check_panel(panel or VIEWS[0], "--panel")
     later = path if opens_later(path, shot, saved, options) else None
@@ -620,7 +622,6 @@ def run(
     if shot is None:  # the window: long operations as jobs, paced frames (idle is idle)
         viewer.background = viewer.pace = True
         state.jobs.processes = True  # load and fields in child processes: no shared GIL
-        warm_up()  # the fork server for them
         prefer_gil_free_solvers()  # an eigenbasis job in a thread must not hold the GIL
         ps.set_max_fps(-1)  # polyscope's limit spins a core; the Pacer sleeps instead
         if later is not None:
