@@ -59,10 +59,9 @@ def default_scan() -> Path:
 def child(scan: Path, smoothing: bool = True) -> dict[str, float]:
     """One measurement in this process (see the module docstring); returns the figures."""
     import polyscope as ps
+    from meshlap_app.jobs import warm_up
     from meshlap_app.state import AppState
     from meshlap_app.viewer import Viewer, init_polyscope
-
-    from meshlap_app.jobs import warm_up
 
     warm_up()  # as `meshlap view` does before it creates the window
     init_polyscope("openGL3_egl")

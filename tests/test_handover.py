@@ -7,7 +7,6 @@ import subprocess
 import sys
 
 import numpy as np
-
 from meshlap_app import handover
 from meshlap_app.handover import SHARED_MIN_BYTES, Packed, pack, unpack
 from meshlap_app.jobs import Jobs, in_child
