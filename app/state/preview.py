@@ -40,6 +40,10 @@ class MeshPreview:
     vminmax : (float, float)
         Its colour range ``(−r, r)``, ``r`` the 98th percentile of ``|field|`` (one outlier
         cannot wash the map out).
+    box : (2,3) float64 or None
+        ``[V.min(axis=0), V.max(axis=0)]``, computed where the preview is made (the window
+        fits its display to these two corners, the same fit as to ``V``, without a pass over
+        millions of points on the UI thread); ``None``: ``V`` itself is used.
     """
 
     name: str
@@ -47,6 +51,11 @@ class MeshPreview:
     F: IntArray
     field: FloatArray
     vminmax: tuple[float, float] = (-1.0, 1.0)
+    box: FloatArray | None = None
+
+    def corners(self) -> FloatArray:
+        """What the display is fitted to: :attr:`box`, else ``V``."""
+        return self.V if self.box is None else self.box
 
     def same_geometry(self, V: FloatArray, F: IntArray) -> bool:
         """Whether the validated mesh ``(V, F)`` is exactly the geometry previewed."""
@@ -114,4 +123,5 @@ def make_preview(name: str, V: FloatArray, F: IntArray) -> MeshPreview:
     H = preview_field(V, F)
     r = float(np.percentile(np.abs(H), 98.0)) if len(H) else 0.0
     r = r if np.isfinite(r) and r > 0 else 1.0
-    return MeshPreview(name, V, F, H, (-r, r))
+    box = np.array([V.min(axis=0), V.max(axis=0)]) if len(V) else None
+    return MeshPreview(name, V, F, H, (-r, r), box)
