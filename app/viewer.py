@@ -104,7 +104,7 @@ class Viewer:
         self.panels = make_panels(state)
         self.background = False  # long operations run as jobs (the window; False: inline)
         self.pace = False  # the window sleeps between frames (Pacer); tests tick freely
-        self.pacer = Pacer()
+        self.pacer = Pacer(sleep=state.jobs.nap)  # woken when a job has something to show
         self._activity: tuple[Any, ...] = ()
         self.reframe = True  # frame the visible structures at the end of the next frame
         self.whole = False  # R: the next framing shows the whole subject (no view's focus)
