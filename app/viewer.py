@@ -567,8 +567,7 @@ def run(
     up (:func:`.state.display.up_rotation`; ``None``: the mesh's rule); a ``ui_scale`` given
     wins over the session's (the room's projector, not the saved view; ``None``: the
     session's, else 1). ``options`` are the panels' start options (``field``, ``vertex``,
-    ``k``: ``None`` when not given), each checked by its panel's state module before the
-    window opens.
+    ``k``: ``None`` when not given), each checked by its panel's state module first.
     """
     from .state.session import check_session_mesh, read_session
 
