@@ -38,6 +38,8 @@ from typing import Any
 from meshlap_core import errors as _errors
 from meshlap_core.errors import MeshError
 
+from .handover import pack, unpack
+
 Cancelled: type[Exception] = getattr(_errors, "Cancelled", None) or type(
     "Cancelled", (Exception,), {"__doc__": "A job stopped because it was cancelled."}
 )
@@ -58,6 +60,8 @@ class Reporter:
         Seconds (monotonic).
     on_report : callable, optional
         Called (from the worker thread) after each report: the host's "something moved".
+    on_partial : callable, optional
+        Called (from the worker thread) after each partial result: something to show.
     """
 
     def __init__(
@@ -65,10 +69,12 @@ class Reporter:
         cancel: threading.Event,
         clock: Callable[[], float] = time.monotonic,
         on_report: Callable[[], None] | None = None,
+        on_partial: Callable[[], None] | None = None,
     ) -> None:
         self.cancel = cancel
         self.clock = clock
         self.on_report = on_report
+        self.on_partial = on_partial
         self.phase = "starting"
         self.fraction: float | None = None
         self.reports = 0
@@ -105,6 +111,8 @@ class Reporter:
         self._partial[:] = [value]
         if self.on_report is not None:
             self.on_report()
+        if self.on_partial is not None:
+            self.on_partial()
 
     def take_partial(self) -> list[Any]:
         """The partial result waiting to be shown (``[]``: none), forgotten once taken."""
@@ -197,6 +205,7 @@ class Jobs:
         self.last_report = clock()  # when a job last reported or finished (the pacer reads it)
         self.cancelled = 0  # jobs cancelled so far (superseded or by the user)
         self.processes = False  # offload() may use child processes (the window sets it)
+        self.news = threading.Event()  # a result or a partial result waits for poll()
 
     # ------------------------------------------------------------------ start / cancel
     def start(
@@ -229,7 +238,7 @@ class Jobs:
             if not replace:
                 return None
             self.cancel(owner)
-        reporter = Reporter(threading.Event(), self.clock, self._reported)
+        reporter = Reporter(threading.Event(), self.clock, self._reported, self.news.set)
         job = Job(owner, title, work, apply, fail, reporter, self.clock(), self.clock, preview)
         self._jobs[owner] = job
         if self.background if background is None else background:
@@ -244,6 +253,7 @@ class Jobs:
         job.run()
         with self._lock:
             self._finished.append(job)
+        self.news.set()
 
     def _reported(self) -> None:
         self.last_report = self.clock()
@@ -278,6 +288,7 @@ class Jobs:
         for a result, ``fail`` for an error; a cancelled job changes nothing. Returns the jobs
         handled (a running job's partial result is shown by its ``preview`` after them; it
         does not count as handled)."""
+        self.news.clear()
         with self._lock:
             finished, self._finished = self._finished, []
         handled = [job for job in finished if self._settle(job)]
@@ -315,6 +326,12 @@ class Jobs:
     def busy(self) -> bool:
         """A job runs (or waits for :meth:`poll`)."""
         return bool(self._jobs)
+
+    def nap(self, seconds: float) -> None:
+        """Sleep up to ``seconds``, woken as soon as a job finishes or hands over a partial
+        result (the window's pause between frames: what a job sends is shown on the next
+        frame, not a busy frame period later)."""
+        self.news.wait(seconds)
 
     def wait(self, owner: str | None = None, timeout: float | None = None) -> bool:
         """Block until ``owner``'s job (every job when ``None``) finished, then :meth:`poll`
@@ -397,8 +414,9 @@ class _ChildReporter:
         """Nothing to check here (the parent ends the process on Cancel)."""
 
     def partial(self, value: Any) -> None:
-        """Send a partial result to the parent (its reporter's :meth:`Reporter.partial`)."""
-        self.conn.send(("partial", value))
+        """Send a partial result to the parent (its reporter's :meth:`Reporter.partial`), its
+        large arrays through shared memory (:mod:`.handover`)."""
+        self.conn.send(("partial", pack(value)))
 
 
 def _child_main(conn: Any, fn: Callable[..., Any], args: tuple[Any, ...]) -> None:
@@ -414,7 +432,7 @@ def _child_main(conn: Any, fn: Callable[..., Any], args: tuple[Any, ...]) -> Non
     except BaseException as exc:  # reported to the parent, never lost
         conn.send(("error", f"{type(exc).__name__}: {exc}"))
     else:
-        conn.send(("result", result))
+        conn.send(("result", pack(result)))  # its large arrays through shared memory
     finally:
         conn.close()
 
@@ -475,9 +493,9 @@ def in_child(fn: Callable[..., Any], *args: Any) -> Callable[[Reporter], Any]:
                     if kind == "progress":
                         reporter(*payload)
                     elif kind == "partial":
-                        reporter.partial(payload[0])
+                        reporter.partial(unpack(payload[0]))
                     elif kind == "result":
-                        return payload[0]
+                        return unpack(payload[0])
                     else:
                         raise MeshError(payload[0])
                 elif not proc.is_alive() and not recv.poll():

@@ -85,7 +85,7 @@ def show_preview(viewer: Any, preview: MeshPreview) -> None:
     failed or cancelled job brings the mesh back (:func:`restore_mesh`)."""
     state = viewer.state
     display = copy.deepcopy(state.display)
-    display.fit(preview.V, state.up_for(preview.name))
+    display.fit(preview.corners(), state.up_for(preview.name))  # the same fit as to V
     points = display.points(preview.V)
     viewer.no_shadow = scene.shadow_for(len(preview.F), viewer.no_shadow)
     scene.show_preview(

@@ -104,7 +104,7 @@ class Viewer:
         self.panels = make_panels(state)
         self.background = False  # long operations run as jobs (the window; False: inline)
         self.pace = False  # the window sleeps between frames (Pacer); tests tick freely
-        self.pacer = Pacer()
+        self.pacer = Pacer(sleep=state.jobs.nap)  # woken when a job has something to show
         self._activity: tuple[Any, ...] = ()
         self.reframe = True  # frame the visible structures at the end of the next frame
         self.whole = False  # R: the next framing shows the whole subject (no view's focus)
@@ -567,8 +567,7 @@ def run(
     up (:func:`.state.display.up_rotation`; ``None``: the mesh's rule); a ``ui_scale`` given
     wins over the session's (the room's projector, not the saved view; ``None``: the
     session's, else 1). ``options`` are the panels' start options (``field``, ``vertex``,
-    ``k``: ``None`` when not given), each checked by its panel's state module before the
-    window opens.
+    ``k``: ``None`` when not given), each checked by its panel's state module first.
     """
     from .state.session import check_session_mesh, read_session
 
@@ -580,6 +579,8 @@ def run(
     shot = Path(screenshot).resolve() if screenshot is not None else None
     if shot is not None and not shot.parent.is_dir():
         raise MeshError(f"output directory {shot.parent} does not exist", shot)
+    if shot is None:  # the fork server of the window's jobs starts while the window opens
+        warm_up()
     state = AppState(folder=cwd)
     state.panel = state.check_panel(panel or VIEWS[0], "--panel")
     later = path if opens_later(path, shot, saved, options) else None
@@ -620,7 +621,6 @@ def run(
     if shot is None:  # the window: long operations as jobs, paced frames (idle is idle)
         viewer.background = viewer.pace = True
         state.jobs.processes = True  # load and fields in child processes: no shared GIL
-        warm_up()  # the fork server for them
         prefer_gil_free_solvers()  # an eigenbasis job in a thread must not hold the GIL
         ps.set_max_fps(-1)  # polyscope's limit spins a core; the Pacer sleeps instead
         if later is not None:

@@ -59,9 +59,11 @@ def default_scan() -> Path:
 def child(scan: Path, smoothing: bool = True) -> dict[str, float]:
     """One measurement in this process (see the module docstring); returns the figures."""
     import polyscope as ps
+    from meshlap_app.jobs import warm_up
     from meshlap_app.state import AppState
     from meshlap_app.viewer import Viewer, init_polyscope
 
+    warm_up()  # as `meshlap view` does before it creates the window
     init_polyscope("openGL3_egl")
     ps.set_max_fps(-1)
     ps.set_window_size(1280, 720)
@@ -73,9 +75,6 @@ def child(scan: Path, smoothing: bool = True) -> dict[str, float]:
     ps.frame_tick()
     viewer.background = viewer.pace = True
     state.jobs.processes = True  # as `meshlap view` sets up the window
-    from meshlap_app.jobs import warm_up
-
-    warm_up()
     rss_before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
     t0 = time.perf_counter()
     viewer.open(scan)

@@ -155,6 +155,30 @@ def test_bulk_path_reads_plain_files():
         assert np.array_equal(bulk.V[3], [0.0, 0, 1])
 
 
+def test_bulk_path_in_threads_reads_the_blocks_in_order(monkeypatch):
+    """A big file's blocks are parsed on two threads: the same mesh as the per-line path,
+    the blocks in file order (tiny blocks here, so many of each kind run at once), and a
+    refused block anywhere still hands the file to the per-line path."""
+    from meshlap_core.io import obj
+
+    rng = np.random.default_rng(7)
+    V = rng.normal(size=(300, 3))
+    F = rng.integers(1, 301, size=(500, 3))
+    lines = [f"v {float(x)!r} {float(y)!r} {float(z)!r}" for x, y, z in V] + [
+        f"f {a} {b}/2 {c}//3" for a, b, c in F
+    ]
+    text = ("\n".join(lines) + "\n").encode()
+    monkeypatch.setattr(obj, "_PARALLEL_BYTES", 0)
+    monkeypatch.setattr(obj, "_BLOCK", 256)
+    bulk = parse_obj_bulk(text)
+    assert bulk is not None and _same_parse(bulk, parse_obj_lines(text, SRC))
+    assert np.array_equal(bulk.V, V) and np.array_equal(bulk.faces, F - 1)
+    bad = text.replace(b"v ", b"v 1 ", 1)  # one vertex line with 4 numbers, in the first block
+    assert parse_obj_bulk(bad) is None
+    bad = text[: len(text) - 20] + text[len(text) - 20 :].replace(b"f ", b"f x", 1)
+    assert parse_obj_bulk(bad) is None
+
+
 # ------------------------------------------------------------------ the contract, by format
 
 

@@ -214,3 +214,35 @@ def test_in_child_reports_returns_fails_and_is_ended_by_cancel():
     jobs.cancel("c")
     job.thread.join(30)  # the child was ended: no 60 s wait
     assert not job.thread.is_alive() and job.outcome == "cancelled" and out == [42]
+
+
+def test_nap_is_woken_by_a_partial_result_and_by_a_finished_job():
+    """The window's pause between frames ends as soon as a job has something to show (a
+    partial result, a result); without news it sleeps its whole time."""
+    import time
+
+    jobs = Jobs()
+    go, handed = threading.Event(), threading.Event()
+
+    def work(reporter):
+        go.wait(30)
+        reporter.partial("half")
+        handed.wait(30)
+        return "whole"
+
+    shown, done = [], []
+    jobs.start("j", "t", work, done.append, preview=shown.append)
+    t0 = time.monotonic()
+    jobs.nap(0.05)  # no news: the whole pause
+    assert time.monotonic() - t0 >= 0.05 and not jobs.news.is_set()
+    go.set()
+    t0 = time.monotonic()
+    jobs.nap(60.0)  # woken by the partial result, long before 60 s
+    assert time.monotonic() - t0 < 30 and jobs.news.is_set()
+    jobs.poll()
+    assert shown == ["half"] and not jobs.news.is_set()  # poll takes the news
+    handed.set()
+    jobs.nap(60.0)  # woken by the result
+    assert jobs.news.is_set()
+    jobs.poll()
+    assert done == ["whole"] and not jobs.busy

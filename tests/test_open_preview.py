@@ -313,6 +313,40 @@ def test_make_preview_range_is_symmetric():
     assert lo == -hi and hi > 0
 
 
+def test_the_preview_box_fits_the_display_as_its_vertices_do():
+    """The window fits its display to the preview's two corners (computed in the child):
+    the same centre, scale and display points as a fit to every vertex."""
+    from meshlap_app.state.display import Display
+
+    V, F = primitives.icosphere(2)
+    V = V * np.array([3.0, 0.5, 1.5]) + np.array([10.0, -2.0, 0.25])
+    p = make_preview("x", V, F)
+    assert np.array_equal(p.box, [[v.min() for v in V.T], [v.max() for v in V.T]])
+    for up in ("y", "z", "-x"):
+        a, b = Display(), Display()
+        a.fit(V, up)
+        b.fit(p.corners(), up)
+        assert np.array_equal(a.centre, b.centre) and a.scale == b.scale
+        assert np.array_equal(a.points(V), b.points(V))
+
+
+@pytest.mark.parametrize("up", ["x", "y", "z", "-x", "-y", "-z"])
+def test_display_points_are_the_rotation_applied_as_a_matrix(up):
+    """The display's signed-permutation fast path gives exactly ``((V − c) s) Rᵀ``; the up axis
+    ends up along +y (the y-up case: the points only centred and scaled)."""
+    from meshlap_app.state.display import Display
+
+    V = np.random.default_rng(1).normal(size=(500, 3)) * [1.0, 5.0, 3.0] + 7.0
+    d = Display()
+    d.fit(V, up)
+    P = d.points(V)
+    assert np.array_equal(P, ((V - d.centre) * d.scale) @ d.rotation.T)
+    assert P.flags.c_contiguous and P.shape == V.shape
+    axis, sign = "xyz".index(up[-1]), (-1.0 if up.startswith("-") else 1.0)
+    assert np.array_equal(P[:, 1], sign * (V[:, axis] - d.centre[axis]) * d.scale)
+    assert np.array_equal(d.points(V[3]), P[3])  # one point
+
+
 def test_after_a_cancelled_preview_the_next_mesh_opened_goes_to_the_recent_list(
     viewer, held, ellipsoid, sphere
 ):

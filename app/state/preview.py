@@ -40,6 +40,10 @@ class MeshPreview:
     vminmax : (float, float)
         Its colour range ``(−r, r)``, ``r`` the 98th percentile of ``|field|`` (one outlier
         cannot wash the map out).
+    box : (2,3) float64 or None
+        ``[V.min(axis=0), V.max(axis=0)]``, computed where the preview is made (the window
+        fits its display to these two corners, the same fit as to ``V``, without a pass over
+        millions of points on the UI thread); ``None``: ``V`` itself is used.
     """
 
     name: str
@@ -47,6 +51,11 @@ class MeshPreview:
     F: IntArray
     field: FloatArray
     vminmax: tuple[float, float] = (-1.0, 1.0)
+    box: FloatArray | None = None
+
+    def corners(self) -> FloatArray:
+        """What the display is fitted to: :attr:`box`, else ``V``."""
+        return self.V if self.box is None else self.box
 
     def same_geometry(self, V: FloatArray, F: IntArray) -> bool:
         """Whether the validated mesh ``(V, F)`` is exactly the geometry previewed."""
@@ -69,7 +78,7 @@ def preview_field(V: FloatArray, F: IntArray) -> FloatArray:
     ``S = x_i + x_j + x_k``; ``d_i`` counts them) and ``n̂`` the unit area-weighted vertex
     normal. On a closed manifold mesh each neighbour is reached by two half-edges, so ``Δx``
     is exactly the uniform Laplacian ``(D⁻¹A − I) x``; on a boundary it differs (a preview
-    only). No edge table, no sparse matrix: seven ``bincount`` calls over the face corners.
+    only). No edge table, no sparse matrix: ``bincount`` calls over the faces' corners.
 
     Parameters
     ----------
@@ -85,22 +94,30 @@ def preview_field(V: FloatArray, F: IntArray) -> FloatArray:
     V = np.asarray(V, dtype=np.float64)
     F = np.asarray(F, dtype=np.int64)
     n = len(V)
-    corners = np.ascontiguousarray(F.T).ravel()  # corner c of every face, then c + 1, ...
-    count = np.bincount(corners, minlength=n).astype(np.float64)  # faces around each vertex
+    C = np.ascontiguousarray(F.T)  # (3, m): corner c of every face, then c + 1, ...
+    count = np.bincount(C.ravel(), minlength=n).astype(np.float64)  # faces around each vertex
+
+    def around(w: FloatArray) -> FloatArray:
+        """Σ over the faces around each vertex of the per-face values ``w (m,)``."""
+        out = np.bincount(C[0], weights=w, minlength=n)
+        out += np.bincount(C[1], weights=w, minlength=n)
+        out += np.bincount(C[2], weights=w, minlength=n)
+        return out
+
     lap = np.empty((3, n))
-    edges = []
+    e1, e2 = np.empty((3, C.shape[1])), np.empty((3, C.shape[1]))
     for d in range(3):  # one coordinate at a time: 1-D gathers, no (m,3,3) temporary
         x = np.ascontiguousarray(V[:, d])
-        xf = x[corners].reshape(3, -1)
+        x0, x1, x2 = x[C[0]], x[C[1]], x[C[2]]
         # Σ over the faces around i of (x_j + x_k − 2x_i) = Σ S_f − 3·count_i·x_i
-        lap[d] = np.bincount(corners, weights=np.tile(xf.sum(axis=0), 3), minlength=n)
-        lap[d] -= 3.0 * count * x
-        edges.append((xf[1] - xf[0], xf[2] - xf[0]))
-    (ax, bx), (ay, by), (az, bz) = edges
+        lap[d] = around(x0 + x1 + x2) - 3.0 * count * x
+        np.subtract(x1, x0, out=e1[d])
+        np.subtract(x2, x0, out=e2[d])
+    (ax, ay, az), (bx, by, bz) = e1, e2
     N = np.empty((3, n))
     for d, nd in enumerate((ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx)):
-        N[d] = np.bincount(corners, weights=np.tile(nd, 3), minlength=n)  # area-weighted
-    del edges, ax, bx, ay, by, az, bz
+        N[d] = around(nd)  # area-weighted
+    del e1, e2, ax, ay, az, bx, by, bz
     length = np.sqrt(np.einsum("dn,dn->n", N, N))
     degree = 2.0 * count  # half-edges leaving each vertex
     ok = (degree > 0) & (length > 0)
@@ -114,4 +131,5 @@ def make_preview(name: str, V: FloatArray, F: IntArray) -> MeshPreview:
     H = preview_field(V, F)
     r = float(np.percentile(np.abs(H), 98.0)) if len(H) else 0.0
     r = r if np.isfinite(r) and r > 0 else 1.0
-    return MeshPreview(name, V, F, H, (-r, r))
+    box = np.array([V.min(axis=0), V.max(axis=0)]) if len(V) else None
+    return MeshPreview(name, V, F, H, (-r, r), box)

@@ -7,7 +7,8 @@ of their own, no continuations, no indentation, every ``v``/``f`` token a litera
 contract, ``f`` corners written ``v``, ``v/vt``, ``v/vt/vn`` or ``v//vn``) and otherwise, or on
 any error, hands the file to the general path, whose messages name the line.
 
-Face lines are read in blocks of about 16 MB, so the temporary arrays of the bulk path stay
+Face and vertex lines are read in blocks of about 8 MB (in two threads for a big file:
+numpy's text parsing releases the GIL), so the temporary arrays of the bulk path stay
 small beside the file (``f a/1 b/1 c/1`` costs about what ``f a b c`` does).
 """
 
@@ -15,6 +16,7 @@ from __future__ import annotations
 
 import re
 from collections.abc import Iterator
+from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
 import numpy as np
@@ -42,7 +44,9 @@ from ._scan import (
 
 # a face corner: v, v/vt, v/vt/vn or v//vn (each an integer of the contract)
 _CORNER = re.compile(rb"([+-]?[0-9]+)(?:/[+-]?[0-9]+(?:/[+-]?[0-9]+)?|//[+-]?[0-9]+)?")
-_BLOCK = 1 << 24  # bytes of face or vertex lines parsed at a time on the bulk path
+_BLOCK = 1 << 23  # bytes of face or vertex lines parsed at a time on the bulk path
+_PARALLEL_BYTES = 1 << 23  # a file at least this big parses its blocks in two threads
+_WORKERS = 2
 _SEP = (9, 10, 11, 12, 13, 32)  # what may follow a keyword: whitespace or the line end
 _BLANK = (9, 11, 12, 32)  # a line starting with one of these is indented
 
@@ -95,12 +99,22 @@ def parse_obj_bulk(data: bytes) -> Parsed | None:
     nv, nf = int(is_v.sum()), int(is_f.sum())
     if nv == 0 or nf == 0:
         return None  # the general parser gives the precise error
-    V = _bulk_vertices(select_lines(data, arr, starts, ends, is_v), nv)
-    if V is None:
-        return None
+    vtext = select_lines(data, arr, starts, ends, is_v)
     ftext = select_lines(data, arr, starts, ends, is_f)
-    got = _bulk_faces(ftext, nf)
-    if got is None:
+    if len(data) < _PARALLEL_BYTES:
+        V, got = _bulk_vertices(vtext, nv, _serial), _bulk_faces(ftext, nf, _serial)
+    else:  # numpy's text parsing releases the GIL: the blocks on two cores
+        with ThreadPoolExecutor(_WORKERS) as pool:
+
+            def parallel(fn: Any, blocks: Iterator[bytes]) -> list[Any]:
+                return [task.result() for task in [pool.submit(fn, b) for b in blocks]]
+
+            # every block submitted before any result is awaited: faces beside vertices
+            vertex_tasks = [pool.submit(_vertex_block, b) for b in _blocks(vtext)]
+            got = _bulk_faces(ftext, nf, parallel)
+            V = _bulk_vertices(vtext, nv, lambda fn, blocks: [t.result() for t in vertex_tasks])
+    del vtext
+    if V is None or got is None:
         return None
     vals, sizes = got
     if b"-" in ftext and np.any(vals < 0):  # relative indices: -1 is the latest vertex
@@ -127,48 +141,68 @@ def _blocks(text: bytes) -> Iterator[bytes]:
         i = j
 
 
-def _keyword_blanked(block: bytes, keyword: bytes, chars: bytes) -> np.ndarray | None:
-    """``block`` as a writable array with each line's keyword byte blanked; None when a byte
-    outside ``chars`` (or a second keyword letter) occurs."""
+def _keyword_blanked(block: bytes, keyword: bytes, chars: bytes) -> bytes | None:
+    """``block`` (lines that each start with ``keyword``) with each line's keyword byte
+    blanked; None when a byte outside ``chars`` (or a second keyword letter) occurs.
+
+    With one keyword letter per line and every line starting with it, the letter occurs
+    nowhere else: one ``bytes.replace`` blanks exactly the first byte of every line."""
     n_lines = block.count(b"\n")
     if block.translate(None, chars + WHITESPACE + keyword) or block.count(keyword) != n_lines:
         return None
-    buf = np.frombuffer(block, dtype=np.uint8).copy()
-    buf[0] = 32
-    buf[np.flatnonzero(buf[:-1] == 10) + 1] = 32
-    return buf
+    return block.replace(keyword, b" ")
 
 
-def _bulk_vertices(vtext: bytes, nv: int) -> np.ndarray | None:
-    """The ``3·nv`` coordinates of the ``v`` lines, or None (not exactly 3 literals per line)."""
-    parts = []
-    for block in _blocks(vtext):
-        buf = _keyword_blanked(block, b"v", FLOAT_CHARS)
-        if buf is None or not np.all(tokens_per_line(buf) == 3):
-            return None  # w coordinates, vertex colours, missing coordinates, other characters
-        vals = bulk_numbers(buf.tobytes(), np.float64)
-        if vals is None or vals.size != 3 * block.count(b"\n"):
-            return None
-        parts.append(vals)
+def _serial(fn: Any, blocks: Iterator[bytes]) -> list[Any]:
+    """``fn`` of each block, one after the other (small files)."""
+    return [fn(b) for b in blocks]
+
+
+def _vertex_block(block: bytes) -> np.ndarray | None:
+    """The coordinates of a block of ``v`` lines, or None (not exactly 3 literals per line)."""
+    text = _keyword_blanked(block, b"v", FLOAT_CHARS)
+    if text is None or not np.all(tokens_per_line(np.frombuffer(text, np.uint8)) == 3):
+        return None  # w coordinates, vertex colours, missing coordinates, other characters
+    vals = bulk_numbers(text, np.float64)
+    if vals is None or vals.size != 3 * block.count(b"\n"):
+        return None
+    return vals
+
+
+def _bulk_vertices(vtext: bytes, nv: int, run: Any) -> np.ndarray | None:
+    """The ``3·nv`` coordinates of the ``v`` lines, or None; ``run(fn, blocks)`` maps
+    :func:`_vertex_block` over the blocks (in order; in threads for a big file)."""
+    parts = run(_vertex_block, _blocks(vtext))
+    if any(p is None for p in parts):
+        return None
     V = np.concatenate(parts) if len(parts) != 1 else parts[0]
     return V if V.size == 3 * nv else None
 
 
-def _bulk_faces(ftext: bytes, nf: int) -> tuple[IntArray, IntArray] | None:
-    """The vertex indices (as written) and corner counts of the ``f`` lines, or None."""
-    vals_parts, size_parts = [], []
-    for block in _blocks(ftext):
-        buf = _keyword_blanked(block, b"f", INT_CHARS + b"/")
-        if buf is None or not _signs_ok(buf):
-            return None
-        if b"/" in block and not _blank_after_slash(buf):
-            return None
-        sizes = tokens_per_line(buf)
-        vals = bulk_numbers(buf.tobytes(), np.int64)
-        if vals is None or vals.size != int(sizes.sum()):
-            return None
-        vals_parts.append(vals)
-        size_parts.append(sizes)
+def _face_block(block: bytes) -> tuple[IntArray, IntArray] | None:
+    """The vertex indices (as written) and corner counts of a block of ``f`` lines, or None."""
+    text = _keyword_blanked(block, b"f", INT_CHARS + b"/")
+    if text is None:
+        return None
+    slashes = b"/" in block
+    buf = np.frombuffer(text, dtype=np.uint8)
+    buf = buf.copy() if slashes else buf  # _blank_after_slash writes into it
+    if not _signs_ok(buf) or (slashes and not _blank_after_slash(buf)):
+        return None
+    sizes = tokens_per_line(buf)
+    vals = bulk_numbers(buf.tobytes() if slashes else text, np.int64)
+    if vals is None or vals.size != int(sizes.sum()):
+        return None
+    return vals, sizes
+
+
+def _bulk_faces(ftext: bytes, nf: int, run: Any) -> tuple[IntArray, IntArray] | None:
+    """The vertex indices (as written) and corner counts of the ``f`` lines, or None;
+    ``run(fn, blocks)`` maps :func:`_face_block` over the blocks (see :func:`_bulk_vertices`)."""
+    parts = run(_face_block, _blocks(ftext))
+    if any(p is None for p in parts):
+        return None
+    vals_parts, size_parts = [p[0] for p in parts], [p[1] for p in parts]
     vals = np.concatenate(vals_parts) if len(vals_parts) != 1 else vals_parts[0]
     sizes = np.concatenate(size_parts) if len(size_parts) != 1 else size_parts[0]
     if len(sizes) != nf:
