@@ -306,9 +306,15 @@ class BlockLanczos:
             C[:] = 0.0
         return th, S, np.linalg.norm(C, axis=0), C
 
-    def vectors(self, S: FloatArray) -> FloatArray:
-        """Ritz vectors ``Q S`` (``n × S.shape[1]``, F-ordered)."""
-        out = np.empty((self.n, S.shape[1]), order="F")
+    def vectors(self, S: FloatArray, out: FloatArray | None = None) -> FloatArray:
+        """Ritz vectors ``Q S`` (``n × S.shape[1]``, F-ordered), written into the leading
+        columns of ``out`` (``n × >= S.shape[1]``, F-ordered: the caller's store, so that the
+        vectors are not copied there afterwards) when given, else into a new array."""
+        s = S.shape[1]
+        if out is None or out.shape[0] != self.n or out.shape[1] < s or not out.flags.f_contiguous:
+            out = np.empty((self.n, s), order="F")
+        else:
+            out = out[:, :s]
         np.matmul(self.Q[:, : self.j], np.ascontiguousarray(S), out=out)
         return out
 

@@ -31,15 +31,26 @@ class FoundPairs:
         self.count = 0
 
     def add(self, lam: FloatArray, Y: FloatArray) -> None:
-        """Append the pairs ``(lam, Y)`` (columns of ``Y``)."""
+        """Append the pairs ``(lam, Y)`` (columns of ``Y``; not copied when ``Y`` is already
+        :meth:`free` ``[:, :len(lam)]``, written there by the slice)."""
         need = self.count + len(lam)
         if need > self.Y.shape[1]:
             Y2 = np.empty((self.n, max(need, int(self.Y.shape[1] * 1.5))), order="F")
             Y2[:, : self.count] = self.Y[:, : self.count]
             self.Y = Y2
-        self.Y[:, self.count : need] = Y
+        dest = self.Y[:, self.count : need]
+        if not (
+            Y.shape == dest.shape
+            and Y.strides == dest.strides
+            and Y.ctypes.data == dest.ctypes.data
+        ):
+            dest[...] = Y
         self.lam = np.concatenate([self.lam, lam])
         self.count = need
+
+    def free(self) -> FloatArray:
+        """The unused columns of the store (F-ordered), where the next pairs go."""
+        return self.Y[:, self.count :]
 
     def below(self, x: float) -> int:
         """How many stored eigenvalues are below ``x``."""
@@ -314,6 +325,9 @@ class SlicedLanczos:
             # (the top slice factors for the check above λ_k while it computes its Ritz
             # vectors; with two workers it also overlaps the other slice)
             check_top=i == self.n_total - 1,
+            # (slice 0 is the first merged into the store after the slices: it may write its
+            # vectors there directly)
+            out=self.found.free() if i == 0 else None,
         )
 
     def absorb(self, r: SliceResult) -> None:
