@@ -168,9 +168,10 @@ class SlicedLanczos:
     ``slice_size`` eigenvalues each (widths from Weyl's law ``N(λ) ≈ area·λ/4π`` at first, then
     from the inertia counts at the shifts); each interval is one task for a pool of
     ``workers`` threads (BLAS and the sparse solves release the GIL), with its shift in its
-    middle (the lowest slice's a little above, :data:`FIRST_SHIFT`). Afterwards the inertia of every shift, and of one extra shift in a gap just above
-    ``λ_k``, is compared with the number of eigenvalues found below it; a deficit is searched
-    for again with the known eigenvectors deflated.
+    middle (the lowest slice's a little above, :data:`FIRST_SHIFT`). Afterwards the inertia
+    of every shift, and of one extra shift in a gap just above ``λ_k``, is compared with the
+    number of eigenvalues found below it; a deficit is searched for again with the known
+    eigenvectors deflated.
 
     Use: ``lam, Y = SlicedLanczos(K, m, k, Z, info, ...).solve()``; ``info`` (a
     :class:`SolveInfo`) receives the shifts, Krylov dimensions, counts, timings and messages.
