@@ -292,3 +292,55 @@ def test_cholmod_analysis_is_done_once_per_pencil_across_threads(spd_backend, mo
     assert neg == np.count_nonzero(ref < 40.0) + np.count_nonzero(
         np.linalg.eigvalsh(A.toarray())[90:] < 40.0
     )
+
+
+def test_ritz_vectors_written_into_the_callers_store_equal_q_times_s():
+    """``BlockLanczos.vectors(S, out)`` writes ``Q S`` into the leading columns of ``out``
+    (the store of found pairs) and returns that view; ``FoundPairs.add`` of that view keeps
+    it without a copy, and of any other array copies it."""
+    from meshlap_core.linalg.slicing import FoundPairs
+
+    theta = np.linspace(1.0, 2.0, 60)
+    lz = _diag_lanczos(theta, delayed=True, steps=5)
+    S_ = np.random.default_rng(1).standard_normal((lz.j, 7))
+    ref = lz.Q[:, : lz.j] @ S_
+    found = FoundPairs(60, 20)
+    found.add(np.zeros(2), np.eye(60)[:, :2])
+    Y = lz.vectors(S_, found.free())
+    assert np.shares_memory(Y, found.Y) and Y.shape == (60, 7)
+    assert np.allclose(Y, ref, atol=1e-13)
+    found.add(np.arange(1.0, 8.0), Y)
+    assert found.count == 9
+    assert np.allclose(found.Y[:, 2:9], ref, atol=1e-13)
+    assert np.array_equal(found.Y[:, :2], np.eye(60)[:, :2])
+    other = np.asfortranarray(ref[:, :3] + 1.0)
+    found.add(np.ones(3), other)
+    assert np.array_equal(found.Y[:, 9:12], other) and not np.shares_memory(other, found.Y)
+    # a store without room: a new array
+    small = np.empty((60, 3), order="F")
+    Y2 = lz.vectors(S_, small)
+    assert not np.shares_memory(Y2, small) and np.allclose(Y2, ref, atol=1e-13)
+
+
+@pytest.mark.parametrize("chunk", [None, 1, 3, 64])
+def test_pair_residuals_equal_the_dense_formula_for_any_chunk(chunk):
+    """``||K u − λ M u||_{M⁻¹} / max(λ, λ_ref)`` column by column with dense algebra, for
+    every chunking of the columns (one component: ``λ_ref = tr(K)/(n·tr(M))``)."""
+    from meshlap_core.linalg.checks import pair_residuals
+
+    rng = np.random.default_rng(3)
+    n, kk = 40, 7
+    Bm = sp.random(n, n, density=0.2, random_state=4)
+    L = sp.diags(np.asarray(abs(Bm + Bm.T).sum(axis=1)).ravel()) - abs(Bm + Bm.T)
+    K = sp.csr_matrix(L + sp.diags(np.ones(n)))  # connected or not: labels say one component
+    m = rng.uniform(0.5, 2.0, n)
+    U = np.asfortranarray(rng.standard_normal((n, kk)))
+    lam = rng.uniform(0.0, 5.0, kk)
+    Kd = K.toarray()
+    ref_scale = np.trace(Kd) / (n * m.sum())
+    want = [
+        np.sqrt(np.sum((Kd @ U[:, j] - lam[j] * m * U[:, j]) ** 2 / m)) / max(lam[j], ref_scale)
+        for j in range(kk)
+    ]
+    got = pair_residuals(K, m, lam, U, None, chunk)
+    assert np.allclose(got, want, rtol=1e-12, atol=0)

@@ -19,6 +19,12 @@ from .factor import ShiftInvert
 from .slice_worker import SliceContext, SliceResult, SliceSpec, run_slice
 
 SPLIT = 0.42  # share of the interior slice when two workers split <= first_slice pairs
+# Where the lowest slice's shift sits in its interval [0, hi): above the middle. Its low end
+# needs no resolving (the null space is deflated: nothing lies below), its high end borders the
+# unwanted spectrum, so the shift leans that way. Krylov dimensions at k = 100 (block 4, one
+# worker), the middle (0.5) against 0.55: armadillo_igl 208 → 196, the 692k scan 220 → 208;
+# k = 60 on armadillo_igl 152 → 144 (0.6: 208, 152; 0.65: 224; 0.45: 220).
+FIRST_SHIFT = 0.55
 
 
 class FoundPairs:
@@ -31,15 +37,26 @@ class FoundPairs:
         self.count = 0
 
     def add(self, lam: FloatArray, Y: FloatArray) -> None:
-        """Append the pairs ``(lam, Y)`` (columns of ``Y``)."""
+        """Append the pairs ``(lam, Y)`` (columns of ``Y``; not copied when ``Y`` is already
+        :meth:`free` ``[:, :len(lam)]``, written there by the slice)."""
         need = self.count + len(lam)
         if need > self.Y.shape[1]:
             Y2 = np.empty((self.n, max(need, int(self.Y.shape[1] * 1.5))), order="F")
             Y2[:, : self.count] = self.Y[:, : self.count]
             self.Y = Y2
-        self.Y[:, self.count : need] = Y
+        dest = self.Y[:, self.count : need]
+        if not (
+            Y.shape == dest.shape
+            and Y.strides == dest.strides
+            and Y.ctypes.data == dest.ctypes.data
+        ):
+            dest[...] = Y
         self.lam = np.concatenate([self.lam, lam])
         self.count = need
+
+    def free(self) -> FloatArray:
+        """The unused columns of the store (F-ordered), where the next pairs go."""
+        return self.Y[:, self.count :]
 
     def below(self, x: float) -> int:
         """How many stored eigenvalues are below ``x``."""
@@ -151,9 +168,10 @@ class SlicedLanczos:
     ``slice_size`` eigenvalues each (widths from Weyl's law ``N(λ) ≈ area·λ/4π`` at first, then
     from the inertia counts at the shifts); each interval is one task for a pool of
     ``workers`` threads (BLAS and the sparse solves release the GIL), with its shift in its
-    middle. Afterwards the inertia of every shift, and of one extra shift in a gap just above
-    ``λ_k``, is compared with the number of eigenvalues found below it; a deficit is searched
-    for again with the known eigenvectors deflated.
+    middle (the lowest slice's a little above, :data:`FIRST_SHIFT`). Afterwards the inertia
+    of every shift, and of one extra shift in a gap just above ``λ_k``, is compared with the
+    number of eigenvalues found below it; a deficit is searched for again with the known
+    eigenvectors deflated.
 
     Use: ``lam, Y = SlicedLanczos(K, m, k, Z, info, ...).solve()``; ``info`` (a
     :class:`SolveInfo`) receives the shifts, Krylov dimensions, counts, timings and messages.
@@ -304,7 +322,7 @@ class SlicedLanczos:
         hi = start + size * (1.0 if count is not None or i < self.n_total - 1 else 1.05) / rho
         return SliceSpec(
             i,
-            0.5 * (start + hi),
+            start + (FIRST_SHIFT if i == 0 and known is None else 0.5) * (hi - start),
             lo,
             hi,
             size,
@@ -314,6 +332,9 @@ class SlicedLanczos:
             # (the top slice factors for the check above λ_k while it computes its Ritz
             # vectors; with two workers it also overlaps the other slice)
             check_top=i == self.n_total - 1,
+            # (slice 0 is the first merged into the store after the slices: it may write its
+            # vectors there directly)
+            out=self.found.free() if i == 0 else None,
         )
 
     def absorb(self, r: SliceResult) -> None:
