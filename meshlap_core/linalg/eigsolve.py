@@ -11,8 +11,7 @@ symmetric scaled pencil ``A = M^-½ K M^-½`` (same eigenvalues, ``y = M^½ u``)
   intervals holding ~64 eigenvalues each (~128 for the lowest with one worker; equal slices, an
   even number of them, with two), planned with Weyl's law ``N(λ) ≈ area·λ/4π`` and then with
   the density the inertia counts at the shifts measure; slices run in two threads when two
-  cores are idle. Every interval gets a shift in its middle (the lowest, one-sided, a little
-  above: :data:`~meshlap_core.linalg.slicing.FIRST_SHIFT`) and an ``LDLᵀ`` factor without
+  cores are idle. Every interval gets a shift in its middle and an ``LDLᵀ`` factor without
   pivoting (QDLDL, AMD ordering; SuperLU in symmetric mode as fallback,
   :mod:`~meshlap_core.linalg.factor`); a singular matrix is never factored. Block Lanczos
   (block 4) with delayed classical Gram–Schmidt against the slice's own basis (DCGS2,

@@ -19,12 +19,6 @@ from .factor import ShiftInvert
 from .slice_worker import SliceContext, SliceResult, SliceSpec, run_slice
 
 SPLIT = 0.42  # share of the interior slice when two workers split <= first_slice pairs
-# Where the lowest slice's shift sits in its interval [0, hi): above the middle. Its low end
-# needs no resolving (the null space is deflated: nothing lies below), its high end borders the
-# unwanted spectrum, so the shift leans that way. Krylov dimensions at k = 100 (block 4, one
-# worker), the middle (0.5) against 0.55: armadillo_igl 208 → 196, the 692k scan 220 → 208;
-# k = 60 on armadillo_igl 152 → 144 (0.6: 208, 152; 0.65: 224; 0.45: 220).
-FIRST_SHIFT = 0.55
 
 
 class FoundPairs:
@@ -168,10 +162,9 @@ class SlicedLanczos:
     ``slice_size`` eigenvalues each (widths from Weyl's law ``N(λ) ≈ area·λ/4π`` at first, then
     from the inertia counts at the shifts); each interval is one task for a pool of
     ``workers`` threads (BLAS and the sparse solves release the GIL), with its shift in its
-    middle (the lowest slice's a little above, :data:`FIRST_SHIFT`). Afterwards the inertia
-    of every shift, and of one extra shift in a gap just above ``λ_k``, is compared with the
-    number of eigenvalues found below it; a deficit is searched for again with the known
-    eigenvectors deflated.
+    middle. Afterwards the inertia of every shift, and of one extra shift in a gap just above
+    ``λ_k``, is compared with the number of eigenvalues found below it; a deficit is searched
+    for again with the known eigenvectors deflated.
 
     Use: ``lam, Y = SlicedLanczos(K, m, k, Z, info, ...).solve()``; ``info`` (a
     :class:`SolveInfo`) receives the shifts, Krylov dimensions, counts, timings and messages.
@@ -322,7 +315,7 @@ class SlicedLanczos:
         hi = start + size * (1.0 if count is not None or i < self.n_total - 1 else 1.05) / rho
         return SliceSpec(
             i,
-            start + (FIRST_SHIFT if i == 0 and known is None else 0.5) * (hi - start),
+            0.5 * (start + hi),
             lo,
             hi,
             size,
