@@ -121,6 +121,7 @@ def _snapshot(sm: Any) -> dict[str, Any]:
         "n_factorizations": sm.n_factorizations,
         "volume_note": sm.volume_note,
         "closed": sm.closed,
+        "box": [sm.V.min(axis=0).tolist(), sm.V.max(axis=0).tolist()] if len(sm.V) else None,
     }
 
 
@@ -282,6 +283,7 @@ class RemoteSmoother:
         self._V = np.zeros((self.n, 3))
         self.V0 = self._V
         self.normals: np.ndarray | None = None
+        self.box: np.ndarray | None = None  # (2,3) min and max of V (the child's)
         self._pending = False  # a step asked for, its answer not read yet
         self._arrived = False  # a step's answer read, not yet collected by poll
         self.error = ""
@@ -369,6 +371,7 @@ class RemoteSmoother:
         self._divergence = snap["divergence"]
         self.volume_note, self.closed = snap["volume_note"], snap["closed"]
         self.history = [snap["last"]] if snap["last"] else []
+        self.box = None if snap["box"] is None else np.array(snap["box"])
         self._V = np.array(self._cur)
         if self._want_normals:
             self.normals = np.array(self._nrm)
