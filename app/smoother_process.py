@@ -404,6 +404,12 @@ class RemoteSmoother:
         self._call("step")
         return self.V
 
+    def steps(self, count: int) -> FloatArray:
+        """``count`` steps in one request, waiting for them (a session's replay); the child
+        stops at a divergence."""
+        self._call("step", max(1, int(count)))
+        return self.V
+
     def reset(self) -> None:
         self._call("reset")
 

@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import threading
 import time
 from collections.abc import Iterator
 from dataclasses import dataclass
@@ -15,6 +16,7 @@ from meshlap_core.errors import MeshError
 from meshlap_core.options import LAPLACIAN_KINDS, SMOOTHING_METHODS
 
 from .. import scene, smoother_process
+from ..jobs import Reporter
 from ..record import Recorder, draw_record
 from ..scene import (
     INPUT_COLOR,
@@ -97,7 +99,8 @@ class SmoothingPanel(Panel):
         def apply(result: tuple[Any, Shown]) -> None:
             smoother, self._ready = result
             st.adopt_built(options, smoother)
-            self.push(host, force=True)
+            if not host.background:  # (the window: the panel's draw this frame registers it,
+                self.push(host, force=True)  # the input copy at the next one)
 
         def fail(message: str) -> None:
             if raise_errors and not host.background:
@@ -318,15 +321,28 @@ class SmoothingPanel(Panel):
         st = self.state
         runs = replay_steps(values)
         st.lam = runs[0][0] if runs else values["lam"]  # the stepper is built with the first λ
-        if not st.rebuild(host.state.mesh.V, host.state.mesh.F):
+        if not st.rebuild(host.state.mesh.V, host.state.mesh.F, self._builder(host)):
             st.lam = values["lam"]  # (set_lam would clear the error the panel shows)
             return
         for lam, steps in runs:
             st.set_lam(lam)
-            if not all(st.step() for _ in range(steps)):
+            if not st.run(steps):
                 break  # a diverging run stops where it stopped when it was saved
         st.set_lam(values["lam"])
         self.push(host, force=True)
+
+    def _builder(self, host: Host) -> Any:
+        """How a session's replay builds its stepper: in the window, in a child process as
+        the panel's own builds (the factor lives there; *play* goes on from it), each run of
+        steps one request; elsewhere (``meshlap animate``, tests: offline) in this process."""
+        st = self.state
+        if not (host.background and host.state.jobs.processes):
+            return None
+
+        def build(V: Any, F: Any, options: Any) -> Any:
+            return smoother_process.build(V, F, options, Reporter(threading.Event()), st.build)
+
+        return build
 
     def start(self, host: Host, options: dict[str, Any], shown: bool, screenshot: bool) -> None:
         if shown:

@@ -239,14 +239,15 @@ class SmoothingState:
         if hasattr(old, "close"):
             old.close()
 
-    def rebuild(self, V: FloatArray, F: IntArray) -> bool:
+    def rebuild(self, V: FloatArray, F: IntArray, build: Any = None) -> bool:
         """Build the stepper for the current options from the clean mesh ``V`` (+ noise).
 
         ``V`` and ``F`` are passed on once: the smoother keeps its own validated copies
-        (``V0``, ``F``, ``reference``) and this state reads them from there.
+        (``V0``, ``F``, ``reference``) and this state reads them from there. ``build``: how
+        (``build(V, F, options)``; default :meth:`build`, in this process).
         """
         try:
-            smoother = self.build(V, F, self.options())
+            smoother = (build or self.build)(V, F, self.options())
         except MeshError as exc:
             self.error = str(exc)
             self.playing = False
@@ -421,6 +422,31 @@ class SmoothingState:
             s.step()
             if s.iteration > done:  # a step taken (a diverging one is discarded)
                 self._count_step(s.lam)
+        if s.diverged:
+            self.playing = False
+            self.error = f"{s.divergence_message()}; press reset"
+            return False
+        return True
+
+    def run(self, count: int) -> bool:
+        """``count`` steps at once (a saved session's replay), stopping where the flow
+        diverges (:meth:`step`); a child-process stepper takes them in one request.
+
+        Returns
+        -------
+        bool
+            False when the run stopped (diverged).
+        """
+        s = self.smoother
+        if s is None:
+            return False
+        many = getattr(s, "steps", None)
+        if many is None or s.diverged:
+            return all(self.step() for _ in range(count))
+        done = s.iteration
+        many(count)
+        for _ in range(s.iteration - done):
+            self._count_step(s.lam)
         if s.diverged:
             self.playing = False
             self.error = f"{s.divergence_message()}; press reset"
