@@ -94,17 +94,36 @@ def face_incidence(F: IntArray, n: int) -> sp.csr_matrix:
     return sp.coo_matrix((np.ones(3 * m), (rows, cols)), shape=(n, m)).tocsr()
 
 
-def _blocks(buf: Any, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The three arrays of the shared block (see the module docstring)."""
+def _blocks(buf: Any, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The arrays of the shared block (see the module docstring); the last one holds the
+    display positions and normals ``(2,n,3) float32``."""
     size = 3 * n
     cur = np.ndarray((n, 3), dtype=np.float64, buffer=buf, offset=0)
     start = np.ndarray((n, 3), dtype=np.float64, buffer=buf, offset=8 * size)
     normals = np.ndarray((n, 3), dtype=np.float32, buffer=buf, offset=16 * size)
-    return cur, start, normals
+    shown = np.ndarray((2, n, 3), dtype=np.float32, buffer=buf, offset=20 * size)
+    return cur, start, normals, shown
 
 
 def _block_bytes(n: int) -> int:
-    return max(1, 20 * 3 * n)
+    return max(1, 28 * 3 * n)
+
+
+def display_arrays(
+    V: FloatArray, N: np.ndarray | None, view: tuple[float, ...], out: np.ndarray
+) -> None:
+    """The positions ``V (n,3)`` as the window shows them, ``((V − c) s) Rᵀ + shift``, and
+    their normals turned, ``N Rᵀ``, into ``out (2,n,3) float32`` (the child's part of an
+    upload: the window passes them to polyscope as they are).
+
+    ``view`` is ``(c (3), s, R (9, row-major), shift (3))`` flattened (:meth:`RemoteSmoother.
+    request_step`)."""
+    c, s = np.asarray(view[:3]), view[3]
+    R = np.asarray(view[4:13]).reshape(3, 3)
+    np.matmul((V - c) * s, R.T, out=out[0], casting="same_kind")
+    out[0] += np.asarray(view[13:16], dtype=np.float32)
+    if N is not None:
+        np.matmul(N, R.T.astype(np.float32), out=out[1])
 
 
 def _snapshot(sm: Any) -> dict[str, Any]:
@@ -141,7 +160,8 @@ def _serve(
     V, F = _read_inputs(*inputs)
     shm = shared_memory.SharedMemory(name=name)  # the fork server's children share the
     # parent's resource tracker: only the parent's unlink unregisters the block
-    cur, start, nrm = _blocks(shm.buf, len(V))
+    cur, start, nrm, shown = _blocks(shm.buf, len(V))
+    view: tuple[float, ...] | None = None  # the window's display transform, once sent
     try:
         sm = SmoothingState.build(V, F, options, _ChildReporter(conn))
         start[...] = sm.V0
@@ -156,18 +176,23 @@ def _serve(
             if cmd == "close":
                 return
             try:
-                if cmd == "step":  # args: how many (stops at a divergence)
+                if cmd == "step":  # args: how many (stops at a divergence), the view
                     for _ in range(args[0] if args else 1):
                         sm.step()
                         if sm.diverged:
                             break
+                    view = args[1] if len(args) > 1 and args[1] is not None else view
                 elif cmd == "reset":
                     sm.reset()
                 elif cmd == "set_lam":
                     sm.set_lam(args[0])
                 elif cmd == "diverge":
                     sm.diverged = True
-                reply = ("state", _publish(sm, cur, nrm, incidence))
+                snap = _publish(sm, cur, nrm, incidence)
+                if view is not None:
+                    display_arrays(sm.V, nrm if normals else None, view, shown)
+                snap["view"] = view
+                reply = ("state", snap)
             except MeshError as exc:
                 reply = ("error", str(exc))
     except MeshError as exc:
@@ -175,7 +200,7 @@ def _serve(
     except BaseException as exc:  # reported to the parent, never lost
         _send(conn, ("error", f"{type(exc).__name__}: {exc}"))
     finally:
-        del cur, start, nrm
+        del cur, start, nrm, shown
         shm.close()
         conn.close()
 
@@ -278,7 +303,9 @@ class RemoteSmoother:
         self.n = len(V)
         self.F = F
         self.reference = V
-        self._cur, self._start, self._nrm = _blocks(shm.buf, self.n)
+        self._cur, self._start, self._nrm, self._shown = _blocks(shm.buf, self.n)
+        self._view: tuple[float, ...] | None = None  # the view of the display arrays held
+        self._display: np.ndarray | None = None  # (2,n,3) float32 copied with each step
         self._want_normals = normals
         self._V = np.zeros((self.n, 3))
         self.V0 = self._V
@@ -375,6 +402,16 @@ class RemoteSmoother:
         self._V = np.array(self._cur)
         if self._want_normals:
             self.normals = np.array(self._nrm)
+        self._view = snap.get("view")
+        self._display = None if self._view is None else np.array(self._shown)
+
+    def display(self, view: tuple[float, ...]) -> tuple[np.ndarray, np.ndarray] | None:
+        """The current positions and normals ``(n,3) float32`` in the window's coordinates
+        made by the child for ``view`` (see :func:`display_arrays`), or ``None`` when it made
+        none for this view yet (the next step asked for with ``view`` brings them)."""
+        if self._display is None or self._view != view:
+            return None
+        return self._display[0], self._display[1]
 
     # ------------------------------------------------------------------ the stepper's interface
     @property
@@ -434,12 +471,13 @@ class RemoteSmoother:
         """A step was asked for and its answer has not been read."""
         return self._pending
 
-    def request_step(self, count: int = 1) -> bool:
+    def request_step(self, count: int = 1, view: tuple[float, ...] | None = None) -> bool:
         """Ask for ``count`` steps (shown together) and return at once (False: a request is
-        already on its way)."""
+        already on its way). ``view``: the window's display transform (:func:`display_arrays`):
+        the child then also writes the positions and normals as the window uploads them."""
         if self._pending:
             return False
-        self._send(("step", max(1, int(count))))
+        self._send(("step", max(1, int(count)), view))
         self._pending = True
         return True
 
@@ -473,7 +511,7 @@ class RemoteSmoother:
     def close(self) -> None:
         """End the child and free the shared block (the proxy is unusable afterwards)."""
         self._V = np.array(self._V)  # own copies: the block goes away
-        self._cur = self._start = self._nrm = None  # type: ignore[assignment]
+        self._cur = self._start = self._nrm = self._shown = None  # type: ignore[assignment]
         self._finalizer()
 
     @property

@@ -394,7 +394,7 @@ def test_play_meter_counts_steps_and_frames_apart():
     """Hand-counted: play from t=10; steps arrive 2 at t=11 and 3 at t=12, frames show a
     step at t=11 and t=12: 2.5 steps/s and 1 frame/s at t=12; events older than the window
     are forgotten; a pause keeps the rates of its moment."""
-    from meshlap_app.state.smoothing import METER_WINDOW_S, PlayMeter
+    from meshlap_app.state.play_meter import METER_WINDOW_S, PlayMeter
 
     m = PlayMeter()
     assert m.rates(5.0) == (0.0, 0.0)
@@ -442,3 +442,32 @@ def test_a_session_replayed_in_the_window_steps_in_a_child_process(viewer):
         assert panel.capture(viewer)["lam_steps"] == [[0.01, 3], [0.02, 2]]
     finally:
         panel.on_new_mesh(viewer)
+
+
+def test_the_child_makes_the_display_arrays_of_the_view_asked_for(mesh):
+    """A step asked for with the window's view brings the positions and normals in display
+    coordinates (``((V − c) s) Rᵀ + shift``, ``N Rᵀ``), made by the child; another view has
+    none until asked for."""
+    from meshlap_app.state.display import Display
+
+    V, F = mesh
+    d = Display()
+    d.fit(V, "z")  # a rotation that permutes and flips axes
+    shift = np.array([0.7, 0.0, -0.1])
+    view = (*d.centre.tolist(), d.scale, *d.rotation.ravel().tolist(), *shift.tolist())
+    remote = RemoteSmoother.start(V, F, OPTIONS, reporter())
+    try:
+        assert remote.display(view) is None  # none asked for yet
+        remote.request_step(2, view)
+        wait_for(remote.poll)
+        P, N = remote.display(view)
+        assert P.dtype == np.float32 and N.dtype == np.float32
+        assert np.abs(P - (d.points(remote.V) + shift)).max() <= 1e-5
+        assert np.abs(N - remote.normals @ d.rotation.T).max() <= 1e-6
+        other = (*view[:-3], 0.0, 0.0, 0.0)
+        assert remote.display(other) is None
+        remote.reset()  # the view stays with the child: the arrays follow every answer
+        P, _ = remote.display(view)
+        assert np.abs(P - (d.points(remote.V0) + shift)).max() <= 1e-5
+    finally:
+        remote.close()

@@ -159,15 +159,28 @@ class SmoothingPanel(Panel):
             host.request_frame()
         elif self.watch.changed("iteration", st.smoother.iteration) or force:
             mesh = ps.get_surface_mesh(SMOOTHED)
-            P = d.points(st.V) + self._shift(host)
-            N = getattr(st.smoother, "normals", None)
             self._shown_at = time.perf_counter()
             if st.playing:
                 st.meter.shown(self._shown_at)
+            made = getattr(st.smoother, "display", None)
+            ready = made(self.view_key(host)) if made is not None else None
+            if ready is not None:  # the child made them in the window's coordinates
+                upload_positions(mesh, *ready)
+                return
+            P = d.points(st.V) + self._shift(host)
+            N = getattr(st.smoother, "normals", None)
             if N is None:
                 mesh.update_vertex_positions(P)
             else:  # the child computed the normals: two buffers, no geometry re-derived here
                 upload_positions(mesh, P, N @ d.rotation.T.astype(np.float32))
+
+    def view_key(self, host: Host) -> tuple[float, ...]:
+        """The smoothed copy's display transform, flattened for the child process
+        (:func:`meshlap_app.smoother_process.display_arrays`): centre, scale, rotation, shift."""
+        d = host.state.display
+        R = np.asarray(d.rotation, dtype=float).ravel()
+        shift = self._shift(host)
+        return (*d.centre.tolist(), float(d.scale), *R.tolist(), *np.asarray(shift).tolist())
 
     def _shown(self, host: Host) -> Shown:
         """The display arrays of the stepper at its adoption: those its build job prepared
@@ -419,6 +432,8 @@ class SmoothingPanel(Panel):
             self.push(host, force=True)
         if self._shown_at is not None:  # the frame that showed new steps has been drawn
             st.show_s, self._shown_at = time.perf_counter() - self._shown_at, None
+        if st.asynchronous:
+            st.view = self.view_key(host)  # asked for with the steps: the child transforms
         st.poll()  # a step a child process finished (never waits)
         if st.playing:
             st.play_step()
@@ -537,7 +552,8 @@ def upload_positions(mesh: Any, P: np.ndarray, N: np.ndarray) -> None:
     if not normals.has_data():  # not drawn yet: polyscope fills it at the first draw
         mesh.update_vertex_positions(P)
         return
-    mesh.get_buffer("vertexPositions").update_data(np.asarray(P, dtype=np.float64))
+    single = np.asarray(P).dtype == np.float32  # (polyscope keeps float32: no conversion)
+    mesh.get_buffer("vertexPositions").update_data(P if single else np.asarray(P, np.float64))
     normals.update_data(np.asarray(N, dtype=np.float32))
     ps.request_redraw()
 

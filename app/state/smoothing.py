@@ -20,6 +20,7 @@ from meshlap_core.types import FloatArray, IntArray
 
 from .animation import Animation, Option
 from .checks import Schema, integer, number, one_of
+from .play_meter import PlayMeter
 
 MAX_BATCH = 8
 """Most steps *play* asks a child-process stepper for at once
@@ -28,63 +29,7 @@ MAX_FRAMES_ITERS = 5000
 """Most smoothing iterations an animation renders (one frame each), and the most a session may
 hold (``smoothing.iterations``): opening a session replays every step before the first frame,
 so ``meshlap view --session`` and ``meshlap animate --session`` share this one limit."""
-METER_WINDOW_S = 5.0
-"""The span over which :class:`PlayMeter` counts (the last seconds of *play*)."""
 _EMPTY_V = np.zeros((0, 3))
-
-
-@dataclass
-class PlayMeter:
-    """Two rates of *play*, counted apart: the steps the stepper computed per second and the
-    frames that showed a new step per second. With a stepper in a child process the two
-    differ: the child runs ahead (several steps per request) while the window draws, and a
-    frame shows the newest step that is done.
-
-    Events older than :data:`METER_WINDOW_S` before the latest are forgotten; a rate is the
-    events of that span over the span since the first of them (or since *play* started)."""
-
-    started: float | None = None
-    stopped: float | None = None  # when *play* paused: the rates stay as they were then
-    steps: list[tuple[float, int]] = field(default_factory=list)
-    frames: list[float] = field(default_factory=list)
-
-    def start(self, now: float) -> None:
-        self.started, self.stopped, self.steps, self.frames = now, None, [], []
-
-    def stop(self, now: float) -> None:
-        if self.started is not None and self.stopped is None:
-            self.stopped = now
-
-    def stepped(self, now: float, count: int) -> None:
-        if self.started is not None:
-            self.steps.append((now, count))
-            self._trim(now)
-
-    def shown(self, now: float) -> None:
-        if self.started is not None:
-            self.frames.append(now)
-            self._trim(now)
-
-    def _trim(self, now: float) -> None:
-        cut = now - METER_WINDOW_S
-        self.steps = [e for e in self.steps if e[0] >= cut]
-        self.frames = [t for t in self.frames if t >= cut]
-
-    def rates(self, now: float) -> tuple[float, float]:
-        """``(steps computed per second, frames showing a step per second)`` (0 before
-        *play*)."""
-        if self.started is None:
-            return 0.0, 0.0
-        if self.stopped is not None:
-            now = self.stopped
-        span = now - max(self.started, now - METER_WINDOW_S)
-        if span <= 0:
-            return 0.0, 0.0
-        steps = sum(n for t, n in self.steps if t >= now - METER_WINDOW_S)
-        frames = sum(1 for t in self.frames if t >= now - METER_WINDOW_S)
-        return steps / span, frames / span
-
-
 _EMPTY_F = np.zeros((0, 3), dtype=np.int64)
 
 
@@ -114,6 +59,7 @@ class SmoothingState:
     asked_at: int = 0  # iteration when a child-process stepper was last asked for a step
     show_s: float = 0.0  # how long the window's last frame showing a new step took
     meter: PlayMeter = field(default_factory=PlayMeter)  # steps/s and frames/s of play
+    view: tuple[float, ...] | None = None  # the window's display transform, for the child
 
     def toggle_play(self) -> None:
         """*play* / *pause* (the button and ``space``)."""
@@ -201,7 +147,7 @@ class SmoothingState:
         elif not s.diverged:
             self.asked_at = s.iteration
             try:
-                s.request_step(count)
+                s.request_step(count, self.view)
             except MeshError as exc:
                 self.error, self.playing = str(exc), False
 
