@@ -94,19 +94,32 @@ def face_incidence(F: IntArray, n: int) -> sp.csr_matrix:
     return sp.coo_matrix((np.ones(3 * m), (rows, cols)), shape=(n, m)).tocsr()
 
 
-def _blocks(buf: Any, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """The arrays of the shared block (see the module docstring); the last one holds the
-    display positions and normals ``(2,n,3) float32``."""
-    size = 3 * n
-    cur = np.ndarray((n, 3), dtype=np.float64, buffer=buf, offset=0)
-    start = np.ndarray((n, 3), dtype=np.float64, buffer=buf, offset=8 * size)
-    normals = np.ndarray((n, 3), dtype=np.float32, buffer=buf, offset=16 * size)
-    shown = np.ndarray((2, n, 3), dtype=np.float32, buffer=buf, offset=20 * size)
-    return cur, start, normals, shown
+PIPELINE = 2
+"""Most step requests on their way at once: the child starts the next batch as soon as it has
+answered one, while the window uploads and draws (each answer has its own slot of the shared
+block, so the child never writes the slot the window is reading)."""
+
+Slot = tuple[np.ndarray, np.ndarray, np.ndarray]
+
+
+def _blocks(buf: Any, n: int) -> tuple[np.ndarray, list[Slot]]:
+    """The arrays of the shared block (see the module docstring): ``V0``, then
+    :data:`PIPELINE` slots of (current positions, normals, display positions and normals
+    ``(2,n,3) float32``); answer ``k`` is written into slot ``k % PIPELINE``."""
+    start = np.ndarray((n, 3), dtype=np.float64, buffer=buf, offset=0)
+    slots: list[Slot] = []
+    offset = 24 * n
+    for _ in range(PIPELINE):
+        cur = np.ndarray((n, 3), dtype=np.float64, buffer=buf, offset=offset)
+        normals = np.ndarray((n, 3), dtype=np.float32, buffer=buf, offset=offset + 24 * n)
+        shown = np.ndarray((2, n, 3), dtype=np.float32, buffer=buf, offset=offset + 36 * n)
+        slots.append((cur, normals, shown))
+        offset += 60 * n
+    return start, slots
 
 
 def _block_bytes(n: int) -> int:
-    return max(1, 28 * 3 * n)
+    return max(1, (24 + 60 * PIPELINE) * n)
 
 
 def display_arrays(
@@ -160,13 +173,26 @@ def _serve(
     V, F = _read_inputs(*inputs)
     shm = shared_memory.SharedMemory(name=name)  # the fork server's children share the
     # parent's resource tracker: only the parent's unlink unregisters the block
-    cur, start, nrm, shown = _blocks(shm.buf, len(V))
+    start, slots = _blocks(shm.buf, len(V))
     view: tuple[float, ...] | None = None  # the window's display transform, once sent
+    answers = 0  # answers published: the next goes to slot answers % PIPELINE
     try:
         sm = SmoothingState.build(V, F, options, _ChildReporter(conn))
         start[...] = sm.V0
         incidence = face_incidence(sm.F, len(V)) if normals else None
-        reply: tuple[Any, ...] = ("ready", _publish(sm, cur, nrm, incidence))
+
+        def publish() -> dict[str, Any]:
+            nonlocal answers
+            slot = answers % PIPELINE
+            cur, nrm, shown = slots[slot]
+            snap = _publish(sm, cur, nrm, incidence)
+            if view is not None:
+                display_arrays(sm.V, nrm if normals else None, view, shown)
+            snap["view"], snap["slot"] = view, slot
+            answers += 1
+            return snap
+
+        reply: tuple[Any, ...] = ("ready", publish())
         while True:
             conn.send(reply)
             try:
@@ -178,9 +204,9 @@ def _serve(
             try:
                 if cmd == "step":  # args: how many (stops at a divergence), the view
                     for _ in range(args[0] if args else 1):
-                        sm.step()
                         if sm.diverged:
                             break
+                        sm.step()
                     view = args[1] if len(args) > 1 and args[1] is not None else view
                 elif cmd == "reset":
                     sm.reset()
@@ -188,11 +214,7 @@ def _serve(
                     sm.set_lam(args[0])
                 elif cmd == "diverge":
                     sm.diverged = True
-                snap = _publish(sm, cur, nrm, incidence)
-                if view is not None:
-                    display_arrays(sm.V, nrm if normals else None, view, shown)
-                snap["view"] = view
-                reply = ("state", snap)
+                reply = ("state", publish())
             except MeshError as exc:
                 reply = ("error", str(exc))
     except MeshError as exc:
@@ -200,7 +222,8 @@ def _serve(
     except BaseException as exc:  # reported to the parent, never lost
         _send(conn, ("error", f"{type(exc).__name__}: {exc}"))
     finally:
-        del cur, start, nrm, shown
+        slots.clear()  # (no view of the block may outlive it)
+        del start
         shm.close()
         conn.close()
 
@@ -303,7 +326,7 @@ class RemoteSmoother:
         self.n = len(V)
         self.F = F
         self.reference = V
-        self._cur, self._start, self._nrm, self._shown = _blocks(shm.buf, self.n)
+        self._start, self._slots = _blocks(shm.buf, self.n)
         self._view: tuple[float, ...] | None = None  # the view of the display arrays held
         self._display: np.ndarray | None = None  # (2,n,3) float32 copied with each step
         self._want_normals = normals
@@ -311,7 +334,7 @@ class RemoteSmoother:
         self.V0 = self._V
         self.normals: np.ndarray | None = None
         self.box: np.ndarray | None = None  # (2,3) min and max of V (the child's)
-        self._pending = False  # a step asked for, its answer not read yet
+        self._pending = 0  # step requests on their way, their answers not read yet
         self._arrived = False  # a step's answer read, not yet collected by poll
         self.error = ""
         self.history: list[dict[str, Any]] = []
@@ -399,11 +422,12 @@ class RemoteSmoother:
         self.volume_note, self.closed = snap["volume_note"], snap["closed"]
         self.history = [snap["last"]] if snap["last"] else []
         self.box = None if snap["box"] is None else np.array(snap["box"])
-        self._V = np.array(self._cur)
+        cur, nrm, shown = self._slots[snap["slot"]]
+        self._V = np.array(cur)
         if self._want_normals:
-            self.normals = np.array(self._nrm)
-        self._view = snap.get("view")
-        self._display = None if self._view is None else np.array(self._shown)
+            self.normals = np.array(nrm)
+        self._view = snap["view"]
+        self._display = None if self._view is None else np.array(shown)
 
     def display(self, view: tuple[float, ...]) -> tuple[np.ndarray, np.ndarray] | None:
         """The current positions and normals ``(n,3) float32`` in the window's coordinates
@@ -469,20 +493,21 @@ class RemoteSmoother:
     @property
     def pending(self) -> bool:
         """A step was asked for and its answer has not been read."""
-        return self._pending
+        return self._pending > 0
 
     def request_step(self, count: int = 1, view: tuple[float, ...] | None = None) -> bool:
-        """Ask for ``count`` steps (shown together) and return at once (False: a request is
-        already on its way). ``view``: the window's display transform (:func:`display_arrays`):
-        the child then also writes the positions and normals as the window uploads them."""
-        if self._pending:
+        """Ask for ``count`` steps (shown together) and return at once (False: already
+        :data:`PIPELINE` requests on their way: the child has work queued). ``view``: the
+        window's display transform (:func:`display_arrays`): the child then also writes the
+        positions and normals as the window uploads them."""
+        if self._pending >= PIPELINE:
             return False
         self._send(("step", max(1, int(count)), view))
-        self._pending = True
+        self._pending += 1
         return True
 
     def poll(self) -> bool:
-        """Read the answer of the step asked for, if it is there (never waits). True when a
+        """Read the answers of the steps asked for that are there (never waits). True when a
         step's answer arrived since the last poll (read here or by a synchronous call).
 
         Raises
@@ -490,8 +515,8 @@ class RemoteSmoother:
         MeshError
             The step failed (e.g. ``W − λK`` could not be factorized) or the child ended.
         """
-        if self._pending and (self._conn.poll() or not self._proc.is_alive()):
-            self._pending = False
+        while self._pending and (self._conn.poll() or not self._proc.is_alive()):
+            self._pending -= 1
             self._wait()
             self._arrived = True
         arrived, self._arrived = self._arrived, False
@@ -502,16 +527,16 @@ class RemoteSmoother:
         self._drain()
 
     def _drain(self) -> None:
-        """Wait for the step on its way (a synchronous call comes after it)."""
-        if self._pending:
-            self._pending = False
+        """Wait for the steps on their way (a synchronous call comes after them)."""
+        while self._pending:
+            self._pending -= 1
             self._wait()
             self._arrived = True
 
     def close(self) -> None:
         """End the child and free the shared block (the proxy is unusable afterwards)."""
         self._V = np.array(self._V)  # own copies: the block goes away
-        self._cur = self._start = self._nrm = self._shown = None  # type: ignore[assignment]
+        self._start, self._slots = None, []  # type: ignore[assignment]
         self._finalizer()
 
     @property

@@ -160,21 +160,24 @@ def smoothing_figures(viewer: Any, state: Any, steps: int = 10) -> dict[str, flo
     viewer.set_panel("smoothing")  # starts the build job
     if st.smoother is None and not panel.building(viewer):  # already the panel shown
         panel.start_build(viewer, raise_errors=False)
-    stall, adopt = 0.0, 0.0
+    stall, adopt, adopt_push = 0.0, 0.0, 0.0
     while st.smoother is None or panel.building(viewer):
         had = st.smoother
+        push_s.clear()
         ps.frame_tick()
         now = time.perf_counter()
         if st.smoother is had:
             stall = max(stall, now - last)  # the job computing: the window should answer
-        else:
-            adopt = now - last  # the frame that adopted the stepper: the smoothed copy
+        else:  # the frame that adopted the stepper: the smoothed copy registered
+            adopt, adopt_push = now - last, sum(push_s)
         last = now
         if now - t0 > 900:
             raise RuntimeError("the smoother was not built in 900 s")
     built = last - t0
+    push_s.clear()
     ps.frame_tick()
     adopt_input = time.perf_counter() - last  # the next frame: the input copy registered
+    adopt_input_push = sum(push_s)
     ps.frame_tick()
     st.toggle_play()
     start, t = st.smoother.iteration, time.perf_counter()
@@ -203,6 +206,8 @@ def smoothing_figures(viewer: Any, state: Any, steps: int = 10) -> dict[str, flo
         "max_stall_smoother_build_s": stall,
         "adopt_frame_s": adopt,
         "adopt_input_frame_s": adopt_input,
+        "adopt_push_s": adopt_push,
+        "adopt_input_push_s": adopt_input_push,
         "live_steps_per_s": done / elapsed,
         "shown_frames_per_s": len(shown) / elapsed,
         "meter_steps_per_s": meter_steps,
@@ -287,7 +292,9 @@ def smoothing_line(r: dict[str, float]) -> str:
         f"smoothing ({where}): build {r['smoother_build_s']:.2f} s, longest stall "
         f"{r['max_stall_smoother_build_s']:.2f} s, then the frame registering the smoothed "
         f"copy {r['adopt_frame_s']:.2f} s and the next, the input copy "
-        f"{r.get('adopt_input_frame_s', float('nan')):.2f} s; play "
+        f"{r.get('adopt_input_frame_s', float('nan')):.2f} s (polyscope's registration in "
+        f"them {r.get('adopt_push_s', float('nan')):.2f} s, "
+        f"{r.get('adopt_input_push_s', float('nan')):.2f} s); play "
         f"{r['live_steps_per_s']:.2f} steps/s computed and "
         f"{r.get('shown_frames_per_s', float('nan')):.2f} frames/s showing a step (the "
         f"panel's meter: {r.get('meter_steps_per_s', float('nan')):.2f} and "

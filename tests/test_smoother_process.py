@@ -12,7 +12,7 @@ import time
 import numpy as np
 import pytest
 from meshlap_app.jobs import Cancelled, Jobs, Reporter
-from meshlap_app.smoother_process import RemoteSmoother, build, vertex_normals
+from meshlap_app.smoother_process import PIPELINE, RemoteSmoother, build, vertex_normals
 from meshlap_app.state.smoothing import MAX_BATCH, SmoothingState
 
 from meshlap_core.errors import MeshError
@@ -72,19 +72,28 @@ def test_child_stepper_matches_the_stepper_in_this_process(mesh, options, spd_ba
 
 
 def test_a_step_asked_for_arrives_later_with_its_normals(mesh):
+    """Up to PIPELINE requests travel at once (the child starts the next while the window
+    draws the last); each answer in its own slot: the positions after all of them are the
+    stepper's here, with their normals."""
     V, F = mesh
     remote = RemoteSmoother.start(V, F, OPTIONS, reporter())
     local = SmoothingState.build(V, F, OPTIONS)
     try:
-        assert remote.request_step() and not remote.request_step()  # one on its way at a time
+        assert all(remote.request_step() for _ in range(PIPELINE))
+        assert not remote.request_step()  # the child has work queued: refused
         wait_for(remote.poll)
-        local.step()
-        assert remote.iteration == 1 and np.abs(remote.V - local.V).max() <= 1e-10
+        remote.finish()
+        for _ in range(PIPELINE):
+            local.step()
+        assert remote.iteration == PIPELINE and np.abs(remote.V - local.V).max() <= 1e-10
         assert np.abs(remote.normals - vertex_normals(local.V, local.F)).max() <= 1e-6
+        remote.poll()
         assert not remote.poll()  # collected once
         remote.request_step()
-        remote.set_lam(0.02)  # a synchronous call waits for the step on its way first
-        assert remote.iteration == 2 and remote.lam == 0.02 and remote.poll()
+        remote.set_lam(0.02)  # a synchronous call waits for the steps on their way first
+        assert remote.iteration == PIPELINE + 1 and remote.lam == 0.02 and remote.poll()
+        local.step()
+        assert np.abs(remote.V - local.V).max() <= 1e-10
     finally:
         remote.close()
 
