@@ -60,6 +60,7 @@ class SmoothingPanel(Panel):
         self._ready: Shown | None = None  # display arrays a build job prepared off the UI thread
         self._input_due = False  # the input copy is registered at the next frame (not this one)
         self._pending_input: np.ndarray | None = None  # its display positions meanwhile
+        self._frame_due = False  # the camera frames the two new copies at the next frame
 
     def on_new_mesh(self, host: Host) -> None:
         self.state.drop()  # a stepper in a child process: the process ends
@@ -67,6 +68,7 @@ class SmoothingPanel(Panel):
             scene.remove_structure(name)
         self.watch.forget()
         self._ready, self._pending_input, self._input_due = None, None, False
+        self._frame_due = False
 
     def show(self, host: Host, active: Panel) -> None:
         if active is self and self.state.smoother is None and not self.building(host):
@@ -143,9 +145,9 @@ class SmoothingPanel(Panel):
         """Upload the current positions (position update; re-register only on a rebuild).
 
         In the window a new stepper's two copies are registered on two frames, the smoothed
-        copy first and the input on the next (polyscope's registration and first draw of a
-        1.4M-face copy is the longest frame; two in one frame froze the window twice as
-        long)."""
+        copy first and the input on the next, and the camera framed on the third
+        (polyscope's registration and first draw of a 1.4M-face copy is the longest frame,
+        0.5 s more to set the camera: one of them per frame)."""
         st = self.state
         if st.smoother is None:
             return
@@ -153,11 +155,17 @@ class SmoothingPanel(Panel):
         if self.watch.changed("registered", st.version, id(st.smoother)):
             self._register(host)
             self.watch.changed("iteration", st.smoother.iteration)
-            host.request_frame()  # a new copy: frame it
-        elif self._input_due:
+            if not self._input_due:
+                host.request_frame()  # a new copy: frame it
+            return
+        if self._input_due:
             self._register_input(host)
-            host.request_frame()
-        elif self.watch.changed("iteration", st.smoother.iteration) or force:
+            self._frame_due = True
+            return
+        if self._frame_due:
+            self._frame_due = False
+            host.request_frame()  # the two new copies
+        if self.watch.changed("iteration", st.smoother.iteration) or force:
             mesh = ps.get_surface_mesh(SMOOTHED)
             self._shown_at = time.perf_counter()
             if st.playing:
