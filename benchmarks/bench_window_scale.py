@@ -178,7 +178,9 @@ def smoothing_figures(viewer: Any, state: Any, steps: int = 10) -> dict[str, flo
     ps.frame_tick()
     adopt_input = time.perf_counter() - last  # the next frame: the input copy registered
     adopt_input_push = sum(push_s)
-    ps.frame_tick()
+    t1 = time.perf_counter()
+    ps.frame_tick()  # the next: the camera frames the two copies (both drawn)
+    framing = time.perf_counter() - t1
     st.toggle_play()
     start, t = st.smoother.iteration, time.perf_counter()
     last, play_stall, shown, solve_ms, pushes = t, 0.0, [], [], []
@@ -207,6 +209,7 @@ def smoothing_figures(viewer: Any, state: Any, steps: int = 10) -> dict[str, flo
         "adopt_frame_s": adopt,
         "adopt_input_frame_s": adopt_input,
         "adopt_push_s": adopt_push,
+        "framing_frame_s": framing,
         "adopt_input_push_s": adopt_input_push,
         "live_steps_per_s": done / elapsed,
         "shown_frames_per_s": len(shown) / elapsed,
@@ -294,7 +297,8 @@ def smoothing_line(r: dict[str, float]) -> str:
         f"copy {r['adopt_frame_s']:.2f} s and the next, the input copy "
         f"{r.get('adopt_input_frame_s', float('nan')):.2f} s (polyscope's registration in "
         f"them {r.get('adopt_push_s', float('nan')):.2f} s, "
-        f"{r.get('adopt_input_push_s', float('nan')):.2f} s); play "
+        f"{r.get('adopt_input_push_s', float('nan')):.2f} s), the next, framing both "
+        f"{r.get('framing_frame_s', float('nan')):.2f} s; play "
         f"{r['live_steps_per_s']:.2f} steps/s computed and "
         f"{r.get('shown_frames_per_s', float('nan')):.2f} frames/s showing a step (the "
         f"panel's meter: {r.get('meter_steps_per_s', float('nan')):.2f} and "
