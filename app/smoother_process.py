@@ -11,12 +11,20 @@ with the stepper's interface (``V``, ``V0``, ``iteration``, ``history``, ``stabi
 ``step``, ``reset``, ``set_lam`` ...) whose commands travel through a pipe and whose positions
 come back through one :class:`multiprocessing.shared_memory.SharedMemory` block::
 
-    [ V current (n,3) float64 | V0, the noisy input (n,3) float64 | normals (n,3) float32 ]
+    [ V0, the noisy input (n,3) float64 | slot 0 | slot 1 ]
+    slot: [ V current (n,3) float64 | normals (n,3) float32 | display P, N (2,n,3) float32 ]
 
 (the mesh itself reaches the child through a second, transient block, read once at its start).
-*play* may ask for several steps at once (:meth:`RemoteSmoother.request_step` with a count).
+*play* may ask for several steps at once (:meth:`RemoteSmoother.request_step` with a count),
+and keeps up to :data:`PIPELINE` requests on their way: the child starts the next batch as
+soon as it has answered one, while the window uploads and draws. Answer ``k`` goes to slot
+``k % PIPELINE`` and the window copies it out when it reads the answer, before it sends the
+request that would reuse the slot. With the window's display transform (sent with each
+request) the child also writes the positions and normals as polyscope takes them
+(:func:`display_arrays`): a play frame's upload is two buffer copies.
 
-Besides the synchronous calls (a session's replay, ``meshlap animate``), a step can be asked
+Besides the synchronous calls (a session replayed in the window, one request per run of steps:
+:meth:`RemoteSmoother.steps`; ``meshlap animate`` steps in its own process, offline), a step can be asked
 for and collected later (:meth:`RemoteSmoother.request_step`, :meth:`RemoteSmoother.poll`):
 the window asks, keeps drawing, and uploads the positions when they arrive. The child also
 computes the vertex normals polyscope's smooth shading uses (:func:`vertex_normals`, the same
