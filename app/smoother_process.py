@@ -24,12 +24,13 @@ request) the child also writes the positions and normals as polyscope takes them
 (:func:`display_arrays`): a play frame's upload is two buffer copies.
 
 Besides the synchronous calls (a session replayed in the window, one request per run of steps:
-:meth:`RemoteSmoother.steps`; ``meshlap animate`` steps in its own process, offline), a step can be asked
-for and collected later (:meth:`RemoteSmoother.request_step`, :meth:`RemoteSmoother.poll`):
-the window asks, keeps drawing, and uploads the positions when they arrive. The child also
-computes the vertex normals polyscope's smooth shading uses (:func:`vertex_normals`, the same
-area-weighted sum as polyscope's ``SurfaceMesh::computeVertexNormals``), so the window
-updates two vertex buffers instead of re-deriving the whole geometry on its own thread.
+:meth:`RemoteSmoother.steps`; ``meshlap animate`` steps in its own process, offline), a step
+can be asked for and collected later (:meth:`RemoteSmoother.request_step`,
+:meth:`RemoteSmoother.poll`): the window asks, keeps drawing, and uploads the positions when
+they arrive. The child also computes the vertex normals polyscope's smooth shading uses
+(:func:`vertex_normals`, the same area-weighted sum as polyscope's
+``SurfaceMesh::computeVertexNormals``), so the window updates two vertex buffers instead of re-
+deriving the whole geometry on its own thread.
 
 Cancel: :meth:`RemoteSmoother.start` ends the child at once; a proxy that is closed or
 garbage-collected ends its child and frees the block. Where no child process can start,
