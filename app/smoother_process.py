@@ -29,8 +29,8 @@ can be asked for and collected later (:meth:`RemoteSmoother.request_step`,
 :meth:`RemoteSmoother.poll`): the window asks, keeps drawing, and uploads the positions when
 they arrive. The child also computes the vertex normals polyscope's smooth shading uses
 (:func:`vertex_normals`, the same area-weighted sum as polyscope's
-``SurfaceMesh::computeVertexNormals``), so the window updates two vertex buffers instead of re-
-deriving the whole geometry on its own thread.
+``SurfaceMesh::computeVertexNormals``), so the window updates two vertex buffers instead of
+re-deriving the whole geometry on its own thread.
 
 Cancel: :meth:`RemoteSmoother.start` ends the child at once; a proxy that is closed or
 garbage-collected ends its child and frees the block. Where no child process can start,
