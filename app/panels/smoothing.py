@@ -60,7 +60,6 @@ class SmoothingPanel(Panel):
         self._ready: Shown | None = None  # display arrays a build job prepared off the UI thread
         self._input_due = False  # the input copy is registered at the next frame (not this one)
         self._pending_input: np.ndarray | None = None  # its display positions meanwhile
-        self._frame_due = False  # the camera frames the two new copies at the next frame
 
     def on_new_mesh(self, host: Host) -> None:
         self.state.drop()  # a stepper in a child process: the process ends
@@ -68,7 +67,6 @@ class SmoothingPanel(Panel):
             scene.remove_structure(name)
         self.watch.forget()
         self._ready, self._pending_input, self._input_due = None, None, False
-        self._frame_due = False
 
     def show(self, host: Host, active: Panel) -> None:
         if active is self and self.state.smoother is None and not self.building(host):
@@ -145,9 +143,10 @@ class SmoothingPanel(Panel):
         """Upload the current positions (position update; re-register only on a rebuild).
 
         In the window a new stepper's two copies are registered on two frames, the smoothed
-        copy first and the input on the next, and the camera framed on the third
-        (polyscope's registration and first draw of a 1.4M-face copy is the longest frame,
-        0.5 s more to set the camera: one of them per frame)."""
+        copy first and the input (and the camera framing both) on the next: polyscope's
+        registration and first draw of a 1.4M-face copy make the longest frames; two in one
+        frame froze the window twice as long. (Framing on a third frame of its own cost one
+        more full redraw of both copies, 1.9–2.4 s at load 5.)"""
         st = self.state
         if st.smoother is None:
             return
@@ -160,11 +159,8 @@ class SmoothingPanel(Panel):
             return
         if self._input_due:
             self._register_input(host)
-            self._frame_due = True
+            host.request_frame()  # the two new copies (redrawn once, framed)
             return
-        if self._frame_due:
-            self._frame_due = False
-            host.request_frame()  # the two new copies
         if self.watch.changed("iteration", st.smoother.iteration) or force:
             mesh = ps.get_surface_mesh(SMOOTHED)
             self._shown_at = time.perf_counter()
