@@ -111,14 +111,14 @@ block, so the child never writes the slot the window is reading)."""
 Slot = tuple[np.ndarray, np.ndarray, np.ndarray]
 
 
-def _blocks(buf: Any, n: int) -> tuple[np.ndarray, list[Slot]]:
+def _blocks(buf: Any, n: int, depth: int) -> tuple[np.ndarray, list[Slot]]:
     """The arrays of the shared block (see the module docstring): ``V0``, then
-    :data:`PIPELINE` slots of (current positions, normals, display positions and normals
-    ``(2,n,3) float32``); answer ``k`` is written into slot ``k % PIPELINE``."""
+    ``depth`` (:data:`PIPELINE`) slots of (current positions, normals, display positions and
+    normals ``(2,n,3) float32``); answer ``k`` is written into slot ``k % depth``."""
     start = np.ndarray((n, 3), dtype=np.float64, buffer=buf, offset=0)
     slots: list[Slot] = []
     offset = 24 * n
-    for _ in range(PIPELINE):
+    for _ in range(depth):
         cur = np.ndarray((n, 3), dtype=np.float64, buffer=buf, offset=offset)
         normals = np.ndarray((n, 3), dtype=np.float32, buffer=buf, offset=offset + 24 * n)
         shown = np.ndarray((2, n, 3), dtype=np.float32, buffer=buf, offset=offset + 36 * n)
@@ -127,8 +127,8 @@ def _blocks(buf: Any, n: int) -> tuple[np.ndarray, list[Slot]]:
     return start, slots
 
 
-def _block_bytes(n: int) -> int:
-    return max(1, (24 + 60 * PIPELINE) * n)
+def _block_bytes(n: int, depth: int) -> int:
+    return max(1, (24 + 60 * depth) * n)
 
 
 def display_arrays(
@@ -172,6 +172,7 @@ def _serve(
     inputs: tuple[str, int, int],
     options: tuple[str, str, float, float, int],
     normals: bool,
+    depth: int = PIPELINE,
 ) -> None:
     """Body of the child: build the stepper (reporting each phase), then answer commands
     (``step`` with a count, ``reset``, ``set_lam``, ``diverge``, ``close``) until ``close`` or
@@ -182,9 +183,9 @@ def _serve(
     V, F = _read_inputs(*inputs)
     shm = shared_memory.SharedMemory(name=name)  # the fork server's children share the
     # parent's resource tracker: only the parent's unlink unregisters the block
-    start, slots = _blocks(shm.buf, len(V))
+    start, slots = _blocks(shm.buf, len(V), depth)
     view: tuple[float, ...] | None = None  # the window's display transform, once sent
-    answers = 0  # answers published: the next goes to slot answers % PIPELINE
+    answers = 0  # answers published: the next goes to slot answers % depth
     try:
         sm = SmoothingState.build(V, F, options, _ChildReporter(conn))
         start[...] = sm.V0
@@ -192,7 +193,7 @@ def _serve(
 
         def publish() -> dict[str, Any]:
             nonlocal answers
-            slot = answers % PIPELINE
+            slot = answers % depth
             cur, nrm, shown = slots[slot]
             snap = _publish(sm, cur, nrm, incidence)
             if view is not None:
@@ -328,6 +329,7 @@ class RemoteSmoother:
         F: IntArray,
         options: tuple[str, str, float, float, int],
         normals: bool,
+        depth: int = PIPELINE,
     ) -> None:
         self._proc, self._conn, self._shm = proc, conn, shm
         self._finalizer = weakref.finalize(self, _shutdown, proc, conn, shm)
@@ -335,7 +337,8 @@ class RemoteSmoother:
         self.n = len(V)
         self.F = F
         self.reference = V
-        self._start, self._slots = _blocks(shm.buf, self.n)
+        self._depth = depth  # requests on their way at most (the child's slots)
+        self._start, self._slots = _blocks(shm.buf, self.n, depth)
         self._view: tuple[float, ...] | None = None  # the view of the display arrays held
         self._display: np.ndarray | None = None  # (2,n,3) float32 copied with each step
         self._want_normals = normals
@@ -371,14 +374,15 @@ class RemoteSmoother:
         """
         V = np.asarray(V, dtype=np.float64)
         F = np.asarray(F, dtype=np.int64)
-        shm = shared_memory.SharedMemory(create=True, size=_block_bytes(len(V)))
+        depth = PIPELINE
+        shm = shared_memory.SharedMemory(create=True, size=_block_bytes(len(V), depth))
         inputs = _write_inputs(V, F)
         try:
             ctx = _context()
             here, there = ctx.Pipe(duplex=True)
             where = (inputs.name, len(V), len(F))
             proc = ctx.Process(
-                target=_serve, args=(there, shm.name, where, options, normals), daemon=True
+                target=_serve, args=(there, shm.name, where, options, normals, depth), daemon=True
             )
             proc.start()
         except BaseException:
@@ -386,7 +390,7 @@ class RemoteSmoother:
             _free(inputs)
             raise
         there.close()
-        proxy = cls(proc, here, shm, V, F, options, normals)
+        proxy = cls(proc, here, shm, V, F, options, normals, depth)
         try:
             proxy._wait(reporter)
         except BaseException:
@@ -509,7 +513,7 @@ class RemoteSmoother:
         :data:`PIPELINE` requests on their way: the child has work queued). ``view``: the
         window's display transform (:func:`display_arrays`): the child then also writes the
         positions and normals as the window uploads them."""
-        if self._pending >= PIPELINE:
+        if self._pending >= self._depth:
             return False
         self._send(("step", max(1, int(count)), view))
         self._pending += 1

@@ -62,6 +62,10 @@ def child(scan: Path, smoothing: bool = True) -> dict[str, float]:
     from meshlap_app.state import AppState
     from meshlap_app.viewer import Viewer, init_polyscope
 
+    if os.environ.get("BENCH_PIPELINE"):  # steps on their way at once (1: no running ahead)
+        from meshlap_app import smoother_process
+
+        smoother_process.PIPELINE = int(os.environ["BENCH_PIPELINE"])
     init_polyscope("openGL3_egl")
     ps.set_max_fps(-1)
     ps.set_window_size(1280, 720)
