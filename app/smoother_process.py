@@ -11,17 +11,26 @@ with the stepper's interface (``V``, ``V0``, ``iteration``, ``history``, ``stabi
 ``step``, ``reset``, ``set_lam`` ...) whose commands travel through a pipe and whose positions
 come back through one :class:`multiprocessing.shared_memory.SharedMemory` block::
 
-    [ V current (n,3) float64 | V0, the noisy input (n,3) float64 | normals (n,3) float32 ]
+    [ V0, the noisy input (n,3) float64 | slot 0 | slot 1 ]
+    slot: [ V current (n,3) float64 | normals (n,3) float32 | display P, N (2,n,3) float32 ]
 
 (the mesh itself reaches the child through a second, transient block, read once at its start).
-*play* may ask for several steps at once (:meth:`RemoteSmoother.request_step` with a count).
+*play* may ask for several steps at once (:meth:`RemoteSmoother.request_step` with a count),
+and keeps up to :data:`PIPELINE` requests on their way: the child starts the next batch as
+soon as it has answered one, while the window uploads and draws. Answer ``k`` goes to slot
+``k % PIPELINE`` and the window copies it out when it reads the answer, before it sends the
+request that would reuse the slot. With the window's display transform (sent with each
+request) the child also writes the positions and normals as polyscope takes them
+(:func:`display_arrays`): a play frame's upload is two buffer copies.
 
-Besides the synchronous calls (a session's replay, ``meshlap animate``), a step can be asked
-for and collected later (:meth:`RemoteSmoother.request_step`, :meth:`RemoteSmoother.poll`):
-the window asks, keeps drawing, and uploads the positions when they arrive. The child also
-computes the vertex normals polyscope's smooth shading uses (:func:`vertex_normals`, the same
-area-weighted sum as polyscope's ``SurfaceMesh::computeVertexNormals``), so the window
-updates two vertex buffers instead of re-deriving the whole geometry on its own thread.
+Besides the synchronous calls (a session replayed in the window, one request per run of steps:
+:meth:`RemoteSmoother.steps`; ``meshlap animate`` steps in its own process, offline), a step
+can be asked for and collected later (:meth:`RemoteSmoother.request_step`,
+:meth:`RemoteSmoother.poll`): the window asks, keeps drawing, and uploads the positions when
+they arrive. The child also computes the vertex normals polyscope's smooth shading uses
+(:func:`vertex_normals`, the same area-weighted sum as polyscope's
+``SurfaceMesh::computeVertexNormals``), so the window updates two vertex buffers instead of
+re-deriving the whole geometry on its own thread.
 
 Cancel: :meth:`RemoteSmoother.start` ends the child at once; a proxy that is closed or
 garbage-collected ends its child and frees the block. Where no child process can start,
@@ -94,17 +103,49 @@ def face_incidence(F: IntArray, n: int) -> sp.csr_matrix:
     return sp.coo_matrix((np.ones(3 * m), (rows, cols)), shape=(n, m)).tocsr()
 
 
-def _blocks(buf: Any, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The three arrays of the shared block (see the module docstring)."""
-    size = 3 * n
-    cur = np.ndarray((n, 3), dtype=np.float64, buffer=buf, offset=0)
-    start = np.ndarray((n, 3), dtype=np.float64, buffer=buf, offset=8 * size)
-    normals = np.ndarray((n, 3), dtype=np.float32, buffer=buf, offset=16 * size)
-    return cur, start, normals
+PIPELINE = 2
+"""Most step requests on their way at once: the child starts the next batch as soon as it has
+answered one, while the window uploads and draws (each answer has its own slot of the shared
+block, so the child never writes the slot the window is reading)."""
+
+Slot = tuple[np.ndarray, np.ndarray, np.ndarray]
 
 
-def _block_bytes(n: int) -> int:
-    return max(1, 20 * 3 * n)
+def _blocks(buf: Any, n: int, depth: int) -> tuple[np.ndarray, list[Slot]]:
+    """The arrays of the shared block (see the module docstring): ``V0``, then
+    ``depth`` (:data:`PIPELINE`) slots of (current positions, normals, display positions and
+    normals ``(2,n,3) float32``); answer ``k`` is written into slot ``k % depth``."""
+    start = np.ndarray((n, 3), dtype=np.float64, buffer=buf, offset=0)
+    slots: list[Slot] = []
+    offset = 24 * n
+    for _ in range(depth):
+        cur = np.ndarray((n, 3), dtype=np.float64, buffer=buf, offset=offset)
+        normals = np.ndarray((n, 3), dtype=np.float32, buffer=buf, offset=offset + 24 * n)
+        shown = np.ndarray((2, n, 3), dtype=np.float32, buffer=buf, offset=offset + 36 * n)
+        slots.append((cur, normals, shown))
+        offset += 60 * n
+    return start, slots
+
+
+def _block_bytes(n: int, depth: int) -> int:
+    return max(1, (24 + 60 * depth) * n)
+
+
+def display_arrays(
+    V: FloatArray, N: np.ndarray | None, view: tuple[float, ...], out: np.ndarray
+) -> None:
+    """The positions ``V (n,3)`` as the window shows them, ``((V − c) s) Rᵀ + shift``, and
+    their normals turned, ``N Rᵀ``, into ``out (2,n,3) float32`` (the child's part of an
+    upload: the window passes them to polyscope as they are).
+
+    ``view`` is ``(c (3), s, R (9, row-major), shift (3))`` flattened (:meth:`RemoteSmoother.
+    request_step`)."""
+    c, s = np.asarray(view[:3]), view[3]
+    R = np.asarray(view[4:13]).reshape(3, 3)
+    np.matmul((V - c) * s, R.T, out=out[0], casting="same_kind")
+    out[0] += np.asarray(view[13:16], dtype=np.float32)
+    if N is not None:
+        np.matmul(N, R.T.astype(np.float32), out=out[1])
 
 
 def _snapshot(sm: Any) -> dict[str, Any]:
@@ -121,6 +162,7 @@ def _snapshot(sm: Any) -> dict[str, Any]:
         "n_factorizations": sm.n_factorizations,
         "volume_note": sm.volume_note,
         "closed": sm.closed,
+        "box": [sm.V.min(axis=0).tolist(), sm.V.max(axis=0).tolist()] if len(sm.V) else None,
     }
 
 
@@ -130,6 +172,7 @@ def _serve(
     inputs: tuple[str, int, int],
     options: tuple[str, str, float, float, int],
     normals: bool,
+    depth: int = PIPELINE,
 ) -> None:
     """Body of the child: build the stepper (reporting each phase), then answer commands
     (``step`` with a count, ``reset``, ``set_lam``, ``diverge``, ``close``) until ``close`` or
@@ -140,12 +183,26 @@ def _serve(
     V, F = _read_inputs(*inputs)
     shm = shared_memory.SharedMemory(name=name)  # the fork server's children share the
     # parent's resource tracker: only the parent's unlink unregisters the block
-    cur, start, nrm = _blocks(shm.buf, len(V))
+    start, slots = _blocks(shm.buf, len(V), depth)
+    view: tuple[float, ...] | None = None  # the window's display transform, once sent
+    answers = 0  # answers published: the next goes to slot answers % depth
     try:
         sm = SmoothingState.build(V, F, options, _ChildReporter(conn))
         start[...] = sm.V0
         incidence = face_incidence(sm.F, len(V)) if normals else None
-        reply: tuple[Any, ...] = ("ready", _publish(sm, cur, nrm, incidence))
+
+        def publish() -> dict[str, Any]:
+            nonlocal answers
+            slot = answers % depth
+            cur, nrm, shown = slots[slot]
+            snap = _publish(sm, cur, nrm, incidence)
+            if view is not None:
+                display_arrays(sm.V, nrm if normals else None, view, shown)
+            snap["view"], snap["slot"] = view, slot
+            answers += 1
+            return snap
+
+        reply: tuple[Any, ...] = ("ready", publish())
         while True:
             conn.send(reply)
             try:
@@ -155,18 +212,19 @@ def _serve(
             if cmd == "close":
                 return
             try:
-                if cmd == "step":  # args: how many (stops at a divergence)
+                if cmd == "step":  # args: how many (stops at a divergence), the view
                     for _ in range(args[0] if args else 1):
-                        sm.step()
                         if sm.diverged:
                             break
+                        sm.step()
+                    view = args[1] if len(args) > 1 and args[1] is not None else view
                 elif cmd == "reset":
                     sm.reset()
                 elif cmd == "set_lam":
                     sm.set_lam(args[0])
                 elif cmd == "diverge":
                     sm.diverged = True
-                reply = ("state", _publish(sm, cur, nrm, incidence))
+                reply = ("state", publish())
             except MeshError as exc:
                 reply = ("error", str(exc))
     except MeshError as exc:
@@ -174,7 +232,8 @@ def _serve(
     except BaseException as exc:  # reported to the parent, never lost
         _send(conn, ("error", f"{type(exc).__name__}: {exc}"))
     finally:
-        del cur, start, nrm
+        slots.clear()  # (no view of the block may outlive it)
+        del start
         shm.close()
         conn.close()
 
@@ -270,6 +329,7 @@ class RemoteSmoother:
         F: IntArray,
         options: tuple[str, str, float, float, int],
         normals: bool,
+        depth: int = PIPELINE,
     ) -> None:
         self._proc, self._conn, self._shm = proc, conn, shm
         self._finalizer = weakref.finalize(self, _shutdown, proc, conn, shm)
@@ -277,12 +337,16 @@ class RemoteSmoother:
         self.n = len(V)
         self.F = F
         self.reference = V
-        self._cur, self._start, self._nrm = _blocks(shm.buf, self.n)
+        self._depth = depth  # requests on their way at most (the child's slots)
+        self._start, self._slots = _blocks(shm.buf, self.n, depth)
+        self._view: tuple[float, ...] | None = None  # the view of the display arrays held
+        self._display: np.ndarray | None = None  # (2,n,3) float32 copied with each step
         self._want_normals = normals
         self._V = np.zeros((self.n, 3))
         self.V0 = self._V
         self.normals: np.ndarray | None = None
-        self._pending = False  # a step asked for, its answer not read yet
+        self.box: np.ndarray | None = None  # (2,3) min and max of V (the child's)
+        self._pending = 0  # step requests on their way, their answers not read yet
         self._arrived = False  # a step's answer read, not yet collected by poll
         self.error = ""
         self.history: list[dict[str, Any]] = []
@@ -310,14 +374,15 @@ class RemoteSmoother:
         """
         V = np.asarray(V, dtype=np.float64)
         F = np.asarray(F, dtype=np.int64)
-        shm = shared_memory.SharedMemory(create=True, size=_block_bytes(len(V)))
+        depth = PIPELINE
+        shm = shared_memory.SharedMemory(create=True, size=_block_bytes(len(V), depth))
         inputs = _write_inputs(V, F)
         try:
             ctx = _context()
             here, there = ctx.Pipe(duplex=True)
             where = (inputs.name, len(V), len(F))
             proc = ctx.Process(
-                target=_serve, args=(there, shm.name, where, options, normals), daemon=True
+                target=_serve, args=(there, shm.name, where, options, normals, depth), daemon=True
             )
             proc.start()
         except BaseException:
@@ -325,7 +390,7 @@ class RemoteSmoother:
             _free(inputs)
             raise
         there.close()
-        proxy = cls(proc, here, shm, V, F, options, normals)
+        proxy = cls(proc, here, shm, V, F, options, normals, depth)
         try:
             proxy._wait(reporter)
         except BaseException:
@@ -369,9 +434,21 @@ class RemoteSmoother:
         self._divergence = snap["divergence"]
         self.volume_note, self.closed = snap["volume_note"], snap["closed"]
         self.history = [snap["last"]] if snap["last"] else []
-        self._V = np.array(self._cur)
+        self.box = None if snap["box"] is None else np.array(snap["box"])
+        cur, nrm, shown = self._slots[snap["slot"]]
+        self._V = np.array(cur)
         if self._want_normals:
-            self.normals = np.array(self._nrm)
+            self.normals = np.array(nrm)
+        self._view = snap["view"]
+        self._display = None if self._view is None else np.array(shown)
+
+    def display(self, view: tuple[float, ...]) -> tuple[np.ndarray, np.ndarray] | None:
+        """The current positions and normals ``(n,3) float32`` in the window's coordinates
+        made by the child for ``view`` (see :func:`display_arrays`), or ``None`` when it made
+        none for this view yet (the next step asked for with ``view`` brings them)."""
+        if self._display is None or self._view != view:
+            return None
+        return self._display[0], self._display[1]
 
     # ------------------------------------------------------------------ the stepper's interface
     @property
@@ -401,6 +478,12 @@ class RemoteSmoother:
         self._call("step")
         return self.V
 
+    def steps(self, count: int) -> FloatArray:
+        """``count`` steps in one request, waiting for them (a session's replay); the child
+        stops at a divergence."""
+        self._call("step", max(1, int(count)))
+        return self.V
+
     def reset(self) -> None:
         self._call("reset")
 
@@ -423,19 +506,21 @@ class RemoteSmoother:
     @property
     def pending(self) -> bool:
         """A step was asked for and its answer has not been read."""
-        return self._pending
+        return self._pending > 0
 
-    def request_step(self, count: int = 1) -> bool:
-        """Ask for ``count`` steps (shown together) and return at once (False: a request is
-        already on its way)."""
-        if self._pending:
+    def request_step(self, count: int = 1, view: tuple[float, ...] | None = None) -> bool:
+        """Ask for ``count`` steps (shown together) and return at once (False: already
+        :data:`PIPELINE` requests on their way: the child has work queued). ``view``: the
+        window's display transform (:func:`display_arrays`): the child then also writes the
+        positions and normals as the window uploads them."""
+        if self._pending >= self._depth:
             return False
-        self._send(("step", max(1, int(count))))
-        self._pending = True
+        self._send(("step", max(1, int(count)), view))
+        self._pending += 1
         return True
 
     def poll(self) -> bool:
-        """Read the answer of the step asked for, if it is there (never waits). True when a
+        """Read the answers of the steps asked for that are there (never waits). True when a
         step's answer arrived since the last poll (read here or by a synchronous call).
 
         Raises
@@ -443,8 +528,8 @@ class RemoteSmoother:
         MeshError
             The step failed (e.g. ``W − λK`` could not be factorized) or the child ended.
         """
-        if self._pending and (self._conn.poll() or not self._proc.is_alive()):
-            self._pending = False
+        while self._pending and (self._conn.poll() or not self._proc.is_alive()):
+            self._pending -= 1
             self._wait()
             self._arrived = True
         arrived, self._arrived = self._arrived, False
@@ -455,16 +540,16 @@ class RemoteSmoother:
         self._drain()
 
     def _drain(self) -> None:
-        """Wait for the step on its way (a synchronous call comes after it)."""
-        if self._pending:
-            self._pending = False
+        """Wait for the steps on their way (a synchronous call comes after them)."""
+        while self._pending:
+            self._pending -= 1
             self._wait()
             self._arrived = True
 
     def close(self) -> None:
         """End the child and free the shared block (the proxy is unusable afterwards)."""
         self._V = np.array(self._V)  # own copies: the block goes away
-        self._cur = self._start = self._nrm = None  # type: ignore[assignment]
+        self._start, self._slots = None, []  # type: ignore[assignment]
         self._finalizer()
 
     @property

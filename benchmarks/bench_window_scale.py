@@ -64,6 +64,10 @@ def child(scan: Path, smoothing: bool = True) -> dict[str, float]:
     from meshlap_app.viewer import Viewer, init_polyscope
 
     warm_up()  # as `meshlap view` does before it creates the window
+    if os.environ.get("BENCH_PIPELINE"):  # steps on their way at once (1: no running ahead)
+        from meshlap_app import smoother_process
+
+        smoother_process.PIPELINE = int(os.environ["BENCH_PIPELINE"])
     init_polyscope("openGL3_egl")
     ps.set_max_fps(-1)
     ps.set_window_size(1280, 720)
@@ -129,10 +133,12 @@ def child(scan: Path, smoothing: bool = True) -> dict[str, float]:
 def smoothing_figures(viewer: Any, state: Any, steps: int = 10) -> dict[str, float]:
     """The smoothing panel on the loaded scan: its implicit cotan stepper built as the panel's
     job (the longest frame meanwhile: the UI stall; then the frame that adopts it, registering
-    and first drawing its two copies of the mesh), then *play* until ``steps`` steps are on
-    screen (steps per second in the window, each step's solve, upload and draw included; the
-    longest frame meanwhile; the frames that uploaded a step; the step's own time in the
-    stepper, ``history[-1]["time_ms"]``).
+    and first drawing the smoothed copy, and the next, registering the input copy: one
+    registration per frame), then *play* until ``steps`` steps are on screen. While playing,
+    two rates counted apart: the steps the stepper computed per second and the frames that
+    showed a new step per second (the child runs ahead: a frame shows the newest step done);
+    the longest frame; the median frame that showed a step and the panel's upload in it (UI
+    thread); the step's own time in the stepper (``history[-1]["time_ms"]``).
 
     With ``state.jobs.processes`` (the window's setting) the stepper lives in a child process
     (:mod:`meshlap_app.smoother_process`) and *play* asks for each step without waiting; without
@@ -144,38 +150,59 @@ def smoothing_figures(viewer: Any, state: Any, steps: int = 10) -> dict[str, flo
     panel = viewer.panels["smoothing"]
     st = panel.state
     st.method, st.laplacian = "implicit", "cotan"
+    push_s: list[float] = []
+    plain_push = panel.push
+
+    def timed_push(host: Any, force: bool = False) -> None:
+        t = time.perf_counter()
+        plain_push(host, force)
+        push_s.append(time.perf_counter() - t)
+
+    panel.push = timed_push  # the panel's upload on the UI thread, frame by frame
     t0 = last = time.perf_counter()
     viewer.set_panel("smoothing")  # starts the build job
     if st.smoother is None and not panel.building(viewer):  # already the panel shown
         panel.start_build(viewer, raise_errors=False)
-    stall, adopt = 0.0, 0.0
+    stall, adopt, adopt_push = 0.0, 0.0, 0.0
     while st.smoother is None or panel.building(viewer):
         had = st.smoother
+        push_s.clear()
         ps.frame_tick()
         now = time.perf_counter()
         if st.smoother is had:
             stall = max(stall, now - last)  # the job computing: the window should answer
-        else:
-            adopt = now - last  # the frame that adopted the stepper: two meshes registered
+        else:  # the frame that adopted the stepper: the smoothed copy registered
+            adopt, adopt_push = now - last, sum(push_s)
         last = now
         if now - t0 > 900:
             raise RuntimeError("the smoother was not built in 900 s")
     built = last - t0
+    push_s.clear()
     ps.frame_tick()
+    adopt_input = time.perf_counter() - last  # the next frame: the input copy registered
+    adopt_input_push = sum(push_s)
+    t1 = time.perf_counter()
+    ps.frame_tick()  # the next: the camera frames the two copies (both drawn)
+    framing = time.perf_counter() - t1
     st.toggle_play()
     start, t = st.smoother.iteration, time.perf_counter()
-    last, play_stall, shown, solve_ms = t, 0.0, [], []
+    last, play_stall, shown, solve_ms, pushes = t, 0.0, [], [], []
     while st.smoother.iteration - start < steps and last - t < 300:
         it = st.smoother.iteration
+        push_s.clear()
         ps.frame_tick()
         now = time.perf_counter()
         play_stall = max(play_stall, now - last)
         if st.smoother.iteration != it:
             shown.append(now - last)  # the frame that uploaded the step and drew it
+            pushes.append(sum(push_s))
             solve_ms.append(st.smoother.history[-1]["time_ms"])
         last = now
     elapsed = last - t
+    meter_steps, meter_frames = st.meter.rates(last)
     st.toggle_play()
+    ps.frame_tick()  # pause: the input copy shown again
+    panel.push = plain_push
     done = st.smoother.iteration - start
     remote = bool(getattr(st.smoother, "asynchronous", False))
     panel.on_new_mesh(viewer)  # the stepper (and its process) goes: the next run starts afresh
@@ -183,9 +210,17 @@ def smoothing_figures(viewer: Any, state: Any, steps: int = 10) -> dict[str, flo
         "smoother_build_s": built,
         "max_stall_smoother_build_s": stall,
         "adopt_frame_s": adopt,
+        "adopt_input_frame_s": adopt_input,
+        "adopt_push_s": adopt_push,
+        "framing_frame_s": framing,
+        "adopt_input_push_s": adopt_input_push,
         "live_steps_per_s": done / elapsed,
+        "shown_frames_per_s": len(shown) / elapsed,
+        "meter_steps_per_s": meter_steps,
+        "meter_frames_per_s": meter_frames,
         "max_stall_playing_s": play_stall,
         "upload_frame_s": float(np.median(shown)) if shown else -1.0,
+        "push_s": float(np.median(pushes)) if pushes else -1.0,
         "step_solve_s": float(np.median(solve_ms)) / 1e3 if solve_ms else -1.0,
         "child_process": float(remote),
     }
@@ -242,7 +277,8 @@ def figures(scan: Path, repeat: int, row: Callable[..., Any] | None = None) -> l
             base=None,
             base_name="",
             note=f"longest UI stall meanwhile {best['max_stall_smoother_build_s']:.2f} s, then "
-            f"the frame registering its two copies {best['adopt_frame_s']:.2f} s",
+            f"the frames registering its two copies {best['adopt_frame_s']:.2f} s and "
+            f"{best['adopt_input_frame_s']:.2f} s",
         ),
         make(
             scan=name,
@@ -250,6 +286,7 @@ def figures(scan: Path, repeat: int, row: Callable[..., Any] | None = None) -> l
             ours=best["live_steps_per_s"],
             base=10.0,
             base_name="target 10 steps/s",
+            note=f"{best['shown_frames_per_s']:.2f} frames/s showing a step",
         ),
     ]
 
@@ -259,10 +296,20 @@ def smoothing_line(r: dict[str, float]) -> str:
     where = "child process" if r["child_process"] else "thread"
     out = (
         f"smoothing ({where}): build {r['smoother_build_s']:.2f} s, longest stall "
-        f"{r['max_stall_smoother_build_s']:.2f} s, then the frame registering the two copies "
-        f"{r['adopt_frame_s']:.2f} s; play {r['live_steps_per_s']:.2f} steps/s, "
-        f"longest stall {r['max_stall_playing_s']:.2f} s, upload+draw frame "
-        f"{r['upload_frame_s']:.2f} s, step in the stepper {r['step_solve_s']:.3f} s"
+        f"{r['max_stall_smoother_build_s']:.2f} s, then the frame registering the smoothed "
+        f"copy {r['adopt_frame_s']:.2f} s and the next, the input copy "
+        f"{r.get('adopt_input_frame_s', float('nan')):.2f} s (polyscope's registration in "
+        f"them {r.get('adopt_push_s', float('nan')):.2f} s, "
+        f"{r.get('adopt_input_push_s', float('nan')):.2f} s), the next, framing both "
+        f"{r.get('framing_frame_s', float('nan')):.2f} s; play "
+        f"{r['live_steps_per_s']:.2f} steps/s computed and "
+        f"{r.get('shown_frames_per_s', float('nan')):.2f} frames/s showing a step (the "
+        f"panel's meter: {r.get('meter_steps_per_s', float('nan')):.2f} and "
+        f"{r.get('meter_frames_per_s', float('nan')):.2f}), longest stall "
+        f"{r['max_stall_playing_s']:.2f} s, frame showing a step "
+        f"{r['upload_frame_s']:.2f} s (the panel's upload in it "
+        f"{r.get('push_s', float('nan')):.2f} s), step in the stepper "
+        f"{r['step_solve_s']:.3f} s"
     )
     if "thread_smoother_build_s" in r:
         out += (

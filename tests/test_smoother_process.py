@@ -12,7 +12,7 @@ import time
 import numpy as np
 import pytest
 from meshlap_app.jobs import Cancelled, Jobs, Reporter
-from meshlap_app.smoother_process import RemoteSmoother, build, vertex_normals
+from meshlap_app.smoother_process import PIPELINE, RemoteSmoother, build, vertex_normals
 from meshlap_app.state.smoothing import MAX_BATCH, SmoothingState
 
 from meshlap_core.errors import MeshError
@@ -72,19 +72,28 @@ def test_child_stepper_matches_the_stepper_in_this_process(mesh, options, spd_ba
 
 
 def test_a_step_asked_for_arrives_later_with_its_normals(mesh):
+    """Up to PIPELINE requests travel at once (the child starts the next while the window
+    draws the last); each answer in its own slot: the positions after all of them are the
+    stepper's here, with their normals."""
     V, F = mesh
     remote = RemoteSmoother.start(V, F, OPTIONS, reporter())
     local = SmoothingState.build(V, F, OPTIONS)
     try:
-        assert remote.request_step() and not remote.request_step()  # one on its way at a time
+        assert all(remote.request_step() for _ in range(PIPELINE))
+        assert not remote.request_step()  # the child has work queued: refused
         wait_for(remote.poll)
-        local.step()
-        assert remote.iteration == 1 and np.abs(remote.V - local.V).max() <= 1e-10
+        remote.finish()
+        for _ in range(PIPELINE):
+            local.step()
+        assert remote.iteration == PIPELINE and np.abs(remote.V - local.V).max() <= 1e-10
         assert np.abs(remote.normals - vertex_normals(local.V, local.F)).max() <= 1e-6
+        remote.poll()
         assert not remote.poll()  # collected once
         remote.request_step()
-        remote.set_lam(0.02)  # a synchronous call waits for the step on its way first
-        assert remote.iteration == 2 and remote.lam == 0.02 and remote.poll()
+        remote.set_lam(0.02)  # a synchronous call waits for the steps on their way first
+        assert remote.iteration == PIPELINE + 1 and remote.lam == 0.02 and remote.poll()
+        local.step()
+        assert np.abs(remote.V - local.V).max() <= 1e-10
     finally:
         remote.close()
 
@@ -300,3 +309,174 @@ def test_without_child_processes_the_stepper_is_built_here(mesh, monkeypatch):
     local = SmoothingState.build(V, F, OPTIONS)
     local.step()
     assert np.abs(got.V - local.V).max() <= 1e-10
+
+
+def test_a_new_steppers_copies_are_registered_one_per_frame(viewer):
+    """In the window the frame that adopts a stepper registers the smoothed copy only, the
+    next one the input (one polyscope registration per frame), each at the display positions
+    the build job prepared; framing reads each copy's box from eight corners, the box of the
+    positions uploaded."""
+    import polyscope as ps
+    from meshlap_app.scene import SMOOTH_INPUT, SMOOTHED, box_of, front_view, side_offset
+
+    viewer.background = True
+    viewer.state.jobs.processes = True
+    panel = viewer.panels["smoothing"]
+    st = panel.state
+    st.method, st.laplacian, st.lam, st.noise_alpha = "implicit", "cotan", 0.01, 0.01
+    try:
+        panel.on_new_mesh(viewer)
+        viewer.set_panel("smoothing")
+        wait_for(lambda: (ps.frame_tick(), st.smoother is not None)[1])
+        assert ps.has_surface_mesh(SMOOTHED) and not ps.has_surface_mesh(SMOOTH_INPUT)
+        ps.frame_tick()
+        assert ps.has_surface_mesh(SMOOTH_INPUT)
+        d, n = viewer.state.display, len(st.V)
+        shown_in = host_values(ps.get_surface_mesh(SMOOTH_INPUT).get_buffer("vertexPositions"), n)
+        assert np.abs(shown_in - d.points(st.V_start)).max() <= 1e-5
+        shown = host_values(ps.get_surface_mesh(SMOOTHED).get_buffer("vertexPositions"), n)
+        shift = shown[0] - d.points(st.V[:1])[0]
+        assert np.abs(shown - (d.points(st.V) + shift)).max() <= 1e-5
+        expected = side_offset(d.points(st.V_start), front_view(viewer.state.mesh.name))
+        assert np.abs(shift - expected).max() <= 1e-5  # beside the input
+        for name, P in ((SMOOTH_INPUT, shown_in), (SMOOTHED, shown)):
+            corners = panel.points(viewer, name)
+            assert corners.shape == (8, 3)
+            assert np.abs(box_of(corners) - box_of(P)).max() <= 1e-5
+        assert not st.error and not any(viewer.state.errors.values()), viewer.state.errors
+    finally:
+        panel.on_new_mesh(viewer)
+
+
+def test_prepared_display_arrays_are_the_displayed_positions(mesh):
+    """:func:`prepare_shown` (the build job's thread) gives the display transform of the input
+    and of the current positions, the copy shifted by ``side_offset`` of the input."""
+    from meshlap_app.panels.smoothing import prepare_shown
+    from meshlap_app.scene import side_offset
+    from meshlap_app.state.display import Display
+
+    V, F = mesh
+    local = SmoothingState.build(V, F, OPTIONS)
+    local.step()
+    d = Display()
+    d.fit(V, "z")
+    front = (0.0, 0.15, -1.0)
+    view = (tuple(d.centre.tolist()), d.scale, tuple(map(tuple, d.rotation.tolist())), front)
+    shown = prepare_shown(local, view)
+    shift = side_offset(d.points(local.V0), front)
+    assert np.abs(shown.P_in - d.points(local.V0)).max() <= 1e-12
+    assert np.abs(shown.P - (d.points(local.V) + shift)).max() <= 1e-12
+    assert np.allclose(shown.box_in, [local.V0.min(axis=0), local.V0.max(axis=0)])
+    assert shown.N is None  # an in-process stepper has no normals: polyscope derives them
+
+
+def test_play_hides_the_input_copy_of_a_big_mesh_and_pause_shows_it(viewer, monkeypatch):
+    """Above ``LARGE_MESH_FACES`` (lowered here) *play* draws the smoothed copy alone, says so,
+    and the caption of the input goes; pause shows the input again."""
+    import polyscope as ps
+    from meshlap_app.panels import smoothing
+    from meshlap_app.scene import SMOOTH_INPUT
+
+    panel = viewer.panels["smoothing"]
+    st = panel.state
+    viewer.set_panel("smoothing")
+    ps.frame_tick()
+    assert ps.get_surface_mesh(SMOOTH_INPUT).is_enabled()
+    monkeypatch.setattr(smoothing, "LARGE_MESH_FACES", 0)
+    panel.on_key(viewer, "space")
+    ps.frame_tick()
+    assert st.playing and not ps.get_surface_mesh(SMOOTH_INPUT).is_enabled()
+    assert SMOOTH_INPUT not in panel.captions(viewer)
+    panel.on_key(viewer, "space")
+    ps.frame_tick()
+    assert not st.playing and ps.get_surface_mesh(SMOOTH_INPUT).is_enabled()
+    assert SMOOTH_INPUT in panel.captions(viewer)
+    monkeypatch.setattr(smoothing, "LARGE_MESH_FACES", 10**12)
+    panel.on_key(viewer, "space")  # a small mesh keeps both copies while playing
+    ps.frame_tick()
+    assert ps.get_surface_mesh(SMOOTH_INPUT).is_enabled()
+    panel.on_key(viewer, "space")
+    panel.on_new_mesh(viewer)
+
+
+def test_play_meter_counts_steps_and_frames_apart():
+    """Hand-counted: play from t=10; steps arrive 2 at t=11 and 3 at t=12, frames show a
+    step at t=11 and t=12: 2.5 steps/s and 1 frame/s at t=12; events older than the window
+    are forgotten; a pause keeps the rates of its moment."""
+    from meshlap_app.state.play_meter import METER_WINDOW_S, PlayMeter
+
+    m = PlayMeter()
+    assert m.rates(5.0) == (0.0, 0.0)
+    m.start(10.0)
+    m.stepped(11.0, 2)
+    m.shown(11.0)
+    m.stepped(12.0, 3)
+    m.shown(12.0)
+    assert m.rates(12.0) == pytest.approx((2.5, 1.0))
+    late = 11.0 + METER_WINDOW_S + 0.5  # the events of t=11 are out of the window
+    assert m.rates(late) == pytest.approx((3 / METER_WINDOW_S, 1 / METER_WINDOW_S))
+    m.stop(12.0)
+    assert m.rates(100.0) == pytest.approx((2.5, 1.0))
+
+
+def test_a_session_replayed_in_the_window_steps_in_a_child_process(viewer):
+    """Restoring a saved run in the window builds the child-process stepper (as the panel's
+    builds do) and replays each run of steps, at its λ, in one request: the positions and
+    the counts of the same run stepped here."""
+    panel = viewer.panels["smoothing"]
+    st = panel.state
+    viewer.background = True
+    viewer.state.jobs.processes = True
+    values = {
+        "method": "implicit",
+        "laplacian": "cotan",
+        "lam": 0.02,
+        "noise_alpha": 0.01,
+        "seed": 3,
+        "iterations": 5,
+        "lam_steps": [[0.01, 3], [0.02, 2]],
+    }
+    try:
+        panel.restore(viewer, values, active=True)
+        assert isinstance(st.smoother, RemoteSmoother)
+        assert st.smoother.iteration == 5 and st.lam_steps == [[0.01, 3], [0.02, 2]]
+        V, F = viewer.state.mesh.V, viewer.state.mesh.F
+        local = SmoothingState.build(V, F, ("implicit", "cotan", 0.01, 0.01, 3))
+        for _ in range(3):
+            local.step()
+        local.set_lam(0.02)
+        for _ in range(2):
+            local.step()
+        assert np.abs(st.V - local.V).max() <= 1e-10
+        assert panel.capture(viewer)["lam_steps"] == [[0.01, 3], [0.02, 2]]
+    finally:
+        panel.on_new_mesh(viewer)
+
+
+def test_the_child_makes_the_display_arrays_of_the_view_asked_for(mesh):
+    """A step asked for with the window's view brings the positions and normals in display
+    coordinates (``((V − c) s) Rᵀ + shift``, ``N Rᵀ``), made by the child; another view has
+    none until asked for."""
+    from meshlap_app.state.display import Display
+
+    V, F = mesh
+    d = Display()
+    d.fit(V, "z")  # a rotation that permutes and flips axes
+    shift = np.array([0.7, 0.0, -0.1])
+    view = (*d.centre.tolist(), d.scale, *d.rotation.ravel().tolist(), *shift.tolist())
+    remote = RemoteSmoother.start(V, F, OPTIONS, reporter())
+    try:
+        assert remote.display(view) is None  # none asked for yet
+        remote.request_step(2, view)
+        wait_for(remote.poll)
+        P, N = remote.display(view)
+        assert P.dtype == np.float32 and N.dtype == np.float32
+        assert np.abs(P - (d.points(remote.V) + shift)).max() <= 1e-5
+        assert np.abs(N - remote.normals @ d.rotation.T).max() <= 1e-6
+        other = (*view[:-3], 0.0, 0.0, 0.0)
+        assert remote.display(other) is None
+        remote.reset()  # the view stays with the child: the arrays follow every answer
+        P, _ = remote.display(view)
+        assert np.abs(P - (d.points(remote.V0) + shift)).max() <= 1e-5
+    finally:
+        remote.close()

@@ -197,9 +197,10 @@ def test_a_692k_scan_opens_without_freezing_and_idles(tmp_path):
 
 
 MAX_SHOW_S = 60.0
-"""Longest still screen before the stepper's two copies appear once it is built: both 1.4M-
+"""Longest still screen before the stepper's two copies appear once it is built: the 1.4M-
 triangle copies registered and drawn for the first time on the UI thread (polyscope owns the
-GL context; 9–21 s measured at load 8–12 by ``benchmarks/bench_window_scale.py``)."""
+GL context), one per frame: 1.1–3.8 s each at load 1.5–6.5 by
+``benchmarks/bench_window_scale.py`` (both in one frame: 9–21 s at load 8–12 before)."""
 
 
 def two_subjects(img: np.ndarray) -> bool:

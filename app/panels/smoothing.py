@@ -3,8 +3,10 @@
 
 from __future__ import annotations
 
+import threading
 import time
 from collections.abc import Iterator
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -14,8 +16,17 @@ from meshlap_core.errors import MeshError
 from meshlap_core.options import LAPLACIAN_KINDS, SMOOTHING_METHODS
 
 from .. import scene, smoother_process
+from ..jobs import Reporter
 from ..record import Recorder, draw_record
-from ..scene import INPUT_COLOR, SMOOTH_INPUT, SMOOTHED, SMOOTHED_COLOR, front_view, side_offset
+from ..scene import (
+    INPUT_COLOR,
+    LARGE_MESH_FACES,
+    SMOOTH_INPUT,
+    SMOOTHED,
+    SMOOTHED_COLOR,
+    front_view,
+    side_offset,
+)
 from ..state.smoothing import (
     ANIMATION,
     SmoothingState,
@@ -46,12 +57,16 @@ class SmoothingPanel(Panel):
         self.state: SmoothingState = state
         self.recorder = Recorder(f"{name}.gif")
         self._shown_at: float | None = None  # when push last uploaded new steps
+        self._ready: Shown | None = None  # display arrays a build job prepared off the UI thread
+        self._input_due = False  # the input copy is registered at the next frame (not this one)
+        self._pending_input: np.ndarray | None = None  # its display positions meanwhile
 
     def on_new_mesh(self, host: Host) -> None:
         self.state.drop()  # a stepper in a child process: the process ends
         for name in (SMOOTHED, SMOOTH_INPUT):
             scene.remove_structure(name)
         self.watch.forget()
+        self._ready, self._pending_input, self._input_due = None, None, False
 
     def show(self, host: Host, active: Panel) -> None:
         if active is self and self.state.smoother is None and not self.building(host):
@@ -59,6 +74,7 @@ class SmoothingPanel(Panel):
         for name in (SMOOTHED, SMOOTH_INPUT):
             if ps.has_surface_mesh(name):
                 ps.get_surface_mesh(name).set_enabled(active is self)
+        self._show_input()
 
     def rebuild(self, host: Host) -> None:
         if self.state.rebuild(host.state.mesh.V, host.state.mesh.F):
@@ -78,9 +94,13 @@ class SmoothingPanel(Panel):
         options = st.plan(**changes)
         V, F = host.state.mesh.V, host.state.mesh.F
 
-        def apply(smoother: Any) -> None:
+        view = view_of(host)
+
+        def apply(result: tuple[Any, Shown]) -> None:
+            smoother, self._ready = result
             st.adopt_built(options, smoother)
-            self.push(host, force=True)
+            if not host.background:  # (the window: the panel's draw this frame registers it,
+                self.push(host, force=True)  # the input copy at the next one)
 
         def fail(message: str) -> None:
             if raise_errors and not host.background:
@@ -92,11 +112,13 @@ class SmoothingPanel(Panel):
             # the window: the stepper lives in a child process (CHOLMOD holds the GIL while
             # it factorizes, which froze the window for seconds from a thread)
             def work(reporter: Any) -> Any:
-                return smoother_process.build(V, F, options, reporter, st.build)
+                smoother = smoother_process.build(V, F, options, reporter, st.build)
+                return smoother, prepare_shown(smoother, view)  # off the UI thread
         else:
 
             def work(reporter: Any) -> Any:
-                return st.build(V, F, options, reporter)
+                smoother = st.build(V, F, options, reporter)
+                return smoother, prepare_shown(smoother, view)
 
         jobs.start(
             self.name,
@@ -107,14 +129,24 @@ class SmoothingPanel(Panel):
             background=host.background,
         )
 
+    def _shift_key(self, host: Host) -> tuple[Any, ...]:
+        d = host.state.display
+        return (self.state.version, d.scale, *d.centre.tolist(), *view_of(host)[3])
+
     def _shift(self, host: Host) -> np.ndarray:
         st, d = self.state, host.state.display
         front = front_view(host.state.mesh.name)
-        key = (st.version, d.scale, *d.centre.tolist(), *front)
-        return self.watch.cached("shift", key, lambda: side_offset(d.points(st.V_start), front))
+        make = lambda: side_offset(d.points(st.V_start), front)  # noqa: E731
+        return self.watch.cached("shift", self._shift_key(host), make)
 
     def push(self, host: Host, force: bool = False) -> None:
-        """Upload the current positions (position update; re-register only on a rebuild)."""
+        """Upload the current positions (position update; re-register only on a rebuild).
+
+        In the window a new stepper's two copies are registered on two frames, the smoothed
+        copy first and the input (and the camera framing both) on the next: polyscope's
+        registration and first draw of a 1.4M-face copy make the longest frames; two in one
+        frame froze the window twice as long. (Framing on a third frame of its own cost one
+        more full redraw of both copies, 1.9–2.4 s at load 5.)"""
         st = self.state
         if st.smoother is None:
             return
@@ -122,65 +154,138 @@ class SmoothingPanel(Panel):
         if self.watch.changed("registered", st.version, id(st.smoother)):
             self._register(host)
             self.watch.changed("iteration", st.smoother.iteration)
-            host.request_frame()  # a new copy: frame it
-        elif self.watch.changed("iteration", st.smoother.iteration) or force:
+            if not self._input_due:
+                host.request_frame()  # a new copy: frame it
+            return
+        if self._input_due:
+            self._register_input(host)
+            host.request_frame()  # the two new copies (redrawn once, framed)
+            return
+        if self.watch.changed("iteration", st.smoother.iteration) or force:
             mesh = ps.get_surface_mesh(SMOOTHED)
+            self._shown_at = time.perf_counter()
+            if st.playing:
+                st.meter.shown(self._shown_at)
+            made = getattr(st.smoother, "display", None)
+            ready = made(self.view_key(host)) if made is not None else None
+            if ready is not None:  # the child made them in the window's coordinates
+                upload_positions(mesh, *ready)
+                return
             P = d.points(st.V) + self._shift(host)
             N = getattr(st.smoother, "normals", None)
-            self._shown_at = time.perf_counter()
             if N is None:
                 mesh.update_vertex_positions(P)
             else:  # the child computed the normals: two buffers, no geometry re-derived here
                 upload_positions(mesh, P, N @ d.rotation.T.astype(np.float32))
 
+    def view_key(self, host: Host) -> tuple[float, ...]:
+        """The smoothed copy's display transform, flattened for the child process
+        (:func:`meshlap_app.smoother_process.display_arrays`): centre, scale, rotation, shift."""
+        d = host.state.display
+        R = np.asarray(d.rotation, dtype=float).ravel()
+        shift = self._shift(host)
+        return (*d.centre.tolist(), float(d.scale), *R.tolist(), *np.asarray(shift).tolist())
+
+    def _shown(self, host: Host) -> Shown:
+        """The display arrays of the stepper at its adoption: those its build job prepared
+        (off the UI thread) when made for this stepper and display, else made here."""
+        st = self.state
+        ready, self._ready = self._ready, None
+        if ready is None or ready.smoother is not st.smoother or ready.view != view_of(host):
+            ready = prepare_shown(st.smoother, view_of(host))
+        return ready
+
     def _register(self, host: Host) -> None:
         """Show a new stepper: the input (with its noise) stays put, the smoothed copy moves
         beside it. The two structures of the previous stepper of this mesh (same faces) get
-        new positions instead of being registered again (0.5–1 s each at 692k vertices)."""
-        st, d = self.state, host.state.display
+        new positions instead of being registered again (0.5–1 s each at 692k vertices);
+        new ones are registered from display arrays made off the UI thread
+        (:func:`prepare_shown`), the input one frame later in the window."""
+        st = self.state
         assert st.smoother is not None
-        P_in = d.points(st.V_start)
-        P = d.points(st.V) + self._shift(host)
-        N = getattr(st.smoother, "normals", None)
-        N = None if N is None else N @ d.rotation.T.astype(np.float32)
-        N_in = N if st.smoother.iteration == 0 else None  # V is V0: the input's normals
+        shown = self._shown(host)
+        self.watch.cached("shift", self._shift_key(host), lambda: shown.shift)
+        self.watch.cached("input box", (st.version,), lambda: shown.box_in)
+        self._input_due = False
         if all(
             ps.has_surface_mesh(name)
-            and ps.get_surface_mesh(name).n_vertices() == len(P)
+            and ps.get_surface_mesh(name).n_vertices() == len(shown.P)
             and ps.get_surface_mesh(name).n_faces() == len(st.F)
             for name in (SMOOTH_INPUT, SMOOTHED)
         ):
-            for name, points, normals in ((SMOOTH_INPUT, P_in, N_in), (SMOOTHED, P, N)):
+            for name, points, normals in (
+                (SMOOTH_INPUT, shown.P_in, shown.N_in),
+                (SMOOTHED, shown.P, shown.N),
+            ):
                 mesh = ps.get_surface_mesh(name)
                 if normals is None:
                     mesh.update_vertex_positions(points)
                 else:
                     upload_positions(mesh, points, normals)
             return
-        inp = ps.register_surface_mesh(SMOOTH_INPUT, P_in, st.F, smooth_shade=True)
-        inp.set_color(INPUT_COLOR)
-        sm = ps.register_surface_mesh(SMOOTHED, P, st.F, smooth_shade=True)
-        sm.set_color(SMOOTHED_COLOR)  # (their normals are derived at their first draw: a
+        for name in (SMOOTH_INPUT, SMOOTHED):
+            scene.remove_structure(name)  # (another mesh's copies, if any)
+        sm = ps.register_surface_mesh(SMOOTHED, shown.P, st.F, smooth_shade=True)
+        sm.set_color(SMOOTHED_COLOR)  # (its normals are derived at its first draw: a
         # buffer that polyscope has not filled yet refuses data)
+        self._pending_input = shown.P_in
+        if host.background:
+            self._input_due = True  # the next frame: one registration per frame
+        else:
+            self._register_input(host)
+
+    def _register_input(self, host: Host) -> None:
+        """Register the input copy (the second of a new stepper's two copies)."""
+        self._input_due = False
+        P_in, self._pending_input = self._pending_input, None
+        if P_in is None or self.state.smoother is None:
+            return
+        inp = ps.register_surface_mesh(SMOOTH_INPUT, P_in, self.state.F, smooth_shade=True)
+        inp.set_color(INPUT_COLOR)
+        inp.set_enabled(ps.get_surface_mesh(SMOOTHED).is_enabled() and not self._hidden_input())
+
+    def _hidden_input(self) -> bool:
+        """The input copy is hidden while *play* runs on a big mesh: the renderer then draws
+        one copy instead of two (with software OpenGL, each frame is about halved)."""
+        st = self.state
+        return st.playing and len(st.F) > LARGE_MESH_FACES
+
+    def _show_input(self) -> None:
+        """Hide the input copy while *play* runs on a big mesh, show it on pause."""
+        if not ps.has_surface_mesh(SMOOTH_INPUT) or not ps.has_surface_mesh(SMOOTHED):
+            return
+        want = ps.get_surface_mesh(SMOOTHED).is_enabled() and not self._hidden_input()
+        mesh = ps.get_surface_mesh(SMOOTH_INPUT)
+        if mesh.is_enabled() != want:
+            mesh.set_enabled(want)
 
     def points(self, host: Host, name: str) -> np.ndarray | None:
-        """Display positions of a structure this panel registered (for camera framing)."""
+        """Display positions of a structure this panel registered, for camera framing: the
+        eight corners of its bounding box (framing reads only the box; made from the
+        positions' box in mesh coordinates, as the display's rotation permutes axes)."""
         st = self.state
-        if st.smoother is None:
+        if st.smoother is None or name not in (SMOOTHED, SMOOTH_INPUT):
             return None
-        if name == SMOOTHED:
-            return host.state.display.points(st.V) + self._shift(host)
-        return host.state.display.points(st.V_start) if name == SMOOTH_INPUT else None
+        d = host.state.display
+        if name == SMOOTH_INPUT:
+            lo, hi = self.watch.cached("input box", (st.version,), lambda: model_box(st.V_start))
+            return corners(d.points(np.array([lo, hi])))
+        box = getattr(st.smoother, "box", None)
+        lo, hi = box if box is not None else model_box(st.V)
+        return corners(d.points(np.array([lo, hi]))) + self._shift(host)
 
     def captions(self, host: Host) -> dict[str, str]:
         sm = self.state
         if sm.smoother is None:
             return {}
         noisy = f"noisy alpha = {sm.noise_alpha:g}" if sm.noise_alpha else "no noise"
-        return {
+        out = {
             SMOOTH_INPUT: f"input, {noisy}",
             SMOOTHED: f"{sm.method}, lambda = {sm.lam:g}, {plural(sm.smoother.iteration, 'step')}",
         }
+        if self._hidden_input():
+            del out[SMOOTH_INPUT]  # hidden while play runs
+        return out
 
     def export_items(self, host: Host) -> list[ExportItem]:
         """The smoothed mesh as it is now (PLY)."""
@@ -233,15 +338,28 @@ class SmoothingPanel(Panel):
         st = self.state
         runs = replay_steps(values)
         st.lam = runs[0][0] if runs else values["lam"]  # the stepper is built with the first λ
-        if not st.rebuild(host.state.mesh.V, host.state.mesh.F):
+        if not st.rebuild(host.state.mesh.V, host.state.mesh.F, self._builder(host)):
             st.lam = values["lam"]  # (set_lam would clear the error the panel shows)
             return
         for lam, steps in runs:
             st.set_lam(lam)
-            if not all(st.step() for _ in range(steps)):
+            if not st.run(steps):
                 break  # a diverging run stops where it stopped when it was saved
         st.set_lam(values["lam"])
         self.push(host, force=True)
+
+    def _builder(self, host: Host) -> Any:
+        """How a session's replay builds its stepper: in the window, in a child process as
+        the panel's own builds (the factor lives there; *play* goes on from it), each run of
+        steps one request; elsewhere (``meshlap animate``, tests: offline) in this process."""
+        st = self.state
+        if not (host.background and host.state.jobs.processes):
+            return None
+
+        def build(V: Any, F: Any, options: Any) -> Any:
+            return smoother_process.build(V, F, options, Reporter(threading.Event()), st.build)
+
+        return build
 
     def start(self, host: Host, options: dict[str, Any], shown: bool, screenshot: bool) -> None:
         if shown:
@@ -318,16 +436,36 @@ class SmoothingPanel(Panel):
             self.push(host, force=True)
         if self._shown_at is not None:  # the frame that showed new steps has been drawn
             st.show_s, self._shown_at = time.perf_counter() - self._shown_at, None
+        if st.asynchronous:
+            st.view = self.view_key(host)  # asked for with the steps: the child transforms
         st.poll()  # a step a child process finished (never waits)
         if st.playing:
             st.play_step()
+        self._show_input()
         self.push(host)
         if st.error:
             ui.error(st.error)
+        self.draw_rates(ui)
         self.draw_figures(ui)
         it = st.smoother.iteration if st.smoother is not None else None
         fps = ANIMATION.fps[ANIMATION.kind({})]
         draw_record(host, self.recorder, (st.version, it), lambda: caption(st), fps)
+
+    def draw_rates(self, ui: UI) -> None:
+        """While *play* runs (and after it, the last run's): the steps computed per second and
+        the frames that showed a step per second, counted apart (the stepper runs ahead of the
+        window on a big mesh); on a big mesh, that the input copy is hidden meanwhile."""
+        st = self.state
+        if st.meter.started is None:
+            return
+        now = time.perf_counter()
+        if not st.playing:
+            st.meter.stop(now)
+        steps, frames = st.meter.rates(now)
+        what = "playing" if st.playing else "last play"
+        ui.text(f"{what}: {steps:.2f} steps/s computed, {frames:.2f} frames/s showing a step")
+        if self._hidden_input():
+            ui.text("the input copy is hidden while playing (one copy to draw); pause shows it")
 
     def draw_figures(self, ui: UI) -> None:
         """Iteration, RMSE, volume change, the stable limit and the amplification plot."""
@@ -418,9 +556,66 @@ def upload_positions(mesh: Any, P: np.ndarray, N: np.ndarray) -> None:
     if not normals.has_data():  # not drawn yet: polyscope fills it at the first draw
         mesh.update_vertex_positions(P)
         return
-    mesh.get_buffer("vertexPositions").update_data(np.asarray(P, dtype=np.float64))
+    single = np.asarray(P).dtype == np.float32  # (polyscope keeps float32: no conversion)
+    mesh.get_buffer("vertexPositions").update_data(P if single else np.asarray(P, np.float64))
     normals.update_data(np.asarray(N, dtype=np.float32))
     ps.request_redraw()
+
+
+@dataclass
+class Shown:
+    """What a new stepper's two copies show, in display coordinates: made by
+    :func:`prepare_shown` in the build job's thread (numpy releases the GIL), so the frame that
+    registers them does no per-vertex arithmetic."""
+
+    smoother: Any
+    view: tuple[Any, ...]  # :func:`view_of` when made
+    P_in: np.ndarray  # (n,3) the input (noisy) copy
+    P: np.ndarray  # (n,3) the smoothed copy, shifted beside it
+    N: np.ndarray | None  # (n,3) float32 its normals (display frame), when the stepper has them
+    N_in: np.ndarray | None  # the input's (the same at iteration 0)
+    shift: np.ndarray  # (3,) the smoothed copy's offset
+    box_in: np.ndarray  # (2,3) the input's box in mesh coordinates
+
+
+def view_of(host: Host) -> tuple[Any, ...]:
+    """The display transform and the mesh's front view (what the copies' positions depend on):
+    ``(centre, scale, rotation, front)`` as tuples (compared, hashed)."""
+    d = host.state.display
+    rot = tuple(map(tuple, np.asarray(d.rotation, dtype=float).tolist()))
+    return (tuple(d.centre.tolist()), float(d.scale), rot, front_view(host.state.mesh.name))
+
+
+def prepare_shown(smoother: Any, view: tuple[Any, ...]) -> Shown:
+    """The display arrays of ``smoother``'s two copies for ``view`` (:func:`view_of`); any
+    thread (no polyscope call)."""
+    centre, scale, rot, front = view
+    c, R = np.asarray(centre), np.asarray(rot)
+    V0 = np.asarray(smoother.V0, dtype=np.float64)
+    P_in = ((V0 - c) * scale) @ R.T
+    shift = side_offset(P_in, front)
+    if smoother.iteration == 0:
+        P = P_in + shift
+    else:
+        P = ((np.asarray(smoother.V, dtype=np.float64) - c) * scale) @ R.T + shift
+    N = getattr(smoother, "normals", None)
+    N = None if N is None else N @ R.T.astype(np.float32)
+    N_in = N if smoother.iteration == 0 else None
+    return Shown(smoother, view, P_in, P, N, N_in, shift, model_box(V0))
+
+
+def model_box(V: np.ndarray) -> np.ndarray:
+    """``[min, max]`` ``(2,3)`` of the positions ``V (n,3)`` (zeros when empty)."""
+    V = np.asarray(V, dtype=np.float64)
+    return np.array([V.min(axis=0), V.max(axis=0)]) if len(V) else np.zeros((2, 3))
+
+
+def corners(box: np.ndarray) -> np.ndarray:
+    """The eight corners ``(8,3)`` of the box spanned by the two points ``box (2,3)``."""
+    lo, hi = np.minimum(box[0], box[1]), np.maximum(box[0], box[1])
+    return np.array(
+        [[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])]
+    )
 
 
 PANEL = SmoothingPanel

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import math
+import time
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -19,6 +20,7 @@ from meshlap_core.types import FloatArray, IntArray
 
 from .animation import Animation, Option
 from .checks import Schema, integer, number, one_of
+from .play_meter import PlayMeter
 
 MAX_BATCH = 8
 """Most steps *play* asks a child-process stepper for at once
@@ -56,11 +58,15 @@ class SmoothingState:
     last_move: float | None = None  # RMS displacement of the last step *play* took
     asked_at: int = 0  # iteration when a child-process stepper was last asked for a step
     show_s: float = 0.0  # how long the window's last frame showing a new step took
+    meter: PlayMeter = field(default_factory=PlayMeter)  # steps/s and frames/s of play
+    view: tuple[float, ...] | None = None  # the window's display transform, for the child
 
     def toggle_play(self) -> None:
         """*play* / *pause* (the button and ``space``)."""
         self.playing = not self.playing
         self.last_move = None
+        if self.playing:
+            self.meter.start(time.perf_counter())
 
     def play_step(self) -> bool:
         """One step of *play*. Beyond the stable ``λ`` (the stability warning is shown), *play*
@@ -86,6 +92,7 @@ class SmoothingState:
         before = np.array(s.V, dtype=float)
         if not self.step():
             return False
+        self.meter.stepped(time.perf_counter(), 1)
         move = float(np.sqrt(np.mean(np.sum((np.asarray(s.V) - before) ** 2, axis=1))))
         return self._check_growth(move)
 
@@ -140,7 +147,7 @@ class SmoothingState:
         elif not s.diverged:
             self.asked_at = s.iteration
             try:
-                s.request_step(count)
+                s.request_step(count, self.view)
             except MeshError as exc:
                 self.error, self.playing = str(exc), False
 
@@ -161,6 +168,8 @@ class SmoothingState:
         stepped = s.iteration > self.asked_at
         for _ in range(s.iteration - self.asked_at):
             self._count_step(s.lam)
+        if stepped and self.playing:
+            self.meter.stepped(time.perf_counter(), s.iteration - self.asked_at)
         self.asked_at = s.iteration
         if s.diverged:
             self.playing = False
@@ -176,14 +185,15 @@ class SmoothingState:
         if hasattr(old, "close"):
             old.close()
 
-    def rebuild(self, V: FloatArray, F: IntArray) -> bool:
+    def rebuild(self, V: FloatArray, F: IntArray, build: Any = None) -> bool:
         """Build the stepper for the current options from the clean mesh ``V`` (+ noise).
 
         ``V`` and ``F`` are passed on once: the smoother keeps its own validated copies
-        (``V0``, ``F``, ``reference``) and this state reads them from there.
+        (``V0``, ``F``, ``reference``) and this state reads them from there. ``build``: how
+        (``build(V, F, options)``; default :meth:`build`, in this process).
         """
         try:
-            smoother = self.build(V, F, self.options())
+            smoother = (build or self.build)(V, F, self.options())
         except MeshError as exc:
             self.error = str(exc)
             self.playing = False
@@ -358,6 +368,31 @@ class SmoothingState:
             s.step()
             if s.iteration > done:  # a step taken (a diverging one is discarded)
                 self._count_step(s.lam)
+        if s.diverged:
+            self.playing = False
+            self.error = f"{s.divergence_message()}; press reset"
+            return False
+        return True
+
+    def run(self, count: int) -> bool:
+        """``count`` steps at once (a saved session's replay), stopping where the flow
+        diverges (:meth:`step`); a child-process stepper takes them in one request.
+
+        Returns
+        -------
+        bool
+            False when the run stopped (diverged).
+        """
+        s = self.smoother
+        if s is None:
+            return False
+        many = getattr(s, "steps", None)
+        if many is None or s.diverged:
+            return all(self.step() for _ in range(count))
+        done = s.iteration
+        many(count)
+        for _ in range(s.iteration - done):
+            self._count_step(s.lam)
         if s.diverged:
             self.playing = False
             self.error = f"{s.divergence_message()}; press reset"
