@@ -751,3 +751,37 @@ def test_one_name_per_thing() -> None:
     s = surfaces.torus(R=2.0, r=0.5)
     V, _ = primitives.torus_mesh(8, 6, R=2.0, r=0.5)
     np.testing.assert_allclose(mesh_surface(s, (8, 6)).V, V, atol=1e-14)
+
+
+def test_closed_form_2x2_eigen_matches_lapack() -> None:
+    # the principal curvatures' closed-form eigen-decomposition against numpy's eigh, including
+    # near-umbilic, diagonal and tiny/huge matrices (eigenvectors compared up to sign)
+    from meshlap_core.surfaces.geometry import _symmetric_eigen_2x2
+
+    rng = np.random.default_rng(7)
+    a, b, c = rng.normal(size=(3, 4000)) * 10.0 ** rng.uniform(-6, 6, (1, 4000))
+    b[:500] *= 1e-13  # nearly diagonal
+    c[500:1000] = a[500:1000] * (1 + 1e-9)  # nearly umbilic with an off-diagonal part
+    b[1000:1100] = 0.0
+    a[1100:1200] = c[1100:1200] + 1e-7 * b[1100:1200]  # d ≈ 0: the two formulas meet
+    k1, k2, y1 = _symmetric_eigen_2x2(a, b, c)
+    lam, Y = np.linalg.eigh(np.stack([np.stack([a, b], -1), np.stack([b, c], -1)], -2))
+    scale = np.maximum(np.abs(a), np.maximum(np.abs(b), np.abs(c)))
+    assert np.all(k1 >= k2)
+    np.testing.assert_allclose(k1 / scale, lam[:, 1] / scale, rtol=0, atol=1e-14)
+    np.testing.assert_allclose(k2 / scale, lam[:, 0] / scale, rtol=0, atol=1e-14)
+    np.testing.assert_allclose(np.linalg.norm(y1, axis=1), 1.0, atol=1e-15)
+    # A y1 = k1 y1 (residual relative to the matrix's size), and y1 = ±eigh's vector where the
+    # gap is large enough for the vector to be well defined
+    res = (
+        np.stack([a * y1[:, 0] + b * y1[:, 1], b * y1[:, 0] + c * y1[:, 1]], -1) - k1[:, None] * y1
+    )
+    assert np.max(np.linalg.norm(res, axis=1) / scale) < 1e-14
+    gap = (k1 - k2) / scale
+    well = gap > 1e-6
+    cos = np.abs(np.einsum("ij,ij->i", y1, Y[:, :, 1]))
+    np.testing.assert_allclose(cos[well], 1.0, atol=1e-12)
+    # the zero matrix: eigenvalues 0, the u direction
+    z = np.zeros(1)
+    k1, k2, y1 = _symmetric_eigen_2x2(z, z, z)
+    assert k1[0] == k2[0] == 0.0 and y1.tolist() == [[1.0, 0.0]]

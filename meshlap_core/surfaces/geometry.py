@@ -14,7 +14,7 @@ import numpy as np
 from ..errors import MeshError
 from ..types import BoolArray, FloatArray
 from .catalogue import ParametricSurface, check_uv, get_surface
-from .derivatives import DerivativeMethod, surface_derivatives
+from .derivatives import DerivativeMethod, Derivatives, surface_derivatives
 from .singular import singular_description, singular_mask
 
 CLASSIFICATIONS: tuple[str, ...] = ("elliptic", "hyperbolic", "parabolic", "planar", "umbilic")
@@ -48,7 +48,11 @@ class CurvatureFields:
 
 
 def surface_curvature_fields(
-    surface: ParametricSurface | str, u: Any, v: Any, method: DerivativeMethod = "auto"
+    surface: ParametricSurface | str,
+    u: Any,
+    v: Any,
+    method: DerivativeMethod = "auto",
+    derivatives: Derivatives | None = None,
 ) -> CurvatureFields:
     """Vectorized fundamental forms and curvatures at ``(u, v)`` (no domain check).
 
@@ -57,6 +61,9 @@ def surface_curvature_fields(
     surface : ParametricSurface or str
     u, v : array_like, broadcastable to a shape ``S``
     method : see :func:`surface_derivatives`
+    derivatives : Derivatives, optional
+        ``surface_derivatives(surface, u, v, method)`` when the caller has it already (then
+        ``method`` is not used): no second evaluation.
 
     Returns
     -------
@@ -70,10 +77,11 @@ def surface_curvature_fields(
     principal curvatures are the eigenvalues of the shape operator ``I⁻¹II``, computed stably
     as those of the symmetric ``L⁻¹ II L⁻ᵀ`` (``I = LLᵀ``, Cholesky), so that ``κ₁ − κ₂`` is
     accurate to rounding even at umbilics; the principal parameter directions are
-    ``w = L⁻ᵀ y`` for its unit eigenvectors ``y`` (so ``wᵀ I w = 1``).
+    ``w = L⁻ᵀ y`` for its unit eigenvectors ``y`` (so ``wᵀ I w = 1``), both in closed form
+    (:func:`_symmetric_eigen_2x2`).
     """
     surface = get_surface(surface)
-    D = surface_derivatives(surface, u, v, method)
+    D = surface_derivatives(surface, u, v, method) if derivatives is None else derivatives
     N = np.cross(D.p_u, D.p_v)
     nn = np.linalg.norm(N, axis=-1)
     singular = singular_mask(surface, u, v, N)
@@ -93,17 +101,15 @@ def surface_curvature_fields(
         a = m11 * m11 * e
         b = m11 * (m21 * e + m22 * f)
         c = m21 * m21 * e + 2 * m21 * m22 * f + m22 * m22 * g
-    S = np.stack([np.stack([a, b], -1), np.stack([b, c], -1)], -2)
-    S = np.where(singular[..., None, None], 0.0, S)
-    lam, Y = np.linalg.eigh(S)  # ascending
-    k2, k1 = lam[..., 0], lam[..., 1]
+    a, b, c = (np.where(singular, 0.0, x) for x in (a, b, c))
+    k1, k2, y1 = _symmetric_eigen_2x2(a, b, c)
     # at umbilics every direction is principal: report u (k1) and its metric-orthogonal (k2)
     umb = np.abs(k1 - k2) <= 1e-12 * np.maximum(1.0, np.maximum(np.abs(k1), np.abs(k2)))
-    Y = np.where(umb[..., None, None], np.eye(2), Y[..., ::-1])  # columns: y1 (k1), y2 (k2)
-    Mt = np.zeros(S.shape)  # L^{-T} = M^T = [[m11, m21], [0, m22]]
-    Mt[..., 0, 0], Mt[..., 0, 1], Mt[..., 1, 1] = m11, m21, m22
-    W = Mt @ Y
-    w1, w2 = W[..., :, 0], W[..., :, 1]
+    y1 = np.where(umb[..., None], np.array([1.0, 0.0]), y1)
+    # w = L^{-T} y, L^{-T} = M^T = [[m11, m21], [0, m22]]; y2 = y1 turned by +90°
+    x, y = y1[..., 0], y1[..., 1]
+    w1 = np.stack([m11 * x + m21 * y, m22 * y], -1)
+    w2 = np.stack([m21 * x - m11 * y, m22 * x], -1)
     nan = np.where(singular, np.nan, 1.0)
     return CurvatureFields(
         n=n,
@@ -121,6 +127,31 @@ def surface_curvature_fields(
         w2=w2 * nan[..., None],
         singular=singular,
     )
+
+
+def _symmetric_eigen_2x2(
+    a: np.ndarray, b: np.ndarray, c: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Eigen-decomposition of the symmetric ``[[a, b], [b, c]]`` in closed form (batched).
+
+    ``λ = m ± r`` with ``m = (a + c)/2``, ``r = hypot((a − c)/2, b)`` (so ``λ₁ − λ₂ = 2r`` has
+    no cancellation); the unit eigenvector of ``λ₁`` is ``(d + r, b)`` for ``d = (a − c)/2 ≥ 0``
+    and ``(b, r − d)`` otherwise (the sum of two non-negative numbers: no cancellation either).
+
+    Returns
+    -------
+    k1, k2 : float arrays of the broadcast shape ``S``, ``k1 ≥ k2``
+    y1 : S + (2,) float
+        Unit eigenvector of ``k1`` (``(1, 0)`` where ``r = 0``).
+    """
+    mid, d = 0.5 * (a + c), 0.5 * (a - c)
+    r = np.hypot(d, b)
+    pos = d >= 0
+    y = np.stack([np.where(pos, d + r, b), np.where(pos, b, r - d)], -1)
+    ny = np.hypot(y[..., 0], y[..., 1])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        y1 = np.where((ny > 0)[..., None], y / ny[..., None], np.array([1.0, 0.0]))
+    return mid + r, mid - r, y1
 
 
 def normal_curvature(
@@ -305,7 +336,7 @@ def point_geometry(
         raise MeshError("expected a single number", "u" if uu.ndim else "v")
     uf, vf = float(uu), float(vv)
     D = surface_derivatives(surface, uf, vf, method)
-    cf = surface_curvature_fields(surface, uf, vf, method)
+    cf = surface_curvature_fields(surface, uf, vf, derivatives=D)
     _require_regular(surface, cf, uf, vf)
     dirs_uv, dirs_3d, angles = [], [], []
     for w in (cf.w1, cf.w2):
