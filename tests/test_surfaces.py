@@ -785,3 +785,17 @@ def test_closed_form_2x2_eigen_matches_lapack() -> None:
     z = np.zeros(1)
     k1, k2, y1 = _symmetric_eigen_2x2(z, z, z)
     assert k1[0] == k2[0] == 0.0 and y1.tolist() == [[1.0, 0.0]]
+
+
+@pytest.mark.parametrize("name", [*surfaces.SURFACES, "flat_helicoid"])
+def test_mesh_boundary_is_the_edges_used_once(name: str) -> None:
+    # the boundary mask of mesh_surface (read off the grid when there is no pole) against the
+    # definition: the vertices of edges used by exactly one face
+    from meshlap_core.topology import boundary_vertex_mask
+
+    s = get_surface("helicoid", c=0.0) if name == "flat_helicoid" else get_surface(name)
+    for res in [(1, 1), (1, 4), (3, 3), (4, 7), (7, 3), (12, 5)]:
+        if (s.closed_u and res[0] < 3) or (s.closed_v and res[1] < 3):
+            continue
+        m = mesh_surface(s, res)
+        np.testing.assert_array_equal(m.boundary, boundary_vertex_mask(m.F, len(m.V)))

@@ -181,12 +181,23 @@ def mesh_surface(surface: ParametricSurface | str, res: int | Sequence[int] = 32
     V = surface(uv[:, 0], uv[:, 1])
     collapsed = np.bincount(idx.ravel(), minlength=Nu * Nv) > 1
     pole = collapsed[used]
+    if surface.poles:
+        boundary = boundary_vertex_mask(F, len(V))
+    else:
+        # a plain grid (every cell two proper triangles, closed sides wrap over >= 3 cells):
+        # the boundary is the rectangle's open sides, no edge table needed
+        side = np.zeros((Nu, Nv), dtype=bool)
+        if not surface.closed_u:
+            side[[0, -1], :] = True
+        if not surface.closed_v:
+            side[:, [0, -1]] = True
+        boundary = side.ravel()[used]
     return SurfaceMesh(
         V=np.ascontiguousarray(V, dtype=np.float64),
         F=np.ascontiguousarray(F),
         uv=uv,
         pole=pole,
-        boundary=boundary_vertex_mask(F, len(V)),
+        boundary=boundary,
         surface=surface.name,
         res=(nu, nv),
     )
