@@ -753,10 +753,10 @@ def test_one_name_per_thing() -> None:
     np.testing.assert_allclose(mesh_surface(s, (8, 6)).V, V, atol=1e-14)
 
 
-def test_closed_form_2x2_eigen_matches_lapack() -> None:
+def test_eig_sym2_matches_lapack() -> None:
     # the principal curvatures' closed-form eigen-decomposition against numpy's eigh, including
     # near-umbilic, diagonal and tiny/huge matrices (eigenvectors compared up to sign)
-    from meshlap_core.surfaces.geometry import _symmetric_eigen_2x2
+    from meshlap_core.principal import eig_sym2
 
     rng = np.random.default_rng(7)
     a, b, c = rng.normal(size=(3, 4000)) * 10.0 ** rng.uniform(-6, 6, (1, 4000))
@@ -764,7 +764,8 @@ def test_closed_form_2x2_eigen_matches_lapack() -> None:
     c[500:1000] = a[500:1000] * (1 + 1e-9)  # nearly umbilic with an off-diagonal part
     b[1000:1100] = 0.0
     a[1100:1200] = c[1100:1200] + 1e-7 * b[1100:1200]  # d ≈ 0: the two formulas meet
-    k1, k2, y1 = _symmetric_eigen_2x2(a, b, c)
+    k1, k2, cs, sn = eig_sym2(a, b, c)
+    y1 = np.stack([cs, sn], -1)
     lam, Y = np.linalg.eigh(np.stack([np.stack([a, b], -1), np.stack([b, c], -1)], -2))
     scale = np.maximum(np.abs(a), np.maximum(np.abs(b), np.abs(c)))
     assert np.all(k1 >= k2)
@@ -783,7 +784,8 @@ def test_closed_form_2x2_eigen_matches_lapack() -> None:
     np.testing.assert_allclose(cos[well], 1.0, atol=1e-12)
     # the zero matrix: eigenvalues 0, the u direction
     z = np.zeros(1)
-    k1, k2, y1 = _symmetric_eigen_2x2(z, z, z)
+    k1, k2, cs, sn = eig_sym2(z, z, z)
+    y1 = np.stack([cs, sn], -1)
     assert k1[0] == k2[0] == 0.0 and y1.tolist() == [[1.0, 0.0]]
 
 

@@ -12,6 +12,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import MeshError
+from ..principal import eig_sym2
 from ..types import BoolArray, FloatArray
 from .catalogue import ParametricSurface, check_uv, get_surface
 from .derivatives import DerivativeMethod, Derivatives, surface_derivatives
@@ -78,7 +79,7 @@ def surface_curvature_fields(
     as those of the symmetric ``L⁻¹ II L⁻ᵀ`` (``I = LLᵀ``, Cholesky), so that ``κ₁ − κ₂`` is
     accurate to rounding even at umbilics; the principal parameter directions are
     ``w = L⁻ᵀ y`` for its unit eigenvectors ``y`` (so ``wᵀ I w = 1``), both in closed form
-    (:func:`_symmetric_eigen_2x2`).
+    (:func:`~meshlap_core.principal.eig_sym2`).
     """
     surface = get_surface(surface)
     D = surface_derivatives(surface, u, v, method) if derivatives is None else derivatives
@@ -102,7 +103,8 @@ def surface_curvature_fields(
         b = m11 * (m21 * e + m22 * f)
         c = m21 * m21 * e + 2 * m21 * m22 * f + m22 * m22 * g
     a, b, c = (np.where(singular, 0.0, x) for x in (a, b, c))
-    k1, k2, y1 = _symmetric_eigen_2x2(a, b, c)
+    k1, k2, cos, sin = eig_sym2(a, b, c)
+    y1 = np.stack([cos, sin], -1)
     # at umbilics every direction is principal: report u (k1) and its metric-orthogonal (k2)
     umb = np.abs(k1 - k2) <= 1e-12 * np.maximum(1.0, np.maximum(np.abs(k1), np.abs(k2)))
     y1 = np.where(umb[..., None], np.array([1.0, 0.0]), y1)
@@ -127,31 +129,6 @@ def surface_curvature_fields(
         w2=w2 * nan[..., None],
         singular=singular,
     )
-
-
-def _symmetric_eigen_2x2(
-    a: np.ndarray, b: np.ndarray, c: np.ndarray
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Eigen-decomposition of the symmetric ``[[a, b], [b, c]]`` in closed form (batched).
-
-    ``λ = m ± r`` with ``m = (a + c)/2``, ``r = hypot((a − c)/2, b)`` (so ``λ₁ − λ₂ = 2r`` has
-    no cancellation); the unit eigenvector of ``λ₁`` is ``(d + r, b)`` for ``d = (a − c)/2 ≥ 0``
-    and ``(b, r − d)`` otherwise (the sum of two non-negative numbers: no cancellation either).
-
-    Returns
-    -------
-    k1, k2 : float arrays of the broadcast shape ``S``, ``k1 ≥ k2``
-    y1 : S + (2,) float
-        Unit eigenvector of ``k1`` (``(1, 0)`` where ``r = 0``).
-    """
-    mid, d = 0.5 * (a + c), 0.5 * (a - c)
-    r = np.hypot(d, b)
-    pos = d >= 0
-    y = np.stack([np.where(pos, d + r, b), np.where(pos, b, r - d)], -1)
-    ny = np.hypot(y[..., 0], y[..., 1])
-    with np.errstate(invalid="ignore", divide="ignore"):
-        y1 = np.where((ny > 0)[..., None], y / ny[..., None], np.array([1.0, 0.0]))
-    return mid + r, mid - r, y1
 
 
 def normal_curvature(
