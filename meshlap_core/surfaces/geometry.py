@@ -103,15 +103,14 @@ def surface_curvature_fields(
         b = m11 * (m21 * e + m22 * f)
         c = m21 * m21 * e + 2 * m21 * m22 * f + m22 * m22 * g
     a, b, c = (np.where(singular, 0.0, x) for x in (a, b, c))
-    k1, k2, cos, sin = eig_sym2(a, b, c)
-    y1 = np.stack([cos, sin], -1)
+    k1, k2, x, y = eig_sym2(a, b, c)  # y1 = (x, y), the unit eigenvector of k1
     # at umbilics every direction is principal: report u (k1) and its metric-orthogonal (k2)
     umb = np.abs(k1 - k2) <= 1e-12 * np.maximum(1.0, np.maximum(np.abs(k1), np.abs(k2)))
-    y1 = np.where(umb[..., None], np.array([1.0, 0.0]), y1)
+    x, y = np.where(umb, 1.0, x), np.where(umb, 0.0, y)
     # w = L^{-T} y, L^{-T} = M^T = [[m11, m21], [0, m22]]; y2 = y1 turned by +90°
-    x, y = y1[..., 0], y1[..., 1]
-    w1 = np.stack([m11 * x + m21 * y, m22 * y], -1)
-    w2 = np.stack([m21 * x - m11 * y, m22 * x], -1)
+    w1, w2 = np.empty((*np.shape(k1), 2)), np.empty((*np.shape(k1), 2))
+    w1[..., 0], w1[..., 1] = m11 * x + m21 * y, m22 * y
+    w2[..., 0], w2[..., 1] = m21 * x - m11 * y, m22 * x
     nan = np.where(singular, np.nan, 1.0)
     return CurvatureFields(
         n=n,
