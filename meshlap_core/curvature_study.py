@@ -101,8 +101,8 @@ def exact_principal(m: SurfaceMesh, surface: ParametricSurface | str) -> ExactPr
     """The exact ``κ₁ ≥ κ₂``, ``H``, ``K`` and directions at the vertices of ``m``."""
     s = get_surface(surface)
     u, v = m.uv[:, 0], m.uv[:, 1]
-    cf = surface_curvature_fields(s, u, v)
     D = surface_derivatives(s, u, v)
+    cf = surface_curvature_fields(s, u, v, derivatives=D)
     dirs = []
     for w in (cf.w1, cf.w2):
         d = w[:, :1] * D.p_u + w[:, 1:] * D.p_v

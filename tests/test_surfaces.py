@@ -751,3 +751,53 @@ def test_one_name_per_thing() -> None:
     s = surfaces.torus(R=2.0, r=0.5)
     V, _ = primitives.torus_mesh(8, 6, R=2.0, r=0.5)
     np.testing.assert_allclose(mesh_surface(s, (8, 6)).V, V, atol=1e-14)
+
+
+def test_eig_sym2_matches_lapack() -> None:
+    # the principal curvatures' closed-form eigen-decomposition against numpy's eigh, including
+    # near-umbilic, diagonal and tiny/huge matrices (eigenvectors compared up to sign)
+    from meshlap_core.principal import eig_sym2
+
+    rng = np.random.default_rng(7)
+    a, b, c = rng.normal(size=(3, 4000)) * 10.0 ** rng.uniform(-6, 6, (1, 4000))
+    b[:500] *= 1e-13  # nearly diagonal
+    c[500:1000] = a[500:1000] * (1 + 1e-9)  # nearly umbilic with an off-diagonal part
+    b[1000:1100] = 0.0
+    a[1100:1200] = c[1100:1200] + 1e-7 * b[1100:1200]  # d ≈ 0: the two formulas meet
+    k1, k2, cs, sn = eig_sym2(a, b, c)
+    y1 = np.stack([cs, sn], -1)
+    lam, Y = np.linalg.eigh(np.stack([np.stack([a, b], -1), np.stack([b, c], -1)], -2))
+    scale = np.maximum(np.abs(a), np.maximum(np.abs(b), np.abs(c)))
+    assert np.all(k1 >= k2)
+    np.testing.assert_allclose(k1 / scale, lam[:, 1] / scale, rtol=0, atol=1e-14)
+    np.testing.assert_allclose(k2 / scale, lam[:, 0] / scale, rtol=0, atol=1e-14)
+    np.testing.assert_allclose(np.linalg.norm(y1, axis=1), 1.0, atol=1e-15)
+    # A y1 = k1 y1 (residual relative to the matrix's size), and y1 = ±eigh's vector where the
+    # gap is large enough for the vector to be well defined
+    res = (
+        np.stack([a * y1[:, 0] + b * y1[:, 1], b * y1[:, 0] + c * y1[:, 1]], -1) - k1[:, None] * y1
+    )
+    assert np.max(np.linalg.norm(res, axis=1) / scale) < 1e-14
+    gap = (k1 - k2) / scale
+    well = gap > 1e-6
+    cos = np.abs(np.einsum("ij,ij->i", y1, Y[:, :, 1]))
+    np.testing.assert_allclose(cos[well], 1.0, atol=1e-12)
+    # the zero matrix: eigenvalues 0, the u direction
+    z = np.zeros(1)
+    k1, k2, cs, sn = eig_sym2(z, z, z)
+    y1 = np.stack([cs, sn], -1)
+    assert k1[0] == k2[0] == 0.0 and y1.tolist() == [[1.0, 0.0]]
+
+
+@pytest.mark.parametrize("name", [*surfaces.SURFACES, "flat_helicoid"])
+def test_mesh_boundary_is_the_edges_used_once(name: str) -> None:
+    # the boundary mask of mesh_surface (read off the grid when there is no pole) against the
+    # definition: the vertices of edges used by exactly one face
+    from meshlap_core.topology import boundary_vertex_mask
+
+    s = get_surface("helicoid", c=0.0) if name == "flat_helicoid" else get_surface(name)
+    for res in [(1, 1), (1, 4), (3, 3), (4, 7), (7, 3), (12, 5)]:
+        if (s.closed_u and res[0] < 3) or (s.closed_v and res[1] < 3):
+            continue
+        m = mesh_surface(s, res)
+        np.testing.assert_array_equal(m.boundary, boundary_vertex_mask(m.F, len(m.V)))

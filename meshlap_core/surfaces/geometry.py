@@ -12,9 +12,10 @@ from typing import Any
 import numpy as np
 
 from ..errors import MeshError
+from ..principal import eig_sym2
 from ..types import BoolArray, FloatArray
 from .catalogue import ParametricSurface, check_uv, get_surface
-from .derivatives import DerivativeMethod, surface_derivatives
+from .derivatives import DerivativeMethod, Derivatives, surface_derivatives
 from .singular import singular_description, singular_mask
 
 CLASSIFICATIONS: tuple[str, ...] = ("elliptic", "hyperbolic", "parabolic", "planar", "umbilic")
@@ -48,7 +49,11 @@ class CurvatureFields:
 
 
 def surface_curvature_fields(
-    surface: ParametricSurface | str, u: Any, v: Any, method: DerivativeMethod = "auto"
+    surface: ParametricSurface | str,
+    u: Any,
+    v: Any,
+    method: DerivativeMethod = "auto",
+    derivatives: Derivatives | None = None,
 ) -> CurvatureFields:
     """Vectorized fundamental forms and curvatures at ``(u, v)`` (no domain check).
 
@@ -57,6 +62,9 @@ def surface_curvature_fields(
     surface : ParametricSurface or str
     u, v : array_like, broadcastable to a shape ``S``
     method : see :func:`surface_derivatives`
+    derivatives : Derivatives, optional
+        ``surface_derivatives(surface, u, v, method)`` when the caller has it already (then
+        ``method`` is not used): no second evaluation.
 
     Returns
     -------
@@ -70,10 +78,11 @@ def surface_curvature_fields(
     principal curvatures are the eigenvalues of the shape operator ``I⁻¹II``, computed stably
     as those of the symmetric ``L⁻¹ II L⁻ᵀ`` (``I = LLᵀ``, Cholesky), so that ``κ₁ − κ₂`` is
     accurate to rounding even at umbilics; the principal parameter directions are
-    ``w = L⁻ᵀ y`` for its unit eigenvectors ``y`` (so ``wᵀ I w = 1``).
+    ``w = L⁻ᵀ y`` for its unit eigenvectors ``y`` (so ``wᵀ I w = 1``), both in closed form
+    (:func:`~meshlap_core.principal.eig_sym2`).
     """
     surface = get_surface(surface)
-    D = surface_derivatives(surface, u, v, method)
+    D = surface_derivatives(surface, u, v, method) if derivatives is None else derivatives
     N = np.cross(D.p_u, D.p_v)
     nn = np.linalg.norm(N, axis=-1)
     singular = singular_mask(surface, u, v, N)
@@ -93,17 +102,15 @@ def surface_curvature_fields(
         a = m11 * m11 * e
         b = m11 * (m21 * e + m22 * f)
         c = m21 * m21 * e + 2 * m21 * m22 * f + m22 * m22 * g
-    S = np.stack([np.stack([a, b], -1), np.stack([b, c], -1)], -2)
-    S = np.where(singular[..., None, None], 0.0, S)
-    lam, Y = np.linalg.eigh(S)  # ascending
-    k2, k1 = lam[..., 0], lam[..., 1]
+    a, b, c = (np.where(singular, 0.0, x) for x in (a, b, c))
+    k1, k2, x, y = eig_sym2(a, b, c)  # y1 = (x, y), the unit eigenvector of k1
     # at umbilics every direction is principal: report u (k1) and its metric-orthogonal (k2)
     umb = np.abs(k1 - k2) <= 1e-12 * np.maximum(1.0, np.maximum(np.abs(k1), np.abs(k2)))
-    Y = np.where(umb[..., None, None], np.eye(2), Y[..., ::-1])  # columns: y1 (k1), y2 (k2)
-    Mt = np.zeros(S.shape)  # L^{-T} = M^T = [[m11, m21], [0, m22]]
-    Mt[..., 0, 0], Mt[..., 0, 1], Mt[..., 1, 1] = m11, m21, m22
-    W = Mt @ Y
-    w1, w2 = W[..., :, 0], W[..., :, 1]
+    x, y = np.where(umb, 1.0, x), np.where(umb, 0.0, y)
+    # w = L^{-T} y, L^{-T} = M^T = [[m11, m21], [0, m22]]; y2 = y1 turned by +90°
+    w1, w2 = np.empty((*np.shape(k1), 2)), np.empty((*np.shape(k1), 2))
+    w1[..., 0], w1[..., 1] = m11 * x + m21 * y, m22 * y
+    w2[..., 0], w2[..., 1] = m21 * x - m11 * y, m22 * x
     nan = np.where(singular, np.nan, 1.0)
     return CurvatureFields(
         n=n,
@@ -305,7 +312,7 @@ def point_geometry(
         raise MeshError("expected a single number", "u" if uu.ndim else "v")
     uf, vf = float(uu), float(vv)
     D = surface_derivatives(surface, uf, vf, method)
-    cf = surface_curvature_fields(surface, uf, vf, method)
+    cf = surface_curvature_fields(surface, uf, vf, derivatives=D)
     _require_regular(surface, cf, uf, vf)
     dirs_uv, dirs_3d, angles = [], [], []
     for w in (cf.w1, cf.w2):

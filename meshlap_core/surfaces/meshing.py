@@ -173,20 +173,35 @@ def mesh_surface(surface: ParametricSurface | str, res: int | Sequence[int] = 32
     if "v1" in surface.poles:
         idx[:, -1] = idx[0, -1]
     F = idx.ravel()[_grid_faces(Nu, Nv, surface.closed_u, surface.closed_v)]
-    F = F[(F[:, 0] != F[:, 1]) & (F[:, 1] != F[:, 2]) & (F[:, 2] != F[:, 0])]
-    used, Fc = np.unique(F, return_inverse=True)
-    F = Fc.reshape(-1, 3).astype(np.int64)
+    if surface.poles:
+        F = F[(F[:, 0] != F[:, 1]) & (F[:, 1] != F[:, 2]) & (F[:, 2] != F[:, 0])]
+        used, Fc = np.unique(F, return_inverse=True)
+        F = Fc.reshape(-1, 3).astype(np.int64)
+    else:  # no collapsed edge: no degenerate triangle, every grid node a vertex of some cell
+        used = np.arange(Nu * Nv)
+        F = F.astype(np.int64)
     U, W = np.meshgrid(us, vs, indexing="ij")
     uv = np.stack([U.ravel(), W.ravel()], axis=1)[used]
     V = surface(uv[:, 0], uv[:, 1])
     collapsed = np.bincount(idx.ravel(), minlength=Nu * Nv) > 1
     pole = collapsed[used]
+    if surface.poles:
+        boundary = boundary_vertex_mask(F, len(V))
+    else:
+        # a plain grid (every cell two proper triangles, closed sides wrap over >= 3 cells):
+        # the boundary is the rectangle's open sides, no edge table needed
+        side = np.zeros((Nu, Nv), dtype=bool)
+        if not surface.closed_u:
+            side[[0, -1], :] = True
+        if not surface.closed_v:
+            side[:, [0, -1]] = True
+        boundary = side.ravel()[used]
     return SurfaceMesh(
         V=np.ascontiguousarray(V, dtype=np.float64),
         F=np.ascontiguousarray(F),
         uv=uv,
         pole=pole,
-        boundary=boundary_vertex_mask(F, len(V)),
+        boundary=boundary,
         surface=surface.name,
         res=(nu, nv),
     )
