@@ -116,9 +116,7 @@ def most_negative_eigenvalue(
     idx = np.flatnonzero(active)
     if len(idx) == 0:
         return 0.0, True
-    s = 1.0 / np.sqrt(W[idx])
-    Ka = K[idx][:, idx]
-    S = (sp.diags(s) @ (-Ka) @ sp.diags(s)).tocsr()
+    S = _scaled_negative(K, W, idx)
     if len(idx) <= 400:
         with blas_threads(1):  # threaded BLAS collapses on small dense work under load
             ev = np.linalg.eigvalsh(S.toarray())
@@ -143,6 +141,23 @@ def most_negative_eigenvalue(
     except (sla.ArpackNoConvergence, _OverBudget):
         return bound, False
     return -float(max(ev[0], 0.0)), True
+
+
+def _scaled_negative(K: sp.csr_matrix, W: FloatArray, idx: np.ndarray) -> sp.csr_matrix:
+    """``S = W^{-1/2} (−K) W^{-1/2}`` on the rows and columns ``idx`` (CSR, sorted indices).
+
+    Each entry is ``(s_i · (−K_ij)) · s_j`` with ``s = W^{-1/2}``, scaled in the stored entries of
+    ``K`` (one new data array; the index arrays are ``K``'s when every vertex is active), where
+    ``diags(s) @ (−K) @ diags(s)`` made three copies of the matrix: 0.7 GB at 2.77M vertices.
+    """
+    s = 1.0 / np.sqrt(W[idx])
+    Ka = sp.csr_matrix(K) if len(idx) == K.shape[0] else sp.csr_matrix(K)[idx][:, idx]
+    if not Ka.has_sorted_indices:
+        Ka = Ka.sorted_indices()  # a copy: the caller's K is left as it is
+    data = -Ka.data
+    data *= np.repeat(s, np.diff(Ka.indptr))  # s_i, row by row
+    data *= s[Ka.indices]
+    return sp.csr_matrix((data, Ka.indices, Ka.indptr), shape=Ka.shape)
 
 
 _EIGEN_WORK = 3e8  # multiply-adds most_negative_eigenvalue may spend before giving the bound
