@@ -312,6 +312,18 @@ def test_a_hostile_task_is_stopped_and_the_next_one_still_runs(name, status):
     assert result["barycentric_areas"].passed
 
 
+def test_the_workers_own_start_up_is_not_the_students_time():
+    """A spawned worker takes about a second (several on a loaded machine) to import numpy,
+    scipy and meshlap before the student's file: with a task limit shorter than that, a right
+    file still passes (the limit starts at the worker's ``ready``), while an infinite loop is
+    still stopped at that limit."""
+    limit = 0.3  # below any worker's start-up (spawn, numpy, scipy, meshlap, the battery)
+    result = check_file(STUDENTS / "right_vectorized.py", ["uniform_laplacian"], timeout=limit)
+    assert result["uniform_laplacian"].passed, result["uniform_laplacian"].message
+    looped = check_file(STUDENTS / "hostile_loop.py", ["uniform_laplacian"], timeout=limit)
+    assert looped["uniform_laplacian"].status == "timeout"
+
+
 def test_a_students_exception_shows_their_frames_only():
     result = check_file(STUDENTS / "hostile_raise.py", ["uniform_laplacian"])
     tb = result["uniform_laplacian"].traceback

@@ -163,6 +163,11 @@ is never stopped as an infinite loop because the machine was busy, nor on a big 
 BUDGET_MIN_VERTICES = 1000
 """Below this the reference takes milliseconds: the task's time limit alone applies."""
 
+STARTUP_TIMEOUT = 120.0
+"""Seconds a worker may take to start before the student's file is imported (the interpreter,
+numpy, scipy and meshlap in a spawned process: ours, not the student's; a few seconds, more on
+a loaded machine). The student's import and every task then get ``timeout`` each."""
+
 
 def _run_task(
     conn: Connection, task: Any, func: Any, cases: list[Case], path: str, fence: guard.Fence
@@ -221,6 +226,7 @@ def _worker(
 
     _limit_memory(budget_mb)
     all_cases = {c.name: c for c in battery()}
+    conn.send(("ready",))  # the worker's own start-up is over: the student's clock starts
     sys.stdout = sys.stderr  # the student's prints must not mix with the checker's output
     refused = guard.scan(path)  # a file calling meshlap itself would check nothing
     if refused:
@@ -321,13 +327,14 @@ def _drive(
 ) -> list[str]:
     """Read one worker's messages until it finishes, dies or overruns; the tasks left to do.
 
-    A worker's start-up (interpreter, numpy, the student's import) has the same deadline as a
-    task; a task that overruns or dies is marked and the remaining ones go to a new worker.
+    A worker's own start-up (interpreter, numpy, meshlap) has :data:`STARTUP_TIMEOUT`; from
+    its ``ready`` message the student's import has the same deadline as a task; a task that
+    overruns or dies is marked and the remaining ones go to a new worker.
     """
     current: str | None = None
     started = False
     done: set[str] = set()
-    deadline = time.monotonic() + timeout
+    deadline = time.monotonic() + max(timeout, STARTUP_TIMEOUT)
     budget: tuple[str, float] | None = None  # (mesh, reference seconds) of the call running
     try:
         while True:
@@ -350,6 +357,9 @@ def _drive(
                 return []
             if msg[0] == "finished":
                 return []
+            if msg[0] == "ready":  # the student's import starts now
+                deadline = time.monotonic() + timeout
+                continue
             if msg[0] == "budget":  # a call on a big mesh: TIME_FACTOR × the reference there
                 budget = (msg[2], msg[3])
                 deadline = max(deadline, time.monotonic() + TIME_FACTOR * msg[3])
