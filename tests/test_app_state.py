@@ -66,6 +66,34 @@ def test_curvature_state_recomputes_only_on_change():
     assert lo == -hi and hi > 0
 
 
+@pytest.mark.parametrize("estimator", ["cotan", "rusinkiewicz", "normal_cycle"])
+def test_shape_operator_patches_share_one_topology_per_mesh(tmp_path, estimator):
+    """Clicks on vertices before the whole mesh's estimate exists: each patch's tensor equals
+    the whole mesh's at that vertex, the faces' topology is built once for the mesh and made
+    again for another mesh."""
+    from meshlap_core.curvature_estimators import estimate_curvature
+
+    m = MeshState()
+    m.load(None)
+    c = CurvatureState()
+    c.set_estimator(estimator)
+    assert not c.principal_current(m)  # the patch path
+    whole = estimate_curvature(m.V, m.F, estimator)
+    kept = None
+    for v in (0, 17, len(m.V) - 1):
+        so = c.shape_operator(m, v)
+        S, _, _ = whole.shape_operator(v)
+        np.testing.assert_allclose(so["S"], S, atol=1e-10)
+        assert so["k1"] == pytest.approx(whole.k1[v]) and so["k1"] >= so["k2"]
+        kept = kept or c.topology(m)
+        assert c.topology(m) is kept  # one topology for every click on this mesh
+    V, F = primitives.torus_mesh(24, 12)
+    save_mesh(tmp_path / "torus.obj", V, F)
+    m.load(tmp_path / "torus.obj")
+    c.shape_operator(m, 5)
+    assert c.topology(m) is not kept and c.topology(m).n == len(V)
+
+
 def test_robust_range_ignores_one_spike():
     v = np.concatenate([np.linspace(-1, 1, 1000), [1e6]])
     lo, hi = robust_range(v, signed=True, percentile=1.0)

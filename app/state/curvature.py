@@ -13,6 +13,7 @@ from meshlap_core.curvature_estimators import (
     curvature_at_vertex,
     estimate_curvature,
 )
+from meshlap_core.curvature_topology import CurvatureTopology
 from meshlap_core.errors import MeshError
 from meshlap_core.options import (
     AREA_KINDS,
@@ -114,6 +115,7 @@ class CurvatureState:
     _key: tuple[Any, ...] = ()
     fields: dict[str, FloatArray] = field(default_factory=dict)
     _summaries: dict[tuple[Any, ...], dict[str, Any]] = field(default_factory=dict)
+    _topology: tuple[Any, CurvatureTopology | None] = (None, None)  # (mesh version, topology)
 
     def update(self, mesh: MeshState) -> bool:
         """Recompute when the mesh, area or boundary rule changed. Returns whether it did."""
@@ -237,6 +239,7 @@ class CurvatureState:
                 mesh.F,
                 vertex,
                 self.estimator,
+                topology=self.topology(mesh),
                 **(options if self.estimator == "cotan" else {}),
             )
         S, t1, t2 = p.shape_operator(i)
@@ -248,6 +251,14 @@ class CurvatureState:
             "k2": float(p.k2[i]),
             "estimator": self.estimator,
         }
+
+    def topology(self, mesh: MeshState) -> CurvatureTopology:
+        """``mesh``'s faces for the estimators' patches (:meth:`shape_operator`), built on the
+        first click and kept for the mesh: the next clicks read only the faces near the
+        vertex (a patch at 692k vertices: about 0.1 s with a new topology, 30–40 ms with it)."""
+        if self._topology[0] != mesh.version or self._topology[1] is None:
+            self._topology = (mesh.version, CurvatureTopology.of(mesh.F, len(mesh.V)))
+        return self._topology[1]
 
     def set_percentile(self, percentile: float) -> None:
         """Clip percentage of the colour range, in ``[0, 49]``.
