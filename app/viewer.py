@@ -282,7 +282,7 @@ class Viewer:
         ui = self.ui
         jobs = self.state.jobs
         if self.pace:
-            self.pacer.wait(jobs.busy)  # sleeps (GIL released): idle is idle
+            self.pacer.wait(jobs.busy, self.active().animating())  # idle is idle, play is not
         self.draw_guarded("jobs", lambda host: host.poll_jobs())
         ui.push_width(200)
         try:

@@ -245,6 +245,12 @@ class Panel:
         session is not loaded (jobs of ``state.jobs`` are seen by the host without it)."""
         return ""
 
+    def animating(self) -> bool:
+        """Something of this panel plays (a sweep, a smoothing run, a turn): while it is the
+        view on screen the window keeps its full frame rate, not the busy or idle rate of a
+        window without input."""
+        return False
+
     # -------------------------------------------------------------- keys, play
     def on_key(self, host: Host, key: str) -> bool:
         """React to a shortcut key; True when it was used."""

@@ -66,6 +66,10 @@ class DiffusionPanel(Panel):
         self._factoring: Any = None  # the geodesic key of the last factorization started
 
     # ------------------------------------------------------------------ the scene
+    def animating(self) -> bool:
+        """T plays up its log scale: the window keeps its full frame rate."""
+        return bool(self.state.playing)
+
     def on_new_mesh(self, host: Host) -> None:
         host.state.jobs.cancel(self.name)
         self.state.clear()

@@ -61,6 +61,10 @@ class SmoothingPanel(Panel):
         self._input_due = False  # the input copy is registered at the next frame (not this one)
         self._pending_input: np.ndarray | None = None  # its display positions meanwhile
 
+    def animating(self) -> bool:
+        """A smoothing run plays: the window keeps its full frame rate."""
+        return bool(self.state.playing)
+
     def on_new_mesh(self, host: Host) -> None:
         self.state.drop()  # a stepper in a child process: the process ends
         for name in (SMOOTHED, SMOOTH_INPUT):

@@ -35,6 +35,10 @@ class SpectralPanel(Panel):
         self.state: SpectralState = state
         self.recorder = Recorder(f"{name}.gif")
 
+    def animating(self) -> bool:
+        """The k sweep or the modes play: the window keeps its full frame rate."""
+        return bool(self.state.playing)
+
     def busy(self) -> str:
         return "the eigenbasis is still being computed" if self.state.busy else ""
 

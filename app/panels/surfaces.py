@@ -44,6 +44,10 @@ class SurfacesPanel(Panel):
         self.state: SurfaceState = state
         self.recorder = Recorder(f"{name}.gif")
 
+    def animating(self) -> bool:
+        """The normal section turns: the window keeps its full frame rate."""
+        return bool(self.state.turning)
+
     def show(self, host: Host, active: Panel) -> None:
         if active is self:
             self.push(host)
