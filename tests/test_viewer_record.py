@@ -453,9 +453,10 @@ def test_recordings_with_real_pixels(tmp_path, sphere, python_ok):
 def test_a_view_that_plays_keeps_the_full_frame_rate_without_input(viewer, panel, play):
     """The window's pacer drops to the busy or idle rate a second after the last input; a
     view that plays (smoothing, the k sweep, heat's t, the section's turn) keeps it at full
-    rate while it plays, and idle comes back when it stops (before: a play with no input
-    showed 2-6 frames per second, seen as "2.87 frames/s showing a step" in the real window
-    on the bundled mesh)."""
+    rate while it plays, and idle comes back when it stops. Before, only polyscope's redraw
+    request kept the rate up: a frame that changed nothing (the k sweep or the modes between
+    two steps, a smoothing step not back yet) fell to 4 frames/s, so the next step could come
+    up to 0.25 s late."""
     from meshlap_app.pacing import FULL_FPS, Pacer
 
     clock = Clock()
