@@ -109,14 +109,15 @@ def discard(packed: Any) -> None:
             os.unlink(path)
 
 
-def remove_stale(folder: str) -> None:
-    """Remove the handover files in ``folder`` whose maker process has ended."""
+def remove_stale(folder: str, prefix: str = SHARED_PREFIX) -> None:
+    """Remove the files ``prefix<pid>-*`` in ``folder`` whose maker process ``pid`` has ended
+    (the handover files by default; the eigenvectors' files of ``state.spectral`` too)."""
     with contextlib.suppress(OSError):
         for name in os.listdir(folder):
-            if not name.startswith(SHARED_PREFIX):
+            if not name.startswith(prefix):
                 continue
             try:
-                pid = int(name[len(SHARED_PREFIX) :].split("-", 1)[0])
+                pid = int(name[len(prefix) :].split("-", 1)[0])
                 os.kill(pid, 0)
             except ProcessLookupError:
                 with contextlib.suppress(OSError):

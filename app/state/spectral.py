@@ -23,6 +23,7 @@ from meshlap_core.frames import parse_range
 from meshlap_core.spectral import SpectralBasis
 from meshlap_core.types import FloatArray, IntArray
 
+from ..handover import remove_stale
 from .animation import Animation, Option
 from .checks import Schema, boolean, integer, one_of
 
@@ -67,7 +68,7 @@ class SharedVectors:
 
     def __init__(self, U: FloatArray) -> None:
         folder = "/dev/shm" if os.path.isdir("/dev/shm") else tempfile.gettempdir()
-        _remove_stale(folder)
+        remove_stale(folder, SHARED_PREFIX)
         fd, self.path = tempfile.mkstemp(prefix=f"{SHARED_PREFIX}{os.getpid()}-", dir=folder)
         with os.fdopen(fd, "wb") as f:
             np.asfortranarray(U, dtype=np.float64).T.tofile(f)
@@ -90,22 +91,6 @@ class SharedVectors:
         if not getattr(self, "opened", True) and getattr(self, "maker", None) != os.getpid():
             with contextlib.suppress(OSError):
                 os.unlink(self.path)
-
-
-def _remove_stale(folder: str) -> None:
-    """Remove the files of :class:`SharedVectors` whose maker process has ended."""
-    with contextlib.suppress(OSError):
-        for name in os.listdir(folder):
-            if not name.startswith(SHARED_PREFIX):
-                continue
-            try:
-                pid = int(name[len(SHARED_PREFIX) :].split("-", 1)[0])
-                os.kill(pid, 0)
-            except ProcessLookupError:
-                with contextlib.suppress(OSError):
-                    os.unlink(os.path.join(folder, name))
-            except (ValueError, OSError):
-                continue
 
 
 def solve_basis(V: FloatArray, F: IntArray, k: int, progress: Any = None) -> tuple[Any, ...]:
