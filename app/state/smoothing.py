@@ -166,14 +166,12 @@ class SmoothingState:
         if not arrived:
             return False
         stepped = s.iteration > self.asked_at
-        for _ in range(s.iteration - self.asked_at):
-            self._count_step(s.lam)
+        self._count_steps(s.lam, s.iteration - self.asked_at)
         if stepped and self.playing:
             self.meter.stepped(time.perf_counter(), s.iteration - self.asked_at)
         self.asked_at = s.iteration
         if s.diverged:
-            self.playing = False
-            self.error = f"{s.divergence_message()}; press reset"
+            self._stop_diverged()
         elif stepped and self.playing:
             move = s.history[-1].get("step_rms", 0.0) if s.history else 0.0
             self._check_growth(float(move))
@@ -366,11 +364,9 @@ class SmoothingState:
         if not s.diverged:
             done = s.iteration
             s.step()
-            if s.iteration > done:  # a step taken (a diverging one is discarded)
-                self._count_step(s.lam)
+            self._count_steps(s.lam, s.iteration - done)  # a diverging step is discarded
         if s.diverged:
-            self.playing = False
-            self.error = f"{s.divergence_message()}; press reset"
+            self._stop_diverged()
             return False
         return True
 
@@ -391,20 +387,27 @@ class SmoothingState:
             return all(self.step() for _ in range(count))
         done = s.iteration
         many(count)
-        for _ in range(s.iteration - done):
-            self._count_step(s.lam)
+        self._count_steps(s.lam, s.iteration - done)
         if s.diverged:
-            self.playing = False
-            self.error = f"{s.divergence_message()}; press reset"
+            self._stop_diverged()
             return False
         return True
 
-    def _count_step(self, lam: float) -> None:
-        """Add one step at ``lam`` to :attr:`lam_steps`."""
+    def _count_steps(self, lam: float, count: int) -> None:
+        """Add ``count`` steps at ``lam`` to :attr:`lam_steps` (none when ``count`` is 0)."""
+        if count <= 0:
+            return
         if self.lam_steps and self.lam_steps[-1][0] == lam:
-            self.lam_steps[-1][1] += 1
+            self.lam_steps[-1][1] += count
         else:
-            self.lam_steps.append([lam, 1])
+            self.lam_steps.append([lam, count])
+
+    def _stop_diverged(self) -> None:
+        """The stepper diverged: *play* stops and the panel says why."""
+        s = self.smoother
+        assert s is not None
+        self.playing = False
+        self.error = f"{s.divergence_message()}; press reset"
 
     def reset(self) -> None:
         """Back to the noisy input (the noise itself stays)."""
