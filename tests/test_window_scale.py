@@ -110,15 +110,20 @@ class ScanSession(Session):
         return img
 
 
-@pytest.mark.window
-def test_a_692k_scan_opens_without_freezing_and_idles(tmp_path):
+def open_scan(tmp_path) -> ScanSession:
+    """``meshlap view`` on the 692k scan at 1280×720 (skips without the window tools or the
+    mesh the scan is made from)."""
     missing = missing_tools()
     if missing:
         pytest.skip(f"real-window tests need {', '.join(missing)} (.ci/run installs them)")
     if not SOURCE.exists():
         pytest.skip(f"{SOURCE} is absent (the scan is made from it with igl.upsample)")
-    scan = scan_path()
-    s = ScanSession((1280, 720), scan, tmp_path)
+    return ScanSession((1280, 720), scan_path(), tmp_path)
+
+
+@pytest.mark.window
+def test_a_692k_scan_opens_without_freezing_and_idles(tmp_path):
+    s = open_scan(tmp_path)
     try:
         assert s.app is not None
         line = s.timeline
@@ -217,13 +222,7 @@ def test_a_692k_scan_smooths_without_freezing(tmp_path):
     so its factorization does not hold the window's GIL): the screen keeps changing at least
     every :data:`MAX_STILL_S` until the input and its smoothed copy appear; then *play* moves
     the copy and *pause* stops it."""
-    missing = missing_tools()
-    if missing:
-        pytest.skip(f"real-window tests need {', '.join(missing)} (.ci/run installs them)")
-    if not SOURCE.exists():
-        pytest.skip(f"{SOURCE} is absent (the scan is made from it with igl.upsample)")
-    scan = scan_path()
-    s = ScanSession((1280, 720), scan, tmp_path)
+    s = open_scan(tmp_path)
     try:
         assert s.app is not None
         s.until(
