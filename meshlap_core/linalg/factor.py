@@ -408,7 +408,7 @@ class SharedAnalysis:
         """CHOLMOD's factor of ``A`` from the shared analysis, or ``None`` when refused."""
         from sksparse.cholmod import CholmodError, CholmodWarning, analyze
 
-        from .spd import PIVOT_RATIO, surely_positive_definite
+        from .spd import pivots_sound
 
         csc = sp.csc_matrix((A.data, A.indices, A.indptr), shape=A.shape)  # symmetric
         try:
@@ -421,13 +421,7 @@ class SharedAnalysis:
                 factor = base.cholesky(csc)
         except (CholmodError, CholmodWarning):
             return None
-        if not surely_positive_definite(A):
-            # a pivot at round-off of its own diagonal entry is refused, as SPDSolver does
-            # (the simplicial LDLᵀ does not stop at a negative one)
-            D = factor.D()
-            if not (np.all(np.isfinite(D)) and np.all(D > PIVOT_RATIO * A.diagonal()[factor.P()])):
-                return None
-        return factor
+        return factor if pivots_sound(A, factor) else None  # the rule SPDSolver applies
 
 
 class CholmodSPDFactor:

@@ -257,12 +257,22 @@ def _cholmod_factor(A: sp.csr_matrix, reuse: Any = None) -> Any:
             factor.cholesky_inplace(csc)
     except (CholmodError, CholmodWarning):
         raise refused from None
-    if not surely_positive_definite(A):
-        # the pivots D = diag(L)²: CHOLMOD only stops at a pivot <= 0, so a pivot that
-        # cancelled to round-off of its own diagonal entry (W − λK with λ beyond double
-        # precision, where cholespy's reference BLAS happens to meet a negative one) is refused;
-        # relative to its own row, so components of very different scales are not refused
-        D = factor.D()  # in the factor's order P: pivot k eliminates row P[k]
-        if not (np.all(np.isfinite(D)) and np.all(D > PIVOT_RATIO * A.diagonal()[factor.P()])):
-            raise refused
+    if not pivots_sound(A, factor):
+        raise refused
     return factor
+
+
+def pivots_sound(A: sp.csr_matrix, factor: Any) -> bool:
+    """Whether a CHOLMOD ``factor`` of ``A`` may be trusted as positive definite: ``A`` is
+    surely so (:func:`surely_positive_definite`), or every pivot is finite and above
+    :data:`PIVOT_RATIO` times its own diagonal entry.
+
+    The pivots are ``D`` (``diag(L)²`` for ``LLᵀ``): CHOLMOD only stops at a pivot ``≤ 0``
+    (and simplicial ``LDLᵀ`` not even there), so a pivot that cancelled to round-off of its
+    own diagonal entry (``W − λK`` with ``λ`` beyond double precision, where cholespy's
+    reference BLAS happens to meet a negative one) is refused; relative to its own row, so
+    components of very different scales are not refused."""
+    if surely_positive_definite(A):
+        return True
+    D = factor.D()  # in the factor's order P: pivot k eliminates row P[k]
+    return bool(np.all(np.isfinite(D)) and np.all(D > PIVOT_RATIO * A.diagonal()[factor.P()]))
