@@ -15,9 +15,10 @@ without a ``cancel=`` argument stops at its next progress report.
 cancels the old one (its result is thrown away, never applied) unless ``replace=False``, which
 refuses the new one instead (``start`` returns ``None``).
 
-:func:`in_child` runs a job's work in a child process instead (the load and the curvature
-fields: scipy's sparse conversions hold the GIL for seconds on a big mesh, which would stall
-the window; a child process shares no GIL, and Cancel ends it at once).
+:func:`in_child` runs a job's work in a child process instead (:func:`meshlap_app.ipc.call`;
+the load and the curvature fields: scipy's sparse conversions hold the GIL for seconds on a
+big mesh, which would stall the window; a child process shares no GIL, and Cancel ends it at
+once).
 
 :func:`call_hooked` is the one adapter to the core's ``progress=`` / ``cancel=`` keywords: it
 passes each only when the callee accepts it (``inspect.signature``), so the viewer works with
@@ -27,20 +28,17 @@ a core that has them and with one that does not.
 from __future__ import annotations
 
 import inspect
-import multiprocessing
 import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from pickle import PicklingError
 from typing import Any
 
-from meshlap_core import errors as _errors
-from meshlap_core.errors import MeshError
+from meshlap_core import errors as core_errors
 
-from .handover import pack, unpack
+from . import ipc
 
-Cancelled: type[Exception] = getattr(_errors, "Cancelled", None) or type(
+Cancelled: type[Exception] = getattr(core_errors, "Cancelled", None) or type(
     "Cancelled", (Exception,), {"__doc__": "A job stopped because it was cancelled."}
 )
 """The core's :class:`meshlap_core.errors.Cancelled` (or a stand-in when the core has none)."""
@@ -169,14 +167,8 @@ class Job:
             self.reporter.check()  # cancelled at the very end: discarded all the same
         except Cancelled:
             self.outcome = CANCELLED
-        except MeshError as exc:
-            self.error, self.outcome = str(exc), FAILED
-        except OSError as exc:
-            name = getattr(exc, "filename", None)
-            self.error = f"{name}: {exc.strerror or exc}" if name else str(exc)
-            self.outcome = FAILED
         except Exception as exc:  # a worker reports, never dies silently
-            self.error, self.outcome = f"{type(exc).__name__}: {exc}", FAILED
+            self.error, self.outcome = ipc.error_message(exc), FAILED
         else:
             self.result, self.outcome = result, DONE
         self.finished = self.clock()
@@ -381,82 +373,15 @@ def call_hooked(fn: Callable[..., Any], *args: Any, reporter: Reporter, **kwargs
 
 
 # ---------------------------------------------------------------------- child processes
-CHILD_PRELOAD = (
-    "numpy",
-    "scipy.sparse",
-    "meshlap_core.io",
-    "meshlap_core.curvature",
-    "meshlap_core.spectral",  # the eigenbasis job (app/state/spectral.py)
-    "meshlap_core.smoothing",  # the stepper process (app/smoother_process.py)
-)
-"""Modules the fork server imports once, so each child starts in milliseconds."""
-
-
-class _ChildReporter:
-    """The reporter a child process's function is given: sends each report to the parent
-    (which checks Cancel and ends the child)."""
-
-    cancel = None  # the parent cancels by ending the process
-    remote = True  # what the function returns is sent to another process
-
-    def __init__(self, conn: Any) -> None:
-        self.conn = conn
-        self.fraction: float | None = None
-
-    def __call__(self, fraction: float | None, message: str = "") -> None:
-        self.fraction = fraction
-        self.conn.send(("progress", fraction, message))
-
-    def phase_only(self, message: str) -> None:
-        self(self.fraction, message)
-
-    def check(self) -> None:
-        """Nothing to check here (the parent ends the process on Cancel)."""
-
-    def partial(self, value: Any) -> None:
-        """Send a partial result to the parent (its reporter's :meth:`Reporter.partial`), its
-        large arrays through shared memory (:mod:`.handover`)."""
-        self.conn.send(("partial", pack(value)))
-
-
-def _child_main(conn: Any, fn: Callable[..., Any], args: tuple[Any, ...]) -> None:
-    """Body of the child process: ``fn(*args, progress=reporter)``, its result or its error
-    sent back as one message."""
-    try:
-        result = fn(*args, progress=_ChildReporter(conn))
-    except MeshError as exc:
-        conn.send(("error", str(exc)))
-    except OSError as exc:
-        name = getattr(exc, "filename", None)
-        conn.send(("error", f"{name}: {exc.strerror or exc}" if name else str(exc)))
-    except BaseException as exc:  # reported to the parent, never lost
-        conn.send(("error", f"{type(exc).__name__}: {exc}"))
-    else:
-        conn.send(("result", pack(result)))  # its large arrays through shared memory
-    finally:
-        conn.close()
-
-
-def _context() -> Any:
-    """The fork server (a clean process that imported :data:`CHILD_PRELOAD` once; never a fork
-    of the window's process with its GL context and threads)."""
-    ctx = multiprocessing.get_context("forkserver")
-    ctx.set_forkserver_preload(list(CHILD_PRELOAD))
-    return ctx
-
-
 def warm_up() -> None:
-    """Start the fork server now, then import matplotlib's colour maps (in a thread: the first
-    job then starts at once, and the first coloured frame of a mesh does not import them on
-    the UI thread, 0.5-1.5 s)."""
+    """Start the fork server of :mod:`.ipc` now, then import matplotlib's colour maps (in a
+    thread: the first job then starts at once, and the first coloured frame of a mesh does
+    not import them on the UI thread, 0.5-1.5 s)."""
 
     def start() -> None:
         try:
-            from multiprocessing import forkserver
-
-            _context()
-            forkserver.ensure_running()
-        except Exception:  # no fork server here: in_child falls back to a thread
+            ipc.start_server()
+        except ipc.NoChildProcess:  # in_child falls back to a thread
             pass
         try:
             from matplotlib import colormaps  # noqa: F401
@@ -467,43 +392,15 @@ def warm_up() -> None:
 
 
 def in_child(fn: Callable[..., Any], *args: Any) -> Callable[[Reporter], Any]:
-    """A job's ``work`` that runs ``fn(*args, progress=...)`` in a child process (``fn`` a
-    module-level function, its arguments and result picklable). Reports arrive through a
-    pipe; Cancel ends the child. Where no child process can start, ``fn`` runs in the job's
-    thread instead."""
+    """A job's ``work`` that runs ``fn(*args, progress=...)`` in a child process
+    (:func:`meshlap_app.ipc.call`: ``fn`` a module-level function, its arguments and result
+    picklable). Reports and partial results arrive through a pipe; Cancel ends the child.
+    Where no child process can start, ``fn`` runs in the job's thread instead."""
 
     def work(reporter: Reporter) -> Any:
         try:
-            ctx = _context()
-            recv, send = ctx.Pipe(duplex=False)
-            proc = ctx.Process(target=_child_main, args=(send, fn, args), daemon=True)
-            proc.start()
-        except (OSError, ValueError, RuntimeError, TypeError, AttributeError, PicklingError):
+            return ipc.call(fn, *args, reporter=reporter)
+        except ipc.NoChildProcess:
             return fn(*args, progress=reporter)  # no child process here (or fn not picklable)
-        send.close()
-        try:
-            while True:
-                reporter.check()  # Cancelled: the finally below ends the child
-                if recv.poll(0.05):
-                    try:
-                        kind, *payload = recv.recv()
-                    except EOFError:
-                        message = f"the worker process ended (exit code {proc.exitcode})"
-                        raise MeshError(message) from None
-                    if kind == "progress":
-                        reporter(*payload)
-                    elif kind == "partial":
-                        reporter.partial(unpack(payload[0]))
-                    elif kind == "result":
-                        return unpack(payload[0])
-                    else:
-                        raise MeshError(payload[0])
-                elif not proc.is_alive() and not recv.poll():
-                    raise MeshError(f"the worker process ended (exit code {proc.exitcode})")
-        finally:
-            recv.close()
-            if proc.is_alive():
-                proc.kill()
-            proc.join(5)
 
     return work

@@ -1,6 +1,12 @@
-"""The report's pictures from the viewer: ``meshlap report`` renders its mesh figures with
-the viewer's screenshot entry point (registered in the ``meshlap.screenshots`` entry-point group,
-which :mod:`meshlap_core.cli.report` reads; the core never imports the viewer)."""
+"""The core's pictures drawn by the viewer, found through entry points (the core never imports
+the viewer):
+
+- ``meshlap report`` renders its mesh figures with the viewer's screenshot entry point
+  (:class:`ViewerScreenshots`, group ``meshlap.screenshots``, read by
+  :mod:`meshlap_core.cli.report`);
+- a check result's notebook picture draws the difference map with :func:`difference_png`
+  (group ``meshlap.check_picture``, read by :mod:`meshlap_core.exercises.result`).
+"""
 
 from __future__ import annotations
 
@@ -14,8 +20,17 @@ from pathlib import Path
 from types import TracebackType
 from typing import Any
 
+import numpy as np
+
+from meshlap_core.errors import MeshError
 from meshlap_core.io import save_mesh
 from meshlap_core.study import MeshSource
+
+from . import ipc
+
+PICTURE_TIMEOUT = 120.0
+"""Seconds the difference map's EGL process may take (start-up of polyscope and EGL
+included)."""
 
 
 class ViewerScreenshots:
@@ -129,3 +144,96 @@ def _captured_output(log: Path) -> Iterator[None]:
             for fd, old in zip((1, 2), saved, strict=True):
                 os.dup2(old, fd)
                 os.close(old)
+
+
+def difference_png(
+    V: np.ndarray, F: np.ndarray, difference: np.ndarray, signed: bool, size: int = 400
+) -> bytes:
+    """The difference map student − reference drawn on the mesh by polyscope's EGL snapshot
+    renderer (``openGL3_egl``, started as the viewer starts it), a ``size``² PNG.
+
+    This is the ``meshlap.check_picture`` entry point that
+    :meth:`meshlap_core.exercises.result.CheckResult.picture` reads. The render runs in a
+    child process (:func:`meshlap_app.ipc.call`): EGL failing to start can abort its
+    process, and a notebook's kernel must survive that (the caller then draws with
+    matplotlib and says why).
+
+    Parameters
+    ----------
+    V : (n,3) float
+    F : (m,3) int
+    difference : (n,) float
+        Per vertex; signed (coolwarm, symmetric range) or a magnitude (viridis from 0).
+    signed : bool
+    size : int
+        Pixels per side.
+
+    Returns
+    -------
+    bytes
+        The PNG.
+
+    Raises
+    ------
+    RuntimeError
+        EGL could not render (why, and polyscope's last message line when it printed one).
+    """
+    V = np.asarray(V, dtype=np.float64)
+    F = np.asarray(F, dtype=np.int64)
+    d = np.asarray(difference, dtype=np.float64)
+    with tempfile.TemporaryDirectory(prefix="meshlap-picture-") as tmp:
+        work = Path(tmp)
+        try:
+            return ipc.call(
+                render_difference,
+                V,
+                F,
+                d,
+                bool(signed),
+                int(size),
+                str(work),
+                timeout=PICTURE_TIMEOUT,
+                name="picture",
+            )
+        except (ipc.NoChildProcess, MeshError) as exc:
+            log = work / "output.log"
+            lines = log.read_text(errors="replace").splitlines() if log.is_file() else []
+            said = [x.strip() for x in lines if x.strip()]
+            why = f"{exc} ({said[-1]})" if said else str(exc)
+            raise RuntimeError(f"polyscope's EGL backend did not render: {why}") from exc
+
+
+def render_difference(
+    V: np.ndarray,
+    F: np.ndarray,
+    d: np.ndarray,
+    signed: bool,
+    size: int,
+    folder: str,
+    progress: Any = None,
+) -> bytes:
+    """The body of :func:`difference_png`'s child process: polyscope started by the viewer's
+    :func:`~meshlap_app.viewer.init_polyscope` on ``openGL3_egl``, the map drawn, a PNG made.
+    Polyscope's messages go to ``folder/output.log``; ``progress`` is unused."""
+    import polyscope as ps
+
+    from .panels.check import DIFF, difference_colours
+    from .scene import write_png
+    from .viewer import init_polyscope
+
+    work = Path(folder)
+    with _in_folder(work), _captured_output(work / "output.log"):
+        init_polyscope("openGL3_egl")
+        ps.set_ground_plane_mode("none")
+        ps.set_window_size(size, size)
+        mesh = ps.register_surface_mesh("mesh", V, F, smooth_shade=True)
+        cmap, (lo, hi) = difference_colours(d, signed)
+        mesh.add_scalar_quantity(
+            DIFF, d, defined_on="vertices", cmap=cmap, vminmax=(lo, hi), enabled=True
+        )
+        ps.reset_camera_to_home_view()
+        rgba = ps.screenshot_to_buffer(transparent_bg=False, include_UI=False)
+        ps.shutdown()
+    out = work / "picture.png"
+    write_png(out, rgba)
+    return out.read_bytes()

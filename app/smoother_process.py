@@ -5,16 +5,18 @@ CHOLMOD (scikit-sparse), cholespy and libigl hold the GIL while they factorize `
 (4–10 s at 692k vertices), so a worker *thread* froze the window for as long. Here the
 stepper (:class:`meshlap_core.smoothing.Smoother`, built by
 :meth:`~.state.smoothing.SmoothingState.build`: noise, operators, factorization, stable λ)
-lives in a child process started from the fork server of :mod:`.jobs`, and stays there: the
-factor never crosses a process boundary. The window holds a :class:`RemoteSmoother`, a proxy
-with the stepper's interface (``V``, ``V0``, ``iteration``, ``history``, ``stability``,
-``step``, ``reset``, ``set_lam`` ...) whose commands travel through a pipe and whose positions
-come back through one :class:`multiprocessing.shared_memory.SharedMemory` block::
+lives in a child process (:class:`meshlap_app.ipc.Child`, from the one fork server), and stays
+there: the factor never crosses a process boundary. The window holds a
+:class:`RemoteSmoother`, a proxy with the stepper's interface (``V``, ``V0``, ``iteration``,
+``history``, ``stability``, ``step``, ``reset``, ``set_lam`` ...) whose commands travel
+through a pipe and whose positions come back through one :class:`meshlap_app.ipc.SharedBlock`
+(its file is unlinked once both processes have mapped it)::
 
     [ V0, the noisy input (n,3) float64 | slot 0 | slot 1 ]
     slot: [ V current (n,3) float64 | normals (n,3) float32 | display P, N (2,n,3) float32 ]
 
-(the mesh itself reaches the child through a second, transient block, read once at its start).
+(the mesh itself reaches the child as a :func:`meshlap_app.ipc.pack` message, mapped once at
+its start).
 *play* may ask for several steps at once (:meth:`RemoteSmoother.request_step` with a count),
 and keeps up to :data:`PIPELINE` requests on their way: the child starts the next batch as
 soon as it has answered one, while the window uploads and draws. Answer ``k`` goes to slot
@@ -40,7 +42,6 @@ garbage-collected ends its child and frees the block. Where no child process can
 from __future__ import annotations
 
 import weakref
-from multiprocessing import shared_memory
 from typing import Any
 
 import numpy as np
@@ -50,10 +51,18 @@ from meshlap_core.errors import MeshError
 from meshlap_core.smoothing import check_lam
 from meshlap_core.types import FloatArray, IntArray
 
-from .jobs import Reporter, _ChildReporter, _context
-
-NO_CHILD = (OSError, ValueError, RuntimeError, TypeError, AttributeError)
-"""What starting a child process may raise where none can start (the in-process fallback)."""
+from .ipc import (
+    Child,
+    ChildReporter,
+    NoChildProcess,
+    Packed,
+    SharedBlock,
+    discard,
+    error_message,
+    pack,
+    unpack,
+)
+from .jobs import Reporter
 
 
 def vertex_normals(V: FloatArray, F: IntArray, incidence: Any = None) -> np.ndarray:
@@ -111,17 +120,17 @@ block, so the child never writes the slot the window is reading)."""
 Slot = tuple[np.ndarray, np.ndarray, np.ndarray]
 
 
-def _blocks(buf: Any, n: int, depth: int) -> tuple[np.ndarray, list[Slot]]:
+def _blocks(block: SharedBlock, n: int, depth: int) -> tuple[np.ndarray, list[Slot]]:
     """The arrays of the shared block (see the module docstring): ``V0``, then
     ``depth`` (:data:`PIPELINE`) slots of (current positions, normals, display positions and
     normals ``(2,n,3) float32``); answer ``k`` is written into slot ``k % depth``."""
-    start = np.ndarray((n, 3), dtype=np.float64, buffer=buf, offset=0)
+    start = block.array((n, 3), np.float64)
     slots: list[Slot] = []
     offset = 24 * n
     for _ in range(depth):
-        cur = np.ndarray((n, 3), dtype=np.float64, buffer=buf, offset=offset)
-        normals = np.ndarray((n, 3), dtype=np.float32, buffer=buf, offset=offset + 24 * n)
-        shown = np.ndarray((2, n, 3), dtype=np.float32, buffer=buf, offset=offset + 36 * n)
+        cur = block.array((n, 3), np.float64, offset)
+        normals = block.array((n, 3), np.float32, offset + 24 * n)
+        shown = block.array((2, n, 3), np.float32, offset + 36 * n)
         slots.append((cur, normals, shown))
         offset += 60 * n
     return start, slots
@@ -168,26 +177,25 @@ def _snapshot(sm: Any) -> dict[str, Any]:
 
 def _serve(
     conn: Any,
-    name: str,
-    inputs: tuple[str, int, int],
+    path: str,
+    inputs: Packed,
     options: tuple[str, str, float, float, int],
     normals: bool,
     depth: int = PIPELINE,
 ) -> None:
     """Body of the child: build the stepper (reporting each phase), then answer commands
     (``step`` with a count, ``reset``, ``set_lam``, ``diverge``, ``close``) until ``close`` or
-    the pipe ends; after each one the positions (and normals) are in the shared block and a
-    snapshot is sent."""
+    the pipe ends; after each one the positions (and normals) are in the shared block (the
+    file ``path``) and a snapshot is sent. ``inputs``: ``(V, F)`` packed by the parent."""
     from .state.smoothing import SmoothingState
 
-    V, F = _read_inputs(*inputs)
-    shm = shared_memory.SharedMemory(name=name)  # the fork server's children share the
-    # parent's resource tracker: only the parent's unlink unregisters the block
-    start, slots = _blocks(shm.buf, len(V), depth)
+    V, F = unpack(inputs)
+    block = SharedBlock.attach(path)
+    start, slots = _blocks(block, len(V), depth)
     view: tuple[float, ...] | None = None  # the window's display transform, once sent
     answers = 0  # answers published: the next goes to slot answers % depth
     try:
-        sm = SmoothingState.build(V, F, options, _ChildReporter(conn))
+        sm = SmoothingState.build(V, F, options, ChildReporter(conn))
         start[...] = sm.V0
         incidence = face_incidence(sm.F, len(V)) if normals else None
 
@@ -227,43 +235,13 @@ def _serve(
                 reply = ("state", publish())
             except MeshError as exc:
                 reply = ("error", str(exc))
-    except MeshError as exc:
-        _send(conn, ("error", str(exc)))
     except BaseException as exc:  # reported to the parent, never lost
-        _send(conn, ("error", f"{type(exc).__name__}: {exc}"))
+        _send(conn, ("error", error_message(exc)))
     finally:
         slots.clear()  # (no view of the block may outlive it)
         del start
-        shm.close()
+        block.close()
         conn.close()
-
-
-def _write_inputs(V: FloatArray, F: IntArray) -> shared_memory.SharedMemory:
-    """``V`` and ``F`` in a new shared block (read once by the child: pickling 50 MB to the
-    fork server held the GIL, and so the window, for a second on a loaded machine)."""
-    shm = shared_memory.SharedMemory(create=True, size=max(1, 24 * len(V) + 24 * len(F)))
-    np.ndarray(V.shape, np.float64, shm.buf)[...] = V
-    np.ndarray(F.shape, np.int64, shm.buf, offset=24 * len(V))[...] = F
-    return shm
-
-
-def _read_inputs(name: str, n: int, m: int) -> tuple[FloatArray, IntArray]:
-    """Copies of ``V (n,3)`` and ``F (m,3)`` from the block :func:`_write_inputs` made."""
-    shm = shared_memory.SharedMemory(name=name)
-    try:
-        V = np.array(np.ndarray((n, 3), np.float64, shm.buf))
-        F = np.array(np.ndarray((m, 3), np.int64, shm.buf, offset=24 * n))
-    finally:
-        shm.close()
-    return V, F
-
-
-def _free(shm: shared_memory.SharedMemory) -> None:
-    shm.close()
-    try:
-        shm.unlink()
-    except FileNotFoundError:
-        pass
 
 
 def _send(conn: Any, message: tuple[Any, ...]) -> None:
@@ -282,28 +260,11 @@ def _publish(sm: Any, cur: np.ndarray, nrm: np.ndarray, incidence: Any) -> dict[
     return _snapshot(sm)
 
 
-def _shutdown(proc: Any, conn: Any, shm: shared_memory.SharedMemory) -> None:
+def _shutdown(child: Child, block: SharedBlock) -> None:
     """End the child and free the block (idempotent; the proxy's finalizer)."""
-    try:
-        conn.send(("close",))
-    except (OSError, ValueError):
-        pass
-    try:
-        conn.close()
-    except OSError:
-        pass
-    proc.join(0.5)
-    if proc.is_alive():
-        proc.kill()
-        proc.join(5)
-    try:
-        shm.close()
-    except BufferError:  # views still alive (a collected proxy): closed when they go
-        pass
-    try:
-        shm.unlink()
-    except FileNotFoundError:
-        pass
+    child.end(goodbye=("close",), grace=0.5)
+    block.close()  # views still alive (a collected proxy): unmapped when they go
+    block.unlink()
 
 
 class RemoteSmoother:
@@ -322,23 +283,22 @@ class RemoteSmoother:
 
     def __init__(
         self,
-        proc: Any,
-        conn: Any,
-        shm: shared_memory.SharedMemory,
+        child: Child,
+        block: SharedBlock,
         V: FloatArray,
         F: IntArray,
         options: tuple[str, str, float, float, int],
         normals: bool,
         depth: int = PIPELINE,
     ) -> None:
-        self._proc, self._conn, self._shm = proc, conn, shm
-        self._finalizer = weakref.finalize(self, _shutdown, proc, conn, shm)
+        self._child = child
+        self._finalizer = weakref.finalize(self, _shutdown, child, block)
         self.method, self.laplacian = options[0], options[1]
         self.n = len(V)
         self.F = F
         self.reference = V
         self._depth = depth  # requests on their way at most (the child's slots)
-        self._start, self._slots = _blocks(shm.buf, self.n, depth)
+        self._start, self._slots = _blocks(block, self.n, depth)
         self._view: tuple[float, ...] | None = None  # the view of the display arrays held
         self._display: np.ndarray | None = None  # (2,n,3) float32 copied with each step
         self._want_normals = normals
@@ -369,62 +329,46 @@ class RemoteSmoother:
             The build failed (the child's message) or the child ended.
         Cancelled
             From ``reporter`` (the child is ended).
-        OSError, ValueError, RuntimeError, TypeError, AttributeError
-            No child process can start here (:data:`NO_CHILD`; :func:`build` falls back).
+        NoChildProcess
+            No child process can start here (:func:`build` falls back).
         """
         V = np.asarray(V, dtype=np.float64)
         F = np.asarray(F, dtype=np.int64)
         depth = PIPELINE
-        shm = shared_memory.SharedMemory(create=True, size=_block_bytes(len(V), depth))
-        inputs = _write_inputs(V, F)
+        block = SharedBlock.create(_block_bytes(len(V), depth))
+        inputs = pack((V, F))  # (pickling 50 MB to the fork server held the GIL for a second)
         try:
-            ctx = _context()
-            here, there = ctx.Pipe(duplex=True)
-            where = (inputs.name, len(V), len(F))
-            proc = ctx.Process(
-                target=_serve, args=(there, shm.name, where, options, normals, depth), daemon=True
+            child = Child(
+                _serve, block.path, inputs, options, normals, depth, duplex=True, name="smoothing"
             )
-            proc.start()
         except BaseException:
-            _free(shm)
-            _free(inputs)
+            block.close()
+            block.unlink()
+            discard(inputs)
             raise
-        there.close()
-        proxy = cls(proc, here, shm, V, F, options, normals, depth)
+        proxy = cls(child, block, V, F, options, normals, depth)
         try:
             proxy._wait(reporter)
         except BaseException:
             proxy.close()
             raise
         finally:
-            _free(inputs)  # read by the child as it started
+            discard(inputs)  # mapped by the child as it started
+            block.unlink()  # mapped by both: the memory stays, the file goes
         proxy.V0 = np.array(proxy._start)
         proxy.V0.flags.writeable = False
         return proxy
 
     def _wait(self, reporter: Reporter | None = None) -> dict[str, Any]:
         """The child's next answer (progress lines go to ``reporter``); adopts a snapshot."""
-        while True:
-            if reporter is not None:
-                reporter.check()  # Cancelled: the caller ends the child
-            if self._conn.poll(0.05):
-                try:
-                    kind, *payload = self._conn.recv()
-                except (EOFError, OSError):
-                    raise MeshError(self._ended()) from None
-                if kind == "progress":
-                    if reporter is not None:
-                        reporter(*payload)
-                    continue
-                if kind == "error":
-                    raise MeshError(payload[0])
-                self._adopt(payload[0])
-                return payload[0]
-            if not self._proc.is_alive() and not self._conn.poll():
-                raise MeshError(self._ended())
+        _kind, snap = self._child.receive(reporter)
+        self._adopt(snap)
+        return snap
 
-    def _ended(self) -> str:
-        return f"the smoothing process ended (exit code {self._proc.exitcode})"
+    @property
+    def process(self) -> Any:
+        """The child process (``multiprocessing.Process``)."""
+        return self._child.process
 
     def _adopt(self, snap: dict[str, Any]) -> None:
         """Mirror a snapshot and copy the positions (and normals) out of the shared block."""
@@ -493,14 +437,8 @@ class RemoteSmoother:
 
     def _call(self, *command: Any) -> None:
         self._drain()
-        self._send(command)
+        self._child.send(command)
         self._wait()
-
-    def _send(self, command: tuple[Any, ...]) -> None:
-        try:
-            self._conn.send(command)
-        except (OSError, ValueError):
-            raise MeshError(self._ended()) from None
 
     # ------------------------------------------------------------------ asynchronous steps
     @property
@@ -515,7 +453,7 @@ class RemoteSmoother:
         positions and normals as the window uploads them."""
         if self._pending >= self._depth:
             return False
-        self._send(("step", max(1, int(count)), view))
+        self._child.send(("step", max(1, int(count)), view))
         self._pending += 1
         return True
 
@@ -528,7 +466,7 @@ class RemoteSmoother:
         MeshError
             The step failed (e.g. ``W − λK`` could not be factorized) or the child ended.
         """
-        while self._pending and (self._conn.poll() or not self._proc.is_alive()):
+        while self._pending and self._child.ready():
             self._pending -= 1
             self._wait()
             self._arrived = True
@@ -554,7 +492,7 @@ class RemoteSmoother:
 
     @property
     def alive(self) -> bool:
-        return self._finalizer.alive and self._proc.is_alive()
+        return self._finalizer.alive and self._child.alive
 
 
 def build(
@@ -568,5 +506,5 @@ def build(
     ``in_process(V, F, options, reporter)`` where no child process can start."""
     try:
         return RemoteSmoother.start(V, F, options, reporter)
-    except NO_CHILD:
+    except NoChildProcess:
         return in_process(V, F, options, reporter)

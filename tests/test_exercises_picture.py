@@ -5,7 +5,6 @@ EGL cannot render."""
 from __future__ import annotations
 
 import io
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -82,11 +81,19 @@ def test_the_picture_is_drawn_by_egl_where_the_mistake_is(two_wrong):
     assert left.sum() > 1000  # the failed task's cell
 
 
+def _egl_process_fails(*args, progress=None) -> None:
+    """Stands in for the EGL child's body: its process ends with exit code 1 (as one whose
+    EGL start-up aborted)."""
+    import os
+
+    os._exit(1)
+
+
 def test_without_egl_the_picture_falls_back_to_matplotlib_and_says_why(two_wrong, monkeypatch):
-    """EGL's process failing (here the interpreter it starts is /bin/false): matplotlib draws
+    """EGL's process failing (here it ends with exit code 1 before drawing): matplotlib draws
     the map, and the picture says why; ``renderer="egl"`` raises instead."""
-    pytest.importorskip("meshlap_app")
-    monkeypatch.setattr(sys, "executable", "/bin/false")
+    screenshots = pytest.importorskip("meshlap_app.screenshots")
+    monkeypatch.setattr(screenshots, "render_difference", _egl_process_fails)
     pic = two_wrong.picture()
     assert pic.renderer == "matplotlib"
     assert "EGL backend did not render" in pic.reason and "exit code 1" in pic.reason

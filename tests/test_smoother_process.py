@@ -192,14 +192,14 @@ def test_steps_asked_for_together_count_each_step(mesh):
 def test_a_dropped_stepper_ends_its_process(mesh):
     V, F = mesh
     remote = RemoteSmoother.start(V, F, OPTIONS, reporter())
-    proc = remote._proc
+    proc = remote.process
     st = SmoothingState()
     st.adopt(remote)
     st.drop()
     proc.join(10)
     assert not proc.is_alive()
     remote = RemoteSmoother.start(V, F, OPTIONS, reporter())
-    proc = remote._proc
+    proc = remote.process
     del remote
     gc.collect()
     proc.join(10)
@@ -294,14 +294,14 @@ def test_a_rebuild_moves_the_shown_copies_to_the_new_stepper(viewer):
 def test_without_child_processes_the_stepper_is_built_here(mesh, monkeypatch):
     """Where no child process can start, the job builds the stepper in its own thread (the
     pure in-process path): the same stepper."""
-    from meshlap_app import smoother_process
+    from meshlap_app import ipc
 
     from meshlap_core.smoothing import Smoother
 
     def refuse() -> None:
         raise OSError("no processes here")
 
-    monkeypatch.setattr(smoother_process, "_context", refuse)
+    monkeypatch.setattr(ipc, "context", refuse)
     V, F = mesh
     got = build(V, F, OPTIONS, reporter(), SmoothingState.build)
     assert isinstance(got, Smoother)

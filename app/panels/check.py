@@ -24,6 +24,15 @@ from .base import Host, Panel
 DIFF = "student - reference"
 
 
+def difference_colours(d: np.ndarray, signed: bool) -> tuple[str, tuple[float, float]]:
+    """The colour map and range of a difference map ``d (n,)``: coolwarm on ``[−r, r]`` when
+    signed, viridis on ``[0, r]`` for a magnitude, ``r = max |d|`` (1 when zero); the
+    panel's map and the notebook picture (:func:`meshlap_app.screenshots.difference_png`)."""
+    r = float(np.abs(d).max()) if d.size else 0.0
+    r = r if r > 0 else 1.0
+    return ("coolwarm", (-r, r)) if signed else ("viridis", (0.0, r))
+
+
 class CheckPanel(Panel):
     """Student file, task, *check*; verdict; difference map; the clicked vertex's rows."""
 
@@ -58,15 +67,13 @@ class CheckPanel(Panel):
         if not self.watch.changed("map", mesh.version, id(st.check), host.state.ui_scale, lines):
             return
         d = np.asarray(st.check.difference, dtype=np.float64)
-        r = float(np.abs(d).max()) if d.size else 0.0
-        r = r if r > 0 else 1.0
-        lo, hi = (-r, r) if st.check.signed else (0.0, r)
+        cmap, (lo, hi) = difference_colours(d, st.check.signed)
         values, (lo, hi), factor = scalar_for_upload(d, (lo, hi))
         ps.get_surface_mesh(MESH).add_scalar_quantity(
             DIFF + factor,
             values,
             defined_on="vertices",
-            cmap="coolwarm" if st.check.signed else "viridis",
+            cmap=cmap,
             vminmax=(lo, hi),
             enabled=True,
             onscreen_colorbar_enabled=True,
@@ -176,98 +183,3 @@ class CheckPanel(Panel):
 
 
 PANEL = CheckPanel
-
-
-# ---- the notebook picture (EGL) -------------------------------------------------------------
-
-EGL_TIMEOUT = 120.0
-"""Seconds the EGL snapshot process may take (start-up of polyscope and EGL included)."""
-
-
-def difference_png(
-    V: np.ndarray, F: np.ndarray, difference: np.ndarray, signed: bool, size: int = 400
-) -> bytes:
-    """The difference map student − reference drawn on the mesh by polyscope's EGL snapshot
-    renderer (``openGL3_egl``, as the viewer's ``--screenshot``), a ``size``² PNG.
-
-    This is the ``meshlap.check_picture`` entry point that
-    :meth:`meshlap_core.exercises.result.CheckResult.picture` reads. The render runs in a
-    child process: EGL failing to start can abort its process, and a notebook's kernel must
-    survive that (the caller then draws with matplotlib and says why).
-
-    Parameters
-    ----------
-    V : (n,3) float
-    F : (m,3) int
-    difference : (n,) float
-        Per vertex; signed (coolwarm, symmetric range) or a magnitude (viridis from 0).
-    signed : bool
-    size : int
-        Pixels per side.
-
-    Returns
-    -------
-    bytes
-        The PNG.
-
-    Raises
-    ------
-    RuntimeError
-        EGL could not render (its last message line).
-    """
-    import subprocess
-    import sys
-    import tempfile
-    from pathlib import Path
-
-    with tempfile.TemporaryDirectory(prefix="meshlap-check-png-") as tmp:
-        work = Path(tmp)
-        np.savez(work / "in.npz", V=V, F=F, d=difference, signed=signed, size=size)
-        code = "from meshlap_app.panels.check import _egl_main; _egl_main()"
-        try:
-            res = subprocess.run(
-                [sys.executable, "-c", code, str(work / "in.npz"), str(work / "out.png")],
-                capture_output=True,
-                text=True,
-                timeout=EGL_TIMEOUT,
-                cwd=work,  # polyscope's .ini files
-            )
-        except subprocess.TimeoutExpired as exc:
-            raise RuntimeError(f"the EGL renderer took over {EGL_TIMEOUT:g} s") from exc
-        out = work / "out.png"
-        if res.returncode != 0 or not out.is_file():
-            lines = [x for x in (res.stderr or "").splitlines() if x.strip()]
-            why = lines[-1] if lines else f"exit code {res.returncode}"
-            raise RuntimeError(f"polyscope's EGL backend did not render: {why}")
-        return out.read_bytes()
-
-
-def _egl_main() -> None:
-    """The EGL child of :func:`difference_png`: ``argv`` = input ``.npz``, output ``.png``."""
-    import sys
-    from pathlib import Path
-
-    from ..scene import write_png
-
-    data = np.load(sys.argv[1])
-    size, signed = int(data["size"]), bool(data["signed"])
-    d = np.asarray(data["d"], dtype=np.float64)
-    ps.set_allow_headless_backends(True)
-    ps.set_use_prefs_file(False)
-    ps.init("openGL3_egl")  # a panel never imports the viewer: polyscope started here
-    ps.set_ground_plane_mode("none")
-    ps.set_window_size(size, size)
-    mesh = ps.register_surface_mesh("mesh", data["V"], data["F"], smooth_shade=True)
-    r = float(np.abs(d).max()) if d.size else 0.0
-    r = r if r > 0 else 1.0
-    mesh.add_scalar_quantity(
-        DIFF,
-        d,
-        defined_on="vertices",
-        cmap="coolwarm" if signed else "viridis",
-        vminmax=(-r, r) if signed else (0.0, r),
-        enabled=True,
-    )
-    ps.reset_camera_to_home_view()
-    write_png(Path(sys.argv[2]), ps.screenshot_to_buffer(transparent_bg=False, include_UI=False))
-    ps.shutdown()

@@ -8,9 +8,6 @@ the previous k.
 
 from __future__ import annotations
 
-import contextlib
-import os
-import tempfile
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -23,7 +20,6 @@ from meshlap_core.frames import parse_range
 from meshlap_core.spectral import SpectralBasis
 from meshlap_core.types import FloatArray, IntArray
 
-from ..handover import remove_stale
 from .animation import Animation, Option
 from .checks import Schema, boolean, integer, one_of
 
@@ -49,61 +45,14 @@ def _finish_basis(basis: SpectralBasis, k: int, progress: Any) -> tuple[Spectral
     return basis, errors
 
 
-SHARED_PREFIX = "meshlap-basis-"
-"""Name prefix of the files that carry eigenvectors from the child process to the window."""
-
-
-class SharedVectors:
-    """The eigenvectors of a basis computed in a child process, handed to the window as a file
-    in shared memory (``/dev/shm``) instead of inside the pickled result: unpickling 550 MB
-    (692k vertices, k = 100) holds the GIL for a second under load, and the window's frames
-    stop meanwhile; mapping the file takes a millisecond and copies nothing.
-
-    Made in the child (the ``(n, k)`` F-ordered array written as raw float64, column after
-    column); :meth:`open` in the window maps it (``np.memmap``) and unlinks the file at once
-    (the mapping stays valid). A copy that is never opened (the job was cancelled or
-    superseded) unlinks the file when it is collected; files left by a child that was ended
-    while it sent are removed by the next child.
-    """
-
-    def __init__(self, U: FloatArray) -> None:
-        folder = "/dev/shm" if os.path.isdir("/dev/shm") else tempfile.gettempdir()
-        remove_stale(folder, SHARED_PREFIX)
-        fd, self.path = tempfile.mkstemp(prefix=f"{SHARED_PREFIX}{os.getpid()}-", dir=folder)
-        with os.fdopen(fd, "wb") as f:
-            np.asfortranarray(U, dtype=np.float64).T.tofile(f)
-        self.shape = (int(U.shape[0]), int(U.shape[1]))
-        self.maker = os.getpid()
-        self.opened = False
-
-    def open(self) -> FloatArray:
-        """The ``(n, k)`` F-ordered eigenvectors, mapped from the file (then unlinked)."""
-        n, k = self.shape
-        try:
-            mm = np.memmap(self.path, dtype=np.float64, mode="r+", shape=(k, n))
-        finally:
-            self.opened = True
-            with contextlib.suppress(OSError):
-                os.unlink(self.path)
-        return np.asarray(mm).T if k else np.zeros((n, 0), order="F")
-
-    def __del__(self) -> None:
-        if not getattr(self, "opened", True) and getattr(self, "maker", None) != os.getpid():
-            with contextlib.suppress(OSError):
-                os.unlink(self.path)
-
-
 def solve_basis(V: FloatArray, F: IntArray, k: int, progress: Any = None) -> tuple[Any, ...]:
     """The eigenbasis job's work in a child process (:func:`meshlap_app.jobs.in_child`, which
     ends the process on Cancel): ``k`` eigenpairs, the errors for every k and the slider's
-    checkpoints, as ``(basis, errors, shared)``: the basis is sent back pickled without its
-    eigenvectors, which travel in ``shared`` (:class:`SharedVectors`). Module level, so it
-    pickles."""
+    checkpoints, as ``(basis, errors)``. Module level, so it pickles; the eigenvectors (550 MB
+    at 692k vertices, k = 100) reach the window mapped from shared memory, not unpickled
+    (:func:`meshlap_app.ipc.pack`)."""
     basis = SpectralBasis.compute(V, F, k, progress=progress)
-    basis, errors = _finish_basis(basis, k, progress)
-    shared = SharedVectors(basis.vectors)
-    basis.vectors = np.zeros((basis.vectors.shape[0], 0), order="F")
-    return basis, errors, shared
+    return _finish_basis(basis, k, progress)
 
 
 @dataclass
@@ -217,9 +166,7 @@ class SpectralState:
         return fresh
 
     def _adopt(self, result: tuple[Any, ...]) -> None:
-        basis, self.errors = result[:2]
-        if len(result) > 2:  # from a child process: the eigenvectors were sent apart
-            basis.vectors = result[2].open()
+        basis, self.errors = result
         self._job = None
         self.basis = basis
         self._fresh = True
