@@ -28,7 +28,6 @@ from collections.abc import Callable
 from typing import Any
 
 import numpy as np
-
 from meshlap_app.ipc import pack, unpack
 
 
