@@ -323,7 +323,7 @@ class Child:
     duplex : bool
         The parent sends messages too (:meth:`send`); else the pipe goes one way, up.
     name : str
-        What the process is called in messages ("the smoothing process ended ...").
+        What the process is called in messages ("the smoothing stepper process ended ...").
 
     Raises
     ------

@@ -338,9 +338,8 @@ class RemoteSmoother:
         block = SharedBlock.create(_block_bytes(len(V), depth))
         inputs = pack((V, F))  # (pickling 50 MB to the fork server held the GIL for a second)
         try:
-            child = Child(
-                _serve, block.path, inputs, options, normals, depth, duplex=True, name="smoothing"
-            )
+            work = (block.path, inputs, options, normals, depth)
+            child = Child(_serve, *work, duplex=True, name="smoothing stepper")
         except BaseException:
             block.close()
             block.unlink()
