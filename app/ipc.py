@@ -235,6 +235,11 @@ class SharedBlock:
 
 
 # ---------------------------------------------------------------------- child processes
+NO_CHILD = (OSError, ValueError, RuntimeError, TypeError, AttributeError, pickle.PicklingError)
+"""What starting a child may raise where none can start (no fork server, an unpicklable
+target or argument): :class:`Child` turns it into :class:`NoChildProcess`."""
+
+
 class NoChildProcess(RuntimeError):
     """No child process can start here (no fork server, or the target does not pickle): the
     caller runs the work in its own process instead."""
@@ -353,9 +358,7 @@ class Child:
                 self.process.start()
             finally:
                 there.close()
-        except (OSError, ValueError, RuntimeError, TypeError, AttributeError) as exc:
-            raise NoChildProcess(f"no child process could start: {exc}") from exc
-        except pickle.PicklingError as exc:
+        except NO_CHILD as exc:
             raise NoChildProcess(f"no child process could start: {exc}") from exc
 
     @property
