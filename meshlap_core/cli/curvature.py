@@ -3,7 +3,7 @@ its statistics.
 
 Without ``--estimator`` the fields of :mod:`meshlap_core.curvature` (``--method uniform, cotan,
 gaussian, k1, k2``); with it (or with ``--method H, K, abs_max``) a field of the principal
-curvatures of :mod:`meshlap_core.curvature_estimators` (``--method k1, k2, H, K, abs_max``,
+curvatures of :mod:`meshlap_core.curvature.estimators` (``--method k1, k2, H, K, abs_max``,
 estimator ``cotan`` when not given), ``--radius`` its scale (quadric: edge rings; jet: world
 units) and ``--directions FILE.npy`` the ``(n, 2, 3)`` principal directions ``d1, d2``.
 """
@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from ..curvature import curvature_field
-from ..curvature_estimators import estimate_curvature
+from ..curvature.estimators import estimate_curvature
 from ..errors import MeshError
 from ..io import check_output_path, load_mesh, save_mesh, save_scalars
 from ..io.atomic import atomic_write

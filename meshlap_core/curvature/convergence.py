@@ -12,21 +12,21 @@ from typing import Any
 
 import numpy as np
 
-from ..curvature import gaussian_curvature, mean_curvature_cotan, mean_curvature_uniform
 from ..errors import MeshError
 from ..options import MESHERS, Mesher, check_choice
 from ..primitives import icosphere
-from ..topology import edges
-from ..types import BoolArray, FloatArray, IntArray
-from .catalogue import EDGES, ParametricSurface, get_surface
-from .geometry import surface_curvature_fields
-from .meshing import (
+from ..surfaces.catalogue import EDGES, ParametricSurface, get_surface
+from ..surfaces.geometry import surface_curvature_fields
+from ..surfaces.meshing import (
     MAX_MESH_BYTES,
     STUDY_BYTES_PER_CELL,
     STUDY_KEPT_BYTES_PER_CELL,
     check_mesh_res,
     mesh_surface,
 )
+from ..topology import edges
+from ..types import BoolArray, FloatArray, IntArray
+from .fields import gaussian_curvature, mean_curvature_cotan, mean_curvature_uniform
 
 ESTIMATORS: tuple[str, ...] = (
     "H uniform",

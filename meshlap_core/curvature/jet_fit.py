@@ -30,12 +30,12 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
-from .curvature import _face_geometry, _normals_from
-from .errors import MeshError
-from .noise import bbox_diagonal
+from ..errors import MeshError
+from ..noise import bbox_diagonal
+from ..topology import edges
+from ..types import FloatArray, IntArray, as_mesh
+from .fields import _face_geometry, _normals_from
 from .principal import PrincipalCurvatures, eig_sym2, tangent_frames
-from .topology import edges
-from .types import FloatArray, IntArray, as_mesh
 
 JET_RADIUS_EDGES = 3.0
 """The automatic radius is at least this many mean edge lengths (enough neighbours to fit)."""
@@ -62,7 +62,7 @@ def estimate_normal_noise(V: FloatArray, F: IntArray) -> float:
     ``σ̂ = 1.4826 · median|r_i| / 1.08`` (the median absolute deviation, so that features do
     not count as noise). On a clean mesh it is of the order ``h²κ``, not zero.
     """
-    from .laplacian import uniform_laplacian
+    from ..laplacian import uniform_laplacian
 
     V, F = as_mesh(V, F)
     fn, theta = _face_geometry(V, F)

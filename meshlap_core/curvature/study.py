@@ -21,12 +21,10 @@ from typing import Any
 
 import numpy as np
 
-from .curvature_estimators import estimate_curvature
-from .errors import MeshError
-from .noise import add_noise, check_noise
-from .options import CURVATURE_ESTIMATORS, PRINCIPAL_FIELDS, check_choice
-from .principal import PrincipalCurvatures
-from .surfaces import (
+from ..errors import MeshError
+from ..noise import add_noise, check_noise
+from ..options import CURVATURE_ESTIMATORS, PRINCIPAL_FIELDS, check_choice
+from ..surfaces import (
     ParametricSurface,
     SurfaceMesh,
     get_surface,
@@ -34,7 +32,9 @@ from .surfaces import (
     surface_curvature_fields,
     surface_derivatives,
 )
-from .types import BoolArray, FloatArray, IntArray
+from ..types import BoolArray, FloatArray, IntArray
+from .estimators import estimate_curvature
+from .principal import PrincipalCurvatures
 
 STUDY_COLUMNS: tuple[str, ...] = (
     "surface",
@@ -399,7 +399,7 @@ def write_study_figure(rows: Sequence[dict[str, Any]], path: Any) -> None:
     from matplotlib.figure import Figure
     from matplotlib.ticker import NullFormatter
 
-    from .io import atomic_write
+    from ..io import atomic_write
 
     path = Path(path)
     if path.suffix.lower() != ".png":
