@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import MeshError
+from ..laplacian import mean_edge_length
 from ..options import MESHERS, Mesher, check_choice
 from ..primitives import icosphere
 from ..surfaces.catalogue import EDGES, ParametricSurface, get_surface
@@ -24,7 +25,6 @@ from ..surfaces.meshing import (
     check_mesh_res,
     mesh_surface,
 )
-from ..topology import edges
 from ..types import BoolArray, FloatArray, IntArray
 from .fields import gaussian_curvature, mean_curvature_cotan, mean_curvature_uniform
 
@@ -45,11 +45,6 @@ def _discrete_estimates(V: FloatArray, F: IntArray) -> dict[str, FloatArray]:
         "K deficit voronoi": gaussian_curvature(V, F, "voronoi"),
         "K deficit barycentric": gaussian_curvature(V, F, "barycentric"),
     }
-
-
-def _mean_edge_length(V: FloatArray, F: IntArray) -> float:
-    E = edges(F)
-    return float(np.mean(np.linalg.norm(V[E[:, 0]] - V[E[:, 1]], axis=1)))
 
 
 def _orders(h: Sequence[float], err: Sequence[float], floor: float = 0.0) -> list[float | None]:
@@ -164,7 +159,7 @@ def _study(
             raise MeshError("the mesh has no interior vertex to compare; use a finer res", "res")
         n_v.append(len(lev.V))
         n_c.append(len(idx))
-        hs.append(_mean_edge_length(lev.V, lev.F))
+        hs.append(mean_edge_length(lev.V, lev.F))
         for name in ESTIMATORS:
             ref = lev.H if name.startswith("H") else lev.K
             err = np.abs(est[name][idx] - ref[idx])

@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import MeshError
+from ..laplacian import mean_edge_length
 from ..noise import add_noise, check_noise
 from ..options import CURVATURE_ESTIMATORS, PRINCIPAL_FIELDS, check_choice
 from ..surfaces import (
@@ -316,8 +317,7 @@ def curvature_study(
         for n in levels:
             res = (2 * int(n), int(n)) if s.name == "torus" else (int(n), int(n))
             m, V = perturbed_mesh(s, res, noise, jitter, seed, flips)
-            E = np.concatenate([m.F[:, [0, 1]], m.F[:, [1, 2]], m.F[:, [2, 0]]])
-            h = float(np.mean(np.linalg.norm(m.V[E[:, 0]] - m.V[E[:, 1]], axis=1)))
+            h = mean_edge_length(m.V, m.F)
             meshes.append((n, m, V, h, exact_principal(m, s)))
         for est in estimators:
             prev: dict[str, Any] | None = None
