@@ -16,10 +16,10 @@ import pytest
 from meshlap_core import primitives
 from meshlap_core.cli import main
 from meshlap_core.curvature import estimators as ce
+from meshlap_core.curvature.refinement import exact_principal
 from meshlap_core.curvature.study import (
     STUDY_COLUMNS,
     curvature_study,
-    exact_principal,
     fitted_orders,
     perturbed_mesh,
     vertex_errors,

@@ -16,7 +16,7 @@ from scipy.optimize import minimize_scalar
 
 import meshlap_core
 from meshlap_core import primitives, surfaces
-from meshlap_core.curvature import convergence, vertex_normals
+from meshlap_core.curvature import convergence, refinement, vertex_normals
 from meshlap_core.curvature.convergence import convergence_study
 from meshlap_core.errors import MeshError
 from meshlap_core.io import load_mesh
@@ -378,7 +378,7 @@ def test_bad_resolution() -> None:
 
 def test_exact_reference_values_used_by_the_study() -> None:
     m = mesh_surface(get_surface("sphere", r=2.0), 6)
-    H, K = convergence.exact_curvature_at(get_surface("sphere", r=2.0), m.uv, m.pole)
+    H, K = refinement.exact_curvature_at(get_surface("sphere", r=2.0), m.uv, m.pole)
     np.testing.assert_allclose(H, 0.5, rtol=1e-9)  # the core's sign: H > 0 with outward n
     np.testing.assert_allclose(K, 0.25, rtol=1e-9)  # including the two pole vertices
 

@@ -18,10 +18,9 @@ from meshlap_core.curvature.estimators import (
     estimate_curvature,
 )
 from meshlap_core.curvature.principal import PrincipalCurvatures, tangent_frames
+from meshlap_core.curvature.refinement import ExactPrincipal, exact_principal
 from meshlap_core.curvature.study import (
-    ExactPrincipal,
     curvature_study,
-    exact_principal,
     flip_edges,
     flipped_and_noisy,
     jittered_mesh,

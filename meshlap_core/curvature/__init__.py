@@ -13,6 +13,9 @@ Modules, each named by what it computes:
 - :mod:`.jet_fit`: the scale-aware estimator, an osculating jet fitted over a world-radius ball.
 - :mod:`.topology`: :class:`~.topology.CurvatureTopology`, what the tensor estimators need from
   the faces alone, built once per mesh.
+- :mod:`.refinement`: the one convergence machinery, meshes of a parametric surface under
+  refinement with the exact curvature at their vertices, and the one order fit (observed
+  orders between consecutive levels, the least-squares order over all of them).
 - :mod:`.convergence`: the classical estimators' convergence tables
   (``meshlap surface --convergence``), and :mod:`.study`: every principal-curvature estimator
   against the exact surfaces (``meshlap curvature-study``, the curvature lab's error maps).
