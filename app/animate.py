@@ -3,7 +3,7 @@
 Frames come from the viewer's own scene code: a :class:`~.viewer.Viewer` (a host of the
 panels) is built on the mesh, and the animated panel's ``frames`` sets up each frame exactly
 as the window shows it; polyscope renders each frame (``screenshot_to_buffer`` with its
-on-screen colour bar) and :mod:`meshlap_core.frames` burns the caption in and writes the GIF
+on-screen colour bar) and :mod:`meshlap_core.io.animation` burns the caption in and writes the GIF
 or MP4 atomically.
 
 Which panels can be animated, their options and frame rates are declared by each panel's state
@@ -28,7 +28,12 @@ import numpy as np
 import polyscope as ps
 
 from meshlap_core.errors import MeshError
-from meshlap_core.frames import FrameWriter, burn_caption, check_animation_output, frame_progress
+from meshlap_core.io.animation import (
+    FrameWriter,
+    burn_caption,
+    check_animation_output,
+    frame_progress,
+)
 from meshlap_core.options import check_choice
 from meshlap_core.progress import Progress
 

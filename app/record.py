@@ -20,7 +20,7 @@ import numpy as np
 import polyscope as ps
 
 from meshlap_core.errors import MeshError
-from meshlap_core.frames import FrameWriter, burn_caption
+from meshlap_core.io.animation import FrameWriter, burn_caption
 
 from .scene import scene_width
 

@@ -22,9 +22,9 @@ from typing import Any
 
 import numpy as np
 
+from meshlap_core.course_report import MeshSource
 from meshlap_core.errors import MeshError
 from meshlap_core.io import save_mesh
-from meshlap_core.study import MeshSource
 
 from . import ipc
 
@@ -34,8 +34,8 @@ included)."""
 
 
 class ViewerScreenshots:
-    """The report's screenshot function (:class:`meshlap_core.study.Screenshot`): the viewer's
-    screenshot entry point called in this process, polyscope's EGL backend started once.
+    """The report's screenshot function (:class:`meshlap_core.course_report.Screenshot`): the
+    viewer's screenshot entry point called in this process, polyscope's EGL backend started once.
 
     A subprocess is not needed for a fresh GL context: one ``polyscope.init("openGL3_egl")``
     renders any number of screenshots of different scenes, since the viewer registers the
@@ -82,7 +82,7 @@ class ViewerScreenshots:
     def __call__(
         self, mesh: MeshSource, panel: str, options: Mapping[str, Any], out_png: Path
     ) -> bool:
-        """Render one frame into ``out_png`` (see :class:`meshlap_core.study.Screenshot`);
+        """Render one frame into ``out_png`` (see :class:`meshlap_core.course_report.Screenshot`);
         a failure raises with the viewer's message."""
         from .viewer import run as run_viewer  # the viewer's screenshot entry point
 

@@ -29,8 +29,8 @@ import igl
 import numpy as np
 from _util import best_of, print_table, shared_mesh
 
-from meshlap_core.curvature_estimators import TOPOLOGY_ESTIMATORS, estimate_curvature
-from meshlap_core.curvature_study import curvature_study, flipped_and_noisy
+from meshlap_core.curvature.estimators import TOPOLOGY_ESTIMATORS, estimate_curvature
+from meshlap_core.curvature.study import curvature_study, flipped_and_noisy
 from meshlap_core.io import load_mesh
 from meshlap_core.options import CURVATURE_ESTIMATORS
 from meshlap_core.primitives import torus_mesh
@@ -183,7 +183,7 @@ def noise_rows(seed: int = 0) -> None:
 def estimator_rows(res: int, repeat: int) -> None:
     """Every estimator at the lab's resolution (the torus of ``2 res × res`` cells, 32k vertices
     at 128), 0.1 % normal noise: the estimator alone (with the kept
-    :class:`~meshlap_core.curvature_topology.CurvatureTopology` where it takes one, as the lab
+    :class:`~meshlap_core.curvature.topology.CurvatureTopology` where it takes one, as the lab
     calls it), the lab's whole result for a noise move (noise, estimate, crosses, error map;
     the exact surface cached) and where the window runs it (a thread when
     ``CurvatureLabState.light()``, else a child process). Best of ``repeat`` wall and CPU

@@ -62,9 +62,9 @@ _PUBLIC: dict[str, str | tuple[str, str]] = {
     "all_curvature_fields": "curvature",
     "vertex_normals": "curvature",
     "principal_curvature_quadric": "curvature",
-    "estimate_curvature": "curvature_estimators",
-    "PrincipalCurvatures": "principal",
-    "jet_curvatures": "curvature_fit",
+    "estimate_curvature": "curvature.estimators",
+    "PrincipalCurvatures": "curvature.principal",
+    "jet_curvatures": "curvature.jet_fit",
     # spectral
     "SpectralBasis": "spectral",
     # smoothing

@@ -1,4 +1,6 @@
-"""Discrete Laplacians: uniform (graph), cotangent stiffness, lumped mass, Laplace–Beltrami.
+"""Discrete Laplacians: uniform (graph), cotangent stiffness, lumped mass, Laplace–Beltrami, and
+the intrinsic quantities they are built from (squared edge lengths, face areas; the mean edge
+length ``h``, the mesh's length scale).
 
 Sign convention (the whole project uses it): every Laplacian here is **negative
 semidefinite**, so that for a surface ``Δx = -2 H n`` with ``H > 0`` on a sphere whose normals
@@ -21,6 +23,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .options import AREA_KINDS, DEFAULT_AREA, DEGENERATE_REL, MASS_AREA, AreaKind, check_choice
+from .topology.edges import edges as unique_edges
 from .types import FloatArray, IntArray, as_faces, as_mesh
 
 # A face with 16 A² ≤ (2·DEGENERATE_REL)² (Σ l²)² is degenerate (see options.DEGENERATE_REL):
@@ -51,6 +54,31 @@ def squared_edge_lengths(V: FloatArray, F: IntArray) -> FloatArray:
         ],
         axis=1,
     )
+
+
+def mean_edge_length(V: FloatArray, F: IntArray, edges: IntArray | None = None) -> float:
+    """The mean length ``h`` of the mesh's edges, each edge counted once: the mesh's length
+    scale (``igl.avg_edge_length``'s value), e.g. the heat method's ``t = m h²``, the jet fit's
+    smallest radius and the ``h`` of every convergence order.
+
+    Parameters
+    ----------
+    V : (n,3) float
+    F : (m,3) int
+    edges : (e,2) int, optional
+        The unique undirected edges of ``F`` when the caller has them already (an edge table
+        it keeps); otherwise they are built (:func:`~meshlap_core.topology.edges`).
+
+    Returns
+    -------
+    h : float
+        ``0.0`` for a mesh without faces.
+    """
+    V, F = as_mesh(V, F)
+    E = unique_edges(F) if edges is None else np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+    if len(E) == 0:
+        return 0.0
+    return float(np.mean(np.linalg.norm(V[E[:, 0]] - V[E[:, 1]], axis=1)))
 
 
 def face_areas(V: FloatArray, F: IntArray) -> FloatArray:

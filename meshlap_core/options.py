@@ -21,7 +21,7 @@ BoundaryRule
     (θ₀ = 2π, as if the vertex were interior) or ``"zero"`` (K = 0 on the boundary).
 CurvatureEstimator, PrincipalField
     The principal-curvature estimators side by side (``meshlap curvature --estimator``, see
-    :mod:`meshlap_core.curvature_estimators`) and the scalar fields of their results.
+    :mod:`meshlap_core.curvature.estimators`) and the scalar fields of their results.
 CurvatureMethod, CurvatureField
     The per-vertex curvature estimators (``meshlap curvature --method``): ``"uniform"`` and
     ``"cotan"`` (mean curvature H from that Laplacian), ``"gaussian"`` (angle deficit K),
@@ -103,7 +103,7 @@ CURVATURE_ESTIMATOR_LABELS: dict[str, str] = {
     "jet": "jet fit over a world-radius ball (Cazals & Pouget 2003), robust to noise",
 }
 """Principal-curvature estimator -> its label shown to users
-(:mod:`meshlap_core.curvature_estimators`)."""
+(:mod:`meshlap_core.curvature.estimators`)."""
 PrincipalField = Literal["k1", "k2", "H", "K", "abs_max"]
 PRINCIPAL_FIELDS: tuple[str, ...] = get_args(PrincipalField)
 """Scalar fields of an estimator's result: ``k1 ≥ k2``, ``H = (k1+k2)/2``, ``K = k1 k2``,

@@ -15,7 +15,7 @@ import pytest
 
 from meshlap_core.cli import main
 from meshlap_core.errors import MeshError
-from meshlap_core.frames import FrameWriter, burn_caption, caption_box, parse_range
+from meshlap_core.io.animation import FrameWriter, burn_caption, caption_box, parse_range
 
 Image = pytest.importorskip("PIL.Image")
 
@@ -77,7 +77,7 @@ def test_bad_output_paths(name, sphere, tmp_path, capsys, no_render):
 def test_unwritable_directory(sphere, tmp_path, capsys, no_render, monkeypatch):
     """A directory this user cannot write in (simulated: the tests may run as root, for whom
     a read-only directory is still writable)."""
-    import meshlap_core.frames as frames
+    import meshlap_core.io.animation as frames
 
     real = os.access
     locked = tmp_path / "locked"
@@ -547,7 +547,7 @@ def test_session_outputs_never_overwrite_an_input(
 
 
 def test_session_unwritable_out(sphere, tmp_path, capsys, no_render, monkeypatch):
-    import meshlap_core.frames as frames
+    import meshlap_core.io.animation as frames
 
     path = _session_file(tmp_path, sphere)
     real = os.access

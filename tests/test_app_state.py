@@ -71,7 +71,7 @@ def test_shape_operator_patches_share_one_topology_per_mesh(tmp_path, estimator)
     """Clicks on vertices before the whole mesh's estimate exists: each patch's tensor equals
     the whole mesh's at that vertex, the faces' topology is built once for the mesh and made
     again for another mesh."""
-    from meshlap_core.curvature_estimators import estimate_curvature
+    from meshlap_core.curvature.estimators import estimate_curvature
 
     m = MeshState()
     m.load(None)

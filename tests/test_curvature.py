@@ -4,8 +4,8 @@ import igl
 import numpy as np
 import pytest
 
-from meshlap_core import curvature as curv
 from meshlap_core import primitives, topology
+from meshlap_core.curvature import fields as curv
 from meshlap_core.laplacian import vertex_areas
 
 

@@ -14,10 +14,10 @@ import igl
 import numpy as np
 import pytest
 
-from meshlap_core import curvature_estimators as ce
 from meshlap_core import primitives
-from meshlap_core.curvature_fit import default_jet_radius, estimate_normal_noise, jet_curvatures
-from meshlap_core.curvature_study import perturbed_mesh
+from meshlap_core.curvature import estimators as ce
+from meshlap_core.curvature.jet_fit import default_jet_radius, estimate_normal_noise, jet_curvatures
+from meshlap_core.curvature.study import perturbed_mesh
 from meshlap_core.errors import MeshError
 from meshlap_core.noise import add_noise, bbox_diagonal
 from meshlap_core.options import CURVATURE_ESTIMATORS
@@ -287,7 +287,7 @@ def test_noise_estimate_and_radius_follow_the_noise(torus32k) -> None:
 def test_mixed_voronoi_areas_from_the_face_frame_equal_libigls_massmatrix() -> None:
     """The cotan and normal-cycle estimators take the mixed Voronoi areas from their one pass
     over the faces (obtuse triangles included: a jittered, flipped saddle)."""
-    from meshlap_core.curvature import _areas_from, _face_frame
+    from meshlap_core.curvature.fields import _areas_from, _face_frame
 
     m, V = perturbed_mesh("saddle", 20, 0.0, jitter=0.4, flips=0.3)
     theta = igl.internal_angles(V, m.F)
@@ -356,7 +356,7 @@ def test_ellipsoid_exact_curvature_is_the_closed_form() -> None:
 def test_mesh_estimators_converge_to_the_exact_ellipsoid(name: str) -> None:
     """Refinement 16 -> 32 -> 64 cells: the relative RMS error of H and K (away from the
     poles) shrinks at order about 2 for every estimator (measured 1.8-2.2)."""
-    from meshlap_core.curvature_study import curvature_study
+    from meshlap_core.curvature.study import curvature_study
 
     rows = curvature_study(["ellipsoid"], [name], (16, 32, 64))
     assert rows[-1]["H_rel"] < 0.015 and rows[-1]["K_rel"] < 0.025
@@ -369,7 +369,7 @@ def test_mesh_estimators_converge_to_the_exact_ellipsoid(name: str) -> None:
 def test_a_kept_topology_gives_the_same_estimate_for_new_positions() -> None:
     """The faces' edges built once (CurvatureTopology) and reused as the vertices move: the same
     values as without it; a topology of other faces is refused, as is one for the quadric."""
-    from meshlap_core.curvature_topology import CurvatureTopology
+    from meshlap_core.curvature.topology import CurvatureTopology
 
     m, V0 = perturbed_mesh("torus", (24, 12), 0.0, jitter=0.3, flips=0.2)
     topo = CurvatureTopology.of(m.F, len(V0))
@@ -393,7 +393,7 @@ def test_a_kept_topology_gives_the_same_estimate_for_new_positions() -> None:
 def test_topology_adjacency_is_the_brute_force_one() -> None:
     """Interior edges (two consistently oriented faces) and the vertex–face CSR against loops
     over a hand-checkable mesh (an open strip of 4 triangles, a boundary everywhere)."""
-    from meshlap_core.curvature_topology import CurvatureTopology
+    from meshlap_core.curvature.topology import CurvatureTopology
 
     F = np.array([[0, 1, 2], [1, 3, 2], [2, 3, 4], [3, 5, 4]])
     topo = CurvatureTopology.of(F, 6)
@@ -415,7 +415,7 @@ def test_topology_adjacency_is_the_brute_force_one() -> None:
 
 
 def test_curvature_at_vertex_takes_a_kept_topology() -> None:
-    from meshlap_core.curvature_topology import CurvatureTopology
+    from meshlap_core.curvature.topology import CurvatureTopology
 
     m, V = perturbed_mesh("torus", (48, 24), 0.002, jitter=0.3)
     topo = CurvatureTopology.of(m.F, len(V))

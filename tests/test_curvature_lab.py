@@ -13,8 +13,8 @@ from meshlap_app.state.curvature_lab import (
     crosses_of,
 )
 
-from meshlap_core import curvature_estimators as ce
 from meshlap_core import primitives
+from meshlap_core.curvature import estimators as ce
 from meshlap_core.errors import MeshError
 from meshlap_core.noise import add_noise
 
@@ -323,7 +323,7 @@ def test_the_flipped_triangulation_and_its_topology_are_kept_per_base():
     flipped_and_noisy makes), and a base sent to a child process leaves them behind."""
     import pickle
 
-    from meshlap_core.curvature_study import flipped_and_noisy
+    from meshlap_core.curvature.study import flipped_and_noisy
 
     lab = CurvatureLabState()
     lab.set_number("res", 12)

@@ -13,13 +13,13 @@ import json
 import numpy as np
 import pytest
 
-from meshlap_core import curvature_estimators as ce
 from meshlap_core import primitives
 from meshlap_core.cli import main
-from meshlap_core.curvature_study import (
+from meshlap_core.curvature import estimators as ce
+from meshlap_core.curvature.refinement import exact_principal
+from meshlap_core.curvature.study import (
     STUDY_COLUMNS,
     curvature_study,
-    exact_principal,
     fitted_orders,
     perturbed_mesh,
     vertex_errors,
@@ -163,7 +163,7 @@ def test_pointwise_estimators_stall_on_irregular_meshes_and_fits_converge():
 
 def test_edge_flips_keep_the_surface_and_orientation_and_break_pointwise_convergence():
     from meshlap_core.curvature import vertex_normals
-    from meshlap_core.curvature_study import flip_edges
+    from meshlap_core.curvature.study import flip_edges
     from meshlap_core.topology import edges, euler_characteristic
 
     m, V = perturbed_mesh("torus", (64, 32))

@@ -388,7 +388,7 @@ def test_genus_none_is_explained_and_small_texts(viewer, tmp_path):
     from meshlap_app.state.surfaces import SurfaceState
     from meshlap_app.text_numbers import plural
 
-    from meshlap_core.frames import VIDEO_EXTRA
+    from meshlap_core.io.animation import VIDEO_EXTRA
 
     fin = tmp_path / "fin.obj"  # three triangles on one edge: not a manifold
     fin.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nf 1 2 3\nf 1 4 2\nf 1 2 5\n")

@@ -98,3 +98,20 @@ def test_inputs_not_modified_and_bad_area_rejected():
     np.testing.assert_array_equal(F, F0)
     with pytest.raises(MeshError, match="area"):
         lap.vertex_areas(V, F, "circumcentric")
+
+
+def test_mean_edge_length_counts_each_edge_once():
+    """By hand: the right triangle's edges 1, 1, √2; two triangles sharing the diagonal of the
+    unit square have five edges 1, 1, 1, 1, √2 (a mean over half-edges would count the shared
+    diagonal twice: (4 + 2√2)/6). Against libigl on a closed and an open mesh; a mesh's own
+    edge list gives the same number; no faces: 0."""
+    assert lap.mean_edge_length(RIGHT_V, RIGHT_F) == pytest.approx((2 + np.sqrt(2)) / 3)
+    V = np.array([[0.0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]])
+    F = np.array([[0, 1, 2], [0, 2, 3]])
+    assert lap.mean_edge_length(V, F) == pytest.approx((4 + np.sqrt(2)) / 5)
+    for V, F in (primitives.icosphere(2), primitives.grid(7, 5)):
+        h = lap.mean_edge_length(V, F)
+        assert h == pytest.approx(igl.avg_edge_length(V, F), rel=1e-12)
+        E = np.sort(np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]]), axis=1)
+        assert lap.mean_edge_length(V, F, np.unique(E, axis=0)) == pytest.approx(h, rel=1e-15)
+    assert lap.mean_edge_length(RIGHT_V, np.zeros((0, 3), dtype=np.int64)) == 0.0

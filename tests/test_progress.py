@@ -18,7 +18,7 @@ def test_bar_fills_the_given_count():
 
 
 def test_frames_are_redrawn_in_place_on_any_stream_and_the_line_ends():
-    from meshlap_core.frames import frame_progress
+    from meshlap_core.io.animation import frame_progress
 
     s = io.StringIO()
     p = frame_progress(4, stream=s)

@@ -58,3 +58,42 @@ def test_diffusion_names_are_the_diffusion_modules():
     d = meshlap_core.HeatGeodesic(V, F).distance([0])
     far = int(np.argmin(V @ V[0]))
     assert abs(d[far] - np.pi) < 0.05 * np.pi
+
+
+def test_the_curvature_names_live_on_the_curvature_shelf():
+    """The top-level curvature names are the objects of the ``meshlap_core.curvature`` package's
+    modules, and the package re-exports every public function of ``curvature.fields``."""
+    import importlib
+
+    from meshlap_core import curvature
+    from meshlap_core.curvature import estimators, fields, jet_fit, principal
+
+    assert meshlap_core.estimate_curvature is estimators.estimate_curvature
+    assert meshlap_core.PrincipalCurvatures is principal.PrincipalCurvatures
+    assert meshlap_core.jet_curvatures is jet_fit.jet_curvatures
+    for name in curvature.__all__:
+        assert getattr(curvature, name) is getattr(fields, name)
+    for name in ("curvature_field", "all_curvature_fields", "vertex_normals"):
+        assert getattr(meshlap_core, name) is getattr(fields, name)
+    assert importlib.import_module("meshlap_core.io.animation").FrameWriter is not None
+
+
+@pytest.mark.parametrize(
+    "old",
+    [
+        "meshlap_core.curvature_estimators",
+        "meshlap_core.curvature_fit",
+        "meshlap_core.curvature_topology",
+        "meshlap_core.curvature_study",
+        "meshlap_core.principal",
+        "meshlap_core.frames",
+        "meshlap_core.study",
+        "meshlap_core.surfaces.convergence",
+    ],
+)
+def test_the_module_paths_renamed_since_0_1_0_are_gone(old):
+    """README's 'Renamed since 0.1.0' lists them, with their new shelves: no alias module."""
+    import importlib
+
+    with pytest.raises(ModuleNotFoundError):
+        importlib.import_module(old)

@@ -16,8 +16,8 @@ import pytest
 from meshlap_app.screenshots import ViewerScreenshots
 
 from meshlap_core.cli import main
+from meshlap_core.course_report import SECTIONS, build_report, parse_sections
 from meshlap_core.errors import MeshError
-from meshlap_core.study import SECTIONS, build_report, parse_sections
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 

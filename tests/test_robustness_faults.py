@@ -22,8 +22,8 @@ import numpy as np
 import pytest
 
 from meshlap_core import MeshError, SpectralBasis, primitives, save_mesh, save_scalars
-from meshlap_core.frames import FrameWriter
 from meshlap_core.io import atomic_write
+from meshlap_core.io.animation import FrameWriter
 
 V, F = primitives.icosphere(1)
 OLD = b"old contents, not to be lost\n"

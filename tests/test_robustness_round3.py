@@ -110,7 +110,7 @@ def test_printable_escapes_what_the_terminal_would_act_on():
 
 # ---------------------------------------------------------------- read-only file systems
 def test_read_only_file_system_is_not_called_permission_denied(tmp_path, monkeypatch):
-    import meshlap_core.frames as frames
+    import meshlap_core.io.animation as frames
     from meshlap_core.io import atomic
 
     class ReadOnly:
@@ -126,7 +126,7 @@ def test_read_only_file_system_is_not_called_permission_denied(tmp_path, monkeyp
 def test_a_full_disk_during_mp4_output_says_so(tmp_path, monkeypatch):
     """ffmpeg dies on a full disk and Python sees a broken pipe with ffmpeg's command line
     appended: the message is the cause, the temporary file is removed."""
-    import meshlap_core.frames as frames
+    import meshlap_core.io.animation as frames
 
     class Full:
         f_bavail, f_frsize, f_flag = 0, 4096, 0
@@ -158,7 +158,7 @@ def test_a_full_disk_during_mp4_output_says_so(tmp_path, monkeypatch):
 
 
 def test_video_cause_prefers_ffmpegs_own_reason(tmp_path):
-    from meshlap_core.frames import video_cause
+    from meshlap_core.io.animation import video_cause
 
     exc = OSError(errno.EPIPE, "Broken pipe\nFFMPEG STDERR: ... Read-only file system")
     assert video_cause(exc, tmp_path) == "read-only file system"
@@ -169,7 +169,7 @@ def test_video_cause_prefers_ffmpegs_own_reason(tmp_path):
 def test_gif_frames_go_to_disk_as_they_arrive(tmp_path):
     """Memory holds one frame: after each frame the temporary file has grown by about one
     encoded frame (the old writer kept every frame until close)."""
-    from meshlap_core.frames import FrameWriter
+    from meshlap_core.io.animation import FrameWriter
 
     rng = np.random.default_rng(0)
     w = FrameWriter(tmp_path / "a.gif", fps=10)

@@ -16,12 +16,12 @@ from scipy.optimize import minimize_scalar
 
 import meshlap_core
 from meshlap_core import primitives, surfaces
-from meshlap_core.curvature import vertex_normals
+from meshlap_core.curvature import convergence, refinement, vertex_normals
+from meshlap_core.curvature.convergence import convergence_study
 from meshlap_core.errors import MeshError
 from meshlap_core.io import load_mesh
 from meshlap_core.surfaces import (
     ParametricSurface,
-    convergence_study,
     get_surface,
     mesh_surface,
     normal_curvature,
@@ -378,7 +378,7 @@ def test_bad_resolution() -> None:
 
 def test_exact_reference_values_used_by_the_study() -> None:
     m = mesh_surface(get_surface("sphere", r=2.0), 6)
-    H, K = surfaces.exact_curvature_at(get_surface("sphere", r=2.0), m.uv, m.pole)
+    H, K = refinement.exact_curvature_at(get_surface("sphere", r=2.0), m.uv, m.pole)
     np.testing.assert_allclose(H, 0.5, rtol=1e-9)  # the core's sign: H > 0 with outward n
     np.testing.assert_allclose(K, 0.25, rtol=1e-9)  # including the two pole vertices
 
@@ -428,7 +428,7 @@ def test_barycentric_K_converges_on_the_torus_grid() -> None:
 def test_study_table_and_dict() -> None:
     st = convergence_study("torus", (6, 12))
     text = st.table()
-    for est in surfaces.ESTIMATORS:
+    for est in convergence.ESTIMATORS:
         assert est in text
     d = st.to_dict()
     assert json.loads(json.dumps(d))["resolutions"] == [6, 12]
@@ -536,7 +536,7 @@ def test_cli_plot_mesh_and_convergence(tmp_path, capsys) -> None:
     assert code == 0
     d = json.loads(out)
     assert d["n_vertices"] == [42, 162]
-    assert set(d["errors"]) == set(surfaces.ESTIMATORS)
+    assert set(d["errors"]) == set(convergence.ESTIMATORS)
     assert "vertices" in err  # progress on stderr, not stdout
 
 
@@ -756,7 +756,7 @@ def test_one_name_per_thing() -> None:
 def test_eig_sym2_matches_lapack() -> None:
     # the principal curvatures' closed-form eigen-decomposition against numpy's eigh, including
     # near-umbilic, diagonal and tiny/huge matrices (eigenvectors compared up to sign)
-    from meshlap_core.principal import eig_sym2
+    from meshlap_core.curvature.principal import eig_sym2
 
     rng = np.random.default_rng(7)
     a, b, c = rng.normal(size=(3, 4000)) * 10.0 ** rng.uniform(-6, 6, (1, 4000))

@@ -24,8 +24,8 @@ from meshlap_app.state.surfaces import TURN_STEP_DEG, section_arc  # noqa: E402
 
 from meshlap_core import primitives  # noqa: E402
 from meshlap_core.errors import MeshError  # noqa: E402
-from meshlap_core.frames import caption_box  # noqa: E402
 from meshlap_core.io import save_mesh  # noqa: E402
+from meshlap_core.io.animation import caption_box  # noqa: E402
 from meshlap_core.surfaces import normal_curvature  # noqa: E402
 
 RECORD_WIDGETS = ("record file", "record", "stop")

@@ -8,12 +8,13 @@ from typing import Any
 import numpy as np
 
 from meshlap_core.curvature import all_curvature_fields
-from meshlap_core.curvature_estimators import (
+from meshlap_core.curvature.estimators import (
     PATCH_RINGS,
     curvature_at_vertex,
     estimate_curvature,
 )
-from meshlap_core.curvature_topology import CurvatureTopology
+from meshlap_core.curvature.principal import PrincipalCurvatures
+from meshlap_core.curvature.topology import CurvatureTopology
 from meshlap_core.errors import MeshError
 from meshlap_core.options import (
     AREA_KINDS,
@@ -26,7 +27,6 @@ from meshlap_core.options import (
     PRINCIPAL_FIELDS,
     check_choice,
 )
-from meshlap_core.principal import PrincipalCurvatures
 from meshlap_core.types import FloatArray
 
 from .checks import Schema, boolean, number, one_of
@@ -222,10 +222,10 @@ class CurvatureState:
 
     def shape_operator(self, mesh: MeshState, vertex: int) -> dict[str, Any] | None:
         """The estimator's 2×2 shape operator at ``vertex`` in its tangent basis
-        (:meth:`~meshlap_core.principal.PrincipalCurvatures.shape_operator`): ``S``, ``t1``,
-        ``t2``, ``k1``, ``k2`` and ``estimator``. From the whole mesh's estimate when it is
+        (:meth:`~meshlap_core.curvature.principal.PrincipalCurvatures.shape_operator`): ``S``,
+        ``t1``, ``t2``, ``k1``, ``k2`` and ``estimator``. From the whole mesh's estimate when it is
         current, else from a patch around the vertex (milliseconds on a big scan:
-        :func:`~meshlap_core.curvature_estimators.curvature_at_vertex`); ``None`` for the jet
+        :func:`~meshlap_core.curvature.estimators.curvature_at_vertex`); ``None`` for the jet
         until its whole-mesh estimate is there (:meth:`want_principal`)."""
         if not 0 <= vertex < len(mesh.V):
             return None

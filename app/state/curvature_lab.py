@@ -11,21 +11,21 @@ from typing import Any
 import numpy as np
 
 from meshlap_core.curvature import vertex_normals
-from meshlap_core.curvature_estimators import (
+from meshlap_core.curvature.estimators import (
     PATCH_RINGS,
     TOPOLOGY_ESTIMATORS,
     disagreement,
     estimate_curvature,
 )
-from meshlap_core.curvature_study import (
-    ExactPrincipal,
+from meshlap_core.curvature.principal import PrincipalCurvatures, tangent_frames
+from meshlap_core.curvature.refinement import ExactPrincipal, exact_principal
+from meshlap_core.curvature.study import (
     curvature_study,
-    exact_principal,
     flip_edges,
     flipped_and_noisy,
     jittered_mesh,
 )
-from meshlap_core.curvature_topology import CurvatureTopology
+from meshlap_core.curvature.topology import CurvatureTopology
 from meshlap_core.errors import MeshError
 from meshlap_core.options import (
     CURVATURE_ESTIMATORS,
@@ -34,7 +34,6 @@ from meshlap_core.options import (
     PRINCIPAL_FIELDS,
     check_choice,
 )
-from meshlap_core.principal import PrincipalCurvatures, tangent_frames
 from meshlap_core.surfaces import SURFACES, SurfaceMesh, mesh_surface
 from meshlap_core.types import FloatArray, IntArray
 
@@ -192,7 +191,7 @@ class Base:
     """A lab surface before flips and noise: the jittered mesh and its exact curvature (what
     a move of the noise or flips slider reuses; the exact values do not depend on them), and
     per ``flips`` value the flipped mesh, its normals and its
-    :class:`~meshlap_core.curvature_topology.CurvatureTopology` (the faces do not change with
+    :class:`~meshlap_core.curvature.topology.CurvatureTopology` (the faces do not change with
     the noise: the estimators' edge tables are built once per resolution, jitter and flips;
     :meth:`triangulation`). The topologies are not pickled to or from a child process."""
 
@@ -206,7 +205,7 @@ class Base:
 
     def triangulation(self, flips: float) -> tuple[SurfaceMesh, FloatArray, CurvatureTopology]:
         """The mesh with a fraction ``flips`` of its edges flipped (seed 0, as
-        :func:`~meshlap_core.curvature_study.flipped_and_noisy`), its unit vertex normals and
+        :func:`~meshlap_core.curvature.study.flipped_and_noisy`), its unit vertex normals and
         its topology, made on first use and kept (the last :data:`KEEP_FLIPS` values; any
         thread: the same values whoever makes them)."""
         got = self.kept.get(float(flips))
@@ -426,7 +425,7 @@ class CurvatureLabState:
 
     @staticmethod
     def study(params: dict[str, Any], progress: Any = None) -> list[dict[str, Any]]:
-        """The estimator's :func:`~meshlap_core.curvature_study.curvature_study` rows at
+        """The estimator's :func:`~meshlap_core.curvature.study.curvature_study` rows at
         :data:`STUDY_LEVELS` (``h``, ``H_rel``, ``K_rel``, ``H_order``, ...): the log-log plot
         of the error against h (any thread or a child process)."""
         return curvature_study(

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from meshlap_core.errors import MeshError
-from meshlap_core.frames import parse_range
+from meshlap_core.io.animation import parse_range
 from meshlap_core.spectral import SpectralBasis
 from meshlap_core.types import FloatArray, IntArray
 

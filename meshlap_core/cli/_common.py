@@ -1,4 +1,4 @@
-"""Helpers shared by the subcommands: argument parsing, JSON output, statistics."""
+"""Helpers shared by the subcommands: argument parsing, JSON output, statistics, field output."""
 
 from __future__ import annotations
 
@@ -6,6 +6,7 @@ import argparse
 import json
 import math
 import sys
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -67,6 +68,21 @@ def summary_stats(values: np.ndarray) -> dict[str, float]:
         "p01": float(p01),
         "p99": float(p99),
     }
+
+
+def save_field(out: Path | None, V: Any, F: Any, values: Any, source: Any) -> None:
+    """Write the per-vertex field ``values`` ``(n,)`` to ``out``: a ``.ply`` is the mesh
+    ``(V, F)`` with the field as its vertex quality, any other suffix a scalars file
+    (:func:`~meshlap_core.io.save_scalars`); nothing when ``out`` is ``None``. The input mesh
+    ``source`` is never overwritten."""
+    if out is None:
+        return
+    from ..io import save_mesh, save_scalars
+
+    if Path(out).suffix.lower() == ".ply":
+        save_mesh(out, V, F, scalars=values, overwrite_inputs=(source,))
+    else:
+        save_scalars(out, values, overwrite_inputs=(source,))
 
 
 def add_json_flag(p: argparse.ArgumentParser) -> None:

@@ -3,7 +3,7 @@ its statistics.
 
 Without ``--estimator`` the fields of :mod:`meshlap_core.curvature` (``--method uniform, cotan,
 gaussian, k1, k2``); with it (or with ``--method H, K, abs_max``) a field of the principal
-curvatures of :mod:`meshlap_core.curvature_estimators` (``--method k1, k2, H, K, abs_max``,
+curvatures of :mod:`meshlap_core.curvature.estimators` (``--method k1, k2, H, K, abs_max``,
 estimator ``cotan`` when not given), ``--radius`` its scale (quadric: edge rings; jet: world
 units) and ``--directions FILE.npy`` the ``(n, 2, 3)`` principal directions ``d1, d2``.
 """
@@ -16,9 +16,9 @@ from pathlib import Path
 import numpy as np
 
 from ..curvature import curvature_field
-from ..curvature_estimators import estimate_curvature
+from ..curvature.estimators import estimate_curvature
 from ..errors import MeshError
-from ..io import check_output_path, load_mesh, save_mesh, save_scalars
+from ..io import check_output_path, load_mesh
 from ..io.atomic import atomic_write
 from ..options import (
     AREA_KINDS,
@@ -30,7 +30,7 @@ from ..options import (
     DEFAULT_CURVATURE_FIELD,
     PRINCIPAL_FIELDS,
 )
-from ._common import add_json_flag, emit_json, print_report, summary_stats
+from ._common import add_json_flag, emit_json, print_report, save_field, summary_stats
 
 OUT_SUFFIXES = (".csv", ".npy", ".ply")
 METHODS: tuple[str, ...] = CURVATURE_METHODS + tuple(
@@ -111,11 +111,7 @@ def run(args: argparse.Namespace) -> int:
         bad = int(np.count_nonzero(~np.isfinite(values)))
         raise MeshError(f"the {args.method} curvature is not finite at {bad} vertices", args.mesh)
     print_report(args.mesh, mesh.report)
-    if out is not None:
-        if out.suffix.lower() == ".ply":
-            save_mesh(out, mesh.V, mesh.F, scalars=values, overwrite_inputs=(args.mesh,))
-        else:
-            save_scalars(out, values, overwrite_inputs=(args.mesh,))
+    save_field(out, mesh.V, mesh.F, values, args.mesh)
     if dirs is not None and result is not None:
         with atomic_write(dirs, "wb", overwrite_inputs=(args.mesh,)) as f:
             np.save(f, np.stack([result.d1, result.d2], axis=1))

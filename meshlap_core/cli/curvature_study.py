@@ -10,7 +10,7 @@ import io
 import math
 from pathlib import Path
 
-from ..curvature_study import STUDY_COLUMNS, curvature_study, write_study_figure
+from ..curvature.study import STUDY_COLUMNS, curvature_study, write_study_figure
 from ..errors import MeshError
 from ..io import check_output_path
 from ..io.atomic import atomic_write

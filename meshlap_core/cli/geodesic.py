@@ -16,10 +16,10 @@ import numpy as np
 from ..diffusion import HeatGeodesic, exact_distance, igl_heat_distance
 from ..diffusion.geodesic import check_time_factor
 from ..errors import MeshError
-from ..io import load_mesh, save_mesh, save_scalars
+from ..io import load_mesh
 from ..options import DEFAULT_HEAT_BOUNDARY, GEODESIC_METHODS, HEAT_BOUNDARIES
 from ..progress import Progress
-from ._common import add_json_flag, emit_json, print_report, summary_stats
+from ._common import add_json_flag, emit_json, print_report, save_field, summary_stats
 from ._curves import add_curve_flags, curves_path, write_curves
 from ._sources import add_vertex_flag, output, vertices
 
@@ -100,11 +100,7 @@ def run(args: argparse.Namespace) -> int:
         result["relative_error_max"] = float(rel.max()) if rel.size else 0.0
         result["relative_error_mean"] = float(rel.mean()) if rel.size else 0.0
     print_report(args.mesh, mesh.report)
-    if out is not None:
-        if out.suffix.lower() == ".ply":
-            save_mesh(out, V, F, scalars=d, overwrite_inputs=(args.mesh,))
-        else:
-            save_scalars(out, d, overwrite_inputs=(args.mesh,))
+    save_field(out, V, F, d, args.mesh)
     write_curves(args, curves, V, F, d, result)
     result["out"] = str(out) if out else None
     if args.json:

@@ -14,9 +14,9 @@ import argparse
 from ..diffusion import HeatDiffusion, heat_spectral, truncation_bound, unit_heat
 from ..diffusion.heat import check_time
 from ..errors import MeshError
-from ..io import load_mesh, save_mesh, save_scalars
+from ..io import load_mesh
 from ..options import HEAT_METHODS, MASS_AREA
-from ._common import add_json_flag, emit_json, print_report, summary_stats
+from ._common import add_json_flag, emit_json, print_report, save_field, summary_stats
 from ._curves import add_curve_flags, curves_path, write_curves
 from ._sources import add_vertex_flag, output, vertices
 
@@ -76,11 +76,7 @@ def run(args: argparse.Namespace) -> int:
     result["total_heat"] = float(hd.mass @ u)
     result.update(summary_stats(u))
     print_report(args.mesh, mesh.report)
-    if out is not None:
-        if out.suffix.lower() == ".ply":
-            save_mesh(out, V, F, scalars=u, overwrite_inputs=(args.mesh,))
-        else:
-            save_scalars(out, u, overwrite_inputs=(args.mesh,))
+    save_field(out, V, F, u, args.mesh)
     write_curves(args, curves, V, F, u, result)
     result["out"] = str(out) if out else None
     if args.json:

@@ -1,7 +1,7 @@
 """``meshlap report [--meshes DIR] [--out DIR] [--quick]``: regenerate the whole study.
 
 Writes ``report.md``, ``report.html``, ``figures/*.png`` and ``tables/*.csv`` into ``--out``
-(see :mod:`meshlap_core.study`). A progress bar and the time of each section go to stderr;
+(see :mod:`meshlap_core.course_report`). A progress bar and the time of each section go to stderr;
 stdout gets the list of files (or one JSON object with ``--json``). Sign convention of every
 Laplacian used: negative semidefinite, ``Δx = −2Hn``.
 """
@@ -82,7 +82,7 @@ def screenshot_provider() -> contextlib.AbstractContextManager[Any]:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..study import build_report
+    from ..course_report import build_report
 
     with screenshot_provider() as screenshot:
         result = build_report(

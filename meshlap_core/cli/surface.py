@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from ..curvature.convergence import convergence_study
 from ..errors import MeshError
 from ..options import MESHERS
 from ..surfaces import (
@@ -23,7 +24,6 @@ from ..surfaces import (
     PointGeometry,
     check_mesh_res,
     check_uv,
-    convergence_study,
     estimate_mesh_bytes,
     get_surface,
     mesh_surface,

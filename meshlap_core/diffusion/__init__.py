@@ -22,6 +22,7 @@ Modules
     The heat kernel signature (Sun et al. 2009).
 """
 
+from ..laplacian import mean_edge_length  # the heat time t = m h²; re-exported here
 from .filters import (
     SpectralFilter,
     band_gain,
@@ -36,7 +37,6 @@ from .geodesic import (
     boundary_vertices,
     exact_distance,
     igl_heat_distance,
-    mean_edge_length,
 )
 from .heat import HeatDiffusion, heat_kernel_column, heat_spectral, truncation_bound
 from .hks import heat_kernel_signature, hks_distance, hks_times

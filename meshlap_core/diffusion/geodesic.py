@@ -41,7 +41,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import MeshError, check_cancel
-from ..laplacian import vertex_areas
+from ..laplacian import mean_edge_length, vertex_areas
 from ..linalg.common import ProgressCallback, report_progress
 from ..linalg.components import components
 from ..linalg.factor import SharedAnalysis, pinned_data
@@ -87,19 +87,11 @@ def edge_counts(F: IntArray, n: int) -> sp.csr_matrix:
     return count
 
 
-def mean_edge_length(V: FloatArray, F: IntArray) -> float:
-    """The mean length ``h`` of the mesh's edges, each edge once (``igl.avg_edge_length``'s
-    value, from a sparse edge table: 20× faster at 43k vertices)."""
-    V, F = as_mesh(V, F)
-    if len(F) == 0:
-        return 0.0
-    return _mean_length(V, edge_counts(F, len(V)))
-
-
-def _mean_length(V: FloatArray, count: sp.csr_matrix) -> float:
-    """The mean length of the edges of the table ``count`` (:func:`edge_counts`)."""
-    i = np.repeat(np.arange(len(V)), np.diff(count.indptr))
-    return float(np.mean(np.linalg.norm(V[i] - V[count.indices], axis=1)))
+def _table_edges(count: sp.csr_matrix) -> IntArray:
+    """The edges ``(i, j)``, ``i < j``, of the table ``count`` (:func:`edge_counts`), ``(e,2)``,
+    sorted as :func:`meshlap_core.topology.edges` sorts them."""
+    i = np.repeat(np.arange(count.shape[0]), np.diff(count.indptr))
+    return np.column_stack((i, count.indices))
 
 
 def boundary_vertices(F: IntArray, n: int) -> IntArray:
@@ -285,7 +277,7 @@ class HeatGeodesic:
                 "V",
             )
         count = edge_counts(self.F, n)  # one edge table: h and the boundary
-        self.h = _mean_length(self.V, count)
+        self.h = mean_edge_length(self.V, self.F, _table_edges(count))
         self.t = self.m * self.h**2
         self.boundary = _boundary(count)
         self.n_components, self.labels = components(K)

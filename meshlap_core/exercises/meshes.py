@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..laplacian import mean_edge_length
 from ..primitives import icosphere
 from ..types import FloatArray, IntArray
 
@@ -54,10 +55,9 @@ class Case:
 
     @property
     def scale(self) -> float:
-        """Mean edge length ``h``: a quantity with units of length^p is compared at ``h^p``."""
-        P = self.V[self.F]
-        e = np.concatenate([P[:, 1] - P[:, 0], P[:, 2] - P[:, 1], P[:, 0] - P[:, 2]])
-        return float(np.mean(np.linalg.norm(e, axis=1)))
+        """Mean edge length ``h`` (each edge once): a quantity with units of length^p is
+        compared at ``h^p``."""
+        return mean_edge_length(self.V, self.F)
 
 
 def _outward(V: FloatArray, F: IntArray, inside: FloatArray) -> IntArray:

@@ -3,9 +3,11 @@
 Modules: :mod:`.catalogue` (:class:`ParametricSurface`, the shipped surfaces, :func:`get_surface`),
 :mod:`.derivatives` (exact / complex-step / central derivatives), :mod:`.geometry` (fundamental
 forms, curvature fields, normal curvature, classification, :func:`point_geometry`),
-:mod:`.meshing` (:func:`mesh_surface`), :mod:`.convergence` (:func:`convergence_study`),
-:mod:`.plot` (the ``κₙ(θ)`` figure) and :mod:`.singular` (singular points: declared poles and
-``|p_u × p_v|`` negligible against the surface's area scale). Everything public is re-exported here.
+:mod:`.meshing` (:func:`mesh_surface`), :mod:`.plot` (the ``κₙ(θ)`` figure) and :mod:`.singular`
+(singular points: declared poles and ``|p_u × p_v|`` negligible against the surface's area
+scale). Everything public is re-exported here. How the discrete estimators converge to the exact
+values on these surfaces is measured above this package, in :mod:`meshlap_core.curvature`
+(:mod:`~meshlap_core.curvature.convergence` and :mod:`~meshlap_core.curvature.study`).
 
 A :class:`ParametricSurface` is a map ``p`` on a parameter rectangle ``[u0,u1] × [v0,v1]``.
 At any ``(u, v)`` this module computes the partial derivatives, the unit normal
@@ -15,16 +17,14 @@ At any ``(u, v)`` this module computes the partial derivatives, the unit normal
 ``K = (eg − f²)/(EG − F²)``, the mean curvature ``H = (eG − 2fF + gE) / (2(EG − F²))``, the
 principal curvatures ``κ₁ ≥ κ₂`` and directions, the normal curvature
 ``κₙ(θ) = II(w, w) / I(w, w)`` for ``w = (cos θ, sin θ)`` and the point classification.
-It also triangulates the parameter rectangle (:func:`mesh_surface`) and measures how the
-discrete estimators of :mod:`meshlap_core.curvature` converge to the exact values
-(:func:`convergence_study`).
+It also triangulates the parameter rectangle (:func:`mesh_surface`).
 
 Sign conventions (one convention for the whole project). The normal is
 ``n = p_u × p_v / |…|``, outward on every shipped closed surface, and ``II`` is measured so that
 ``κₙ > 0`` where the surface bends **away** from ``n``: ``e = −p_uu · n = p_u · n_u`` (do Carmo's
 ``II`` negated). The unit sphere has ``κ₁ = κ₂ = H = +1`` here, the same sign as the discrete
 core's ``Δx = −2 H n`` (negative semidefinite Laplacian) with outward normals from
-counter-clockwise faces, so :func:`convergence_study` compares ``H`` directly; ``K`` does not
+counter-clockwise faces, so the convergence studies compare ``H`` directly; ``K`` does not
 depend on the sign. ``κ₁ ≥ κ₂`` always.
 
 Derivatives. A surface may carry its exact derivatives; otherwise (and in the tests, to check
@@ -39,10 +39,6 @@ References
 M. do Carmo, *Differential Geometry of Curves and Surfaces*, 1976, ch. 3.
 Squire & Trapp, "Using complex variables to estimate derivatives of real functions", SIAM
 Review 40, 1998 (the complex step).
-Meyer, Desbrun, Schröder & Barr, "Discrete differential-geometry operators for triangulated
-2-manifolds", 2003 (the estimators being tested).
-Xu, "Convergence of the discrete Laplace–Beltrami operator", 2004; Hildebrandt, Polthier &
-Wardetzky, "On the convergence of metric and geometric properties of polyhedral surfaces", 2006.
 """
 
 from .catalogue import (
@@ -63,7 +59,6 @@ from .catalogue import (
     sphere,
     torus,
 )
-from .convergence import ESTIMATORS, ConvergenceStudy, convergence_study, exact_curvature_at
 from .derivatives import Derivatives, surface_derivatives
 from .geometry import (
     CLASSIFICATIONS,
@@ -92,14 +87,12 @@ from .singular import SINGULAR_REL, is_singular, surface_scale
 __all__ = [
     "CLASSIFICATIONS",
     "EDGES",
-    "ESTIMATORS",
     "MAX_CELLS",
     "MAX_MESH_BYTES",
     "MESH_BYTES_PER_CELL",
     "SINGULAR_REL",
     "STUDY_BYTES_PER_CELL",
     "SURFACES",
-    "ConvergenceStudy",
     "CurvatureFields",
     "DerivativeMap",
     "Derivatives",
@@ -111,12 +104,10 @@ __all__ = [
     "check_mesh_res",
     "check_uv",
     "classify",
-    "convergence_study",
     "cylinder",
     "ellipsoid",
     "ellipsoid_curvature",
     "estimate_mesh_bytes",
-    "exact_curvature_at",
     "get_surface",
     "helicoid",
     "is_singular",

@@ -11,8 +11,8 @@ from typing import Any
 
 import numpy as np
 
+from ..curvature.principal import eig_sym2
 from ..errors import MeshError
-from ..principal import eig_sym2
 from ..types import BoolArray, FloatArray
 from .catalogue import ParametricSurface, check_uv, get_surface
 from .derivatives import DerivativeMethod, Derivatives, surface_derivatives
@@ -79,7 +79,7 @@ def surface_curvature_fields(
     as those of the symmetric ``L⁻¹ II L⁻ᵀ`` (``I = LLᵀ``, Cholesky), so that ``κ₁ − κ₂`` is
     accurate to rounding even at umbilics; the principal parameter directions are
     ``w = L⁻ᵀ y`` for its unit eigenvectors ``y`` (so ``wᵀ I w = 1``), both in closed form
-    (:func:`~meshlap_core.principal.eig_sym2`).
+    (:func:`~meshlap_core.curvature.principal.eig_sym2`).
     """
     surface = get_surface(surface)
     D = surface_derivatives(surface, u, v, method) if derivatives is None else derivatives

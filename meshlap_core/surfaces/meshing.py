@@ -59,8 +59,9 @@ MESH_BYTES_PER_CELL = 512
 (``V, F, uv, pole, boundary``) is 90 bytes per cell, the edge table of the boundary mask most of
 the rest."""
 STUDY_BYTES_PER_CELL = 1536
-"""Estimated peak bytes per cell of one :func:`~meshlap_core.surfaces.convergence_study` level
-(the five discrete estimators): measured 1170–1440 bytes at 256² and 512² cells."""
+"""Estimated peak bytes per cell of one level of
+:func:`~meshlap_core.curvature.convergence.convergence_study` (the five discrete estimators):
+measured 1170–1440 bytes at 256² and 512² cells."""
 STUDY_KEPT_BYTES_PER_CELL = 128
 """Bytes per cell a finished study level keeps (mesh, exact values) until the table is built."""
 MAX_CELLS = MAX_MESH_BYTES // MESH_BYTES_PER_CELL

@@ -1,4 +1,9 @@
-"""``meshlap report``: the whole curvature / spectral / smoothing study, reproduced and checked.
+"""``meshlap report``: the course report, the whole curvature / spectral / smoothing analysis of
+the course reproduced and checked.
+
+Not :mod:`meshlap_core.curvature.study`, which measures the curvature estimators against exact
+surfaces. This package was ``meshlap_core.study`` in 0.1.0 (README, "Renamed since 0.1.0"); the
+older module name ``meshlap_core.report`` is gone, and this name says which report it is.
 
 :func:`build_report` runs seven sections on the course meshes (``../shared/meshes`` beside the
 checkout, or ``--meshes DIR``; the bundled ``assets/`` stand in for missing ones and the report
@@ -25,7 +30,7 @@ fundamental form against ``n = p_u × p_v`` with the same sign (``e = −p_uu ·
 is the core's for the same normal.
 
 This package is headless: it never imports polyscope nor the viewer. Mesh pictures come from a
-screenshot function the caller passes (:class:`~meshlap_core.study.shots.Screenshot`; the
+screenshot function the caller passes (:class:`~meshlap_core.course_report.shots.Screenshot`; the
 ``meshlap report`` command passes the viewer's, rendering with polyscope's EGL backend in its own
 process); without one, or when it fails (no EGL, no display libraries), the report still builds,
 says why, and draws the mesh with matplotlib instead. Plots use matplotlib's Agg canvas

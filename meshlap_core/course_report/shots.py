@@ -1,9 +1,9 @@
 """The interface through which the report gets viewer screenshots without importing the viewer.
 
-The study is part of the headless core, which never imports polyscope nor the viewer package.
-:func:`~meshlap_core.study.build.build_report` therefore takes the screenshot function as an
-argument: the ``meshlap report`` command (the top layer, which never imports the viewer either)
-passes the viewer's (``meshlap_app.screenshots.ViewerScreenshots``, found through the
+The course report is part of the headless core, which never imports polyscope nor the viewer
+package. :func:`~meshlap_core.course_report.build.build_report` therefore takes the screenshot
+function as an argument: the ``meshlap report`` command (the top layer, which never imports the
+viewer either) passes the viewer's (``meshlap_app.screenshots.ViewerScreenshots``, found through the
 ``meshlap.screenshots`` entry point); tests pass fakes.
 """
 

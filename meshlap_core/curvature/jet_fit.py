@@ -30,12 +30,12 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
-from .curvature import _face_geometry, _normals_from
-from .errors import MeshError
-from .noise import bbox_diagonal
+from ..errors import MeshError
+from ..laplacian import mean_edge_length, uniform_laplacian
+from ..noise import bbox_diagonal
+from ..types import FloatArray, IntArray, as_mesh
+from .fields import _face_geometry, _normals_from
 from .principal import PrincipalCurvatures, eig_sym2, tangent_frames
-from .topology import edges
-from .types import FloatArray, IntArray, as_mesh
 
 JET_RADIUS_EDGES = 3.0
 """The automatic radius is at least this many mean edge lengths (enough neighbours to fit)."""
@@ -44,13 +44,6 @@ JET_RADIUS_GAIN = 0.47
 r = 1 with 32k vertices: 0.47 at 0.1 % and 0.75 at 1 % normal noise)."""
 MAX_PAIRS = 2_000_000
 """Neighbour pairs processed at once (bounds the memory of one chunk to ~300 MB)."""
-
-
-def _mean_edge(V: FloatArray, F: IntArray) -> float:
-    E = edges(F)
-    if len(E) == 0:
-        raise MeshError("the jet fit needs a mesh with edges", "F")
-    return float(np.mean(np.linalg.norm(V[E[:, 0]] - V[E[:, 1]], axis=1)))
 
 
 def estimate_normal_noise(V: FloatArray, F: IntArray) -> float:
@@ -62,8 +55,6 @@ def estimate_normal_noise(V: FloatArray, F: IntArray) -> float:
     ``σ̂ = 1.4826 · median|r_i| / 1.08`` (the median absolute deviation, so that features do
     not count as noise). On a clean mesh it is of the order ``h²κ``, not zero.
     """
-    from .laplacian import uniform_laplacian
-
     V, F = as_mesh(V, F)
     fn, theta = _face_geometry(V, F)
     N = _normals_from(F, len(V), fn, theta)
@@ -82,7 +73,9 @@ def default_jet_radius(V: FloatArray, F: IntArray) -> float:
     deviation ``∝ σ/(r² √(r²/h²))``): the optimum grows only like ``(σ h)^(1/5)``.
     """
     V, F = as_mesh(V, F)
-    h = _mean_edge(V, F)
+    if len(F) == 0:
+        raise MeshError("the jet fit needs a mesh with edges", "F")
+    h = mean_edge_length(V, F)
     sigma = estimate_normal_noise(V, F)
     D = bbox_diagonal(V)
     return max(JET_RADIUS_EDGES * h, JET_RADIUS_GAIN * (sigma * h * D**3) ** 0.2)

@@ -27,9 +27,9 @@ from typing import NamedTuple
 import igl
 import numpy as np
 
-from .errors import MeshError
-from .laplacian import cotangents_intrinsic, uniform_laplacian, vertex_areas
-from .options import (
+from ..errors import MeshError
+from ..laplacian import cotangents_intrinsic, uniform_laplacian, vertex_areas
+from ..options import (
     AREA_KINDS,
     BOUNDARY_RULES,
     CURVATURE_AREA,
@@ -40,8 +40,8 @@ from .options import (
     CurvatureField,
     check_choice,
 )
-from .topology import EdgeTable, boundary_vertex_mask
-from .types import BoolArray, FloatArray, IntArray, as_mesh
+from ..topology import EdgeTable, boundary_vertex_mask
+from ..types import BoolArray, FloatArray, IntArray, as_mesh
 
 
 def _check_boundary(boundary: str) -> None:

@@ -1,6 +1,11 @@
-"""Convergence of the discrete curvature estimators of :mod:`meshlap_core.curvature` to the
-exact curvature of a parametric surface under refinement (Meyer, Desbrun, Schröder & Barr 2003;
-Xu 2004; Hildebrandt, Polthier & Wardetzky 2006).
+"""Convergence of the course's curvature estimators (:mod:`.fields`: uniform and cotangent
+``H``, angle-deficit ``K``, each vertex area) to the exact curvature of a parametric surface
+under refinement: the tables of ``meshlap surface --convergence`` and of the course report.
+
+The levels, the exact values and the observed orders are the one machinery of
+:mod:`.refinement` (shared with :mod:`.study`); this module chooses the estimators, the meshes
+(the surface's grid, or icospheres for the sphere), the statistics (max and mean error, where
+the max is) and prints the table. References: see :mod:`.refinement`.
 """
 
 from __future__ import annotations
@@ -12,21 +17,19 @@ from typing import Any
 
 import numpy as np
 
-from ..curvature import gaussian_curvature, mean_curvature_cotan, mean_curvature_uniform
 from ..errors import MeshError
 from ..options import MESHERS, Mesher, check_choice
-from ..primitives import icosphere
-from ..topology import edges
-from ..types import BoolArray, FloatArray, IntArray
-from .catalogue import EDGES, ParametricSurface, get_surface
-from .geometry import surface_curvature_fields
-from .meshing import (
+from ..surfaces.catalogue import ParametricSurface, get_surface
+from ..surfaces.meshing import (
     MAX_MESH_BYTES,
     STUDY_BYTES_PER_CELL,
     STUDY_KEPT_BYTES_PER_CELL,
     check_mesh_res,
     mesh_surface,
 )
+from ..types import FloatArray, IntArray
+from .fields import gaussian_curvature, mean_curvature_cotan, mean_curvature_uniform
+from .refinement import Level, observed_orders, sphere_level, surface_level
 
 ESTIMATORS: tuple[str, ...] = (
     "H uniform",
@@ -45,26 +48,6 @@ def _discrete_estimates(V: FloatArray, F: IntArray) -> dict[str, FloatArray]:
         "K deficit voronoi": gaussian_curvature(V, F, "voronoi"),
         "K deficit barycentric": gaussian_curvature(V, F, "barycentric"),
     }
-
-
-def _mean_edge_length(V: FloatArray, F: IntArray) -> float:
-    E = edges(F)
-    return float(np.mean(np.linalg.norm(V[E[:, 0]] - V[E[:, 1]], axis=1)))
-
-
-def _orders(h: Sequence[float], err: Sequence[float], floor: float = 0.0) -> list[float | None]:
-    """Observed orders ``log(e_k/e_{k+1}) / log(h_k/h_{k+1})`` between consecutive levels.
-
-    ``None`` where undefined: equal ``h``, or an error at or below ``floor`` (rounding level,
-    e.g. the level-1 icosphere, where the Voronoi cotangent ``H`` is exact by symmetry).
-    """
-    out: list[float | None] = []
-    for k in range(len(h) - 1):
-        if err[k] > floor and err[k + 1] > floor and h[k] != h[k + 1]:
-            out.append(math.log(err[k] / err[k + 1]) / math.log(h[k] / h[k + 1]))
-        else:
-            out.append(None)
-    return out
 
 
 @dataclass(frozen=True)
@@ -139,19 +122,8 @@ class ConvergenceStudy:
         return "\n".join(lines)
 
 
-@dataclass(frozen=True)
-class _Level:
-    V: FloatArray
-    F: IntArray
-    compare: BoolArray  # vertices compared
-    H: FloatArray  # exact H (positive on spheres)
-    K: FloatArray
-    uv: FloatArray | None
-    pole: BoolArray
-
-
 def _study(
-    surface: str, mesher: str, levels: Sequence[int], exclude_poles: bool, meshes: Sequence[_Level]
+    surface: str, mesher: str, levels: Sequence[int], exclude_poles: bool, meshes: Sequence[Level]
 ) -> ConvergenceStudy:
     keys = ("max", "mean", "worst_uv", "worst_is_pole")
     errs: dict[str, dict[str, list[Any]]] = {e: {k: [] for k in keys} for e in ESTIMATORS}
@@ -159,67 +131,30 @@ def _study(
     scale = {"H": 0.0, "K": 0.0}
     for lev in meshes:
         est = _discrete_estimates(lev.V, lev.F)
-        idx = np.flatnonzero(lev.compare)
+        idx = np.flatnonzero(lev.exact.compared)
         if len(idx) == 0:
             raise MeshError("the mesh has no interior vertex to compare; use a finer res", "res")
         n_v.append(len(lev.V))
         n_c.append(len(idx))
-        hs.append(_mean_edge_length(lev.V, lev.F))
+        hs.append(lev.h)
         for name in ESTIMATORS:
-            ref = lev.H if name.startswith("H") else lev.K
+            ref = lev.exact.H if name.startswith("H") else lev.exact.K
             err = np.abs(est[name][idx] - ref[idx])
             w = idx[int(np.argmax(err))]
             errs[name]["max"].append(float(err.max()))
             errs[name]["mean"].append(float(err.mean()))
             errs[name]["worst_uv"].append(None if lev.uv is None else lev.uv[w].tolist())
             errs[name]["worst_is_pole"].append(bool(lev.pole[w]))
-        scale = {"H": float(np.abs(lev.H[idx]).max()), "K": float(np.abs(lev.K[idx]).max())}
+        H, K = lev.exact.H[idx], lev.exact.K[idx]
+        scale = {"H": float(np.abs(H).max()), "K": float(np.abs(K).max())}
     # rounding level: 1e-10 of the curvature scale (K in its square), so that an estimator that
     # is exact on this mesh (the cylinder, the level-1 icosphere) gets no meaningless order
     kappa = max(scale["H"], math.sqrt(scale["K"]), 1e-300)
     for name, d in errs.items():
         floor = 1e-10 * (kappa if name.startswith("H") else kappa * kappa)
-        d["order_max"] = _orders(hs, d["max"], floor)
-        d["order_mean"] = _orders(hs, d["mean"], floor)
+        d["order_max"] = observed_orders(hs, d["max"], floor)
+        d["order_mean"] = observed_orders(hs, d["mean"], floor)
     return ConvergenceStudy(surface, mesher, list(levels), exclude_poles, n_v, n_c, hs, scale, errs)
-
-
-def exact_curvature_at(
-    surface: ParametricSurface | str, uv: Any, pole: Any = None
-) -> tuple[FloatArray, FloatArray]:
-    """Exact ``H`` and ``K`` at mesh vertices (``H > 0`` on a sphere, the core's sign).
-
-    Parameters
-    ----------
-    surface : ParametricSurface or str
-    uv : (n,2) float
-        Vertex parameters, as in :attr:`SurfaceMesh.uv`.
-    pole : (n,) bool, optional
-        Pole vertices (singular parameterization): their values are the limits, evaluated
-        ``10⁻⁶`` of the domain width inside the rectangle.
-
-    Returns
-    -------
-    H_core, K : (n,) float
-    """
-    surface = get_surface(surface)
-    uv = np.array(uv, dtype=np.float64).reshape(-1, 2)
-    if pole is not None and np.any(pole):
-        pole = np.asarray(pole, dtype=bool)
-        u0, u1, v0, v1 = surface.domain
-        eps_u, eps_v = 1e-6 * (u1 - u0), 1e-6 * (v1 - v0)
-        tol = 1e-9 * (u1 - u0 + v1 - v0)
-        for edge, col, inside in (
-            ("u0", 0, u0 + eps_u),
-            ("u1", 0, u1 - eps_u),
-            ("v0", 1, v0 + eps_v),
-            ("v1", 1, v1 - eps_v),
-        ):
-            if edge in surface.poles:
-                at = pole & (np.abs(uv[:, col] - surface.domain[EDGES.index(edge)]) <= tol)
-                uv[at, col] = inside
-    cf = surface_curvature_fields(surface, uv[:, 0], uv[:, 1])
-    return cf.H, cf.K
 
 
 def convergence_study(
@@ -334,22 +269,11 @@ def _check_has_interior(
         )
 
 
-def _make_level(surface: ParametricSurface, mesher: str, lev: int, exclude_poles: bool) -> _Level:
-    """One level of the study: the mesh, the vertices compared and the exact values there."""
-    if mesher == "grid":
-        m = mesh_surface(surface, lev)
-        H_ex, K_ex = exact_curvature_at(surface, m.uv, m.pole)
-        compare = ~m.boundary & ~(m.pole if exclude_poles else False)
-        return _Level(m.V, m.F, compare, H_ex, K_ex, m.uv, m.pole)
-    r = float(surface.params.get("r", 1.0))
-    V, F = icosphere(lev, r)
-    n = len(V)
-    return _Level(
-        V,
-        F,
-        np.ones(n, bool),
-        np.full(n, 1.0 / r),
-        np.full(n, 1.0 / r**2),
-        None,
-        np.zeros(n, bool),
-    )
+def _make_level(surface: ParametricSurface, mesher: str, lev: int, exclude_poles: bool) -> Level:
+    """One level of the study: the mesh, the vertices compared (every interior one, the poles
+    too unless ``exclude_poles``) and the exact values there (the limits at the poles)."""
+    if mesher == "icosphere":
+        return sphere_level(float(surface.params.get("r", 1.0)), lev)
+    m = mesh_surface(surface, lev)
+    compare = ~m.boundary & ~(m.pole if exclude_poles else False)
+    return surface_level(surface, lev, m, compared=compare, pole_limits=True, directions=False)

@@ -9,32 +9,32 @@ the edges flipped) and noisy (``noise``:
 Gaussian displacement along the normal of standard deviation ``noise × bounding-box
 diagonal``, the exact values being those of the clean point). Errors are measured at the
 vertices away from the boundary and the poles (one-sided stencils and sliver cells there), in
-the project's sign convention (``H > 0`` on a sphere, ``κ₁ ≥ κ₂``).
+the project's sign convention (``H > 0`` on a sphere, ``κ₁ ≥ κ₂``). The levels, the exact values
+and the orders are those of :mod:`.refinement`, the machinery :mod:`.convergence` uses too.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-from .curvature_estimators import estimate_curvature
-from .errors import MeshError
-from .noise import add_noise, check_noise
-from .options import CURVATURE_ESTIMATORS, PRINCIPAL_FIELDS, check_choice
+from ..errors import MeshError
+from ..noise import add_noise, check_noise
+from ..options import CURVATURE_ESTIMATORS, PRINCIPAL_FIELDS, check_choice
+from ..surfaces import ParametricSurface, SurfaceMesh, get_surface, mesh_surface
+from ..types import FloatArray, IntArray
+from .estimators import estimate_curvature
 from .principal import PrincipalCurvatures
-from .surfaces import (
-    ParametricSurface,
-    SurfaceMesh,
-    get_surface,
-    mesh_surface,
-    surface_curvature_fields,
-    surface_derivatives,
+from .refinement import (
+    ExactPrincipal,
+    Level,
+    fitted_order,
+    observed_orders,
+    surface_level,
 )
-from .types import BoolArray, FloatArray, IntArray
 
 STUDY_COLUMNS: tuple[str, ...] = (
     "surface",
@@ -61,53 +61,6 @@ previous resolution, empty at the first; angles: ``d1`` against the exact direct
 
 H_AND_K: tuple[str, ...] = PRINCIPAL_FIELDS[2:4]
 """The two quantities whose orders are fitted and plotted (mean and Gaussian curvature)."""
-
-
-@dataclass(frozen=True)
-class ExactPrincipal:
-    """Exact curvature at the vertices of a surface mesh (NaN at singular points).
-
-    Attributes
-    ----------
-    k1, k2, H, K : (n,) float
-    d1, d2 : (n,3) float
-        Unit 3-D principal directions.
-    compared : (n,) bool
-        Vertices away from the boundary and the poles (where errors are measured).
-    """
-
-    k1: FloatArray
-    k2: FloatArray
-    H: FloatArray
-    K: FloatArray
-    d1: FloatArray
-    d2: FloatArray
-    compared: BoolArray
-
-
-def compared_vertices(m: SurfaceMesh, surface: ParametricSurface, margin: float = 0.1) -> BoolArray:
-    """Vertices at least ``margin`` of the domain from an open edge or a pole, ``(n,)`` bool."""
-    u, v = m.uv[:, 0], m.uv[:, 1]
-    u0, u1, v0, v1 = surface.domain
-    keep = ~m.pole & ~m.boundary
-    if not surface.closed_u or {"u0", "u1"} & set(surface.poles):
-        keep &= np.minimum(u - u0, u1 - u) > margin * (u1 - u0)
-    if not surface.closed_v or {"v0", "v1"} & set(surface.poles):
-        keep &= np.minimum(v - v0, v1 - v) > margin * (v1 - v0)
-    return keep
-
-
-def exact_principal(m: SurfaceMesh, surface: ParametricSurface | str) -> ExactPrincipal:
-    """The exact ``κ₁ ≥ κ₂``, ``H``, ``K`` and directions at the vertices of ``m``."""
-    s = get_surface(surface)
-    u, v = m.uv[:, 0], m.uv[:, 1]
-    D = surface_derivatives(s, u, v)
-    cf = surface_curvature_fields(s, u, v, derivatives=D)
-    dirs = []
-    for w in (cf.w1, cf.w2):
-        d = w[:, :1] * D.p_u + w[:, 1:] * D.p_v
-        dirs.append(d / np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-300))
-    return ExactPrincipal(cf.k1, cf.k2, cf.H, cf.K, dirs[0], dirs[1], compared_vertices(m, s))
 
 
 def flip_edges(V: FloatArray, F: IntArray, fraction: float, seed: int = 0) -> IntArray:
@@ -249,10 +202,14 @@ def perturbed_mesh(
 def vertex_errors(result: PrincipalCurvatures, exact: ExactPrincipal) -> dict[str, FloatArray]:
     """Per-vertex errors of an estimate (the error maps), each ``(n,)``, NaN where not compared:
     ``H``, ``K``, ``k1``, ``k2`` (signed, estimate − exact) and ``angle`` (degrees between
-    ``d1`` and the exact direction, NaN near umbilics)."""
+    ``d1`` and the exact direction, NaN near umbilics and without exact directions)."""
     keep = exact.compared
     gap = np.abs(exact.k1 - exact.k2) > 0.1 * np.maximum(np.abs(exact.k1), np.abs(exact.k2))
-    cos = np.abs(np.sum(result.d1 * exact.d1, axis=1))
+    if exact.d1 is None:
+        gap = np.zeros(len(gap), dtype=bool)
+        cos = np.ones(len(gap))
+    else:
+        cos = np.abs(np.sum(result.d1 * exact.d1, axis=1))
     out = {
         "H": result.H - exact.H,
         "K": result.K - exact.K,
@@ -266,12 +223,6 @@ def vertex_errors(result: PrincipalCurvatures, exact: ExactPrincipal) -> dict[st
 def _rms(x: FloatArray) -> float:
     x = x[np.isfinite(x)]
     return float(np.sqrt(np.mean(x * x))) if x.size else math.nan
-
-
-def _order(e0: float, e1: float, h0: float, h1: float) -> float | None:
-    if e0 > 0 and e1 > 0 and h0 != h1 and math.isfinite(e0) and math.isfinite(e1):
-        return math.log(e0 / e1) / math.log(h0 / h1)
-    return None
 
 
 def curvature_study(
@@ -312,47 +263,57 @@ def curvature_study(
     total, done = len(surfaces) * len(estimators) * len(levels), 0
     for name in surfaces:
         s = get_surface(name)
-        meshes = []
-        for n in levels:
-            res = (2 * int(n), int(n)) if s.name == "torus" else (int(n), int(n))
-            m, V = perturbed_mesh(s, res, noise, jitter, seed, flips)
-            E = np.concatenate([m.F[:, [0, 1]], m.F[:, [1, 2]], m.F[:, [2, 0]]])
-            h = float(np.mean(np.linalg.norm(m.V[E[:, 0]] - m.V[E[:, 1]], axis=1)))
-            meshes.append((n, m, V, h, exact_principal(m, s)))
+        meshes = [_level(s, int(n), noise, jitter, seed, flips) for n in levels]
         for est in estimators:
-            prev: dict[str, Any] | None = None
-            for n, m, V, h, ex in meshes:
+            group = []
+            for lev in meshes:
                 if progress is not None:
-                    progress(done / total, f"{s.name}, {est}, {n} cells")
+                    progress(done / total, f"{s.name}, {est}, {lev.res} cells")
                 done += 1
-                r = estimate_curvature(V, m.F, est, **options.get(est, {}))  # type: ignore[arg-type]
-                err = vertex_errors(r, ex)
-                scale = _rms(np.maximum(np.abs(ex.k1), np.abs(ex.k2))[ex.compared])
-                row: dict[str, Any] = {
-                    "surface": s.name,
-                    "estimator": est,
-                    "res": int(n),
-                    "n_vertices": len(V),
-                    "n_compared": int(ex.compared.sum()),
-                    "h": h,
-                    "H_rms": _rms(err["H"]),
-                    "K_rms": _rms(err["K"]),
-                    "k_max_err": float(np.nanmax(np.abs(np.concatenate([err["k1"], err["k2"]])))),
-                    "angle_median_deg": float(np.nanmedian(err["angle"]))
-                    if np.isfinite(err["angle"]).any()
-                    else math.nan,
-                    "angle_p95_deg": float(np.nanpercentile(err["angle"], 95))
-                    if np.isfinite(err["angle"]).any()
-                    else math.nan,
-                }
-                row["H_rel"] = row["H_rms"] / scale if scale > 0 else math.nan
-                row["K_rel"] = row["K_rms"] / scale**2 if scale > 0 else math.nan
-                for key in ("H_order", "K_order"):
-                    rms = key.replace("order", "rms")
-                    row[key] = _order(prev[rms], row[rms], prev["h"], h) if prev else None
-                rows.append({c: row[c] for c in STUDY_COLUMNS})
-                prev = row
+                r = estimate_curvature(lev.V, lev.F, est, **options.get(est, {}))  # type: ignore[arg-type]
+                group.append(_row(s.name, est, lev, r))
+            h = [row["h"] for row in group]
+            for q in H_AND_K:
+                orders = observed_orders(h, [row[f"{q}_rms"] for row in group])
+                for row, order in zip(group, [None, *orders], strict=True):
+                    row[f"{q}_order"] = order
+            rows.extend({c: row[c] for c in STUDY_COLUMNS} for row in group)
     return rows
+
+
+def _level(
+    s: ParametricSurface, n: int, noise: float, jitter: float, seed: int, flips: float
+) -> Level:
+    """The study's level of ``n`` cells (the torus twice as many around its axis): the
+    :func:`perturbed_mesh`, the noisy positions estimated, the exact values at the clean ones."""
+    res = (2 * n, n) if s.name == "torus" else (n, n)
+    m, V = perturbed_mesh(s, res, noise, jitter, seed, flips)
+    return surface_level(s, n, m, V)
+
+
+def _row(surface: str, estimator: str, lev: Level, r: PrincipalCurvatures) -> dict[str, Any]:
+    """One row of :data:`STUDY_COLUMNS` but the orders: the errors of ``r`` at ``lev``."""
+    ex = lev.exact
+    err = vertex_errors(r, ex)
+    scale = _rms(np.maximum(np.abs(ex.k1), np.abs(ex.k2))[ex.compared])
+    angle = err["angle"]
+    some = bool(np.isfinite(angle).any())
+    row: dict[str, Any] = {
+        "surface": surface,
+        "estimator": estimator,
+        "res": lev.res,
+        "n_vertices": len(lev.V),
+        "n_compared": int(ex.compared.sum()),
+        "h": lev.h,
+        "H_rms": _rms(err["H"]),
+        "K_rms": _rms(err["K"]),
+        "k_max_err": float(np.nanmax(np.abs(np.concatenate([err["k1"], err["k2"]])))),
+        "angle_median_deg": float(np.nanmedian(angle)) if some else math.nan,
+        "angle_p95_deg": float(np.nanpercentile(angle, 95)) if some else math.nan,
+    }
+    row["H_rel"] = row["H_rms"] / scale if scale > 0 else math.nan
+    row["K_rel"] = row["K_rms"] / scale**2 if scale > 0 else math.nan
+    return row
 
 
 def fitted_orders(rows: Sequence[dict[str, Any]]) -> dict[tuple[str, str], dict[str, float]]:
@@ -368,19 +329,13 @@ def fitted_orders(rows: Sequence[dict[str, Any]]) -> dict[tuple[str, str], dict[
     groups: dict[tuple[str, str], list[dict[str, Any]]] = {}
     for r in rows:
         groups.setdefault((r["surface"], r["estimator"]), []).append(r)
-    out: dict[tuple[str, str], dict[str, float]] = {}
-    for key, group in groups.items():
-        h = np.array([r["h"] for r in group], dtype=np.float64)
-        orders = {}
-        for q in H_AND_K:
-            e = np.array([r[f"{q}_rms"] for r in group], dtype=np.float64)
-            ok = np.isfinite(e) & (e > 0) & (h > 0)
-            if np.unique(h[ok]).size < 2:
-                orders[q] = math.nan
-            else:
-                orders[q] = float(np.polyfit(np.log(h[ok]), np.log(e[ok]), 1)[0])
-        out[key] = orders
-    return out
+    return {
+        key: {
+            q: fitted_order([r["h"] for r in group], [r[f"{q}_rms"] for r in group])
+            for q in H_AND_K
+        }
+        for key, group in groups.items()
+    }
 
 
 def write_study_figure(rows: Sequence[dict[str, Any]], path: Any) -> None:
@@ -399,7 +354,7 @@ def write_study_figure(rows: Sequence[dict[str, Any]], path: Any) -> None:
     from matplotlib.figure import Figure
     from matplotlib.ticker import NullFormatter
 
-    from .io import atomic_write
+    from ..io import atomic_write
 
     path = Path(path)
     if path.suffix.lower() != ".png":

@@ -11,8 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .options import PRINCIPAL_FIELDS, check_choice
-from .types import FloatArray
+from ..options import PRINCIPAL_FIELDS, check_choice
+from ..types import FloatArray
 
 
 @dataclass(frozen=True)

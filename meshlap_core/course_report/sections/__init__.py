@@ -2,7 +2,7 @@
 
 Each module defines ``KEY`` (its name for ``--sections``), ``TITLE``, ``STEPS`` (progress steps
 in quick and in full mode) and ``run(ctx, sec)``, which measures, writes its tables and figures
-through the :class:`~meshlap_core.study.context.Context` and appends its blocks to ``sec``.
+through the :class:`~meshlap_core.course_report.context.Context` and appends its blocks to ``sec``.
 """
 
 from __future__ import annotations

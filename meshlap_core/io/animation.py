@@ -19,10 +19,9 @@ from typing import IO, Any
 
 import numpy as np
 
-from .errors import MeshError
-from .io import atomic_write, check_output_path
-from .io.atomic import os_cause, unwritable_cause
-from .progress import Progress, bar
+from ..errors import MeshError
+from ..progress import Progress, bar
+from .atomic import atomic_write, check_output_path, os_cause, unwritable_cause
 
 SUFFIXES = (".gif", ".mp4")
 VIDEO_EXTRA = (

@@ -111,10 +111,10 @@ def build_report(
     progress_stream : text stream, optional
         Where the progress bar goes (the CLI passes stderr); ``None``: silent.
     screenshot : Screenshot, optional
-        The function that renders a viewer frame (:class:`~meshlap_core.study.shots.Screenshot`;
-        the ``meshlap report`` command passes the viewer's, from the ``meshlap.screenshots``
-        entry point).
-        The study never imports the viewer itself.
+        The function that renders a viewer frame
+        (:class:`~meshlap_core.course_report.shots.Screenshot`; the ``meshlap report`` command
+        passes the viewer's, from the ``meshlap.screenshots`` entry point).
+        The report never imports the viewer itself.
     max_screenshots : int, optional
         Take at most this many viewer screenshots; the later pictures are drawn with
         matplotlib and the report says so. Default: no limit.

@@ -1,6 +1,7 @@
 """Principal curvatures and directions per vertex: the estimators side by side.
 
-(The result type :class:`~meshlap_core.principal.PrincipalCurvatures` is re-exported here.)
+(The result type :class:`~meshlap_core.curvature.principal.PrincipalCurvatures` is re-exported
+here.)
 
 Every estimator returns a :class:`PrincipalCurvatures` in **one convention** (the project's, see
 ``docs/conventions.md``): the normal is the outward one given by the face orientation
@@ -21,12 +22,12 @@ Estimators (:data:`~meshlap_core.options.CURVATURE_ESTIMATORS`):
   mixed Voronoi weights (Rusinkiewicz 2004).
 - ``"normal_cycle"`` — :func:`normal_cycle_curvatures`: the normal-cycle tensor, dihedral angles
   times edge lengths over the Voronoi cell (Cohen-Steiner & Morvan 2003).
-- ``"jet"`` — :func:`meshlap_core.curvature_fit.jet_curvatures`: the scale-aware estimator, a
+- ``"jet"`` — :func:`meshlap_core.curvature.jet_fit.jet_curvatures`: the scale-aware estimator, a
   weighted osculating-jet fit over a ball of a radius in world units (Cazals & Pouget 2003),
   robust to noise.
 
 Cotan, Rusinkiewicz and the normal cycle take a ``topology``
-(:class:`~meshlap_core.curvature_topology.CurvatureTopology`, :data:`TOPOLOGY_ESTIMATORS`): the
+(:class:`~meshlap_core.curvature.topology.CurvatureTopology`, :data:`TOPOLOGY_ESTIMATORS`): the
 faces' edges built once and reused while the vertices move (noise, a slider of the lab).
 """
 
@@ -38,7 +39,17 @@ from typing import Any
 
 import numpy as np
 
-from .curvature import (
+from ..errors import MeshError
+from ..options import (
+    CURVATURE_AREA,
+    CURVATURE_ESTIMATORS,
+    DEFAULT_BOUNDARY,
+    AreaKind,
+    CurvatureEstimator,
+    check_choice,
+)
+from ..types import FloatArray, IntArray, as_mesh
+from .fields import (
     _areas_from,
     _cotan_Cx,
     _cotan_H,
@@ -50,19 +61,9 @@ from .curvature import (
     _normals_from,
     principal_curvature_quadric,
 )
-from .curvature_fit import jet_curvatures
-from .curvature_topology import CurvatureTopology, topology_for
-from .errors import MeshError
-from .options import (
-    CURVATURE_AREA,
-    CURVATURE_ESTIMATORS,
-    DEFAULT_BOUNDARY,
-    AreaKind,
-    CurvatureEstimator,
-    check_choice,
-)
+from .jet_fit import jet_curvatures
 from .principal import PrincipalCurvatures, eig_sym2, tangent_frames
-from .types import FloatArray, IntArray, as_mesh
+from .topology import CurvatureTopology, topology_for
 
 
 def _from_tensor(
@@ -192,7 +193,7 @@ def cotan_curvatures(
     boundary : {"pi", "2pi", "zero"}
         Rule of the angle deficit at boundary vertices.
     topology : CurvatureTopology, optional
-        ``F``'s edges built once (:class:`~meshlap_core.curvature_topology.CurvatureTopology`):
+        ``F``'s edges built once (:class:`~meshlap_core.curvature.topology.CurvatureTopology`):
         pass it again with every new ``V`` of the same faces.
 
     Returns
@@ -429,7 +430,7 @@ ESTIMATOR_FUNCTIONS: dict[str, Callable[..., PrincipalCurvatures]] = {
 TOPOLOGY_ESTIMATORS: tuple[str, ...] = tuple(
     name for name, f in ESTIMATOR_FUNCTIONS.items() if "topology" in signature(f).parameters
 )
-"""The estimators taking a ``topology`` (:class:`~meshlap_core.curvature_topology.
+"""The estimators taking a ``topology`` (:class:`~meshlap_core.curvature.topology.
 CurvatureTopology`): its faces' edges built once, reused for every new ``V`` (cotan,
 Rusinkiewicz, normal cycle)."""
 
@@ -478,7 +479,7 @@ def curvature_at_vertex(
     automatic radius depends on the whole mesh: it is refused here).
 
     The patch grows ring by ring through the vertex–face adjacency
-    (:attr:`~meshlap_core.curvature_topology.CurvatureTopology.vertex_faces`, CSR): only the
+    (:attr:`~meshlap_core.curvature.topology.CurvatureTopology.vertex_faces`, CSR): only the
     faces near the vertex are read once it is built. Pass ``topology`` (of ``F``) to build it
     once for many vertices; ``options`` go to the estimator on the patch.
 

@@ -10,6 +10,7 @@ import math
 import numpy as np
 
 from ... import surfaces
+from ...curvature.convergence import ConvergenceStudy, convergence_study
 from ..context import Context
 from ..document import Fig, Section, num
 from ..figures import new_figure
@@ -169,7 +170,7 @@ def _convergence(ctx: Context, sec: Section) -> None:
         ]
     studies = []
     for surf, mesher, res in plan:
-        studies.append(surfaces.convergence_study(surf, res, mesher))
+        studies.append(convergence_study(surf, res, mesher))
         ctx.progress.step(f"convergence {surf} {mesher}")
     sec.p(
         "Convergence: meshes of the parameter rectangle (`grid`) or subdivided icospheres, "
@@ -183,7 +184,7 @@ def _convergence(ctx: Context, sec: Section) -> None:
     _convergence_plot(ctx, sec, studies)
 
 
-def _level_rows(studies: list[surfaces.ConvergenceStudy]) -> list[list]:
+def _level_rows(studies: list[ConvergenceStudy]) -> list[list]:
     """One row per study, estimator and level, with the observed orders."""
     rows = []
     for st in studies:
@@ -206,9 +207,7 @@ def _level_rows(studies: list[surfaces.ConvergenceStudy]) -> list[list]:
     return rows
 
 
-def _convergence_tables(
-    ctx: Context, sec: Section, studies: list[surfaces.ConvergenceStudy]
-) -> None:
+def _convergence_tables(ctx: Context, sec: Section, studies: list[ConvergenceStudy]) -> None:
     """The summary table (coarsest and finest level) and the table of every level."""
     summary = []
     for st in studies:
@@ -267,7 +266,7 @@ def _convergence_tables(
     )
 
 
-def _convergence_summary(sec: Section, studies: list[surfaces.ConvergenceStudy]) -> None:
+def _convergence_summary(sec: Section, studies: list[ConvergenceStudy]) -> None:
     """Which estimators converge (order > 1.5) and which stall, read off the finest levels."""
     finals = []
     for st in studies:
@@ -285,7 +284,7 @@ def _convergence_summary(sec: Section, studies: list[surfaces.ConvergenceStudy])
     )
 
 
-def _convergence_plot(ctx: Context, sec: Section, studies: list[surfaces.ConvergenceStudy]) -> None:
+def _convergence_plot(ctx: Context, sec: Section, studies: list[ConvergenceStudy]) -> None:
     """Max error against h, one log-log panel per study."""
     from matplotlib.ticker import NullFormatter
 
