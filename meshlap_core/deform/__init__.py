@@ -28,7 +28,7 @@ Modules
 ``rigidity``
     Each vertex's deviation from a rotation of its one-ring.
 ``methods``
-    :func:`make_deformer` by name, and the one-shot :func:`deform`.
+    :func:`make_deformer` by name, and the one-shot :func:`deform_mesh`.
 """
 
 from .arap import ArapDeformer
@@ -37,7 +37,7 @@ from .base import Deformer
 from .constraints import Constraints, check_targets, check_vertices, make_constraints
 from .harmonic import HarmonicDeformer, k_harmonic_operator
 from .laplacian_coordinates import LaplacianCoordinates
-from .methods import deform, make_deformer
+from .methods import deform_mesh, make_deformer
 from .regions import HandleRegions, farthest_region, grow_handles
 from .rigidity import rotation_error
 from .rotations import fit_rotations, fit_rotations_igl
@@ -56,7 +56,7 @@ __all__ = [
     "SystemStats",
     "check_targets",
     "check_vertices",
-    "deform",
+    "deform_mesh",
     "farthest_region",
     "fit_rotations",
     "fit_rotations_igl",

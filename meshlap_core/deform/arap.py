@@ -120,13 +120,12 @@ class ArapDeformer(Deformer):
         """Start again from the rest pose (or ``positions`` ``(n,3)``), the current targets
         kept; the iteration count and the energies start again."""
         if positions is None:
-            self._U = self.V.copy()
+            start = self.V.copy()
         else:
-            self._U = as_vertices(positions, "positions")
-            if self._U.shape != self.V.shape:
-                raise MeshError(
-                    f"should have shape {self.V.shape}; got {self._U.shape}", "positions"
-                )
+            start = as_vertices(positions, "positions")
+            if start.shape != self.V.shape:
+                raise MeshError(f"should have shape {self.V.shape}; got {start.shape}", "positions")
+        self._U = start
         self._R: FloatArray | None = None
         self.iteration = 0
         self.total_iterations = getattr(self, "total_iterations", 0)

@@ -20,6 +20,10 @@ triangle meshes in 3D). Each term ``c ‖(x_j − x_k) − R_r (p_j − p_k)‖�
 * **global step**: for fixed ``R``, ``∂E/∂x = 0`` is ``K x = b`` with ``K = −C`` the cotangent
   stiffness and ``b = (1/μ) Σ_t c_t R_r e_t (δ_j − δ_k)`` — for spokes
   ``b_i = Σ_j (w_ij/2) (R_i + R_j)(p_i − p_j)`` (eq. 9 of the paper); ``b = Zᵀ R / μ``;
+* the weights are the cotangents, negative across obtuse angles, so a term, a vertex's share
+  and even the total can fall below 0 on a mesh with obtuse triangles (libigl's too): the
+  iterations then stretch the edges of negative weight (``rigidity.rotation_error``, with
+  ``|w|``, shows where);
 * **energy** of the global step's minimizer: ``E = μ (tr xᵀKx − 2 tr xᵀb + tr pᵀKp)``
   (three products, no loop over terms; exact up to round-off of order ``ε μ tr pᵀKp``), and
   each vertex's share from the terms directly (:meth:`ArapEnergy.vertex_energy`).

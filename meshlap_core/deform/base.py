@@ -95,10 +95,14 @@ class Deformer:
         """The handles' current targets ``(h,3)`` (a copy)."""
         return self._targets.copy()
 
-    def _known(self, values_at_handles: FloatArray, rest: FloatArray) -> FloatArray:
-        """The known rows' values ``(k,3)``: ``rest`` for fixed and still vertices, the
-        handles' values in their slots."""
-        known = rest[self.constraints.known].copy()
+    def _known(self, values_at_handles: FloatArray, rest: FloatArray | None = None) -> FloatArray:
+        """The known rows' values ``(k,3)``: ``rest`` (zero when ``None``) for the fixed and
+        still vertices, the handles' values in their slots."""
+        known = (
+            np.zeros((len(self.constraints.known), 3))
+            if rest is None
+            else rest[self.constraints.known]
+        )
         known[self._slot] = values_at_handles
         return known
 

@@ -104,7 +104,7 @@ class HarmonicDeformer(Deformer):
         progress: ProgressCallback | None = None,
         cancel: Any = None,
     ) -> None:
-        if k not in HARMONIC_ORDERS.values():
+        if isinstance(k, bool) or k not in HARMONIC_ORDERS.values():
             raise MeshError(f"k must be 1, 2 or 3, got {k!r}", "k")
         super().__init__(V, F, handles, fixed)
         self.k = int(k)
@@ -128,11 +128,13 @@ class HarmonicDeformer(Deformer):
     def update(self, targets: Any) -> FloatArray:
         """Move the handles to ``targets`` ``(h,3)``; the deformed positions ``(n,3)``."""
         self._set_targets(targets)
-        d = self.system.solve(self._known(self._targets - self.V[self.handles], 0.0 * self.V))
+        d = self.system.solve(self._known(self._targets - self.V[self.handles]))
         self._U = self.V + d
+        self._U[self.handles] = self._targets  # p + (u − p) is u only up to round-off
         return self.positions
 
     def energy(self) -> float:
-        """``Σ dᵀ Q_k d`` over the coordinates of the current displacement."""
+        """``Σ dᵀ Q_k d`` over the coordinates of the current displacement (a positive
+        semidefinite form: a value below 0 is round-off, shown as 0)."""
         d = self._U - self.V
-        return float(np.einsum("ij,ij->", d, self.Q @ d))
+        return max(float(np.einsum("ij,ij->", d, self.Q @ d)), 0.0)

@@ -131,13 +131,15 @@ class LaplacianCoordinates(Deformer):
                 np.zeros((len(self.constraints.still), 3)), self._penalty[:, None] * g
             )
         self._U = self.V + d
+        if self.kind == "hard":
+            self._U[self.handles] = self._targets  # p + (u − p) is u only up to round-off
         return self.positions
 
     def energy_parts(self) -> tuple[float, float]:
         """``(‖Δx − δ‖²_M, Σ ω q_c ‖x_c − u_c‖²)`` at the current positions."""
         d = self._U - self.V
         miss = d - self._goal()
-        shape = float(np.einsum("ij,ij->", d, self.Q @ d))
+        shape = max(float(np.einsum("ij,ij->", d, self.Q @ d)), 0.0)  # below 0: round-off
         return shape, float(np.einsum("i,ij,ij->", self._penalty, miss, miss))
 
     def energy(self) -> float:

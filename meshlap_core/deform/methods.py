@@ -61,7 +61,7 @@ def make_deformer(
     return HarmonicDeformer(V, F, handles, fixed, k=HARMONIC_ORDERS[method], **hooks, **options)
 
 
-def deform(
+def deform_mesh(
     V: FloatArray,
     F: Any,
     handles: Any,
@@ -81,7 +81,7 @@ def deform(
     --------
     >>> from meshlap_core.primitives import icosphere
     >>> V, F = icosphere(2)
-    >>> U = deform(V, F, [0], V[[0]] + 0.1, "biharmonic", fixed=[100])
+    >>> U = deform_mesh(V, F, [0], V[[0]] + 0.1, "biharmonic", fixed=[100])
     >>> U.shape
     (162, 3)
     """
