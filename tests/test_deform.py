@@ -1,5 +1,7 @@
 """Deformation (meshlap_core.deform): hand-computed cases, invariants, libigl, bad input."""
 
+import doctest
+import importlib
 import threading
 
 import igl
@@ -240,7 +242,7 @@ def test_rotation_error_is_zero_for_a_rigid_motion_and_grows_with_a_stretch(bump
 
 @pytest.mark.parametrize("k", [1, 2, 3])
 @pytest.mark.parametrize("mesh", ["bumpy", "grid"])
-def test_k_harmonic_displacement_equals_igl_harmonic(bumpy, k, mesh):
+def test_k_harmonic_displacement_equals_igl_harmonic(bumpy, k, mesh, spd_backend):
     if mesh == "bumpy":
         V, F = bumpy
         handles, fixed = np.array([0, 5, 40]), np.array([100, 101, 150])
@@ -256,7 +258,7 @@ def test_k_harmonic_displacement_equals_igl_harmonic(bumpy, k, mesh):
 
 
 @pytest.mark.parametrize("energy", ["spokes", "spokes-and-rims"])
-def test_arap_with_libigls_rotations_equals_igl_arap_solve(bumpy, energy):
+def test_arap_with_libigls_rotations_equals_igl_arap_solve(bumpy, energy, spd_backend):
     V, F = bumpy
     handles, fixed = np.array([0, 5, 40]), np.array([100])
     targets = V[handles] + [[0.3, 0.1, 0.0], [0.0, 0.0, 0.0], [-0.2, 0.0, 0.1]]
@@ -303,7 +305,7 @@ def dense_arap_reference(V, F, handles, targets, iters):
     return U
 
 
-def test_arap_equals_a_vertex_by_vertex_reference_and_libigl_within_its_precision():
+def test_arap_equals_a_vertex_by_vertex_reference_and_libigl_within_its_precision(spd_backend):
     V, F = primitives.icosphere(2)
     V = V * [1.0, 0.8, 1.2]
     handles = np.array([0, 30, 90])
@@ -381,6 +383,12 @@ def test_deform_mesh_is_the_solver_in_one_call(bumpy):
     A = ArapDeformer(V, F, [0], [100])
     A.set_targets(t)
     np.testing.assert_array_equal(deform_mesh(V, F, [0], t, "arap", [100], iters=4), A.run(4))
+
+
+@pytest.mark.parametrize("module", ["harmonic", "arap", "methods", "rotations", "targets"])
+def test_docstring_examples_run(module):
+    result = doctest.testmod(importlib.import_module(f"meshlap_core.deform.{module}"))
+    assert result.attempted >= 2 and result.failed == 0
 
 
 # ---------------------------------------------------------------- bad input

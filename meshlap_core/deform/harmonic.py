@@ -59,6 +59,8 @@ def k_harmonic_operator(K: sp.csr_matrix, mass: FloatArray, k: int) -> sp.csr_ma
     Q : (n,n) scipy.sparse.csr_matrix
     """
     K = sp.csr_matrix(K)
+    if k == 1:
+        return K
     inv = np.divide(1.0, mass, out=np.zeros_like(mass, dtype=np.float64), where=mass > 0)
     MinvK = sp.diags(inv) @ K
     Q = K
@@ -89,8 +91,8 @@ class HarmonicDeformer(Deformer):
     >>> V, F = icosphere(2)
     >>> bi = HarmonicDeformer(V, F, handles=[0], fixed=[100], k=2)
     >>> U = bi.update(V[[0]] + [0.0, 0.0, 0.2])
-    >>> float(U[0, 2] - V[0, 2]), float(abs(U[100] - V[100]).max())
-    (0.2, 0.0)
+    >>> bool(np.array_equal(U[0], V[0] + [0.0, 0.0, 0.2])), bool(np.array_equal(U[100], V[100]))
+    (True, True)
     """
 
     def __init__(
