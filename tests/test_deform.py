@@ -24,7 +24,7 @@ from meshlap_core.deform import (
     rotation_matrix,
 )
 from meshlap_core.deform.rotations import fit_rotations_igl
-from meshlap_core.errors import Cancelled, MeshError
+from meshlap_core.errors import Cancelled, MeshError, MeshWarning
 
 
 @pytest.fixture(scope="module")
@@ -228,6 +228,21 @@ def test_a_component_without_a_handle_stays_put():
         np.testing.assert_array_equal(U[len(V1) :], V[len(V1) :])
 
 
+@pytest.mark.parametrize("method", ["biharmonic", "laplacian", "arap"])
+def test_a_vertex_only_in_a_degenerate_face_is_held(method):
+    """libigl's cotangents divide by zero on a zero-area face: the guarded ones give it zero
+    weights, and its lone vertex (no area, a component of its own) stays put."""
+    V1, F1 = primitives.icosphere(1)
+    a, b = F1[0, 0], F1[0, 1]
+    V = np.concatenate([V1, [(V1[a] + V1[b]) / 2]])
+    F = np.concatenate([F1, [[a, b, len(V1)]]])
+    s = make_deformer(method, V, F, [5])
+    U = s.update(V[[5]] + [0.0, 0.0, 0.3])
+    assert len(V1) in s.constraints.still and np.isfinite(U).all()
+    np.testing.assert_array_equal(U[len(V1)], V[len(V1)])
+    assert U[5, 2] == pytest.approx(V[5, 2] + 0.3)
+
+
 def test_rotation_error_is_zero_for_a_rigid_motion_and_grows_with_a_stretch(bumpy):
     V, F = bumpy
     rigid = V @ rotation_matrix([0, 1, 1], 70).T + 2.0
@@ -348,6 +363,18 @@ def test_overlapping_discs_go_to_the_nearer_seed_and_radius_zero_keeps_the_seeds
     np.testing.assert_array_equal(regions.region[~tie], nearer[~tie])
     same = grow_handles(V, F, [9, 3], 0.0)
     np.testing.assert_array_equal(same.vertices, [3, 9])
+
+
+def test_a_disc_over_the_exact_limit_is_measured_along_edges_with_a_warning(bumpy, monkeypatch):
+    from meshlap_core.deform import regions
+
+    V, F = bumpy
+    monkeypatch.setattr(regions, "MAX_EXACT_PATCH", 50)
+    with pytest.warns(MeshWarning, match="along edges"):
+        big = grow_handles(V, F, [7], 0.8)
+    np.testing.assert_array_equal(
+        big.vertices, grow_handles(V, F, [7], 0.8, distance="graph").vertices
+    )
 
 
 def test_the_default_fixed_region_is_far_from_every_handle():

@@ -16,10 +16,9 @@ from typing import Any
 import numpy as np
 
 from ..errors import check_cancel
-from ..laplacian import face_areas
 from ..linalg.common import ProgressCallback, report_progress
 from ..types import FloatArray, as_mesh
-from .constraints import check_targets, make_constraints
+from .constraints import check_targets, make_constraints, solid_faces
 from .rigidity import rotation_error
 from .system import SystemStats
 
@@ -65,9 +64,8 @@ class Deformer:
         self._t0 = time.perf_counter()
         self.V, self.F = as_mesh(V, F)
         self.n = len(self.V)
-        self.constraints = make_constraints(
-            self.F, self.n, face_areas(self.V, self.F), handles, fixed
-        )
+        self.solid = solid_faces(self.V, self.F)
+        self.constraints = make_constraints(self.F, self.n, self.solid, handles, fixed)
         self.handles, self.fixed = self.constraints.handles, self.constraints.fixed
         self._slot = np.searchsorted(self.constraints.known, self.handles)
         self._targets = self.V[self.handles].copy()

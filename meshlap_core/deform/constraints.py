@@ -4,10 +4,11 @@ and the checks that make the linear systems solvable.
 Every method minimizes a quadratic (or, for ARAP, alternately quadratic) energy whose matrix is
 positive *semi*definite: the cotangent stiffness ``K = −C`` and its powers ``K (M⁻¹K)ᵏ⁻¹``
 annihilate exactly the functions that are constant on each connected component (connected
-through faces of positive area). Holding one vertex of a component makes the rest of it
-determined; a component that holds none would leave the system singular. Such a component
-cannot be moved by any handle, so it is *held at rest* (:attr:`Constraints.still`) and reported,
-rather than refused: a scan with a loose eye keeps its eye where it was.
+through faces that are not degenerate, :func:`solid_faces`). Holding one vertex of a component
+makes the rest of it determined; a component that holds none would leave the system singular.
+Such a component cannot be moved by any handle, so it is *held at rest*
+(:attr:`Constraints.still`) and reported, rather than refused: a scan with a loose eye keeps
+its eye where it was.
 """
 
 from __future__ import annotations
@@ -20,7 +21,9 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
 from ..errors import MeshError
-from ..types import FloatArray, IntArray, real_array
+from ..laplacian import squared_edge_lengths
+from ..options import DEGENERATE_REL
+from ..types import BoolArray, FloatArray, IntArray, real_array
 
 MAX_LISTED = 8
 """An error message lists at most this many offending indices."""
@@ -89,27 +92,36 @@ def check_targets(targets: Any, count: int, name: str = "targets") -> FloatArray
     return arr
 
 
-def surface_components(F: IntArray, n: int, area: FloatArray) -> tuple[int, IntArray]:
-    """Components of the mesh joined through faces of positive area: the null space of the
-    cotangent stiffness is the functions constant on each (a vertex only in degenerate faces,
-    or in none, is a component of its own).
+def solid_faces(V: FloatArray, F: IntArray) -> BoolArray:
+    """Which faces are not degenerate, by the rule the cotangent weights use
+    (:data:`~meshlap_core.options.DEGENERATE_REL`: ``16 A² > (2·DEGENERATE_REL)² (Σ l²)²``,
+    Heron's ``16 A²`` from the squared lengths); a degenerate face gets zero weights."""
+    l2 = squared_edge_lengths(V, F)
+    a, b, c = l2[:, 0], l2[:, 1], l2[:, 2]
+    area16 = 2.0 * (a * b + b * c + c * a) - (a * a + b * b + c * c)
+    return area16 > (2.0 * DEGENERATE_REL) ** 2 * (a + b + c) ** 2
+
+
+def surface_components(F: IntArray, n: int, solid: BoolArray) -> tuple[int, IntArray]:
+    """Components of the mesh joined through its solid faces (:func:`solid_faces`): the null
+    space of the cotangent stiffness is the functions constant on each (a vertex only in
+    degenerate faces, or in none, is a component of its own).
 
     Parameters
     ----------
     F : (m,3) int
     n : int
-    area : (m,) float
-        Face areas.
+    solid : (m,) bool
 
     Returns
     -------
     count : int
     labels : (n,) int
     """
-    G = F[area > 0]
-    i = np.concatenate([G[:, 0], G[:, 1], G[:, 2]])
-    j = np.concatenate([G[:, 1], G[:, 2], G[:, 0]])
-    A = sp.coo_matrix((np.ones(len(i)), (i, j)), shape=(n, n)).tocsr()
+    G = F[solid]
+    i = np.concatenate([G[:, 0], G[:, 1]])  # two edges of each face join its three corners
+    j = np.concatenate([G[:, 1], G[:, 2]])
+    A = sp.csr_matrix((np.ones(len(i), dtype=np.int8), (i, j)), shape=(n, n))
     count, labels = connected_components(A, directed=False)
     return int(count), labels.astype(np.int64)
 
@@ -133,7 +145,7 @@ class Constraints:
     free : (n−k,) int
         The unknowns, sorted.
     n_components : int
-        Connected components (through faces of positive area).
+        Connected components (through solid faces).
     """
 
     n: int
@@ -151,7 +163,7 @@ class Constraints:
 
 
 def make_constraints(
-    F: IntArray, n: int, area: FloatArray, handles: Any, fixed: Any = None
+    F: IntArray, n: int, solid: BoolArray, handles: Any, fixed: Any = None
 ) -> Constraints:
     """Check a handle set and partition the vertices (see :class:`Constraints`).
 
@@ -159,8 +171,8 @@ def make_constraints(
     ----------
     F : (m,3) int
     n : int
-    area : (m,) float
-        Face areas (components are joined through faces of positive area).
+    solid : (m,) bool
+        The faces that are not degenerate (:func:`solid_faces`; they join the components).
     handles : (h,) int
         The handle vertices (all of them: a disc is grown before, by
         :func:`~meshlap_core.deform.regions.grow_handles`).
@@ -186,7 +198,7 @@ def make_constraints(
             "is moved or held, not both",
             "fixed",
         )
-    count, labels = surface_components(F, n, area)
+    count, labels = surface_components(F, n, solid)
     held = np.zeros(count, dtype=bool)
     held[labels[h]] = True
     held[labels[f]] = True

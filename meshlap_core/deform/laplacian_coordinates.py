@@ -35,12 +35,12 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import MeshError
-from ..laplacian import cotan_stiffness, vertex_areas
+from ..laplacian import vertex_areas
 from ..linalg.common import ProgressCallback
 from ..options import CONSTRAINT_KINDS, DEFAULT_CONSTRAINTS, MASS_AREA, ConstraintKind, check_choice
 from ..types import FloatArray
 from .base import Deformer, phase
-from .harmonic import k_harmonic_operator
+from .harmonic import k_harmonic_operator, stiffness
 from .system import PinnedSystem
 
 SOFT_WEIGHT = 100.0
@@ -94,7 +94,7 @@ class LaplacianCoordinates(Deformer):
             " + w sum_c q_c |x_c - u_c|^2" if self.kind == "soft" else ""
         )
         phase(progress, cancel, 0.0, "deformation: cotangent stiffness and mass")
-        K = -cotan_stiffness(self.V, self.F)
+        K = stiffness(self.V, self.F, self.solid)
         self.Q = k_harmonic_operator(K, vertex_areas(self.V, self.F, MASS_AREA), 2)
         c = self.constraints
         held = np.union1d(c.handles, c.fixed)
