@@ -102,6 +102,7 @@ BAD = [
     (["--rotate", "a,b,c,d"], "--rotate"),
     (["--move", "1,2"], "--move"),
     (["--move", "0,nan,0"], "--move"),
+    (["--move", "1e300,0,0"], "--move"),
     (["--iters", "5"], "--iters"),  # not ARAP
 ]
 

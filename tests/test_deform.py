@@ -243,6 +243,27 @@ def test_a_vertex_only_in_a_degenerate_face_is_held(method):
     assert U[5, 2] == pytest.approx(V[5, 2] + 0.3)
 
 
+@pytest.mark.parametrize("scale", [1e70, 1e-55])
+@pytest.mark.parametrize("method", ["triharmonic", "laplacian", "arap"])
+def test_results_scale_with_the_mesh_to_the_edges_of_the_coordinate_range(bumpy, scale, method):
+    """The rotations, the powers of M⁻¹ and the energies at coordinates 1e70 and 1e-55 (where
+    SᵀS of a one-ring would overflow or underflow unnormalized)."""
+    V, F = bumpy
+    t = V[[0, 40]] + [[0.3, 0.1, 0.0], [0.0, 0.0, -0.2]]
+    one = make_deformer(method, V, F, [0, 40], [100])
+    big = make_deformer(method, V * scale, F, [0, 40], [100])
+    np.testing.assert_allclose(big.update(t * scale) / scale, one.update(t), atol=1e-9)
+    assert np.isfinite(big.energy()) and np.isfinite(big.rotation_error()).all()
+
+
+def test_targets_beyond_the_coordinate_range_are_refused(bumpy):
+    V, F = bumpy
+    s = make_deformer("biharmonic", V, F, [0])
+    with pytest.raises(MeshError, match="beyond") as info:
+        s.update([[1e300, 0.0, 0.0]])
+    assert info.value.source == "targets"
+
+
 def test_rotation_error_is_zero_for_a_rigid_motion_and_grows_with_a_stretch(bumpy):
     V, F = bumpy
     rigid = V @ rotation_matrix([0, 1, 1], 70).T + 2.0

@@ -37,6 +37,7 @@ FLAGS = {
     "rotate": "--rotate",
     "move": "--move",
     "iters": "--iters",
+    "targets": "--move",  # a target out of range: the move took the handles there
 }
 """The core's argument names and the flags users typed."""
 

@@ -22,7 +22,7 @@ from scipy.sparse.csgraph import connected_components
 
 from ..errors import MeshError
 from ..laplacian import squared_edge_lengths
-from ..options import DEGENERATE_REL
+from ..options import DEGENERATE_REL, MAX_COORDINATE
 from ..types import BoolArray, FloatArray, IntArray, real_array
 
 MAX_LISTED = 8
@@ -86,9 +86,13 @@ def check_targets(targets: Any, count: int, name: str = "targets") -> FloatArray
         raise MeshError(
             f"should have shape ({count}, 3), one row per handle; got {arr.shape}", name
         )
-    if not np.isfinite(arr).all():
-        row = int(np.flatnonzero(~np.isfinite(arr).all(axis=1))[0])
-        raise MeshError(f"row {row} has a NaN or infinite coordinate", name)
+    if arr.size and not np.abs(arr).max() <= MAX_COORDINATE:  # NaN fails the test too
+        row = int(np.flatnonzero(~(np.abs(arr) <= MAX_COORDINATE).all(axis=1))[0])
+        if not np.isfinite(arr[row]).all():
+            raise MeshError(f"row {row} has a NaN or infinite coordinate", name)
+        raise MeshError(
+            f"row {row} has a coordinate beyond ±{MAX_COORDINATE:.0e} (as vertices may not)", name
+        )
     return arr
 
 

@@ -177,7 +177,11 @@ def svd_rotations(
     V : (3,3,n) float
         The right singular vectors (columns, ``det = +1``), sorted by decreasing singular value.
     """
-    s = [[S[i, j] for j in range(3)] for i in range(3)]
+    # each matrix divided by its largest entry (the rotation does not change): SᵀS neither
+    # overflows (coordinates up to 1e75) nor underflows (down to 1e-60)
+    big = np.abs(S).max(axis=(0, 1))
+    inv = 1.0 / np.where(big > 0, big, 1.0)
+    s = [[S[i, j] * inv for j in range(3)] for i in range(3)]
     if basis is None:
         n = S.shape[2]
         one, zero = np.ones(n), np.zeros(n)
