@@ -243,6 +243,21 @@ def test_a_vertex_only_in_a_degenerate_face_is_held(method):
     assert U[5, 2] == pytest.approx(V[5, 2] + 0.3)
 
 
+@pytest.mark.parametrize("method", ["laplacian", "harmonic", "biharmonic", "triharmonic", "arap"])
+def test_a_handle_in_no_face_goes_to_its_target_and_faceless_meshes_work(bumpy, method):
+    """An unreferenced handle vertex has no stiffness: the soft penalty weighed by it would be
+    0 and the system singular (the bundled Cholesky then crashed); it is held exactly."""
+    V, F = bumpy
+    W = np.concatenate([V, [[3.0, 3.0, 3.0]]])
+    s = make_deformer(method, W, F, [0, len(V)])
+    U = s.update([V[0] + 0.1, [4.0, 4.0, 4.0]])
+    np.testing.assert_array_equal(U[len(V)], [4.0, 4.0, 4.0])
+    none = make_deformer(method, V[:4], np.zeros((0, 3), dtype=np.int64), [1])
+    U = none.update([[1.0, 2.0, 3.0]])
+    np.testing.assert_array_equal(U[1], [1.0, 2.0, 3.0])
+    np.testing.assert_array_equal(np.delete(U, 1, axis=0), np.delete(V[:4], 1, axis=0))
+
+
 @pytest.mark.parametrize("scale", [1e70, 1e-55])
 @pytest.mark.parametrize("method", ["triharmonic", "laplacian", "arap"])
 def test_results_scale_with_the_mesh_to_the_edges_of_the_coordinate_range(bumpy, scale, method):
@@ -529,6 +544,26 @@ def test_bad_method_options_are_named(bumpy, method, kwargs, source):
     with pytest.raises(MeshError) as info:
         make_deformer(method, V, F, [0], **kwargs)
     assert info.value.source == source
+
+
+@pytest.mark.parametrize(
+    ("which", "bad"),
+    [
+        ("V", lambda V, F: V[:, :2]),
+        ("V", lambda V, F: V.astype(complex)),
+        ("V", lambda V, F: V.astype(str)),
+        ("F", lambda V, F: F + 0.5),
+        ("F", lambda V, F: F[:, :2]),
+        ("F", lambda V, F: -F),
+    ],
+)
+@pytest.mark.parametrize("method", ["laplacian", "biharmonic", "arap"])
+def test_bad_mesh_arrays_are_named(bumpy, which, bad, method):
+    V, F = bumpy
+    args = (bad(V, F), F) if which == "V" else (V, bad(V, F))
+    with pytest.raises(MeshError) as info:
+        make_deformer(method, *args, [0])
+    assert info.value.source == which
 
 
 def test_bad_meshes_are_named(bumpy):

@@ -102,13 +102,18 @@ class LaplacianCoordinates(Deformer):
         if self.kind == "hard":
             free, known = c.free, c.known
             self._penalty = np.zeros(self.n)
+            self._lone = np.zeros(0, dtype=np.int64)
             A = self.Q
         else:
-            known = c.still
+            q = self.Q.diagonal()
+            # a held vertex in no solid face has no stiffness to weigh its penalty by: exact
+            self._lone = held[~(q[held] > 0)]
+            known = np.union1d(c.still, self._lone)
             free = np.setdiff1d(np.arange(self.n), known, assume_unique=True)
             self._penalty = np.zeros(self.n)
-            self._penalty[held] = self.weight * self.Q.diagonal()[held]
+            self._penalty[held] = self.weight * q[held]
             A = (self.Q + sp.diags(self._penalty)).tocsr()
+        self._known_rows = known
         phase(progress, cancel, 0.2, f"deformation: factorizing ({len(free):,} unknowns)")
         self.system = PinnedSystem(A, free, known)
         self._finish_setup(self.system.stats)
@@ -124,15 +129,11 @@ class LaplacianCoordinates(Deformer):
         """Move the handles to ``targets`` ``(h,3)``; the deformed positions ``(n,3)``."""
         self._set_targets(targets)
         g = self._goal()
-        if self.kind == "hard":
-            d = self.system.solve(g[self.constraints.known])
-        else:
-            d = self.system.solve(
-                np.zeros((len(self.constraints.still), 3)), self._penalty[:, None] * g
-            )
+        b = None if self.kind == "hard" else self._penalty[:, None] * g
+        d = self.system.solve(g[self._known_rows], b)
         self._U = self.V + d
-        if self.kind == "hard":
-            self._U[self.handles] = self._targets  # p + (u − p) is u only up to round-off
+        exact = self.handles if self.kind == "hard" else np.intersect1d(self.handles, self._lone)
+        self._U[exact] = self._targets[np.searchsorted(self.handles, exact)]  # p + (u − p) ≈ u
         return self.positions
 
     def energy_parts(self) -> tuple[float, float]:
