@@ -19,8 +19,10 @@ handles rotated about their centroid by up to 30° and moved by up to 5 % of the
   from their last positions: time per iteration with the targets held, and per drag update
   (new targets, one iteration).
 
-Times are medians (updates, iterations) and the best of ``--repeat`` (precomputations);
-ratios are ours / libigl's (below 1: ours faster). The load average is printed with them.
+Ours and libigl's alternate (precomputations, then drag by drag), so a load that comes and
+goes falls on both alike; times are medians (updates, iterations) and the best of ``--repeat``
+(precomputations); ratios are ours / libigl's (below 1: ours faster). The load average is
+printed with them.
 """
 
 from __future__ import annotations
@@ -79,57 +81,58 @@ def median_ms(times: list[float]) -> float:
     return 1e3 * statistics.median(times)
 
 
+def _timed(fn):
+    t0 = time.perf_counter()
+    out = fn()
+    return time.perf_counter() - t0, out
+
+
+def _igl_split_precompute(V, F, b, k):
+    """libigl's ``harmonic`` split in two: ``min_quad_with_fixed_precompute`` on ``K(M⁻¹K)ᵏ⁻¹``
+    (``K = −L``, the sign that makes it positive definite), to solve per drag."""
+    L = igl.cotmatrix(V, F)
+    M = igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_VORONOI)
+    Q = -L
+    if k > 1:
+        MiK = sp.diags(1.0 / M.diagonal()) @ Q
+        for _ in range(k - 1):
+            Q = Q @ MiK
+    data = igl.min_quad_with_fixed_data()
+    igl.min_quad_with_fixed_precompute(sp.csc_matrix(Q), b, sp.csc_matrix((0, len(V))), True, data)
+    return data
+
+
 def harmonic_rows(V, F, handles, fixed, poses, k, repeat):
-    """Ours, igl.harmonic and libigl's split path for one k: a table row each."""
+    """Ours, igl.harmonic and libigl's split path for one k, alternating (so the load falls
+    on each alike): a table row each."""
     b = np.concatenate([handles, fixed]).astype(np.int64)
     zeros = np.zeros((len(fixed), 3))
-    pre, ours = best_of(lambda: HarmonicDeformer(V, F, handles, fixed, k=k), repeat)
-    upd = []
-    for t in poses:
-        t0 = time.perf_counter()
-        ours.update(t)
-        upd.append(time.perf_counter() - t0)
     bc = np.concatenate([poses[-1] - V[handles], zeros])
-    whole, W = best_of(lambda: igl.harmonic(V, F, b, bc, k), repeat)
-    err = float(np.abs(ours.positions - V - W).max())
-
-    def split_pre():
-        L = igl.cotmatrix(V, F)
-        M = igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_VORONOI)
-        Q = -L  # libigl's -L (M⁻¹L)ᵏ⁻¹ with the sign that makes it positive definite
-        if k > 1:
-            MiK = sp.diags(1.0 / M.diagonal()) @ Q
-            for _ in range(k - 1):
-                Q = Q @ MiK
-        data = igl.min_quad_with_fixed_data()
-        igl.min_quad_with_fixed_precompute(
-            sp.csc_matrix(Q), b, sp.csc_matrix((0, len(V))), True, data
-        )
-        return data
-
-    spre, data = best_of(split_pre, repeat)
-    supd = []
+    pre, whole, spre = [], [], []
+    for _ in range(repeat):
+        t, ours = _timed(lambda: HarmonicDeformer(V, F, handles, fixed, k=k))
+        pre.append(t)
+        t, W = _timed(lambda: igl.harmonic(V, F, b, bc, k))
+        whole.append(t)
+        t, data = _timed(lambda: _igl_split_precompute(V, F, b, k))
+        spre.append(t)
+    upd, supd = [], []
     B = np.zeros((len(V), 3))
     for t in poses:
         bct = np.concatenate([t - V[handles], zeros])
-        t0 = time.perf_counter()
-        igl.min_quad_with_fixed_solve(data, B, bct, np.zeros((0, 3)))
-        supd.append(time.perf_counter() - t0)
+        upd.append(_timed(lambda t=t: ours.update(t))[0])
+        supd.append(
+            _timed(lambda bct=bct: igl.min_quad_with_fixed_solve(data, B, bct, zeros[:0]))[0]
+        )
+    err = float(np.abs(ours.positions - V - W).max())
     name = ours.method
-    u, s = median_ms(upd), median_ms(supd)
+    p, w, s_ = min(pre), min(whole), min(spre)
+    u, su = median_ms(upd), median_ms(supd)
     return (
         [
-            [name, "ours", pre, u, 1e3 / u, "", ""],
-            [
-                name,
-                "igl.harmonic (per call)",
-                whole,
-                1e3 * whole,
-                1 / whole,
-                pre / whole,
-                u / (1e3 * whole),
-            ],
-            [name, "igl min_quad_with_fixed", spre, s, 1e3 / s, pre / spre, u / s],
+            [name, "ours", p, u, 1e3 / u, "", ""],
+            [name, "igl.harmonic (per call)", w, 1e3 * w, 1 / w, p / w, u / (1e3 * w)],
+            [name, "igl min_quad_with_fixed", s_, su, 1e3 / su, p / s_, u / su],
         ],
         err,
         ours.stats,
@@ -150,7 +153,6 @@ def laplacian_row(V, F, handles, fixed, poses, repeat):
 def arap_rows(V, F, handles, fixed, poses, iters, repeat):
     """Iterations with the targets held and drag updates, ours beside libigl's."""
     b = np.concatenate([handles, fixed])
-    pre, ours = best_of(lambda: ArapDeformer(V, F, handles, fixed), repeat)
 
     def igl_pre():
         data = igl.ARAPData()
@@ -159,7 +161,13 @@ def arap_rows(V, F, handles, fixed, poses, iters, repeat):
         igl.arap_precomputation(V, F, 3, b.astype(np.int32), data)
         return data
 
-    ipre, data = best_of(igl_pre, repeat)
+    pres, ipres = [], []
+    for _ in range(repeat):
+        t, ours = _timed(lambda: ArapDeformer(V, F, handles, fixed))
+        pres.append(t)
+        t, data = _timed(igl_pre)
+        ipres.append(t)
+    pre, ipre = min(pres), min(ipres)
     target = poses[-1]
     bc = np.concatenate([target, V[fixed]])
     ours.set_targets(target)

@@ -36,7 +36,9 @@ import scipy.sparse as sp
 
 from ..laplacian import cotangents_intrinsic, squared_edge_lengths
 from ..options import ARAP_ENERGIES, DEFAULT_ARAP_ENERGY, ArapEnergyKind, check_choice
-from ..types import FloatArray, IntArray
+from ..types import BoolArray, FloatArray, IntArray
+from .constraints import solid_faces
+from .stiffness import stiffness
 
 
 def arap_terms(F: IntArray, half_cot: FloatArray, kind: str) -> tuple[IntArray, ...]:
@@ -92,23 +94,22 @@ class ArapEnergy:
         F: IntArray,
         kind: ArapEnergyKind = DEFAULT_ARAP_ENERGY,
         absolute: bool = False,
+        solid: BoolArray | None = None,
     ) -> None:
         self.kind = check_choice(kind, ARAP_ENERGIES, "ARAP energy", "energy")
         self.P = V
         n = self.n = len(V)
-        l2 = squared_edge_lengths(V, F)
-        half = 0.5 * cotangents_intrinsic(l2)
-        if absolute:
-            half = np.abs(half)
-        self.K = _graph_laplacian(F, half, n)
         self.multiplicity = 2 if self.kind == "spokes" else 3
-        self.terms = arap_terms(F, half, self.kind)
-        r, j, k, c = self.terms
-        e = V[j] - V[k]
-        rows = np.concatenate([a * n + r for a in range(3)] * 2)
-        cols = np.concatenate([j, j, j, k, k, k])
-        vals = np.concatenate([c * e[:, a] for a in range(3)] + [-c * e[:, a] for a in range(3)])
-        self.Z = sp.coo_matrix((vals, (rows, cols)), shape=(3 * n, n)).tocsr()
+        if self.kind == "spokes":
+            K = stiffness(V, F, solid_faces(V, F) if solid is None else solid)
+            self.K, self.Z, self.terms = _spokes(V, K, absolute)
+        else:
+            half = 0.5 * cotangents_intrinsic(squared_edge_lengths(V, F))
+            if absolute:
+                half = np.abs(half)
+            self.K = _graph_laplacian(F, half, n)
+            self.terms = arap_terms(F, half, self.kind)
+            self.Z = _covariance_operator(V, self.terms, n)
         self.Zt = (self.Z.T / self.multiplicity).tocsr()
         self.rest = self.multiplicity * float(np.einsum("ij,ij->", V, self.K @ V))
 
@@ -142,6 +143,49 @@ class ArapEnergy:
         r, j, k, c = self.terms
         e = self.P[j] - self.P[k]
         return np.bincount(r, c * np.einsum("ij,ij->i", e, e), minlength=self.n)
+
+
+def _spokes(
+    V: FloatArray, K: sp.csr_matrix, absolute: bool
+) -> tuple[sp.csr_matrix, sp.csr_matrix, tuple[IntArray, ...]]:
+    """The spokes energy's stiffness, covariance operator ``Z`` and terms, from the cotangent
+    stiffness ``K`` (sorted CSR, its diagonal stored) without assembling anything:
+    ``Z_a[r, j] = −w_rj (p_r − p_j)_a`` and ``Z_a[r, r] = Σ_j w_rj (p_r − p_j)_a`` have the
+    pattern of ``K``, and the terms are its off-diagonal entries (each directed spoke once,
+    ``c = w_rj``). ``absolute``: ``|w_rj|`` (and ``K`` rebuilt from them)."""
+    n = K.shape[0]
+    rows = np.repeat(np.arange(n), np.diff(K.indptr))
+    cols = K.indices
+    off = rows != cols
+    w = np.where(off, -K.data, 0.0)
+    diagonal = np.flatnonzero(~off)
+    if absolute:
+        w = np.abs(w)
+        kdata = -w
+        kdata[diagonal] = np.bincount(rows, w, minlength=n)[rows[diagonal]]
+        K = sp.csr_matrix((kdata, cols, K.indptr), shape=(n, n))
+    data = []
+    for a in range(3):
+        e = w * (V[rows, a] - V[cols, a])  # w_rj (p_r − p_j)_a, 0 on the diagonal
+        z = -e
+        z[diagonal] = np.bincount(rows, e, minlength=n)[rows[diagonal]]
+        data.append(z)
+    nnz = len(cols)
+    indptr = np.concatenate([K.indptr, K.indptr[1:] + nnz, K.indptr[1:] + 2 * nnz])
+    Z = sp.csr_matrix((np.concatenate(data), np.tile(cols, 3), indptr), shape=(3 * n, n))
+    terms = (rows[off], rows[off], cols[off], w[off])
+    return K, Z, terms
+
+
+def _covariance_operator(V: FloatArray, terms: tuple[IntArray, ...], n: int) -> sp.csr_matrix:
+    """``Z`` ``(3n, n)`` assembled from the terms: row ``a·n + r`` holds ``c e_a`` at ``j`` and
+    ``−c e_a`` at ``k`` for each term ``(r, j, k, c)``, ``e = p_j − p_k``."""
+    r, j, k, c = terms
+    e = V[j] - V[k]
+    rows = np.concatenate([a * n + r for a in range(3)] * 2)
+    cols = np.concatenate([j, j, j, k, k, k])
+    vals = np.concatenate([c * e[:, a] for a in range(3)] + [-c * e[:, a] for a in range(3)])
+    return sp.coo_matrix((vals, (rows, cols)), shape=(3 * n, n)).tocsr()
 
 
 def _graph_laplacian(F: IntArray, half: FloatArray, n: int) -> sp.csr_matrix:

@@ -23,16 +23,16 @@ from __future__ import annotations
 
 from typing import Any
 
-import igl
 import numpy as np
 import scipy.sparse as sp
 
 from ..errors import MeshError
-from ..laplacian import cotan_stiffness_intrinsic, squared_edge_lengths, vertex_areas
+from ..laplacian import vertex_areas
 from ..linalg.common import ProgressCallback
 from ..options import HARMONIC_ORDERS, MASS_AREA
-from ..types import BoolArray, FloatArray, IntArray
+from ..types import FloatArray
 from .base import Deformer, phase
+from .stiffness import stiffness
 from .system import PinnedSystem
 
 ENERGY_NAMES = {
@@ -40,20 +40,6 @@ ENERGY_NAMES = {
     2: "Laplacian energy of the displacement: sum d^T K M^-1 K d = int (Delta d)^2",
     3: "sum d^T K M^-1 K M^-1 K d = int |grad Delta d|^2",
 }
-
-
-def stiffness(V: FloatArray, F: IntArray, solid: BoolArray) -> sp.csr_matrix:
-    """The cotangent stiffness ``K = −C`` ``(n,n)``: libigl's ``cotmatrix`` negated (its CSC
-    arrays read as CSR: the same symmetric matrix, no conversion); with a degenerate face
-    (``solid`` false somewhere), where libigl's cotangents blow up, the guarded
-    :func:`~meshlap_core.laplacian.cotan_stiffness_intrinsic` (zero weights there)."""
-    n = len(V)
-    if len(F) == 0:
-        return sp.csr_matrix((n, n))
-    C = None if not solid.all() else igl.cotmatrix(V, F)
-    if C is None or C.shape != (n, n) or not np.isfinite(C.data).all():
-        return (-cotan_stiffness_intrinsic(squared_edge_lengths(V, F), F, n)).tocsr()
-    return sp.csr_matrix((-C.data, C.indices, C.indptr), shape=(n, n))
 
 
 def k_harmonic_operator(K: sp.csr_matrix, mass: FloatArray, k: int) -> sp.csr_matrix:

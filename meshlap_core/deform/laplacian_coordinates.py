@@ -40,7 +40,8 @@ from ..linalg.common import ProgressCallback
 from ..options import CONSTRAINT_KINDS, DEFAULT_CONSTRAINTS, MASS_AREA, ConstraintKind, check_choice
 from ..types import FloatArray
 from .base import Deformer, phase
-from .harmonic import k_harmonic_operator, stiffness
+from .harmonic import k_harmonic_operator
+from .stiffness import stiffness
 from .system import PinnedSystem
 
 SOFT_WEIGHT = 100.0
