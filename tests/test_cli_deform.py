@@ -2,6 +2,7 @@
 
 import json
 
+import hostile
 import numpy as np
 import pytest
 
@@ -149,3 +150,28 @@ def test_a_mesh_that_cannot_be_read_is_one_line(capsys, tmp_path):
         capsys, "deform", bad, "--handle", 0, "--method", "arap", "--out", tmp_path / "o.obj"
     )
     assert code == 2 and err.startswith("meshlap: error:") and err.count("\n") == 1
+
+
+@pytest.mark.parametrize("method", ["laplacian", "triharmonic", "arap"])
+@pytest.mark.parametrize("case", hostile.CORPUS, ids=lambda h: h.name)
+def test_hostile_files_deform_or_fail_with_one_line(capsys, tmp_path, case, method):
+    """Every file of the robustness corpus: one error line (and no output) for the broken
+    ones; a finite mesh for those that load, whatever their repairs (a handle on vertex 0
+    moved by a tenth of the mesh's size)."""
+    src = tmp_path / "in"
+    src.mkdir()
+    mesh = case.build(src)
+    out = tmp_path / "o.obj"
+    iters = ["--iters", 2] if method == "arap" else []
+    size = 1.0 if case.expect == "error" else float(np.ptp(load_mesh(mesh).V, axis=0).max())
+    code, text, err = run_cli(
+        capsys, "deform", mesh, "--handle", 0, "--rotate", "1,0,0,40", "--move",
+        f"{0.1 * size!r},0,0", "--method", method, *iters, "--out", out, "--json",
+    )  # fmt: skip
+    if case.expect == "error":
+        assert code == 2 and text == "" and err.count("\n") == 1 and not out.exists(), err
+        assert err.startswith("meshlap: error: ") and "Traceback" not in err
+        return
+    assert code == 0, err
+    r = json.loads(text)
+    assert np.isfinite(load_mesh(out).V).all() and np.isfinite(r["energy"])

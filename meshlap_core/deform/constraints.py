@@ -21,7 +21,6 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
 from ..errors import MeshError
-from ..laplacian import squared_edge_lengths
 from ..options import DEGENERATE_REL, MAX_COORDINATE
 from ..types import BoolArray, FloatArray, IntArray, real_array
 
@@ -100,8 +99,10 @@ def solid_faces(V: FloatArray, F: IntArray) -> BoolArray:
     """Which faces are not degenerate, by the rule the cotangent weights use
     (:data:`~meshlap_core.options.DEGENERATE_REL`: ``16 A² > (2·DEGENERATE_REL)² (Σ l²)²``,
     Heron's ``16 A²`` from the squared lengths); a degenerate face gets zero weights."""
-    l2 = squared_edge_lengths(V, F)
-    a, b, c = l2[:, 0], l2[:, 1], l2[:, 2]
+    P0, P1, P2 = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
+    a = np.einsum("ij,ij->i", P1 - P2, P1 - P2)
+    b = np.einsum("ij,ij->i", P2 - P0, P2 - P0)
+    c = np.einsum("ij,ij->i", P0 - P1, P0 - P1)
     area16 = 2.0 * (a * b + b * c + c * a) - (a * a + b * b + c * c)
     return area16 > (2.0 * DEGENERATE_REL) ** 2 * (a + b + c) ** 2
 
