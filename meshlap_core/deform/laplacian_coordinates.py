@@ -44,9 +44,10 @@ from .harmonic import k_harmonic_operator
 from .stiffness import stiffness
 from .system import PinnedSystem
 
-SOFT_WEIGHT = 100.0
-"""Default ``ω`` of the soft constraints: a single-vertex handle reaches about 99 % of its
-move."""
+SOFT_WEIGHT = 1.0
+"""Default ``ω`` of the soft constraints: a single-vertex handle then reaches 98 % (bumpy
+sphere, 642 vertices) to 99.999 % (armadillo_igl, 43k) of its move; the lag shrinks like
+``1/ω`` (hard constraints in the limit)."""
 
 
 def check_weight(weight: Any) -> float:
