@@ -110,7 +110,7 @@ class ArapDeformer(Deformer):
         self.energy_name = "sum_i sum_j w_ij |(x_i - x_j) - R_i (p_i - p_j)|^2" + (
             " over spokes" if self.terms.kind == "spokes" else " over spokes and rims"
         )
-        c = self.constraints
+        c = self._constrain(self.terms.K)
         phase(progress, cancel, 0.3, f"deformation: factorizing K ({c.n_unknowns:,} unknowns)")
         self.system = PinnedSystem(self.terms.K, c.free, c.known)
         self._basis: FloatArray | None = None  # the last local step's right singular vectors

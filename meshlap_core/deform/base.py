@@ -18,7 +18,7 @@ import numpy as np
 from ..errors import check_cancel
 from ..linalg.common import ProgressCallback, report_progress
 from ..types import FloatArray, as_mesh
-from .constraints import check_targets, make_constraints, solid_faces
+from .constraints import Constraints, check_sets, check_targets, make_constraints, solid_faces
 from .rigidity import rotation_error
 from .system import SystemStats
 
@@ -65,14 +65,21 @@ class Deformer:
         self.V, self.F = as_mesh(V, F)
         self.n = len(self.V)
         self.solid = solid_faces(self.V, self.F)
-        self.constraints = make_constraints(self.F, self.n, self.solid, handles, fixed)
-        self.handles, self.fixed = self.constraints.handles, self.constraints.fixed
-        self._slot = np.searchsorted(self.constraints.known, self.handles)
+        self.handles, self.fixed = check_sets(self.n, handles, fixed)
         self._targets = self.V[self.handles].copy()
         self._U = self.V.copy()
         self.stats = SystemStats(0, 0, 0.0, "")
         self.setup_seconds = 0.0
         self._abs_terms: Any = None
+
+    def _constrain(self, K: Any) -> Constraints:
+        """Partition the vertices (:attr:`constraints`), the components read off the pattern
+        of the stiffness ``K`` just built (:func:`make_constraints`)."""
+        self.constraints = make_constraints(
+            self.F, self.n, self.solid, self.handles, self.fixed, graph=K
+        )
+        self._slot = np.searchsorted(self.constraints.known, self.handles)
+        return self.constraints
 
     def _finish_setup(self, stats: SystemStats) -> None:
         """Record the system's figures and the precomputation's wall time."""

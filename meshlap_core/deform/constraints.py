@@ -167,22 +167,8 @@ class Constraints:
         return len(self.free)
 
 
-def make_constraints(
-    F: IntArray, n: int, solid: BoolArray, handles: Any, fixed: Any = None
-) -> Constraints:
-    """Check a handle set and partition the vertices (see :class:`Constraints`).
-
-    Parameters
-    ----------
-    F : (m,3) int
-    n : int
-    solid : (m,) bool
-        The faces that are not degenerate (:func:`solid_faces`; they join the components).
-    handles : (h,) int
-        The handle vertices (all of them: a disc is grown before, by
-        :func:`~meshlap_core.deform.regions.grow_handles`).
-    fixed : (f,) int, optional
-        Vertices held at rest; none by default.
+def check_sets(n: int, handles: Any, fixed: Any = None) -> tuple[IntArray, IntArray]:
+    """The handle and fixed vertices checked: sorted ``(h,)`` and ``(f,)`` int, disjoint.
 
     Raises
     ------
@@ -203,11 +189,50 @@ def make_constraints(
             "is moved or held, not both",
             "fixed",
         )
-    count, labels = surface_components(F, n, solid)
+    return h, f
+
+
+def make_constraints(
+    F: IntArray,
+    n: int,
+    solid: BoolArray,
+    handles: Any,
+    fixed: Any = None,
+    graph: sp.spmatrix | None = None,
+) -> Constraints:
+    """Check a handle set and partition the vertices (see :class:`Constraints`).
+
+    Parameters
+    ----------
+    F : (m,3) int
+    n : int
+    solid : (m,) bool
+        The faces that are not degenerate (:func:`solid_faces`; they join the components).
+    handles : (h,) int
+        The handle vertices (all of them: a disc is grown before, by
+        :func:`~meshlap_core.deform.regions.grow_handles`).
+    fixed : (f,) int, optional
+        Vertices held at rest; none by default.
+    graph : (n,n) scipy.sparse matrix, optional
+        A matrix whose pattern joins the corners of every face (the cotangent stiffness):
+        when every face is solid its components are the mesh's, found without building a
+        graph of the faces.
+
+    Raises
+    ------
+    MeshError
+        As :func:`check_sets`.
+    """
+    h, f = check_sets(n, handles, fixed)
+    if graph is not None and solid.all():
+        count, labels = connected_components(graph, directed=False)
+        labels = labels.astype(np.int64)
+    else:
+        count, labels = surface_components(F, n, solid)
     held = np.zeros(count, dtype=bool)
     held[labels[h]] = True
     held[labels[f]] = True
     still = np.flatnonzero(~held[labels]).astype(np.int64)
     known = np.union1d(np.union1d(h, f), still).astype(np.int64)
     free = np.setdiff1d(np.arange(n, dtype=np.int64), known, assume_unique=True)
-    return Constraints(n, h, f, still, known, free, count)
+    return Constraints(n, h, f, still, known, free, int(count))

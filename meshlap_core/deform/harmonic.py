@@ -117,7 +117,7 @@ class HarmonicDeformer(Deformer):
         K = stiffness(self.V, self.F, self.solid)
         mass = vertex_areas(self.V, self.F, MASS_AREA) if self.k > 1 else np.ones(self.n)
         self.Q = k_harmonic_operator(K, mass, self.k)
-        c = self.constraints
+        c = self._constrain(K)
         phase(
             progress,
             cancel,

@@ -98,7 +98,7 @@ class LaplacianCoordinates(Deformer):
         phase(progress, cancel, 0.0, "deformation: cotangent stiffness and mass")
         K = stiffness(self.V, self.F, self.solid)
         self.Q = k_harmonic_operator(K, vertex_areas(self.V, self.F, MASS_AREA), 2)
-        c = self.constraints
+        c = self._constrain(K)
         held = np.union1d(c.handles, c.fixed)
         self._held = held
         if self.kind == "hard":
