@@ -15,6 +15,7 @@ from meshlap_core.deform import (
     HarmonicDeformer,
     LaplacianCoordinates,
     deform_mesh,
+    edge_graph,
     farthest_region,
     fit_rotations,
     grow_handles,
@@ -387,6 +388,8 @@ def test_discs_are_the_exact_geodesic_discs(bumpy):
         np.testing.assert_allclose(regions.distance, exact[regions.vertices], atol=1e-12)
         graph = grow_handles(V, F, [7], radius, distance="graph")
         assert set(graph.vertices) <= set(regions.vertices)  # paths along edges are longer
+        again = grow_handles(V, F, [7], radius, graph=edge_graph(V, F))  # a cached graph
+        np.testing.assert_array_equal(again.vertices, regions.vertices)
 
 
 def test_overlapping_discs_go_to_the_nearer_seed_and_radius_zero_keeps_the_seeds(bumpy):

@@ -38,7 +38,7 @@ from .constraints import Constraints, check_targets, check_vertices, make_constr
 from .harmonic import HarmonicDeformer, k_harmonic_operator
 from .laplacian_coordinates import LaplacianCoordinates
 from .methods import deform_mesh, make_deformer
-from .regions import HandleRegions, farthest_region, grow_handles
+from .regions import HandleRegions, edge_graph, farthest_region, grow_handles
 from .rigidity import rotation_error
 from .rotations import fit_rotations, fit_rotations_igl
 from .system import PinnedSystem, SystemStats
@@ -57,6 +57,7 @@ __all__ = [
     "check_targets",
     "check_vertices",
     "deform_mesh",
+    "edge_graph",
     "farthest_region",
     "fit_rotations",
     "fit_rotations_igl",

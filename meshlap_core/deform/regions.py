@@ -148,6 +148,7 @@ def grow_handles(
     radius: float = 0.0,
     *,
     distance: HandleDistance = DEFAULT_HANDLE_DISTANCE,
+    graph: sp.csr_matrix | None = None,
     cancel: Any = None,
 ) -> HandleRegions:
     """Grow each seed vertex into the disc of vertices within geodesic ``radius`` of it.
@@ -165,6 +166,9 @@ def grow_handles(
         In the mesh's units of length, ``≥ 0``.
     distance : {"exact", "graph"}
         See the module docstring.
+    graph : (n,n) scipy.sparse.csr_matrix, optional
+        :func:`edge_graph` of ``V, F``, built once per mesh by a caller that grows handles
+        often (a second at 692k vertices); built here when not given.
     cancel : threading.Event or callable, optional
         Checked between seeds.
 
@@ -181,7 +185,7 @@ def grow_handles(
     check_choice(distance, HANDLE_DISTANCES, "handle distance", "distance")
     if r == 0 or len(F) == 0:
         return HandleRegions(s, s, np.arange(len(s)), np.zeros(len(s)), r)
-    G = edge_graph(V, F)
+    G = edge_graph(V, F) if graph is None else graph
     best = np.full(n, np.inf)
     owner = np.full(n, -1, dtype=np.int64)
     for i, seed in enumerate(s):
@@ -201,7 +205,13 @@ def grow_handles(
     return HandleRegions(s, vertices, owner[vertices], best[vertices], r)
 
 
-def farthest_region(V: FloatArray, F: IntArray, handles: Any, fraction: float = 0.1) -> IntArray:
+def farthest_region(
+    V: FloatArray,
+    F: IntArray,
+    handles: Any,
+    fraction: float = 0.1,
+    graph: sp.csr_matrix | None = None,
+) -> IntArray:
     """The default fixed region: in each component holding a handle, the vertices whose
     distance from the nearest handle (along edges) is at least ``1 − fraction`` of that
     component's largest.
@@ -213,6 +223,8 @@ def farthest_region(V: FloatArray, F: IntArray, handles: Any, fraction: float = 
     handles : (h,) int
     fraction : float
         In ``(0, 1)``: the share of the largest distance the region spans.
+    graph : (n,n) scipy.sparse.csr_matrix, optional
+        :func:`edge_graph` of ``V, F`` (built when not given).
 
     Returns
     -------
@@ -230,7 +242,7 @@ def farthest_region(V: FloatArray, F: IntArray, handles: Any, fraction: float = 
         raise MeshError(f"must be between 0 and 1, got {fraction!r}", "fraction")
     if len(F) == 0:
         return np.zeros(0, dtype=np.int64)
-    d = dijkstra(edge_graph(V, F), indices=h, min_only=True)
+    d = dijkstra(edge_graph(V, F) if graph is None else graph, indices=h, min_only=True)
     count, labels = surface_components(F, n, solid_faces(V, F))
     far = np.zeros(n, dtype=bool)
     reached = np.isfinite(d)
