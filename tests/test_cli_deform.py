@@ -72,6 +72,19 @@ def test_arap_runs_the_iterations_asked_and_grows_the_handles(capsys, sphere_obj
     np.testing.assert_allclose(load_mesh(out).V, arap.positions, atol=1e-6)
 
 
+def test_negative_first_numbers_are_given_with_an_equals_sign(capsys, sphere_obj, tmp_path):
+    out = tmp_path / "o.obj"
+    code, text, err = run_cli(
+        capsys, "deform", sphere_obj, "--handle", 3, "--rotate=-1,0,0,-30", "--move=-0.1,0,0",
+        "--method", "harmonic", "--out", out, "--json",
+    )  # fmt: skip
+    assert code == 0, err
+    r = json.loads(text)
+    assert r["rotate"] == [-1.0, 0.0, 0.0, -30.0] and r["move"] == [-0.1, 0.0, 0.0]
+    V = load_mesh(sphere_obj).V
+    np.testing.assert_allclose(load_mesh(out).V[3], V[3] + [-0.1, 0, 0], atol=1e-6)
+
+
 @pytest.mark.parametrize("method", ["laplacian", "harmonic", "triharmonic"])
 def test_text_report_names_the_energy_and_the_system(capsys, sphere_obj, tmp_path, method):
     out = tmp_path / "o.off"

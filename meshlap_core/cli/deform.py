@@ -65,8 +65,13 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--fixed", action="append", metavar="V[,V...]", help="vertices held at rest (none)"
     )
-    p.add_argument("--rotate", metavar="ax,ay,az,deg", help="rotate the handles (degrees)")
-    p.add_argument("--move", metavar="dx,dy,dz", help="then translate them")
+    p.add_argument(
+        "--rotate",
+        metavar="ax,ay,az,deg",
+        help="rotate the handles about their centroid (degrees; --rotate=-1,0,0,30 with '=' "
+        "when the first number is negative)",
+    )
+    p.add_argument("--move", metavar="dx,dy,dz", help="then translate them (--move=-1,0,0)")
     p.add_argument("--method", choices=DEFORM_METHODS, required=True)
     p.add_argument("--iters", help=f"ARAP iterations (default {DEFAULT_ITERS})")
     p.add_argument("--out", required=True, help="the deformed mesh (.obj, .off, .ply)")
