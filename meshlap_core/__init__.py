@@ -82,6 +82,14 @@ _PUBLIC: dict[str, str | tuple[str, str]] = {
     "heat_kernel_signature": "diffusion",
     "isolines": "diffusion",
     "save_polylines": "diffusion",
+    # deformation: handles dragged, the rest following (meshlap_core.deform)
+    "make_deformer": "deform",
+    "deform_mesh": "deform",
+    "HarmonicDeformer": "deform",
+    "LaplacianCoordinates": "deform",
+    "ArapDeformer": "deform",
+    "grow_handles": "deform",
+    "rotation_error": "deform",
     # parametric surfaces
     "get_surface": "surfaces",
     "mesh_surface": "surfaces",

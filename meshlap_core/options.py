@@ -159,6 +159,34 @@ FILTER_KINDS: tuple[str, ...] = get_args(FilterKind)
 """Spectral transfer functions: an ideal low-pass, a band gain (exaggeration), and the transfer
 functions of the three smoothing methods."""
 
+DeformMethod = Literal["laplacian", "harmonic", "biharmonic", "triharmonic", "arap"]
+DEFORM_METHODS: tuple[str, ...] = get_args(DeformMethod)
+"""Shape deformation (:mod:`meshlap_core.deform`, ``meshlap deform --method``): Laplacian
+coordinates (Sorkine et al. 2004), the k-harmonic displacement ``Δᵏd = 0`` for k = 1, 2, 3, and
+as-rigid-as-possible (Sorkine & Alexa 2007)."""
+HARMONIC_ORDERS: dict[str, int] = {"harmonic": 1, "biharmonic": 2, "triharmonic": 3}
+"""The power k of each k-harmonic deformation method."""
+ArapEnergyKind = Literal["spokes", "spokes-and-rims"]
+ARAP_ENERGIES: tuple[str, ...] = get_args(ArapEnergyKind)
+DEFAULT_ARAP_ENERGY: ArapEnergyKind = "spokes"
+"""The edges each ARAP rotation fits: the one-ring's spokes (Sorkine & Alexa 2007) or the
+spokes and the rim edges of every incident face (Chao et al. 2010; libigl's default for
+triangle meshes in 3D)."""
+RotationFit = Literal["exact", "igl"]
+ROTATION_FITS: tuple[str, ...] = get_args(RotationFit)
+"""How ARAP's local step fits rotations: this project's double-precision 3×3 SVD
+(``"exact"``) or libigl's single-precision one (``"igl"``, what ``igl.arap_solve`` uses)."""
+ConstraintKind = Literal["soft", "hard"]
+CONSTRAINT_KINDS: tuple[str, ...] = get_args(ConstraintKind)
+DEFAULT_CONSTRAINTS: ConstraintKind = "soft"
+"""How Laplacian coordinates hold the handles and the fixed region: least-squares penalties
+(``"soft"``, Sorkine et al. 2004) or exactly (``"hard"``)."""
+HandleDistance = Literal["exact", "graph"]
+HANDLE_DISTANCES: tuple[str, ...] = get_args(HandleDistance)
+DEFAULT_HANDLE_DISTANCE: HandleDistance = "exact"
+"""The distance that grows a handle vertex into a disc: exact polyhedral geodesic distance
+(MMP on the disc's neighbourhood) or shortest paths along edges (instant, up to ~15 % long)."""
+
 
 def check_choice(value: str, choices: tuple[str, ...], what: str, where: str | None = None) -> str:
     """Return ``value`` if it is one of ``choices``, else raise the one standard error.

@@ -1,0 +1,56 @@
+"""How far each vertex's neighbourhood is from having moved rigidly: the rotation error.
+
+For vertex ``i`` with rest spokes ``e_ij = p_i − p_j`` and deformed spokes ``e'_ij``,
+
+    err_i = sqrt( min_{R ∈ SO(3)} Σ_j |w_ij| ‖e'_ij − R e_ij‖²  /  Σ_j |w_ij| ‖e_ij‖² ),
+
+the relative RMS deviation of the one-ring from its best-fitting rotation (the local step of
+ARAP with the absolute cotangent weights, so every term counts and the error is never
+negative): 0 where the ring was rotated and translated, about 0.1 where its edges changed by
+10 %. It compares every method alike: Laplacian coordinates under a rotation of the handles
+show large errors where details kept their orientation; ARAP drives them down.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ..types import FloatArray, IntArray
+from .arap_energy import ArapEnergy
+from .rotations import fit_rotations_stacked
+
+
+def rotation_error(
+    V: FloatArray, F: IntArray, U: FloatArray, *, terms: ArapEnergy | None = None
+) -> tuple[FloatArray, Any]:
+    """Each vertex's relative deviation from a rotation of its one-ring (module docstring).
+
+    Parameters
+    ----------
+    V : (n,3) float
+        Rest positions (checked by the caller).
+    F : (m,3) int
+    U : (n,3) float
+        Deformed positions.
+    terms : ArapEnergy, optional
+        The spokes energy of ``V`` with absolute weights, from an earlier call (built when
+        ``None``).
+
+    Returns
+    -------
+    err : (n,) float
+        0 for vertices in no face.
+    terms : ArapEnergy
+        Pass it back on the next call with the same ``V, F``.
+    """
+    if terms is None:
+        terms = ArapEnergy(V, F, "spokes", absolute=True)
+    R = fit_rotations_stacked(terms.covariances(U))
+    residual = terms.vertex_energy(U, R)
+    scale = terms.rest_terms()
+    ok = scale > 0
+    err = np.zeros(len(V))
+    err[ok] = np.sqrt(np.maximum(residual[ok], 0.0) / scale[ok])
+    return err, terms
