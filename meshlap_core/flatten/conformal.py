@@ -17,8 +17,11 @@ sums; its null space holds the translations (and, on a developable surface, ever
 **LSCM** (Lévy, Petitjean, Ray & Maillot, "Least squares conformal maps", SIGGRAPH 2002; the
 same minimizer as Desbrun, Meyer & Alliez 2002) minimizes ``E_C`` with two vertices pinned,
 which removes the similarities: here the two outer-boundary vertices farthest apart (a double
-sweep), at ``(0, 0)`` and ``(d, 0)``, ``d`` their distance in space. Any two pins give the same
-map up to a similarity. ``L_C`` is factorized once with the four pinned unknowns decoupled.
+sweep), at ``(0, 0)`` and ``(d, 0)``, ``d`` their distance in space. The same two vertices
+pinned anywhere else give the same map up to a similarity (``E_C`` does not see
+similarities); two other vertices give another map: the pins pull on the layout, the bias
+the spectral map removes. ``L_C`` is factorized once with the four pinned unknowns
+decoupled.
 """
 
 from __future__ import annotations

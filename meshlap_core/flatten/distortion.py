@@ -9,9 +9,11 @@ From each face's Jacobian ``J`` (:mod:`.jacobian`) and its singular values ``σ�
   ``s = √(Σ_f A_f / Σ_f |a_f|)`` (``A_f`` the face's area on the surface, ``a_f`` in the
   plane), so that the total areas agree and only the *relative* change is counted; every
   ``σ`` reported is that of the normalized map;
-* **flipped** faces: signed area in the plane below ``−τ`` (the map reverses their orientation;
-  ``τ = 16 ε D²``, ``D`` the layout's bounding-box diagonal: round-off); **collapsed** faces:
-  ``|a_f| ≤ τ`` (flattened to a segment; their ``σ₂ = 0``, so they are left out of the means);
+* **flipped** faces: signed area in the plane below ``−τ_f`` (the map reverses their
+  orientation; ``τ_f = 8ε(|d₁||d₂| + |u|(|d₁| + |d₂|))`` the round-off of the face's signed area
+  from its edge vectors ``d₁, d₂`` in the plane and the coordinates' size ``|u|``);
+  **collapsed** faces: ``|a_f| ≤ τ_f`` (flattened to a segment, or too small to tell their
+  orientation; their ``σ₂`` is at round-off, so they are left out of the means);
 * for a click, :meth:`Distortion.ellipse`: the ellipse a small circle on the face maps to
   (semi-axes ``σ₁``, ``σ₂`` along the left singular vectors; the surface directions mapped to
   them are the right singular vectors, in 3-D).
@@ -176,6 +178,15 @@ def _face_index(face: Any, m: int) -> int:
     return f
 
 
+def _roundoff(uv: FloatArray, d1: FloatArray, d2: FloatArray) -> FloatArray:
+    """The round-off of each face's signed area ``½ d₁ × d₂`` ``(m,)``: the cross product's
+    own (``ε|d₁||d₂|``) and that of the differences ``d = u_j − u₀`` of coordinates of size
+    ``|u|`` (``ε|u|`` per component), with a safety factor 8."""
+    l1, l2 = np.linalg.norm(d1, axis=1), np.linalg.norm(d2, axis=1)
+    size = float(np.abs(uv).max(initial=0.0))
+    return 8.0 * np.finfo(float).eps * (l1 * l2 + size * (l1 + l2))
+
+
 def check_uv(uv: Any, n: int, name: str = "uv") -> FloatArray:
     """``uv`` as a finite ``(n,2)`` float64 array (a copy), else :class:`MeshError`."""
     raw = real_array(uv, name, "texture coordinates")
@@ -213,8 +224,7 @@ def measure_distortion(V: Any, F: Any, uv: Any, frames: FaceFrames | None = None
     Jraw = jacobians(fr, F, uv)
     d1, d2 = uv[F[:, 1]] - uv[F[:, 0]], uv[F[:, 2]] - uv[F[:, 0]]
     signed = 0.5 * (d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0])
-    diag = float(np.linalg.norm(np.ptp(uv, axis=0))) if len(uv) else 0.0
-    tol = 16.0 * np.finfo(float).eps * diag**2
+    tol = _roundoff(uv, d1, d2)
     flipped = signed < -tol
     collapsed = np.abs(signed) <= tol
     layout = float(np.abs(signed).sum())
