@@ -457,6 +457,54 @@ def test_closed_meshes_are_cut_to_a_disk(make, how):
     assert {tuple(e) for e in disk.cut_edges} <= pairs
 
 
+def test_a_tetrahedron_is_slit_along_two_edges():
+    """Every pair of its vertices is an edge, and a lone cut edge doubles no vertex: the slit
+    goes one edge further (found by the hostile corpus: an IndexError before)."""
+    V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.0]])
+    F = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+    disk = make_disk(V, F)
+    assert disk.how == "slit" and len(disk.cut_edges) == 2 and len(disk.outer) == 4
+    assert flatten(V, F, "tutte").summary()["flipped"] == 0
+
+
+def test_non_manifold_vertices_are_split_into_their_fans():
+    """Two triangles meeting at a vertex are two pieces once it is split: refused, naming F;
+    a vertex where a closed fan meets an open one is split and the mesh flattens."""
+    bowtie_V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [-1, 0, 0], [0, -1, 0.0]])
+    bowtie_F = np.array([[0, 1, 2], [0, 3, 4]])
+    with pytest.raises(MeshError, match="non-manifold vertices split the mesh into 2 pieces"):
+        make_disk(bowtie_V, bowtie_F)
+    # a closed tetrahedron touching a flat grid at one vertex: one piece until split
+    V, F = grid(4, 4)
+    apex = len(V)
+    tet_V = np.array([[0.5, -0.5, 0], [0, -0.5, 0.5], [0.3, -0.9, 0.2]])
+    V2 = np.vstack([V, tet_V])
+    tet_F = np.array(
+        [
+            [0, apex, apex + 1],
+            [0, apex + 1, apex + 2],
+            [0, apex + 2, apex],
+            [apex, apex + 2, apex + 1],
+        ]
+    )
+    with pytest.raises(MeshError, match="pieces"):
+        make_disk(V2, np.vstack([F, tet_F]))
+
+
+def test_needle_faces_make_a_clear_error_and_tutte_still_works(tmp_path):
+    """Cotangent weights of needle faces break LSCM's system (found by the hostile corpus: a
+    LinAlgError before); the uniform weights of Tutte's map do not mind them."""
+    import hostile
+
+    case = next(h for h in hostile.LOADABLE if h.name == "needles.obj")
+    mesh = load_mesh(case.build(tmp_path))
+    flat = Flattener(mesh.V, mesh.F)
+    with pytest.raises(MeshError, match="not numerically positive definite") as info:
+        flat.map("lscm")
+    assert info.value.source == "F"
+    assert flat.map("tutte").summary()["flipped"] == 0
+
+
 def test_a_seam_is_cut_and_a_splitting_seam_is_refused():
     V, F = grid(6, 6)  # vertex 6i + j at (i, j)/5; the diagonals join k and k + 7
     disk = make_disk(V, F, seam=[0, 7, 14])  # from a corner into the interior

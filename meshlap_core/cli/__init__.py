@@ -152,6 +152,7 @@ COMMANDS: tuple[str, ...] = (
     "geodesic",
     "heat",
     "filter",
+    "flatten",
     "curvature_study",
 )
 COMMAND_GROUP = "meshlap.commands"

@@ -117,8 +117,10 @@ def slit(V: FloatArray, table: EdgeTable) -> BoolArray:
     """The shortest edge path between two far-apart vertices, ``(e,)`` bool.
 
     A double sweep: ``a`` the vertex farthest (along edges) from the first vertex of a face,
-    ``b`` the one farthest from ``a``, and the shortest path from ``a`` to ``b``. Cutting a
-    closed genus-0 mesh along it gives a disk whose boundary runs along the path twice.
+    ``b`` the one farthest from ``a``, and the shortest path from ``a`` to ``b`` (one more
+    edge from ``b`` when that path is a single edge, as on a tetrahedron: cutting a lone edge
+    doubles no vertex). Cutting a closed genus-0 mesh along it gives a disk whose boundary
+    runs along the path twice.
     """
     G = _graph(V, table)
     start = int(table.F[0, 0])
@@ -129,6 +131,9 @@ def slit(V: FloatArray, table: EdgeTable) -> BoolArray:
     path = [b]
     while path[-1] != a:
         path.append(int(pred[path[-1]]))
+    if len(path) == 2:  # one edge opens nothing (both ends are tips): go one edge further
+        ring = table.edges[(table.edges == b).any(axis=1)].ravel()
+        path.insert(0, int(ring[(ring != a) & (ring != b)][0]))
     cut = np.zeros(table.n_edges, dtype=bool)
     cut[edge_ids(table, path_pairs([path]))] = True
     return cut

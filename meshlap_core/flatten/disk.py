@@ -201,17 +201,29 @@ def make_disk(V: Any, F: Any, seam: Any = None) -> Disk:
         how.append("seam")
         messages.append(f"seam: cut along {count_phrase(int(cut.sum()), 'edge')}")
         cuts.append(table.edges[cut])
-    if cut.any() or np.count_nonzero(np.bincount(F.ravel(), minlength=len(V))) < len(V):
-        F1, source = split_along(table, cut)  # (also drops vertices in no face)
-        table1 = EdgeTable.from_faces(F1, len(source))
-    else:  # nothing to cut, every vertex in a face: the disk's numbering is the input's
-        table1, source = table, np.arange(len(V), dtype=np.int64)
+    # one split: the seam's edges cut, every non-manifold vertex split into its fans (a
+    # pinch point opens), vertices in no face dropped; the numbering is the input's when
+    # none of these happens
+    F1, source = split_along(table, cut)
+    table1 = EdgeTable.from_faces(F1, len(source))
+    used = int(np.count_nonzero(np.bincount(F.ravel(), minlength=len(V))))
+    if seam is None and len(source) > used:
+        messages.append(
+            f"{count_phrase(len(source) - used, 'extra vertex copy', 'extra vertex copies')}: "
+            "vertices where several fans of faces meet were split into one vertex per fan"
+        )
     pieces, _ = table1.vertex_components
     if pieces > 1:
-        raise MeshError(f"the seam cuts the mesh into {pieces} pieces; a seam must not", "seam")
+        what = "the seam cuts" if seam is not None else "its non-manifold vertices split"
+        raise MeshError(
+            f"{what} the mesh into {pieces} pieces; flatten one piece at a time",
+            "seam" if seam is not None else "F",
+        )
     table2, source, more = _open(V, table1, source, how, messages)
     cuts.append(more)
     loops = boundary_loops(table2.F, table2)
+    if not loops or _genus(table2, len(loops)) != 0:  # (cut_to_disk's promise, checked)
+        raise MeshError("could not open the mesh into a disk (is it a manifold?)", "F")
     Vd = V[source]
     lengths = [_loop_length(Vd, loop) for loop in loops]
     order = np.argsort(lengths, kind="stable")[::-1]

@@ -24,12 +24,14 @@ rows are the natural (Neumann) ones.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
 
 from ..diffusion.geodesic import SIMPLICIAL_MAX_N
+from ..errors import MeshError
 from ..laplacian import cotangents_intrinsic, squared_edge_lengths
 from ..linalg.factor import SharedAnalysis, pinned_data
 from ..linalg.spd import solver_backend
@@ -88,6 +90,22 @@ def cotan_laplacian(V: FloatArray, F: IntArray, cot: FloatArray | None = None) -
     return K
 
 
+NOT_DEFINITE = (
+    "the map's linear system is not numerically positive definite: needle or cap faces (a "
+    "corner angle near 0 or 180 degrees) make cotangent weights blow up; remesh the surface, "
+    "or use tutte (uniform weights)"
+)
+
+
+def definite(factorize: Callable[[], Any]) -> Any:
+    """``factorize()``, its ``LinAlgError`` (a matrix that is not numerically positive
+    definite) turned into the :class:`MeshError` :data:`NOT_DEFINITE` naming ``F``."""
+    try:
+        return factorize()
+    except np.linalg.LinAlgError:
+        raise MeshError(NOT_DEFINITE, "F") from None
+
+
 def factor_mode(n: int) -> str:
     """CHOLMOD's factorization for ``n`` unknowns: simplicial below
     :data:`~meshlap_core.diffusion.geodesic.SIMPLICIAL_MAX_N`, supernodal above."""
@@ -112,7 +130,9 @@ class DirichletSolver:
         self.pinned = np.asarray(pinned, dtype=np.int64)
         self.diagonal = K.diagonal()
         shared = SharedAnalysis(K.indptr, K.indices, solver_backend(), factor_mode(K.shape[0]))
-        self._factor = shared.factor(pinned_data(K.indptr, K.indices, K.data, self.pinned))
+        self._factor = definite(
+            lambda: shared.factor(pinned_data(K.indptr, K.indices, K.data, self.pinned))
+        )
 
     def lift(self, values: Any) -> FloatArray:
         """The right-hand side ``(n,c)`` of the pinned ``values`` ``(p,c)``: ``−K u_pinned``

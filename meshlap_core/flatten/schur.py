@@ -37,7 +37,7 @@ from ..linalg.common import ProgressCallback, report_progress
 from ..linalg.factor import SharedAnalysis
 from ..linalg.spd import solver_backend
 from ..types import FloatArray, IntArray
-from .fixed_boundary import factor_mode, sorted_csr
+from .fixed_boundary import definite, factor_mode, sorted_csr
 
 BLOCK = 64
 """Right-hand sides per solve while ``S`` is built from solves."""
@@ -163,7 +163,7 @@ def _by_solves(
         return S, lambda r: np.zeros((0, r.shape[1]))
     K_II = sorted_csr(K[interior][:, interior])
     shared = SharedAnalysis(K_II.indptr, K_II.indices, solver_backend(), factor_mode(n_i))
-    factor = shared.factor(K_II.data)
+    factor = definite(lambda: shared.factor(K_II.data))
     cols = sp.csc_matrix(K_IB)
     for c0 in range(0, b, BLOCK):
         check_cancel(cancel, "spectral conformal map")
