@@ -82,6 +82,11 @@ _PUBLIC: dict[str, str | tuple[str, str]] = {
     "heat_kernel_signature": "diffusion",
     "isolines": "diffusion",
     "save_polylines": "diffusion",
+    # maps to the plane (meshlap_core.flatten; its one-shot is meshlap_core.flatten.flatten)
+    "Flattener": "flatten",
+    "UVMap": "flatten",
+    "make_disk": "flatten",
+    "measure_distortion": "flatten",
     # parametric surfaces
     "get_surface": "surfaces",
     "mesh_surface": "surfaces",

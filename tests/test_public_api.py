@@ -58,3 +58,15 @@ def test_diffusion_names_are_the_diffusion_modules():
     d = meshlap_core.HeatGeodesic(V, F).distance([0])
     far = int(np.argmin(V @ V[0]))
     assert abs(d[far] - np.pi) < 0.05 * np.pi
+
+
+def test_flatten_names_are_the_flatten_package():
+    """The maps to the plane from the top level: the same objects as ``meshlap_core.flatten``
+    (whose one-shot ``flatten`` stays there: the top-level name is the package); Tutte's map
+    of a flat grid has no flipped face."""
+    from meshlap_core import flatten
+
+    for name in ("Flattener", "UVMap", "make_disk", "measure_distortion"):
+        assert getattr(meshlap_core, name) is getattr(flatten, name)
+    V, F = meshlap_core.grid(5, 5)
+    assert meshlap_core.Flattener(V, F).map("tutte").summary()["flipped"] == 0

@@ -307,8 +307,9 @@ class Flattener:
         t0 = time.perf_counter()
         report_progress(progress, 0.0, f"{method} map")
         out: dict[str, Any] = {}
-        if method in ("tutte", "harmonic"):
-            uv = self._fixed("uniform" if method == "tutte" else "cotan", boundary)
+        weights = {"tutte": "uniform", "harmonic": "cotan"}.get(method)  # the fixed-boundary maps
+        if weights is not None:
+            uv = self._fixed(weights, boundary)
         elif method == "lscm":
             uv, out["pins"] = self.lscm()
         elif method == "scp":
