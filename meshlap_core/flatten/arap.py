@@ -32,11 +32,11 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import MeshError, check_cancel
-from ..laplacian import cotangents_intrinsic, squared_edge_lengths
+from ..laplacian import cotangents_intrinsic
 from ..linalg.common import ProgressCallback, report_progress
 from ..types import FloatArray, IntArray, as_mesh, exact_indices
 from .distortion import check_uv
-from .fixed_boundary import DirichletSolver, cotan_laplacian
+from .fixed_boundary import DirichletSolver, cotan_laplacian, squared_lengths
 from .jacobian import FaceFrames, face_frames
 
 
@@ -111,7 +111,7 @@ class ARAP:
                 raise MeshError(f"must be vertex indices in [0, {n}), at least one", "pinned")
         self.frames = face_frames(V, F) if frames is None else frames
         if cot is None:  # corner i: the angle opposite the edge (i+1, i+2)
-            cot = cotangents_intrinsic(squared_edge_lengths(V, F))
+            cot = cotangents_intrinsic(squared_lengths(V, F))
         K = cotan_laplacian(V, F, cot) if K is None else K
         self.uv = np.array(init, dtype=np.float64)
         self.pinned = np.array([F[0, 0]] if pinned is None else pinned, dtype=np.int64)

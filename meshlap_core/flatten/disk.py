@@ -202,15 +202,19 @@ def make_disk(V: Any, F: Any, seam: Any = None) -> Disk:
         messages.append(f"seam: cut along {count_phrase(int(cut.sum()), 'edge')}")
         cuts.append(table.edges[cut])
     # one split: the seam's edges cut, every non-manifold vertex split into its fans (a
-    # pinch point opens), vertices in no face dropped; the numbering is the input's when
-    # none of these happens
-    F1, source = split_along(table, cut)
-    table1 = EdgeTable.from_faces(F1, len(source))
-    used = int(np.count_nonzero(np.bincount(F.ravel(), minlength=len(V))))
-    if seam is None and len(source) > used:
+    # pinch point opens), vertices in no face dropped; when none of these is needed the
+    # disk keeps the input's numbering (and its edge table)
+    fans = table.wedge_counts()
+    if cut.any() or np.any(fans != 1):
+        F1, source = split_along(table, cut)
+        table1 = EdgeTable.from_faces(F1, len(source))
+    else:
+        table1, source = table, np.arange(len(V), dtype=np.int64)
+    extra = int(np.sum(fans[fans > 1] - 1))
+    if extra:
         messages.append(
-            f"{count_phrase(len(source) - used, 'extra vertex copy', 'extra vertex copies')}: "
-            "vertices where several fans of faces meet were split into one vertex per fan"
+            f"{count_phrase(int(np.count_nonzero(fans > 1)), 'vertex', 'vertices')} where "
+            f"several fans of faces meet: split into one vertex per fan ({extra} more)"
         )
     pieces, _ = table1.vertex_components
     if pieces > 1:

@@ -32,7 +32,7 @@ import scipy.sparse as sp
 
 from ..diffusion.geodesic import SIMPLICIAL_MAX_N
 from ..errors import MeshError
-from ..laplacian import cotangents_intrinsic, squared_edge_lengths
+from ..laplacian import cotangents_intrinsic
 from ..linalg.factor import SharedAnalysis, pinned_data
 from ..linalg.spd import solver_backend
 from ..topology import EdgeTable
@@ -48,23 +48,64 @@ def sorted_csr(K: sp.spmatrix) -> sp.csr_matrix:
     return K
 
 
-def graph_laplacian(table: EdgeTable) -> sp.csr_matrix:
-    """``K = D − A`` of the mesh's edge graph (Tutte's weights), ``(n,n)`` CSR, sorted."""
+def edge_matrix(table: EdgeTable, w: FloatArray) -> sp.csr_matrix:
+    """The symmetric ``K`` with ``K_ij = −w_e`` on every edge ``e = (i, j)`` of ``table`` and
+    ``K_ii = Σ_j w_ij`` (so ``K·1 = 0``), ``(n,n)`` CSR with sorted indices, each entry once,
+    the whole diagonal stored.
+
+    Built straight into CSR: row ``r`` holds its lower-triangle entries (the edges ``(i, r)``,
+    ``i < r``, ordered by one ``lexsort`` of the edges), then ``K_rr``, then its upper-triangle
+    entries (the table's edges ``(r, j)``, already sorted): no COO conversion, no sort of the
+    ``2e + n`` entries (a third faster than ``coo → csr`` at 43k vertices).
+    """
     n = table.n
     i, j = table.edges[:, 0], table.edges[:, 1]
-    deg = np.bincount(np.concatenate([i, j]), minlength=n).astype(np.float64)
-    ones = np.ones(len(i))
-    rows = np.concatenate([i, j, np.arange(n)])
-    cols = np.concatenate([j, i, np.arange(n)])
-    return sorted_csr(sp.coo_matrix((np.concatenate([-ones, -ones, deg]), (rows, cols)), (n, n)))
+    diag = np.bincount(i, w, minlength=n) + np.bincount(j, w, minlength=n)
+    up = np.bincount(i, minlength=n)
+    low = np.bincount(j, minlength=n)
+    indptr = np.zeros(n + 1, dtype=np.int64)
+    np.cumsum(up + low + 1, out=indptr[1:])
+    indices = np.empty(indptr[-1], dtype=np.int64)
+    data = np.empty(indptr[-1])
+    order = np.lexsort((i, j))  # the edges by their larger end: the lower triangle's rows
+    rank = np.arange(len(i)) - np.repeat(np.cumsum(low) - low, low)
+    at = indptr[:-1][j[order]] + rank
+    indices[at], data[at] = i[order], -w[order]
+    at_diag = indptr[:-1] + low
+    indices[at_diag], data[at_diag] = np.arange(n), diag
+    rank = np.arange(len(i)) - np.repeat(np.cumsum(up) - up, up)
+    at = at_diag[i] + 1 + rank
+    indices[at], data[at] = j, -w
+    return sp.csr_matrix((data, indices, indptr), shape=(n, n))
 
 
-def cotan_laplacian(V: FloatArray, F: IntArray, cot: FloatArray | None = None) -> sp.csr_matrix:
+def graph_laplacian(table: EdgeTable) -> sp.csr_matrix:
+    """``K = D − A`` of the mesh's edge graph (Tutte's weights), ``(n,n)`` CSR, sorted."""
+    return edge_matrix(table, np.ones(table.n_edges))
+
+
+def squared_lengths(V: FloatArray, F: IntArray) -> FloatArray:
+    """Squared edge lengths ``(m,3)``, column ``k`` opposite corner ``k``: libigl's and
+    :func:`~meshlap_core.laplacian.squared_edge_lengths`' values, for arrays already checked
+    (no copy, three gathers: 40 % faster at 86k faces)."""
+    p0, p1, p2 = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
+    out = np.empty((len(F), 3))
+    for k, e in enumerate((p1 - p2, p2 - p0, p0 - p1)):
+        out[:, k] = np.einsum("ij,ij->i", e, e)
+    return out
+
+
+def cotan_laplacian(
+    V: FloatArray,
+    F: IntArray,
+    cot: FloatArray | None = None,
+    table: EdgeTable | None = None,
+) -> sp.csr_matrix:
     """``K = −C`` (cotangent weights, positive semidefinite), ``(n,n)`` CSR, sorted.
 
     ``K_ij = −½ (cot α_ij + cot β_ij)`` on an edge, ``K_ii = −Σ_j K_ij``: libigl's
-    ``−cotmatrix`` to round-off, assembled here from the corner cotangents in one COO → CSR
-    pass (faster than ``igl.cotmatrix`` plus the conversions, and with the diagonal stored).
+    ``−cotmatrix`` to round-off, from the corner cotangents summed per edge
+    (:func:`edge_matrix`).
 
     Parameters
     ----------
@@ -73,21 +114,16 @@ def cotan_laplacian(V: FloatArray, F: IntArray, cot: FloatArray | None = None) -
     cot : (m,3) float, optional
         The cotangent of every corner angle
         (:func:`~meshlap_core.laplacian.cotangents_intrinsic`), when the caller has them.
+    table : EdgeTable, optional
+        The mesh's edge table, when the caller has it.
     """
-    n = len(V)
     if cot is None:
-        cot = cotangents_intrinsic(squared_edge_lengths(V, F))
-    i = np.concatenate([F[:, 1], F[:, 2], F[:, 0]])  # the edge opposite corner k: (k+1, k+2)
-    j = np.concatenate([F[:, 2], F[:, 0], F[:, 1]])
-    w = 0.5 * np.concatenate([cot[:, 0], cot[:, 1], cot[:, 2]])
-    diag = np.bincount(i, w, minlength=n) + np.bincount(j, w, minlength=n)
-    ar = np.arange(n)
-    rows = np.concatenate([i, j, ar])
-    cols = np.concatenate([j, i, ar])
-    K = sp.coo_matrix((np.concatenate([-w, -w, diag]), (rows, cols)), shape=(n, n)).tocsr()
-    K.sum_duplicates()
-    K.sort_indices()
-    return K
+        cot = cotangents_intrinsic(squared_lengths(V, F))
+    if table is None:
+        table = EdgeTable.from_faces(F, len(V))
+    # half-edge 3f + k runs from corner k to k + 1: the angle opposite it is at corner k + 2
+    w = 0.5 * np.bincount(table.halfedge_edge, cot[:, [2, 0, 1]].ravel(), minlength=table.n_edges)
+    return edge_matrix(table, w)
 
 
 NOT_DEFINITE = (

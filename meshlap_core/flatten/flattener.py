@@ -24,7 +24,7 @@ import numpy as np
 from ..errors import MeshError
 from ..io import save_mesh
 from ..io.atomic import PathLike
-from ..laplacian import cotangents_intrinsic, squared_edge_lengths
+from ..laplacian import cotangents_intrinsic
 from ..linalg.common import ProgressCallback, report_progress
 from ..options import (
     DEFAULT_ARAP_ITERS,
@@ -40,7 +40,7 @@ from .boundary import boundary_positions
 from .conformal import LSCMSolver, far_pair, image_area
 from .disk import Disk, make_disk
 from .distortion import Distortion, measure_distortion
-from .fixed_boundary import DirichletSolver, cotan_laplacian, graph_laplacian
+from .fixed_boundary import DirichletSolver, cotan_laplacian, graph_laplacian, squared_lengths
 from .jacobian import FaceFrames, face_frames
 from .spectral_conformal import spectral_conformal
 
@@ -231,14 +231,14 @@ class Flattener:
     def cotangents(self) -> FloatArray:
         """The cotangent of every corner angle ``(m,3)`` (made once)."""
         V, F = self.disk.V, self.disk.F
-        return self._once("cot", lambda: cotangents_intrinsic(squared_edge_lengths(V, F)))
+        return self._once("cot", lambda: cotangents_intrinsic(squared_lengths(V, F)))
 
     def stiffness(self, weights: str) -> Any:
         """``K`` with ``"uniform"`` (Tutte) or ``"cotan"`` weights (made once)."""
         if weights == "uniform":
             return self._once("K uniform", lambda: graph_laplacian(self._table))
         V, F = self.disk.V, self.disk.F
-        return self._once("K cotan", lambda: cotan_laplacian(V, F, self.cotangents))
+        return self._once("K cotan", lambda: cotan_laplacian(V, F, self.cotangents, self._table))
 
     def _fixed(self, weights: str, shape: str, scale: float = 1.0) -> FloatArray:
         solver = self._once(
