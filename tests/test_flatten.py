@@ -505,6 +505,19 @@ def test_needle_faces_make_a_clear_error_and_tutte_still_works(tmp_path):
     assert flat.map("tutte").summary()["flipped"] == 0
 
 
+def test_without_the_automatic_cut_a_non_disk_is_refused():
+    """``cut=False``: a torus or a sphere is refused (naming F); a seam that opens the sphere
+    makes it a disk all the same, and holes are no obstacle."""
+    for V, F in (torus_mesh(12, 6), icosphere(1)):
+        with pytest.raises(MeshError, match=r"not a disk .* cutting is off") as info:
+            flatten(V, F, cut=False)
+        assert info.value.source == "F"
+    V, F = icosphere(1)
+    path = [int(F[0, 0]), int(F[0, 1]), int(F[0, 2])]  # two edges of one face
+    assert make_disk(V, F, seam=path, cut=False).how == "seam"
+    assert len(make_disk(*annulus(), cut=False).holes) == 1
+
+
 def test_a_seam_is_cut_and_a_splitting_seam_is_refused():
     V, F = grid(6, 6)  # vertex 6i + j at (i, j)/5; the diagonals join k and k + 7
     disk = make_disk(V, F, seam=[0, 7, 14])  # from a corner into the interior
@@ -564,7 +577,11 @@ def test_cancel_stops_the_long_maps():
     stop = threading.Event()
     stop.set()
     with pytest.raises(Cancelled):
+        Flattener(V, F, cancel=stop)
+    with pytest.raises(Cancelled):
         flat.map("scp", cancel=stop)
+    with pytest.raises(Cancelled):
+        flat.arap(cancel=stop)
     solver = flat.arap()
     calls = []
 

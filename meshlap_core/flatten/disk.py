@@ -142,12 +142,23 @@ def _genus(table: EdgeTable, n_loops: int) -> int:
 
 
 def _open(
-    V: FloatArray, table: EdgeTable, source: IntArray, how: list[str], messages: list[str]
+    V: FloatArray,
+    table: EdgeTable,
+    source: IntArray,
+    how: list[str],
+    messages: list[str],
+    cut_allowed: bool,
 ) -> tuple[EdgeTable, IntArray, IntArray]:
     """Cut the mesh of ``table`` (vertices ``V[source]``) into a disk if it is not one yet;
     returns ``(table, source, cut edges in input indices)``."""
     loops = boundary_loops(table.F, table)
     genus = _genus(table, len(loops))
+    if not cut_allowed and (genus > 0 or not loops):
+        raise MeshError(
+            f"the mesh is not a disk (genus {genus}, {count_phrase(len(loops), 'boundary loop')}) "
+            "and cutting is off: allow the automatic cut or give a seam that opens it",
+            "F",
+        )
     if genus > 0:
         cut = genus_cut(table)
         how.append("genus-cut")
@@ -168,7 +179,7 @@ def _open(
     return EdgeTable.from_faces(F2, len(src2)), source[src2], source[table.edges[cut]]
 
 
-def make_disk(V: Any, F: Any, seam: Any = None) -> Disk:
+def make_disk(V: Any, F: Any, seam: Any = None, *, cut: bool = True) -> Disk:
     """Open a connected triangle mesh into a topological disk (see the module's rules).
 
     Parameters
@@ -178,6 +189,9 @@ def make_disk(V: Any, F: Any, seam: Any = None) -> Disk:
     seam : (k,) int, optional
         A path of vertex indices along edges to cut first (a closed path repeats its first
         vertex).
+    cut : bool
+        Cut handles and slit spheres automatically (default); ``False`` refuses a mesh that
+        is not a disk (with holes) once the seam is cut.
 
     Returns
     -------
@@ -195,18 +209,18 @@ def make_disk(V: Any, F: Any, seam: Any = None) -> Disk:
     how: list[str] = []
     messages: list[str] = []
     cuts = [np.zeros((0, 2), dtype=np.int64)]
-    cut = np.zeros(table.n_edges, dtype=bool)
+    seam_cut = np.zeros(table.n_edges, dtype=bool)
     if seam is not None:
-        cut = seam_edges(seam, table)
+        seam_cut = seam_edges(seam, table)
         how.append("seam")
-        messages.append(f"seam: cut along {count_phrase(int(cut.sum()), 'edge')}")
-        cuts.append(table.edges[cut])
+        messages.append(f"seam: cut along {count_phrase(int(seam_cut.sum()), 'edge')}")
+        cuts.append(table.edges[seam_cut])
     # one split: the seam's edges cut, every non-manifold vertex split into its fans (a
     # pinch point opens), vertices in no face dropped; when none of these is needed the
     # disk keeps the input's numbering (and its edge table)
     fans = table.wedge_counts()
-    if cut.any() or np.any(fans != 1):
-        F1, source = split_along(table, cut)
+    if seam_cut.any() or np.any(fans != 1):
+        F1, source = split_along(table, seam_cut)
         table1 = EdgeTable.from_faces(F1, len(source))
     else:
         table1, source = table, np.arange(len(V), dtype=np.int64)
@@ -223,7 +237,7 @@ def make_disk(V: Any, F: Any, seam: Any = None) -> Disk:
             f"{what} the mesh into {pieces} pieces; flatten one piece at a time",
             "seam" if seam is not None else "F",
         )
-    table2, source, more = _open(V, table1, source, how, messages)
+    table2, source, more = _open(V, table1, source, how, messages, bool(cut))
     cuts.append(more)
     loops = boundary_loops(table2.F, table2)
     if not loops or _genus(table2, len(loops)) != 0:  # (cut_to_disk's promise, checked)

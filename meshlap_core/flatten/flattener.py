@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import MeshError
+from ..errors import MeshError, check_cancel
 from ..io import save_mesh
 from ..io.atomic import PathLike
 from ..laplacian import cotangents_intrinsic
@@ -163,8 +163,13 @@ class Flattener:
     F : (m,3) int
     seam : (k,) int, optional
         A path of vertex indices to cut first (:func:`~meshlap_core.flatten.disk.make_disk`).
+    cut : bool
+        Cut handles and slit spheres automatically (default); ``False``: a mesh that is not
+        a disk is refused.
     progress : callable, optional
         ``progress(fraction, message)`` while the disk is made.
+    cancel : threading.Event or callable, optional
+        Checked before and after the disk is made (:class:`~meshlap_core.errors.Cancelled`).
 
     Attributes
     ----------
@@ -187,11 +192,20 @@ class Flattener:
     """
 
     def __init__(
-        self, V: Any, F: Any, seam: Any = None, *, progress: ProgressCallback | None = None
+        self,
+        V: Any,
+        F: Any,
+        seam: Any = None,
+        *,
+        cut: bool = True,
+        progress: ProgressCallback | None = None,
+        cancel: Any = None,
     ) -> None:
         t0 = time.perf_counter()
+        check_cancel(cancel, "flattening")
         report_progress(progress, 0.0, "cutting to a disk")
-        self.disk = make_disk(V, F, seam)
+        self.disk = make_disk(V, F, seam, cut=cut)
+        check_cancel(cancel, "flattening")
         self.V_input = np.array(V, dtype=np.float64)
         table = self.disk.table
         if table is None:  # (a Disk made by hand)
@@ -260,11 +274,12 @@ class Flattener:
         )
         return solver.solve(), solver.pins
 
-    def arap(self, boundary: str = "free") -> ARAP:
+    def arap(self, boundary: str = "free", *, cancel: Any = None) -> ARAP:
         """A new ARAP iteration object: from LSCM's map scaled to the surface's area (free
         boundary), or from Tutte's with the outer loop pinned on a circle or square of the
-        surface's area."""
+        surface's area (``cancel`` checked between the start map and ARAP's factorization)."""
         check_options("arap", boundary, 0)
+        check_cancel(cancel, "ARAP")
         if boundary == "free":
             uv, _ = self.lscm()
             uv = uv * np.sqrt(self.area / max(image_area(uv, self.halfedges), np.finfo(float).tiny))
@@ -273,6 +288,7 @@ class Flattener:
             shape_area = np.pi if boundary == "circle" else 4.0
             uv = self._fixed("uniform", boundary, np.sqrt(self.area / shape_area))
             pinned = self.disk.outer
+        check_cancel(cancel, "ARAP")
         return ARAP(
             self.disk.V,
             self.disk.F,
@@ -322,7 +338,7 @@ class Flattener:
                 cancel=cancel,
             )
         else:
-            solver = self.arap(boundary)
+            solver = self.arap(boundary, cancel=cancel)
             solver.run(n_iter, progress=progress, cancel=cancel)
             uv, out["iterations"], out["energies"] = solver.uv, n_iter, solver.energies
         seconds = time.perf_counter() - t0
@@ -354,6 +370,7 @@ def flatten(
     *,
     iters: int | None = None,
     seam: Any = None,
+    cut: bool = True,
     progress: ProgressCallback | None = None,
     cancel: Any = None,
 ) -> UVMap:
@@ -367,6 +384,6 @@ def flatten(
     True
     """
     check_options(method, boundary, iters)  # before the disk is made
-    return Flattener(V, F, seam).map(
+    return Flattener(V, F, seam, cut=cut).map(
         method, boundary, iters=iters, progress=progress, cancel=cancel
     )
