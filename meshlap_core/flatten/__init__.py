@@ -7,7 +7,13 @@ everywhere: ``C`` the cotangent stiffness (negative semidefinite), ``K = −C``.
 Build once, map many: ``Flattener(V, F)`` opens the mesh into a disk and keeps its operators;
 ``.map(method, boundary)`` gives a :class:`UVMap` (``.uv``, ``.distortion()``, ``.summary()``);
 ``.arap()`` an :class:`ARAP` object stepped one iteration at a time. :func:`flatten` is the
-one-shot version.
+one-shot version. Long calls take ``progress(fraction, message)`` and ``cancel`` (an event
+or a callable) like the rest of the core, and raise
+:class:`~meshlap_core.errors.Cancelled` between steps.
+
+Orientation: the outer loop runs with the interior on its left, so every map keeps the
+faces' orientation (positive signed areas in the plane); a face with a negative one is
+*flipped*.
 
 Modules
 -------
@@ -25,6 +31,9 @@ Modules
 ``spectral_conformal``
     The spectral conformal map (Mullen et al. 2008): a generalized eigenproblem on the
     boundary, solved by :func:`~meshlap_core.linalg.eigsolve.pencil_eigenpairs`.
+``schur``
+    The boundary's Schur complement of ``K`` (its Dirichlet-to-Neumann map) and the harmonic
+    extension inside.
 ``arap``
     ARAP's local/global iterations (Liu et al. 2008).
 ``jacobian``
