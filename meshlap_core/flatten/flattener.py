@@ -171,6 +171,12 @@ class Flattener:
     cancel : threading.Event or callable, optional
         Checked before and after the disk is made (:class:`~meshlap_core.errors.Cancelled`).
 
+    Notes
+    -----
+    Its caches are filled on first use, so one thread (one job) at a time may call it; the
+    :class:`UVMap` and :class:`~meshlap_core.flatten.arap.ARAP` objects it returns are
+    independent of it once made.
+
     Attributes
     ----------
     disk : Disk
