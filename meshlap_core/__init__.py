@@ -90,6 +90,11 @@ _PUBLIC: dict[str, str | tuple[str, str]] = {
     "ArapDeformer": "deform",
     "grow_handles": "deform",
     "rotation_error": "deform",
+    # maps to the plane (meshlap_core.flatten; its one-shot is meshlap_core.flatten.flatten)
+    "Flattener": "flatten",
+    "UVMap": "flatten",
+    "make_disk": "flatten",
+    "measure_distortion": "flatten",
     # parametric surfaces
     "get_surface": "surfaces",
     "mesh_surface": "surfaces",

@@ -188,6 +188,31 @@ DEFAULT_HANDLE_DISTANCE: HandleDistance = "exact"
 (MMP on the disc's neighbourhood) or shortest paths along edges (instant, up to ~15 % long)."""
 
 
+FlattenMethod = Literal["tutte", "harmonic", "lscm", "scp", "arap"]
+FLATTEN_METHODS: tuple[str, ...] = get_args(FlattenMethod)
+"""Maps of a disk to the plane (:mod:`meshlap_core.flatten`): Tutte's (uniform weights) and the
+harmonic one (cotangent weights) with a fixed boundary, the least-squares conformal map (two
+pinned vertices), the spectral conformal map (Mullen et al. 2008) and ARAP (Liu et al. 2008)."""
+FlattenBoundary = Literal["circle", "square", "free"]
+FLATTEN_BOUNDARIES: tuple[str, ...] = get_args(FlattenBoundary)
+"""Where a map puts the outer boundary: on the unit circle or the unit square (by arc length),
+or nowhere in particular (``"free"``: the map's natural boundary)."""
+FLATTEN_METHOD_BOUNDARIES: dict[str, tuple[str, ...]] = {
+    "tutte": ("circle", "square"),
+    "harmonic": ("circle", "square"),
+    "lscm": ("free",),
+    "scp": ("free",),
+    "arap": ("free", "circle", "square"),
+}
+"""The boundaries each map accepts, its default first: a fixed-boundary map has no natural
+boundary (a harmonic map with a free boundary is constant), the conformal maps have only theirs."""
+DEFAULT_ARAP_ITERS = 50
+"""ARAP local/global iterations of ``meshlap flatten --method arap`` when ``--iters`` is not
+given."""
+MAX_FLATTEN_ITERS = 100_000
+"""Most ARAP iterations one call runs (``--iters``; about 1.5 hours at 43k vertices)."""
+
+
 def check_choice(value: str, choices: tuple[str, ...], what: str, where: str | None = None) -> str:
     """Return ``value`` if it is one of ``choices``, else raise the one standard error.
 

@@ -97,3 +97,15 @@ def test_the_module_paths_renamed_since_0_1_0_are_gone(old):
 
     with pytest.raises(ModuleNotFoundError):
         importlib.import_module(old)
+
+
+def test_flatten_names_are_the_flatten_package():
+    """The maps to the plane from the top level: the same objects as ``meshlap_core.flatten``
+    (whose one-shot ``flatten`` stays there: the top-level name is the package); Tutte's map
+    of a flat grid has no flipped face."""
+    from meshlap_core import flatten
+
+    for name in ("Flattener", "UVMap", "make_disk", "measure_distortion"):
+        assert getattr(meshlap_core, name) is getattr(flatten, name)
+    V, F = meshlap_core.grid(5, 5)
+    assert meshlap_core.Flattener(V, F).map("tutte").summary()["flipped"] == 0

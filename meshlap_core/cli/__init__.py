@@ -153,6 +153,7 @@ COMMANDS: tuple[str, ...] = (
     "heat",
     "filter",
     "deform",
+    "flatten",
     "curvature_study",
 )
 COMMAND_GROUP = "meshlap.commands"

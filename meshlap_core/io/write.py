@@ -11,7 +11,7 @@ from typing import IO, Any
 import numpy as np
 
 from ..errors import MeshError
-from ..types import FloatArray, IntArray, as_mesh
+from ..types import FloatArray, IntArray, as_faces, as_mesh, real_array
 from .atomic import PathLike, atomic_write
 
 WRITE_FORMATS: tuple[str, ...] = (".obj", ".off", ".ply")
@@ -24,6 +24,8 @@ def save_mesh(
     F: Any,
     *,
     scalars: Any = None,
+    uv: Any = None,
+    uv_faces: Any = None,
     overwrite_inputs: Iterable[PathLike] = (),
     binary: bool = True,
 ) -> None:
@@ -38,6 +40,12 @@ def save_mesh(
     scalars : (n,) float, optional
         Per-vertex values, stored as the PLY vertex property ``quality`` (``double``); only
         ``.ply`` can carry them.
+    uv : (t,2) float, optional
+        Texture coordinates, written as OBJ ``vt`` lines (17 significant digits); only
+        ``.obj`` can carry them.
+    uv_faces : (m,3) int, optional
+        The ``vt`` index of every face corner (0-based; written ``f v/vt``): a seam gives one
+        vertex several texture coordinates. Default ``F`` (one ``vt`` per vertex, ``t = n``).
     overwrite_inputs : iterable of path
         Paths that must not be overwritten (the CLI passes its input file).
     binary : bool
@@ -46,8 +54,10 @@ def save_mesh(
     Raises
     ------
     MeshError
-        Unknown extension, scalars of the wrong length or on a non-PLY file, a missing output
-        directory (named), or writing onto an input.
+        Unknown extension, scalars of the wrong length or on a non-PLY file, texture
+        coordinates on a non-OBJ file or not finite ``(t,2)``, ``uv_faces`` of the wrong shape
+        or out of range (each named), a missing output directory (named), or writing onto an
+        input.
 
     Notes
     -----
@@ -70,6 +80,11 @@ def save_mesh(
         q = np.asarray(scalars, dtype=np.float64).ravel()
         if len(q) != len(V):
             raise MeshError(f"has {len(q):,} values for {len(V):,} vertices", "scalars")
+    texture = None
+    if uv is not None or uv_faces is not None:
+        if ext != ".obj":
+            raise MeshError("only .obj files can carry texture coordinates", os.fspath(path))
+        texture = _texture(uv, uv_faces, F)
     if ext == ".ply":
         with atomic_write(path, "wb", overwrite_inputs=overwrite_inputs) as f:
             _write_ply(f, V, F, q, binary)
@@ -78,11 +93,44 @@ def save_mesh(
         if ext == ".obj":
             f.write(f"# written by meshlap: {len(V)} vertices, {len(F)} faces\n".encode())
             np.savetxt(f, V, fmt="v %.17g %.17g %.17g")
-            np.savetxt(f, F + 1, fmt="f %d %d %d")
+            if texture is None:
+                np.savetxt(f, F + 1, fmt="f %d %d %d")
+            else:
+                np.savetxt(f, texture[0], fmt="vt %.17g %.17g")
+                corners = np.stack([F + 1, texture[1] + 1], axis=2).reshape(-1, 6)
+                np.savetxt(f, corners, fmt="f %d/%d %d/%d %d/%d")
         else:
             f.write(f"OFF\n{len(V)} {len(F)} 0\n".encode())
             np.savetxt(f, V, fmt="%.17g %.17g %.17g")
             np.savetxt(f, F, fmt="3 %d %d %d")
+
+
+def _texture(uv: Any, uv_faces: Any, F: IntArray) -> tuple[FloatArray, IntArray]:
+    """The checked ``(uv (t,2), uv_faces (m,3))`` of :func:`save_mesh`."""
+    if uv is None:
+        raise MeshError("uv_faces without uv: give the texture coordinates too", "uv")
+    raw = real_array(uv, "uv", "texture coordinates")
+    coords = np.array(raw, dtype=np.float64)
+    if coords.ndim != 2 or coords.shape[1] != 2:
+        raise MeshError(f"should have shape (t,2); shape is {coords.shape}", "uv")
+    if not np.isfinite(coords).all():
+        bad = int(np.flatnonzero(~np.isfinite(coords).all(axis=1))[0])
+        raise MeshError(f"texture coordinate {bad} is NaN or infinite", "uv")
+    if uv_faces is None:
+        used = int(F.max(initial=-1)) + 1
+        if len(coords) < used:
+            raise MeshError(
+                f"has {len(coords)} coordinates but the faces use {used} vertices (give "
+                "uv_faces for a map with seams)",
+                "uv",
+            )
+        return coords, F
+    FT = as_faces(uv_faces, len(coords), "uv_faces")
+    if FT.shape != F.shape:
+        raise MeshError(
+            f"should have shape {F.shape} (one per face corner); shape is {FT.shape}", "uv_faces"
+        )
+    return coords, FT
 
 
 def _write_ply(
