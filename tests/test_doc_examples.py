@@ -1,7 +1,7 @@
 """The examples the documentation shows run: the package docstring (a doctest), the
 *Examples* section of every public name's docstring (the API reference shows them; a public
-name without one fails here) and README's "From Python" block (executed in a temporary folder
-holding the bundled mesh)."""
+name without one fails here) and the "From Python" page's block (``docs/python.md``, executed
+in a temporary folder holding the bundled mesh)."""
 
 from __future__ import annotations
 
@@ -33,27 +33,30 @@ def test_options_doctests_run():
     assert result.attempted >= 2 and result.failed == 0
 
 
-def _readme_python_block() -> str:
-    text = (ROOT / "README.md").read_text(encoding="utf-8")
-    section = text.split("## From Python", 1)[1]
+PYTHON_PAGE = ROOT / "docs" / "python.md"
+
+
+def _python_page_block() -> str:
+    text = PYTHON_PAGE.read_text(encoding="utf-8")
+    section = text.split("# From Python", 1)[1]
     match = re.search(r"```python\n(.*?)```", section, re.S)
-    assert match, "README's 'From Python' section has no python block"
+    assert match, "docs/python.md ('From Python') has no python block"
     return match.group(1)
 
 
-def test_readme_python_example_runs(tmp_path, monkeypatch, capsys):
+def test_python_page_example_runs(tmp_path, monkeypatch, capsys):
     (tmp_path / "assets").mkdir()
     shutil.copy(ROOT / "assets" / "bumpy.obj", tmp_path / "assets" / "bumpy.obj")
     monkeypatch.chdir(tmp_path)
     monkeypatch.setenv("MESHLAP_CACHE_DIR", str(tmp_path / "cache"))  # the basis cache
-    code = _readme_python_block()
-    exec(compile(code, "README.md", "exec"), {"__name__": "readme"})
+    code = _python_page_block()
+    exec(compile(code, "docs/python.md", "exec"), {"__name__": "python_page"})
     printed = capsys.readouterr().out.strip()
     assert math.isfinite(float(printed))  # the inspector's H at vertex 100 of the bumpy sphere
 
 
-def test_readme_lists_exactly_the_public_names():
-    text = (ROOT / "README.md").read_text(encoding="utf-8")
+def test_python_page_lists_exactly_the_public_names():
+    text = PYTHON_PAGE.read_text(encoding="utf-8")
     para = text.split("The names: ", 1)[1].split(". `examples/`", 1)[0]
     listed = set(re.findall(r"`(\w+)`", para))
     public = set(meshlap_core.__all__) - {"__version__"}
