@@ -37,6 +37,15 @@ def mesh_info(
     info : dict
         JSON-ready values; ``genus`` is ``None`` (with ``genus_note``) when the mesh is not a
         manifold surface.
+
+    Examples
+    --------
+    >>> from meshlap_core import icosphere, mesh_info
+    >>> info = mesh_info(*icosphere(2))
+    >>> info["n_vertices"], info["n_faces"], info["n_edges"]
+    (162, 320, 480)
+    >>> info["euler_characteristic"], info["genus"], info["closed"]  # V − E + F = 2 − 2g
+    (2, 0, True)
     """
     V, F = as_mesh(V, F)
     n, m = len(V), len(F)

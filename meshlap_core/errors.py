@@ -59,6 +59,17 @@ class MeshError(ValueError):
     source : str or os.PathLike, optional
         The file or argument the problem is in; prefixed to the message with its non-printable
         characters escaped (:func:`printable`); :attr:`source` keeps it as given.
+
+    Examples
+    --------
+    >>> from meshlap_core import MeshError, validate_mesh
+    >>> try:
+    ...     validate_mesh([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 5]])
+    ... except MeshError as error:
+    ...     print(error)
+    F: face 0 has index 5 but the mesh has 3 vertices (valid indices 0..2)
+    >>> issubclass(MeshError, ValueError)
+    True
     """
 
     def __init__(self, problem: str, source: str | os.PathLike | None = None) -> None:
@@ -75,7 +86,23 @@ class MeshError(ValueError):
 
 
 class MeshWarning(UserWarning):
-    """Something was repaired or is numerically doubtful; the result is still usable."""
+    """Something was repaired or is numerically doubtful; the result is still usable.
+
+    Examples
+    --------
+    An explicit step above the stability limit still runs, with a warning:
+
+    >>> import warnings
+    >>> from meshlap_core import MeshWarning, Smoother, icosphere
+    >>> V, F = icosphere(2)
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     smoother = Smoother(V, F, "explicit", "uniform", lam=1.5)
+    >>> [w.category is MeshWarning for w in caught]
+    [True]
+    >>> "largest stable lam 1.346" in str(caught[0].message)
+    True
+    """
 
 
 class Cancelled(Exception):

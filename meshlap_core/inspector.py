@@ -228,6 +228,21 @@ def inspect_vertex(
     VertexInspection
         Neighbours in ring order (counter-clockwise seen from the side the normals point to;
         each fan of a non-manifold vertex in turn), incident faces, and the vertex quantities.
+
+    Examples
+    --------
+    On the unit sphere the cotangent mean curvature at a vertex is 1; its cotangent weights
+    and uniform weights are listed per neighbour:
+
+    >>> from meshlap_core import icosphere, inspect_vertex
+    >>> V, F = icosphere(2)
+    >>> ins = inspect_vertex(V, F, 0)
+    >>> len(ins.neighbors), round(ins.H_cotan, 6)
+    (5, 1.0)
+    >>> ins.neighbors[0].weight_uniform  # 1/|N| at a valence-5 vertex
+    0.2
+    >>> round(ins.angle_deficit / ins.area, 6) == round(ins.K, 6)  # K = (2π − Σθ) / A_i
+    True
     """
     check_choice(area, AREA_KINDS, "area")
     check_choice(boundary, BOUNDARY_RULES, "boundary")

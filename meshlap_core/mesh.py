@@ -70,6 +70,19 @@ class MeshReport:
         The non-manifold edges (vertex pairs, ``i < j``).
     nonmanifold_vertices : (k,) int
         The non-manifold vertices.
+
+    Examples
+    --------
+    A triangle given twice and a vertex no face uses:
+
+    >>> from meshlap_core import validate_mesh
+    >>> mesh = validate_mesh([[0, 0, 0], [1, 0, 0], [0, 1, 0], [5, 5, 5]], [[0, 1, 2], [2, 0, 1]])
+    >>> for repair in mesh.report.repairs:
+    ...     print(repair)
+    removed 1 duplicate face (same three vertices as an earlier face, in any order)
+    removed 1 unreferenced vertex
+    >>> mesh.report.n_input_vertices, mesh.report.n_boundary_edges, mesh.V.shape
+    (4, 3, (3, 3))
     """
 
     repairs: list[str] = field(default_factory=list)
@@ -141,6 +154,15 @@ class Mesh:
         of the half-edges, with the vertex components), shared by the callers that need edges
         (``meshlap info``, the boundary of a smoother) instead of rebuilt; ``None`` when the
         mesh was made by hand. Do not modify ``F`` in place while it is set.
+
+    Examples
+    --------
+    >>> from meshlap_core import Mesh, icosphere, validate_mesh
+    >>> mesh = validate_mesh(*icosphere(1))
+    >>> isinstance(mesh, Mesh), mesh.V.shape, mesh.F.shape, mesh.F.dtype
+    (True, (42, 3), (80, 3), dtype('int64'))
+    >>> mesh.vertex_map[:3].tolist(), mesh.report.repairs  # nothing to repair
+    ([0, 1, 2], [])
     """
 
     V: FloatArray

@@ -63,6 +63,12 @@ def rmse(V: FloatArray, V_ref: FloatArray) -> float:
     -------
     float
         0 for identical positions; in the mesh's length unit.
+
+    Examples
+    --------
+    >>> from meshlap_core import rmse
+    >>> rmse([[0, 0, 0], [1, 1, 1]], [[3, 4, 0], [4, 5, 1]])  # both points moved by 5
+    5.0
     """
     e = vertex_errors(V, V_ref)
     return float(np.sqrt(np.mean(e**2))) if e.size else 0.0

@@ -17,6 +17,16 @@ from .types import FloatArray, IntArray
 def icosphere(subdivisions: int = 2, radius: float = 1.0) -> tuple[FloatArray, IntArray]:
     """Icosphere: the icosahedron, midpoint-subdivided ``subdivisions`` times, projected on the
     sphere of the given radius. ``10·4^s + 2`` vertices, ``20·4^s`` faces.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from meshlap_core import icosphere
+    >>> V, F = icosphere(2, radius=2.0)
+    >>> V.shape, F.shape  # 10·4² + 2 vertices, 20·4² faces
+    ((162, 3), (320, 3))
+    >>> bool(np.allclose(np.linalg.norm(V, axis=1), 2.0))
+    True
     """
     if subdivisions < 0:
         raise MeshError("must be >= 0", "subdivisions")
@@ -43,7 +53,17 @@ def _grid_faces(nu: int, nv: int, wrap_u: bool, wrap_v: bool) -> IntArray:
 
 
 def grid(nx: int = 10, ny: int = 10, size: float = 1.0) -> tuple[FloatArray, IntArray]:
-    """Flat ``nx × ny`` vertex grid in the plane ``z = 0`` over ``[0,size]²``, normals ``+z``."""
+    """Flat ``nx × ny`` vertex grid in the plane ``z = 0`` over ``[0,size]²``, normals ``+z``.
+
+    Examples
+    --------
+    >>> from meshlap_core import boundary_loops, grid
+    >>> V, F = grid(3, 3)
+    >>> V.shape, F.shape, V.max(axis=0).tolist()
+    ((9, 3), (8, 3), [1.0, 1.0, 0.0])
+    >>> boundary_loops(F)[0].tolist()  # the eight outer vertices, the interior on the left
+    [0, 3, 6, 7, 8, 5, 2, 1]
+    """
     if nx < 2 or ny < 2:
         raise MeshError("a grid needs at least 2 x 2 vertices", "grid")
     x, y = np.meshgrid(np.linspace(0, size, nx), np.linspace(0, size, ny), indexing="ij")
@@ -61,6 +81,14 @@ def torus_mesh(
     The *parametric* torus (exact geometry at any ``(u, v)``) is
     :func:`meshlap_core.surfaces.torus`; ``mesh_surface(surfaces.torus(R, r), (n_major, n_minor))``
     gives this same mesh.
+
+    Examples
+    --------
+    >>> from meshlap_core import EdgeTable, torus_mesh
+    >>> V, F = torus_mesh(32, 16)
+    >>> n_edges = len(EdgeTable.from_faces(F).edges)
+    >>> len(V), len(F), len(V) - n_edges + len(F)  # Euler characteristic 0: genus 1
+    (512, 1024, 0)
     """
     if n_major < 3 or n_minor < 3:
         raise MeshError("a torus needs at least 3 x 3 samples", "torus")
@@ -81,6 +109,22 @@ def cube(subdivisions: int = 0, size: float = 1.0) -> tuple[FloatArray, IntArray
 
     Subdivision keeps the vertices on the faces, so the corner angle sums and the volume
     (``size³``) are unchanged.
+
+    Examples
+    --------
+    Midpoint subdivision keeps the cube's shape: only its 8 corners carry an angle deficit
+    (π/2 each, 4π in all):
+
+    >>> import numpy as np
+    >>> from meshlap_core import cube, curvature_field, vertex_areas
+    >>> V, F = cube(1)
+    >>> V.shape, F.shape
+    ((26, 3), (48, 3))
+    >>> A = vertex_areas(V, F, "barycentric")
+    >>> deficit = curvature_field(V, F, "gaussian", area="barycentric") * A  # K·A = 2π − Σθ
+    >>> curved = np.abs(deficit) > 1e-9
+    >>> int(curved.sum()), bool(np.allclose(deficit[curved], np.pi / 2))
+    (8, True)
     """
     V = (
         np.array(

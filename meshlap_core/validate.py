@@ -527,6 +527,20 @@ def validate_mesh(
     -----
     Order: triangulate, drop degenerate faces, drop duplicate faces, drop unreferenced vertices
     (including those referenced only by dropped faces), then :func:`topology_report`.
+
+    Examples
+    --------
+    A quad is fan-triangulated; an index past the last vertex is refused, naming the face:
+
+    >>> from meshlap_core import MeshError, validate_mesh
+    >>> square = [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]
+    >>> validate_mesh(square, [[0, 1, 2, 3]]).F.tolist()
+    [[0, 1, 2], [0, 2, 3]]
+    >>> try:
+    ...     validate_mesh(square, [[0, 1, 4]], source="square.obj")
+    ... except MeshError as error:
+    ...     print(error)
+    square.obj: face 0 has index 4 but the mesh has 4 vertices (valid indices 0..3)
     """
     src = None if source is None else os.fspath(source)
     vlabel = src or "V"

@@ -1,4 +1,5 @@
-"""Project promises: README's commands, CI in sync, a headless core, ruff clean."""
+"""Project promises: README's commands (and the install page's), CI in sync, a headless core,
+ruff clean."""
 
 import shutil
 import subprocess
@@ -26,8 +27,17 @@ def test_readme_starts_with_the_two_commands_and_ci_runs_the_second():
     assert test_cmd in ci
 
 
-def test_ci_runs_the_fast_solver_step_of_the_readme():
-    text = (ROOT / "README.md").read_text()
+def test_install_page_repeats_the_readme_commands():
+    text = (ROOT / "docs" / "install.md").read_text()
+    block = text.split("```", 2)[1]
+    commands = [ln for ln in block.splitlines()[1:] if ln.strip() and not ln.startswith("#")]
+    assert commands == readme_commands()[:2]
+
+
+def test_ci_runs_the_fast_solver_step_of_the_install_page():
+    readme = (ROOT / "README.md").read_text()
+    assert "**Fast solver (optional).**" in readme and "docs/install.md#fast-solver" in readme
+    text = (ROOT / "docs" / "install.md").read_text()
     block = text.split("**Fast solver (optional).**", 1)[1].split("```", 2)[1]
     steps = [ln for ln in block.splitlines()[1:] if ln.strip()]
     assert any("apt-get install" in ln for ln in steps) and any("[fast]" in ln for ln in steps)

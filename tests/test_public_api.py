@@ -92,7 +92,8 @@ def test_the_curvature_names_live_on_the_curvature_shelf():
     ],
 )
 def test_the_module_paths_renamed_since_0_1_0_are_gone(old):
-    """README's 'Renamed since 0.1.0' lists them, with their new shelves: no alias module."""
+    """docs/commands.md's 'Renamed since 0.1.0' lists them, with their new shelves: no alias
+    module."""
     import importlib
 
     with pytest.raises(ModuleNotFoundError):

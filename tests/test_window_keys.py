@@ -1,9 +1,9 @@
-"""Every documented key in the real window (issue 23): the keys of the README's **Keys:** item
-and of the Help window's table (:func:`meshlap_app.panels.help.shortcut_rows`, the rows the
-Help pane draws), each pressed with xdotool in ``meshlap view`` under Xvfb at 1280×720, in the
-view its row names (a view's number from another view; F and R after the camera was turned
-with a drag); each must change the picture. ``tests/test_issue23.py`` checks the same keys
-through the widgets (which state each one changes).
+"""Every documented key in the real window (issue 23): the keys of the **Keys:** item of
+docs/window.md and of the Help window's table (:func:`meshlap_app.panels.help.shortcut_rows`,
+the rows the Help pane draws), each pressed with xdotool in ``meshlap view`` under Xvfb at
+1280×720, in the view its row names (a view's number from another view; F and R after the
+camera was turned with a drag); each must change the picture. ``tests/test_issue23.py`` checks
+the same keys through the widgets (which state each one changes).
 
 Set ``MESHLAP_WINDOW_SHOTS=<folder>`` to keep the screenshots (one after each key).
 """
@@ -15,7 +15,7 @@ from types import SimpleNamespace
 
 import pytest
 from imgui_screen import changed_fraction, parse
-from test_issue23 import readme_keys
+from test_issue23 import window_page_keys
 from test_window import WAIT, Session, keep_shots, scene_box, spectral
 from xwindow import missing_tools
 
@@ -44,9 +44,9 @@ def documented_keys() -> list[tuple[str, str]]:
     return out
 
 
-def test_the_help_rows_hold_every_readme_key():
+def test_the_help_rows_hold_every_key_of_the_window_page():
     keys = {k for k, _ in documented_keys()}
-    assert set(readme_keys()) <= keys, set(readme_keys()) - keys
+    assert set(window_page_keys()) <= keys, set(window_page_keys()) - keys
     assert {"1", "5", "f", "r", "h", "space", "right", "left"} <= keys
 
 

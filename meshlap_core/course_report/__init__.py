@@ -2,8 +2,9 @@
 the course reproduced and checked.
 
 Not :mod:`meshlap_core.curvature.study`, which measures the curvature estimators against exact
-surfaces. This package was ``meshlap_core.study`` in 0.1.0 (README, "Renamed since 0.1.0"); the
-older module name ``meshlap_core.report`` is gone, and this name says which report it is.
+surfaces. This package was ``meshlap_core.study`` in 0.1.0 (docs/commands.md, "Renamed since
+0.1.0"); the older module name ``meshlap_core.report`` is gone, and this name says which
+report it is.
 
 :func:`build_report` runs seven sections on the course meshes (``../shared/meshes`` beside the
 checkout, or ``--meshes DIR``; the bundled ``assets/`` stand in for missing ones and the report

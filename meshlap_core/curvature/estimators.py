@@ -447,6 +447,16 @@ def estimate_curvature(
     ------
     MeshError
         An unknown estimator or option, or a mesh the estimator cannot use.
+
+    Examples
+    --------
+    On a sphere of radius 2 every estimator finds ``k1 ≈ k2 ≈ ½``:
+
+    >>> from meshlap_core import estimate_curvature, icosphere
+    >>> V, F = icosphere(2)
+    >>> pc = estimate_curvature(2 * V, F, "rusinkiewicz")
+    >>> pc.estimator, round(float(pc.k1.mean()), 2), round(float(pc.k2.mean()), 2)
+    ('rusinkiewicz', 0.5, 0.5)
     """
     check_choice(estimator, CURVATURE_ESTIMATORS, "estimator")
     try:

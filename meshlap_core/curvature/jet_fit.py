@@ -190,6 +190,16 @@ def jet_curvatures(V: FloatArray, F: IntArray, radius: float | None = None) -> P
     ------
     MeshError
         A radius that is not a positive finite number.
+
+    Examples
+    --------
+    On a sphere of radius ½ both principal curvatures are 2:
+
+    >>> from meshlap_core import icosphere, jet_curvatures
+    >>> V, F = icosphere(3)
+    >>> pc = jet_curvatures(0.5 * V, F)
+    >>> round(float(pc.k1.mean()), 1), round(float(pc.k2.mean()), 1), pc.estimator
+    (2.1, 2.1, 'jet')
     """
     V, F = as_mesh(V, F)
     r = default_jet_radius(V, F) if radius is None else float(radius)

@@ -100,6 +100,17 @@ def transfer(
     Returns
     -------
     h : (k,) float
+
+    Examples
+    --------
+    Two explicit steps of ``s = ¼`` scale mode ``λ`` by ``(1 − sλ)²``:
+
+    >>> import numpy as np
+    >>> from meshlap_core import transfer_function
+    >>> transfer_function("explicit", np.array([0.0, 1.0, 2.0]), step=0.25, iters=2).tolist()
+    [1.0, 0.5625, 0.25]
+    >>> transfer_function("low-pass", np.array([0.0, 2.0, 2.0, 6.0]), keep=2).tolist()
+    [1.0, 1.0, 0.0, 0.0]
     """
     check_choice(kind, FILTER_KINDS, "filter")
     lam = np.asarray(eigenvalues, dtype=np.float64)
@@ -133,6 +144,22 @@ class SpectralFilter:
     few gains at a time, so :meth:`apply` updates the previous result with the changed modes
     only, ``X̃ += U_J diag(Δh_J) C_J``, when fewer than a quarter of the gains changed (and
     recomputes in full every :data:`RESYNC` incremental updates, so round-off cannot build up).
+
+    Examples
+    --------
+    A gain of 1 on every mode gives the reconstruction from all the basis's modes; a low-pass
+    keeps the first ones:
+
+    >>> import numpy as np
+    >>> from meshlap_core import SpectralBasis, SpectralFilter, icosphere, transfer_function
+    >>> V, F = icosphere(2)
+    >>> basis = SpectralBasis.compute(V, F, 30, cache=False)
+    >>> filt = SpectralFilter(basis)
+    >>> bool(np.allclose(filt.apply(np.ones(30)), basis.reconstruct(30)))
+    True
+    >>> h = transfer_function("low-pass", basis.eigenvalues, keep=4)
+    >>> bool(np.allclose(filt.apply(h), basis.reconstruct(4)))
+    True
     """
 
     RESYNC = 64

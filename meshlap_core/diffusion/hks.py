@@ -46,6 +46,23 @@ def heat_kernel_signature(
     Returns
     -------
     H : (n,s) float
+
+    Examples
+    --------
+    Integrated over the surface, ``HKS(·, t)`` is the heat trace ``Σ_i e^{−λ_i t}`` (the
+    eigenvectors are ``M``-orthonormal):
+
+    >>> import numpy as np
+    >>> from meshlap_core import SpectralBasis, heat_kernel_signature, icosphere
+    >>> V, F = icosphere(2)
+    >>> basis = SpectralBasis.compute(V, F, 40, cache=False)
+    >>> times = np.array([0.1, 1.0])
+    >>> hks = heat_kernel_signature(basis, times)
+    >>> hks.shape
+    (162, 2)
+    >>> trace = np.exp(-np.outer(times, basis.eigenvalues)).sum(axis=1)
+    >>> bool(np.allclose(basis.mass @ hks, trace))
+    True
     """
     k = basis.k_max if k is None else int(k)
     t = np.atleast_1d(np.asarray(times, dtype=np.float64))

@@ -50,6 +50,17 @@ def isolines(
         Segments (indices into ``P``).
     level : (e,) int
         Which level each segment belongs to.
+
+    Examples
+    --------
+    The level ``x = ¼`` of the field ``x`` on the unit square is the segment ``x = ¼``:
+
+    >>> import numpy as np
+    >>> from meshlap_core import grid, isolines
+    >>> V, F = grid(5, 5)
+    >>> P, E, level = isolines(V, F, V[:, 0], np.array([0.25]))
+    >>> bool(np.allclose(P[:, 0], 0.25)), sorted(P[:, 1].round(2).tolist()), len(E)
+    (True, [0.0, 0.25, 0.5, 0.75, 1.0], 4)
     """
     V, F = as_mesh(V, F)
     s = np.asarray(values, dtype=np.float64)
@@ -67,7 +78,20 @@ def isolines(
 def save_polylines(
     path: str | os.PathLike, P: FloatArray, E: IntArray, *, overwrite_inputs: Iterable[Any] = ()
 ) -> None:
-    """Write curve segments as an OBJ of ``v`` and ``l`` lines (1-based), atomically."""
+    """Write curve segments as an OBJ of ``v`` and ``l`` lines (1-based), atomically.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from pathlib import Path
+    >>> import numpy as np
+    >>> from meshlap_core import save_polylines
+    >>> path = Path(tempfile.mkdtemp()) / "curves.obj"
+    >>> P = np.array([[0.0, 0, 0], [1, 0, 0], [1, 1, 0]])  # an L of two segments
+    >>> save_polylines(path, P, np.array([[0, 1], [1, 2]]))
+    >>> path.read_text().splitlines()[1:]
+    ['v 0 0 0', 'v 1 0 0', 'v 1 1 0', 'l 1 2', 'l 2 3']
+    """
     P = np.asarray(P, dtype=np.float64)
     E = np.asarray(E, dtype=np.int64)
     with atomic_write(path, "wb", overwrite_inputs=overwrite_inputs) as f:

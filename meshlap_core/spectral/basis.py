@@ -109,11 +109,20 @@ class SpectralBasis:
 
     Examples
     --------
-    >>> from meshlap_core.primitives import icosphere
-    >>> V, F = icosphere(2)
-    >>> basis = SpectralBasis.compute(V, F, 16, cache=False)
-    >>> basis.reconstruct(16).shape
-    (162, 3)
+    The unit sphere's Laplace–Beltrami frequencies are ``l(l+1)``: 0 once, 2 three times,
+    6 five times; the eigenvectors are ``M``-orthonormal:
+
+    >>> import numpy as np
+    >>> from meshlap_core import SpectralBasis, icosphere
+    >>> V, F = icosphere(3)
+    >>> basis = SpectralBasis.compute(V, F, 9, cache=False)
+    >>> basis.eigenvalues.round(1).tolist()
+    [0.0, 2.0, 2.0, 2.0, 6.0, 6.0, 6.0, 6.0, 6.0]
+    >>> U = basis.vectors
+    >>> bool(np.allclose(U.T @ (basis.mass[:, None] * U), np.eye(9)))
+    True
+    >>> basis.reconstruct(4).shape  # U₄ U₄ᵀ M X
+    (642, 3)
     """
 
     def __init__(

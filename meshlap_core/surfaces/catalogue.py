@@ -437,6 +437,16 @@ def get_surface(name: str | ParametricSurface, **params: float) -> ParametricSur
     ------
     MeshError
         For an unknown name (the message lists the known ones) or an unknown parameter.
+
+    Examples
+    --------
+    On the outer equator of a torus (``v = 0``) ``K = 1 / (r (R + r))``:
+
+    >>> from meshlap_core import get_surface, point_geometry
+    >>> torus = get_surface("torus", R=2, r=0.5)
+    >>> g = point_geometry(torus, 0.0, 0.0)
+    >>> round(g.K, 9), round(1 / (0.5 * 2.5), 9)
+    (0.8, 0.8)
     """
     if isinstance(name, ParametricSurface):
         if params:

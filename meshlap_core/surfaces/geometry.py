@@ -300,6 +300,7 @@ def point_geometry(
 
     Examples
     --------
+    >>> from meshlap_core import point_geometry
     >>> g = point_geometry("helicoid", 0.0, 0.0)
     >>> round(g.f, 12), round(g.K, 12), g.classification
     (1.0, -1.0, 'hyperbolic')

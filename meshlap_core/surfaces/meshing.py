@@ -154,6 +154,18 @@ def mesh_surface(surface: ParametricSurface | str, res: int | Sequence[int] = 32
     MeshError
         On a bad ``res`` (see :func:`check_mesh_res`: checked before anything is allocated,
         including the memory estimate against :data:`MAX_MESH_BYTES`).
+
+    Examples
+    --------
+    The parametric sphere meshed with 16 cells per direction: the poles collapse to one vertex
+    each and the seam is welded, so the mesh is a closed surface (χ = 2):
+
+    >>> from meshlap_core import EdgeTable, mesh_surface
+    >>> sm = mesh_surface("sphere", 16)
+    >>> sm.V.shape, sm.F.shape
+    ((242, 3), (480, 3))
+    >>> len(sm.V) - len(EdgeTable.from_faces(sm.F).edges) + len(sm.F)
+    2
     """
     surface = get_surface(surface)
     nu, nv = check_mesh_res(surface, res)

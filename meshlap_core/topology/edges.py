@@ -73,6 +73,15 @@ class EdgeTable:
     -----
     Built by :meth:`from_faces` with one sort of the ``3m`` keys ``min(a,b)·n + max(a,b)``
     (:func:`sort_with_order`), ``O(m log m)``.
+
+    Examples
+    --------
+    >>> from meshlap_core import EdgeTable, icosphere
+    >>> table = EdgeTable.from_faces(icosphere(0)[1])
+    >>> table.edges.shape, sorted(set(table.counts.tolist()))  # 30 edges, two faces on each
+    ((30, 2), [2])
+    >>> table.edges[:3].tolist()
+    [[0, 1], [0, 2], [0, 3]]
     """
 
     F: IntArray
@@ -407,6 +416,14 @@ def boundary_loops(F: IntArray, table: EdgeTable | None = None) -> list[IntArray
     Returns
     -------
     loops : list of (k,) int
+
+    Examples
+    --------
+    >>> from meshlap_core import boundary_loops, grid, icosphere
+    >>> [loop.tolist() for loop in boundary_loops(grid(3, 3)[1])]
+    [[0, 3, 6, 7, 8, 5, 2, 1]]
+    >>> boundary_loops(icosphere(1)[1])  # a closed surface has none
+    []
     """
     B = (EdgeTable.from_faces(F) if table is None else table).boundary_halfedges()
     if len(B) == 0:

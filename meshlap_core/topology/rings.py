@@ -81,6 +81,20 @@ class OneRing:
         Faces of fan ``s``: ``fan_faces[fan_face_ptr[s]:fan_face_ptr[s+1]]``.
     fan_closed : (f,) bool
     ccw : bool
+
+    Examples
+    --------
+    On a 3 × 3 grid the centre has a closed ring of six, a corner an open fan:
+
+    >>> from meshlap_core import grid, one_ring
+    >>> V, F = grid(3, 3)
+    >>> ring = one_ring(F, len(V))
+    >>> ring[4].tolist(), bool(ring.boundary[4])
+    ([7, 8, 5, 1, 0, 3], False)
+    >>> ring[0].tolist(), bool(ring.boundary[0]), len(ring.fans(0))
+    ([3, 4, 1], True, 1)
+    >>> ring.reversed()[4].tolist()  # clockwise
+    [3, 0, 1, 5, 8, 7]
     """
 
     offsets: IntArray
@@ -231,6 +245,19 @@ def one_ring(F: IntArray, n: int) -> OneRing:
     OneRing
         Counter-clockwise rings and fans (see :class:`OneRing`); ``.reversed()`` gives
         clockwise ones.
+
+    Examples
+    --------
+    The icosahedron's vertex 0 has five neighbours; consecutive ones make a face with it:
+
+    >>> from meshlap_core import icosphere, one_ring
+    >>> V, F = icosphere(0)
+    >>> ring = one_ring(F, len(V))
+    >>> ring[0].tolist()
+    [1, 2, 3, 4, 5]
+    >>> corners = {(f[s], f[(s + 1) % 3], f[(s + 2) % 3]) for f in F.tolist() for s in range(3)}
+    >>> all((0, a, b) in corners for a, b in [(1, 2), (2, 3), (3, 4), (4, 5), (5, 1)])
+    True
     """
     F = as_faces(F, n)
     m = len(F)
