@@ -79,6 +79,7 @@ class ArapDeformer(Deformer):
 
     Examples
     --------
+    >>> from meshlap_core import ArapDeformer
     >>> from meshlap_core.primitives import icosphere
     >>> V, F = icosphere(2)
     >>> arap = ArapDeformer(V, F, handles=[0, 50, 100])
@@ -86,6 +87,21 @@ class ArapDeformer(Deformer):
     >>> float(abs(arap.positions - V).max()) < 1e-12
     True
     >>> abs(arap.energies[-1]) < 1e-12 * arap.terms.rest  # 0 up to round-off of the terms
+    True
+
+    Two opposite sides of a flat grid moved by one translation: the iterations approach
+    the translated grid, and the energy never rises:
+
+    >>> import numpy as np
+    >>> from meshlap_core import ArapDeformer, grid
+    >>> V, F = grid(5, 5)
+    >>> sides = np.flatnonzero((V[:, 0] == 0) | (V[:, 0] == 1))
+    >>> arap = ArapDeformer(V, F, sides)
+    >>> arap.set_targets(V[sides] + [0.5, 0, 0])
+    >>> U = arap.run(20)
+    >>> bool(np.abs(U - (V + [0.5, 0, 0])).max() < 0.01)
+    True
+    >>> bool(np.all(np.diff(arap.energies) <= 1e-12))
     True
     """
 

@@ -88,12 +88,26 @@ class HarmonicDeformer(Deformer):
 
     Examples
     --------
+    >>> import numpy as np
+    >>> from meshlap_core import HarmonicDeformer
     >>> from meshlap_core.primitives import icosphere
     >>> V, F = icosphere(2)
     >>> bi = HarmonicDeformer(V, F, handles=[0], fixed=[100], k=2)
     >>> U = bi.update(V[[0]] + [0.0, 0.0, 0.2])
     >>> bool(np.array_equal(U[0], V[0] + [0.0, 0.0, 0.2])), bool(np.array_equal(U[100], V[100]))
     (True, True)
+
+    A flat 5×5 grid held at x = 0 and its x = 1 column lifted by 1: the harmonic (k = 1)
+    displacement is linear in x, so every vertex rises by its x:
+
+    >>> import numpy as np
+    >>> from meshlap_core import HarmonicDeformer, grid
+    >>> V, F = grid(5, 5)
+    >>> left, right = np.flatnonzero(V[:, 0] == 0), np.flatnonzero(V[:, 0] == 1)
+    >>> solver = HarmonicDeformer(V, F, right, left, k=1)  # factorized once
+    >>> U = solver.update(V[right] + [0, 0, 1])  # one back-substitution per drag
+    >>> bool(np.allclose(U[:, 2], V[:, 0]))
+    True
     """
 
     def __init__(

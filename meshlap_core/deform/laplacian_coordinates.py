@@ -73,6 +73,21 @@ class LaplacianCoordinates(Deformer):
         ``ω`` of the soft constraints (ignored when hard).
     progress, cancel :
         As :class:`~meshlap_core.deform.harmonic.HarmonicDeformer`.
+
+    Examples
+    --------
+    With hard constraints, keeping ``δ = Δx`` of the rest shape is the biharmonic
+    displacement (both minimize ``‖Δd‖²_M`` with the same handles):
+
+    >>> import numpy as np
+    >>> from meshlap_core import HarmonicDeformer, LaplacianCoordinates, grid
+    >>> V, F = grid(5, 5)
+    >>> left, right = np.flatnonzero(V[:, 0] == 0), np.flatnonzero(V[:, 0] == 1)
+    >>> targets = V[right] + [0, 0, 0.3]
+    >>> coords = LaplacianCoordinates(V, F, right, left, constraints="hard").update(targets)
+    >>> biharmonic = HarmonicDeformer(V, F, right, left, k=2).update(targets)
+    >>> bool(np.allclose(coords, biharmonic))
+    True
     """
 
     method = "laplacian"

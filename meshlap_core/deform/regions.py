@@ -175,6 +175,16 @@ def grow_handles(
     Returns
     -------
     HandleRegions
+
+    Examples
+    --------
+    The centre of a 5×5 grid of spacing ¼ grown by a radius of 0.3: its four edge
+    neighbours (at 0.25) join it, the diagonal ones (at 0.354) do not:
+
+    >>> from meshlap_core import grid, grow_handles
+    >>> V, F = grid(5, 5)
+    >>> grow_handles(V, F, [12], 0.3).vertices.tolist()
+    [7, 11, 12, 13, 17]
     """
     V, F = as_mesh(V, F)
     n = len(V)

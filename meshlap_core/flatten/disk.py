@@ -202,6 +202,19 @@ def make_disk(V: Any, F: Any, seam: Any = None, *, cut: bool = True) -> Disk:
     MeshError
         No faces, a zero-area face, non-manifold edges, inconsistent orientation, several
         connected components, a bad seam, or a seam that cuts the mesh in pieces.
+
+    Examples
+    --------
+    A flat grid is a disk already; a closed sphere is slit open, a torus cut along its
+    generators:
+
+    >>> from meshlap_core import grid, icosphere, make_disk, torus_mesh
+    >>> make_disk(*grid(5, 5)).how
+    'disk'
+    >>> make_disk(*icosphere(1)).how
+    'slit'
+    >>> make_disk(*torus_mesh(8, 16)).how
+    'genus-cut'
     """
     V, F = as_mesh(V, F)
     table = EdgeTable.from_faces(F, len(V))

@@ -216,6 +216,21 @@ def measure_distortion(V: Any, F: Any, uv: Any, frames: FaceFrames | None = None
     Returns
     -------
     Distortion
+
+    Examples
+    --------
+    A flat grid mapped by ``(x, y) → (2x, y)``: after the map's area is scaled to the
+    surface's, every face has σ₁ = √2, σ₂ = 1/√2, angle distortion σ₁/σ₂ = 2 and no area
+    distortion:
+
+    >>> import numpy as np
+    >>> from meshlap_core import grid, measure_distortion
+    >>> V, F = grid(5, 5)
+    >>> d = measure_distortion(V, F, V[:, :2] * [2, 1])
+    >>> bool(np.allclose(d.angle, 2) and np.allclose(d.area, 0, atol=1e-12))
+    True
+    >>> int(d.flipped.sum())
+    0
     """
     V = as_vertices(V)
     F = as_faces(F, len(V))

@@ -101,6 +101,19 @@ class UVMap:
         ARAP's energy at the start and after each iteration.
     pins : tuple of int
         LSCM's pinned disk vertices.
+
+    Examples
+    --------
+    Tutte's map of a flat grid: its boundary on the unit circle, no face flipped:
+
+    >>> import numpy as np
+    >>> from meshlap_core import Flattener, grid
+    >>> flat = Flattener(*grid(5, 5))
+    >>> tutte = flat.map("tutte")
+    >>> float(np.abs(np.linalg.norm(tutte.uv[flat.disk.outer], axis=1) - 1).max()) < 1e-12
+    True
+    >>> tutte.summary()["flipped"]
+    0
     """
 
     method: str
@@ -187,6 +200,7 @@ class Flattener:
 
     Examples
     --------
+    >>> from meshlap_core import Flattener
     >>> from meshlap_core.primitives import grid
     >>> flat = Flattener(*grid(6, 6))
     >>> tutte = flat.map("tutte")
@@ -194,6 +208,16 @@ class Flattener:
     0
     >>> arap = flat.arap()  # starts from LSCM
     >>> arap.step() <= arap.energies[0]
+    True
+
+    A flat grid is its own conformal map: LSCM reproduces it up to a similarity, with
+    angle distortion 1 and no area distortion:
+
+    >>> import numpy as np
+    >>> from meshlap_core import Flattener, grid
+    >>> lscm = Flattener(*grid(5, 5)).map("lscm")
+    >>> d = lscm.distortion()
+    >>> bool(np.allclose(d.angle, 1) and np.allclose(d.area, 0, atol=1e-9))
     True
     """
 
