@@ -71,6 +71,9 @@ class PictureProcess:
                 self.child = ipc.Child(_serve, self.folder.name, duplex=True, name="picture")
             self.child.send(("render", ipc.pack(scene)))
             return self.child.receive(timeout=PICTURE_TIMEOUT)[1]
+        except KeyboardInterrupt:  # a notebook's interrupt: its answer would come next time
+            self.end()
+            raise
         except ipc.NoChildProcess as exc:
             self.failed = f"no process could start for the picture: {exc}"
             raise RuntimeError(self.failed) from exc
@@ -132,6 +135,9 @@ def render_frames(scene: dict[str, Any]) -> list[np.ndarray]:
 def _serve(conn: Any, folder: str) -> None:
     """The picture process: polyscope started once on EGL, then one scene per message until
     ``("bye",)`` or the parent's end. polyscope's messages go to ``folder/output.log``."""
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # a notebook's interrupt is the parent's
     work = Path(folder)
     with _in_folder(work), _captured_output(work / "output.log"):
         import polyscope as ps
@@ -189,7 +195,7 @@ def draw(scene: dict[str, Any]) -> list[np.ndarray]:
         w = scene["size"][0]
         for slot, (pane, sm) in enumerate(zip(panes, meshes, strict=True)):
             # the second pane's colour bar on the right, beside its mesh
-            at = sc.colorbar_at(0) if slot == 0 else (w - sc.COLORBAR_PX + 15.0, 15.0)
+            at = sc.colorbar_at(0) if slot == 0 else (w - _bar_width(pane) + 15.0, 15.0)
             _paint(sm, pane, at, display)
         ps.set_user_callback(_overlay_of(viewer))
         frames = []
@@ -247,12 +253,21 @@ def _paint(sm: Any, pane: dict[str, Any], at: tuple[float, float], display: Any)
             onscreen_colorbar_location=at,
             **isolines.options(label, values),
         )
+    # polyscope keeps a structure's options by its name: set them for every picture
+    sm.set_edge_width(1.0 if pane.get("edges") else 0.0)
+    sm.set_edge_color((0.15, 0.15, 0.15))
     arrows = pane.get("arrows")
     if arrows is not None:
+        from .state.curvature_lab import cross_length
+
+        # the longest arrow 5 crosses long (two mean edges), the others in proportion
+        top = float(np.linalg.norm(arrows, axis=1).max()) or 1.0
+        scale = 5.0 * cross_length(pane["V"], pane["F"]) / top
         sm.add_vector_quantity(
-            pane.get("arrows_label") or "vectors",
-            display.vectors(arrows),
+            "vectors",
+            display.vectors(scale * arrows),
             defined_on="vertices",
+            vectortype="ambient",
             enabled=True,
             color=(0.1, 0.1, 0.1),
         )
@@ -282,6 +297,14 @@ def _crosses(sm: Any, pane: dict[str, Any], c: dict[str, Any], display: Any) -> 
         )  # fmt: skip
 
 
+def _bar_width(pane: dict[str, Any]) -> float:
+    """Pixels a colour bar takes at UI scale 1: its box, or its label when longer (about
+    7.5 pixels a character in polyscope's font)."""
+    from .scene import COLORBAR_PX
+
+    return max(COLORBAR_PX, 7.5 * len(pane.get("label") or "") + 25.0)
+
+
 def _toward_eye(scene: dict[str, Any], viewer: Any) -> tuple[float, float, float]:
     cam = scene.get("camera")
     return tuple(cam) if cam is not None else viewer.view_direction()
@@ -308,11 +331,12 @@ def _frame(scene: dict[str, Any], viewer: Any, points: list[np.ndarray], turn: f
         centre = 0.5 * (P.min(axis=0) + P.max(axis=0))
         r = float(np.linalg.norm(P - centre, axis=1).max())
         P = centre + r * np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)])
-    w, _ = ps.get_window_size()
-    strip = min(sc.COLORBAR_PX / max(w, 1), 0.3)
+    w = max(ps.get_window_size()[0], 1)
     panes = scene["panes"]
-    left = strip if panes[0].get("field") is not None else 0.02
-    right = strip if len(panes) > 1 and panes[1].get("field") is not None else 0.02
+    left = min(sc.COLORBAR_PX / w, 0.3) if panes[0].get("field") is not None else 0.02
+    right = 0.02
+    if len(panes) > 1 and panes[1].get("field") is not None:
+        right = min(_bar_width(panes[1]) / w, 0.3)
     sc.frame_points(P, tuple(eye), fraction=1.0 - right, left=left)
 
 

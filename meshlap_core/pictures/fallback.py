@@ -113,7 +113,10 @@ def _draw_pane(
         colours = _colours(pane, pane["field"][faces].mean(axis=1))
     colours[:, :3] *= shade[:, None]
     ax.computed_zorder = False  # what is drawn after the mesh stays in front of it
-    ax.add_collection3d(Poly3DCollection(tris, facecolors=colours, edgecolors="none"))
+    edges = ("#262626", 0.3) if pane.get("edges") else ("none", 0.0)
+    ax.add_collection3d(
+        Poly3DCollection(tris, facecolors=colours, edgecolors=edges[0], linewidths=edges[1])
+    )
     if pane.get("isolines"):
         _isolines(ax, V, F, pane, R)
     if "arrows" in pane:
@@ -174,7 +177,7 @@ def _arrows(ax: Any, P: FloatArray, D: FloatArray) -> None:
     idx = _glyph_vertices(len(P))
     D = D[:, [2, 0, 1]][idx]
     top = float(np.linalg.norm(D, axis=1).max()) or 1.0
-    scale = 0.08 * float(np.ptp(P, axis=0).max()) / top
+    scale = 0.06 * float(np.ptp(P, axis=0).max()) / top
     X = P[idx]
     ax.quiver(X[:, 0], X[:, 1], X[:, 2], *(scale * D).T, color="#1a1a1a", linewidth=0.6)
 

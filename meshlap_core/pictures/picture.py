@@ -175,6 +175,7 @@ def show(
     cmap: str | None = None,
     clip: float = sc.CLIP_PERCENT,
     isolines: int = 0,
+    edges: bool = False,
     up: str = "y",
     renderer: Renderer = "auto",
 ) -> MeshPicture:
@@ -208,6 +209,8 @@ def show(
         Force the symmetric signed map or the one-sign map.
     isolines : int
         Level curves of the field (0: none).
+    edges : bool
+        Draw the triangles' edges.
     up : str
         The mesh axis drawn up (``"y"``, ``"z"``, ``"-z"``...), as ``meshlap view --up``.
     renderer : {"auto", "egl", "matplotlib"}
@@ -234,7 +237,7 @@ def show(
     """
     V, Fc, name = sc.subject(mesh_or_V, F)
     one = sc.pane(V, Fc, field, label=label, cmap=cmap, clip=clip, isolines=isolines,
-                  vectors=vectors)  # fmt: skip
+                  vectors=vectors, edges=edges)  # fmt: skip
     one["title"] = str(title)
     scene = sc.build_scene([one], name, up=up, vertex=vertex, camera=camera, size=size)
     frames, used, reason = render(scene, renderer)
@@ -256,6 +259,7 @@ def show_side_by_side(
     cmap: str | None = None,
     clip: float = sc.CLIP_PERCENT,
     isolines: int = 0,
+    edges: bool = False,
     up: str = "y",
     renderer: Renderer = "auto",
 ) -> MeshPicture:
@@ -277,7 +281,7 @@ def show_side_by_side(
     same_range : bool
         One colour range for both (the union of theirs), so that equal colours mean equal
         values; only when both maps are the same kind.
-    vectors, camera, size, cmap, clip, isolines, up, renderer
+    vectors, camera, size, cmap, clip, isolines, edges, up, renderer
         As :func:`show` (``vectors`` on the left mesh).
 
     Returns
@@ -293,7 +297,7 @@ def show_side_by_side(
     for k, (Vp, Fp, field) in enumerate(((V, Fc, left), (V2, F2, right))):
         p = sc.pane(
             Vp, Fp, field, label=None, cmap=cmap, clip=clip, isolines=isolines,
-            vectors=vectors if k == 0 else None, prefix="" if k == 0 else "right ",
+            vectors=vectors if k == 0 else None, edges=edges, prefix="" if k == 0 else "right ",
         )  # fmt: skip
         p["title"] = str(titles[k]) if k < len(titles) else ""
         if p.get("field") is not None:

@@ -278,12 +278,13 @@ def pane(
     clip: float,
     isolines: int,
     vectors: Any,
+    edges: bool = False,
     prefix: str = "",
 ) -> dict[str, Any]:
-    """One mesh of a picture with its field, colours, isolines and vectors, checked (the
-    arguments are named ``prefix + name`` in errors)."""
+    """One mesh of a picture with its field, colours, isolines, vectors and edges, checked
+    (the arguments are named ``prefix + name`` in errors)."""
     values, default_label, signed = field_values(field, V, F, prefix + "field")
-    out: dict[str, Any] = {"V": V, "F": F, "field": values, "isolines": 0}
+    out: dict[str, Any] = {"V": V, "F": F, "field": values, "isolines": 0, "edges": bool(edges)}
     out.update(check_vectors(vectors, len(V), prefix + "vectors"))
     if values is None:
         return out

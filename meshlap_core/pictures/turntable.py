@@ -89,6 +89,7 @@ def turntable(
     cmap: str | None = None,
     clip: float = sc.CLIP_PERCENT,
     isolines: int = 0,
+    edges: bool = False,
     up: str = "y",
     renderer: Renderer = "auto",
 ) -> Turntable:
@@ -120,7 +121,7 @@ def turntable(
         raise MeshError(f"must be between 0.1 and 120, got {fps!r}", "fps")
     V, Fc, name = sc.subject(mesh_or_V, F)
     one = sc.pane(V, Fc, field, label=label, cmap=cmap, clip=clip, isolines=isolines,
-                  vectors=vectors)  # fmt: skip
+                  vectors=vectors, edges=edges)  # fmt: skip
     one["title"] = str(title)
     turns = tuple(float(degrees) * k / count for k in range(count))
     scene = sc.build_scene([one], name, up=up, camera=camera, turns=turns, size=size)
