@@ -167,8 +167,28 @@ def _serve(conn: Any, folder: str) -> None:
 
 
 def draw(scene: dict[str, Any]) -> list[np.ndarray]:
-    """Set ``scene`` up with the viewer's code and render one frame per turn (polyscope
-    already started, on any backend: the tests use ``openGL_mock`` too)."""
+    """Set ``scene`` up with the viewer's code (:func:`set_up`) and render one frame per
+    turn; the scene is removed afterwards (polyscope already started, on any backend)."""
+    import polyscope as ps
+
+    try:
+        viewer, points = set_up(scene)
+        frames = []
+        for turn in scene["turns"]:
+            _frame(scene, viewer, points, float(turn))
+            frames.append(ps.screenshot_to_buffer(transparent_bg=False, include_UI=True))
+        return frames
+    finally:
+        ps.clear_user_callback()
+        ps.set_open_imgui_window_for_user_callback(True)  # the viewer's setting
+        ps.remove_all_structures()
+
+
+def set_up(scene: dict[str, Any]) -> tuple[Any, list[np.ndarray]]:
+    """Register ``scene`` in polyscope: a viewer on the first pane's mesh (:func:`_viewer`),
+    the panes' fields, colour bars, isolines, arrows and crosses, the second pane beside the
+    first, the one-ring's numbers as the overlay. Returns the viewer and each pane's display
+    positions ``(n,3)`` (what the camera frames)."""
     import polyscope as ps
 
     from . import scene as sc
@@ -179,34 +199,25 @@ def draw(scene: dict[str, Any]) -> list[np.ndarray]:
     ps.set_right_gui_pane_width(1)  # no meshlap panel: the framing uses the whole width
     ps.set_open_imgui_window_for_user_callback(False)  # the overlay's text only
     viewer = _viewer(scene)
-    try:
-        panes = scene["panes"]
-        display = viewer.state.display
-        main = ps.get_surface_mesh(sc.MESH)
-        main.remove_all_quantities()  # the scene's field, not the view's default one
-        points = [viewer.mesh_points()]
-        meshes = [main]
-        if len(panes) > 1:
-            second = panes[1]
-            P = display.points(second["V"])
-            P = P + sc.side_offset(np.vstack([points[0], P]), _toward_eye(scene, viewer))
-            meshes.append(ps.register_surface_mesh(SECOND, P, second["F"], smooth_shade=True))
-            points.append(P)
-        w = scene["size"][0]
-        for slot, (pane, sm) in enumerate(zip(panes, meshes, strict=True)):
-            # the second pane's colour bar on the right, beside its mesh
-            at = sc.colorbar_at(0) if slot == 0 else (w - _bar_width(pane) + 15.0, 15.0)
-            _paint(sm, pane, at, display)
-        ps.set_user_callback(_overlay_of(viewer))
-        frames = []
-        for turn in scene["turns"]:
-            _frame(scene, viewer, points, float(turn))
-            frames.append(ps.screenshot_to_buffer(transparent_bg=False, include_UI=True))
-        return frames
-    finally:
-        ps.clear_user_callback()
-        ps.set_open_imgui_window_for_user_callback(True)  # the viewer's setting
-        ps.remove_all_structures()
+    panes = scene["panes"]
+    display = viewer.state.display
+    main = ps.get_surface_mesh(sc.MESH)
+    main.remove_all_quantities()  # the scene's field, not the view's default one
+    points = [viewer.mesh_points()]
+    meshes = [main]
+    if len(panes) > 1:
+        second = panes[1]
+        P = display.points(second["V"])
+        P = P + sc.side_offset(np.vstack([points[0], P]), _toward_eye(scene, viewer))
+        meshes.append(ps.register_surface_mesh(SECOND, P, second["F"], smooth_shade=True))
+        points.append(P)
+    w = scene["size"][0]
+    for slot, (pane, sm) in enumerate(zip(panes, meshes, strict=True)):
+        # the second pane's colour bar on the right, beside its mesh
+        at = sc.colorbar_at(0) if slot == 0 else (w - _bar_width(pane) + 15.0, 15.0)
+        _paint(sm, pane, at, display)
+    ps.set_user_callback(_overlay_of(viewer))
+    return viewer, points
 
 
 def _viewer(scene: dict[str, Any]) -> Any:

@@ -11,7 +11,6 @@ import shutil
 import subprocess
 import sys
 import tempfile
-import time
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -62,7 +61,7 @@ class ViewerWindow:
     command : list of str
         The command line.
     message : str
-        What happened, in a sentence.
+        Why nothing was started, or what was started.
     """
 
     process: subprocess.Popen[bytes] | None
@@ -82,18 +81,39 @@ class ViewerWindow:
         log = self.path.parent / "viewer.log"
         return log.read_text(errors="replace") if log.is_file() else ""
 
+    def status(self) -> str:
+        """What the window is doing now: not started (why), running, or ended (its exit code
+        and its error, else the last line it printed)."""
+        if self.process is None:
+            return self.message
+        code = self.process.poll()
+        if code is None:
+            return f"meshlap view is running on {self.path} (pid {self.process.pid})"
+        said = [x.strip() for x in self.output().splitlines() if x.strip()]
+        errors = [x for x in said if x.startswith("meshlap: error:")]  # not polyscope's exit
+        last = (errors or said or [""])[-1]
+        return f"meshlap view ended (exit code {code})" + (f": {last}" if last else "")
+
+    def wait(self, timeout: float | None = None) -> int | None:
+        """Wait up to ``timeout`` seconds for the window to close; its exit code, or ``None``
+        while it still runs (or when nothing was started)."""
+        if self.process is None:
+            return None
+        try:
+            return self.process.wait(timeout)
+        except subprocess.TimeoutExpired:
+            return None
+
     def close(self) -> None:
         """End the window's process (nothing when it has ended)."""
         if self.running:
             assert self.process is not None
             self.process.terminate()
-            try:
-                self.process.wait(5)
-            except subprocess.TimeoutExpired:
+            if self.wait(5) is None:
                 self.process.kill()
 
     def __repr__(self) -> str:
-        return f"<ViewerWindow: {self.message}>"
+        return f"<ViewerWindow: {self.status()}>"
 
 
 def open_viewer(
@@ -129,12 +149,14 @@ def open_viewer(
     -------
     ViewerWindow
         With ``process=None`` and the reason in ``message`` when no display exists or the
-        viewer is not installed; a window that fails at once says why in ``message``.
+        viewer is not installed; :meth:`ViewerWindow.status` says later whether the window
+        still runs or why it ended.
 
     Raises
     ------
     MeshError
-        A bad mesh or argument (named in the message).
+        A bad mesh or argument (named in the message), or a window that ended with an error
+        within :data:`FIRST_LOOK_SECONDS` (its exit code and last message).
     """
     V, Fc, name = sc.subject(mesh_or_V, F)
     args: list[str] = []
@@ -165,15 +187,8 @@ def open_viewer(
             command, stdout=log, stderr=subprocess.STDOUT, start_new_session=True,
             env=dict(os.environ if environ is None else environ),
         )  # fmt: skip
-    window = ViewerWindow(process, path, command, f"meshlap view opened {path} (pid {process.pid})")
-    deadline = time.monotonic() + FIRST_LOOK_SECONDS
-    while time.monotonic() < deadline and process.poll() is None:
-        time.sleep(0.05)
-    if process.poll() is not None:
-        said = window.output().strip().splitlines()
-        window.message = f"meshlap view ended at once (exit code {process.returncode})" + (
-            f": {said[-1]}" if said else ""
-        )
-        if process.returncode not in (0, None):
-            raise MeshError(window.message, "open_viewer")
+    window = ViewerWindow(process, path, command, f"meshlap view started on {path}")
+    code = window.wait(FIRST_LOOK_SECONDS)
+    if code not in (0, None):
+        raise MeshError(window.status(), "open_viewer")
     return window
