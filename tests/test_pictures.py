@@ -440,8 +440,8 @@ def test_open_viewer_reports_a_window_that_fails_at_once(tmp_path):
 def test_the_docstring_examples_run():
     import doctest
 
-    from meshlap_core.pictures import turntable
+    from meshlap_core.pictures import turntable_gif
 
-    for module in (picture_module, turntable):
+    for module in (picture_module, turntable_gif):
         result = doctest.testmod(module, raise_on_error=False, report=True)
         assert result.attempted >= 2 and result.failed == 0, module.__name__

@@ -15,7 +15,7 @@ core never imports the viewer); matplotlib draws them where it cannot, and says 
 from __future__ import annotations
 
 from .picture import MeshPicture, show, show_side_by_side
-from .turntable import Turntable, turntable
+from .turntable_gif import Turntable, turntable
 from .window import ViewerWindow, open_viewer
 
 __all__ = [
