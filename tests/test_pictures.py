@@ -445,3 +445,31 @@ def test_the_docstring_examples_run():
     for module in (picture_module, turntable_gif):
         result = doctest.testmod(module, raise_on_error=False, report=True)
         assert result.attempted >= 2 and result.failed == 0, module.__name__
+
+
+@pytest.mark.window
+def test_open_viewer_opens_the_window_on_a_display():
+    """Under Xvfb: the window appears titled after the mesh's file, the notebook's process
+    goes on, and ``close`` ends the window."""
+    from xwindow import XServer, missing_tools
+
+    missing = missing_tools()
+    if missing:
+        pytest.skip(f"real-window tests need {', '.join(missing)} (.ci/run installs them)")
+    pytest.importorskip("meshlap_app")
+    x = XServer(1280, 720).start()
+    w = None
+    try:
+        mesh = ml.validate_mesh(*ml.icosphere(2), "ball.obj")
+        w = ml.open_viewer(mesh, vertex=3, environ=x.env())
+        assert w.process is not None and w.path.name == "ball.obj"
+        assert w.command[-2:] == ["--vertex", "3"]
+        found = x.run("xdotool", "search", "--sync", "--onlyvisible", "--name", "ball.obj",
+                      timeout=180)  # fmt: skip
+        assert found.split() and w.running and "running" in w.status()
+        w.close()
+        assert w.wait(30) is not None and not w.running
+    finally:
+        if w is not None:
+            w.close()
+        x.stop()
