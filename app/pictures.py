@@ -39,9 +39,10 @@ PICTURE_TIMEOUT = 120.0
 """Seconds a picture may take, the start of polyscope and EGL in a new process included."""
 
 SECOND = "mesh (second field)"
+"""The structure of the second pane of a side-by-side picture."""
+
 STARTED = "meshlap: picture process started"
 """What the picture process prints once polyscope's EGL backend has started."""
-"""The structure of the second pane of a side-by-side picture."""
 
 
 class PictureProcess:
@@ -117,7 +118,8 @@ def render_frames(scene: dict[str, Any]) -> list[np.ndarray]:
     scene : dict
         Plain data (:func:`meshlap_core.pictures.scene.build_scene`): ``panes`` (one or two
         dicts with ``V (n,3)``, ``F (m,3)``, ``field (n,)`` or ``None``, ``label``, ``cmap``,
-        ``range``, ``isolines``, ``arrows (n,3)`` or ``None``, ``crosses`` or ``None``),
+        ``range``, ``isolines``, ``edges``, ``title`` and optionally ``arrows (n,3)`` or
+        ``crosses`` (``normal``, ``d1``, ``d2`` ``(n,3)``, ``k1``, ``k2`` ``(n,)``)),
         ``name`` (the mesh's file name: its up axis and front view as in the window), ``up``,
         ``panel`` and ``options`` (the viewer's view and start options, as ``meshlap view
         --panel P --vertex I``), ``camera`` (towards the eye, or ``None``), ``turns``
