@@ -383,6 +383,19 @@ def test_the_fallback_draws_the_colour_maps_ends():
     assert right[2] > right[1] + 20 and right[0] > right[1]
 
 
+def test_the_fallback_draws_the_one_ring_and_the_crosses():
+    V, F = ml.icosphere(2)
+    red = lambda img: int(((img[..., 0] > 200) & (img[..., 1] < 60) & (img[..., 2] < 60)).sum())  # noqa: E731
+    ring = ml.show(V, F, "cotan", vertex=0, renderer="matplotlib", size=(400, 300))
+    assert red(ring.image.astype(int)) > 20  # the selected vertex's red dot
+    assert red(ml.show(V, F, renderer="matplotlib", size=(400, 300)).image.astype(int)) == 0
+    Vt, Ft = ml.torus_mesh(24, 10)
+    pc = ml.estimate_curvature(Vt, Ft, "rusinkiewicz")
+    img = ml.show(Vt, Ft, vectors=pc, up="z", renderer="matplotlib", size=(400, 300)).image
+    green = (img[..., 1].astype(int) - img[..., 2] > 50) & (img[..., 0] < 80)
+    assert green.sum() > 20  # the green k2 crosses
+
+
 def test_a_turntable_is_a_gif_of_its_frames(tmp_path):
     from PIL import Image
 

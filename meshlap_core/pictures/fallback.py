@@ -209,7 +209,7 @@ def _ring_of(F: Any, n: int, vertex: int) -> tuple[np.ndarray, bool]:
 def _ring_view(V: FloatArray, F: Any, vertex: int, R: np.ndarray) -> np.ndarray:
     """The window's view of a one-ring (display coordinates): about 40° off the vertex's
     normal, tilted towards the up axis."""
-    from ..curvature import vertex_normals
+    from .. import vertex_normals  # the public name (wherever the curvature code lives)
 
     around = F[(F == vertex).any(axis=1)]
     normal = R @ vertex_normals(V, around)[vertex]

@@ -101,7 +101,7 @@ def field_values(
     if field is None:
         return None, "", None
     if isinstance(field, str):
-        from ..curvature import curvature_field
+        from .. import curvature_field  # the public name (wherever the curvature code lives)
 
         check_choice(field, tuple(CURVATURE_FIELD_LABELS), "curvature field", name)
         values = curvature_field(V, F, field, area="voronoi")  # type: ignore[arg-type]
