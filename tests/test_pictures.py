@@ -136,6 +136,16 @@ def test_colour_range_is_the_windows_rule():
                 assert ours == pytest.approx(state.robust_range(values, signed, clip))
 
 
+def test_the_fallback_stands_a_mesh_up_as_the_window_does():
+    """The fallback's copy of the window's up rule gives the same rotation for every axis."""
+    display = pytest.importorskip("meshlap_app.state.display")
+    from meshlap_core.options import UP_AXES
+    from meshlap_core.pictures import fallback
+
+    for up in UP_AXES:
+        np.testing.assert_array_equal(fallback.up_rotation(up), display.up_rotation(up))
+
+
 def test_the_map_follows_the_sign_and_a_curvature_name_uses_the_windows_field():
     V, F = ml.icosphere(2)
     p = sc.pane(V, F, V[:, 0], label=None, cmap=None, clip=2, isolines=0, vectors=None)
