@@ -99,6 +99,14 @@ _PUBLIC: dict[str, str | tuple[str, str]] = {
     "get_surface": "surfaces",
     "mesh_surface": "surfaces",
     "point_geometry": "surfaces",
+    # pictures in notebooks, drawn by the viewer's EGL renderer (matplotlib without it)
+    "show": "pictures",
+    "show_side_by_side": "pictures",
+    "turntable": "pictures",
+    "open_viewer": "pictures",
+    "MeshPicture": "pictures",
+    "Turntable": "pictures",
+    "ViewerWindow": "pictures",
 }
 
 __all__ = ["MeshError", "MeshWarning", "__version__", *_PUBLIC]
