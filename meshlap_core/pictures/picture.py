@@ -43,6 +43,17 @@ class MeshPicture:
         What drew it.
     reason : str
         Why matplotlib drew it ("" when EGL did, or when matplotlib was asked for).
+
+    Examples
+    --------
+    A picture drawn by matplotlib (asked for here; the default tries the viewer's EGL
+    renderer first) is a PNG of the requested size:
+
+    >>> from meshlap_core import icosphere, show
+    >>> V, F = icosphere(2)
+    >>> pic = show(V, F, V[:, 1], size=(400, 300), renderer="matplotlib")
+    >>> pic.png[1:4], pic.image.shape  # the PNG signature, rows × columns × RGB
+    (b'PNG', (300, 400, 3))
     """
 
     png: bytes
@@ -143,7 +154,7 @@ def _viewer_frames(scene: dict[str, Any]) -> list[np.ndarray]:
 
 def _caption(frame: np.ndarray, scene: dict[str, Any]) -> np.ndarray:
     """The titles of the panes written along the bottom (``left | right``), RGB."""
-    from ..frames import burn_caption
+    from ..io.animation import burn_caption
 
     titles = [p.get("title") or "" for p in scene["panes"]]
     text = "   |   ".join(t for t in titles if t) if any(titles) else ""
@@ -287,6 +298,16 @@ def show_side_by_side(
     Returns
     -------
     MeshPicture
+
+    Examples
+    --------
+    Two fields of one sphere side by side on one colour range:
+
+    >>> from meshlap_core import icosphere, show_side_by_side
+    >>> V, F = icosphere(2)
+    >>> pic = show_side_by_side(V, F, V[:, 0], V[:, 1], titles=("x", "y"), renderer="matplotlib")
+    >>> pic.size, pic.image.shape
+    ((900, 450), (450, 900, 3))
     """
     V, Fc, name = sc.subject(mesh_or_V, F)
     V2, F2 = V, Fc

@@ -32,6 +32,16 @@ class Turntable:
     renderer : {"egl", "matplotlib"}
     reason : str
         Why matplotlib drew it ("" when EGL did).
+
+    Examples
+    --------
+    Four frames of a turning sphere; the GIF starts with its signature:
+
+    >>> from meshlap_core import icosphere, turntable
+    >>> V, F = icosphere(2)
+    >>> turn = turntable(V, F, V[:, 2], frames=4, renderer="matplotlib")
+    >>> len(turn.frames), turn.gif[:6]
+    (4, b'GIF89a')
     """
 
     frames: list[np.ndarray]
@@ -42,7 +52,7 @@ class Turntable:
     def save(self, path: str | os.PathLike) -> Path:
         """Write the frames to ``path`` (``.gif``, or ``.mp4`` with the ``video`` extra)
         atomically; returns the path."""
-        from ..frames import FrameWriter
+        from ..io.animation import FrameWriter
 
         writer = FrameWriter(path, self.fps)
         try:
@@ -113,6 +123,14 @@ def turntable(
     >>> t = turntable(V, F, V[:, 0], frames=3, size=(96, 72), renderer="matplotlib")
     >>> len(t.frames), t.gif[:6]
     (3, b'GIF89a')
+
+    Examples
+    --------
+    >>> from meshlap_core import icosphere, turntable
+    >>> V, F = icosphere(2)
+    >>> turn = turntable(V, F, V[:, 2], frames=3, size=(200, 150), renderer="matplotlib")
+    >>> [frame.shape for frame in turn.frames]
+    [(150, 200, 3), (150, 200, 3), (150, 200, 3)]
     """
     count = sc.check_count(frames, "frames", *FRAME_COUNTS)
     if not (isinstance(degrees, int | float) and np.isfinite(degrees) and degrees != 0):

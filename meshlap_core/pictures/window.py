@@ -62,6 +62,15 @@ class ViewerWindow:
         The command line.
     message : str
         Why nothing was started, or what was started.
+
+    Examples
+    --------
+    Where no display exists nothing is started, and the window says why:
+
+    >>> from meshlap_core import icosphere, open_viewer
+    >>> window = open_viewer(*icosphere(1), environ={})  # an environment without DISPLAY
+    >>> window.process is None, window.running, window.status().startswith("no display")
+    (True, False, True)
     """
 
     process: subprocess.Popen[bytes] | None
@@ -157,6 +166,15 @@ def open_viewer(
     MeshError
         A bad mesh or argument (named in the message), or a window that ended with an error
         within :data:`FIRST_LOOK_SECONDS` (its exit code and last message).
+
+    Examples
+    --------
+    Without a display (here an empty environment) nothing starts and the message says why:
+
+    >>> from meshlap_core import icosphere, open_viewer
+    >>> window = open_viewer(*icosphere(1), vertex=0, environ={})
+    >>> window.process is None and "no display" in window.message
+    True
     """
     V, Fc, name = sc.subject(mesh_or_V, F)
     args: list[str] = []
