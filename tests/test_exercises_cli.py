@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 from meshlap_core.cli import main
-from meshlap_core.options import EXERCISE_TASKS
+from meshlap_core.exercises.tasks import EXERCISE_TASKS
 
 STUDENTS = Path(__file__).parent / "exercises"
 

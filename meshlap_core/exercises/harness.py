@@ -28,10 +28,10 @@ command                                reply
 Every command carries a fresh nonce that its reply repeats: a line the student's code writes on
 the channel cannot answer a command it has not seen. The checker trusts none of it: it owns the
 clock (wall time between command and reply, CPU time from ``/proc``), it reads an answer as
-plain arrays only (no pickle, dtype and size checked), and a task without an answer has failed. The :class:`Fence` (audit hooks, PEP 578)
-names what the student tried — a window, a process, a file outside the folder, the network,
-C calls through ctypes — for the report; the sandbox's walls are the namespaces and limits
-around this process, not the fence.
+plain arrays only (no pickle, dtype and size checked), and a task without an answer has failed.
+The :class:`Fence` (audit hooks, PEP 578) names what the student tried — a window, a process,
+a file outside the folder, the network, C calls through ctypes — for the report; the sandbox's
+walls are the namespaces and limits around this process, not the fence.
 """
 
 from __future__ import annotations
