@@ -82,7 +82,8 @@ WRONG = [  # (student file, task, the diagnosis it must get)
 ]
 STOPPED = {"dense_at_size": "memory"}
 """Diagnoses of a task the sandbox stopped (not a compared value)."""
-RIGHT = ["right_vectorized", "right_loops", "right_other_order", "right_igl"]
+RIGHT = ["right_vectorized", "right_loops", "right_other_order", "right_igl", "right_helper_module"]
+"""(right_helper_module.py keeps its work in mesh_helpers.py beside it: copied with it.)"""
 HOSTILE_TIMEOUT = 4.0
 
 
@@ -139,12 +140,6 @@ def test_the_right_solutions_cover_every_task():
     assert covered == set(EXERCISE_TASKS)
 
 
-def test_a_right_file_with_a_helper_module_beside_it_passes(checked):
-    """right_helper_module.py imports mesh_helpers.py beside it: the checker copies the module
-    it imports with it (before, every file ran in the class folder itself)."""
-    assert checked("right_helper_module").passed, checked("right_helper_module").format_text()
-
-
 def test_a_right_but_slow_answer_passes_with_its_speed_line_unless_speed_is_required():
     """wrong_cotan_slow.py writes a sparse matrix entry by entry: right, and hundreds of times
     the reference's CPU time. It passes, its speed line says SLOW and names the loop; with
@@ -171,8 +166,10 @@ def test_every_task_gets_the_same_speed_line(checked):
 
 def test_a_wrong_value_names_the_mesh_the_vertex_expected_and_got(checked):
     r = checked("wrong_cotan_abs")["cotan_laplacian"]
-    # the obtuse fan's and the non-Delaunay pair's negative weights: nowhere else
-    assert r.case in ("obtuse_fan", "non_delaunay_pair") and r.n_failed == 2
+    # the negative weights of the obtuse fan, the non-Delaunay pair and the cap (slivers), and
+    # the zero-area triangle its unguarded cot divides by (said in the note): nowhere else
+    assert r.case in ("obtuse_fan", "non_delaunay_pair") and r.n_failed == 4
+    assert "also on mesh degenerate: NaN or inf" in r.note
     got, expected = dict(r.got), dict(r.expected)
     assert got.keys() == expected.keys()
     assert any(
@@ -329,8 +326,10 @@ def test_the_battery_has_degenerate_thin_and_big_meshes():
             if name in task.cases:
                 for _, args in task.calls(case):
                     ref = task.reference(case, args)
-                    values = ref.data if hasattr(ref, "data") else np.asarray(ref, dtype=float)
-                    assert np.isfinite(values).all(), (task.name, name)
+                    parts = ref if isinstance(ref, (list, tuple)) else [ref]
+                    for part in parts:
+                        values = part.data if hasattr(part, "nnz") else np.asarray(part, float)
+                        assert np.isfinite(values).all(), (task.name, name)
 
 
 def test_every_battery_mesh_is_oriented_outwards():

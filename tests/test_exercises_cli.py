@@ -166,7 +166,7 @@ def test_without_bubblewrap_every_run_says_it_is_not_isolated(capsys):
 def test_asking_for_bubblewrap_where_it_does_not_work_is_an_error(monkeypatch, capsys):
     from meshlap_core.exercises import isolation
 
-    monkeypatch.setattr(isolation, "_bwrap_problem", lambda: "bubblewrap is not installed")
+    monkeypatch.setattr(isolation, "bwrap_problem", lambda: "bubblewrap is not installed")
     code = main(["check", str(STUDENTS / "right_loops.py"), "--sandbox", "bwrap"])
     err = capsys.readouterr().err
     assert code == 2 and "bubblewrap does not work here: bubblewrap is not installed" in err

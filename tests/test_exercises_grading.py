@@ -119,3 +119,15 @@ def test_the_class_benchmark_grades_every_row_right(python_ok):
     The 200-submission run and its timings are the benchmark's, not a test's."""
     out = python_ok(BENCH, "--files", "12", "--serial", "0", "--timeout", "5").stdout
     assert "12 submissions, every row right" in out, out
+
+
+def test_a_submission_stops_at_its_time_cap(tmp_path):
+    """``file_timeout``: the task running when the cap passes, and every task after it, are
+    ``timeout`` with the cap named (an endless loop under a 30 s task limit, a 3 s cap)."""
+    folder = tmp_path / "class"
+    folder.mkdir()
+    shutil.copy(STUDENTS / "hostile_loop.py", folder / "zed.py")
+    (result,) = grade_folder(folder, TASKS, timeout=30.0, file_timeout=3.0)
+    loop, after = result["uniform_laplacian"], result["barycentric_areas"]
+    assert loop.status == "timeout" and "time cap" in loop.message, loop.lines()
+    assert after.status == "timeout" and "time cap" in after.message, after.lines()

@@ -121,8 +121,8 @@ DIAGNOSES: dict[str, str] = {
     'runs without a screen; keep viewers and plots under `if __name__ == "__main__":`',
     "spawns_process": "starts a process (subprocess, os.system, multiprocessing, fork): a "
     "check runs your functions only",
-    "outside_folder": "reads or writes outside your own folder ({what}): another submission, "
-    "the reference, the system; a check reads and writes only beside your file",
+    "outside_folder": "reads or writes outside your own folder: {what} (another submission, "
+    "the reference, the system); a check reads and writes only beside your file",
     "hangs_at_import": "the file never finishes importing (a loop, a sleep or input() at "
     'module level?): put work inside the functions or under `if __name__ == "__main__":`',
     "too_slow": "far slower than the reference on this mesh (a time limit scaled to the "

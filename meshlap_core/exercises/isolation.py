@@ -222,7 +222,7 @@ def choose(level: str | None = None) -> Isolation:
     asked = requested_level(level)
     if asked == "process":
         return Isolation("process", f"{SANDBOX_ENV}=process or --sandbox process", _worker_user())
-    problem = _bwrap_problem()
+    problem = bwrap_problem()
     if problem is None:
         return Isolation("bwrap", "", _worker_user())
     if asked == "bwrap":
@@ -230,24 +230,34 @@ def choose(level: str | None = None) -> Isolation:
     return Isolation("process", problem, _worker_user())
 
 
+def bwrap_problem() -> str | None:
+    """Why bubblewrap cannot run a worker here (``None``: it can)."""
+    return _bwrap_setup()[1]
+
+
 @functools.cache
-def _bwrap_problem() -> str | None:
-    """Why bubblewrap cannot run a worker here (``None``: it can), tried with the real mounts."""
+def _bwrap_setup() -> tuple[bool, str | None]:
+    """``(newer, problem)``: whether bubblewrap takes the options of 0.8 (``--disable-userns``,
+    ``--size``: tried first, then without), and why it cannot run a worker here (``None``: it
+    can), tried with the real mounts, once per process."""
     exe = shutil.which("bwrap")
     if exe is None:
-        return "bubblewrap is not installed"
+        return False, "bubblewrap is not installed"
     probe = Path(os.environ.get("TMPDIR", "/tmp"))
     user = _worker_user()
     where = {"folder": str(probe), "inputs": str(probe), "outputs": str(probe)}
-    argv = [*_bwrap_argv(exe, where, {}, user), sys.executable, "-I", "-c", "pass"]
-    try:
-        res = subprocess.run(argv, capture_output=True, timeout=60, user=user)
-    except (OSError, subprocess.TimeoutExpired) as exc:
-        return f"bubblewrap did not start ({exc})"
-    if res.returncode != 0:
+    problem = ""
+    for newer in (True, False):
+        argv = [*_bwrap_argv(exe, where, {}, user, newer), sys.executable, "-I", "-c", "pass"]
+        try:
+            res = subprocess.run(argv, capture_output=True, timeout=60, user=user)
+        except (OSError, subprocess.TimeoutExpired) as exc:
+            return False, f"bubblewrap did not start ({exc})"
+        if res.returncode == 0:
+            return newer, None
         lines = res.stderr.decode(errors="replace").strip().splitlines()
-        return f"bubblewrap failed: {lines[-1] if lines else res.returncode}"
-    return None
+        problem = problem or f"bubblewrap failed: {lines[-1] if lines else res.returncode}"
+    return False, problem
 
 
 def _mounts() -> list[str]:
@@ -286,15 +296,16 @@ def _mounts() -> list[str]:
 
 
 def _bwrap_argv(
-    exe: str, paths: dict[str, str], env: dict[str, str], user: int | None
+    exe: str, paths: dict[str, str], env: dict[str, str], user: int | None, newer: bool
 ) -> list[str]:
     """bubblewrap's command line up to (not including) the program it runs (``user``: the
-    user bubblewrap itself runs as, None for the checker's)."""
+    user bubblewrap itself runs as, None for the checker's; ``newer``: bubblewrap 0.8's
+    options, no nested user namespace and a size for ``/tmp``)."""
     argv = [
         exe,
         "--unshare-all",
         "--unshare-user",
-        "--disable-userns",
+        *(["--disable-userns"] if newer else []),
         "--uid",
         str(NOBODY),
         "--gid",
@@ -307,7 +318,8 @@ def _bwrap_argv(
     if os.geteuid() == 0 and user is None:  # bubblewrap as root keeps capabilities otherwise
         argv += ["--cap-drop", "ALL"]
     argv += _mounts()
-    argv += ["--proc", "/proc", "--dev", "/dev", "--size", str(TMP_BYTES), "--tmpfs", "/tmp"]
+    argv += ["--proc", "/proc", "--dev", "/dev"]
+    argv += [*(["--size", str(TMP_BYTES)] if newer else []), "--tmpfs", "/tmp"]
     argv += ["--ro-bind", harness_path(), INSIDE["harness"]]
     argv += ["--ro-bind", paths["inputs"], INSIDE["inputs"]]
     argv += ["--bind", paths["outputs"], INSIDE["outputs"]]
@@ -350,7 +362,8 @@ def command(
             "student": INSIDE["folder"] + "/" + config["student"],
         }
         env = environment(INSIDE["folder"], INSIDE["tmp"], token)
-        argv = _bwrap_argv(shutil.which("bwrap") or "bwrap", paths, env, iso.user)
+        exe = shutil.which("bwrap") or "bwrap"
+        argv = _bwrap_argv(exe, paths, env, iso.user, _bwrap_setup()[0])
         argv += [sys.executable, "-I", "-B", INSIDE["harness"], json.dumps(config)]
         return argv, {}, paths["folder"]
     tmp = os.path.join(paths["folder"], ".tmp")

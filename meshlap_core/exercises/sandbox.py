@@ -407,6 +407,9 @@ def run_student(
         result = StudentRun(runs, session.isolation, notes=notes)
         todo = list(names)
         while todo:
+            if time.monotonic() >= plan.deadline:
+                todo = _capped(todo, runs)
+                break
             worker = Worker(session, copy, main, todo, limits)
             try:
                 todo = _drive(worker, plan, todo, runs, limits)
