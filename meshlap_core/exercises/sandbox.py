@@ -194,7 +194,7 @@ def _correctness(
     deadline = time.monotonic() + plan.timeout
     for case in _meshes(plan, task):
         if run.failing and len(case.V) >= BUDGET_MIN_VERTICES and refs.is_battery(case):
-            break  # wrong already: the small meshes diagnose it, the big ones would only cost
+            continue  # wrong already: the small meshes diagnose it, the big ones would only cost
         for label, args in refs.calls(task, case):
             counter[0] += 1
             command = _call_command(plan, task, case, label, args, counter[0], False)
