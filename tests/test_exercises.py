@@ -274,6 +274,22 @@ def test_a_constant_factor_is_named_with_its_value():
     assert constant_factor(task, failures) == -2.0
 
 
+def test_an_answer_right_to_a_few_digits_only_is_named_so():
+    """Values 1e-5 off (relative): no mistake, no constant factor, a few digits."""
+    from meshlap_core.exercises.diagnose import few_digits
+
+    task = TASKS["barycentric_areas"]
+    failures = []
+    for name in ("one_triangle", "scaled"):
+        case = case_named(name)
+        ((label, args),) = task.calls(case)
+        ref = task.reference(case, args)
+        wobble = 1.0 + 1e-5 * np.cos(np.arange(len(ref)))
+        failures.append((case, label, args, ref * wobble))
+    assert diagnose(task, failures) is None and constant_factor(task, failures) is None
+    assert few_digits(task, failures)
+
+
 def test_a_task_without_its_answers_has_failed():
     """A task whose calls were never answered (a forged "finished", a worker that stopped
     replying) fails with ``no_answer``: before, a task with 0 calls counted as passed."""

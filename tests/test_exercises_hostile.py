@@ -112,7 +112,9 @@ def test_the_folder_run_is_complete_whatever_the_students_did(graded):
     assert all(t.status == "error" for t in by["empty_student"].tasks)
     assert "no exercises.py" in by["empty_student"].tasks[0].message
     unreadable = by["hostile_unreadable_answer"]
-    assert not any(unreadable[t].passed for t in ("uniform_laplacian", "barycentric_areas"))
+    assert unreadable["uniform_laplacian"].status == "error"  # its __array__ raised
+    assert unreadable["barycentric_areas"].diagnosis == "not_numbers"  # a dict
+    assert unreadable["voronoi_areas"].diagnosis == "not_numbers"  # a generator
     iso = by["zz_carol"].isolation
     assert iso["level"] == graded["mode"] and iso["isolated"] == (graded["mode"] == "bwrap")
 

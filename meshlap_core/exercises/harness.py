@@ -459,6 +459,7 @@ def _failure(exc: BaseException, fence: Fence, finder: _NoMeshlap, folder: str) 
     if isinstance(exc, MemoryError):
         return {"kind": "memory", "key": None, "text": text}
     key = "imports_meshlap" if isinstance(exc, ImportError) and finder.asked else None
+    finder.asked = None
     return {"kind": "error", "key": key, "text": text}
 
 

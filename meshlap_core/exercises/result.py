@@ -53,8 +53,6 @@ class TaskResult:
         A key of :data:`~.diagnose.DIAGNOSES`; ``diagnosis_text`` its sentence.
     message, traceback : str
     n_failed, n_calls : int
-    speed_ratio : float or None
-        Student time / reference time on the large mesh (speed-checked tasks).
     difference : (n,) float or None
         Student − reference per vertex of ``case`` (the difference map).
     note : str
@@ -62,6 +60,11 @@ class TaskResult:
     picture : (V, F, difference, mesh name, signed) or None
         The largest failing mesh and its difference map (the notebook picture); ``signed``:
         a scalar per vertex (coolwarm around 0), else a magnitude (viridis from 0).
+    speed : Speed or None
+        The speed line (a right task timed on the large mesh); ``speed_required``: a slow one
+        fails (``--require-speed``).
+    repro : (case, label, args) or None
+        The first failing call: the mesh and arguments a student can export.
     """
 
     task: str
@@ -79,14 +82,12 @@ class TaskResult:
     traceback: str = ""
     n_failed: int = 0
     n_calls: int = 0
-    speed_ratio: float | None = None
     difference: np.ndarray | None = field(default=None, repr=False)
     picture: tuple | None = field(default=None, repr=False)
     note: str = ""
     speed: Speed | None = None
     speed_required: bool = False
     repro: tuple | None = field(default=None, repr=False)
-    """``(case, label, args)`` of the first failing call: the mesh a student can export."""
 
     @property
     def passed(self) -> bool:
