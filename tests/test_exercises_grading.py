@@ -99,18 +99,21 @@ def test_a_classmates_file_is_not_copied_with_a_student_who_imports_it(tmp_path)
     assert results["alice"].passed
 
 
-def test_a_student_folder_with_a_link_out_of_it_is_copied_without_it(tmp_path):
-    """A link inside a student's folder to a file outside it is not followed (the checker
-    would read it for the student): the copy leaves it out and the report says so."""
+def test_a_link_out_of_a_submission_is_never_followed(tmp_path):
+    """A link inside a student's folder to a file outside it, or a class folder's entry that
+    is such a link, is not followed (the checker would read the file for the student): the copy
+    leaves it out, the report says so."""
     folder = tmp_path / "class" / "eve"
     folder.mkdir(parents=True)
     shutil.copy(STUDENTS / "right_vectorized.py", folder / "exercises.py")
     secret = tmp_path / "secret.txt"
     secret.write_text("the teacher's notes\n")
     (folder / "notes.txt").symlink_to(secret)
-    (result,) = grade_folder(tmp_path / "class", ["barycentric_areas"])
-    assert result.passed
-    assert any("notes.txt" in n and "outside the submission" in n for n in result.notes)
+    (tmp_path / "class" / "trudy.py").symlink_to(secret)  # a "submission" that is a link out
+    eve, trudy = grade_folder(tmp_path / "class", ["barycentric_areas"])
+    assert eve.passed
+    assert any("notes.txt" in n and "outside the submission" in n for n in eve.notes)
+    assert trudy.tasks[0].status == "error" and "outside the class folder" in trudy.tasks[0].message
 
 
 def test_the_class_benchmark_grades_every_row_right(python_ok):

@@ -126,8 +126,11 @@ def _copy_tree(src: Path, dst: Path, root: Path, notes: list[str], budget: list[
         shown = printable(os.fspath(path.relative_to(root)))
         if entry.is_symlink():
             real = Path(os.path.realpath(path))
-            if not (real.is_file() and real.is_relative_to(os.path.realpath(root))):
+            if not real.is_relative_to(os.path.realpath(root)):
                 notes.append(f"skipped {shown}: a link to something outside the submission")
+                continue
+            if not real.is_file():
+                notes.append(f"skipped {shown}: a link to a folder (not followed)")
                 continue
         if entry.is_dir(follow_symlinks=False):
             _copy_tree(path, target, root, notes, budget)

@@ -72,14 +72,20 @@ def find_submissions(folder: Path) -> list[Submission | tuple[str, str]]:
     for entry in sorted(folder.iterdir(), key=lambda p: p.name):
         if entry.name.startswith((".", "__")):
             continue
-        if entry.is_dir():
+        if entry.is_dir() and entry.is_symlink():
+            found.append((entry.name, "a link to a folder: not followed"))
+        elif entry.is_dir():
             main = _main_file(entry)
             if main is None:
                 found.append((entry.name, f"no {MAIN_FILE} and no .py file defining a task"))
             else:
                 found.append(Submission(entry.name, main, entry))
         elif entry.suffix == ".py" and entry.is_file():
-            found.append(Submission(entry.stem, entry, among_others=True))
+            real = Path(os.path.realpath(entry))
+            if entry.is_symlink() and not real.is_relative_to(os.path.realpath(folder)):
+                found.append((entry.stem, "a link to a file outside the class folder: not read"))
+            else:
+                found.append(Submission(entry.stem, entry, among_others=True))
     if not found:
         raise MeshError("no .py submissions and no student folders here", printable(str(folder)))
     return found
