@@ -172,6 +172,11 @@ def copy_submission(
         for name in sorted(_imported_siblings(todo.pop(), folder) - done):
             done.add(name)
             module = folder / f"{name}.py"
+            if module.is_symlink() and not Path(os.path.realpath(module)).is_relative_to(
+                os.path.realpath(folder)
+            ):
+                notes.append(f"not copied: {printable(module.name)}, a link out of the folder")
+                continue
             if sub.among_others and module.is_file() and defines_tasks(module, tasks):
                 notes.append(f"not copied: {printable(module.name)}, another student's file")
                 continue
