@@ -172,7 +172,8 @@ def copy_submission(
         for name in sorted(_imported_siblings(todo.pop(), folder) - done):
             done.add(name)
             module = folder / f"{name}.py"
-            if module.is_symlink() and not Path(os.path.realpath(module)).is_relative_to(
+            linked = module if module.is_file() else folder / name
+            if linked.is_symlink() and not Path(os.path.realpath(linked)).is_relative_to(
                 os.path.realpath(folder)
             ):
                 notes.append(f"not copied: {printable(module.name)}, a link out of the folder")
