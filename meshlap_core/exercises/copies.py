@@ -22,6 +22,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import MeshError, printable
+from ..io.reader import read_input
 
 COPY_BYTES = 64 * 2**20
 """Bytes of a student's folder copied at most."""
@@ -80,20 +81,44 @@ def student_file(path: str | os.PathLike) -> Path:
     return p
 
 
+SOURCE_BYTES = 16 * 2**20
+"""The largest student source file the checker parses (never runs): for the tasks it defines,
+the modules it imports, the loop a slow answer spends its time in."""
+
+
+def read_source(path: Path) -> str | None:
+    """The student's file ``path`` as text (through the checked reader: no FIFO, no device,
+    at most :data:`SOURCE_BYTES`), or None when it cannot be read."""
+    try:
+        return read_input(path, what="student file", max_bytes=SOURCE_BYTES).decode(
+            "utf-8", errors="replace"
+        )
+    except (MeshError, OSError):
+        return None
+
+
+def parse_source(path: Path) -> ast.Module | None:
+    """The student's file ``path`` parsed (never run), or None when it cannot be read or
+    parsed (running it then says why)."""
+    text = read_source(path)
+    try:
+        return None if text is None else ast.parse(text)
+    except (SyntaxError, ValueError):
+        return None
+
+
 def defines_tasks(path: Path, names: tuple[str, ...]) -> bool:
     """``path`` defines a top-level function named like a task (parsed, never run)."""
-    try:
-        tree = ast.parse(path.read_bytes())
-    except (OSError, SyntaxError, ValueError):
+    tree = parse_source(path)
+    if tree is None:
         return False
     return any(isinstance(n, ast.FunctionDef) and n.name in names for n in tree.body)
 
 
 def _imported_siblings(source: Path, folder: Path) -> set[str]:
     """Top-level names ``source`` imports that are modules or packages in ``folder``."""
-    try:
-        tree = ast.parse(source.read_bytes())
-    except (OSError, SyntaxError, ValueError):
+    tree = parse_source(source)
+    if tree is None:
         return set()
     names: set[str] = set()
     for node in ast.walk(tree):

@@ -30,7 +30,7 @@ from ..errors import MeshError, printable
 from ..io.atomic import atomic_write
 from ..options import EXERCISE_MEMORY_MB, EXERCISE_TIMEOUT
 from .check import check_file
-from .copies import Submission
+from .copies import Submission, parse_source
 from .result import CheckResult, TaskResult
 from .tasks import EXERCISE_TASKS
 from .worker import Session
@@ -41,9 +41,8 @@ MAIN_FILE = "exercises.py"
 
 def _task_count(path: Path) -> int:
     """How many task functions ``path`` defines (parsed, never run)."""
-    try:
-        tree = ast.parse(path.read_bytes())
-    except (OSError, SyntaxError, ValueError):
+    tree = parse_source(path)
+    if tree is None:
         return 0
     names = {n.name for n in tree.body if isinstance(n, ast.FunctionDef)}
     return len(names & set(EXERCISE_TASKS))

@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from ..options import EXERCISE_SLOW_MIN_SECONDS, EXERCISE_SLOW_RATIO
+from .copies import read_source
 
 CPU_RESOLUTION = 0.1
 """Student CPU seconds below which a run is measured by its wall time (``/proc`` counts in
@@ -101,11 +102,12 @@ def hot_loop(hot: list[list[Any]], folder: Path) -> str:
     around the line the profiler saw most, read from the student's own file (parsed, never
     run), or ``""``."""
     for file, line, _count in hot:
-        path = folder / file
+        source = read_source(folder / file)
         try:
-            source = path.read_text(encoding="utf-8", errors="replace")
-            tree = ast.parse(source)
-        except (OSError, SyntaxError, ValueError):
+            tree = ast.parse(source) if source is not None else None
+        except (SyntaxError, ValueError):
+            tree = None
+        if tree is None or source is None:
             continue
         loops = [
             n for n in ast.walk(tree)

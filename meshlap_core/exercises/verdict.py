@@ -15,6 +15,7 @@ import numpy as np
 
 from . import references as refs
 from .compare import COMPARE, Comparison
+from .copies import parse_source
 from .diagnose import constant_factor, describe, diagnose, factor_text, few_digits
 from .meshes import Case
 from .result import TaskResult
@@ -196,9 +197,8 @@ def _picture(failures: list, comparisons: list[Comparison], task: Task) -> tuple
 def calls_in_file(path: Path) -> dict[str, set[str]]:
     """For every top-level function of the student's file, the top-level functions it calls,
     directly or through others (the file is parsed, never run)."""
-    try:
-        tree = ast.parse(path.read_bytes())
-    except (OSError, SyntaxError, ValueError):
+    tree = parse_source(path)
+    if tree is None:
         return {}
     funcs = {n.name: n for n in tree.body if isinstance(n, ast.FunctionDef)}
     direct = {
