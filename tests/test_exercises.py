@@ -416,14 +416,16 @@ def test_adding_a_task_is_one_declaration():
 # ---- hostile files: stopped and reported, the checker survives --------------------------------
 
 
+@pytest.mark.parametrize("sandbox", ["auto", "process"])
 @pytest.mark.parametrize(
     ("name", "status"),
     [("hostile_loop", "timeout"), ("hostile_memory", "memory"), ("hostile_crash", "crashed")],
 )
-def test_a_hostile_task_is_stopped_and_the_next_one_still_runs(name, status):
+def test_a_hostile_task_is_stopped_and_the_next_one_still_runs(name, status, sandbox):
     result = check_file(
-        STUDENTS / f"{name}.py", ["uniform_laplacian", "barycentric_areas"], timeout=HOSTILE_TIMEOUT
-    )
+        STUDENTS / f"{name}.py", ["uniform_laplacian", "barycentric_areas"],
+        timeout=HOSTILE_TIMEOUT, sandbox=sandbox, speed=False,
+    )  # fmt: skip
     assert result["uniform_laplacian"].status == status
     assert result["barycentric_areas"].passed
 

@@ -299,9 +299,13 @@ class CheckResult:
                 f"{html.escape(STATUS_WORDS.get(t.status, t.status))}</td>"
                 f"<td style='text-align:left'>{detail}</td></tr>"
             )
+        sandbox = self.isolation.get("description", "")
+        warn = "" if self.isolation.get("isolated", True) else (
+            f"<p style='color:#9a6700'>sandbox: {html.escape(sandbox)}</p>")  # fmt: skip
         return (
             f"<p><b>{html.escape(self.file)}</b>: {self.n_passed}/{len(self.tasks)} passed</p>"
-            "<table><tr><th>task</th><th>verdict</th><th>where and why</th></tr>"
+            + warn
+            + "<table><tr><th>task</th><th>verdict</th><th>where and why</th></tr>"
             + "".join(rows)
             + "</table>"
         )
