@@ -115,6 +115,7 @@ def test_the_folder_run_is_complete_whatever_the_students_did(graded):
     assert unreadable["uniform_laplacian"].status == "error"  # its __array__ raised
     assert unreadable["barycentric_areas"].diagnosis == "not_numbers"  # a dict
     assert unreadable["voronoi_areas"].diagnosis == "not_numbers"  # a generator
+    assert unreadable["mass_matrix"].diagnosis == "no_answer"  # None
     iso = by["zz_carol"].isolation
     assert iso["level"] == graded["mode"] and iso["isolated"] == (graded["mode"] == "bwrap")
 
