@@ -181,3 +181,22 @@ def test_a_second_piece_is_not_called_heat_underflow():
     ((_, args),) = geo.heat_calls(case)
     reason = geo.heat_not_judged(case, args)
     assert "2 separate pieces" in reason and "underflow" not in reason
+
+
+def test_a_killed_checkers_temporary_folder_is_removed_by_the_next(tmp_path, monkeypatch):
+    """A viewer killed during a check never runs its exit handler: its session's folder (the
+    battery's inputs) is removed by the next session, not left in /tmp."""
+    import tempfile
+
+    from meshlap_core.exercises.worker import PREFIX, Session
+
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+    dead = subprocess.Popen([sys.executable, "-c", "pass"])
+    dead.wait()
+    orphan = tmp_path / f"{PREFIX}{dead.pid}-abc"
+    (orphan / "in").mkdir(parents=True)
+    alive = tmp_path / f"{PREFIX}{os.getpid()}-def"
+    alive.mkdir()
+    with Session("process") as session:
+        assert session.root.parent == tmp_path
+        assert not orphan.exists() and alive.exists()

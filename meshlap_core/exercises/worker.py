@@ -86,12 +86,32 @@ class CappedLog(threading.Thread):
         return out
 
 
+PREFIX = "meshlap-grade-"
+"""A session's temporary folder: ``meshlap-grade-<pid>-<random>``."""
+
+
+def _remove_orphans() -> None:
+    """Remove the temporary folders of sessions whose process is gone (a viewer killed while
+    a check's inputs were kept: its exit handler never ran)."""
+    for path in Path(tempfile.gettempdir()).glob(f"{PREFIX}*-*"):
+        pid = path.name[len(PREFIX) :].split("-")[0]
+        if pid.isdigit() and not os.path.exists(f"/proc/{pid}") and path.owner() == _me():
+            shutil.rmtree(path, ignore_errors=True)
+
+
+def _me() -> str:
+    import pwd
+
+    return pwd.getpwuid(os.geteuid()).pw_name
+
+
 class Session:
     """A grading run: the isolation, a private temporary folder, the inputs written once."""
 
     def __init__(self, sandbox: str | None = None) -> None:
         self.isolation: Isolation = choose(sandbox)
-        self.root = Path(tempfile.mkdtemp(prefix="meshlap-grade-"))
+        _remove_orphans()
+        self.root = Path(tempfile.mkdtemp(prefix=f"{PREFIX}{os.getpid()}-"))
         os.chmod(self.root, 0o711)
         inputs = self.root / "in"
         inputs.mkdir(mode=0o755)
