@@ -278,25 +278,8 @@ cotangent code gives them zero weights; in the squared form the Laplacian uses,
 
 # ---- exercises (meshlap check) ---------------------------------------------------------------
 
-ExerciseTask = Literal[
-    "uniform_laplacian",
-    "cotan_laplacian",
-    "barycentric_areas",
-    "voronoi_areas",
-    "mass_matrix",
-    "mean_curvature_normal",
-    "mean_curvature",
-    "angle_defect",
-    "one_ring",
-    "eigenbasis",
-    "spectral_reconstruction",
-    "explicit_step",
-    "implicit_step",
-    "taubin_step",
-    "heat_geodesic",
-]
-EXERCISE_TASKS: tuple[str, ...] = get_args(ExerciseTask)
-"""The exercises of ``meshlap exercises init`` / ``meshlap check --task``, in template order."""
+# The task names are declared with the tasks themselves: meshlap_core.exercises.tasks
+# (EXERCISE_TASKS there), one declaration per task.
 EXERCISE_RTOL = 1e-7
 """A student's value passes when ``|got − expected| ≤ EXERCISE_RTOL · max(max|expected|, h^p)``
 on every vertex, ``h`` the mesh's mean edge length and ``p`` the quantity's units (length^p):

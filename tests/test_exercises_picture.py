@@ -19,19 +19,22 @@ import numpy as np
 
 
 def barycentric_areas(V, F):
-    """Right (a third of each face), then wrong at the highest and the lowest vertex."""
+    """Right (a third of each face), then, on a mesh of more than 1000 vertices, wrong at the
+    highest and the lowest vertex (the checker skips the big meshes once a task has failed on
+    a small one: wrong only on big ones, it fails on the 2562-vertex sphere)."""
     P = V[F]
     A = 0.5 * np.linalg.norm(np.cross(P[:, 1] - P[:, 0], P[:, 2] - P[:, 0]), axis=1)
     a = np.bincount(F.ravel(), np.repeat(A / 3.0, 3), minlength=len(V))
-    wrong = [int(np.argmax(V[:, 2])), int(np.argmin(V[:, 2]))]
-    a[wrong] += 0.5 * a.max()
+    if len(V) > 1000:
+        wrong = [int(np.argmax(V[:, 2])), int(np.argmin(V[:, 2]))]
+        a[wrong] += 0.5 * a.max()
     return a
 '''
 
 
 @pytest.fixture(scope="module")
 def two_wrong(tmp_path_factory):
-    """A check whose mistake is at two vertices of each mesh only."""
+    """A check whose mistake is at two vertices of each big mesh only."""
     path = tmp_path_factory.mktemp("student") / "two_wrong.py"
     path.write_text(TWO_VERTICES_WRONG)
     return check_file(path, ["barycentric_areas"])

@@ -1,11 +1,12 @@
-"""The sandbox's fences (:class:`meshlap_core.exercises.guard.Fence`): a student file that
+"""The sandbox's fences (:class:`meshlap_core.exercises.harness.Fence`): a student file that
 opens a window, starts a process, opens a file outside its folder, or never finishes importing
 is stopped and reported with its diagnosis, and the checker (and the file's other tasks) go on.
 Each case has its hostile student file in ``tests/exercises/``."""
 
 from __future__ import annotations
 
-import multiprocessing
+import glob
+import os
 from pathlib import Path
 
 import numpy as np
@@ -25,15 +26,19 @@ FENCED = [  # (student file, task, status, diagnosis, the line of the file named
 ]
 
 
-@pytest.fixture(scope="module")
-def fenced():
-    """Each hostile file checked once on the tasks it defines."""
+@pytest.fixture(scope="module", params=["auto", "process"])
+def fenced(request):
+    """Each hostile file checked once on the tasks it defines, under bubblewrap where it works
+    and forced without it: the fence names the same attempts either way."""
     tasks = {
         "hostile_window": ["uniform_laplacian", "one_ring"],
         "hostile_spawn": ["uniform_laplacian", "barycentric_areas", "one_ring"],
         "hostile_read_outside": ["barycentric_areas", "mean_curvature_normal"],
     }
-    return {name: check_file(STUDENTS / f"{name}.py", t) for name, t in tasks.items()}
+    return {
+        name: check_file(STUDENTS / f"{name}.py", t, sandbox=request.param, speed=False)
+        for name, t in tasks.items()
+    }
 
 
 @pytest.mark.parametrize(("name", "task", "status", "diagnosis", "line"), FENCED)
@@ -62,6 +67,14 @@ def test_a_caught_refusal_is_still_refused(fenced):
     assert r.status == "refused" and r.n_calls == 0
 
 
+def _children() -> list[int]:
+    out = []
+    for f in glob.glob(f"/proc/{os.getpid()}/task/*/children"):
+        with open(f) as fh:
+            out += [int(p) for p in fh.read().split()]
+    return out
+
+
 def test_a_file_that_hangs_at_import_is_stopped_and_diagnosed():
     result = check_file(
         STUDENTS / "hostile_import_hang.py", ["uniform_laplacian", "one_ring"], timeout=4.0
@@ -69,13 +82,13 @@ def test_a_file_that_hangs_at_import_is_stopped_and_diagnosed():
     for t in result.tasks:
         assert t.status == "timeout" and t.diagnosis == "hangs_at_import", t.lines()
         assert "while importing your file" in t.message
-    assert not multiprocessing.active_children()
+    assert not _children()
 
 
 def test_a_right_file_is_not_fenced(tmp_path):
-    """A right file in another folder that reads a data file beside it, imports scipy's
+    """A right file in a student's folder that reads a data file beside it, imports scipy's
     submodules lazily inside the call and writes a scratch file in its folder: nothing is
-    refused."""
+    refused, and what it writes stays in its copy (the submitted folder is left as it was)."""
     (tmp_path / "factor.txt").write_text("1.0\n")
     (tmp_path / "mine.py").write_text(
         "import os\nimport numpy as np\n\n"
@@ -89,9 +102,9 @@ def test_a_right_file_is_not_fenced(tmp_path):
         "    A = 0.5 * np.linalg.norm(np.cross(P[:, 1] - P[:, 0], P[:, 2] - P[:, 0]), axis=1)\n"
         "    return s * np.bincount(F.ravel(), np.repeat(A / 3.0, 3), minlength=len(V))\n"
     )
-    result = check_file(tmp_path / "mine.py", ["barycentric_areas"])
+    result = check_file(tmp_path / "mine.py", ["barycentric_areas"], folder=tmp_path)
     assert result.passed, result.format_text()
-    assert (tmp_path / "scratch.npy").is_file()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["factor.txt", "mine.py"]
 
 
 # ---- time limits in proportion to the reference on the same mesh ---------------------------
@@ -116,11 +129,11 @@ def _slow_student(tmp_path: Path, body: str) -> Path:
 
 def test_a_right_answer_slower_than_the_time_limit_on_a_big_mesh_passes(tmp_path):
     """The call on the large sphere takes longer than the task's time limit (here 4 s): it is
-    given TIME_FACTOR × the reference's time on that mesh, measured just before in the same
-    worker, and passes (right_dense.py's dense heat method took 82 s there with the machine's
+    given TIME_FACTOR × the reference's time on that mesh, measured in the checker, and passes
+    (the former right_dense.py's dense heat method took 82 s there with the machine's
     load at 14 and was stopped as an infinite loop at 60 s)."""
     path = _slow_student(tmp_path, "time.sleep(6.0)")
-    result = check_file(path, ["heat_geodesic"], timeout=4.0)
+    result = check_file(path, ["heat_geodesic"], timeout=4.0, speed=False)
     assert result.passed, result.format_text()
 
 
@@ -132,7 +145,7 @@ def test_an_endless_call_on_a_big_mesh_is_stopped_at_its_budget(tmp_path, monkey
 
     monkeypatch.setattr(sandbox, "TIME_FACTOR", 100.0)
     path = _slow_student(tmp_path, "while True:\n    time.sleep(0.01)")
-    t = check_file(path, ["heat_geodesic"], timeout=4.0)["heat_geodesic"]
+    t = check_file(path, ["heat_geodesic"], timeout=4.0, speed=False)["heat_geodesic"]
     assert t.status == "timeout", t.lines()
     if t.diagnosis is None:  # the reference took under 40 ms: the 4 s limit came first
         assert "infinite loop" in t.message

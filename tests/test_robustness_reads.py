@@ -36,7 +36,11 @@ READER = CORE / "io" / "reader.py"
 ALLOWED = {
     ("linalg/slicing.py", "open"): "/proc/stat, the kernel's CPU counters (not a user's file)",
     ("io/atomic.py", "open"): "the output's directory, opened to fsync the rename",
-    ("exercises/sandbox.py", "open"): "/proc/self/statm, the worker's own size (not a user's file)",
+    ("exercises/harness.py", "open"): "/proc/self/statm and /dev/null in the grading harness, "
+    "which runs beside a student's file and imports no meshlap module (not a user's file)",
+    ("exercises/harness.py", "np.load"): "a call's inputs, written by the checker itself",
+    ("exercises/isolation.py", "open"): "/proc: a worker's CPU time, parent and token (not a "
+    "user's file)",
 }
 # calls that read a file by name
 READ_CALLS = {"read_text", "read_bytes", "load", "loadtxt", "genfromtxt", "fromfile", "imread"}

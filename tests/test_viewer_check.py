@@ -14,8 +14,8 @@ from meshlap_app.state.check import VIEWER_TASKS, CheckState
 
 from meshlap_core import primitives
 from meshlap_core.errors import MeshError
+from meshlap_core.exercises.tasks import EXERCISE_TASKS
 from meshlap_core.laplacian import cotan_stiffness, mass_matrix, vertex_areas
-from meshlap_core.options import EXERCISE_TASKS
 
 STUDENTS = Path(__file__).parent / "exercises"
 

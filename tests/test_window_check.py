@@ -15,7 +15,7 @@ from test_viewer_check import ONE_VERTEX_WRONG, _facing_vertex
 from test_window import Session, keep_shots, scene_box
 from xwindow import missing_tools
 
-from meshlap_core.options import EXERCISE_TASKS
+from meshlap_core.exercises.tasks import EXERCISE_TASKS
 
 CHECK_KEY = 6  # the Check panel's number key (its place among the registry's views)
 

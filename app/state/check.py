@@ -17,7 +17,8 @@ import numpy as np
 
 from meshlap_core.errors import MeshError
 from meshlap_core.exercises.check import MeshCheck, check_on_mesh
-from meshlap_core.options import EXERCISE_TASKS, check_choice
+from meshlap_core.exercises.tasks import EXERCISE_TASKS
+from meshlap_core.options import check_choice
 
 from .checks import Schema, boolean, integer, one_of
 

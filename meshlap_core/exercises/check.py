@@ -1,4 +1,6 @@
-"""Check a student's file: run it sandboxed, compare every answer, diagnose every failure.
+"""Check a student's file: run it sandboxed, compare every answer, diagnose every failure
+(:func:`check_file`); on the battery and one more mesh with both whole answers kept, for the
+viewer (:func:`check_on_mesh`).
 
 >>> from meshlap_core.exercises import check_file            # doctest: +SKIP
 >>> result = check_file("exercises.py", ["cotan_laplacian"])  # doctest: +SKIP
@@ -11,115 +13,80 @@ import contextlib
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
 
-from ..errors import MeshError
+from ..errors import MeshError, printable
 from ..laplacian import vertex_areas
-from ..options import (
-    EXERCISE_MEMORY_MB,
-    EXERCISE_SLOW_MIN_SECONDS,
-    EXERCISE_SLOW_RATIO,
-    EXERCISE_TASKS,
-    EXERCISE_TIMEOUT,
-    MASS_AREA,
-    check_choice,
-)
-from .compare import COMPARE, Comparison, aligned_columns, as_matrix
-from .diagnose import describe, diagnose
+from ..options import EXERCISE_MEMORY_MB, EXERCISE_TIMEOUT, MASS_AREA, check_choice
+from . import references as refs
+from .compare import COMPARE, aligned_columns, as_matrix
+from .copies import student_file
 from .meshes import Case, battery
-from .result import CheckResult, TaskResult
-from .sandbox import TaskRun, run_student
-from .tasks import TASKS, Task
+from .result import CheckResult
+from .sandbox import StudentRun, run_student
+from .tasks import EXERCISE_TASKS, TASKS
+from .verdict import evaluate, name_dependencies
+from .worker import Session, default_session
 
-_STOPPED = {
-    "missing": "no function of this name in the file",
-    "not_implemented": "not implemented yet (the stub raises NotImplementedError)",
-}
-
-
-def _cases(extra: Sequence[Case]) -> dict[str, Case]:
-    return {c.name: c for c in [*battery(), *extra]}
+MEMORY_MIN_MB = 32
+"""The smallest ``--memory``: a student's arrays on top of the harness's own numpy."""
 
 
-def evaluate(
-    task: Task, run: TaskRun, cases: dict[str, Case], kept: dict[str, Any] | None = None
-) -> TaskResult:
-    """Turn the worker's report of one task into a :class:`TaskResult` (compare, diagnose);
-    ``kept`` receives the reference answer of every call by mesh name (the viewer's mesh's is
-    then not computed twice)."""
-    if run.status != "ran":
-        shows_traceback = ("error", "memory", "import_error", "refused")
-        return TaskResult(
-            task.name,
-            run.status,
-            case=run.case if run.status not in _STOPPED else "",
-            label=run.label if run.status not in _STOPPED else "",
-            diagnosis=run.diagnosis,
-            diagnosis_text=describe(run.diagnosis),
-            message=_STOPPED.get(run.status, run.message),
-            traceback=run.message if run.status in shows_traceback else "",
+def task_names(tasks: Sequence[str] | None) -> list[str]:
+    """The tasks asked for, each once, in the order given (all by default).
+
+    Raises
+    ------
+    MeshError
+        An unknown task name.
+    """
+    names = list(EXERCISE_TASKS) if not tasks else [str(t) for t in tasks]
+    for name in names:
+        check_choice(name, EXERCISE_TASKS, "exercise", "--task")
+    return list(dict.fromkeys(names))
+
+
+def check_limits(timeout: float, memory_mb: int) -> None:
+    """Raises :class:`MeshError` for a time limit that is not positive, or a memory budget
+    under :data:`MEMORY_MIN_MB`."""
+    if not timeout > 0:
+        raise MeshError("must be a positive number of seconds", "--timeout")
+    if memory_mb < MEMORY_MIN_MB:
+        raise MeshError(
+            f"{memory_mb} MiB is too little: a student's file needs at least {MEMORY_MIN_MB} "
+            f"MiB for its arrays (default {EXERCISE_MEMORY_MB})",
+            "--memory",
         )
-    failures: list[tuple[Case, Any, Any, Comparison, str]] = []
-    first_fail: Comparison | None = None
-    notes: list[str] = []
-    for case_name, label, answer, _seconds in run.calls:
-        case = cases[case_name]
-        args = dict(task.calls(case))[label]
-        ref = task.reference(case, args)
-        if kept is not None:
-            kept[case_name] = ref
-        cmp = COMPARE[task.kind](answer, ref, case, task.power)
-        reason = None if cmp.ok or task.not_judged is None else task.not_judged(case, args)
-        if reason is not None:
-            notes.append(reason)
-        elif not cmp.ok:
-            failures.append((case, args, answer, cmp, label))
-            first_fail = first_fail or cmp
-    if failures:
-        case, args, answer, cmp, label = failures[0]
-        valued = [(c, a, g) for c, a, g, cm, _ in failures if not cm.structural]
-        key = diagnose(task, valued) if len(valued) == len(failures) else None
-        if key is None and any("F.max()+1" in f[3].message for f in failures):
-            key = "sized_by_faces"
-        return TaskResult(
-            task.name, "failed", case.name, label, cmp.vertex, cmp.expected, cmp.got,
-            cmp.error, cmp.tol, key, describe(key), cmp.message,
-            n_failed=len(failures), n_calls=len(run.calls), difference=cmp.difference,
-            picture=_picture(failures, task), note="; ".join(notes),
-        )  # fmt: skip
-    ratio, seconds, n = _speed(task, run, cases)
-    if ratio is not None and ratio >= EXERCISE_SLOW_RATIO and seconds >= EXERCISE_SLOW_MIN_SECONDS:
-        return TaskResult(
-            task.name, "failed", "large", diagnosis="slow_loop",
-            diagnosis_text=describe("slow_loop", ratio=ratio, n=n, seconds=seconds),
-            n_calls=len(run.calls), speed_ratio=ratio, note="; ".join(notes),
-        )  # fmt: skip
-    return TaskResult(
-        task.name, "passed", n_calls=len(run.calls), speed_ratio=ratio, note="; ".join(notes)
-    )
 
 
-def _picture(failures: list[tuple[Case, Any, Any, Comparison, str]], task: Task) -> tuple | None:
-    """(V, F, difference, mesh name, signed) of the largest failing mesh with a difference
-    map (``signed``: a scalar per vertex, student − reference)."""
-    shown = [(c, cm) for c, _, _, cm, _ in failures if cm.difference is not None]
-    if not shown:
-        return None
-    case, cmp = max(shown, key=lambda s: len(s[0].V))
-    signed = task.kind == "array" and np.ndim(cmp.expected) == 0
-    return case.V, case.F, cmp.difference, case.name, signed
-
-
-def _speed(task: Task, run: TaskRun, cases: dict[str, Case]) -> tuple[float | None, float, int]:
-    """(student time / reference time, student seconds, vertices) on the speed case."""
-    if not task.speed or run.speed is None:
-        return None, 0.0, 0
-    mine, ref = run.speed
-    n = next((len(c.V) for c in cases.values() if "speed" in c.tags), 0)
-    return mine / max(ref, 1e-9), mine, n
+def result_of(
+    student: StudentRun,
+    names: list[str],
+    shown: str,
+    source: Path | None,
+    cases: dict[str, Case],
+    *,
+    require_speed: bool = False,
+    kept: dict[str, Any] | None = None,
+) -> CheckResult:
+    """The :class:`CheckResult` of a sandbox run (``source``: the student's file, parsed for
+    the slow loop and the failed dependencies, never run)."""
+    folder = source.parent if source is not None else None
+    results = [
+        evaluate(TASKS[n], student.tasks[n], cases, kept, require_speed=require_speed,
+                 source=folder)
+        for n in names
+    ]  # fmt: skip
+    name_dependencies(results, source)
+    return CheckResult(
+        shown, results, isolation=student.isolation.to_dict(), log=student.log,
+        log_bytes=student.log_bytes, notes=student.notes, seconds=student.seconds,
+        survivors=len(student.survivors),
+    )  # fmt: skip
 
 
 def check_file(
@@ -129,22 +96,48 @@ def check_file(
     extra: Sequence[Case] = (),
     timeout: float = EXERCISE_TIMEOUT,
     memory_mb: int = EXERCISE_MEMORY_MB,
+    session: Session | None = None,
+    sandbox: str | None = None,
+    folder: str | os.PathLike | None = None,
+    among_others: bool = False,
+    file_timeout: float | None = None,
+    require_speed: bool = False,
+    speed: bool = True,
+    name: str | None = None,
 ) -> CheckResult:
     """Check the student file ``path`` on ``tasks`` (all by default).
 
-    The file runs in a spawned worker process with ``timeout`` seconds per task and
-    ``memory_mb`` MiB of address space (:mod:`.sandbox`); this process only compares.
+    The file runs in a sandboxed worker (:mod:`.sandbox`, :mod:`.isolation`) on a copy of its
+    own, with ``timeout`` seconds per task and ``memory_mb`` MiB of address space; this process
+    computes the references and compares.
 
     Parameters
     ----------
     path : str or PathLike
         The student's Python file (``meshlap exercises init`` writes the template).
     tasks : sequence of str, optional
-        Names from :data:`~meshlap_core.options.EXERCISE_TASKS`.
+        Names from :data:`~.tasks.EXERCISE_TASKS` (a name given twice is checked once).
     extra : sequence of Case
         More meshes to check on (the viewer's).
     timeout : float
     memory_mb : int
+    session : Session, optional
+        The grading run (isolation, inputs); the process's default one when omitted.
+    sandbox : {"auto", "bwrap", "process"}, optional
+        The isolation of the default session (``$MESHLAP_SANDBOX``, else ``auto``).
+    folder : str or PathLike, optional
+        The student's folder, copied whole (helper modules, data files): ``path`` is in it.
+    among_others : bool
+        ``path`` lies among other students' files: a module beside it defining a task is
+        theirs, and not copied with it (a class folder of files).
+    file_timeout : float, optional
+        Seconds for the whole file.
+    require_speed : bool
+        A right but slow answer fails (``slow_loop``).
+    speed : bool
+        Time every task (the speed line).
+    name : str, optional
+        The file as the report names it (default: ``path``).
 
     Returns
     -------
@@ -153,17 +146,20 @@ def check_file(
     Raises
     ------
     MeshError
-        The file does not exist, or an unknown task name.
+        Not a regular file, an unknown task name, a limit out of range.
     """
-    names = list(EXERCISE_TASKS) if not tasks else [str(t) for t in tasks]
-    for name in names:
-        check_choice(name, EXERCISE_TASKS, "exercise", "--task")
-    if not os.path.isfile(path):
-        raise MeshError("no such file", os.fspath(path))
-    runs = run_student(path, names, list(extra), timeout=timeout, memory_mb=memory_mb)
-    cases = _cases(extra)
-    results = [evaluate(TASKS[n], runs[n], cases) for n in names]
-    return CheckResult(os.fspath(path), results)
+    names = task_names(tasks)
+    check_limits(timeout, memory_mb)
+    student = student_file(path)
+    session = session or default_session(sandbox)
+    root = Path(folder) if folder is not None else None
+    student_run = run_student(
+        student, names, list(extra), timeout=timeout, memory_mb=memory_mb, session=session,
+        folder=root, among_others=among_others, file_timeout=file_timeout, speed=speed,
+    )  # fmt: skip
+    cases = {c.name: c for c in [*battery(), *extra]}
+    shown = printable(name if name is not None else os.fspath(path))
+    return result_of(student_run, names, shown, student, cases, require_speed=require_speed)
 
 
 @dataclass
@@ -266,16 +262,17 @@ def check_on_mesh(
     whole answers on that mesh for the viewer's difference map and row inspector (``cancel``:
     an event or callable that stops the worker and raises ``Cancelled``)."""
     check_choice(task, EXERCISE_TASKS, "exercise", "task")
-    if not os.path.isfile(path):
-        raise MeshError("no such file", os.fspath(path))
+    student = student_file(path)
     case = Case("your_mesh", np.asarray(V, float), np.asarray(F, np.int64), "the mesh on screen")
     t = TASKS[task]
-    runs = run_student(path, [task], [case], timeout=timeout, memory_mb=memory_mb, cancel=cancel)
+    run = run_student(student, [task], [case], timeout=timeout, memory_mb=memory_mb,
+                      cancel=cancel, speed=False)  # fmt: skip
     kept: dict[str, Any] = {}
-    result = CheckResult(os.fspath(path), [evaluate(t, runs[task], _cases([case]), kept)])
-    (_, args), *_ = t.calls(case)
-    expected = kept[case.name] if case.name in kept else t.reference(case, args)
-    got = next((a for c, _, a, _ in runs[task].calls if c == case.name), None)
+    cases = {c.name: c for c in [*battery(), case]}
+    result = result_of(run, [task], printable(os.fspath(path)), student, cases, kept=kept)
+    (label, args), *_ = refs.calls(t, case)
+    expected = kept[case.name] if case.name in kept else refs.expected(t, case, label, args)
+    got = next((a for c, _, a, _ in run.tasks[task].calls if c == case.name), None)
     difference, signed = None, False
     if got is not None:
         cmp = COMPARE[t.kind](got, expected, case, t.power)

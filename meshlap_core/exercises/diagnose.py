@@ -5,7 +5,13 @@ Every classic mistake is written as the wrong answer it produces (the task's own
 A wrong answer is diagnosed as the first mistake whose wrong answer matches the student's on
 *every* failing call (each mesh, each boundary rule): one mesh where two mistakes coincide (on a
 single acute triangle clamping the cot weights changes nothing) cannot mislead the diagnosis.
-A student whose answer matches none gets no diagnosis, only the vertex, expected and got.
+Then, for an answer no classic mistake explains: a constant factor on every failing call
+(``−2 ×`` the expected), and single precision (float32, or values that agree to a few digits
+only). A student whose answer matches none gets no diagnosis, only the vertex, expected and got.
+
+The checker's own verdicts have keys here too: a failed dependency, the sandbox's refusals, an
+answer that is not numbers, the wrong shape, NaN at a triangle of zero area, a dense matrix on
+the big mesh, a file that exits or writes on the checker's channel.
 """
 
 from __future__ import annotations
@@ -16,10 +22,17 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 
+from . import references as refs
 from .compare import COMPARE
 from .meshes import Case
 from .tasks import Args, Mistake, Task
 
+Failure = tuple[Case, str, Args, Any]
+"""One failing call: (mesh, label, arguments, the student's answer)."""
+FEW_DIGITS_RTOL = 1e-4
+"""An answer within this (relative to the answer's scale) but not within the task's tolerance
+agrees to a few digits only: single precision somewhere, or a formula that loses digits."""
+NICE_FACTORS = (-4.0, -3.0, -2.0, -0.5, -0.25, 0.25, 1 / 3, 3.0, 4.0, 2 * np.pi, 1 / (2 * np.pi))
 DIAGNOSES: dict[str, str] = {
     "sign_flip": "sign flip: the answer is the negative of the expected one (our Laplacians are "
     "negative semidefinite, Δx = −2Hn, and the frequencies λ ≥ 0)",
@@ -72,12 +85,44 @@ DIAGNOSES: dict[str, str] = {
     "the Poisson solution is only defined up to a constant",
     "sized_by_faces": "the answer is sized by F.max()+1: a vertex in no face (the last one here) "
     "still has its row; use n = len(V)",
+    "constant_factor": "a constant factor: the answer is {factor} × the expected one on every "
+    "failing mesh (a ½ forgotten or doubled, a sign, a normalisation?)",
+    "single_precision": "single precision: the answer is float32 (about 7 digits; the check "
+    "needs float64's). Compute and return float64",
+    "few_digits": "right to a few digits only (about 4–7): float32 somewhere in the "
+    "computation, or a formula that loses digits on thin triangles (Heron's formula, "
+    "arccos near 0 or π)",
+    "wrong_shape": "the wrong shape (see the message): return the shape the template gives",
+    "not_finite": "NaN or inf in the answer: a division by zero (an unguarded 1/area, 1/degree)",
+    "nan_on_degenerate": "NaN or inf at a triangle of zero area (collinear corners): such a "
+    "triangle adds nothing; guard the division by its area (np.divide(..., where=area > 0))",
+    "complex_values": "complex numbers: the answer must be real (a symmetric solver — "
+    "np.linalg.eigh, scipy eigsh —, not np.linalg.eig; no square root of a negative number)",
+    "not_numbers": "not an array of numbers (see the message): return numpy arrays or "
+    "scipy.sparse matrices",
+    "no_answer": "no answer: the function returned nothing (a missing return?)",
+    "dense_at_size": "a dense n×n array on the mesh of {n} vertices ({gigabytes:.1f} GB): out "
+    "of memory or over the answer's size; build scipy.sparse matrices (COO triplets) and use "
+    "sparse solvers",
+    "failed_dependency": "your {dependency} fails, so {task} cannot pass: fix {dependency} first",
+    "calls_exit": "your file calls sys.exit() or exit() ({what}): a check calls your functions "
+    'and must not be ended; keep script code under `if __name__ == "__main__":`',
+    "tampers": "your file wrote on the checker's own channel (its pipe to the checker): the "
+    "rest of the file is not checked",
+    "signals_process": "sends a signal to another process ({what}): a check runs your "
+    "functions only",
+    "uses_network": "uses the network ({what}): a check runs offline; compute from the "
+    "arguments only",
+    "native_calls": "calls C functions directly through ctypes ({what}): a check runs numpy, "
+    "scipy and libigl code, not raw C calls",
+    "imports_meshlap": "imports meshlap itself: the checker compares your answer with "
+    "meshlap's, so calling it would check nothing; use numpy, scipy (and libigl)",
     "opens_window": "opens a window (polyscope, a GUI toolkit, an X/GL library): the checker "
     'runs without a screen; keep viewers and plots under `if __name__ == "__main__":`',
     "spawns_process": "starts a process (subprocess, os.system, multiprocessing, fork): a "
     "check runs your functions only",
-    "outside_folder": "opens a file outside the exercises file's folder (another submission, "
-    "the reference, the system): a check reads and writes only beside your file",
+    "outside_folder": "reads or writes outside your own folder: {what} (another submission, "
+    "the reference, the system); a check reads and writes only beside your file",
     "hangs_at_import": "the file never finishes importing (a loop, a sleep or input() at "
     'module level?): put work inside the functions or under `if __name__ == "__main__":`',
     "too_slow": "far slower than the reference on this mesh (a time limit scaled to the "
@@ -91,12 +136,11 @@ DIAGNOSES: dict[str, str] = {
 
 
 def _generic(task: Task) -> list[Mistake]:
-    out = [
+    return [
         Mistake("sign_flip", lambda c, a: _scaled(task.reference(c, a), -1.0)),
         Mistake("factor_2", lambda c, a: _scaled(task.reference(c, a), 2.0)),
         Mistake("factor_half", lambda c, a: _scaled(task.reference(c, a), 0.5)),
     ]
-    return out
 
 
 def _scaled(x: Any, s: float) -> Any:
@@ -108,22 +152,26 @@ def candidates(task: Task) -> list[Mistake]:
     return list(task.mistakes) + (_generic(task) if task.generic else [])
 
 
-def _matches(task: Task, mistake: Mistake, case: Case, args: Args, got: Any) -> bool:
-    wrong = mistake.wrong(case, args)
-    if wrong is None:
-        return False
-    expected = task.reference(case, args)
+def _same(task: Task, wrong: Any, expected: Any) -> bool:
+    """The mistake makes no difference on this call (it cannot explain a failure there)."""
     if task.kind == "ring":
-        same = all(np.array_equal(w, e) for w, e in zip(wrong, expected, strict=True))
-    elif task.kind == "eigen":
-        same = np.allclose(wrong[0], expected[0]) and np.allclose(
+        return all(np.array_equal(w, e) for w, e in zip(wrong, expected, strict=True))
+    if task.kind == "eigen":
+        return np.allclose(wrong[0], expected[0]) and np.allclose(
             np.abs(wrong[1]), np.abs(expected[1])
         )
-    elif sp.issparse(wrong):
-        same = (abs(sp.csr_matrix(wrong) - expected)).max() == 0
-    else:
-        same = np.array_equal(np.asarray(wrong), np.asarray(expected))
-    if same:  # the mistake makes no difference on this call: it cannot explain a failure
+    if sp.issparse(wrong):
+        return (abs(sp.csr_matrix(wrong) - expected)).max() == 0
+    return np.array_equal(np.asarray(wrong), np.asarray(expected))
+
+
+def _matches(task: Task, index: int, mistake: Mistake, failure: Failure) -> bool:
+    case, label, args, got = failure
+    wrong = refs.wrong(task, index, mistake, case, label, args)
+    if wrong is None:
+        return False
+    expected = refs.expected(task, case, label, args)
+    if _same(task, wrong, expected):
         return False
     if mistake.fits is not None:
         return mistake.fits(got, expected, case)
@@ -149,25 +197,84 @@ def _eigen_matches(key: str, got: Any, wrong: tuple[np.ndarray, np.ndarray]) -> 
     return True
 
 
-def diagnose(task: Task, failures: Sequence[tuple[Case, Args, Any]]) -> str | None:
+def diagnose(task: Task, failures: Sequence[Failure]) -> str | None:
     """The key of the first mistake that explains every failing call, or None.
 
     Parameters
     ----------
     task : Task
-    failures : sequence of (case, args, got)
+    failures : sequence of (case, label, args, got)
         Every call the student failed (compared values, not crashes).
     """
     if not failures:
         return None
-    for mistake in candidates(task):
-        if all(_matches(task, mistake, c, a, g) for c, a, g in failures):
+    for index, mistake in enumerate(candidates(task)):
+        if all(_matches(task, index, mistake, f) for f in failures):
             return mistake.key
     return None
+
+
+def _flat(x: Any) -> np.ndarray | None:
+    try:
+        a = x.toarray() if sp.issparse(x) else x
+        return np.asarray(a, dtype=np.float64).ravel()
+    except (TypeError, ValueError):
+        return None
+
+
+def constant_factor(task: Task, failures: Sequence[Failure]) -> float | None:
+    """The one factor ``c`` with ``got = c × expected`` on every failing call (within the
+    task's tolerance), or None; a factor of 1 or 0 is no such mistake."""
+    if task.kind not in ("matrix", "array") or not failures:
+        return None
+    factor = None
+    for case, label, args, got in failures:
+        e, g = _flat(refs.expected(task, case, label, args)), _flat(got)
+        if e is None or g is None or e.shape != g.shape or not e.any():
+            return None
+        c = float(e @ g / (e @ e))
+        nice = min(NICE_FACTORS, key=lambda f: abs(f - c))
+        c = nice if abs(nice - c) <= 1e-9 * abs(c) else c
+        if factor is not None and abs(c - factor) > 1e-6 * abs(factor):
+            return None
+        factor = c
+        if not COMPARE[task.kind](got, _scaled(refs.expected(task, case, label, args), c),
+                                  case, task.power).ok:  # fmt: skip
+            return None
+    return None if factor is None or abs(factor - 1.0) < 1e-6 or abs(factor) < 1e-12 else factor
+
+
+def few_digits(task: Task, failures: Sequence[Failure]) -> bool:
+    """Every failing call agrees with the reference to about :data:`FEW_DIGITS_RTOL`."""
+    if task.kind not in ("matrix", "array") or not failures:
+        return False
+    for case, label, args, got in failures:
+        e, g = _flat(refs.expected(task, case, label, args)), _flat(got)
+        if e is None or g is None or e.shape != g.shape or not np.isfinite(g).all():
+            return False
+        finite = np.isfinite(e)
+        scale = max(float(np.abs(e[finite]).max(initial=0.0)), case.scale**task.power)
+        if np.abs(g[finite] - e[finite]).max(initial=0.0) > FEW_DIGITS_RTOL * scale:
+            return False
+    return True
+
+
+def factor_text(c: float) -> str:
+    """``−2``, ``½``, ``2π``... as the report writes a factor."""
+    names = {0.5: "½", -0.5: "−½", 0.25: "¼", -0.25: "−¼", 1 / 3: "⅓", 2 * np.pi: "2π",
+             1 / (2 * np.pi): "1/(2π)"}  # fmt: skip
+    for value, name in names.items():
+        if abs(c - value) <= 1e-12 * abs(value):
+            return name
+    return f"{c:.6g}".replace("-", "−")
 
 
 def describe(key: str | None, **details: Any) -> str:
     """The sentence of diagnosis ``key`` (with ``details`` filled in), or ``""``."""
     if key is None:
         return ""
-    return DIAGNOSES[key].format(**details) if details else DIAGNOSES[key]
+    text = DIAGNOSES[key]
+    try:
+        return text.format(**details) if "{" in text else text
+    except (KeyError, IndexError, ValueError):
+        return text.split(" ({")[0].split(" {")[0]

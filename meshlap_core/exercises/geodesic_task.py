@@ -22,17 +22,39 @@ import igl
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
+from scipy.sparse import csgraph
 
 from ..diffusion.geodesic import HeatGeodesic, mean_edge_length
 from ..spectral.operators import spectral_operators
 from .compare import compare_array
 from .meshes import Case
 
-HEAT_CASES = ("small_sphere", "scaled", "large")
+HEAT_CASES = ("small_sphere", "scaled", "large", "huge")
 """Closed, connected, without symmetric ties (on a regular tetrahedron the face opposite the
 source is at constant heat: its direction is round-off, and no two codes agree on it)."""
 HEAT_M = 1.0
 """The time factor passed to the student: ``t = m·h²`` (the paper's choice)."""
+
+
+STUB = '''
+def heat_geodesic(V, F, source, m):
+    """Geodesic distance from vertex ``source`` by the heat method (Crane, Weischedel &
+    Wardetzky, "Geodesics in heat", ACM TOG 2013), on a closed connected mesh.
+
+    K = −C (cotan_laplacian), M = mass_matrix (mixed Voronoi), h the mean edge length (each
+    edge once), t = m·h² (the time must scale with the mesh):
+    1. heat: solve (M + t K) u = δ, δ one at the source and zero elsewhere;
+    2. per face: X = −∇u / |∇u| (∇ the gradient of the piecewise-linear u; X = 0 where ∇u = 0);
+    3. Poisson: K φ = Gᵀ A X (G the (3m, n) face gradient, A the diagonal of face areas:
+       Gᵀ A X is minus the integrated divergence of X); K is singular (constants): pin one
+       vertex, e.g. φ_0 = 0, and solve for the others;
+    4. d = φ − φ[source].
+
+    Returns d : (n,), 0 at the source and increasing away from it (units of length).
+    """
+    raise NotImplementedError
+'''
+"""The template's stub (declared with the task in :mod:`.tasks`)."""
 
 
 def heat_calls(case: Case) -> list[tuple[str, tuple[Any, ...]]]:
@@ -60,7 +82,17 @@ def heat_not_judged(case: Case, args: tuple[Any, ...]) -> str | None:
     source (a big scan, a long tube) it underflows to 0, and the template's ``−∇u/|∇u|`` is
     0/0 there; a right answer written from the template is then NaN, or noise, on such a mesh.
     The lab's reference takes those faces' direction from a longer time's heat, which the
-    template does not ask for, so such a mesh cannot judge the student (the battery does)."""
+    template does not ask for, so such a mesh cannot judge the student (the battery does).
+    A mesh of several pieces cannot judge it either: the template's method assumes one (the
+    distance to another piece is infinite, and its heat exactly 0 by topology, not by
+    underflow)."""
+    pieces = _pieces(case)
+    if pieces > 1:
+        return (
+            f"not judged on mesh {case.name}: it has {pieces} separate pieces (connected "
+            "components); the template's heat method is for one connected mesh (the distance "
+            "to another piece is infinite); the battery's meshes judge the task"
+        )
     u = HeatGeodesic(case.V, case.F, m=args[3], boundary="neumann").heat([args[2]])
     a = np.abs(u)
     lost = a[case.F].max(axis=1) <= UNDERFLOW * float(a.max(initial=0.0))
@@ -71,6 +103,18 @@ def heat_not_judged(case: Case, args: tuple[Any, ...]) -> str | None:
         f"{100 * lost.mean():.2g} % of its faces (far from the source), where −∇u/|∇u| has no "
         "direction; the battery's meshes judge the task"
     )
+
+
+def _pieces(case: Case) -> int:
+    """Connected components of the faces' vertices (unreferenced vertices not counted)."""
+    used = np.unique(case.F)
+    if len(used) == 0:
+        return 0
+    n = len(case.V)
+    e = np.concatenate([case.F[:, [0, 1]], case.F[:, [1, 2]]])
+    A = sp.coo_matrix((np.ones(len(e)), (e[:, 0], e[:, 1])), shape=(n, n))
+    _, labels = csgraph.connected_components(A, directed=False)
+    return len(np.unique(labels[used]))
 
 
 def heat_steps(

@@ -13,21 +13,29 @@ case                   what it catches
                        ``F.max()+1``, zero rows, no division by zero
 ``scaled``             a bumpy sphere scaled by 250 and moved: units and scale-aware tolerances
 ``small_sphere``       a closed bumpy sphere (42 vertices) for the eigenproblem
+``degenerate``         a triangle of zero area (three collinear corners): no NaN or inf, its
+                       cot weights, normal and areas are 0
+``slivers``            a needle and a cap (angles of 0.06° and 179.9°): cot weights near ±1000,
+                       float32 loses them, an absolute "small area" threshold drops them
 ``large``              an icosphere of 2562 vertices, perturbed: correctness at size and speed
+``huge``               a bumpy torus of 20,480 vertices: a dense n×n array there needs 3.4 GB
+                       (fails on memory or time, and is named so)
 =====================  ==========================================================================
 
 Every mesh is generated here (seeded), never read from disk, and oriented counter-clockwise
-seen from outside.
+seen from outside. :func:`battery` builds them once per process; their arrays are read-only
+(the checker hands every student call a copy).
 """
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..laplacian import mean_edge_length
-from ..primitives import icosphere
+from ..primitives import icosphere, torus_mesh
 from ..types import FloatArray, IntArray
 
 
@@ -88,8 +96,48 @@ def _bumpy_sphere(subdivisions: int, seed: int, amount: float = 0.08):
     return V, F
 
 
-def battery() -> list[Case]:
-    """All cases, in the order they are tried (the small hand-checkable ones first)."""
+def _degenerate() -> tuple[FloatArray, IntArray]:
+    """Vertex 1 on the segment from 0 to 2 (exact coordinates: the face (2, 0, 1) has area 0 in
+    any formula), a face above and two below; vertex 1 is interior (angles π, π/2, π/2)."""
+    V = np.array(
+        [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0], [1.0, 1.0, 0.3], [1.0, -1.0, 0.2]]
+    )
+    return V, np.array([[0, 2, 3], [2, 0, 1], [1, 0, 4], [2, 1, 4]])
+
+
+def _slivers() -> tuple[FloatArray, IntArray]:
+    """The same layout with vertex 1 lifted 10⁻³ off the segment (a cap: 179.9° at vertex 1,
+    0.06° at vertices 0 and 2) and a needle beside it (0.08° at vertex 4, on a base 0.002
+    long from vertex 2 to vertex 5)."""
+    V, F = _degenerate()
+    V = np.vstack([V, [[2.0, -0.002, 0.0]]])
+    V[1, 1] = 0.001
+    F = np.vstack([F, [[2, 4, 5]]])
+    return V, F
+
+
+def _huge() -> tuple[FloatArray, IntArray]:
+    V, F = torus_mesh(160, 128, R=3.0, r=1.0)
+    rng = np.random.default_rng(11)
+    ring = V.copy()
+    ring[:, 2] = 0.0
+    centre = 3.0 * ring / np.linalg.norm(ring, axis=1, keepdims=True)  # the core circle
+    return centre + (V - centre) * (1.0 + 0.02 * rng.uniform(-1.0, 1.0, (len(V), 1))), F
+
+
+@functools.cache
+def battery() -> tuple[Case, ...]:
+    """All cases, in the order they are tried (the small hand-checkable ones first); built once,
+    their arrays read-only."""
+    cases = _cases()
+    for c in cases:
+        c.V.flags.writeable = False
+        c.F.flags.writeable = False
+    return tuple(cases)
+
+
+def _cases() -> list[Case]:
+    """Long because it is the battery itself: one mesh per paragraph, read top to bottom."""
     cases: list[Case] = []
     V = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.3, 0.8, 0.0]])
     cases.append(Case("one_triangle", V, np.array([[0, 1, 2]]), "factors 2, ½, 3 by hand"))
@@ -130,8 +178,14 @@ def battery() -> list[Case]:
     cases.append(
         Case("scaled", 250.0 * V + [40.0, -7.0, 3.0], F, "units: a copy scaled by 250", True)
     )
+    V, F = _degenerate()
+    cases.append(Case("degenerate", V, F, "a triangle of zero area: no NaN or inf"))
+    V, F = _slivers()
+    cases.append(Case("slivers", V, F, "a needle and a cap: cot weights near ±1000"))
     V, F = _bumpy_sphere(4, seed=7, amount=0.02)
-    cases.append(Case("large", V, F, "correct at size, and not 100× slower", True, ("speed",)))
+    cases.append(Case("large", V, F, "correct at size, and the speed", True, ("speed",)))
+    V, F = _huge()
+    cases.append(Case("huge", V, F, "20,480 vertices: sparse, not dense n×n", True, ("huge",)))
     return cases
 
 

@@ -8,11 +8,15 @@ from __future__ import annotations
 
 import html
 import io
+import os
+import re
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
 import numpy as np
+
+from .speed import Speed
 
 STATUS_WORDS = {
     "passed": "passed",
@@ -26,6 +30,8 @@ STATUS_WORDS = {
     "import_error": "ERROR (the file does not import)",
     "refused": "REFUSED (the sandbox stopped it)",
 }
+LOG_LINES = 20
+"""Lines of what the student's file printed that the text report shows."""
 
 
 @dataclass
@@ -47,8 +53,6 @@ class TaskResult:
         A key of :data:`~.diagnose.DIAGNOSES`; ``diagnosis_text`` its sentence.
     message, traceback : str
     n_failed, n_calls : int
-    speed_ratio : float or None
-        Student time / reference time on the large mesh (speed-checked tasks).
     difference : (n,) float or None
         Student − reference per vertex of ``case`` (the difference map).
     note : str
@@ -56,6 +60,11 @@ class TaskResult:
     picture : (V, F, difference, mesh name, signed) or None
         The largest failing mesh and its difference map (the notebook picture); ``signed``:
         a scalar per vertex (coolwarm around 0), else a magnitude (viridis from 0).
+    speed : Speed or None
+        The speed line (a right task timed on the large mesh); ``speed_required``: a slow one
+        fails (``--require-speed``).
+    repro : (case, label, args) or None
+        The first failing call: the mesh and arguments a student can export.
     """
 
     task: str
@@ -73,10 +82,12 @@ class TaskResult:
     traceback: str = ""
     n_failed: int = 0
     n_calls: int = 0
-    speed_ratio: float | None = None
     difference: np.ndarray | None = field(default=None, repr=False)
     picture: tuple | None = field(default=None, repr=False)
     note: str = ""
+    speed: Speed | None = None
+    speed_required: bool = False
+    repro: tuple | None = field(default=None, repr=False)
 
     @property
     def passed(self) -> bool:
@@ -84,23 +95,25 @@ class TaskResult:
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready fields (no difference array)."""
-        out = {k: v for k, v in vars(self).items() if k not in ("difference", "picture")}
+        hidden = ("difference", "picture", "repro", "speed")
+        out = {k: v for k, v in vars(self).items() if k not in hidden}
+        out["speed"] = self.speed.to_dict() if self.speed is not None else None
         out["passed"] = self.passed
         return out
 
     def lines(self) -> list[str]:
         """The text report of this task (first line: name and verdict)."""
         head = f"{self.task:<24} {STATUS_WORDS.get(self.status, self.status)}"
+        speed = [f"  {self.speed.line(self.speed_required)}"] if self.speed is not None else []
         if self.passed:
-            speed = f", {self.speed_ratio:.0f}× the reference's time" if self.speed_ratio else ""
-            return [f"{head} ({self.n_calls} calls{speed})", *self._note()]
+            return [f"{head} ({self.n_calls} calls)", *speed, *self._note()]
         out = [head]
         if self.case:
             where = f"  on mesh {self.case}" + (f" ({self.label})" if self.label else "")
             if self.n_failed > 1:
                 where += f", and {self.n_failed - 1} more failing call(s)"
             out.append(where)
-        if self.vertex is not None or self.expected is not None:
+        if self.expected is not None or self.got is not None:
             out.append(f"  at vertex {self.vertex}:" if self.vertex is not None else "  values:")
             out.append(f"    expected {_short(self.expected)}")
             out.append(f"    got      {_short(self.got)}")
@@ -112,7 +125,7 @@ class TaskResult:
             out.append(f"  {self.message}")
         if self.traceback:
             out.extend("  " + line for line in self.traceback.splitlines())
-        return out + self._note()
+        return out + speed + self._note()
 
     def _note(self) -> list[str]:
         return [f"  note: {self.note}"] if self.note else []
@@ -132,10 +145,36 @@ def _short(value: Any, limit: int = 160) -> str:
 
 @dataclass
 class CheckResult:
-    """All tasks of one student file."""
+    """All tasks of one student file, and how the file was run.
+
+    Attributes
+    ----------
+    file : str
+        The file as the report names it (control characters escaped).
+    tasks : list of TaskResult
+    isolation : dict
+        :meth:`.isolation.Isolation.to_dict` of the sandbox it ran in.
+    log : str
+        What the file printed (capped; control characters escaped), ``log_bytes`` in all.
+    notes : list of str
+        What the copy of the submission left out, and why.
+    seconds : float
+        Wall time of the whole check.
+    survivors : int
+        Processes the file left running that the end of the check killed.
+    submission : str
+        The student (a folder's submission name; ``""`` for a single file).
+    """
 
     file: str
     tasks: list[TaskResult]
+    isolation: dict[str, Any] = field(default_factory=dict)
+    log: str = ""
+    log_bytes: int = 0
+    notes: list[str] = field(default_factory=list)
+    seconds: float = 0.0
+    survivors: int = 0
+    submission: str = ""
 
     @property
     def passed(self) -> bool:
@@ -153,15 +192,33 @@ class CheckResult:
 
     def format_text(self) -> str:
         lines = [f"{self.file}: {self.n_passed}/{len(self.tasks)} tasks passed"]
+        if self.isolation:
+            lines.append(f"  sandbox: {self.isolation.get('description', '')}")
+        lines.extend(f"  note: {n}" for n in self.notes)
         for t in self.tasks:
             lines.extend(t.lines())
+        if self.survivors:
+            lines.append(f"  the file left {self.survivors} process(es) running: killed")
+        if self.log_bytes:
+            shown = self.log.splitlines()
+            lines.append(f"  your file printed ({self.log_bytes} bytes; the first lines):")
+            lines.extend("  | " + x for x in shown[:LOG_LINES])
+            if len(shown) > LOG_LINES:
+                lines.append(f"  | … ({len(shown) - LOG_LINES} more lines)")
         return "\n".join(lines)
 
     def to_dict(self) -> dict[str, Any]:
         return {
             "file": self.file,
+            "submission": self.submission,
             "passed": self.n_passed,
             "total": len(self.tasks),
+            "isolation": self.isolation,
+            "seconds": self.seconds,
+            "notes": self.notes,
+            "log": self.log,
+            "log_bytes": self.log_bytes,
+            "survivors": self.survivors,
             "tasks": [t.to_dict() for t in self.tasks],
         }
 
@@ -175,20 +232,59 @@ class CheckResult:
         errors = sum(t.status not in ("passed", "failed") for t in self.tasks)
         suite = ET.Element(
             "testsuite",
-            name=f"meshlap check {self.file}",
+            name=xml_text(f"meshlap check {self.file}"),
             tests=str(len(self.tasks)),
             failures=str(failures),
             errors=str(errors),
+            time=f"{self.seconds:.3f}",
         )
+        student = xml_text(self.submission or os.path.splitext(os.path.basename(self.file))[0])
+        share = self.seconds / max(len(self.tasks), 1)
         for t in self.tasks:
-            case = ET.SubElement(suite, "testcase", classname="meshlap.exercises", name=t.task)
+            case = ET.SubElement(suite, "testcase", classname=student, name=t.task,
+                                 time=f"{share:.3f}")  # fmt: skip
+            if t.speed is not None:
+                ET.SubElement(case, "system-out").text = xml_text(t.speed.line(t.speed_required))
             if t.passed:
                 continue
             tag = "failure" if t.status == "failed" else "error"
-            text = "\n".join(t.lines()[1:])
-            node = ET.SubElement(case, tag, message=t.diagnosis_text or t.message or t.status)
-            node.text = text
+            why = t.diagnosis_text or (t.message.splitlines() or [t.status])[0]
+            node = ET.SubElement(case, tag, message=xml_text(why or t.status), type=t.status)
+            node.text = xml_text("\n".join(t.lines()[1:]))
         return suite
+
+    def gradescope(self) -> dict[str, Any]:
+        """Gradescope's ``results.json`` of this file: one test per task (1 point each),
+        its output the report's lines, and the file's score."""
+        tests = [
+            {"name": t.task, "number": str(i + 1), "score": float(t.passed), "max_score": 1.0,
+             "status": "passed" if t.passed else "failed", "output": "\n".join(t.lines()),
+             "visibility": "visible"}
+            for i, t in enumerate(self.tasks)
+        ]  # fmt: skip
+        head = [self.format_text().splitlines()[0], *self.format_text().splitlines()[1:2]]
+        return {"score": float(self.n_passed), "max_score": float(len(self.tasks)),
+                "execution_time": round(self.seconds, 3), "output": "\n".join(head),
+                "visibility": "visible", "stdout_visibility": "hidden", "tests": tests}  # fmt: skip
+
+    def export_failing(self, folder: str | os.PathLike) -> list[str]:
+        """Write each failing task's first failing mesh (``<task>_<mesh>.obj``) and its call's
+        arguments (``.npz``: arrays, numbers; a sparse matrix as ``NAME_data``,
+        ``NAME_indices``, ``NAME_indptr``, ``NAME_shape``) into ``folder``: the student can
+        reproduce the call. Returns the files written."""
+        from ..io.write import save_mesh
+        from .plain import save_arguments
+
+        written = []
+        for t in self.tasks:
+            if t.passed or t.repro is None:
+                continue
+            case, _label, args = t.repro
+            stem = os.path.join(os.fspath(folder), f"{t.task}_{case.name}")
+            save_mesh(stem + ".obj", case.V, case.F)
+            save_arguments(stem + ".npz", tuple(args))
+            written += [stem + ".obj", stem + ".npz"]
+        return written
 
     # ---- notebooks ------------------------------------------------------------------------
 
@@ -203,9 +299,13 @@ class CheckResult:
                 f"{html.escape(STATUS_WORDS.get(t.status, t.status))}</td>"
                 f"<td style='text-align:left'>{detail}</td></tr>"
             )
+        sandbox = self.isolation.get("description", "")
+        warn = "" if self.isolation.get("isolated", True) else (
+            f"<p style='color:#9a6700'>sandbox: {html.escape(sandbox)}</p>")  # fmt: skip
         return (
             f"<p><b>{html.escape(self.file)}</b>: {self.n_passed}/{len(self.tasks)} passed</p>"
-            "<table><tr><th>task</th><th>verdict</th><th>where and why</th></tr>"
+            + warn
+            + "<table><tr><th>task</th><th>verdict</th><th>where and why</th></tr>"
             + "".join(rows)
             + "</table>"
         )
@@ -358,6 +458,14 @@ def _draw_difference(fig: Any, t: TaskResult) -> None:
     extent = np.ptp(V, axis=0)
     ax.set_box_aspect(np.maximum(extent, 0.05 * max(float(extent.max()), 1e-300)))
     _caption(fig, t)
+
+
+_NOT_XML = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\x7f\ufffe\uffff]")
+
+
+def xml_text(text: str) -> str:
+    """``text`` with the characters XML 1.0 cannot carry escaped (``\x1b`` as ``\\x1b``)."""
+    return _NOT_XML.sub(lambda m: repr(m.group())[1:-1], text)
 
 
 def junit_document(results: list[CheckResult]) -> str:

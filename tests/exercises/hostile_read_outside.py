@@ -27,7 +27,8 @@ def mean_curvature_normal(V, F):
     for c in range(3):
         i, j, k = F[:, c], F[:, (c + 1) % 3], F[:, (c + 2) % 3]
         u, w = V[j] - V[i], V[k] - V[i]
-        cot = np.einsum("ij,ij->i", u, w) / np.linalg.norm(np.cross(u, w), axis=1)
+        dot, cross = np.einsum("ij,ij->i", u, w), np.linalg.norm(np.cross(u, w), axis=1)
+        cot = np.divide(dot, cross, out=np.zeros(len(F)), where=cross > 0)
         d = V[k] - V[j]  # the edge opposite corner i, weight ½ cot(angle at i)
         np.add.at(CV, j, 0.5 * cot[:, None] * d)
         np.add.at(CV, k, -0.5 * cot[:, None] * d)
@@ -35,7 +36,7 @@ def mean_curvature_normal(V, F):
         [np.einsum("ij,ij->i", P[:, (c + 1) % 3] - P[:, c], P[:, (c + 2) % 3] - P[:, c])
          for c in range(3)], axis=1,
     )  # fmt: skip
-    cots = dots / (2 * A[:, None])
+    cots = np.divide(dots, 2 * A[:, None], out=np.zeros_like(dots), where=A[:, None] > 0)
     obtuse = (dots < 0).any(axis=1)
     for c in range(3):
         lj = ((P[:, (c + 1) % 3] - P[:, c]) ** 2).sum(1)

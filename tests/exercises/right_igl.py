@@ -9,6 +9,7 @@ import scipy.sparse.linalg as spla
 
 def cotan_laplacian(V, F):
     n = len(V)
+    F = F[igl.doublearea(V, F).ravel() > 0]  # libigl's cot of a zero-area triangle is inf
     C = igl.cotmatrix(V, F).tocoo()
     return sp.csr_matrix((C.data, (C.row, C.col)), shape=(n, n))
 

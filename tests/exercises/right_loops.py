@@ -50,7 +50,10 @@ def cotan_laplacian(V, F):
         for k in range(3):
             o, i, j = f[k], f[(k + 1) % 3], f[(k + 2) % 3]
             u, w = _sub(P[i], P[o]), _sub(P[j], P[o])
-            h = 0.5 * _dot(u, w) / _cross_norm(u, w)
+            twice_area = _cross_norm(u, w)
+            if twice_area == 0.0:  # a triangle of zero area adds nothing
+                continue
+            h = 0.5 * _dot(u, w) / twice_area
             rows += [i, j, i, j]
             cols += [j, i, i, j]
             vals += [h, h, -h, -h]

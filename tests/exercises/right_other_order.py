@@ -22,8 +22,9 @@ def _heron(ln):
 def _cot(ln):
     A = _heron(ln)
     l2 = ln**2
-    return np.stack(
-        [(l2[:, (k + 1) % 3] + l2[:, (k + 2) % 3] - l2[:, k]) / (4 * A) for k in range(3)], axis=1
+    num = [l2[:, (k + 1) % 3] + l2[:, (k + 2) % 3] - l2[:, k] for k in range(3)]
+    return np.stack(  # a triangle of zero area: cot 0, it adds nothing
+        [np.divide(x, 4 * A, out=np.zeros_like(x), where=A > 0) for x in num], axis=1
     )
 
 

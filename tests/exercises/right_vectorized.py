@@ -27,7 +27,8 @@ def _cots(V, F):
     for c in range(3):
         a, b, o = F[:, c], F[:, (c + 1) % 3], F[:, (c + 2) % 3]
         u, w = V[b] - V[a], V[o] - V[a]
-        cots[:, c] = np.einsum("ij,ij->i", u, w) / np.linalg.norm(np.cross(u, w), axis=1)
+        dot, cross = np.einsum("ij,ij->i", u, w), np.linalg.norm(np.cross(u, w), axis=1)
+        cots[:, c] = np.divide(dot, cross, out=np.zeros(len(F)), where=cross > 0)  # area 0: 0
     return cots
 
 
@@ -98,7 +99,8 @@ def _angles(V, F):
 def mean_curvature(V, F):
     th = _angles(V, F)
     fn = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
-    fn /= np.linalg.norm(fn, axis=1, keepdims=True)
+    length = np.linalg.norm(fn, axis=1, keepdims=True)
+    fn = np.divide(fn, length, out=np.zeros_like(fn), where=length > 0)  # area 0: no normal
     N = np.zeros_like(V)
     for c in range(3):
         np.add.at(N, F[:, c], th[:, c : c + 1] * fn)

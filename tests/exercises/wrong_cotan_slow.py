@@ -18,7 +18,10 @@ def cotan_laplacian(V, F):
             j, o = f[(k + 1) % 3], f[(k + 2) % 3]
             for a, b in ((j, o), (o, j)):  # the weight of edge (i, a) from the angle at b
                 u, w = V[i] - V[b], V[a] - V[b]
-                half_cot = 0.5 * np.dot(u, w) / np.linalg.norm(np.cross(u, w))
+                twice_area = np.linalg.norm(np.cross(u, w))
+                if twice_area == 0:  # a triangle of zero area adds nothing
+                    continue
+                half_cot = 0.5 * np.dot(u, w) / twice_area
                 C[i, a] = C[i, a] + half_cot
                 C[i, i] = C[i, i] - half_cot
     return C.tocsr()
