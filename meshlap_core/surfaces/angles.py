@@ -68,10 +68,11 @@ def tangent_angle(forms: Any, theta_uv: Any) -> FloatArray:
 
     Examples
     --------
+    >>> import numpy as np
     >>> from meshlap_core.surfaces import point_geometry, tangent_angle
     >>> g = point_geometry("helicoid", 0.8, 0.3)  # E = 1, F = 0, G = 1.64
     >>> round(float(np.degrees(tangent_angle(g, np.radians(45.0)))), 4)  # atan(√1.64)
-    52.0089
+    52.0148
     """
     th = np.asarray(theta_uv, dtype=np.float64)
     l11, l21, l22 = _cholesky(forms)

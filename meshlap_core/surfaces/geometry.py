@@ -417,14 +417,15 @@ def point_geometry(
 
     Examples
     --------
+    >>> import math
     >>> from meshlap_core import point_geometry
     >>> g = point_geometry("helicoid", 0.0, 0.0)
     >>> round(g.f, 12), round(g.K, 12), g.classification
     (1.0, -1.0, 'hyperbolic')
-    >>> round(float(np.degrees(g.theta_max)), 9)  # κₙ(θ) = sin 2θ at the origin
+    >>> round(math.degrees(g.theta_max), 9)  # κₙ(θ) = sin 2θ at the origin
     45.0
     >>> dc = point_geometry("helicoid", 0.0, 0.0, signs="do-carmo")  # the course's sign
-    >>> round(dc.f, 12), round(dc.K, 12), round(float(np.degrees(dc.theta_max)), 9)
+    >>> round(dc.f, 12), round(dc.K, 12), round(math.degrees(dc.theta_max), 9)
     (-1.0, -1.0, 135.0)
     """
     surface = get_surface(surface)
