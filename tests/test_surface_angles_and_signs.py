@@ -307,3 +307,32 @@ def test_cli_bad_signs_exits_2_with_one_line(capsys) -> None:
     code, out, err = _cli(capsys, "sphere", "--convergence", "--signs", "do-carmo")
     assert code == 2 and out == "" and err.count("\n") == 1
     assert err.startswith("meshlap: error: --signs: cannot be combined with --convergence")
+
+
+# ------------------------------------------------------------------------------------------
+# the window computes with the same core functions
+# ------------------------------------------------------------------------------------------
+
+
+def test_window_and_cli_agree_and_one_setting_switches_the_signs(capsys) -> None:
+    """The Surfaces panel's state reads the core's point (the CLI's numbers); its Euler curve
+    and section angle come from the core's angle map, so a point computed with
+    ``signs="do-carmo"`` is all the panel needs to show the course's sign."""
+    from meshlap_app.state.surfaces import SurfaceState, euler_curve, geometric_angle
+
+    s = SurfaceState()
+    s.set_surface("helicoid", 8)
+    assert s.set_uv(0.8, 0.3)
+    _, out, _ = _cli(capsys, "helicoid", "--u", "0.8", "--v", "0.3", "--json")
+    d = json.loads(out)
+    for key in ("theta_max", "theta_min", "theta_uv_max", "theta_uv_min", "k1", "k2"):
+        assert getattr(s.point, key) == d[key]
+    for signs in SIGNS:
+        p = point_geometry("helicoid", 0.8, 0.3, signs=signs)
+        phi, kn = euler_curve(p, 73)
+        np.testing.assert_allclose(
+            kn, p.k1 * np.cos(phi) ** 2 + p.k2 * np.sin(phi) ** 2, atol=1e-15
+        )
+        # φ of the k1 parameter direction is 0, of the k2 one ±90° (a line: modulo 180°)
+        assert geometric_angle(p, p.theta_uv_max) == pytest.approx(0.0, abs=1e-12)
+        assert geometric_angle(p, p.theta_uv_min) % np.pi == pytest.approx(np.pi / 2, abs=1e-12)
