@@ -43,6 +43,15 @@ DerivativeMethod
 Mesher
     How a convergence study meshes a parametric surface: ``"grid"`` (the (u, v) grid) or
     ``"icosphere"`` (the sphere only).
+DirectionAngle
+    A tangent direction of a parametric surface as an angle in the ``(u, v)`` plane (``"uv"``)
+    or in the tangent plane from ``p_u`` (``"tangent"``).
+SurfaceSigns
+    The sign of a parametric surface's second fundamental form (``meshlap surface --signs``,
+    :mod:`meshlap_core.surfaces`): ``"outward"`` (the project's one convention, ``e = −p_uu · n``,
+    so ``H > 0`` on a sphere with its outward normal, as on meshes) or ``"do-carmo"`` (do Carmo's
+    and the course's ``e = p_uu · n``: ``II``, the shape operator, ``H``, ``κ₁``, ``κ₂`` and
+    ``κₙ`` change sign, the principal directions swap roles, ``K`` and ``n`` stay).
 UpAxis
     The mesh's axis that points up on screen (``meshlap view --up``): ``"y"`` (the default,
     most scans and the course meshes), ``"z"`` (CAD and some scans, e.g. nefertiti),
@@ -137,6 +146,18 @@ DERIVATIVE_METHODS: tuple[str, ...] = get_args(DerivativeMethod)
 
 Mesher = Literal["grid", "icosphere"]
 MESHERS: tuple[str, ...] = get_args(Mesher)
+
+DirectionAngle = Literal["uv", "tangent"]
+DIRECTION_ANGLES: tuple[str, ...] = get_args(DirectionAngle)
+"""How a tangent direction of a parametric surface is given by one angle: ``"uv"``, the
+parameter angle ``θ_uv`` (``p_u cos θ_uv + p_v sin θ_uv``) or ``"tangent"``, the true angle
+``θ`` in the tangent plane from ``p_u / |p_u|`` (:mod:`meshlap_core.surfaces.angles`)."""
+
+SurfaceSigns = Literal["outward", "do-carmo"]
+SURFACE_SIGNS: tuple[str, ...] = get_args(SurfaceSigns)
+DEFAULT_SURFACE_SIGNS: SurfaceSigns = "outward"
+"""The project's one convention by default; ``"do-carmo"`` where a student checks a hand
+calculation made with do Carmo's (the course's) ``e = p_uu · n`` (see ``docs/conventions.md``)."""
 
 HeatBoundary = Literal["neumann", "dirichlet", "average"]
 HEAT_BOUNDARIES: tuple[str, ...] = get_args(HeatBoundary)

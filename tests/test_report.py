@@ -45,6 +45,16 @@ EXPECTED_COLUMNS = {
     ],
     "gauss_bonnet": ["mesh", "euler_characteristic", "sum_K_A", "two_pi_chi", "abs_difference"],
     "helicoid_origin": ["quantity", "computed", "closed_form", "abs_difference"],
+    "helicoid_coursework": [
+        "u",
+        "v",
+        "quantity",
+        "signs",
+        "computed",
+        "closed_form",
+        "abs_difference",
+        "outward",
+    ],
     "helicoid_principal": [
         "u",
         "v",
@@ -368,6 +378,34 @@ def test_tables_agree_with_the_mathematics(quick):
     # helicoid at the origin: E = G = 1, F = 0, e = g = 0, f = 1 (II = -p_uv . n), K = -1, k = ±1
     for r in read_table(quick, "helicoid_origin"):
         assert float(r["abs_difference"]) < 1e-8, r
+    # the coursework's sign (do Carmo, e = p_uu . n): f = -1/sqrt(1+u²), κₙ = -sin 2θ at the
+    # origin with its maximum at 135° in the tangent plane; meshlap's outward sign beside it
+    course = {
+        (float(r["u"]), float(r["v"]), r["quantity"]): r
+        for r in read_table(quick, "helicoid_coursework")
+    }
+    assert {r["signs"] for r in course.values()} == {"do-carmo"}
+    for (u, _v, q), r in course.items():
+        assert float(r["abs_difference"]) < 1e-9, r
+        if q == "f":
+            w = 1 + u**2
+            assert float(r["computed"]) == pytest.approx(-1 / np.sqrt(w), abs=1e-12)
+            assert float(r["outward"]) == pytest.approx(1 / np.sqrt(w), abs=1e-12)
+        if q == "K":
+            assert float(r["outward"]) == pytest.approx(float(r["computed"]), abs=1e-12)
+    assert float(course[(0.0, 0.0, "theta_max (deg, tangent plane)")]["computed"]) == (
+        pytest.approx(135.0)
+    )
+    assert float(course[(0.0, 0.0, "theta_max (deg, tangent plane)")]["outward"]) == (
+        pytest.approx(45.0)
+    )
+    at = {q: float(r["computed"]) for (u, _v, q), r in course.items() if u == 0.8}
+    assert at["theta_max (deg, tangent plane)"] - at["theta_min (deg, tangent plane)"] == (
+        pytest.approx(90.0)
+    )
+    # tan θ_uv = tan 45° / √1.64 at u = 0.8: the (u, v) angles are 104° apart
+    assert at["theta_uv_max (deg, (u, v) plane)"] == pytest.approx(142.0148, abs=1e-4)
+    assert at["theta_uv_min (deg, (u, v) plane)"] == pytest.approx(37.9852, abs=1e-4)
     for r in read_table(quick, "helicoid_principal"):
         u = float(r["u"])
         assert float(r["k1"]) == pytest.approx(1 / (1 + u * u), abs=1e-9)

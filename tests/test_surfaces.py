@@ -78,8 +78,9 @@ def test_helicoid_origin_normal_curvature_is_sin_2theta() -> None:
     assert theta[0] == 0 and theta[-1] == pytest.approx(2 * np.pi)
     np.testing.assert_allclose(kn, np.sin(2 * theta), atol=1e-12)
     g = point_geometry("helicoid", 0.0, 0.0)
-    assert g.theta_max == pytest.approx(np.pi / 4)  # sin 2θ = +1
-    assert g.theta_min == pytest.approx(3 * np.pi / 4)  # sin 2θ = -1
+    # I is the identity at the origin: the tangent-plane and the parameter angles agree
+    assert g.theta_max == g.theta_uv_max == pytest.approx(np.pi / 4)  # sin 2θ = +1
+    assert g.theta_min == g.theta_uv_min == pytest.approx(3 * np.pi / 4)  # sin 2θ = -1
 
 
 @pytest.mark.parametrize("r", [0.5, 1.0, 2.0])
@@ -188,7 +189,7 @@ def test_extremes_of_normal_curvature_are_the_principal_curvatures(
 ) -> None:
     g = point_geometry(name, u, v)
     theta, kn = normal_curvature_curve(name, u, v, 2001)
-    for sign, k, t_ext in ((-1, g.k1, g.theta_max), (1, g.k2, g.theta_min)):
+    for sign, k, t_ext in ((-1, g.k1, g.theta_uv_max), (1, g.k2, g.theta_uv_min)):
         t0 = theta[np.argmin(sign * kn)]
         res = minimize_scalar(
             lambda t, sg=sign: sg * normal_curvature(name, u, v, t),
@@ -473,6 +474,9 @@ def test_point_geometry_to_dict_is_json() -> None:
         "dir2_uv",
         "theta_max",
         "theta_min",
+        "theta_uv_max",
+        "theta_uv_min",
+        "signs",
         "n",
     ):
         assert k in back

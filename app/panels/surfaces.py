@@ -200,8 +200,8 @@ class SurfacesPanel(Panel):
         ui.text(f"II: e = {sig(p.e, s2)}  f = {sig(p.f, s2)}  g = {sig(p.g, s2)}")
         ui.text(f"K = {sig(p.K, sk * sk)}  H = {sig(p.H, sk)}  ({p.classification})")
         ui.text(
-            f"k1 = {sig(p.k1, sk)} at parameter angle {np.degrees(p.theta_max):.1f} deg,  "
-            f"k2 = {sig(p.k2, sk)} at {np.degrees(p.theta_min):.1f} deg (in the (u, v) plane; "
+            f"k1 = {sig(p.k1, sk)} at parameter angle {np.degrees(p.theta_uv_max):.1f} deg,  "
+            f"k2 = {sig(p.k2, sk)} at {np.degrees(p.theta_uv_min):.1f} deg (in the (u, v) plane; "
             "90 deg apart in the tangent plane)"
         )
         ui.text("signs: e = -p_uu . n, n = p_u x p_v (H > 0 on a sphere, as on meshes)")

@@ -59,19 +59,19 @@ def tangent_frame(p: surfaces.PointGeometry) -> tuple[FloatArray, FloatArray]:
 def geometric_angle(p: surfaces.PointGeometry, theta: float) -> float:
     """The angle φ in ``[0, 2π)``, measured in the tangent plane from the first principal
     direction (towards ``n × e1``), of the direction of parameter angle ``theta`` (radians,
-    ``d = p_u cos θ + p_v sin θ``): the first fundamental form turns the parameter-plane angle
-    into the true one."""
-    d = p.p_u * math.cos(theta) + p.p_v * math.sin(theta)
-    e1, e2 = tangent_frame(p)
-    return float(math.atan2(float(d @ e2), float(d @ e1)) % (2 * np.pi))
+    ``d = p_u cos θ + p_v sin θ``): the core's tangent-plane angle from ``p_u``
+    (:func:`meshlap_core.surfaces.tangent_angle`, what ``meshlap surface`` reports) less
+    that of the first principal direction, ``p.theta_max``."""
+    phi = float(surfaces.tangent_angle(p, theta)) - p.theta_max
+    return float(phi % (2 * np.pi))
 
 
 def euler_curve(p: surfaces.PointGeometry, n: int = 181) -> tuple[FloatArray, FloatArray]:
     """``κₙ(φ)`` at ``n`` angles ``φ ∈ [0, 2π]`` measured in the tangent plane from the first
-    principal direction: each unit tangent ``t = e1 cos φ + e2 sin φ`` is written in the
-    parameter basis (``t = a p_u + b p_v``) and ``κₙ = II(t, t) / I(t, t)`` is evaluated from
-    the point's forms, so the curve is Euler's ``κ₁ cos² φ + κ₂ sin² φ`` (what the tests
-    check), not an assumption of it.
+    principal direction: the core's ``κₙ`` at the tangent-plane angle ``p.theta_max + φ``
+    (:func:`meshlap_core.surfaces.normal_curvature_from_forms` with ``angle="tangent"``, the
+    curve ``meshlap surface --plot`` draws, shifted), evaluated from the point's forms, so the
+    curve is Euler's ``κ₁ cos² φ + κ₂ sin² φ`` (what the tests check), not an assumption of it.
 
     Returns
     -------
@@ -80,12 +80,8 @@ def euler_curve(p: surfaces.PointGeometry, n: int = 181) -> tuple[FloatArray, Fl
     kn : (n,) float
     """
     phi = np.linspace(0.0, 2 * np.pi, int(n))
-    e1, e2 = tangent_frame(p)
-    t = np.cos(phi)[:, None] * e1[None, :] + np.sin(phi)[:, None] * e2[None, :]
-    J = np.column_stack([p.p_u, p.p_v])  # (3, 2)
-    ab, *_ = np.linalg.lstsq(J, t.T, rcond=None)  # (2, n) parameter components
-    theta = np.arctan2(ab[1], ab[0])
-    return phi, np.asarray(surfaces.normal_curvature_from_forms(p, theta), dtype=float)
+    kn = surfaces.normal_curvature_from_forms(p, p.theta_max + phi, angle="tangent")
+    return phi, np.asarray(kn, dtype=float)
 
 
 @dataclass

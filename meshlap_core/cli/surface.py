@@ -1,9 +1,11 @@
 """``meshlap surface NAME``: the differential geometry of a parametric surface.
 
-At one point (``--u U --v V``): fundamental forms, curvatures, principal directions and the
-point's class; ``--plot kn.png`` draws the normal curvature ``κₙ(θ)``; ``--mesh out.obj --res N``
-triangulates the surface; ``--convergence`` measures the discrete estimators against the exact
-curvature under refinement.
+At one point (``--u U --v V``): fundamental forms, curvatures, principal directions (their
+angles in the tangent plane from ``p_u``, ``theta_max``/``theta_min``, and in the ``(u, v)``
+plane, ``theta_uv_max``/``theta_uv_min``) and the point's class; ``--plot kn.png`` draws the
+normal curvature ``κₙ`` against the tangent-plane angle; ``--signs do-carmo`` reports them with
+do Carmo's (the course's) sign of ``II``; ``--mesh out.obj --res N`` triangulates the surface;
+``--convergence`` measures the discrete estimators against the exact curvature under refinement.
 """
 
 from __future__ import annotations
@@ -17,9 +19,11 @@ import numpy as np
 
 from ..curvature.convergence import convergence_study
 from ..errors import MeshError
-from ..options import MESHERS
+from ..options import DEFAULT_SURFACE_SIGNS, MESHERS, SURFACE_SIGNS
 from ..surfaces import (
+    PARAMETER_ANGLE_REFERENCE,
     SURFACES,
+    TANGENT_ANGLE_REFERENCE,
     ParametricSurface,
     PointGeometry,
     check_mesh_res,
@@ -29,6 +33,7 @@ from ..surfaces import (
     mesh_surface,
     plot_normal_curvature,
     point_geometry,
+    signs_note,
 )
 from ._common import add_json_flag, emit_json, parse_list
 
@@ -42,7 +47,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="fundamental forms, curvature and meshes of a parametric surface",
         description="Exact differential geometry of a parametric surface p(u,v) at one point, "
         "its normal-curvature plot, a mesh of it, or the convergence of the discrete curvature "
-        "estimators on its meshes.",
+        "estimators on its meshes. Angles: theta_max/theta_min are the principal directions' "
+        "angles in the tangent plane, measured from the unit p_u direction towards n × p_u "
+        "(90° apart); theta_uv_max/theta_uv_min are the same directions in the (u, v) plane.",
     )
     p.add_argument(
         "name",
@@ -59,7 +66,19 @@ def register(sub: argparse._SubParsersAction) -> None:
         metavar="KEY=VALUE",
         help="shape parameter, e.g. --param R=2 --param r=0.5 (repeatable)",
     )
-    p.add_argument("--plot", metavar="PNG", help="save a plot of the normal curvature κn(θ)")
+    p.add_argument(
+        "--plot",
+        metavar="PNG",
+        help="save a plot of the normal curvature κn against θ, the direction's angle in the "
+        "tangent plane from p_u (towards n × p_u)",
+    )
+    p.add_argument(
+        "--signs",
+        choices=SURFACE_SIGNS,
+        help="sign of the second fundamental form: outward (default, meshlap's: e = −p_uu·n, "
+        "H > 0 on spheres as on meshes) or do-carmo (do Carmo's and the course's: e = p_uu·n; "
+        "II, H, κ1, κ2 and κn negated, κ1 and κ2 swap directions, K unchanged)",
+    )
     p.add_argument("--mesh", metavar="OUT", help="write a triangle mesh of the surface")
     p.add_argument(
         "--res",
@@ -136,6 +155,7 @@ def _run_convergence(args: argparse.Namespace, surface: Any) -> int:
         ("--plot", args.plot),
         ("--u", args.u),
         ("--v", args.v),
+        ("--signs", None if args.signs in (None, DEFAULT_SURFACE_SIGNS) else args.signs),
     ):
         if val is not None:
             raise MeshError("cannot be combined with --convergence", flag)
@@ -195,10 +215,11 @@ def _run(args: argparse.Namespace) -> int:
         if len(res) > 2:
             raise MeshError(f"expected N or NU,NV, got {args.res!r}", "--res")
         nu, nv = check_mesh_res(surface, res[0] if len(res) == 1 else (res[0], res[1]), "--res")
+    signs = args.signs or DEFAULT_SURFACE_SIGNS
     if plot is not None:
-        geo = plot_normal_curvature(surface, u, v, plot)
+        geo = plot_normal_curvature(surface, u, v, plot, signs=signs)
     else:
-        geo = point_geometry(surface, u, v)
+        geo = point_geometry(surface, u, v, signs=signs)
 
     mesh_info = None if args.mesh is None else _write_mesh(surface, args.mesh, nu, nv)
 
@@ -206,6 +227,12 @@ def _run(args: argparse.Namespace) -> int:
         emit_json(
             {
                 **geo.to_dict(),
+                "angles": {
+                    "theta_max, theta_min": "radians in [0, pi), in the tangent plane from "
+                    + TANGENT_ANGLE_REFERENCE,
+                    "theta_uv_max, theta_uv_min": "radians in [0, pi), in "
+                    + PARAMETER_ANGLE_REFERENCE,
+                },
                 "params": dict(surface.params),
                 "plot": str(plot) if plot else None,
                 "mesh": mesh_info,
@@ -258,12 +285,15 @@ def _print_point(geo: PointGeometry, surface: ParametricSurface) -> None:
     print(f"  first form   E = {geo.E:.6g}   F = {geo.F:.6g}   G = {geo.G:.6g}")
     print(f"  second form  e = {geo.e:.6g}   f = {geo.f:.6g}   g = {geo.g:.6g}")
     print(f"  K = {geo.K:.6g}   H = {geo.H:.6g}   ({geo.classification})")
-    for k, t, d_uv, d3, what in (
-        (geo.k1, geo.theta_max, geo.dir1_uv, geo.dir1, "max"),
-        (geo.k2, geo.theta_min, geo.dir2_uv, geo.dir2, "min"),
+    for k, t, t_uv, d_uv, d3, what in (
+        (geo.k1, geo.theta_max, geo.theta_uv_max, geo.dir1_uv, geo.dir1, "max"),
+        (geo.k2, geo.theta_min, geo.theta_uv_min, geo.dir2_uv, geo.dir2, "min"),
     ):
         name = "k1" if what == "max" else "k2"
         print(
-            f"  {name} = {k:.6g}: κn is {what} at θ = {t:.6g} (and θ + π); "
-            f"direction (u,v) {_vec(d_uv)}, 3-D {_vec(d3)}"
+            f"  {name} = {k:.6g}: κn is {what} at θ = {np.degrees(t):.6g}° (and θ + 180°), "
+            f"θ_uv = {np.degrees(t_uv):.6g}°; direction (u,v) {_vec(d_uv)}, 3-D {_vec(d3)}"
         )
+    print(f"  θ: angle in the tangent plane from {TANGENT_ANGLE_REFERENCE}")
+    print(f"  θ_uv: angle in {PARAMETER_ANGLE_REFERENCE}")
+    print(f"  {signs_note(geo.signs)}")

@@ -3,6 +3,7 @@
 Modules: :mod:`.catalogue` (:class:`ParametricSurface`, the shipped surfaces, :func:`get_surface`),
 :mod:`.derivatives` (exact / complex-step / central derivatives), :mod:`.geometry` (fundamental
 forms, curvature fields, normal curvature, classification, :func:`point_geometry`),
+:mod:`.angles` (a direction's angle in the ``(u, v)`` plane and in the tangent plane),
 :mod:`.meshing` (:func:`mesh_surface`), :mod:`.plot` (the ``κₙ(θ)`` figure) and :mod:`.singular`
 (singular points: declared poles and ``|p_u × p_v|`` negligible against the surface's area
 scale). Everything public is re-exported here. How the discrete estimators converge to the exact
@@ -16,7 +17,9 @@ At any ``(u, v)`` this module computes the partial derivatives, the unit normal
 ``e = −p_uu · n, f = −p_uv · n, g = −p_vv · n``, the Gaussian curvature
 ``K = (eg − f²)/(EG − F²)``, the mean curvature ``H = (eG − 2fF + gE) / (2(EG − F²))``, the
 principal curvatures ``κ₁ ≥ κ₂`` and directions, the normal curvature
-``κₙ(θ) = II(w, w) / I(w, w)`` for ``w = (cos θ, sin θ)`` and the point classification.
+``κₙ = II(w, w) / I(w, w)`` of a direction given by its angle ``θ`` in the tangent plane (from
+the unit ``p_u``) or ``θ_uv`` in the parameter plane (``w = (cos θ_uv, sin θ_uv)``) and the
+point classification.
 It also triangulates the parameter rectangle (:func:`mesh_surface`).
 
 Sign conventions (one convention for the whole project). The normal is
@@ -26,6 +29,14 @@ Sign conventions (one convention for the whole project). The normal is
 core's ``Δx = −2 H n`` (negative semidefinite Laplacian) with outward normals from
 counter-clockwise faces, so the convergence studies compare ``H`` directly; ``K`` does not
 depend on the sign. ``κ₁ ≥ κ₂`` always.
+
+do Carmo's sign (the course's, where a student checks a hand calculation) is one argument away:
+``signs="do-carmo"`` (:func:`point_geometry`, :func:`surface_curvature_fields`,
+:func:`normal_curvature`, :func:`plot_normal_curvature`; ``meshlap surface --signs do-carmo``)
+takes ``e = p_uu · n`` with the same ``n``: ``e, f, g``, the shape operator, ``H`` and ``κₙ``
+change sign, ``κ₁, κ₂`` become ``−κ₂, −κ₁`` (still ``κ₁ ≥ κ₂``, so the principal directions
+swap roles), and ``K``, ``n`` and the classification stay. On the helicoid ``f = −1/√(1+u²)``
+and at its origin ``κₙ(θ) = −sin 2θ``, largest at ``θ = 3π/4`` (``docs/conventions.md``).
 
 Derivatives. A surface may carry its exact derivatives; otherwise (and in the tests, to check
 them) they are computed numerically: first derivatives by the complex step
@@ -41,6 +52,13 @@ Squire & Trapp, "Using complex variables to estimate derivatives of real functio
 Review 40, 1998 (the complex step).
 """
 
+from .angles import (
+    PARAMETER_ANGLE_REFERENCE,
+    TANGENT_ANGLE_REFERENCE,
+    parameter_angle,
+    tangent_angle,
+    tangent_components,
+)
 from .catalogue import (
     EDGES,
     SURFACES,
@@ -69,6 +87,8 @@ from .geometry import (
     normal_curvature_curve,
     normal_curvature_from_forms,
     point_geometry,
+    signs_factor,
+    signs_note,
     surface_curvature_fields,
 )
 from .meshing import (
@@ -81,7 +101,7 @@ from .meshing import (
     estimate_mesh_bytes,
     mesh_surface,
 )
-from .plot import plot_normal_curvature
+from .plot import normal_curvature_figure, plot_normal_curvature
 from .singular import SINGULAR_REL, is_singular, surface_scale
 
 __all__ = [
@@ -90,9 +110,11 @@ __all__ = [
     "MAX_CELLS",
     "MAX_MESH_BYTES",
     "MESH_BYTES_PER_CELL",
+    "PARAMETER_ANGLE_REFERENCE",
     "SINGULAR_REL",
     "STUDY_BYTES_PER_CELL",
     "SURFACES",
+    "TANGENT_ANGLE_REFERENCE",
     "CurvatureFields",
     "DerivativeMap",
     "Derivatives",
@@ -115,13 +137,19 @@ __all__ = [
     "monkey_saddle",
     "normal_curvature",
     "normal_curvature_curve",
+    "normal_curvature_figure",
     "normal_curvature_from_forms",
+    "parameter_angle",
     "plot_normal_curvature",
     "point_geometry",
     "saddle",
+    "signs_factor",
+    "signs_note",
     "sphere",
     "surface_curvature_fields",
     "surface_derivatives",
     "surface_scale",
+    "tangent_angle",
+    "tangent_components",
     "torus",
 ]

@@ -1,6 +1,7 @@
 """Fundamental forms, curvature fields, normal curvature, point classification and the
 geometry of one point of a parametric surface (do Carmo, ch. 3, with ``II`` negated so that a
-sphere with its outward normal has ``H > 0``: the signs are in the package notes).
+sphere with its outward normal has ``H > 0``: the signs are in the package notes; ``signs=
+"do-carmo"`` gives do Carmo's own).
 """
 
 from __future__ import annotations
@@ -13,7 +14,16 @@ import numpy as np
 
 from ..curvature.principal import eig_sym2
 from ..errors import MeshError
+from ..options import (
+    DEFAULT_SURFACE_SIGNS,
+    DIRECTION_ANGLES,
+    SURFACE_SIGNS,
+    DirectionAngle,
+    SurfaceSigns,
+    check_choice,
+)
 from ..types import BoolArray, FloatArray
+from .angles import tangent_angle, tangent_components
 from .catalogue import ParametricSurface, check_uv, get_surface
 from .derivatives import DerivativeMethod, Derivatives, surface_derivatives
 from .singular import singular_description, singular_mask
@@ -23,6 +33,32 @@ CLASSIFICATIONS: tuple[str, ...] = ("elliptic", "hyperbolic", "parabolic", "plan
 
 def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.einsum("...i,...i->...", a, b)
+
+
+def signs_factor(signs: SurfaceSigns) -> float:
+    """``+1`` for ``"outward"`` (``e = −p_uu · n``, the project's), ``−1`` for ``"do-carmo"``
+    (``e = p_uu · n``): the factor on the project's ``II``.
+
+    Raises
+    ------
+    MeshError
+        ``signs`` is not one of :data:`~meshlap_core.options.SURFACE_SIGNS`.
+    """
+    return 1.0 if check_choice(signs, SURFACE_SIGNS, "signs") == "outward" else -1.0
+
+
+def signs_note(signs: SurfaceSigns) -> str:
+    """One line that says which sign ``II`` has (for text outputs, plots and the window)."""
+    if signs_factor(signs) > 0:
+        return (
+            "signs: outward (meshlap's): e = -p_uu . n, n = p_u x p_v / |p_u x p_v| "
+            "(H > 0 on a sphere, as on meshes)"
+        )
+    return (
+        "signs: do-carmo (do Carmo's, the coursework's): e = p_uu . n, n = p_u x p_v / "
+        "|p_u x p_v|; II, H, k1, k2 and k_n are meshlap's negated (k1, k2 and their directions "
+        "swap), K is unchanged"
+    )
 
 
 @dataclass(frozen=True)
@@ -46,6 +82,7 @@ class CurvatureFields:
     w1: FloatArray  # S + (2,): parameter direction of k1, unit in the metric (w·I·w = 1)
     w2: FloatArray  # S + (2,)
     singular: BoolArray
+    signs: SurfaceSigns = DEFAULT_SURFACE_SIGNS  # the sign of e, f, g (and so H, k1, k2)
 
 
 def surface_curvature_fields(
@@ -54,6 +91,7 @@ def surface_curvature_fields(
     v: Any,
     method: DerivativeMethod = "auto",
     derivatives: Derivatives | None = None,
+    signs: SurfaceSigns = DEFAULT_SURFACE_SIGNS,
 ) -> CurvatureFields:
     """Vectorized fundamental forms and curvatures at ``(u, v)`` (no domain check).
 
@@ -65,6 +103,11 @@ def surface_curvature_fields(
     derivatives : Derivatives, optional
         ``surface_derivatives(surface, u, v, method)`` when the caller has it already (then
         ``method`` is not used): no second evaluation.
+    signs : {"outward", "do-carmo"}
+        The sign of ``II``: the project's ``e = −p_uu · n`` (default) or do Carmo's
+        ``e = p_uu · n``. ``n``, ``E, F, G`` and ``K`` do not depend on it; ``e, f, g``, ``H``
+        and the shape operator change sign, so ``κ₁``, ``κ₂`` become ``−κ₂``, ``−κ₁`` and
+        ``w1``, ``w2`` swap (up to sign).
 
     Returns
     -------
@@ -73,7 +116,8 @@ def surface_curvature_fields(
     Notes
     -----
     ``e = −p_uu · n, f = −p_uv · n, g = −p_vv · n`` (``= p_u · n_u, …``: positive where the
-    surface bends away from ``n``), ``K = (eg − f²)/(EG − F²)`` and
+    surface bends away from ``n``; all three negated with ``signs="do-carmo"``),
+    ``K = (eg − f²)/(EG − F²)`` and
     ``H = (eG − 2fF + gE)/(2(EG − F²))`` as in do Carmo. The
     principal curvatures are the eigenvalues of the shape operator ``I⁻¹II``, computed stably
     as those of the symmetric ``L⁻¹ II L⁻ᵀ`` (``I = LLᵀ``, Cholesky), so that ``κ₁ − κ₂`` is
@@ -82,14 +126,16 @@ def surface_curvature_fields(
     (:func:`~meshlap_core.curvature.principal.eig_sym2`).
     """
     surface = get_surface(surface)
+    sign = signs_factor(signs)
     D = surface_derivatives(surface, u, v, method) if derivatives is None else derivatives
     N = np.cross(D.p_u, D.p_v)
     nn = np.linalg.norm(N, axis=-1)
     singular = singular_mask(surface, u, v, N)
     n = np.divide(N, nn[..., None], out=np.full_like(N, np.nan), where=~singular[..., None])
     E, F, G = _dot(D.p_u, D.p_u), _dot(D.p_u, D.p_v), _dot(D.p_v, D.p_v)
-    # II against the outward normal with the sign that makes a sphere positive (package notes)
-    e, f, g = -_dot(D.p_uu, n), -_dot(D.p_uv, n), -_dot(D.p_vv, n)
+    # II against the outward normal with the sign that makes a sphere positive (package notes),
+    # or do Carmo's (sign = -1)
+    e, f, g = -sign * _dot(D.p_uu, n), -sign * _dot(D.p_uv, n), -sign * _dot(D.p_vv, n)
     with np.errstate(invalid="ignore", divide="ignore"):
         det = np.where(singular, np.nan, E * G - F * F)
         K = (e * g - f * f) / det
@@ -127,6 +173,7 @@ def surface_curvature_fields(
         w1=w1 * nan[..., None],
         w2=w2 * nan[..., None],
         singular=singular,
+        signs=signs,
     )
 
 
@@ -136,30 +183,58 @@ def normal_curvature(
     v: float,
     theta: Any,
     method: DerivativeMethod = "auto",
+    *,
+    angle: DirectionAngle = "uv",
+    signs: SurfaceSigns = DEFAULT_SURFACE_SIGNS,
 ) -> FloatArray:
-    """Normal curvature ``κₙ(θ) = (e c² + 2f cs + g s²) / (E c² + 2F cs + G s²)`` at ``(u, v)``,
-    ``c = cos θ``, ``s = sin θ``, θ the angle of the direction in the ``(u, v)`` plane.
+    """Normal curvature ``κₙ = II(d, d) / I(d, d)`` at ``(u, v)`` of the direction ``d`` at
+    angle ``theta`` (:func:`normal_curvature_from_forms`).
+
+    Parameters
+    ----------
+    surface, u, v, method : as in :func:`point_geometry`
+    theta : array_like
+        Radians: the parameter angle ``θ_uv`` (``angle="uv"``, the default) or the angle in the
+        tangent plane from ``p_u / |p_u|`` (``angle="tangent"``).
+    angle : {"uv", "tangent"}
+    signs : {"outward", "do-carmo"}
+        The sign of ``II`` (:func:`surface_curvature_fields`); do Carmo's negates ``κₙ``.
 
     Returns
     -------
     kn : float array of the shape of ``theta``
     """
     surface = get_surface(surface)
+    check_choice(angle, DIRECTION_ANGLES, "angle")
     uu, vv = check_uv(surface, u, v)
-    cf = surface_curvature_fields(surface, uu, vv, method)
+    cf = surface_curvature_fields(surface, uu, vv, method, signs=signs)
     _require_regular(surface, cf, float(uu), float(vv))
-    return normal_curvature_from_forms(cf, theta)
+    return normal_curvature_from_forms(cf, theta, angle)
 
 
-def normal_curvature_from_forms(forms: Any, theta: Any) -> FloatArray:
-    """``κₙ(θ) = II(d, d) / I(d, d)`` for ``d = (cos θ, sin θ)`` from fundamental forms already
-    computed: ``forms`` has ``E, F, G, e, f, g`` (a :class:`CurvatureFields` or a
-    :class:`PointGeometry`), broadcast against ``theta``.
+def normal_curvature_from_forms(forms: Any, theta: Any, angle: DirectionAngle = "uv") -> FloatArray:
+    """``κₙ = II(d, d) / I(d, d)`` of the direction at angle ``theta`` from fundamental forms
+    already computed: ``forms`` has ``E, F, G, e, f, g`` (a :class:`CurvatureFields` or a
+    :class:`PointGeometry`, whose ``signs`` the result has), broadcast against ``theta``.
+
+    Parameters
+    ----------
+    forms : CurvatureFields or PointGeometry
+    theta : array_like
+        Radians, a parameter angle (``angle="uv"``: ``d = (cos θ, sin θ)`` in the ``(u, v)``
+        plane, ``κₙ = (e c² + 2f cs + g s²)/(E c² + 2F cs + G s²)``) or a tangent-plane angle
+        from ``p_u / |p_u|`` (``angle="tangent"``: ``d = L⁻ᵀ (cos θ, sin θ)``, unit in ``I``, so
+        ``κₙ = II(d, d)``; :mod:`.angles`). In the tangent angle the curve is Euler's
+        ``κ₁ cos²(θ − θ₁) + κ₂ sin²(θ − θ₁)``.
+    angle : {"uv", "tangent"}
 
     Returns
     -------
     kn : float array of the broadcast shape
     """
+    if check_choice(angle, DIRECTION_ANGLES, "angle") == "tangent":
+        a, b = tangent_components(forms, theta)
+        return forms.e * a * a + 2 * forms.f * a * b + forms.g * b * b
     th = np.asarray(theta, dtype=np.float64)
     c, s = np.cos(th), np.sin(th)
     second = forms.e * c * c + 2 * forms.f * c * s + forms.g * s * s
@@ -168,10 +243,17 @@ def normal_curvature_from_forms(forms: Any, theta: Any) -> FloatArray:
 
 
 def normal_curvature_curve(
-    surface: ParametricSurface | str, u: float, v: float, n: int = 361
+    surface: ParametricSurface | str,
+    u: float,
+    v: float,
+    n: int = 361,
+    *,
+    angle: DirectionAngle = "uv",
+    signs: SurfaceSigns = DEFAULT_SURFACE_SIGNS,
 ) -> tuple[FloatArray, FloatArray]:
-    """``κₙ(θ)`` sampled at ``n`` equally spaced angles ``θ ∈ [0, 2π]`` (both ends, so that a
-    plot closes; the default 361 is a 1° step).
+    """``κₙ`` sampled at ``n`` equally spaced angles in ``[0, 2π]`` (both ends, so that a plot
+    closes; the default 361 is a 1° step), parameter angles or tangent-plane angles
+    (``angle``, as in :func:`normal_curvature`), with the sign ``signs``.
 
     Returns
     -------
@@ -181,7 +263,7 @@ def normal_curvature_curve(
     if int(n) < 2:
         raise MeshError(f"needs at least 2 samples, got {n}", "n")
     theta = np.linspace(0.0, 2 * np.pi, int(n))
-    return theta, normal_curvature(surface, u, v, theta)
+    return theta, normal_curvature(surface, u, v, theta, angle=angle, signs=signs)
 
 
 def classify(k1: float, k2: float, tol: float = 1e-8) -> str:
@@ -204,7 +286,7 @@ def classify(k1: float, k2: float, tol: float = 1e-8) -> str:
 
 @dataclass(frozen=True)
 class PointGeometry:
-    """Everything at one point ``(u, v)`` of a surface (see the module notes for the signs).
+    """Everything at one point ``(u, v)`` of a surface (see the package notes for the signs).
 
     Attributes
     ----------
@@ -214,18 +296,31 @@ class PointGeometry:
     n : (3,) float
         ``(p_u × p_v) / |p_u × p_v|``.
     E, F, G, e, f, g : float
-        First and second fundamental forms (``e = −p_uu · n``: positive on a sphere).
+        First and second fundamental forms (``e = −p_uu · n``: positive on a sphere; with
+        ``signs="do-carmo"`` ``e = p_uu · n``).
     K, H, k1, k2 : float
         Gaussian, mean and principal curvatures (``k1 ≥ k2``, ``H = (k1 + k2)/2``).
     dir1_uv, dir2_uv : (2,) float
-        Principal directions in the parameter plane, unit Euclidean vectors ``(cos θ, sin θ)``.
+        Principal directions in the parameter plane, unit Euclidean vectors
+        ``(cos θ_uv, sin θ_uv)``.
     dir1, dir2 : (3,) float
-        The same as unit 3-D tangent vectors ``(p_u cos θ + p_v sin θ) / |…|``.
+        The same as unit 3-D tangent vectors ``(p_u cos θ_uv + p_v sin θ_uv) / |…|``.
     theta_max, theta_min : float
-        Angles in ``[0, π)`` where ``κₙ`` is largest (``= k1``) and smallest (``= k2``); the
-        extremes repeat at ``+π``. At an umbilic ``κₙ`` is constant and ``theta_max = 0``.
+        Angles in the **tangent plane**, radians in ``[0, π)`` measured from the unit ``p_u``
+        direction towards ``n × p_u`` (:func:`~.angles.tangent_angle`), of the directions where
+        ``κₙ`` is largest (``= k1``, along ``dir1``) and smallest (``= k2``, along ``dir2``):
+        always 90° apart. The extremes repeat at ``+π``. At an umbilic ``κₙ`` is constant and
+        ``theta_max = 0`` (``p_u``).
+    theta_uv_max, theta_uv_min : float
+        The same two directions as angles in the ``(u, v)`` parameter plane, radians in
+        ``[0, π)`` from the ``u`` axis towards ``v`` (the angles of ``dir1_uv``, ``dir2_uv``);
+        90° apart only where ``I`` is a multiple of the identity.
     classification : str
-        One of ``elliptic, hyperbolic, parabolic, planar, umbilic`` (see :func:`classify`).
+        One of ``elliptic, hyperbolic, parabolic, planar, umbilic`` (see :func:`classify`);
+        the same under both signs.
+    signs : {"outward", "do-carmo"}
+        The sign of ``II`` every curvature above was computed with
+        (:func:`surface_curvature_fields`).
     """
 
     surface: str
@@ -254,7 +349,10 @@ class PointGeometry:
     dir2: FloatArray
     theta_max: float
     theta_min: float
+    theta_uv_max: float
+    theta_uv_min: float
     classification: str
+    signs: SurfaceSigns = DEFAULT_SURFACE_SIGNS
 
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON-ready dict (lists for vectors); keys are the attribute names."""
@@ -276,10 +374,15 @@ def _require_regular(surface: ParametricSurface, cf: CurvatureFields, u: float, 
         )
 
 
+def _line_angle(t: float) -> float:
+    """An angle of a line (direction up to sign) in ``[0, π)``."""
+    t = float(t) % np.pi
+    return 0.0 if t >= np.pi - 1e-15 else t
+
+
 def _direction_angle(w: np.ndarray) -> float:
     """Angle in ``[0, π)`` of the line spanned by the parameter vector ``w``."""
-    t = math.atan2(float(w[1]), float(w[0])) % np.pi
-    return 0.0 if t >= np.pi - 1e-15 else t
+    return _line_angle(math.atan2(float(w[1]), float(w[0])))
 
 
 def point_geometry(
@@ -288,8 +391,22 @@ def point_geometry(
     v: float | None = None,
     method: DerivativeMethod = "auto",
     tol: float = 1e-8,
+    signs: SurfaceSigns = DEFAULT_SURFACE_SIGNS,
 ) -> PointGeometry:
     """Everything about the surface at one point ``(u, v)`` (default: ``surface.default_uv``).
+
+    Parameters
+    ----------
+    surface : ParametricSurface or str
+    u, v : float, optional
+    method : see :func:`surface_derivatives`
+    tol : float
+        Of :func:`classify`.
+    signs : {"outward", "do-carmo"}
+        The sign of ``II`` (:func:`surface_curvature_fields`): the project's (default) or do
+        Carmo's, which negates ``e, f, g``, ``H`` and ``κₙ``, turns ``κ₁, κ₂`` into
+        ``−κ₂, −κ₁`` and so swaps ``dir1, dir2`` and ``theta_max, theta_min``; ``K``, ``n``
+        and the classification do not change.
 
     Raises
     ------
@@ -300,10 +417,16 @@ def point_geometry(
 
     Examples
     --------
+    >>> import math
     >>> from meshlap_core import point_geometry
     >>> g = point_geometry("helicoid", 0.0, 0.0)
     >>> round(g.f, 12), round(g.K, 12), g.classification
     (1.0, -1.0, 'hyperbolic')
+    >>> round(math.degrees(g.theta_max), 9)  # κₙ(θ) = sin 2θ at the origin
+    45.0
+    >>> dc = point_geometry("helicoid", 0.0, 0.0, signs="do-carmo")  # the course's sign
+    >>> round(dc.f, 12), round(dc.K, 12), round(math.degrees(dc.theta_max), 9)
+    (-1.0, -1.0, 135.0)
     """
     surface = get_surface(surface)
     u = surface.default_uv[0] if u is None else u
@@ -313,16 +436,18 @@ def point_geometry(
         raise MeshError("expected a single number", "u" if uu.ndim else "v")
     uf, vf = float(uu), float(vv)
     D = surface_derivatives(surface, uf, vf, method)
-    cf = surface_curvature_fields(surface, uf, vf, derivatives=D)
+    cf = surface_curvature_fields(surface, uf, vf, derivatives=D, signs=signs)
     _require_regular(surface, cf, uf, vf)
-    dirs_uv, dirs_3d, angles = [], [], []
+    dirs_uv, dirs_3d, angles_uv = [], [], []
     for w in (cf.w1, cf.w2):
         t = _direction_angle(w)
         d_uv = np.array([math.cos(t), math.sin(t)])
         d3 = d_uv[0] * D.p_u + d_uv[1] * D.p_v
         dirs_uv.append(d_uv)
         dirs_3d.append(d3 / np.linalg.norm(d3))
-        angles.append(t)
+        angles_uv.append(t)
+    # the same directions in the tangent plane (θ_uv ∈ [0, π) keeps θ ∈ [0, π))
+    angles = [_line_angle(tangent_angle(cf, t)) for t in angles_uv]
     k1, k2 = float(cf.k1), float(cf.k2)
     return PointGeometry(
         surface=surface.name,
@@ -351,5 +476,8 @@ def point_geometry(
         dir2=dirs_3d[1],
         theta_max=angles[0],
         theta_min=angles[1],
+        theta_uv_max=angles_uv[0],
+        theta_uv_min=angles_uv[1],
         classification=classify(k1, k2, tol),
+        signs=signs,
     )

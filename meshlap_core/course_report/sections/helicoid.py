@@ -1,7 +1,7 @@
 """Section 3: the helicoid at the origin (fundamental forms, normal curvature, principal
-curvatures, in the project's sign: positive where the surface bends away from n) and the
-convergence of the discrete H and K on meshed helicoid, sphere and torus against their closed
-forms."""
+curvatures, in the project's sign: positive where the surface bends away from n, and in the
+coursework's, do Carmo's ``e = p_uu · n``) and the convergence of the discrete H and K on meshed
+helicoid, sphere and torus against their closed forms."""
 
 from __future__ import annotations
 
@@ -36,7 +36,9 @@ def _origin(ctx: Context, sec: Section) -> None:
         "Carmo's II negated), so a sphere with its outward normal has H > 0, as the mesh "
         "code's Δx = −2Hn; K does not depend on the sign. "
         "The closed forms below for c = 1: E = 1, F = 0, G = 1 + u², "
-        "e = g = 0, f = 1/√(1+u²), K = −1/(1+u²)², κ = ±1/(1+u²), κₙ(θ) = sin 2θ at u = 0."
+        "e = g = 0, f = 1/√(1+u²), K = −1/(1+u²)², κ = ±1/(1+u²), κₙ(θ) = sin 2θ at u = 0. "
+        "Angles θ are measured in the tangent plane from the unit p_u direction towards "
+        "n × p_u (at the origin I is the identity, so they equal the (u, v) angles)."
     )
     exact = {
         "E": 1.0,
@@ -82,6 +84,77 @@ def _origin(ctx: Context, sec: Section) -> None:
         f"most {num(dev)} over 721 angles."
     )
     _origin_figures(ctx, sec)
+    _coursework(ctx, sec)
+
+
+def _coursework(ctx: Context, sec: Section) -> None:
+    """The coursework's numbers: do Carmo's sign ``e = p_uu · n`` (meshlap's ``signs=
+    "do-carmo"``) at the origin and at (0.8, 0.3), against their closed forms, and its κₙ
+    figure at the origin."""
+    sign = "do-carmo"
+    rows = []
+    for u, v in ((0.0, 0.0), (0.8, 0.3)):
+        w = 1.0 + u * u
+        dc = surfaces.point_geometry("helicoid", u, v, signs=sign)
+        out = surfaces.point_geometry("helicoid", u, v)
+        theta_uv = math.degrees(math.atan(1.0 / math.sqrt(w)))  # tan θ_uv = tan 45° / √G
+        closed = {
+            "e": 0.0,
+            "f": -1.0 / math.sqrt(w),
+            "g": 0.0,
+            "K": -1.0 / w**2,
+            "H": 0.0,
+            "k1": 1.0 / w,
+            "k2": -1.0 / w,
+            "theta_max (deg, tangent plane)": 135.0,
+            "theta_min (deg, tangent plane)": 45.0,
+            "theta_uv_max (deg, (u, v) plane)": 180.0 - theta_uv,
+            "theta_uv_min (deg, (u, v) plane)": theta_uv,
+        }
+        for q, exact in closed.items():
+            key = q.split(" ")[0]
+            got, ours = getattr(dc, key), getattr(out, key)
+            if q.startswith("theta"):
+                got, ours = math.degrees(got), math.degrees(ours)
+            rows.append([u, v, q, sign, got, exact, abs(got - exact), ours])
+    theta, kn = surfaces.normal_curvature_curve("helicoid", 0.0, 0.0, 721, signs=sign)
+    dev = float(np.abs(kn + np.sin(2 * theta)).max())
+    sec.p(
+        "The coursework's sign. The coursework this lab grew from follows do Carmo: "
+        "e = p_uu · n, f = p_uv · n, g = p_vv · n with the same n = p_u × p_v / |p_u × p_v|, "
+        "i.e. II with the opposite sign. Then the helicoid has f = −1/√(1+u²) and, at the "
+        "origin, κₙ(θ) = −sin 2θ, largest (κ₁ = 1) at θ = 3π/4 (135°) and smallest at π/4. "
+        "meshlap gives these numbers with `meshlap surface helicoid --signs do-carmo` "
+        '(`point_geometry(..., signs="do-carmo")`); the table below is computed so '
+        "(signs = do-carmo) beside meshlap's own sign (the last column). II, the shape "
+        "operator, H, κₙ change sign between the two, κ₁ and κ₂ become −κ₂ and −κ₁ (so their "
+        "directions swap), K, n and the classification do not."
+    )
+    sec.add(
+        ctx.table(
+            "helicoid_coursework",
+            "The helicoid in the coursework's sign (do Carmo's e = p_uu · n), against the "
+            "closed forms, with meshlap's outward sign beside it.",
+            ["u", "v", "quantity", "signs", "computed", "closed_form", "abs_difference", "outward"],
+            rows,
+        )
+    )
+    path = ctx.fig_dir / "helicoid_kn_do_carmo.png"
+    surfaces.plot_normal_curvature("helicoid", 0.0, 0.0, path, signs=sign)
+    ctx.figures.append(path)
+    sec.p(
+        f"Measured in the coursework's sign: the sampled κₙ(θ) at the origin differs from "
+        f"−sin 2θ by at most {num(dev)} over 721 angles."
+    )
+    sec.figs(
+        [
+            Fig(
+                ctx.rel(path),
+                "κₙ(θ) of the helicoid at the origin in the coursework's sign (do Carmo's, "
+                "signs: do-carmo): −sin 2θ, maximum κ₁ = 1 at θ = 3π/4.",
+            )
+        ]
+    )
 
 
 def _principal(ctx: Context, sec: Section) -> float:
