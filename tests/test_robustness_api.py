@@ -51,6 +51,24 @@ CALLS: dict[str, Callable[[Any, Any, Any], Any]] = {
     "HeatGeodesic": lambda V, F, t: mc.HeatGeodesic(V, F),
     "exact_distance": lambda V, F, t: mc.exact_distance(V, F, [0]),
     "isolines": lambda V, F, t: mc.isolines(V, F, np.linspace(0.0, 1.0, len(V0)), [0.5]),
+    "make_deformer": lambda V, F, t: mc.make_deformer("biharmonic", V, F, [0], [5]),
+    "deform_mesh": lambda V, F, t: mc.deform_mesh(V, F, [0], V0[[0]], "harmonic", [5]),
+    "HarmonicDeformer": lambda V, F, t: mc.HarmonicDeformer(V, F, [0], [5], k=3),
+    "LaplacianCoordinates": lambda V, F, t: mc.LaplacianCoordinates(V, F, [0], [5]),
+    "ArapDeformer": lambda V, F, t: mc.ArapDeformer(V, F, [0, 5]),
+    "grow_handles": lambda V, F, t: mc.grow_handles(V, F, [0], 0.5),
+    "rotation_error": lambda V, F, t: mc.rotation_error(V, F, V0),
+    "Flattener": lambda V, F, t: mc.Flattener(V, F).map("lscm"),
+    "make_disk": lambda V, F, t: mc.make_disk(V, F),
+    "measure_distortion": lambda V, F, t: mc.measure_distortion(V, F, V0[:, :2]),
+    "show": lambda V, F, t: mc.show(V, F, renderer="matplotlib", size=(160, 120)),
+    "show_side_by_side": lambda V, F, t: mc.show_side_by_side(
+        V, F, V0[:, 0], V0[:, 1], renderer="matplotlib", size=(200, 100)
+    ),
+    "turntable": lambda V, F, t: mc.turntable(
+        V, F, frames=2, renderer="matplotlib", size=(120, 90)
+    ),
+    "open_viewer": lambda V, F, t: mc.open_viewer(V, F, environ={}),  # no display: not opened
 }
 # names that take no vertex / face arrays (files, generators, surfaces, records, the errors)
 NO_MESH_ARRAYS = {
@@ -75,6 +93,10 @@ NO_MESH_ARRAYS = {
     "heat_kernel_signature",  # a SpectralBasis and times
     "transfer_function",  # eigenvalues only
     "save_polylines",  # a file of curves: tests/test_isolines.py
+    "UVMap",  # a record built by Flattener.map
+    "MeshPicture",  # a record built by show
+    "Turntable",  # a record built by turntable
+    "ViewerWindow",  # a record built by open_viewer
 }
 USES_V = {"rmse", "add_noise"} | {
     n for n in CALLS if n not in ("one_ring", "boundary_loops", "uniform_laplacian")

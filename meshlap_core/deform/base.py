@@ -19,7 +19,7 @@ from ..errors import check_cancel
 from ..linalg.common import ProgressCallback, report_progress
 from ..types import FloatArray, as_mesh
 from .constraints import Constraints, check_sets, check_targets, make_constraints, solid_faces
-from .rigidity import rotation_error
+from .rigidity import rotation_error_checked
 from .system import SystemStats
 
 
@@ -143,7 +143,7 @@ class Deformer:
     def rotation_error(self) -> FloatArray:
         """Each vertex's deviation from a rotation of its one-ring ``(n,)``
         (:func:`~meshlap_core.deform.rigidity.rotation_error`)."""
-        err, self._abs_terms = rotation_error(self.V, self.F, self._U, terms=self._abs_terms)
+        err, self._abs_terms = rotation_error_checked(self.V, self.F, self._U, self._abs_terms)
         return err
 
     def summary(self) -> dict[str, Any]:

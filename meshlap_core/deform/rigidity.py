@@ -17,7 +17,8 @@ from typing import Any
 
 import numpy as np
 
-from ..types import FloatArray, IntArray
+from ..errors import MeshError
+from ..types import FloatArray, IntArray, as_mesh, as_vertices
 from .arap_energy import ArapEnergy
 from .rotations import fit_rotations_stacked
 
@@ -30,10 +31,10 @@ def rotation_error(
     Parameters
     ----------
     V : (n,3) float
-        Rest positions (checked by the caller).
+        Rest positions.
     F : (m,3) int
     U : (n,3) float
-        Deformed positions.
+        Deformed positions (the same number of vertices as ``V``).
     terms : ArapEnergy, optional
         The spokes energy of ``V`` with absolute weights, from an earlier call (built when
         ``None``).
@@ -58,6 +59,18 @@ def rotation_error(
     >>> float(rotation_error(V, F, V * [2, 1, 1])[0].max()) > 0.5
     True
     """
+    V, F = as_mesh(V, F)
+    U = as_vertices(U, "U")
+    if U.shape != V.shape:
+        raise MeshError(f"U: {len(U)} deformed positions for {len(V)} vertices of V")
+    return rotation_error_checked(V, F, U, terms)
+
+
+def rotation_error_checked(
+    V: FloatArray, F: IntArray, U: FloatArray, terms: ArapEnergy | None = None
+) -> tuple[FloatArray, ArapEnergy]:
+    """:func:`rotation_error` of arrays already checked (a deformer's own ``V, F`` and
+    positions, on every drag: no second coercion of a big mesh)."""
     if terms is None:
         terms = ArapEnergy(V, F, "spokes", absolute=True)
     R = fit_rotations_stacked(terms.covariances(U))
