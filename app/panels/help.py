@@ -4,9 +4,11 @@ from __future__ import annotations
 
 import polyscope as ps
 
-from ..registry import VIEWS
+from ..host import Host
+from ..panel_spec import PanelSpec
+from ..registry import REGISTRY, VIEWS
 from ..session import SessionWidgets
-from .base import HOST_SHORTCUTS, Host, Panel
+from .base import HOST_SHORTCUTS, Panel
 
 
 def shortcut_rows(host: Host) -> list[tuple[str, str]]:
@@ -18,15 +20,21 @@ def shortcut_rows(host: Host) -> list[tuple[str, str]]:
     return rows
 
 
+def view_rows() -> list[tuple[str, str]]:
+    """Each view's key and what it shows (its spec's title and summary), in the registry's
+    order: a new panel's help entry, with no line here."""
+    views = [spec for spec in REGISTRY if spec.view]
+    return [(str(i + 1), f"{spec.title}: {spec.summary}") for i, spec in enumerate(views)]
+
+
 class HelpPanel(Panel):
     """Shortcut list, a toggle for polyscope's own panels, the UI scale, saved sessions."""
 
-    title = "Help and window (H)"
     keys = ("h",)
     shortcuts = (("H", "this help"),)
 
-    def __init__(self, name: str, state: object = None) -> None:
-        super().__init__(name, state)
+    def __init__(self, spec: PanelSpec, state: object = None) -> None:
+        super().__init__(spec, state)
         self.open: bool | None = None  # H toggles: force the header open / closed once
         self.shown = False
         self.polyscope_panels = False
@@ -51,6 +59,8 @@ class HelpPanel(Panel):
         self.session.draw(host)  # first: the lecture's prepared view, one click away
         for key, what in shortcut_rows(host):
             ui.text(f"{key:>12}  {what}")
+        for key, what in view_rows():
+            ui.text_whole_words(f"{key:>12}  {what}")
         ch, on = ui.checkbox(
             "polyscope's own panels",
             self.polyscope_panels,
@@ -70,6 +80,3 @@ class HelpPanel(Panel):
         )
         if ch:
             host.set_ui_scale(scale)
-
-
-PANEL = HelpPanel

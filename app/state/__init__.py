@@ -5,8 +5,10 @@ setting), :mod:`.watch` (``Watch``, the one invalidation rule), :mod:`.display`,
 :mod:`.mesh` (``MeshState``, the mesh list),
 :mod:`.curvature` (``CurvatureState``, ``robust_range``), and one module per panel that has a
 state (named as the panel in :mod:`meshlap_app.registry`: :mod:`.onering`, :mod:`.spectral`,
-:mod:`.smoothing`, :mod:`.surfaces`), which also declares the panel's section of a saved session
-(:mod:`.session`) and its animation (:mod:`.animation`). The classes are re-exported here
+:mod:`.smoothing`, :mod:`.surfaces`, ...), which also declares the panel's spec
+(:class:`meshlap_app.panel_spec.PanelSpec`: its settings schema, :mod:`.settings`, from which its
+section of a saved session, :mod:`.session`, comes; its checks; its animation,
+:mod:`.animation`). The classes are re-exported here
 lazily, so importing the names for the CLI's argument parser does not import numpy, scipy or
 libigl.
 """
