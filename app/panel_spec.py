@@ -17,7 +17,7 @@ spec missing a required part fails when its module is imported, naming the panel
 
 from __future__ import annotations
 
-import importlib
+import pkgutil
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any, Literal
@@ -110,17 +110,21 @@ class PanelSpec:
 
     # -------------------------------------------------------------- the panel
     def panel_class(self) -> type:
-        """The panel's class, from ``app/panels/<name>.py`` (imports polyscope).
+        """The panel's class, resolved from its reference ``meshlap_app.panels.<name>:<panel>``
+        (imports polyscope; :func:`pkgutil.resolve_name`, as an entry point is loaded).
 
         Raises
         ------
         SpecError
             The module has no class of that name.
         """
-        module = importlib.import_module(f"meshlap_app.panels.{self.name}")
-        cls = vars(module).get(self.panel)
+        reference = f"meshlap_app.panels.{self.name}:{self.panel}"
+        try:
+            cls = pkgutil.resolve_name(reference)
+        except AttributeError:
+            cls = None
         if not isinstance(cls, type):
-            raise SpecError(f"panel {self.name!r}: {module.__name__} has no class {self.panel}")
+            raise SpecError(f"panel {self.name!r}: {reference} is not a class")
         return cls
 
     # -------------------------------------------------------------- flags

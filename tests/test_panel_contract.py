@@ -105,7 +105,7 @@ def test_a_spec_that_contradicts_itself_fails_naming_the_panel():
         )
     with pytest.raises(SpecError, match="'sketch': settings must be a Settings"):
         PanelSpec(**base, settings=[Toggle("t", False, label="t")])  # type: ignore[arg-type]
-    with pytest.raises(SpecError, match="has no class Nope"):
+    with pytest.raises(SpecError, match=r"panels\.help:Nope is not a class"):
         PanelSpec(**{**base, "name": "help", "panel": "Nope"}).panel_class()
 
 
