@@ -175,9 +175,6 @@ class CheckPanel(Panel):
                     ui.row((term, mine, ref), RED if mine != ref else None)
 
 
-PANEL = CheckPanel
-
-
 # ---- the notebook picture (EGL) -------------------------------------------------------------
 
 EGL_TIMEOUT = 120.0

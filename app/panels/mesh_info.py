@@ -98,9 +98,6 @@ class MeshPanel(Panel):
         self.recent = [path, *(p for p in self.recent if p != path)][:8]
 
 
-PANEL = MeshPanel
-
-
 def _load_session(host: Host, path: Path) -> None:
     from ..session import load
 

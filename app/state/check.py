@@ -47,7 +47,7 @@ loading the session runs it again, as a job, on the session's mesh). A student f
 this machine does not refuse the session: the panel says so in red."""
 
 
-def check_session(values: dict[str, Any], mesh: Any, source: Any) -> None:
+def check_mesh(values: dict[str, Any], mesh: Any, source: Any) -> None:
     """A saved vertex the session's mesh has (``-1``: none).
 
     Raises
@@ -160,6 +160,6 @@ SPEC = PanelSpec(
     panel="CheckPanel",
     state=CheckState,
     settings=SETTINGS,
-    check_mesh=check_session,
+    check_mesh=check_mesh,
 )
 """The Check panel."""

@@ -97,7 +97,7 @@ SETTINGS = Settings(
 # fmt: on
 """The Curvature lab's settings (its section of a saved session: its choices, sliders and
 the picked vertex of the lab's mesh, the parametric surface's at ``res`` or the loaded mesh,
-which bounds it: :func:`check_session`)."""
+which bounds it: :func:`check_mesh`)."""
 SHOWN_ONLY = ("crosses", "vertex")
 """Settings the result does not depend on (the rest are :meth:`CurvatureLabState.params`)."""
 
@@ -112,7 +112,7 @@ def lab_vertex_count(values: dict[str, Any], mesh: Any) -> int:
     return len(mesh_surface(values["surface"], res).V)
 
 
-def check_session(values: dict[str, Any], mesh: Any, source: Any) -> None:
+def check_mesh(values: dict[str, Any], mesh: Any, source: Any) -> None:
     """A saved picked vertex that the lab's mesh has.
 
     Raises
@@ -335,7 +335,7 @@ class CurvatureLabState:
 
     def configure(self, values: dict[str, Any]) -> None:
         """Take a session's section (checked against :data:`SETTINGS` and by
-        :func:`check_session`); the result is recomputed for it, the picked vertex kept."""
+        :func:`check_mesh`); the result is recomputed for it, the picked vertex kept."""
         for s in SETTINGS:
             if s.key not in SHOWN_ONLY:
                 setter = self.set_choice if isinstance(s, Choice) else self.set_number
@@ -633,6 +633,6 @@ SPEC = PanelSpec(
     panel="CurvatureLabPanel",
     state=CurvatureLabState,
     settings=SETTINGS,
-    check_mesh=check_session,
+    check_mesh=check_mesh,
 )
 """The Curvature lab panel."""

@@ -98,7 +98,7 @@ def check_isoline_fields(x: Any) -> str | None:
 
 def check_sources(x: Any) -> str | None:
     """A list of vertex indices (each an integer ``0 .. MAX_INT - 1``; the session's mesh
-    bounds them further, :func:`check_session`)."""
+    bounds them further, :func:`check_mesh`)."""
     if not isinstance(x, list):
         return f"must be a list of vertices, got {shown(x)}"
     for v in x:
@@ -154,10 +154,10 @@ SETTINGS = Settings(
 )
 # fmt: on
 """The Diffusion panel's section of a saved session (:mod:`.session`): the sources are
-kept without repeats and the session's mesh bounds them (:func:`check_session`)."""
+kept without repeats and the session's mesh bounds them (:func:`check_mesh`)."""
 
 
-def check_session(values: dict[str, Any], mesh: Any, source: Any) -> None:
+def check_mesh(values: dict[str, Any], mesh: Any, source: Any) -> None:
     """Saved sources the session's mesh has (so at most its vertex count of them, once the
     repeats are dropped when the file was read).
 
@@ -546,7 +546,7 @@ SPEC = PanelSpec(
     panel="DiffusionPanel",
     state=DiffusionState,
     settings=SETTINGS,
-    check_mesh=check_session,
+    check_mesh=check_mesh,
     animation=ANIMATION,
 )
 """The Diffusion panel."""

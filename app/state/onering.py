@@ -29,10 +29,10 @@ SETTINGS = Settings(
 )
 # fmt: on
 """The One-ring panel's settings: the selected vertex (-1: none; the mesh bounds it,
-:func:`check_session`) and the order."""
+:func:`check_mesh`) and the order."""
 
 
-def check_view_options(options: dict[str, Any], state: Any) -> None:
+def check_start(options: dict[str, Any], state: Any) -> None:
     """``meshlap view --vertex``: a vertex of the mesh.
 
     Raises
@@ -48,7 +48,7 @@ def check_view_options(options: dict[str, Any], state: Any) -> None:
         )
 
 
-def check_session(values: dict[str, Any], mesh: MeshState, source: Any) -> None:
+def check_mesh(values: dict[str, Any], mesh: MeshState, source: Any) -> None:
     """A saved one-ring vertex the session's mesh has (``-1``: none selected).
 
     Raises
@@ -352,7 +352,7 @@ SPEC = PanelSpec(
     panel="OneRingPanel",
     state=OneRingState,
     settings=SETTINGS,
-    check_mesh=check_session,
-    check_start=check_view_options,
+    check_mesh=check_mesh,
+    check_start=check_start,
 )
 """The One-ring panel."""

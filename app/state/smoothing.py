@@ -78,7 +78,7 @@ SETTINGS = Settings(
     Number("lam", 0.5, lo=0.0, lo_open=True, hi=MAX_LAM, widget="input", fmt="%.4g",
            label="lambda", example=0.25, animate=Flag("--lam", "the step λ", default=1.0),
            tooltip="step size lam > 0; type a number and press Enter (keeps the current mesh)"),
-    Number("noise_alpha", 0.0, lo=0.0, hi=FLOAT_MAX,  # the mesh bounds it: check_session
+    Number("noise_alpha", 0.0, lo=0.0, hi=FLOAT_MAX,  # the mesh bounds it: check_mesh
            slider=(0.0, 0.05), fmt="%.4f", label="noise alpha", example=0.01,
            tooltip="Gaussian noise along the normals, sigma = alpha x mean edge length "
            "(rebuilds the input)", animate=Flag("--noise", "noise α added before smoothing")),
@@ -549,7 +549,7 @@ def check_section(sm: dict[str, Any], source: Any) -> None:
     sm["lam_steps"] = [[float(lam), int(n)] for lam, n in runs]
 
 
-def check_session(sm: dict[str, Any], mesh: Any, source: Any) -> None:
+def check_mesh(sm: dict[str, Any], mesh: Any, source: Any) -> None:
     """Refuse a saved noise α whose noise would push this mesh's coordinates past the
     coordinate limit (:func:`meshlap_core.noise.check_noise`); without it, 1e308 passes the
     section's check and the noisy mesh is then blamed ("vertex 0 has a NaN ...").
@@ -632,7 +632,7 @@ SPEC = PanelSpec(
     state=SmoothingState,
     settings=SETTINGS,
     check_section=check_section,
-    check_mesh=check_session,
+    check_mesh=check_mesh,
     animation=ANIMATION,
 )
 """The Smoothing panel."""
