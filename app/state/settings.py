@@ -63,9 +63,7 @@ def shown(x: Any) -> str:
 
 def integer_problem(x: Any, lo: int, hi: int) -> str | None:
     """What is wrong with ``x`` as an integer in ``[lo, hi]`` (``None``: nothing)."""
-    if not isinstance(x, int) or isinstance(x, bool):
-        return f"must be an integer {lo} to {hi}, got {shown(x)}"
-    if not lo <= x <= hi:
+    if not isinstance(x, int) or isinstance(x, bool) or not lo <= x <= hi:
         return f"must be an integer {lo} to {hi}, got {shown(x)}"
     return None
 
@@ -84,8 +82,8 @@ def number_problem(x: Any, lo: float, hi: float, lo_open: bool = False) -> str |
         return f"must be a finite number, got {shown(x)}"
     if (v <= lo if lo_open else v < lo) or v > hi:
         if lo_open:
-            return f"must be {low} and <= {hi:g}, got {x}"
-        return f"must be between {lo:g} and {hi:g}, got {x}"
+            return f"must be {low} and <= {hi:g}, got {shown(x)}"
+        return f"must be between {lo:g} and {hi:g}, got {shown(x)}"
     return None
 
 
@@ -155,7 +153,6 @@ class Setting:
     quiet: Any = UNSET
     example: Any = UNSET
 
-    kind: ClassVar[str] = ""
     widgets: ClassVar[tuple[str, ...]] = ("button", "none")
 
     def __post_init__(self) -> None:
@@ -211,7 +208,7 @@ class Setting:
                 value = self.parse(value)
             except (ValueError, OverflowError):
                 expected = self.describe() or "a valid value"
-                raise MeshError(f"{expected} expected, got {value!r}", flag) from None
+                raise MeshError(f"{expected} expected, got {shown(value)}", flag) from None
         return self.checked(value, flag)
 
     def flag_help(self, flag: Flag, panel: str, default: bool = True) -> str:
@@ -246,7 +243,6 @@ class Choice(Setting):
     """One string of ``choices`` (a combo)."""
 
     choices: tuple[str, ...]
-    kind: ClassVar[str] = "choice"
     widgets: ClassVar[tuple[str, ...]] = ("combo", "button", "none")
 
     def __post_init__(self) -> None:
@@ -285,7 +281,6 @@ class Choice(Setting):
 class Toggle(Setting):
     """``true`` or ``false`` (a checkbox, or a button that switches it)."""
 
-    kind: ClassVar[str] = "toggle"
     widgets: ClassVar[tuple[str, ...]] = ("checkbox", "button", "none")
 
     def problem(self, value: Any) -> str | None:
@@ -309,7 +304,6 @@ class Integer(Setting):
     lo: int
     hi: int
     above: str = ""
-    kind: ClassVar[str] = "integer"
     widgets: ClassVar[tuple[str, ...]] = ("input", "slider", "button", "none")
 
     def __post_init__(self) -> None:
@@ -355,7 +349,6 @@ class Number(Setting):
     lo_open: bool = False
     slider: tuple[float, float] | None = None
     fmt: str = "%.3f"
-    kind: ClassVar[str] = "number"
     widgets: ClassVar[tuple[str, ...]] = ("slider", "input", "none")
 
     def __post_init__(self) -> None:
@@ -400,7 +393,6 @@ class Text(Setting):
     """One line of text, at most ``max_len`` characters (a file name as typed)."""
 
     max_len: int = 4096
-    kind: ClassVar[str] = "text"
     widgets: ClassVar[tuple[str, ...]] = ("input", "none")
 
     def problem(self, value: Any) -> str | None:
@@ -429,7 +421,6 @@ class Custom(Setting):
     check: Callable[[Any], str | None]
     normalize: Callable[[Any], Any] | None = None
     refused: tuple[Any, ...] = ()
-    kind: ClassVar[str] = "custom"
     widgets: ClassVar[tuple[str, ...]] = ("none", "button")
 
     def __post_init__(self) -> None:
