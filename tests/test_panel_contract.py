@@ -138,6 +138,27 @@ def test_every_number_a_user_can_type_has_both_bounds(spec, setting):
         assert setting.problem(setting.quiet) is None
 
 
+def test_no_module_looks_a_panel_hook_up_by_name():
+    """The contract is the spec: no module of the viewer wing finds a module global by a
+    constant name (``getattr(module, "SESSION", None)`` switched a feature off silently when
+    the name was misspelt)."""
+    import ast
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1] / "app"
+    old = {"make_state", "check_section", "check_session", "check_view_options"}
+    found = []
+    for path in sorted(root.rglob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text())):
+            if not (isinstance(node, ast.Call) and getattr(node.func, "id", "") == "getattr"):
+                continue
+            name = node.args[1] if len(node.args) > 1 else None
+            if isinstance(name, ast.Constant) and isinstance(name.value, str):
+                if name.value.isupper() or name.value in old:
+                    found.append(f"{path.relative_to(root)}:{node.lineno} {name.value}")
+    assert not found, found
+
+
 # ---------------------------------------------------------------- sessions, on disk
 @pytest.mark.parametrize("spec", WITH_SETTINGS, ids=_id)
 def test_every_setting_changed_is_saved_and_reopened(spec, tmp_path, sphere):
@@ -201,6 +222,13 @@ def test_every_declared_flag_is_in_the_commands_help(command, spec, setting, fla
     text = _help(command, capsys)
     assert flag.name in text
     assert f"{spec.name}: {flag.help or setting.label}" in text  # its help, derived
+
+
+def test_every_view_is_in_view_help(capsys):
+    text = _help("view", capsys)
+    for spec in REGISTRY:
+        if spec.view:
+            assert f"{spec.name}: {' '.join(spec.summary.split())}" in text
 
 
 def test_every_animation_option_is_in_animate_help(capsys):

@@ -11,6 +11,7 @@ import polyscope.
 from __future__ import annotations
 
 import argparse
+import textwrap
 
 from meshlap_core.errors import MeshError
 from meshlap_core.options import UP_AXES
@@ -25,7 +26,17 @@ def start_options() -> list[str]:
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("view", help="open the polyscope viewer (default: the bundled mesh)")
+    p = sub.add_parser(
+        "view",
+        help="open the polyscope viewer (default: the bundled mesh)",
+        epilog="views (--panel, keys 1, 2, ...):\n"
+        + "\n".join(
+            textwrap.fill(f"{s.name}: {s.summary}", 78, initial_indent="  ", subsequent_indent="  ")
+            for s in REGISTRY
+            if s.view
+        ),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     p.add_argument("mesh", nargs="?", help="mesh file (default: assets/bumpy.obj)")
     p.add_argument(
         "--screenshot",
