@@ -1,8 +1,8 @@
 """The panel contract: one :class:`PanelSpec` per panel, declared in ``app/state/<name>.py``.
 
 A spec says, in one typed place, everything a host needs to know of a panel before it draws:
-its name (module, session section, ``--panel`` value), its title and one-line summary (the
-header, the Help window, ``--help``), whether it is a *view* of the combo or a section drawn on
+its name (module, session section, ``--panel`` value), its title (its header) and one-line
+summary (``meshlap view --help``), whether it is a *view* of the combo or a section drawn on
 every frame, its panel class (named, loaded only when a window or a render needs it, so
 ``meshlap view --help`` never imports polyscope), its state factory, its one settings schema
 (:class:`~meshlap_app.state.settings.Settings`) and, as named members, what the schema cannot
@@ -44,9 +44,9 @@ class PanelSpec:
         The panel's name: ``app/panels/<name>.py``, ``app/state/<name>.py``, its session
         section and ``--panel`` value.
     title : str
-        Its header in meshlap's panel (and its name in the Help window).
+        Its header in meshlap's panel.
     summary : str
-        One line: what it shows or does (the Help window, ``--help``).
+        One line: what it shows or does (``meshlap view --help``).
     panel : str
         The name of its :class:`~meshlap_app.panels.base.Panel` subclass in
         ``app/panels/<name>.py`` (imported by :meth:`panel_class`, not before).

@@ -6,7 +6,7 @@ import polyscope as ps
 
 from ..host import Host
 from ..panel_spec import PanelSpec
-from ..registry import REGISTRY, VIEWS
+from ..registry import VIEWS
 from ..session import SessionWidgets
 from .base import HOST_SHORTCUTS, Panel
 
@@ -18,13 +18,6 @@ def shortcut_rows(host: Host) -> list[tuple[str, str]]:
     for p in host.panels.values():
         rows += list(p.shortcuts)
     return rows
-
-
-def view_rows() -> list[tuple[str, str]]:
-    """Each view's key and what it shows (its spec's title and summary), in the registry's
-    order: a new panel's help entry, with no line here."""
-    views = [spec for spec in REGISTRY if spec.view]
-    return [(str(i + 1), f"{spec.title}: {spec.summary}") for i, spec in enumerate(views)]
 
 
 class HelpPanel(Panel):
@@ -59,8 +52,6 @@ class HelpPanel(Panel):
         self.session.draw(host)  # first: the lecture's prepared view, one click away
         for key, what in shortcut_rows(host):
             ui.text(f"{key:>12}  {what}")
-        for key, what in view_rows():
-            ui.text_whole_words(f"{key:>12}  {what}")
         ch, on = ui.checkbox(
             "polyscope's own panels",
             self.polyscope_panels,

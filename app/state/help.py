@@ -1,5 +1,5 @@
-"""The Help and window section's spec: the keys, each view's summary, polyscope's own panels,
-the UI scale and saved sessions. No settings of its own (the UI scale is the session's
+"""The Help and window section's spec: the keys, polyscope's own panels, the UI scale and
+saved sessions. No settings of its own (the UI scale is the session's
 top-level ``ui_scale``)."""
 
 from __future__ import annotations
@@ -9,7 +9,7 @@ from ..panel_spec import PanelSpec
 SPEC = PanelSpec(
     name="help",
     title="Help and window (H)",
-    summary="the keys, the views, the UI scale and saved sessions",
+    summary="the keys, polyscope's own panels, the UI scale and saved sessions",
     panel="HelpPanel",
     view=False,
 )
