@@ -163,11 +163,15 @@ class Panel:
 
     def capture(self, host: Host) -> dict[str, Any]:
         """Its settings for a saved session: its section, one value per key of its spec's
-        ``settings``."""
-        return {}
+        ``settings``; by default each its state's attribute of the same name (a panel whose
+        state names them otherwise, or derives one, overrides this)."""
+        return {s.key: s.coerce(getattr(self.state, s.key)) for s in self.spec.settings}
 
     def configure(self, host: Host, values: dict[str, Any]) -> None:
-        """Restore settings of a session before the mesh is registered (no computation)."""
+        """Restore settings of a session before the mesh is registered (no computation); by
+        default each declared setting's value goes to its state's attribute of that name."""
+        for s in self.spec.settings:
+            setattr(self.state, s.key, values[s.key])
 
     def restore(self, host: Host, values: dict[str, Any], active: bool) -> None:
         """Restore the rest of a session once the mesh is registered (``active``: the session's

@@ -89,6 +89,9 @@ class SurfacesPanel(Panel):
         s = self.state
         return {"surface": s.name, "res": int(s.res), "u": s.u, "v": s.v, "theta": s.section_deg}
 
+    def configure(self, host: Host, values: dict[str, Any]) -> None:
+        """Nothing before the mesh: :meth:`restore` meshes the surface and sets the point."""
+
     def restore(self, host: Host, values: dict[str, Any], active: bool) -> None:
         s = self.state
         if s.set_surface(values["surface"], values["res"]):

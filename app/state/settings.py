@@ -286,6 +286,9 @@ class Toggle(Setting):
     def problem(self, value: Any) -> str | None:
         return None if isinstance(value, bool) else f"must be true or false, got {shown(value)}"
 
+    def coerce(self, value: Any) -> Any:
+        return bool(value)
+
     def describe(self) -> str:
         return "true or false"
 
@@ -318,6 +321,9 @@ class Integer(Setting):
             if value > self.hi:  # a count too large: said why
                 return f"must be {self.lo} to {self.hi} ({self.above.format(x=shown(value))})"
         return integer_problem(value, self.lo, self.hi)
+
+    def coerce(self, value: Any) -> Any:
+        return int(value)
 
     def clamp(self, value: int) -> int:
         return int(min(max(int(value), self.lo), self.hi))
