@@ -73,19 +73,6 @@ def _check_registry() -> None:
 _check_registry()
 
 
-def spec_of(name: str) -> PanelSpec:
-    """The spec of the registered panel ``name`` (KeyError: none)."""
-    for spec in REGISTRY:
-        if spec.name == name:
-            return spec
-    raise KeyError(name)
-
-
 def animated() -> dict[str, PanelSpec]:
     """The animatable panels' specs (``meshlap animate --panel``), in the registry's order."""
     return {s.name: s for s in REGISTRY if s.animation is not None}
-
-
-def view_flags() -> list[tuple[PanelSpec, str]]:
-    """Every ``meshlap view`` flag a panel declares, as ``(spec, setting key)``."""
-    return [(spec, s.key) for spec in REGISTRY for s, _ in spec.flags("view")]
