@@ -6,8 +6,9 @@ as the window shows it; polyscope renders each frame (``screenshot_to_buffer`` w
 on-screen colour bar) and :mod:`meshlap_core.io.animation` burns the caption in and writes the GIF
 or MP4 atomically.
 
-Which panels can be animated, their options and frame rates are declared by each panel's state
-module (``ANIMATION``, :class:`~.state.animation.Animation`); this module never names a panel.
+Which panels can be animated, their options and frame rates are declared by each panel's spec
+(its ``animation``, :class:`~.state.animation.Animation`, and its settings' flags); this module
+never names a panel.
 
 With a saved session (``meshlap animate --session``) the viewer is first restored from it
 (:func:`.session.apply`: mesh, settings, cached basis, camera) and the frames start from that
@@ -38,8 +39,9 @@ from meshlap_core.options import check_choice
 from meshlap_core.progress import Progress
 
 from . import scene
-from .registry import REGISTRY
-from .state.animation import Animation, animations
+from .panel_spec import PanelSpec
+from .registry import REGISTRY, animated
+from .state.animation import Animation
 from .state.app import AppState
 from .state.camera import MAX_WINDOW, window_size
 from .state.mesh import MeshState
@@ -53,8 +55,8 @@ if TYPE_CHECKING:
 class AnimationSpec:
     """What ``meshlap animate`` renders (validated by :func:`check_spec` before any rendering).
 
-    ``options`` are the animated panel's own (its ``ANIMATION.options``, defaults filled and
-    checked); ``size`` is ``(width, height)`` pixels.
+    ``options`` are the animated panel's own (its settings' flags and its animation's options,
+    by dest: defaults filled and checked); ``size`` is ``(width, height)`` pixels.
     """
 
     panel: str
@@ -68,9 +70,15 @@ class AnimationSpec:
     session_file: Path | None = None  # its file (named in errors; never overwritten)
 
     @property
+    def panel_spec(self) -> PanelSpec:
+        """The animated panel's spec."""
+        return animated()[self.panel]
+
+    @property
     def animation(self) -> Animation:
-        """The animated panel's declaration."""
-        return animations()[self.panel]
+        """The animated panel's animation (:func:`.registry.animated` lists only panels that
+        have one)."""
+        return self.panel_spec.animation_declared()
 
     @property
     def what(self) -> str:
@@ -93,14 +101,13 @@ def check_spec(spec: AnimationSpec, mesh: MeshState | None) -> None:
     MeshError
         An inconsistent or out-of-range option, naming it.
     """
-    kinds = animations()
-    check_choice(spec.panel, tuple(kinds), "panel", "--panel")
+    check_choice(spec.panel, tuple(animated()), "panel", "--panel")
     w, h = spec.size
     if not (64 <= w <= 4096 and 64 <= h <= 4096):
         raise MeshError(f"each side must be 64 to 4096 pixels, got {w}x{h}", "--size")
     if mesh is not None and spec.session is not None:  # the file first, as `view --session`
         check_session_mesh(spec.session, mesh, spec.session_file or "--session")
-    spec.animation.check(spec.options)
+    spec.panel_spec.check_options(spec.options)
     if mesh is not None:
         spec.animation.check_mesh(spec.options, mesh)
     if spec.session is not None:
@@ -263,14 +270,13 @@ def restore_session(viewer: Viewer, spec: AnimationSpec, mesh: MeshState) -> int
     window = session_window(session, spec.size, source)  # None: no camera
     keep_camera = spec.keeps_camera
     settings = copy.deepcopy(session.settings)
-    for e in REGISTRY:  # the frames start their own run: no computation nobody will see
-        if e.name not in settings:
+    for p in REGISTRY:  # the frames start their own run: no computation nobody will see
+        if p.name not in settings:
             continue
-        if e.name == spec.panel:
-            settings[e.name].update(spec.animation.session_overrides)
+        if p.name == spec.panel:
+            settings[p.name].update(spec.animation.session_overrides)
         else:
-            module = e.state_module()
-            settings[e.name].update(getattr(module, "QUIET", {}) if module is not None else {})
+            settings[p.name].update(p.settings.quiet())
     session = dataclasses.replace(session, settings=settings)
     if session.camera is not None:
         camera = dict(session.camera)

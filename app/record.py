@@ -25,7 +25,7 @@ from meshlap_core.io.animation import FrameWriter, burn_caption
 from .scene import scene_width
 
 if TYPE_CHECKING:
-    from .panels.base import Host
+    from .host import Host
 
 RECORD_HEADER = "record (GIF / MP4)"
 FIRST_FPS = 10.0

@@ -1,59 +1,78 @@
-"""The registry of the viewer's panels: the one place that lists them.
+"""The registry of the viewer's panels: the one place that lists them, as their specs.
 
-Each line names a panel. Its code lives in ``app/panels/<name>.py`` (a class named ``PANEL``
-there, following :class:`meshlap_app.panels.base.Panel`) and its polyscope-free state, when it
-has one, in ``app/state/<name>.py``. The viewer, the session, the animator, the recorder, the
-export and the help all loop over this tuple and never name a panel.
+Each line is one panel's :class:`~meshlap_app.panel_spec.PanelSpec`, declared in its
+polyscope-free module ``app/state/<name>.py`` (its code is ``app/panels/<name>.py``, loaded
+only when a window or a render starts). The viewer, the session file, the command-line flags,
+the animator, the recorder, the export and the help all loop over this tuple and never name a
+panel. Views (``view=True``) are in the *view* combo and on the number keys in this order;
+sections are drawn on every frame (the mesh, export and help sections).
 
-Adding a panel: write ``app/panels/<name>.py`` (and ``app/state/<name>.py``), its tests, and
-one line here. ``view=True`` puts it in the *view* combo and on a number key (in this order);
-``view=False`` is a section drawn on every frame (the mesh, export and help sections).
+Adding a panel: its two files, its test file, and one line here.
 
-This module imports nothing heavy: ``meshlap view --help`` reads the view names from it.
+The import is polyscope-free: ``meshlap view --help`` reads the views and flags from here.
 """
 
 from __future__ import annotations
 
-import importlib
-from dataclasses import dataclass
-from types import ModuleType
-
-
-@dataclass(frozen=True)
-class Entry:
-    """One registered panel: its ``name`` (module, session section and ``--panel`` value) and
-    whether it is a ``view`` of the combo or an always-drawn section."""
-
-    name: str
-    view: bool = True
-
-    def panel_module(self) -> ModuleType:
-        """``meshlap_app.panels.<name>`` (imports polyscope)."""
-        return importlib.import_module(f"meshlap_app.panels.{self.name}")
-
-    def state_module(self) -> ModuleType | None:
-        """``meshlap_app.state.<name>`` (no polyscope), or ``None`` when the panel has none."""
-        try:
-            return importlib.import_module(f"meshlap_app.state.{self.name}")
-        except ModuleNotFoundError as exc:
-            if exc.name != f"meshlap_app.state.{self.name}":
-                raise
-            return None
-
-
-REGISTRY: tuple[Entry, ...] = (
-    Entry("mesh_info", view=False),
-    Entry("curvature"),
-    Entry("onering"),
-    Entry("spectral"),
-    Entry("smoothing"),
-    Entry("surfaces"),
-    Entry("check"),
-    Entry("diffusion"),
-    Entry("curvature_lab"),
-    Entry("export", view=False),
-    Entry("help", view=False),
+from .panel_spec import PanelSpec
+from .state import (
+    check,
+    curvature,
+    curvature_lab,
+    diffusion,
+    export,
+    help,
+    mesh_info,
+    onering,
+    smoothing,
+    spectral,
+    surfaces,
 )
 
-VIEWS: tuple[str, ...] = tuple(e.name for e in REGISTRY if e.view)
+REGISTRY: tuple[PanelSpec, ...] = (
+    mesh_info.SPEC,
+    curvature.SPEC,
+    onering.SPEC,
+    spectral.SPEC,
+    smoothing.SPEC,
+    surfaces.SPEC,
+    check.SPEC,
+    diffusion.SPEC,
+    curvature_lab.SPEC,
+    export.SPEC,
+    help.SPEC,
+)
+
+VIEWS: tuple[str, ...] = tuple(s.name for s in REGISTRY if s.view)
 """The views of the *view* combo, in its order (keys 1, 2, ...); the first is the default."""
+
+
+def _check_registry() -> None:
+    """Distinct names; every flag of a command declared once (a second ``--vertex`` would
+    silently shadow the first)."""
+    names = [s.name for s in REGISTRY]
+    twice = sorted({n for n in names if names.count(n) > 1})
+    if twice:
+        raise ValueError(f"panels registered twice: {', '.join(twice)}")
+    if not VIEWS:
+        raise ValueError("the registry has no view")
+    for command in ("view", "animate"):
+        owner: dict[str, str] = {}
+        for spec in REGISTRY:
+            flags = [f.name for _, f in spec.flags(command)]  # type: ignore[arg-type]
+            if command == "animate" and spec.animation is not None:
+                flags += [o.flag for o in spec.animation.options]
+            for flag in flags:
+                if owner.get(flag, spec.name) != spec.name:
+                    raise ValueError(
+                        f"meshlap {command} {flag} is declared by {owner[flag]} and {spec.name}"
+                    )
+                owner[flag] = spec.name
+
+
+_check_registry()
+
+
+def animated() -> dict[str, PanelSpec]:
+    """The animatable panels' specs (``meshlap animate --panel``), in the registry's order."""
+    return {s.name: s for s in REGISTRY if s.animation is not None}

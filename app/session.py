@@ -24,7 +24,7 @@ from .state.mesh import MeshState
 from .state.session import Session, check_session_mesh, read_session, write_session
 
 if TYPE_CHECKING:
-    from .panels.base import Host
+    from .host import Host
 
 
 def _finite_json(x: Any) -> bool:

@@ -9,7 +9,7 @@ The :class:`Viewer` owns the one :class:`~.state.app.AppState`, the UI adapter a
 mesh structure; everything else belongs to a panel. Each frame it draws the sections and the
 active view, lets every panel bring its uploads up to date (``sync``: cheap when nothing
 changed), hands clicks and keys to the panels, and frames the scene when asked. It implements
-:class:`~.panels.base.Host`, the narrow interface panels are given; it never names a panel.
+:class:`~.host.Host`, the narrow interface panels are given; it never names a panel.
 """
 
 from __future__ import annotations
@@ -82,8 +82,8 @@ def init_polyscope(backend: str) -> None:
 
 
 def make_panels(state: AppState) -> dict[str, Panel]:
-    """One instance of every registered panel, each given its slice of ``state``."""
-    return {e.name: e.panel_module().PANEL(e.name, state.slices.get(e.name)) for e in REGISTRY}
+    """One instance of every registered panel (its spec's class), given its slice of ``state``."""
+    return {s.name: s.panel_class()(s, state.slices.get(s.name)) for s in REGISTRY}
 
 
 class Viewer:
@@ -540,13 +540,10 @@ def opens_later(path: Path | None, shot: Path | None, saved: Any, options: dict[
 
 
 def check_options(options: dict[str, Any], state: AppState) -> None:
-    """Each panel's state module checks the ``meshlap view`` options it knows
-    (``check_view_options``) against the loaded mesh, before any window opens."""
-    for e in REGISTRY:
-        module = e.state_module()
-        check = getattr(module, "check_view_options", None) if module is not None else None
-        if check is not None:
-            check(options, state)
+    """Each panel's ``meshlap view`` options, checked before any window opens
+    (:meth:`.panel_spec.PanelSpec.check_view`: parsed in place, then against the mesh)."""
+    for spec in REGISTRY:
+        spec.check_view(options, state)
 
 
 def run(

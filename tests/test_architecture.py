@@ -139,7 +139,7 @@ def test_only_a_panels_own_files_name_it(module):
 
 @pytest.mark.parametrize("module", [m for m in SOURCES if m.startswith("meshlap_app.panels")])
 def test_panels_never_import_the_viewer(module):
-    """Not even for type hints: a panel types against ``panels.base.Host``."""
+    """Not even for type hints: a panel types against ``host.Host``."""
     imported = _imports(module, top_level_only=False)
     bad = {n for n in imported if n.startswith(("meshlap_app.viewer", "meshlap_app.animate"))}
     assert not bad, f"{module} imports {sorted(bad)}"

@@ -11,6 +11,7 @@ import threading
 
 import numpy as np
 import pytest
+from meshlap_app.registry import VIEWS
 from meshlap_app.state.session import (
     VERSION,
     Session,
@@ -36,62 +37,11 @@ def sphere(tmp_path):
 
 
 def non_default_session(mesh) -> Session:
-    """A session whose every field differs from the default."""
-    s = Session(mesh=mesh.resolve(), panel="smoothing", ui_scale=1.75)
+    """A session whose every field differs from the default: each registered panel's every
+    declared setting at its sample value (derived from the specs, no table here)."""
+    s = Session(mesh=mesh.resolve(), panel=VIEWS[-1], ui_scale=1.75)
     s.camera = {"fov": 40.0, "viewMat": [float(i) for i in range(16)], "upDir": "Y Up"}
-    s.settings = {
-        "curvature": {
-            "field": "gaussian",
-            "area": "barycentric",  # the default is voronoi
-            "boundary": "2pi",
-            "clip": 7.5,
-            "side_by_side": True,
-            "second_field": "k1",
-            "estimator": "rusinkiewicz",
-        },
-        "onering": {"vertex": 17, "reverse": True},
-        "spectral": {"computed": True, "k_request": 24, "k": 9, "mode": 4, "play": "modes"},
-        "smoothing": {
-            "method": "taubin",
-            "laplacian": "cotan",
-            "lam": 0.25,
-            "noise_alpha": 0.01,
-            "seed": 7,
-            "iterations": 5,
-            "lam_steps": [[0.5, 2], [0.25, 3]],
-        },
-        "surfaces": {"surface": "torus", "res": 30, "u": 1.25, "v": -0.5, "theta": 30.0},
-        "diffusion": {
-            "show": "heat",
-            "sources": [3, 5],
-            "log_t": -1.5,
-            "steps": 4,
-            "heat_field": "difference",
-            "m": 2.0,
-            "boundary": "neumann",
-            "isolines": False,
-            "isoline_count": 7,
-            "isoline_fields": {"heat": {"on": True, "count": 5}},
-            "filter": "band",
-            "keep": 12,
-            "gain": 3.0,
-            "hks_scale": 2,
-        },
-        "curvature_lab": {
-            "source": "mesh",
-            "estimator": "jet",
-            "quantity": "k1",
-            "show": "estimate",
-            "crosses": False,
-            "surface": "saddle",
-            "res": 20,
-            "noise": 0.001,
-            "jitter": 0.2,
-            "flips": 0.1,
-            "vertex": 40,
-        },
-        "check": {"file": "hw/exercises.py", "task": "voronoi_areas", "vertex": 5, "checked": True},
-    }
+    s.settings = {sec: settings.samples() for sec, settings in schema().items()}
     return s
 
 
@@ -99,9 +49,9 @@ def non_default_session(mesh) -> Session:
 def test_every_field_differs_from_its_default_and_round_trips(tmp_path, sphere):
     s = non_default_session(sphere)
     defaults = default_settings()
-    for sec, keys in schema().items():
-        assert set(s.settings[sec]) == set(keys)  # the test covers every field
-        for key in keys:
+    for sec, settings in schema().items():
+        assert set(s.settings[sec]) == set(settings.keys())  # the test covers every field
+        for key in settings.keys():
             assert s.settings[sec][key] != defaults[sec][key], f"{sec}.{key}"
     out = write_session(tmp_path / "lecture.json", s)
     data = json.loads(out.read_text())
@@ -621,14 +571,11 @@ def test_added_keys_are_written_only_when_they_say_something(tmp_path, sphere):
     plain = json.loads(write_session(tmp_path / "plain.json", Session(mesh=sphere)).read_text())
     for sec, key in ADDED_KEYS:
         assert key not in plain[sec], f"{sec}.{key}"
+    assert ADDED_KEYS  # the spectral play choice, the λ of each step, ...
     s = non_default_session(sphere)
     data = json.loads(write_session(tmp_path / "all.json", s).read_text())
-    assert {(sec, key): data[sec][key] for sec, key in ADDED_KEYS} == {
-        ("smoothing", "lam_steps"): [[0.5, 2], [0.25, 3]],
-        ("spectral", "play"): "modes",
-        ("surfaces", "theta"): 30.0,
-        ("curvature", "estimator"): "rusinkiewicz",
-    }
+    for sec, key in ADDED_KEYS:
+        assert data[sec][key] == s.settings[sec][key] != schema()[sec].default(key)
     assert read_session(tmp_path / "all.json") == s
 
 

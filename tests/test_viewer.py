@@ -208,12 +208,13 @@ def test_no_display_is_one_clear_error(tmp_path):
 
 
 def test_cli_uses_the_viewers_single_definition_of_panels_and_fields():
-    """`meshlap view` takes its choices from the registry and the field names (pure data, no
-    polyscope)."""
+    """`meshlap view` takes its choices from the registry and the field names from the
+    setting that declares ``--field`` (pure data, no polyscope)."""
     from meshlap_app import registry
     from meshlap_app.commands import view
 
     from meshlap_core import options
 
     assert view.VIEWS is registry.VIEWS
-    assert view.CURVATURE_FIELDS is options.CURVATURE_FIELDS
+    flags = {f.name: s for spec in registry.REGISTRY for s, f in spec.flags("view")}
+    assert flags["--field"].choices is options.CURVATURE_FIELDS

@@ -16,10 +16,10 @@ ps = pytest.importorskip("polyscope")
 Image = pytest.importorskip("PIL.Image")
 
 from meshlap_app.record import RECORD_HEADER  # noqa: E402
+from meshlap_app.registry import animated  # noqa: E402
 from meshlap_app.scene import NORMAL_SECTION  # noqa: E402
-from meshlap_app.state.animation import animations  # noqa: E402
 
-DEFAULT_FPS = {kind: fps for a in animations().values() for kind, fps in a.fps.items()}
+DEFAULT_FPS = {k: fps for s in animated().values() for k, fps in s.animation.fps.items()}
 from meshlap_app.state.surfaces import TURN_STEP_DEG, section_arc  # noqa: E402
 
 from meshlap_core import primitives  # noqa: E402

@@ -7,7 +7,7 @@ Each widget gets good values and bad ones (empty, 0, negative, NaN, 1e309, out o
 session never ends, bad input is shown in red in its panel and the last good state stays.
 ``test_every_widget_is_driven`` runs ``drive_panel_<name>(viewer, tmp_path)`` of every registered
 panel (each panel's test module defines its own) and fails when a panel draws a widget that no
-driver drives.
+driver drives, or when a setting its spec declares has a widget no driver drove.
 """
 
 from __future__ import annotations
@@ -582,6 +582,12 @@ def test_every_widget_is_driven(viewer, tmp_path):
     ui = viewer.ui
     undriven = sorted(set(ui.seen) - ui.driven)
     assert not undriven, f"widgets no test drives: {undriven}"
+    from meshlap_app.registry import REGISTRY
+
+    declared = {(spec.name, s.label) for spec in REGISTRY for s in spec.settings if s.label}
+    assert len(declared) >= 40
+    missing = sorted(declared - ui.driven)  # each declared setting's own widget, driven
+    assert not missing, f"declared settings whose widget no driver drove: {missing}"
     untipped = sorted(k for k, kind in ui.seen.items() if kind not in ("key", "click", "hover"))
     untipped = sorted(set(untipped) - set(ui.tooltips))
     assert not untipped, f"widgets without a tooltip: {untipped}"

@@ -29,7 +29,7 @@ def documented_keys() -> list[tuple[str, str]]:
     from meshlap_app.panels.help import shortcut_rows
     from meshlap_app.registry import REGISTRY
 
-    panels = {e.name: e.panel_module().PANEL for e in REGISTRY}
+    panels = {spec.name: spec.panel_class() for spec in REGISTRY}
     out: list[tuple[str, str]] = []
     for key, what in shortcut_rows(SimpleNamespace(panels=panels)):
         if key in ("mouse", "drop"):

@@ -3,9 +3,11 @@ rendered headless (EGL) with the viewer's scene code (:mod:`..animate`). ``--ses
 FILE.json`` animates a view prepared in the window: its mesh, settings and camera (an option
 typed on the command line wins over the session's value, which wins over the built-in default).
 
-The animatable panels and their options come from the panels' state modules (``ANIMATION``);
-this module names none of them. Every argument, the session, the mesh and the output path are
-checked before the renderer starts: a bad one is one line ``meshlap: error: ...`` and exit 2.
+The animatable panels and their options come from the panels' specs (the registry): each
+setting's ``animate`` flag (its type, range and help from the settings schema) and the
+animation's own options; this module names none of them. Every argument, the session, the
+mesh and the output path are checked before the renderer starts: a bad one is one line
+``meshlap: error: ...`` and exit 2.
 """
 
 from __future__ import annotations
@@ -18,7 +20,8 @@ from typing import Any
 
 from meshlap_core.errors import MeshError
 
-from ..state.animation import Animation, animations
+from ..panel_spec import PanelSpec
+from ..registry import animated
 
 DEFAULT_SIZE = "960x540"
 
@@ -40,12 +43,19 @@ value, which wins over the built-in default.
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    kinds = animations()
+    kinds = animated()
     p = sub.add_parser(
         "animate",
-        help="render an animation (GIF/MP4): " + "; ".join(a.summary for a in kinds.values()),
+        help="render an animation (GIF/MP4): "
+        + "; ".join(s.animation_declared().summary for s in kinds.values()),
+        description="Render an animation for slides, headless.\n"
+        + "\n".join(f"  --panel {n}: {s.animation_declared().summary}" for n, s in kinds.items()),
         epilog=SESSION_HELP.format(
-            sections="\n".join("  " + a.session_help for a in kinds.values() if a.session_help)
+            sections="\n".join(
+                "  " + s.animation_declared().session_help
+                for s in kinds.values()
+                if s.animation_declared().session_help
+            )
         ),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
@@ -56,18 +66,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="what to animate (required without --session; default: the session's panel)",
     )
     p.add_argument("--out", required=True, metavar="OUT.gif|OUT.mp4", help="the animation file")
-    seen: set[str] = set()
-    for anim in kinds.values():
-        for opt in anim.options:
-            if opt.flag in seen:
-                continue
-            seen.add(opt.flag)
-            if opt.store_true:
-                p.add_argument(opt.flag, action="store_true", default=None, help=opt.help)
-            else:
-                p.add_argument(
-                    opt.flag, type=opt.type, choices=opt.choices, metavar=opt.metavar, help=opt.help
-                )
+    for spec in kinds.values():
+        add_flags(p, spec)
     p.add_argument("--fps", type=float, help="frames per second (default depends on the kind)")
     p.add_argument(
         "--size",
@@ -88,6 +88,26 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
+def add_flags(p: argparse.ArgumentParser, spec: PanelSpec) -> None:
+    """The flags of ``spec``'s animation: each setting's (typed text, checked by the setting
+    when the command runs, so a bad value is one ``meshlap: error`` line naming the flag) and
+    the animation's own options."""
+    for setting, flag in spec.flags("animate"):
+        p.add_argument(
+            flag.name,
+            dest=flag.dest,
+            metavar=setting.metavar(),
+            help=setting.flag_help(flag, spec.name),
+        )
+    for opt in spec.animation_declared().options:
+        if opt.store_true:
+            p.add_argument(opt.flag, action="store_true", default=None, help=opt.help)
+        else:
+            p.add_argument(
+                opt.flag, type=opt.type, choices=opt.choices, metavar=opt.metavar, help=opt.help
+            )
+
+
 def _size(text: str) -> tuple[int, int]:
     try:
         w, h = (int(t) for t in text.lower().split("x"))
@@ -96,9 +116,9 @@ def _size(text: str) -> tuple[int, int]:
     return w, h
 
 
-def _choose(args: argparse.Namespace, session: Any) -> tuple[str, Animation]:
-    """The animated panel (typed, else the session's) and its animation."""
-    kinds = animations()
+def _choose(args: argparse.Namespace, session: Any) -> tuple[str, PanelSpec]:
+    """The animated panel (typed, else the session's) and its spec."""
+    kinds = animated()
     if args.panel is None and session is not None:
         if session.panel not in kinds:
             raise MeshError(
@@ -128,16 +148,16 @@ def _read_session(args: argparse.Namespace) -> Any:
 
 def run(args: argparse.Namespace) -> int:
     session = _read_session(args) if args.session is not None else None
-    panel, anim = _choose(args, session)
-    options = {opt.dest: getattr(args, opt.dest) for opt in anim.options}
-    if session is not None:
-        anim.from_session(options, session.settings[panel], args.session)
-        if args.size is None:
-            from ..animate import session_size
+    panel, declared = _choose(args, session)
+    anim = declared.animation_declared()
+    options = declared.animation_options(vars(args))
+    saved = session.settings[panel] if session is not None else None
+    declared.fill_options(options, saved, args.session)
+    if session is not None and args.size is None:
+        from ..animate import session_size
 
-            size = session_size(session, args.session)
-            args.size = f"{size[0]}x{size[1]}" if size is not None else None
-    anim.fill_defaults(options)
+        size = session_size(session, args.session)
+        args.size = f"{size[0]}x{size[1]}" if size is not None else None
     if args.fps is not None and not (math.isfinite(args.fps) and 0.1 <= args.fps <= 120):
         raise MeshError(f"must be between 0.1 and 120, got {args.fps}", "--fps")
     from ..animate import AnimationSpec, check_spec, load_mesh_state, render

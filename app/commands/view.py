@@ -1,25 +1,42 @@
 """``meshlap view [MESH] [--screenshot OUT.png]``: the polyscope viewer (:mod:`..viewer`).
 
-Registered with the core's command line through the ``meshlap.commands`` entry point; the
-parser reads only pure data (the registry's views, the field names), so ``meshlap --help``
-does not import polyscope.
+Registered with the core's command line through the ``meshlap.commands`` entry point. The
+host's own options (MESH, ``--screenshot``, ``--session``, ``--panel``, ``--ui-scale``,
+``--up``) are here; every panel's options (``--field``, ``--vertex``, ``--k`` ...) are the
+``view`` flags of the registered specs' settings, with their help, type and range from the
+settings schema. The parser reads only the specs (pure data), so ``meshlap --help`` does not
+import polyscope.
 """
 
 from __future__ import annotations
 
 import argparse
+import textwrap
 
 from meshlap_core.errors import MeshError
-from meshlap_core.options import CURVATURE_FIELDS, UP_AXES
+from meshlap_core.options import UP_AXES
 
-from ..registry import VIEWS
+from ..registry import REGISTRY, VIEWS
 
-START_OPTIONS = ("field", "vertex", "k")
-"""The options handed to the panels when the window opens (each checks its own)."""
+
+def start_options() -> list[str]:
+    """The dests of the panels' ``meshlap view`` flags: handed to the panels when the window
+    opens (each parsed and checked by its setting, then against the mesh by its spec)."""
+    return [flag.dest for spec in REGISTRY for _, flag in spec.flags("view")]
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("view", help="open the polyscope viewer (default: the bundled mesh)")
+    p = sub.add_parser(
+        "view",
+        help="open the polyscope viewer (default: the bundled mesh)",
+        epilog="views (--panel, keys 1, 2, ...):\n"
+        + "\n".join(
+            textwrap.fill(f"{s.name}: {s.summary}", 78, initial_indent="  ", subsequent_indent="  ")
+            for s in REGISTRY
+            if s.view
+        ),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     p.add_argument("mesh", nargs="?", help="mesh file (default: assets/bumpy.obj)")
     p.add_argument(
         "--screenshot",
@@ -32,12 +49,15 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="reopen a saved session (mesh, panel settings, camera); replaces MESH and the "
         "options below",
     )
-    p.add_argument(
-        "--field", choices=CURVATURE_FIELDS, help="curvature field shown first (default cotan)"
-    )
     p.add_argument("--panel", choices=VIEWS, help=f"panel shown first (default {VIEWS[0]})")
-    p.add_argument("--vertex", type=int, help="one-ring panel: the selected vertex")
-    p.add_argument("--k", type=int, help="spectral panel: reconstruct from k eigenvectors")
+    for spec in REGISTRY:
+        for setting, flag in spec.flags("view"):
+            p.add_argument(
+                flag.name,
+                dest=flag.dest,
+                metavar=setting.metavar(),
+                help=setting.flag_help(flag, spec.name, default=False),
+            )
     p.add_argument(
         "--ui-scale",
         type=float,
@@ -57,7 +77,7 @@ def run(args: argparse.Namespace) -> int:
     if args.session is not None:
         given = [("MESH", args.mesh)] + [
             (f"--{name.replace('_', '-')}", getattr(args, name))
-            for name in (*START_OPTIONS, "panel", "up")  # --ui-scale: the projector's, wins
+            for name in (*start_options(), "panel", "up")  # --ui-scale: the projector's, wins
         ]
         given = [flag for flag, value in given if value is not None]
         if given:
@@ -86,5 +106,5 @@ def run(args: argparse.Namespace) -> int:
         ui_scale=args.ui_scale,
         session=args.session,
         up=args.up,
-        **{name: getattr(args, name) for name in START_OPTIONS},
+        **{name: getattr(args, name) for name in start_options()},
     )

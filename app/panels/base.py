@@ -1,28 +1,29 @@
-"""The protocol every panel follows, and the narrow host it is given.
+"""The protocol every panel's code follows (its hooks, with defaults).
 
-A panel owns one feature end to end: its widgets (:meth:`Panel.draw`), the structures it
-registers (shown, hidden, framed), the captions under them, what *export* writes, its slice of a
-saved session, its shortcut keys and what *play* / *record* / ``meshlap animate`` advance. The
-viewer (:mod:`meshlap_app.viewer`) and the headless animator (:mod:`meshlap_app.animate`) are
-*hosts*: they loop over the registered panels (:mod:`meshlap_app.registry`) and never name one.
-A panel never imports the viewer; it types against :class:`Host`.
+A panel is declared by its spec (:class:`meshlap_app.panel_spec.PanelSpec`: name, title,
+settings, checks, animation) and drawn by a subclass of :class:`Panel` named there. It owns one
+feature end to end: its widgets (:meth:`Panel.draw`), the structures it registers (shown,
+hidden, framed), the captions under them, what *export* writes, its slice of a saved session,
+its shortcut keys and what *play* / *record* / ``meshlap animate`` advance. The viewer
+(:mod:`meshlap_app.viewer`) and the headless animator (:mod:`meshlap_app.animate`) are *hosts*:
+they loop over the registered specs (:mod:`meshlap_app.registry`) and never name a panel. A
+panel never imports the viewer; it types against :class:`meshlap_app.host.Host`.
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
-from pathlib import Path
-from typing import TYPE_CHECKING, Any, ClassVar, Protocol
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
+from ..host import Host
 from ..state.isolines import Isolines
 from ..state.watch import Watch
 
 if TYPE_CHECKING:
-    from ..state.app import AppState
-    from ..ui import UI
+    from ..panel_spec import PanelSpec
 
 ExportItem = tuple[str, "np.ndarray | None", "np.ndarray | None", "np.ndarray | None"]
 """(file name, V or ``None``, F or ``None``, per-vertex scalars or ``None``): a mesh (PLY with
@@ -79,77 +80,12 @@ HOST_SHORTCUTS: tuple[tuple[str, str], ...] = (
 """The keys and gestures every host answers itself (each panel lists its own ``shortcuts``)."""
 
 
-class Host(Protocol):
-    """What a panel may use of the program that shows it (the window or the animator)."""
-
-    state: AppState
-    ui: UI
-    panels: dict[str, Panel]  # every registered panel, in the registry's order
-
-    def open(self, path: Path | None) -> bool:
-        """Load the mesh file ``path`` (``None``: the bundled default); on failure the mesh's
-        error is set and the mesh on screen stays."""
-        ...
-
-    def active(self) -> Panel:
-        """The panel of the active view."""
-        ...
-
-    def set_panel(self, name: str) -> None:
-        """Switch the active view (its structures shown, the others hidden, re-framed)."""
-        ...
-
-    def sync_mesh(self) -> None:
-        """Register the mesh if it changed (each panel's ``on_new_mesh``), sync every panel
-        and show the active view."""
-        ...
-
-    def keep_view(self) -> None:
-        """Keep the camera as it is now: no pending re-frame, the window size taken as seen."""
-        ...
-
-    def refresh(self) -> None:
-        """Show the active view's structures and hide the others (after registering some)."""
-        ...
-
-    def request_frame(self) -> None:
-        """Frame what is shown again at the end of this frame."""
-        ...
-
-    def frame(self, strip: float | None = None) -> None:
-        """Frame what is shown now (``strip``: an animation frame, that left fraction of the
-        width kept for the colour bar; a kept camera is not moved)."""
-        ...
-
-    def flush_frame(self) -> None:
-        """Frame now if a re-frame was requested (before a recorded picture)."""
-        ...
-
-    def set_ui_scale(self, scale: float) -> None:
-        """Set the UI scale (text, widgets, the panel's width) everywhere it applies."""
-        ...
-
-    def mesh_points(self) -> np.ndarray:
-        """Display positions ``(n,3)`` of the mesh's vertices (as uploaded)."""
-        ...
-
-    background: bool
-    """Long operations run as jobs of ``state.jobs`` (the window); ``False``: right away (the
-    animator, headless renders, tests)."""
-
-    def draw_job(self, owner: str) -> bool:
-        """Draw the progress line and Cancel button of ``owner``'s running job (a panel passes
-        its name); True when one runs."""
-        ...
-
-
 class Panel:
     """Defaults for every hook of the protocol; a panel overrides what it does.
 
+    It is made with its spec (``name`` and ``title`` come from there) and its state slice.
     Class attributes a panel sets:
 
-    ``title``
-        Its header in meshlap's panel.
     ``shows_mesh``
         The main mesh is visible while this view is active.
     ``shows_curvature``
@@ -169,7 +105,6 @@ class Panel:
         Where the camera looks from when it frames this view (``None``: the mesh's front).
     """
 
-    title: ClassVar[str] = ""
     shows_mesh: ClassVar[bool] = True
     shows_curvature: ClassVar[bool] = False
     pick_through: ClassVar[bool] = False
@@ -178,8 +113,10 @@ class Panel:
     keys: ClassVar[tuple[str, ...]] = ()
     view_direction: ClassVar[tuple[float, float, float] | None] = None
 
-    def __init__(self, name: str, state: Any = None) -> None:
-        self.name = name
+    def __init__(self, spec: PanelSpec, state: Any = None) -> None:
+        self.spec = spec
+        self.name = spec.name
+        self.title = spec.title  # its header
         self.state = state  # this panel's slice of the AppState (None: it has none)
         self.watch = Watch()  # what was uploaded, and from which inputs
         self.isolines = Isolines()  # isoline toggle and count of each scalar field it shows
@@ -225,11 +162,16 @@ class Panel:
         return []
 
     def capture(self, host: Host) -> dict[str, Any]:
-        """Its settings for a saved session (its section, ``SESSION`` of its state module)."""
-        return {}
+        """Its settings for a saved session: its section, one value per key of its spec's
+        ``settings``; by default each its state's attribute of the same name (a panel whose
+        state names them otherwise, or derives one, overrides this)."""
+        return {s.key: s.coerce(getattr(self.state, s.key)) for s in self.spec.settings}
 
     def configure(self, host: Host, values: dict[str, Any]) -> None:
-        """Restore settings of a session before the mesh is registered (no computation)."""
+        """Restore settings of a session before the mesh is registered (no computation); by
+        default each declared setting's value goes to its state's attribute of that name."""
+        for s in self.spec.settings:
+            setattr(self.state, s.key, values[s.key])
 
     def restore(self, host: Host, values: dict[str, Any], active: bool) -> None:
         """Restore the rest of a session once the mesh is registered (``active``: the session's
@@ -258,5 +200,5 @@ class Panel:
 
     def frames(self, host: Host, options: dict[str, Any]) -> Iterator[str]:
         """``meshlap animate``: set up each frame of its animation, yield the frame's caption
-        (only panels whose state module declares ``ANIMATION``)."""
+        (only panels whose spec has an ``animation``)."""
         raise NotImplementedError(f"the {self.name} panel has no animation")

@@ -15,11 +15,13 @@ import polyscope as ps
 
 from meshlap_core.errors import MeshError
 
+from ..host import Host
 from ..isolines import draw_isolines
 from ..scene import MESH, colorbar_at, picked_vertex, scalar_for_upload
-from ..state.check import VIEWER_TASKS, CheckState
+from ..setting_widgets import setting_widget
+from ..state.check import SETTINGS, CheckState
 from ..ui import RED
-from .base import Host, Panel
+from .base import Panel
 
 DIFF = "student - reference"
 
@@ -36,7 +38,6 @@ def difference_colours(d: np.ndarray, signed: bool) -> tuple[str, tuple[float, f
 class CheckPanel(Panel):
     """Student file, task, *check*; verdict; difference map; the clicked vertex's rows."""
 
-    title = "Check (exercises)"
     state: CheckState
 
     def on_new_mesh(self, host: Host) -> None:
@@ -148,14 +149,13 @@ class CheckPanel(Panel):
         ui, st = host.ui, self.state
         if not ui.header(self.title):
             return
-        _, st.file = ui.input_text(
-            "student file", st.file, "your exercises .py (meshlap exercises init DIR writes one)"
-        )
-        changed, task = ui.combo("task", st.task, VIEWER_TASKS, "the function of your file")
+        _, st.file = setting_widget(ui, SETTINGS["file"], st.file)
+        changed, task = setting_widget(ui, SETTINGS["task"], st.task)
         if changed:
             st.set_task(task)
         running = host.draw_job(self.name)
-        if not running and ui.button("check", "run your function on this mesh and the battery"):
+        check = SETTINGS["checked"]  # the button: a check shown is what a session keeps
+        if not running and ui.button(check.label, check.tooltip):
             self.start_check(host)
         for k, line in enumerate(st.verdict()):
             passed = st.check is not None and st.check.result.passed
@@ -169,7 +169,7 @@ class CheckPanel(Panel):
 
     def _draw_rows(self, host: Host) -> None:
         ui, st = host.ui, self.state
-        changed, vertex = ui.input_int("vertex", st.vertex, "click the mesh, or type a vertex")
+        changed, vertex = setting_widget(ui, SETTINGS["vertex"], st.vertex)
         if changed:
             st.select(vertex, len(host.state.mesh.V))
         rows = st.rows()
@@ -180,6 +180,3 @@ class CheckPanel(Panel):
             if shown:
                 for term, mine, ref in rows:
                     ui.row((term, mine, ref), RED if mine != ref else None)
-
-
-PANEL = CheckPanel

@@ -7,23 +7,14 @@ from typing import Any
 import numpy as np
 import polyscope as ps
 
-from meshlap_core.options import AREA_KINDS as AREAS
-from meshlap_core.options import (
-    BOUNDARY_RULES,
-    CURVATURE_ESTIMATORS,
-    CURVATURE_FIELD_LABELS,
-    PRINCIPAL_FIELDS,
-)
+from meshlap_core.options import CURVATURE_FIELD_LABELS, PRINCIPAL_FIELDS
 
+from ..host import Host
 from ..isolines import draw_isolines
 from ..scene import MESH, MESH_B, colorbar_at, front_view, scalar_for_upload, side_offset
-from ..state.curvature import ESTIMATOR_HELP, PRINCIPAL_JOB
-from .base import Host, Panel
-
-FIELD_HELP = (
-    "H = |Lx|/2 with the uniform or cotangent Laplacian (signed by the normal); "
-    "K = (2 pi - sum of angles) / A_i; k1,2 = H +- sqrt(H^2 - K)"
-)
+from ..setting_widgets import setting_widget
+from ..state.curvature import PRINCIPAL_JOB, SETTINGS
+from .base import Panel
 
 
 class CurvaturePanel(Panel):
@@ -34,7 +25,6 @@ class CurvaturePanel(Panel):
     view ``shows_curvature``.
     """
 
-    title = "Curvature"
     shows_curvature = True
     pick_through = True  # a click on the mesh selects a vertex (the one-ring view takes it)
     framed = (MESH_B,)
@@ -197,45 +187,20 @@ class CurvaturePanel(Panel):
         host.draw_job(self.name)  # new area or boundary rule: the fields' progress, Cancel
         host.draw_job(PRINCIPAL_JOB)  # the estimator's run (k1, k2 and directions)
         c = host.state.curv
-        names = tuple(CURVATURE_FIELD_LABELS)
-        ch1, c.field_name = ui.combo("field", c.field_name, names, FIELD_HELP)
-        ch7, estimator = ui.combo(
-            "estimator",
-            c.estimator,
-            CURVATURE_ESTIMATORS,
-            "k1, k2 (and the One-ring view's shape operator) by:\n" + ESTIMATOR_HELP,
-        )
+        ch1, c.field_name = setting_widget(ui, SETTINGS["field"], c.field_name)
+        ch7, estimator = setting_widget(ui, SETTINGS["estimator"], c.estimator)
         if ch7:
             c.set_estimator(estimator)
         if c.principal_error:
             ui.error(f"{c.estimator}: {c.principal_error}")
-        ch2, c.area = ui.combo(
-            "area", c.area, AREAS, "vertex area A_i: barycentric (1/3 of each face) or Voronoi"
-        )
-        ch3, c.boundary = ui.combo(
-            "boundary rule",
-            c.boundary,
-            BOUNDARY_RULES,
-            "Gaussian curvature at boundary vertices: pi - sum(angles) (geodesic curvature) "
-            "or not defined",
-        )
-        ch4, pct = ui.slider_float(
-            "clip %",
-            c.percentile,
-            0.0,
-            20.0,
-            "%.1f",
-            "colour range clips this percentage of vertices at each end (0 to 49)",
-        )
+        ch2, c.area = setting_widget(ui, SETTINGS["area"], c.area)
+        ch3, c.boundary = setting_widget(ui, SETTINGS["boundary"], c.boundary)
+        ch4, pct = setting_widget(ui, SETTINGS["clip"], c.percentile)
         if ch4:
             c.set_percentile(pct)
-        ch5, c.side_by_side = ui.checkbox(
-            "side by side", c.side_by_side, "show a second field on a copy beside the mesh"
-        )
+        ch5, c.side_by_side = setting_widget(ui, SETTINGS["side_by_side"], c.side_by_side)
         if c.side_by_side:
-            _, c.second_field = ui.combo(
-                "second field", c.second_field, names, "the field on the copy"
-            )
+            _, c.second_field = setting_widget(ui, SETTINGS["second_field"], c.second_field)
         ch6 = draw_isolines(ui, self.isolines, c.field_name)
         if ch1 or ch2 or ch3 or ch4 or ch5 or ch6 or ch7:
             self.sync(host)
@@ -273,6 +238,3 @@ def _bar_colors(centers: np.ndarray, lo: float, hi: float, signed: bool) -> np.n
     c = np.asarray(centers, dtype=np.float64)
     t = (c - lo) / (hi - lo) if hi > lo else np.full(len(c), 0.5)
     return colormaps["coolwarm" if signed else "viridis"](np.clip(t, 0.0, 1.0))
-
-
-PANEL = CurvaturePanel

@@ -10,25 +10,21 @@ import numpy as np
 import polyscope as ps
 
 from meshlap_core.options import (
-    CURVATURE_ESTIMATOR_LABELS,
-    CURVATURE_ESTIMATORS,
-    LAB_SHOWS,
-    LAB_SOURCES,
     PRINCIPAL_FIELDS,
 )
-from meshlap_core.surfaces import SURFACES
 
+from ..host import Host
 from ..isolines import draw_isolines
+from ..panel_spec import PanelSpec
 from ..scene import COLORBAR_AT, picked_vertex
+from ..setting_widgets import setting_widget
 from ..state.curvature_lab import (
-    MAX_JITTER,
-    MAX_NOISE,
-    MAX_RES,
+    SETTINGS,
     STUDY_LEVELS,
     CurvatureLabState,
     LabResult,
 )
-from .base import Host, Panel
+from .base import Panel
 
 LAB = "curvature lab"
 """The lab's surface mesh (the parametric surface's, or a copy of the loaded mesh)."""
@@ -41,12 +37,11 @@ class CurvatureLabPanel(Panel):
     """Source (surface / mesh), estimator, quantity, what is coloured, crosses; on a surface
     its resolution, noise and jitter."""
 
-    title = "Curvature lab"
     shows_mesh = False  # its own copy: a parametric surface or the loaded mesh
     framed = (LAB,)
 
-    def __init__(self, name: str, state: CurvatureLabState) -> None:
-        super().__init__(name, state)
+    def __init__(self, spec: PanelSpec, state: CurvatureLabState) -> None:
+        super().__init__(spec, state)
         self.state: CurvatureLabState = state
         self._study_for: tuple[Any, ...] | None = None  # the study job's inputs
         self._field: str | None = None  # the scalar quantity on the lab's mesh
@@ -226,35 +221,12 @@ class CurvatureLabPanel(Panel):
         host.draw_job(self.study_owner)
         lab = self.state
         changed = False
-        for what, items, tip in (
-            ("source", LAB_SOURCES, "a parametric surface (exact values known) or the loaded mesh"),
-            (
-                "estimator",
-                CURVATURE_ESTIMATORS,
-                "; ".join(f"{k}: {v}" for k, v in CURVATURE_ESTIMATOR_LABELS.items()),
-            ),
-            (
-                "quantity",
-                PRINCIPAL_FIELDS,
-                "k1 >= k2, H = (k1+k2)/2 > 0 on spheres, K = k1 k2, abs_max",
-            ),
-            (
-                "show",
-                LAB_SHOWS,
-                "the estimate, its error against the exact surface, or the largest "
-                "difference between all the estimators",
-            ),
-        ):
-            ch, value = ui.combo(what, getattr(lab, what), items, tip)
+        for what in ("source", "estimator", "quantity", "show"):
+            ch, value = setting_widget(ui, SETTINGS[what], getattr(lab, what))
             if ch:
                 lab.set_choice(what, value)
                 changed = True
-        ch, lab.crosses = ui.checkbox(
-            "crosses",
-            lab.crosses,
-            "principal directions: black k1 (max), green k2 (min), length by |k| "
-            "(the exact k1 in magenta, off by default)",
-        )
+        ch, lab.crosses = setting_widget(ui, SETTINGS["crosses"], lab.crosses)
         changed |= ch
         if lab.source == "surface":
             changed |= self._draw_surface_sliders(host)
@@ -274,33 +246,12 @@ class CurvatureLabPanel(Panel):
         one changed."""
         ui, lab = host.ui, self.state
         changed = False
-        ch, value = ui.combo("lab surface", lab.surface, tuple(SURFACES), "the parametric surface")
+        ch, value = setting_widget(ui, SETTINGS["surface"], lab.surface)
         if ch:
             lab.set_choice("surface", value)
             changed = True
-        for what, lo, hi, tip in (
-            ("resolution", 3, MAX_RES, "cells per direction (the torus: twice around)"),
-        ):
-            ch, value = ui.slider_int(what, lab.res, lo, hi, tip)
-            if ch:
-                lab.set_number("res", value)
-                changed = True
-        for what, key, hi, tip in (
-            (
-                "noise",
-                "noise",
-                MAX_NOISE,
-                "normal noise, a fraction of the bounding-box diagonal",
-            ),
-            (
-                "jitter",
-                "jitter",
-                MAX_JITTER,
-                "parameter jitter of interior vertices, a fraction of a cell",
-            ),
-            ("edge flips", "flips", 1.0, "fraction of the interior edges flipped"),
-        ):
-            ch, value = ui.slider_float(what, getattr(lab, key), 0.0, hi, "%.4f", tip)
+        for key in ("res", "noise", "jitter", "flips"):
+            ch, value = setting_widget(ui, SETTINGS[key], getattr(lab, key))
             if ch:
                 lab.set_number(key, value)
                 changed = True
@@ -309,9 +260,7 @@ class CurvatureLabPanel(Panel):
     def _draw_shape_operator(self, host: Host) -> None:
         """The picked vertex's 2×2 tensor with its basis and Euler's κn(θ), exact beside it."""
         ui, lab = host.ui, self.state
-        ch, v = ui.input_int(
-            "vertex", lab.vertex, "pick a vertex (or click the mesh): its shape operator"
-        )
+        ch, v = setting_widget(ui, SETTINGS["vertex"], lab.vertex)
         if ch:
             lab.pick(v)
         so = lab.shape_operator()
@@ -342,6 +291,3 @@ class CurvatureLabPanel(Panel):
                     order = rows[-1][f"{q}_order"]
                     tag = f"{q}, order {order:.2f}" if order is not None else q
                     host.ui.plot_line(tag, x, np.log10([row[f"{q}_rel"] for row in rows]))
-
-
-PANEL = CurvatureLabPanel

@@ -12,24 +12,24 @@ import numpy as np
 import polyscope as ps
 
 from meshlap_core.diffusion import HeatGeodesic, exact_distance, mean_edge_length
-from meshlap_core.options import HEAT_BOUNDARIES, SMOOTHING_METHODS
+from meshlap_core.options import SMOOTHING_METHODS
 
 from .. import scene
+from ..host import Host
 from ..isolines import draw_isolines
+from ..panel_spec import PanelSpec
 from ..scene import MESH, front_view, picked_vertex, side_offset
+from ..setting_widgets import setting_widget
 from ..state.diffusion import (
     HEAT_FIELDS,
-    HKS_SCALES,
     ISO_FIELDS,
-    LOG_T_RANGE,
-    PANEL_FILTERS,
-    SHOWS,
+    SETTINGS,
     DiffusionState,
     find_basis,
     symmetric_range,
 )
 from ..state.isolines import DEFAULT_COUNT
-from .base import ExportItem, Host, Panel
+from .base import ExportItem, Panel
 
 FIELD = "diffusion field"
 SOURCES = "heat sources"
@@ -51,7 +51,6 @@ blacken it)."""
 class DiffusionPanel(Panel):
     """Heat, distance, filters and HKS from clicked vertices."""
 
-    title = "Diffusion"
     framed = (FILTERED, *HEAT_COPIES)
     shortcuts = (
         (
@@ -60,8 +59,8 @@ class DiffusionPanel(Panel):
         ),
     )
 
-    def __init__(self, name: str, state: DiffusionState) -> None:
-        super().__init__(name, state)
+    def __init__(self, spec: PanelSpec, state: DiffusionState) -> None:
+        super().__init__(spec, state)
         self.state: DiffusionState = state
         self._factoring: Any = None  # the geodesic key of the last factorization started
 
@@ -430,13 +429,9 @@ class DiffusionPanel(Panel):
             return
         st = self.state
         host.draw_job(self.name)
-        ch, show = ui.combo(
-            "show", st.show, SHOWS,
-            "heat: u_t = Lap u from the clicked vertices; distance: heat method (Crane et al. "
-            "2013); filter: U h(Lambda) U^T M X; hks: heat kernel signature",
-        )  # fmt: skip
+        ch, show = setting_widget(ui, SETTINGS["show"], st.show)
         if ch:
-            st.set_choice("show", show, SHOWS)
+            st.set_choice("show", show)
             st.playing = False  # t plays in the heat view only
             self.recompute(host)
         if ui.button("clear sources", "forget the clicked vertices"):
@@ -458,10 +453,7 @@ class DiffusionPanel(Panel):
     def _draw_heat(self, host: Host, basis: Any) -> None:
         ui, st = host.ui, self.state
         h = self._h(host)
-        lo, hi = LOG_T_RANGE
-        ch, x = ui.slider_float(
-            "log10 t/h^2", st.log_t, lo, hi, "%.2f", "heat time t = 10^x h^2 (h: mean edge)"
-        )
+        ch, x = setting_widget(ui, SETTINGS["log_t"], st.log_t)
         if ch:
             st.set_log_t(x)
             self.recompute(host)
@@ -473,17 +465,13 @@ class DiffusionPanel(Panel):
         # a step once the last field is shown: each t refactorizes M + tau K (a job)
         if st.playing and host.state.jobs.running(self.name) is None and st.play_step():
             self.recompute(host)
-        ch, steps = ui.input_int("Euler steps", st.steps, "(M + tau K) u' = M u, tau = t/steps")
+        ch, steps = setting_widget(ui, SETTINGS["steps"], st.steps)
         if ch:
-            st.steps = int(min(max(steps, 1), 1000))
+            st.steps = SETTINGS["steps"].clamp(steps)
             self.recompute(host)
-        ch, which = ui.combo(
-            "heat field", st.heat_field, HEAT_FIELDS,
-            "euler, spectral (sum exp(-lambda_i t) phi_i phi_i^T M u0) or spectral - euler; "
-            "all three on one colour range",
-        )  # fmt: skip
+        ch, which = setting_widget(ui, SETTINGS["heat_field"], st.heat_field)
         if ch:
-            st.set_choice("heat_field", which, HEAT_FIELDS)
+            st.set_choice("heat_field", which)
             self.push(host)
         ui.text(f"t = {st.t(h):.4g}")
         if basis is None:
@@ -498,16 +486,13 @@ class DiffusionPanel(Panel):
 
     def _draw_distance(self, host: Host, basis: Any) -> None:
         ui, st = host.ui, self.state
-        ch, m = ui.input_float("m (t = m h^2)", st.m, "%.4g", "heat time factor (default 1)")
+        ch, m = setting_widget(ui, SETTINGS["m"], st.m)
         if ch:
             st.set_m(m)
             self.recompute(host)
-        ch, rule = ui.combo(
-            "boundary condition", st.boundary, HEAT_BOUNDARIES,
-            "heat step on open meshes: Neumann, Dirichlet or their average (the paper's)",
-        )  # fmt: skip
+        ch, rule = setting_widget(ui, SETTINGS["boundary"], st.boundary)
         if ch:
-            st.set_choice("boundary", rule, HEAT_BOUNDARIES)
+            st.set_choice("boundary", rule)
             self.recompute(host)
         if ui.button("exact distance", "igl.exact_geodesic (MMP) as a job; error map after"):
             self.start_exact(host)
@@ -529,9 +514,9 @@ class DiffusionPanel(Panel):
             ui.note(f"{st.show} {NEEDS_BASIS}")
             return
         if st.show == "hks":
-            ch, s = ui.slider_int("HKS time", st.hks_scale, 0, HKS_SCALES - 1, "log-spaced t")
+            ch, s = setting_widget(ui, SETTINGS["hks_scale"], st.hks_scale)
             if ch:
-                st.hks_scale = int(min(max(s, 0), HKS_SCALES - 1))
+                st.hks_scale = SETTINGS["hks_scale"].clamp(s)
                 self.recompute(host)
             ui.text(f"t = {st.hks_time():.4g}; with a source: signature distance from it")
             return
@@ -539,21 +524,16 @@ class DiffusionPanel(Panel):
 
     def _draw_filter(self, host: Host, basis: Any) -> None:
         ui, st = host.ui, self.state
-        ch, kind = ui.combo(
-            "filter", st.filter, PANEL_FILTERS,
-            "low-pass: first modes; band: gain on modes; explicit/implicit/taubin: the "
-            "smoothers' transfer functions (1 - s lam)^n, (1 + s lam)^-n, ...; drawn: drag "
-            "the curve's points in the plot",
-        )  # fmt: skip
+        ch, kind = setting_widget(ui, SETTINGS["filter"], st.filter)
         if ch:
-            st.set_choice("filter", kind, PANEL_FILTERS)
-        ch, keep = ui.slider_int("modes kept", st.keep, 0, basis.k_max, "low-pass / band end")
+            st.set_choice("filter", kind)
+        ch, keep = setting_widget(ui, SETTINGS["keep"], min(st.keep, basis.k_max), 0, basis.k_max)
         if ch:
             st.keep = int(min(max(keep, 0), basis.k_max))
             st.band = (1, max(st.keep, 2))
-        ch, gain = ui.slider_float("band gain", st.gain, -2.0, 5.0, "%.2f", "gain of the band")
+        ch, gain = setting_widget(ui, SETTINGS["gain"], st.gain)
         if ch:
-            st.gain = float(gain)
+            st.gain = SETTINGS["gain"].checked(gain, "band gain")
         ch, iters = ui.input_int("smoother steps", st.iters, "n of the smoothers' filters")
         if ch:
             st.iters = int(min(max(iters, 0), 10_000))
@@ -641,6 +621,3 @@ class DiffusionPanel(Panel):
             )  # fmt: skip
             self._push_sources(host)
             yield f"heat from vertex {source}: t = {st.t(h):.3g} = 10^{x:.2f} h^2, peak {top:.3g}"
-
-
-PANEL = DiffusionPanel

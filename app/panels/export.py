@@ -7,8 +7,10 @@ from pathlib import Path
 from meshlap_core.errors import MeshError
 from meshlap_core.io import save_mesh, save_scalars
 
+from ..host import Host
+from ..panel_spec import PanelSpec
 from ..scene import save_screenshot
-from .base import ExportItem, Host, Panel
+from .base import ExportItem, Panel
 
 
 class ExportPanel(Panel):
@@ -18,10 +20,8 @@ class ExportPanel(Panel):
     files go there too.
     """
 
-    title = "Export"
-
-    def __init__(self, name: str, state: object = None) -> None:
-        super().__init__(name, state)
+    def __init__(self, spec: PanelSpec, state: object = None) -> None:
+        super().__init__(spec, state)
         self.folder_text = ""
         self.status = ""
 
@@ -100,6 +100,3 @@ def field_items(host: Host) -> list[ExportItem]:
         (f"{stem}_{curv.field_name}.ply", mesh.V, mesh.F, field),
         (f"{stem}_{curv.field_name}.csv", None, None, field),
     ]
-
-
-PANEL = ExportPanel

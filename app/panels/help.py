@@ -4,9 +4,11 @@ from __future__ import annotations
 
 import polyscope as ps
 
+from ..host import Host
+from ..panel_spec import PanelSpec
 from ..registry import VIEWS
 from ..session import SessionWidgets
-from .base import HOST_SHORTCUTS, Host, Panel
+from .base import HOST_SHORTCUTS, Panel
 
 
 def shortcut_rows(host: Host) -> list[tuple[str, str]]:
@@ -21,12 +23,11 @@ def shortcut_rows(host: Host) -> list[tuple[str, str]]:
 class HelpPanel(Panel):
     """Shortcut list, a toggle for polyscope's own panels, the UI scale, saved sessions."""
 
-    title = "Help and window (H)"
     keys = ("h",)
     shortcuts = (("H", "this help"),)
 
-    def __init__(self, name: str, state: object = None) -> None:
-        super().__init__(name, state)
+    def __init__(self, spec: PanelSpec, state: object = None) -> None:
+        super().__init__(spec, state)
         self.open: bool | None = None  # H toggles: force the header open / closed once
         self.shown = False
         self.polyscope_panels = False
@@ -70,6 +71,3 @@ class HelpPanel(Panel):
         )
         if ch:
             host.set_ui_scale(scale)
-
-
-PANEL = HelpPanel

@@ -6,17 +6,17 @@ import time
 from pathlib import Path
 from typing import Any
 
+from ..host import Host
+from ..panel_spec import PanelSpec
 from ..state.mesh import list_meshes
-from .base import Host, Panel
+from .base import Panel
 
 
 class MeshPanel(Panel):
     """Counts and topology of the current mesh; open a file by path or from the list."""
 
-    title = "Mesh"
-
-    def __init__(self, name: str, state: object = None) -> None:
-        super().__init__(name, state)
+    def __init__(self, spec: PanelSpec, state: object = None) -> None:
+        super().__init__(spec, state)
         self.path_text = ""
         self.recent: list[Path] = []  # the last meshes opened, newest first
         self._listed: tuple[float, list[tuple[str, Path]]] = (-1e9, [])
@@ -96,9 +96,6 @@ class MeshPanel(Panel):
         """Put ``path`` first in the recent-files list (at most 8)."""
         path = Path(path).resolve()
         self.recent = [path, *(p for p in self.recent if p != path)][:8]
-
-
-PANEL = MeshPanel
 
 
 def _load_session(host: Host, path: Path) -> None:

@@ -17,8 +17,12 @@ from meshlap_core.options import AREA_KINDS, BOUNDARY_RULES
 
 from .. import scene
 from ..camera import project_to_screen
+from ..host import Host
+from ..panel_spec import PanelSpec
 from ..scene import MESH, RING_CENTER, RING_CURVE, RING_POINTS, picked_vertex, scene_fraction
+from ..setting_widgets import setting_widget
 from ..state.onering import (
+    SETTINGS,
     HoverThrottle,
     OneRingState,
     angle_arcs,
@@ -27,7 +31,7 @@ from ..state.onering import (
     weight_segments,
 )
 from ..text_numbers import sig
-from .base import Host, Panel
+from .base import Panel
 
 NEGATIVE_RGBA = (*scene.NEGATIVE_COLOR, 1.0)
 
@@ -74,13 +78,12 @@ class OneRingPanel(Panel):
         Seconds (monotonic) for the hover throttle; a test passes a fake clock.
     """
 
-    title = "One-ring"
     shows_curvature = True  # the mesh keeps the curvature field and its colour bar
 
     def __init__(
-        self, name: str, state: OneRingState, clock: Callable[[], float] = time.monotonic
+        self, spec: PanelSpec, state: OneRingState, clock: Callable[[], float] = time.monotonic
     ) -> None:
-        super().__init__(name, state)
+        super().__init__(spec, state)
         self.state: OneRingState = state
         self.labels: list[tuple[tuple[float, float], str]] = []  # the one-ring numbers drawn
         self.clock = clock
@@ -389,16 +392,12 @@ class OneRingPanel(Panel):
         ui.text("click a vertex of the mesh")
         n = len(host.state.mesh.V)
         r = self.state
-        ch, v = ui.input_int(
-            "vertex", max(r.vertex, 0), f"vertex index, 0 to {n - 1}; Enter or -/+ selects it"
-        )
+        ch, v = setting_widget(ui, SETTINGS["vertex"], max(r.vertex, 0), 0, n - 1)
         if ch:
             if not 0 <= v < n:
                 raise MeshError(f"{v} is out of range (the mesh has {n} vertices)", "vertex")
             self.select(host, v)
-        ch, _ = ui.checkbox(
-            "clockwise (reverse)", r.reverse, "list the neighbours clockwise instead"
-        )
+        ch, _ = setting_widget(ui, SETTINGS["reverse"], r.reverse)
         if ch:
             r.toggle_reverse(host.state.mesh, host.state.curv)
             self.push(host)
@@ -568,6 +567,3 @@ def face_cells(f: FaceTerm) -> list[str]:
         f"{f.share_voronoi:.4g}",
         rule,
     ]
-
-
-PANEL = OneRingPanel

@@ -13,10 +13,11 @@ import numpy as np
 import polyscope as ps
 
 from meshlap_core.errors import MeshError
-from meshlap_core.options import LAPLACIAN_KINDS, SMOOTHING_METHODS
 
 from .. import scene, smoother_process
+from ..host import Host
 from ..jobs import Reporter
+from ..panel_spec import PanelSpec
 from ..record import Recorder, draw_record
 from ..scene import (
     INPUT_COLOR,
@@ -27,8 +28,10 @@ from ..scene import (
     front_view,
     side_offset,
 )
+from ..setting_widgets import setting_widget
 from ..state.smoothing import (
     ANIMATION,
+    SETTINGS,
     SmoothingState,
     caption,
     encode_lam_steps,
@@ -36,13 +39,12 @@ from ..state.smoothing import (
 )
 from ..text_numbers import plural
 from ..ui import UI
-from .base import ExportItem, Host, Panel
+from .base import ExportItem, Panel
 
 
 class SmoothingPanel(Panel):
     """Method, Laplacian, λ, noise; step / play / pause / reset; live figures; g(μ)."""
 
-    title = "Smoothing"
     shows_mesh = False  # the input and the smoothed copy replace it
     framed = (SMOOTHED, SMOOTH_INPUT)
     keys = ("space", "right", "r")
@@ -52,10 +54,10 @@ class SmoothingPanel(Panel):
         ("R", "smoothing: back to the input"),
     )
 
-    def __init__(self, name: str, state: SmoothingState) -> None:
-        super().__init__(name, state)
+    def __init__(self, spec: PanelSpec, state: SmoothingState) -> None:
+        super().__init__(spec, state)
         self.state: SmoothingState = state
-        self.recorder = Recorder(f"{name}.gif")
+        self.recorder = Recorder(f"{spec.name}.gif")
         self._shown_at: float | None = None  # when push last uploaded new steps
         self._ready: Shown | None = None  # display arrays a build job prepared off the UI thread
         self._input_due = False  # the input copy is registered at the next frame (not this one)
@@ -386,46 +388,23 @@ class SmoothingPanel(Panel):
             return
         st = self.state
         host.draw_job(self.name)  # a stepper being built: progress and Cancel
-        ch, method = ui.combo(
-            "method",
-            st.method,
-            SMOOTHING_METHODS,
-            "explicit: x <- x + lam L x;  implicit: (I - lam L) x' = x (backward Euler);  "
-            "taubin: lam step, then a negative nu step (no shrinkage)",
-        )
+        ch, method = setting_widget(ui, SETTINGS["method"], st.method)
         if ch:
             self.start_build(host, method=method)
-        ch, lap = ui.combo(
-            "Laplacian",
-            st.laplacian,
-            LAPLACIAN_KINDS,
-            "uniform: L = D^-1 A - I (lam dimensionless);  cotan: L = M^-1 C (lam in length^2)",
-        )
+        ch, lap = setting_widget(ui, SETTINGS["laplacian"], st.laplacian)
         if ch:
             self.start_build(host, laplacian=lap)
-        ch, lam = ui.input_float(
-            "lambda",
-            st.lam,
-            "%.4g",
-            "step size lam > 0; type a number and press Enter (keeps the current mesh)",
-        )
+        ch, lam = setting_widget(ui, SETTINGS["lam"], st.lam)
         if ch:
             st.set_lam(lam)
-        ch, alpha = ui.slider_float(
-            "noise alpha",
-            st.noise_alpha,
-            0.0,
-            0.05,
-            "%.4f",
-            "Gaussian noise along the normals, sigma = alpha x mean edge length "
-            "(rebuilds the input)",
-        )
+        ch, alpha = setting_widget(ui, SETTINGS["noise_alpha"], st.noise_alpha)
         if ch:
             self.start_build(host, noise_alpha=alpha)
-        ch, seed = ui.input_int("noise seed", st.seed, "seed of the noise (an integer >= 0)")
+        ch, seed = setting_widget(ui, SETTINGS["seed"], st.seed)
         if ch:
             self.start_build(host, seed=seed)
-        if ui.button("step", "one iteration"):
+        step = SETTINGS["iterations"]  # a step: one more iteration of the run
+        if ui.button(step.label, step.tooltip):
             st.advance()
         ui.same_line()
         if ui.button(
@@ -620,6 +599,3 @@ def corners(box: np.ndarray) -> np.ndarray:
     return np.array(
         [[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])]
     )
-
-
-PANEL = SmoothingPanel

@@ -13,11 +13,14 @@ import polyscope as ps
 from meshlap_core.errors import MeshError
 
 from .. import scene
+from ..host import Host
 from ..isolines import draw_isolines
+from ..panel_spec import PanelSpec
 from ..record import Recorder, draw_record
 from ..scene import COLORBAR_AT, EIGEN, MESH, RECON, front_view, side_offset
-from ..state.spectral import ANIMATION, PLAY_KINDS, SCREENSHOT_K, SpectralState
-from .base import ExportItem, Host, Panel
+from ..setting_widgets import setting_widget
+from ..state.spectral import ANIMATION, PLAY_KINDS, SCREENSHOT_K, SETTINGS, SpectralState
+from .base import ExportItem, Panel
 
 ERROR_NAME = "error |x - x_k|"  # the reconstruction's per-vertex error quantity
 
@@ -25,15 +28,14 @@ ERROR_NAME = "error |x - x_k|"  # the reconstruction's per-vertex error quantity
 class SpectralPanel(Panel):
     """Eigenmode browser and k slider; the reconstruction sits beside the original."""
 
-    title = "Spectral"
     framed = (RECON,)
     keys = ("right", "left")
     shortcuts = (("right / left", "spectral: k + 1 / k - 1"),)
 
-    def __init__(self, name: str, state: SpectralState) -> None:
-        super().__init__(name, state)
+    def __init__(self, spec: PanelSpec, state: SpectralState) -> None:
+        super().__init__(spec, state)
         self.state: SpectralState = state
-        self.recorder = Recorder(f"{name}.gif")
+        self.recorder = Recorder(f"{spec.name}.gif")
 
     def animating(self) -> bool:
         """The k sweep or the modes play: the window keeps its full frame rate."""
@@ -231,16 +233,11 @@ class SpectralPanel(Panel):
         st = self.state
         self.adopt(host)
         n = len(host.state.mesh.V)
-        ch, k_request = ui.input_int(
-            "modes to compute",
-            st.k_request,
-            f"number of eigenpairs of -C u = lambda M u to compute (2 to {n}); Enter applies",
-        )
+        ch, k_request = setting_widget(ui, SETTINGS["k_request"], st.k_request, 2, max(n, 2))
         if ch:
             st.set_k_request(k_request, n)
-        if not host.draw_job(self.name) and ui.button(
-            "compute eigenbasis", "solve for the modes in the background (progress, Cancel)"
-        ):
+        computed = SETTINGS["computed"]  # the button that computes the basis
+        if not host.draw_job(self.name) and ui.button(computed.label, computed.tooltip):
             self.compute(host)
         if st.error:
             ui.error(st.error)
@@ -252,13 +249,7 @@ class SpectralPanel(Panel):
         if st.tick():  # what plays advances before the sliders, so they show this frame's k
             self.push_k(host)  # (or mode), as the captions drawn after the panels do
             self.push_mode(host)
-        ch, mode = ui.slider_int(
-            "eigenmode i",
-            st.mode,
-            0,
-            st.basis.k_max - 1,
-            "eigenfunction u_i shown as a colour map (i = 0 is constant)",
-        )
+        ch, mode = setting_widget(ui, SETTINGS["mode"], st.mode, 0, st.basis.k_max - 1)
         if ch:
             st.set_mode(mode)
             self.push_mode(host)
@@ -266,13 +257,7 @@ class SpectralPanel(Panel):
             self.push_mode(host)
         _, lam = st.eigenfunction()
         ui.text(f"lambda_{st.mode} = {lam:.6g}  (frequency of -Laplacian, >= 0)")
-        ch, k = ui.slider_int(
-            "k (reconstruct)",
-            st.k,
-            1,
-            st.basis.k_max,
-            "x_k = sum_{i<k} u_i (u_i^T M x): the shape from its first k modes",
-        )
+        ch, k = setting_widget(ui, SETTINGS["k"], st.k, 1, st.basis.k_max)
         if ch:
             st.set_k(k)
             self.push_k(host)
@@ -293,13 +278,7 @@ class SpectralPanel(Panel):
     def draw_play(self, host: Host) -> None:
         """What plays (the k sweep or the eigenmodes), play / pause, and this frame's step."""
         ui, st = host.ui, self.state
-        ch, what = ui.combo(
-            "play what",
-            st.play_what,
-            PLAY_KINDS,
-            "k sweep: k = 1, 2, ... one per frame (as meshlap animate --k); modes: the "
-            "eigenmodes 1, 2, ... at 1.5 per second (as --modes); playing stops at the end",
-        )
+        ch, what = setting_widget(ui, SETTINGS["play"], st.play_what)
         if ch:
             st.set_play_what(what)
         ui.same_line()
@@ -387,6 +366,3 @@ class SpectralPanel(Panel):
             st.set_mode(m)
             self.push_mode(host, force=True)
             yield st.mode_caption()  # shared with the viewer's recording
-
-
-PANEL = SpectralPanel

@@ -13,7 +13,9 @@ import polyscope as ps
 from meshlap_core.errors import MeshError
 
 from .. import scene
+from ..host import Host
 from ..isolines import draw_isolines
+from ..panel_spec import PanelSpec
 from ..record import Recorder, draw_record
 from ..scene import (
     COLORBAR_AT,
@@ -24,25 +26,25 @@ from ..scene import (
     Z_TO_Y,
     picked_vertex,
 )
-from ..state.surfaces import ANIMATION, TURN_STEP_DEG, SurfaceState, section_arc
+from ..setting_widgets import setting_widget
+from ..state.surfaces import ANIMATION, SETTINGS, TURN_STEP_DEG, SurfaceState, section_arc
 from ..text_numbers import sig
-from .base import ExportItem, Host, Panel
+from .base import ExportItem, Panel
 
 
 class SurfacesPanel(Panel):
     """Surface choice, (u, v) sliders, fundamental forms, principal directions, k_n(θ), the
     normal section at θ (slider, *turn*) and its recording."""
 
-    title = "Surfaces"
     shows_mesh = False  # a parametric surface instead of the mesh
     framed = (SURFACE,)
     view_direction = scene.OBLIQUE_VIEW
     SECTION_COLOR = (0.95, 0.55, 0.05)
 
-    def __init__(self, name: str, state: SurfaceState) -> None:
-        super().__init__(name, state)
+    def __init__(self, spec: PanelSpec, state: SurfaceState) -> None:
+        super().__init__(spec, state)
         self.state: SurfaceState = state
-        self.recorder = Recorder(f"{name}.gif")
+        self.recorder = Recorder(f"{spec.name}.gif")
 
     def animating(self) -> bool:
         """The normal section turns: the window keeps its full frame rate."""
@@ -86,6 +88,9 @@ class SurfacesPanel(Panel):
     def capture(self, host: Host) -> dict[str, Any]:
         s = self.state
         return {"surface": s.name, "res": int(s.res), "u": s.u, "v": s.v, "theta": s.section_deg}
+
+    def configure(self, host: Host, values: dict[str, Any]) -> None:
+        """Nothing before the mesh: :meth:`restore` meshes the surface and sets the point."""
 
     def restore(self, host: Host, values: dict[str, Any], active: bool) -> None:
         s = self.state
@@ -173,19 +178,19 @@ class SurfacesPanel(Panel):
         if not ui.header(self.title):
             return
         s = self.state
-        ch, name = ui.combo("surface", s.name, s.names, "a parametric surface p(u, v)")
+        ch, name = setting_widget(ui, SETTINGS["surface"], s.name)
         if ch and s.set_surface(name):
             self.push(host)
             host.request_frame()
-        ch, res = ui.input_int("resolution", s.res, "cells per parameter direction; Enter applies")
+        ch, res = setting_widget(ui, SETTINGS["res"], s.res)
         if ch:
             s.set_resolution(res)
             self.push(host)
         if draw_isolines(ui, self.isolines, "Gaussian curvature"):
             self.push(host)
         u0, u1, v0, v1 = s.domain
-        ch1, u = ui.slider_float("u", s.u, u0, u1, "%.3f", "first parameter of the point")
-        ch2, v = ui.slider_float("v", s.v, v0, v1, "%.3f", "second parameter of the point")
+        ch1, u = setting_widget(ui, SETTINGS["u"], s.u, u0, u1)
+        ch2, v = setting_widget(ui, SETTINGS["v"], s.v, v0, v1)
         if (ch1 or ch2) and s.set_uv(u, v):
             self.push_point(host)
         if s.error:
@@ -234,18 +239,8 @@ class SurfacesPanel(Panel):
         """The θ slider (showing κₙ(θ)), *turn* / *pause turn* and this frame's turn step."""
         ui, s = host.ui, self.state
         _, kn = s.section()
-        ch, deg = ui.slider_float(
-            "section theta",
-            s.section_deg,
-            0.0,
-            360.0,
-            f"%.1f deg: k_n = {kn:.4g}",  # κₙ shown in the slider, φ in the row below
-            "direction of the normal section (orange) as a parameter angle theta: degrees in "
-            "the (u, v) plane from the u axis towards v, i.e. the tangent p_u cos theta + "
-            "p_v sin theta (normalized). phi is the same direction measured in the tangent "
-            "plane from the first principal direction (the plot's axis). Drawn: its tangent "
-            "t and its osculating arc of curvature k_n",
-        )
+        shown = f"%.1f deg: k_n = {kn:.4g}"  # κₙ shown in the slider, φ in the row below
+        ch, deg = setting_widget(ui, SETTINGS["theta"], s.section_deg, fmt=shown)
         if ch:
             self.push_section(host, deg)
         ui.same_line()
@@ -277,6 +272,3 @@ class SurfacesPanel(Panel):
         for theta in np.linspace(start, start + 360.0, int(options["frames"]), endpoint=False):
             self.push_section(host, theta)
             yield surf.section_caption()
-
-
-PANEL = SurfacesPanel

@@ -3,10 +3,12 @@
 One module per concern: :mod:`.app` (``AppState``, the one owner of every state object and
 setting), :mod:`.watch` (``Watch``, the one invalidation rule), :mod:`.display`,
 :mod:`.mesh` (``MeshState``, the mesh list),
-:mod:`.curvature` (``CurvatureState``, ``robust_range``), and one module per panel that has a
-state (named as the panel in :mod:`meshlap_app.registry`: :mod:`.onering`, :mod:`.spectral`,
-:mod:`.smoothing`, :mod:`.surfaces`), which also declares the panel's section of a saved session
-(:mod:`.session`) and its animation (:mod:`.animation`). The classes are re-exported here
+:mod:`.curvature` (``CurvatureState``, ``robust_range``), :mod:`.settings` (the typed settings
+schema), and one module per registered panel (named as the panel in :mod:`meshlap_app.registry`:
+:mod:`.onering`, :mod:`.spectral`, :mod:`.smoothing`, :mod:`.surfaces`, ...) declaring its spec
+(:class:`meshlap_app.panel_spec.PanelSpec`: its settings, from which its section of a saved
+session, :mod:`.session`, comes; its checks; its animation, :mod:`.animation`) and its state
+slice when it has one. The shared classes are re-exported here
 lazily, so importing the names for the CLI's argument parser does not import numpy, scipy or
 libigl.
 """

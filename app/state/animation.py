@@ -1,9 +1,11 @@
 """What a panel declares to be animated by ``meshlap animate --panel NAME`` (no polyscope).
 
-A panel's state module that defines ``ANIMATION`` (an :class:`Animation`) is animatable: the
-animate command adds its options to the command line, fills the ones not typed from a saved
-session's section, checks them before the renderer starts, and the panel's ``frames`` sets up
-each frame. Nothing outside the panel's files names its options.
+A panel whose spec (:class:`~meshlap_app.panel_spec.PanelSpec`) has an ``animation`` (an
+:class:`Animation`) is animatable: the animate command adds its options to the command line
+(the flags of its settings, :attr:`.settings.Setting.animate`, and the animation's own
+:class:`Option` s: ranges, frame counts), fills the ones not typed from a saved session's
+section, checks them before the renderer starts, and the panel's ``frames`` sets up each frame.
+Nothing outside the panel's files names its options.
 """
 
 from __future__ import annotations
@@ -12,13 +14,12 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
-from ..registry import REGISTRY
-
 
 @dataclass(frozen=True)
 class Option:
-    """One command-line option of an animation (argparse's default is ``None`` so that a typed
-    value can be told apart from a session's; ``default`` is the built-in one)."""
+    """One command-line option of an animation that is not a setting of the panel (a range of
+    k, a frame count; argparse's default is ``None`` so that a typed value can be told apart
+    from a session's; ``default`` is the built-in one)."""
 
     flag: str
     help: str
@@ -51,7 +52,7 @@ class Animation:
     summary : str
         One line for ``meshlap animate --help`` (what the frames show).
     options : tuple of Option
-        Its command-line options.
+        Its command-line options besides its settings' flags.
     session_help : str
         How a saved session's section fills the options (``--help`` epilog).
     check : callable
@@ -66,7 +67,8 @@ class Animation:
         ``frame_count(options)``.
     from_session : callable
         ``from_session(options, section, source)`` fills the options not typed (``None``)
-        from the panel's saved section.
+        from the panel's saved section, before each setting's flag takes its saved value (so
+        it still sees which of those were typed).
     check_mesh : callable
         ``check_mesh(options, mesh)`` once the mesh is loaded (e.g. k ≤ vertices).
     uses_mesh : bool
@@ -77,7 +79,7 @@ class Animation:
     session_overrides : dict
         Settings of the panel's section replaced when a session is restored before its
         animation (e.g. the smoothing restarts at iteration 0: the frames run it). Other
-        panels' sections take their state module's ``QUIET`` (nothing computed).
+        panels' sections take their settings' ``quiet`` values (nothing computed).
     """
 
     summary: str
@@ -92,20 +94,3 @@ class Animation:
     uses_mesh: bool = True
     colorbar: bool = True
     session_overrides: dict[str, Any] = field(default_factory=dict)
-
-    def fill_defaults(self, options: dict[str, Any]) -> None:
-        """Every option not typed (``None``) takes its built-in default."""
-        for opt in self.options:
-            if options.get(opt.dest) is None and opt.default is not None:
-                options[opt.dest] = opt.default
-
-
-def animations() -> dict[str, Animation]:
-    """Each animatable panel's :class:`Animation`, by panel name (registry order)."""
-    out = {}
-    for e in REGISTRY:
-        module = e.state_module()
-        anim = getattr(module, "ANIMATION", None) if module is not None else None
-        if anim is not None:
-            out[e.name] = anim
-    return out

@@ -2,7 +2,7 @@
 
 The viewer (and the headless animator) hold one :class:`AppState`; panels read and change it
 through their host. What belongs to one panel lives in that panel's *slice*
-(``slices[name]``, made by ``app/state/<name>.py``'s ``make_state()``); what several panels read
+(``slices[name]``, made by its spec's ``state`` factory); what several panels read
 lives here: the mesh, its curvature fields, the display transform, the active view, the UI
 scale, the export folder and the background jobs (:class:`~meshlap_app.jobs.Jobs`).
 """
@@ -27,15 +27,8 @@ UI_SCALES = (0.5, 3.0)
 
 
 def make_slices() -> dict[str, Any]:
-    """A fresh state slice for every registered panel that has one (``make_state()`` of
-    ``app/state/<name>.py``)."""
-    out: dict[str, Any] = {}
-    for entry in REGISTRY:
-        module = entry.state_module()
-        make = getattr(module, "make_state", None) if module is not None else None
-        if make is not None:
-            out[entry.name] = make()
-    return out
+    """A fresh state slice for every registered panel that has one (its spec's ``state``)."""
+    return {spec.name: spec.state() for spec in REGISTRY if spec.state is not None}
 
 
 @dataclass

@@ -18,9 +18,9 @@ import numpy as np
 from meshlap_core.errors import MeshError
 from meshlap_core.exercises.check import MeshCheck, check_on_mesh
 from meshlap_core.exercises.tasks import EXERCISE_TASKS
-from meshlap_core.options import check_choice
 
-from .checks import Schema, boolean, integer, one_of
+from ..panel_spec import PanelSpec
+from .settings import MAX_INT, Choice, Integer, Settings, Text, Toggle
 
 VIEWER_TASKS: tuple[str, ...] = EXERCISE_TASKS
 """Every task ``meshlap check`` checks: each has a difference map per vertex of the mesh on
@@ -28,30 +28,26 @@ screen (the eigenbasis: ``|u_j − u_ref,j|`` with signs aligned, or the residua
 reconstruction: the row's largest component) and rows at a vertex."""
 
 
-def _file(x: Any) -> str | None:
-    """What is wrong with a saved student file: a string (``""``: none typed), one line."""
-    if not isinstance(x, str):
-        return f"must be a string, got {type(x).__name__}"
-    if len(x) > 4096 or any(c in x for c in "\x00\n\r"):
-        return "must be one file path (at most 4096 characters, one line)"
-    return None
+# fmt: off
+SETTINGS = Settings(
+    Text("file", "", label="student file", max_len=4096, example="hw/exercises.py",
+         tooltip="your exercises .py (meshlap exercises init DIR writes one)"),
+    Choice("task", "cotan_laplacian", choices=VIEWER_TASKS, label="task",
+           tooltip="the function of your file"),
+    Integer("vertex", -1, lo=-1, hi=MAX_INT - 1, label="vertex",
+            tooltip="click the mesh, or type a vertex"),
+    Toggle("checked", False, label="check", widget="button",
+           tooltip="run your function on this mesh and the battery",
+           quiet=False),  # another panel's animation runs no student code
+)
+# fmt: on
+"""The Check panel's section of a saved session: the student file as typed (relative: in the
+viewer's folder), the task, the clicked vertex, and whether a check was shown (``checked``:
+loading the session runs it again, as a job, on the session's mesh). A student file missing on
+this machine does not refuse the session: the panel says so in red."""
 
 
-SESSION: Schema = {
-    "file": ("", _file),
-    "task": ("cotan_laplacian", one_of(VIEWER_TASKS)),
-    "vertex": (-1, integer(-1)),
-    "checked": (False, boolean),
-}
-"""The Check panel's section of a saved session (:mod:`.session`): the student file as typed
-(relative: in the viewer's folder), the task, the clicked vertex, and whether a check was shown
-(``checked``: loading the session runs it again, as a job, on the session's mesh). A student
-file missing on this machine does not refuse the session: the panel says so in red."""
-QUIET: dict[str, Any] = {"checked": False}
-"""Restored for another panel's animation: no student code run."""
-
-
-def check_session(values: dict[str, Any], mesh: Any, source: Any) -> None:
+def check_mesh(values: dict[str, Any], mesh: Any, source: Any) -> None:
     """A saved vertex the session's mesh has (``-1``: none).
 
     Raises
@@ -65,11 +61,6 @@ def check_session(values: dict[str, Any], mesh: Any, source: Any) -> None:
             f"{len(mesh.V)} vertices)",
             source,
         )
-
-
-def make_state() -> CheckState:
-    """The Check panel's slice of the :class:`~.app.AppState`."""
-    return CheckState()
 
 
 @dataclass
@@ -90,14 +81,14 @@ class CheckState:
         The clicked vertex (``-1``: none).
     """
 
-    file: str = ""
-    task: str = "cotan_laplacian"
+    file: str = SETTINGS.default("file")
+    task: str = SETTINGS.default("task")
     check: MeshCheck | None = None
     checked_for: tuple[Any, ...] = ()
-    vertex: int = -1
+    vertex: int = SETTINGS.default("vertex")
 
     def set_task(self, task: str) -> None:
-        self.task = check_choice(task, VIEWER_TASKS, "exercise", "task")
+        self.task = SETTINGS["task"].checked(task, "task")
 
     def student_path(self, folder: Path) -> Path:
         """The typed file (relative to ``folder``), checked to exist.
@@ -159,3 +150,16 @@ class CheckState:
         if self.check is None:
             return []
         return self.check.result.tasks[0].lines()
+
+
+SPEC = PanelSpec(
+    name="check",
+    title="Check (exercises)",
+    summary="a student's exercises file checked on the mesh on screen: the verdict, the "
+    "difference map student - reference, and the rows at a clicked vertex",
+    panel="CheckPanel",
+    state=CheckState,
+    settings=SETTINGS,
+    check_mesh=check_mesh,
+)
+"""The Check panel."""

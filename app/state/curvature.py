@@ -1,4 +1,7 @@
-"""Curvature fields of the current mesh (``CurvatureState``) and their colour ranges."""
+"""Curvature fields of the current mesh (``CurvatureState``), their colour ranges, and the
+Curvature panel's spec (its settings: field, area, boundary rule, clip, side by side, second
+field, estimator; the state is the :class:`~.app.AppState`'s ``curv``, which the One-ring view
+and the export read too)."""
 
 from __future__ import annotations
 
@@ -25,43 +28,43 @@ from meshlap_core.options import (
     CURVATURE_FIELD_LABELS,
     CURVATURE_FIELDS,
     PRINCIPAL_FIELDS,
-    check_choice,
 )
 from meshlap_core.types import FloatArray
 
-from .checks import Schema, boolean, number, one_of
+from ..panel_spec import PanelSpec
 from .mesh import MeshState
-
-SESSION: Schema = {
-    "field": ("cotan", one_of(CURVATURE_FIELDS)),
-    "area": (CURVATURE_AREA, one_of(AREA_KINDS)),
-    "boundary": ("pi", one_of(BOUNDARY_RULES)),
-    "clip": (2.0, number(0.0, 49.0)),
-    "side_by_side": (False, boolean),
-    "second_field": ("uniform", one_of(CURVATURE_FIELDS)),
-    "estimator": ("cotan", one_of(CURVATURE_ESTIMATORS)),
-}
-"""The Curvature panel's section of a saved session (:mod:`.session`)."""
-SESSION_ADDED = ("estimator",)
-"""Keys newer than the first session files: written only when not the default (cotan), so a
-session that does not need it stays readable by an older meshlap."""
+from .settings import Choice, Flag, Number, Settings, Toggle
 
 ESTIMATOR_HELP = "\n".join(f"{k}: {v}" for k, v in CURVATURE_ESTIMATOR_LABELS.items())
 """The estimator combo's tooltip: every estimator with its paper."""
 PRINCIPAL_JOB = "principal curvatures"
 """The job owner of the estimator's run (the Curvature and One-ring views both start it)."""
+FIELD_HELP = (
+    "H = |Lx|/2 with the uniform or cotangent Laplacian (signed by the normal); "
+    "K = (2 pi - sum of angles) / A_i; k1,2 = H +- sqrt(H^2 - K)"
+)
 
-
-def check_view_options(options: dict[str, Any], state: Any) -> None:
-    """``meshlap view --field``: a known field.
-
-    Raises
-    ------
-    MeshError
-        An unknown field, naming the choices.
-    """
-    if options.get("field") is not None:
-        check_choice(options["field"], CURVATURE_FIELDS, "field", "--field")
+# fmt: off
+SETTINGS = Settings(
+    Choice("field", "cotan", choices=CURVATURE_FIELDS, label="field", tooltip=FIELD_HELP,
+           view=Flag("--field", "the curvature field shown first")),
+    Choice("area", CURVATURE_AREA, choices=AREA_KINDS, label="area",
+           tooltip="vertex area A_i: barycentric (1/3 of each face) or Voronoi"),
+    Choice("boundary", "pi", choices=BOUNDARY_RULES, label="boundary rule",
+           tooltip="Gaussian curvature at boundary vertices: pi - sum(angles) (geodesic "
+           "curvature) or not defined"),
+    Number("clip", 2.0, lo=0.0, hi=49.0, slider=(0.0, 20.0), fmt="%.1f", label="clip %",
+           tooltip="colour range clips this percentage of vertices at each end (0 to 49)"),
+    Toggle("side_by_side", False, label="side by side",
+           tooltip="show a second field on a copy beside the mesh"),
+    Choice("second_field", "uniform", choices=CURVATURE_FIELDS, label="second field",
+           tooltip="the field on the copy"),
+    Choice("estimator", "cotan", choices=CURVATURE_ESTIMATORS, label="estimator",
+           tooltip="k1, k2 (and the One-ring view's shape operator) by:\n" + ESTIMATOR_HELP,
+           added=True),  # written only when not cotan: older meshlaps read the file
+)
+# fmt: on
+"""The Curvature panel's settings (its section of a saved session, ``--field``, widgets)."""
 
 
 def robust_range(values: FloatArray, signed: bool, percentile: float = 2.0) -> tuple[float, float]:
@@ -100,13 +103,13 @@ class CurvatureState:
     """Curvature fields of the current mesh for the chosen area and boundary rule, and how
     they are shown (the field, its clip percentage, a second field side by side)."""
 
-    area: str = CURVATURE_AREA
-    boundary: str = "pi"
-    field_name: str = "cotan"
-    percentile: float = 2.0
-    side_by_side: bool = False
-    second_field: str = "uniform"
-    estimator: str = "cotan"
+    area: str = SETTINGS.default("area")
+    boundary: str = SETTINGS.default("boundary")
+    field_name: str = SETTINGS.default("field")
+    percentile: float = SETTINGS.default("clip")
+    side_by_side: bool = SETTINGS.default("side_by_side")
+    second_field: str = SETTINGS.default("second_field")
+    estimator: str = SETTINGS.default("estimator")
     principal: PrincipalCurvatures | None = None  # the estimator's, for ``_pkey``
     principal_error: str = ""  # the last failed estimator run's message
     _pkey: tuple[Any, ...] = ()
@@ -154,7 +157,7 @@ class CurvatureState:
         MeshError
             An unknown name (the previous one stays).
         """
-        self.estimator = check_choice(name, CURVATURE_ESTIMATORS, "estimator")
+        self.estimator = SETTINGS["estimator"].checked(name, "estimator")
 
     def principal_inputs(self, mesh: MeshState) -> tuple[Any, ...]:
         """What the estimate depends on: the mesh, the estimator, and for ``cotan`` the area
@@ -261,17 +264,18 @@ class CurvatureState:
         return self._topology[1]
 
     def set_percentile(self, percentile: float) -> None:
-        """Clip percentage of the colour range, in ``[0, 49]``.
+        """Clip percentage of the colour range, clamped into its setting's range (0 to 49).
 
         Raises
         ------
         MeshError
             ``percentile`` is not a finite number (the previous one stays).
         """
+        clip = SETTINGS["clip"]
         p = float(percentile)
         if not np.isfinite(p):
-            raise MeshError(f"must be a finite number, got {percentile!r}", "clip %")
-        self.percentile = float(np.clip(p, 0.0, 49.0))
+            raise MeshError(f"must be a finite number, got {percentile!r}", clip.label)
+        self.percentile = clip.clamp(p)
 
     def color_range(self, name: str | None = None) -> tuple[float, float]:
         """Robust colour range of a field (symmetric around 0 for signed fields)."""
@@ -298,3 +302,14 @@ class CurvatureState:
             self._summaries = {k: v for k, v in self._summaries.items() if k[0] == self._key}
             self._summaries[key] = cached
         return cached
+
+
+SPEC = PanelSpec(
+    name="curvature",
+    title="Curvature",
+    summary="a curvature field as a colour map (uniform or cotangent H, K, k1, k2), its "
+    "histogram, a second field side by side",
+    panel="CurvaturePanel",
+    settings=SETTINGS,
+)
+"""The Curvature panel (its state is the app's ``curv``: no slice of its own)."""

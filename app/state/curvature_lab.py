@@ -28,16 +28,17 @@ from meshlap_core.curvature.study import (
 from meshlap_core.curvature.topology import CurvatureTopology
 from meshlap_core.errors import MeshError
 from meshlap_core.options import (
+    CURVATURE_ESTIMATOR_LABELS,
     CURVATURE_ESTIMATORS,
     LAB_SHOWS,
     LAB_SOURCES,
     PRINCIPAL_FIELDS,
-    check_choice,
 )
 from meshlap_core.surfaces import SURFACES, SurfaceMesh, mesh_surface
 from meshlap_core.types import FloatArray, IntArray
 
-from .checks import Schema, boolean, integer, number, one_of
+from ..panel_spec import PanelSpec
+from .settings import MAX_INT, Choice, Integer, Number, Settings, Toggle
 
 MAX_RES = 256
 """Largest lab resolution (cells per direction; the torus gets twice as many around)."""
@@ -65,22 +66,39 @@ LIGHT_RES = 128
 the window's longest gap measured 0.02-0.12 s under load)."""
 
 
-SESSION: Schema = {
-    "source": ("surface", one_of(LAB_SOURCES)),
-    "estimator": ("cotan", one_of(CURVATURE_ESTIMATORS)),
-    "quantity": ("H", one_of(PRINCIPAL_FIELDS)),
-    "show": ("error", one_of(LAB_SHOWS)),
-    "crosses": (True, boolean),
-    "surface": ("torus", one_of(tuple(SURFACES))),
-    "res": (32, integer(3, MAX_RES)),
-    "noise": (0.0, number(0.0, MAX_NOISE)),
-    "jitter": (0.0, number(0.0, MAX_JITTER)),
-    "flips": (0.0, number(0.0, 1.0)),
-    "vertex": (-1, integer(-1)),
-}
-"""The Curvature lab's section of a saved session (:mod:`.session`): its choices, sliders and
-the picked vertex (of the lab's mesh: the parametric surface's at ``res``, or the loaded
-mesh)."""
+# fmt: off
+SETTINGS = Settings(
+    Choice("source", "surface", choices=LAB_SOURCES, label="source",
+           tooltip="a parametric surface (exact values known) or the loaded mesh"),
+    Choice("estimator", "cotan", choices=CURVATURE_ESTIMATORS, label="estimator",
+           tooltip="; ".join(f"{k}: {v}" for k, v in CURVATURE_ESTIMATOR_LABELS.items())),
+    Choice("quantity", "H", choices=PRINCIPAL_FIELDS, label="quantity",
+           tooltip="k1 >= k2, H = (k1+k2)/2 > 0 on spheres, K = k1 k2, abs_max"),
+    Choice("show", "error", choices=LAB_SHOWS, label="show",
+           tooltip="the estimate, its error against the exact surface, or the largest "
+           "difference between all the estimators"),
+    Toggle("crosses", True, label="crosses",
+           tooltip="principal directions: black k1 (max), green k2 (min), length by |k| "
+           "(the exact k1 in magenta, off by default)"),
+    Choice("surface", "torus", choices=tuple(SURFACES), label="lab surface",
+           tooltip="the parametric surface"),
+    Integer("res", 32, lo=3, hi=MAX_RES, label="resolution", widget="slider",
+            tooltip="cells per direction (the torus: twice around)"),
+    Number("noise", 0.0, lo=0.0, hi=MAX_NOISE, fmt="%.4f", label="noise",
+           tooltip="normal noise, a fraction of the bounding-box diagonal"),
+    Number("jitter", 0.0, lo=0.0, hi=MAX_JITTER, fmt="%.4f", label="jitter",
+           tooltip="parameter jitter of interior vertices, a fraction of a cell"),
+    Number("flips", 0.0, lo=0.0, hi=1.0, fmt="%.4f", label="edge flips",
+           tooltip="fraction of the interior edges flipped"),
+    Integer("vertex", -1, lo=-1, hi=MAX_INT - 1, label="vertex",
+            tooltip="pick a vertex (or click the mesh): its shape operator"),
+)
+# fmt: on
+"""The Curvature lab's settings (its section of a saved session: its choices, sliders and
+the picked vertex of the lab's mesh, the parametric surface's at ``res`` or the loaded mesh,
+which bounds it: :func:`check_mesh`)."""
+SHOWN_ONLY = ("crosses", "vertex")
+"""Settings the result does not depend on (the rest are :meth:`CurvatureLabState.params`)."""
 
 
 def lab_vertex_count(values: dict[str, Any], mesh: Any) -> int:
@@ -93,7 +111,7 @@ def lab_vertex_count(values: dict[str, Any], mesh: Any) -> int:
     return len(mesh_surface(values["surface"], res).V)
 
 
-def check_session(values: dict[str, Any], mesh: Any, source: Any) -> None:
+def check_mesh(values: dict[str, Any], mesh: Any, source: Any) -> None:
     """A saved picked vertex that the lab's mesh has.
 
     Raises
@@ -108,11 +126,6 @@ def check_session(values: dict[str, Any], mesh: Any, source: Any) -> None:
             raise MeshError(
                 f'"curvature_lab.vertex" is {v}; the lab\'s mesh has vertices 0..{n - 1}', source
             )
-
-
-def make_state() -> CurvatureLabState:
-    """The lab's initial state (the torus at 32 cells, cotan, H)."""
-    return CurvatureLabState()
 
 
 @dataclass
@@ -255,19 +268,19 @@ def make_base(params: dict[str, Any]) -> Base:
 class CurvatureLabState:
     """The lab's choices and its last result (``inputs()`` names what the result is for)."""
 
-    source: str = "surface"
-    estimator: str = "cotan"
-    quantity: str = "H"
-    show: str = "error"
-    crosses: bool = True
-    surface: str = "torus"
-    res: int = 32
-    noise: float = 0.0
-    jitter: float = 0.0
-    flips: float = 0.0
+    source: str = SETTINGS.default("source")
+    estimator: str = SETTINGS.default("estimator")
+    quantity: str = SETTINGS.default("quantity")
+    show: str = SETTINGS.default("show")
+    crosses: bool = SETTINGS.default("crosses")
+    surface: str = SETTINGS.default("surface")
+    res: int = SETTINGS.default("res")
+    noise: float = SETTINGS.default("noise")
+    jitter: float = SETTINGS.default("jitter")
+    flips: float = SETTINGS.default("flips")
     result: LabResult | None = None
     computed_for: tuple[Any, ...] = field(default=())
-    vertex: int = -1  # the picked vertex of the result's mesh (-1: none)
+    vertex: int = SETTINGS.default("vertex")  # the picked vertex of the result's mesh
     bases: dict[tuple[Any, ...], Base] = field(default_factory=dict)  # newest last
     studies: dict[tuple[Any, ...], list[dict[str, Any]]] = field(default_factory=dict)
     estimates: dict[tuple[Any, ...], Estimate] = field(default_factory=dict)  # newest last
@@ -287,14 +300,7 @@ class CurvatureLabState:
         MeshError
             An unknown value (the previous one stays).
         """
-        choices = {
-            "source": LAB_SOURCES,
-            "estimator": CURVATURE_ESTIMATORS,
-            "quantity": PRINCIPAL_FIELDS,
-            "show": LAB_SHOWS,
-            "surface": tuple(SURFACES),
-        }[what]
-        setattr(self, what, check_choice(value, choices, what))
+        setattr(self, what, SETTINGS[what].checked(value, what))
 
     def set_number(self, what: str, value: Any) -> None:
         """Set ``res`` (3..MAX_RES), ``noise`` (0..MAX_NOISE), ``jitter`` (0..MAX_JITTER) or
@@ -305,51 +311,34 @@ class CurvatureLabState:
         MeshError
             Not a finite number in range (the previous value stays).
         """
-        lo, hi = {
-            "res": (3, MAX_RES),
-            "noise": (0.0, MAX_NOISE),
-            "jitter": (0.0, MAX_JITTER),
-            "flips": (0.0, 1.0),
-        }[what]
+        lo, hi = SETTINGS[what].lo, SETTINGS[what].hi
         try:
             x = float(value)
         except (TypeError, ValueError):
             raise MeshError(f"must be a number, got {value!r}", what) from None
         if not math.isfinite(x) or not lo <= x <= hi:
             raise MeshError(f"must be between {lo} and {hi}, got {value!r}", what)
-        setattr(self, what, int(x) if what == "res" else x)
+        setattr(self, what, int(x) if isinstance(SETTINGS[what], Integer) else x)
 
     def params(self) -> dict[str, Any]:
-        """The inputs as a plain dict for :meth:`compute` (picklable, for a child process)."""
-        return {
-            k: getattr(self, k)
-            for k in (
-                "source",
-                "estimator",
-                "quantity",
-                "show",
-                "surface",
-                "res",
-                "noise",
-                "jitter",
-                "flips",
-            )
-        }
+        """The inputs as a plain dict for :meth:`compute` (picklable, for a child process):
+        every setting but what is only shown (:data:`SHOWN_ONLY`)."""
+        return {k: getattr(self, k) for k in SETTINGS.keys() if k not in SHOWN_ONLY}
 
     def settings(self) -> dict[str, Any]:
-        """Its section of a saved session (:data:`SESSION`'s keys)."""
+        """Its section of a saved session (:data:`SETTINGS`' keys)."""
         out = self.params()
         out["crosses"] = bool(self.crosses)
         out["vertex"] = int(self.vertex)
-        return out
+        return {k: out[k] for k in SETTINGS.keys()}
 
     def configure(self, values: dict[str, Any]) -> None:
-        """Take a session's section (checked against :data:`SESSION` and by
-        :func:`check_session`); the result is recomputed for it, the picked vertex kept."""
-        for key in ("source", "estimator", "quantity", "show", "surface"):
-            self.set_choice(key, values[key])
-        for key in ("res", "noise", "jitter", "flips"):
-            self.set_number(key, values[key])
+        """Take a session's section (checked against :data:`SETTINGS` and by
+        :func:`check_mesh`); the result is recomputed for it, the picked vertex kept."""
+        for s in SETTINGS:
+            if s.key not in SHOWN_ONLY:
+                setter = self.set_choice if isinstance(s, Choice) else self.set_number
+                setter(s.key, values[s.key])
         self.crosses = bool(values["crosses"])
         self.result, self.computed_for = None, ()
         self.vertex = int(values["vertex"])
@@ -632,3 +621,17 @@ def cross_length(V: FloatArray, F: IntArray) -> float:
         d = [P[j][c] - P[i][c] for c in range(3)]
         total += float(np.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sum())
     return 0.4 * total / (3 * len(F))
+
+
+SPEC = PanelSpec(
+    name="curvature_lab",
+    title="Curvature lab",
+    summary="one estimator's principal curvatures and directions, its error against an exact "
+    "parametric surface under resolution, noise, jitter and flips, or the estimators' "
+    "disagreement on the loaded mesh",
+    panel="CurvatureLabPanel",
+    state=CurvatureLabState,
+    settings=SETTINGS,
+    check_mesh=check_mesh,
+)
+"""The Curvature lab panel."""

@@ -36,13 +36,24 @@ from meshlap_core.options import (
     FILTER_KINDS,
     HEAT_BOUNDARIES,
     HEAT_METHODS,
-    check_choice,
 )
 from meshlap_core.spectral import SpectralBasis
 from meshlap_core.types import FloatArray
 
+from ..panel_spec import PanelSpec
 from .animation import Animation, Option
-from .checks import Schema, boolean, integer, number, one_of
+from .isolines import COUNT_RANGE, DEFAULT_COUNT
+from .settings import (
+    MAX_INT,
+    Choice,
+    Custom,
+    Integer,
+    Number,
+    Settings,
+    Toggle,
+    integer_problem,
+    shown,
+)
 
 SHOWS: tuple[str, ...] = ("heat", "distance", "filter", "hks")
 """What the Diffusion view shows on the mesh."""
@@ -80,41 +91,75 @@ def check_isoline_fields(x: Any) -> str | None:
             return f"has {name!r}; fields are {', '.join(ISO_FIELDS)}"
         if not (isinstance(v, dict) and set(v) == {"on", "count"}):
             return f'{name!r} must be {{"on": true/false, "count": N}}'
-        if boolean(v["on"]) or integer(1, 200)(v["count"]):
+        if not isinstance(v["on"], bool) or integer_problem(v["count"], *COUNT_RANGE):
             return f"{name!r}: on must be true/false, count 1..200"
     return None
 
 
-SESSION: Schema = {
-    "show": ("distance", one_of(SHOWS)),
-    "sources": ([], lambda x: None if isinstance(x, list) else "must be a list of vertices"),
-    "log_t": (0.0, number(*LOG_T_RANGE)),
-    "steps": (1, integer(1, 1000)),
-    "heat_field": ("euler", one_of(HEAT_FIELDS)),
-    "m": (1.0, number(1e-3, 1e4)),
-    "boundary": (DEFAULT_HEAT_BOUNDARY, one_of(HEAT_BOUNDARIES)),
-    "isolines": (True, boolean),
-    "isoline_count": (12, integer(1, 200)),
-    "isoline_fields": ({}, check_isoline_fields),
-    "filter": ("low-pass", one_of(PANEL_FILTERS)),
-    "keep": (10, integer(0)),
-    "gain": (2.0, number(-100.0, 100.0)),
-    "hks_scale": (8, integer(0, HKS_SCALES - 1)),
-}
-"""The Diffusion panel's section of a saved session (:mod:`.session`)."""
+def check_sources(x: Any) -> str | None:
+    """A list of vertex indices (each an integer ``0 .. MAX_INT - 1``; the session's mesh
+    bounds them further, :func:`check_mesh`)."""
+    if not isinstance(x, list):
+        return f"must be a list of vertices, got {shown(x)}"
+    for v in x:
+        if integer_problem(v, 0, MAX_INT - 1):
+            return f"has {shown(v)}; a source is a vertex index (an integer >= 0)"
+    return None
 
 
-def make_state() -> DiffusionState:
-    """The Diffusion panel's slice of the :class:`~.app.AppState`."""
-    return DiffusionState()
+def distinct(sources: list[int]) -> list[int]:
+    """The sources without repeats, in their order (``[0, 0, 0]`` is one source: a unit of
+    heat each, three would triple the heat; and a list of a million repeats costs nothing)."""
+    return list(dict.fromkeys(sources))
 
 
-def check_view_options(options: dict[str, Any], state: Any) -> None:
-    """No ``meshlap view`` option of its own (``--vertex`` is the one-ring's)."""
+# fmt: off
+SETTINGS = Settings(
+    Choice("show", "distance", choices=SHOWS, label="show",
+           tooltip="heat: u_t = Lap u from the clicked vertices; distance: heat method (Crane et "
+           "al. 2013); filter: U h(Lambda) U^T M X; hks: heat kernel signature"),
+    Custom("sources", [], check=check_sources, normalize=distinct, widget="none",
+           example=[3, 5], refused=("3", [1.5], [-1], [True], [10**400], {"0": 1})),
+    Number("log_t", 0.0, lo=LOG_T_RANGE[0], hi=LOG_T_RANGE[1], fmt="%.2f",
+           label="log10 t/h^2", tooltip="heat time t = 10^x h^2 (h: mean edge)"),
+    Integer("steps", 1, lo=1, hi=1000, label="Euler steps",
+            tooltip="(M + tau K) u' = M u, tau = t/steps"),
+    Choice("heat_field", "euler", choices=HEAT_FIELDS, label="heat field",
+           tooltip="euler, spectral (sum exp(-lambda_i t) phi_i phi_i^T M u0) or spectral - "
+           "euler; all three on one colour range"),
+    Number("m", 1.0, lo=1e-3, hi=1e4, widget="input", fmt="%.4g", label="m (t = m h^2)",
+           tooltip="heat time factor (default 1)"),
+    Choice("boundary", DEFAULT_HEAT_BOUNDARY, choices=HEAT_BOUNDARIES,
+           label="boundary condition",
+           tooltip="heat step on open meshes: Neumann, Dirichlet or their average (the "
+           "paper's)"),
+    Toggle("isolines", True, label="isolines",
+           tooltip="level curves of the distance field on the mesh"),
+    Integer("isoline_count", DEFAULT_COUNT, lo=COUNT_RANGE[0], hi=COUNT_RANGE[1],
+            label="isoline count", tooltip="curves over the field's range"),
+    Custom("isoline_fields", {}, check=check_isoline_fields, widget="none",
+           example={"heat": {"on": True, "count": 5}},
+           refused=([], {"nope": {"on": True, "count": 5}}, {"heat": {"on": 1, "count": 5}},
+                    {"heat": {"on": True, "count": 10**400}})),
+    Choice("filter", "low-pass", choices=PANEL_FILTERS, label="filter",
+           tooltip="low-pass: first modes; band: gain on modes; explicit/implicit/taubin: the "
+           "smoothers' transfer functions (1 - s lam)^n, (1 + s lam)^-n, ...; drawn: drag "
+           "the curve's points in the plot"),
+    Integer("keep", 10, lo=0, hi=MAX_INT, label="modes kept", widget="slider",
+            tooltip="low-pass / band end"),
+    Number("gain", 2.0, lo=-100.0, hi=100.0, slider=GAIN_RANGE, fmt="%.2f", label="band gain",
+           tooltip="gain of the band"),
+    Integer("hks_scale", 8, lo=0, hi=HKS_SCALES - 1, label="HKS time", widget="slider",
+            tooltip="log-spaced t"),
+)
+# fmt: on
+"""The Diffusion panel's section of a saved session (:mod:`.session`): the sources are
+kept without repeats and the session's mesh bounds them (:func:`check_mesh`)."""
 
 
-def check_session(values: dict[str, Any], mesh: Any, source: Any) -> None:
-    """Saved sources the session's mesh has.
+def check_mesh(values: dict[str, Any], mesh: Any, source: Any) -> None:
+    """Saved sources the session's mesh has (so at most its vertex count of them, once the
+    repeats are dropped when the file was read).
 
     Raises
     ------
@@ -122,9 +167,9 @@ def check_session(values: dict[str, Any], mesh: Any, source: Any) -> None:
         A source that is not a vertex index of the mesh.
     """
     n = len(mesh.V)
-    for v in values["sources"]:
-        if not isinstance(v, int) or isinstance(v, bool) or not 0 <= v < n:
-            raise MeshError(f'"diffusion.sources" has {v!r}; vertices are 0..{n - 1}', source)
+    bad = next((v for v in values["sources"] if v >= n), None)
+    if bad is not None:
+        raise MeshError(f'"diffusion.sources" has {bad}; vertices are 0..{n - 1}', source)
 
 
 def find_basis(slices: Any, V: FloatArray) -> SpectralBasis | None:
@@ -153,23 +198,23 @@ def symmetric_range(*fields: FloatArray) -> tuple[float, float]:
 class DiffusionState:
     """Settings, the reusable solvers, and the fields the panel shows."""
 
-    show: str = "distance"
+    show: str = SETTINGS.default("show")
     sources: list[int] = field(default_factory=list)
-    log_t: float = 0.0  # t = 10^log_t · h²
+    log_t: float = SETTINGS.default("log_t")  # t = 10^log_t · h²
     playing: bool = False  # t sweeps up its log scale (the play button)
-    steps: int = 1
-    heat_field: str = "euler"
-    m: float = 1.0
-    boundary: str = DEFAULT_HEAT_BOUNDARY
-    filter: str = "low-pass"
-    keep: int = 10
-    gain: float = 2.0
+    steps: int = SETTINGS.default("steps")
+    heat_field: str = SETTINGS.default("heat_field")
+    m: float = SETTINGS.default("m")
+    boundary: str = SETTINGS.default("boundary")
+    filter: str = SETTINGS.default("filter")
+    keep: int = SETTINGS.default("keep")
+    gain: float = SETTINGS.default("gain")
     band: tuple[int, int] = (1, 10)
     knots: list[tuple[float, float]] = field(default_factory=lambda: list(DEFAULT_KNOTS))
     step: float = 0.0  # smoother step; 0: 0.5 / λ_max of the basis
     iters: int = 10
     residual: bool = False
-    hks_scale: int = 8
+    hks_scale: int = SETTINGS.default("hks_scale")
     error: str = ""
     message: str = ""
     # results
@@ -229,10 +274,10 @@ class DiffusionState:
 
     # ------------------------------------------------------------------ settings
     def set_log_t(self, value: float) -> None:
-        lo, hi = LOG_T_RANGE
+        log_t = SETTINGS["log_t"]
         if not math.isfinite(value):
-            raise MeshError(f"must be a number between {lo:g} and {hi:g}", "log10 t/h^2")
-        self.log_t = float(min(max(value, lo), hi))
+            raise MeshError(f"must be a number between {log_t.lo:g} and {log_t.hi:g}", log_t.label)
+        self.log_t = log_t.clamp(value)
 
     def toggle_play(self) -> None:
         """Play or pause the sweep of t; played from the top of the range, it starts over."""
@@ -253,12 +298,13 @@ class DiffusionState:
         return moved
 
     def set_m(self, value: float) -> None:
-        if not (math.isfinite(value) and value > 0):
-            raise MeshError(f"must be a positive number, got {value!r}", "m (t = m h^2)")
-        self.m = float(value)
+        """The heat time factor, in its setting's range (the previous one stays when not)."""
+        m = SETTINGS["m"]
+        self.m = m.checked(value, m.label)
 
-    def set_choice(self, name: str, value: str, choices: tuple[str, ...]) -> None:
-        setattr(self, name, check_choice(value, choices, name))
+    def set_choice(self, name: str, value: str) -> None:
+        """Set the choice ``name`` (one of its setting's choices; ``MeshError`` otherwise)."""
+        setattr(self, name, SETTINGS[name].checked(value, name))
 
     # ------------------------------------------------------------------ heat
     def heat_solver(self, V: FloatArray, F: Any) -> HeatDiffusion:
@@ -490,3 +536,17 @@ ANIMATION = Animation(
     check_mesh=_animation_check_mesh,
 )
 """``meshlap animate --panel diffusion --heat``."""
+
+
+SPEC = PanelSpec(
+    name="diffusion",
+    title="Diffusion",
+    summary="heat from clicked vertices two ways, geodesic distance by the heat method, "
+    "spectral filters and the heat kernel signature",
+    panel="DiffusionPanel",
+    state=DiffusionState,
+    settings=SETTINGS,
+    check_mesh=check_mesh,
+    animation=ANIMATION,
+)
+"""The Diffusion panel."""

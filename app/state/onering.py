@@ -14,20 +14,25 @@ from meshlap_core.inspector import VertexInspection, inspect_vertex
 from meshlap_core.options import AREA_KINDS, BOUNDARY_RULES, check_choice
 from meshlap_core.types import FloatArray, IntArray
 
-from .checks import Schema, boolean, integer
+from ..panel_spec import PanelSpec
 from .curvature import CurvatureState
 from .mesh import MeshState
+from .settings import MAX_INT, Flag, Integer, Settings, Toggle
 
-SESSION: Schema = {"vertex": (-1, integer(-1)), "reverse": (False, boolean)}
-"""The One-ring panel's section of a saved session (:mod:`.session`)."""
+# fmt: off
+SETTINGS = Settings(
+    Integer("vertex", -1, lo=-1, hi=MAX_INT - 1, label="vertex",
+            tooltip="vertex index; Enter or -/+ selects it",
+            view=Flag("--vertex", "the vertex selected first (one of the mesh)")),
+    Toggle("reverse", False, label="clockwise (reverse)",
+           tooltip="list the neighbours clockwise instead"),
+)
+# fmt: on
+"""The One-ring panel's settings: the selected vertex (-1: none; the mesh bounds it,
+:func:`check_mesh`) and the order."""
 
 
-def make_state() -> OneRingState:
-    """The One-ring panel's slice of the :class:`~.app.AppState`."""
-    return OneRingState()
-
-
-def check_view_options(options: dict[str, Any], state: Any) -> None:
+def check_start(options: dict[str, Any], state: Any) -> None:
     """``meshlap view --vertex``: a vertex of the mesh.
 
     Raises
@@ -43,7 +48,7 @@ def check_view_options(options: dict[str, Any], state: Any) -> None:
         )
 
 
-def check_session(values: dict[str, Any], mesh: MeshState, source: Any) -> None:
+def check_mesh(values: dict[str, Any], mesh: MeshState, source: Any) -> None:
     """A saved one-ring vertex the session's mesh has (``-1``: none selected).
 
     Raises
@@ -72,8 +77,8 @@ class OneRingState:
     kind and boundary rule (``None`` for a vertex in no face, with ``inspection_error``).
     """
 
-    vertex: int = -1
-    reverse: bool = False
+    vertex: int = SETTINGS.default("vertex")
+    reverse: bool = SETTINGS.default("reverse")
     neighbors: list[int] = field(default_factory=list)
     boundary: bool = False
     ordered: bool = True
@@ -337,3 +342,17 @@ class HoverThrottle:
     def current(self, pos: tuple[float, float]) -> bool:
         """Whether the last pick was made at ``pos`` (its answer describes the cursor)."""
         return pos == self.last_pos
+
+
+SPEC = PanelSpec(
+    name="onering",
+    title="One-ring",
+    summary="a clicked vertex, its neighbours numbered in order, H and K there, and the "
+    "vertex inspector (every term of the operators at that vertex)",
+    panel="OneRingPanel",
+    state=OneRingState,
+    settings=SETTINGS,
+    check_mesh=check_mesh,
+    check_start=check_start,
+)
+"""The One-ring panel."""

@@ -14,8 +14,10 @@ A session file is one JSON object::
      "surfaces": {"surface": "helicoid", "res": 48, "u": 0.0, "v": 0.0, "theta": 30.0}}
 
 Each section after ``camera`` is one registered panel's settings (:mod:`meshlap_app.registry`):
-its keys, defaults and checks are declared beside the panel's state (``SESSION`` in
-``app/state/<panel>.py``; :func:`schema` collects them), so a new panel brings its own section.
+its keys, defaults and checks are the panel's spec's settings schema
+(:class:`~meshlap_app.state.settings.Settings`, declared once in ``app/state/<panel>.py``;
+:func:`schema` collects them), so a new panel brings its own section. A value refused is named
+``section.key`` (a wrong type, a value out of range, NaN, an integer too large for a float).
 ``camera`` is polyscope's ``get_view_as_json()`` parsed (or ``null``), checked like every other
 section (:func:`.camera.check_camera`: its keys, window size, projection, ``fov``,
 ``viewMat``). The file is read through :func:`meshlap_core.io.reader.read_json` (a regular file
@@ -33,7 +35,7 @@ replays the runs exactly (bit for bit). The key is written only when it says som
 ``lam`` and ``iterations`` do not (λ changed during the run); missing or ``null``, the run is
 ``iterations`` steps at ``lam``, as version-1 files have always been read.
 
-**Keys added after the first files** (``SESSION_ADDED`` of a state module, :func:`added_keys`):
+**Keys added after the first files** (settings declared ``added``, :func:`added_keys`):
 ``smoothing.lam_steps``, ``spectral.play`` (what the Spectral panel's *play* plays: ``k sweep``
 or ``modes``) and ``surfaces.theta`` (the normal section's θ in degrees). Each is written only
 when it differs from its default, and a missing one takes its default. The top-level ``up``
@@ -68,8 +70,8 @@ from meshlap_core.options import UP_AXES
 
 from ..registry import REGISTRY, VIEWS
 from .camera import check_camera
-from .checks import Check, Schema, number, one_of
 from .mesh import MeshState
+from .settings import Choice, Number, Setting, Settings
 
 FORMAT = "meshlap-session"
 VERSION = 1
@@ -77,29 +79,17 @@ VERSION = 1
 
 
 @functools.cache
-def schema() -> dict[str, Schema]:
-    """Section -> key -> (default, check): each registered panel's ``SESSION`` (declared in
-    ``app/state/<panel>.py``), in the registry's order. The defaults are the viewer's own start
-    values."""
-    out: dict[str, Schema] = {}
-    for e in REGISTRY:
-        module = e.state_module()
-        section = getattr(module, "SESSION", None) if module is not None else None
-        if section:
-            out[e.name] = section
-    return out
+def schema() -> dict[str, Settings]:
+    """Section -> its settings: each registered panel with settings (its spec's
+    ``settings``), in the registry's order. The defaults are the viewer's own start values."""
+    return {spec.name: spec.settings for spec in REGISTRY if len(spec.settings)}
 
 
 @functools.cache
 def added_keys() -> tuple[tuple[str, str], ...]:
-    """Keys newer than the first session files (each state module's ``SESSION_ADDED``):
-    written only when they differ from the default."""
-    return tuple(
-        (e.name, key)
-        for e in REGISTRY
-        if (m := e.state_module()) is not None
-        for key in getattr(m, "SESSION_ADDED", ())
-    )
+    """Keys newer than the first session files (settings declared ``added``): written only
+    when they differ from the default."""
+    return tuple((sec, key) for sec, settings in schema().items() for key in settings.added())
 
 
 def top_level() -> tuple[str, ...]:
@@ -109,7 +99,15 @@ def top_level() -> tuple[str, ...]:
 
 def default_settings() -> dict[str, dict[str, Any]]:
     """Every section's settings at the viewer's defaults."""
-    return {sec: {k: d for k, (d, _) in keys.items()} for sec, keys in schema().items()}
+    return {sec: settings.defaults() for sec, settings in schema().items()}
+
+
+TOP_LEVEL = (
+    Choice("panel", VIEWS[0], choices=VIEWS, widget="none"),
+    Number("ui_scale", 1.0, lo=0.5, hi=3.0, widget="none"),
+    Choice("up", UP_AXES[0], choices=UP_AXES, widget="none"),
+)
+"""The top-level settings of a session (``up``: also ``null``, the mesh's rule)."""
 
 
 @dataclass
@@ -156,7 +154,7 @@ def _without_default_added_keys(settings: dict[str, dict[str, Any]]) -> dict[str
     refuse unknown keys: a file that does not need them stays readable there)."""
     sections = schema()
     for sec, key in added_keys():
-        default = sections[sec][key][0]
+        default = sections[sec].default(key)
         if sec in settings and settings[sec].get(key, default) == default:
             settings[sec].pop(key, None)
     return settings
@@ -199,36 +197,24 @@ def from_dict(
     if unknown:
         raise MeshError(f"unknown key(s) {', '.join(map(repr, unknown))}", source)
     session = Session(mesh=_mesh_path(data.get("mesh"), source, folder))
-    session.panel = _checked(data, "panel", VIEWS[0], one_of(VIEWS), source)
-    session.ui_scale = float(_checked(data, "ui_scale", 1.0, number(0.5, 3.0), source))
-    up = data.get("up")
-    session.up = None if up is None else _checked(data, "up", None, one_of(UP_AXES), source)
+    panel, ui_scale, up = TOP_LEVEL
+    session.panel = _checked(data, panel, source)
+    session.ui_scale = _checked(data, ui_scale, source)
+    session.up = None if data.get("up") is None else _checked(data, up, source)
     session.camera = check_camera(data.get("camera"), source)
-    for sec, keys in schema().items():
-        values = data.get(sec, {})
-        if not isinstance(values, dict):
-            raise MeshError(f'"{sec}" must be an object, got {json.dumps(values)}', source)
-        unknown = sorted(set(values) - set(keys))
-        if unknown:
-            raise MeshError(f"unknown key(s) in {sec!r}: {', '.join(map(repr, unknown))}", source)
-        for key, (default, check) in keys.items():
-            session.settings[sec][key] = _checked(values, key, default, check, source, sec)
-    for e in REGISTRY:  # checks across the keys of a section (e.g. a run's step counts)
-        module = e.state_module()
-        whole = getattr(module, "check_section", None) if module is not None else None
-        if whole is not None:
-            whole(session.settings[e.name], source)
+    specs = {spec.name: spec for spec in REGISTRY}
+    for sec in schema():  # each key, then across the keys (e.g. a run's step counts)
+        session.settings[sec] = specs[sec].check_values(data.get(sec, {}), source)
     return session
 
 
-def _checked(
-    values: dict[str, Any], key: str, default: Any, check: Check, source: Any, sec: str = ""
-) -> Any:
-    value = values.get(key, default)
-    problem = check(value)
+def _checked(data: dict[str, Any], setting: Setting, source: Any) -> Any:
+    """A top-level value (its default when missing), or a MeshError naming it."""
+    value = data.get(setting.key, setting.default)
+    problem = setting.problem(value)
     if problem:
-        raise MeshError(f'"{sec + "." if sec else ""}{key}" {problem}', source)
-    return float(value) if isinstance(default, float) else value
+        raise MeshError(f'"{setting.key}" {problem}', source)
+    return setting.coerce(value)
 
 
 def _mesh_path(mesh: Any, source: str | os.PathLike, folder: Path | None) -> Path | None:
@@ -249,19 +235,17 @@ def _mesh_path(mesh: Any, source: str | os.PathLike, folder: Path | None) -> Pat
 
 
 def check_session_mesh(session: Session, mesh: MeshState, source: str | os.PathLike) -> None:
-    """Refuse a session whose settings do not fit its mesh (each state module's
-    ``check_session(values, mesh, source)``, e.g. a one-ring vertex the mesh does not have).
+    """Refuse a session whose settings do not fit its mesh (each spec's ``check_mesh``, e.g.
+    a one-ring vertex the mesh does not have).
 
     Raises
     ------
     MeshError
         Naming the setting and the mesh's size.
     """
-    for e in REGISTRY:
-        module = e.state_module()
-        check = getattr(module, "check_session", None) if module is not None else None
-        if check is not None and e.name in session.settings:
-            check(session.settings[e.name], mesh, source)
+    for spec in REGISTRY:
+        if spec.check_mesh is not None and spec.name in session.settings:
+            spec.check_mesh(session.settings[spec.name], mesh, source)
 
 
 def read_session(path: str | os.PathLike) -> Session:

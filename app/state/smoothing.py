@@ -5,7 +5,6 @@ noise first, live figures and the amplification curve. No polyscope import.
 from __future__ import annotations
 
 import json
-import math
 import time
 from dataclasses import dataclass, field
 from typing import Any
@@ -13,14 +12,25 @@ from typing import Any
 import numpy as np
 
 from meshlap_core.errors import MeshError
-from meshlap_core.noise import add_noise, check_noise, check_seed
-from meshlap_core.options import LAPLACIAN_KINDS, SMOOTHING_METHODS
+from meshlap_core.noise import MAX_SEED, add_noise, check_noise, check_seed
+from meshlap_core.options import LAPLACIAN_KINDS, MAX_COORDINATE, SMOOTHING_METHODS
 from meshlap_core.smoothing import Smoother, amplification_curve, check_lam
 from meshlap_core.types import FloatArray, IntArray
 
+from ..panel_spec import PanelSpec
 from .animation import Animation, Option
-from .checks import Schema, integer, number, one_of
 from .play_meter import PlayMeter
+from .settings import (
+    FLOAT_MAX,
+    Choice,
+    Custom,
+    Flag,
+    Integer,
+    Number,
+    Settings,
+    number_problem,
+    shown,
+)
 
 MAX_BATCH = 8
 """Most steps *play* asks a child-process stepper for at once
@@ -31,6 +41,62 @@ hold (``smoothing.iterations``): opening a session replays every step before the
 so ``meshlap view --session`` and ``meshlap animate --session`` share this one limit."""
 _EMPTY_V = np.zeros((0, 3))
 _EMPTY_F = np.zeros((0, 3), dtype=np.int64)
+
+
+def _lam_steps(x: Any) -> str | None:
+    """What is wrong with a ``lam_steps`` value (``null`` or a list of ``[λ > 0, count >= 1]``);
+    the counts' sum is checked against ``iterations`` by :func:`check_section`."""
+    if x is None:
+        return None
+    if not isinstance(x, list):
+        return f"must be a list of [lam, steps] pairs or null, got {json.dumps(x)}"
+    for k, run in enumerate(x):
+        if not isinstance(run, list) or len(run) != 2:
+            return f"entry {k} must be a [lam, steps] pair, got {json.dumps(run)}"
+        problem = number_problem(run[0], 0.0, MAX_LAM, lo_open=True)
+        if problem:
+            return f"entry {k}: lam {problem}"
+        n = run[1]
+        if not isinstance(n, int) or isinstance(n, bool):
+            return f"entry {k}: steps must be an integer, got {shown(n)}"
+        if not 1 <= n <= MAX_FRAMES_ITERS:
+            return f"entry {k}: steps must be >= 1 and <= {MAX_FRAMES_ITERS}, got {shown(n)}"
+    return None
+
+
+MAX_LAM = MAX_COORDINATE**2
+"""The largest λ: with the cotangent Laplacian λ is in length², coordinates at most 1e75."""
+# fmt: off
+SETTINGS = Settings(
+    Choice("method", "implicit", choices=SMOOTHING_METHODS, label="method",
+           tooltip="explicit: x <- x + lam L x;  implicit: (I - lam L) x' = x (backward "
+           "Euler);  taubin: lam step, then a negative nu step (no shrinkage)",
+           animate=Flag("--method", "the smoothing method")),
+    Choice("laplacian", "uniform", choices=LAPLACIAN_KINDS, label="Laplacian",
+           tooltip="uniform: L = D^-1 A - I (lam dimensionless);  cotan: L = M^-1 C (lam in "
+           "length^2)", animate=Flag("--laplacian", "the Laplacian")),
+    Number("lam", 0.5, lo=0.0, lo_open=True, hi=MAX_LAM, widget="input", fmt="%.4g",
+           label="lambda", example=0.25, animate=Flag("--lam", "the step λ", default=1.0),
+           tooltip="step size lam > 0; type a number and press Enter (keeps the current mesh)"),
+    Number("noise_alpha", 0.0, lo=0.0, hi=FLOAT_MAX,  # the mesh bounds it: check_mesh
+           slider=(0.0, 0.05), fmt="%.4f", label="noise alpha", example=0.01,
+           tooltip="Gaussian noise along the normals, sigma = alpha x mean edge length "
+           "(rebuilds the input)", animate=Flag("--noise", "noise α added before smoothing")),
+    Integer("seed", 0, lo=0, hi=MAX_SEED, label="noise seed",
+            tooltip="seed of the noise (an integer >= 0)",
+            animate=Flag("--seed", "the noise seed")),
+    Integer("iterations", 0, lo=0, hi=MAX_FRAMES_ITERS, label="step", widget="button",
+            tooltip="one iteration",
+            quiet=0,  # another panel's animation replays no run
+            above="the smoothing ran {x} iterations; an animation has at most "
+            f"{MAX_FRAMES_ITERS}, and opening a session replays each one before the first frame"),
+    Custom("lam_steps", None, check=_lam_steps, widget="none", added=True, quiet=None,
+           example=[[0.5, 1]],
+           refused=("0.5", {}, [0.5, 1], [[0, 1]], [[float("nan"), 1]], [[0.5, 1.5]])),
+)
+# fmt: on
+"""The Smoothing panel's settings: a run is ``iterations`` steps, each at its λ of
+``lam_steps`` (run-length encoded; missing: every step at ``lam``), from the noisy input."""
 
 
 @dataclass
@@ -45,11 +111,11 @@ class SmoothingState:
     mid-way comes back bit for bit.
     """
 
-    method: str = "implicit"
-    laplacian: str = "uniform"
-    lam: float = 0.5
-    noise_alpha: float = 0.0
-    seed: int = 0
+    method: str = SETTINGS.default("method")
+    laplacian: str = SETTINGS.default("laplacian")
+    lam: float = SETTINGS.default("lam")
+    noise_alpha: float = SETTINGS.default("noise_alpha")
+    seed: int = SETTINGS.default("seed")
     playing: bool = False
     error: str = ""
     smoother: Smoother | None = None
@@ -446,11 +512,6 @@ class SmoothingState:
         return mu, amplification_curve(self.method, self.lam, mu, k_pb=s.k_pb)
 
 
-def make_state() -> SmoothingState:
-    """The Smoothing panel's slice of the :class:`~.app.AppState`."""
-    return SmoothingState()
-
-
 def caption(st: SmoothingState, iters: int | None = None) -> str:
     """``implicit (uniform L), λ = 1   iteration 3/30   RMSE 0.0012`` for a smoothing state
     (read from the stepper's history: never the lazy stability estimate, an eigensolve); the
@@ -467,65 +528,6 @@ def caption(st: SmoothingState, iters: int | None = None) -> str:
 
 
 # ---------------------------------------------------------------- saved sessions
-def _lam_steps(x: Any) -> str | None:
-    """What is wrong with a ``lam_steps`` value (``null`` or a list of ``[λ > 0, count >= 1]``);
-    the counts' sum is checked against ``iterations`` by :func:`check_section`."""
-    if x is None:
-        return None
-    if not isinstance(x, list):
-        return f"must be a list of [lam, steps] pairs or null, got {json.dumps(x)}"
-    positive = number(positive=True)
-    for k, run in enumerate(x):
-        if not isinstance(run, list) or len(run) != 2:
-            return f"entry {k} must be a [lam, steps] pair, got {json.dumps(run)}"
-        problem = positive(run[0])
-        if problem:
-            return f"entry {k}: lam {problem}"
-        problem = integer(1)(run[1])
-        if problem:
-            return f"entry {k}: steps {problem}"
-    return None
-
-
-def _seed(x: Any) -> str | None:
-    """What is wrong with a saved noise seed (:func:`meshlap_core.noise.check_seed`: an
-    integer ``0..MAX_SEED``, what the panel's seed field holds)."""
-    try:
-        check_seed(x)
-    except MeshError as exc:
-        return exc.problem
-    return None
-
-
-def _iterations(x: Any) -> str | None:
-    """What is wrong with a saved iteration count: an integer ``0..MAX_FRAMES_ITERS`` (each
-    step is replayed before the first frame; an animation has as many frames)."""
-    problem = integer(0)(x)
-    if problem or x <= MAX_FRAMES_ITERS:
-        return problem
-    return (
-        f"must be 0 to {MAX_FRAMES_ITERS} (the smoothing ran {x} iterations; an animation has "
-        f"at most {MAX_FRAMES_ITERS}, and opening a session replays each one before the first "
-        "frame)"
-    )
-
-
-SESSION: Schema = {
-    "method": ("implicit", one_of(SMOOTHING_METHODS)),
-    "laplacian": ("uniform", one_of(LAPLACIAN_KINDS)),
-    "lam": (0.5, number(positive=True)),
-    "noise_alpha": (0.0, number(0.0)),
-    "seed": (0, _seed),
-    "iterations": (0, _iterations),
-    "lam_steps": (None, _lam_steps),
-}
-"""The Smoothing panel's section of a saved session (:mod:`.session`); ``noise_alpha`` is
-checked against the mesh too (:func:`check_session`)."""
-SESSION_ADDED = ("lam_steps",)
-QUIET: dict[str, Any] = {"iterations": 0}
-"""Restored for another panel's animation: no run replayed."""
-
-
 def check_section(sm: dict[str, Any], source: Any) -> None:
     """Check that ``lam_steps`` counts ``iterations`` steps; λ as floats, counts as ints.
 
@@ -547,7 +549,7 @@ def check_section(sm: dict[str, Any], source: Any) -> None:
     sm["lam_steps"] = [[float(lam), int(n)] for lam, n in runs]
 
 
-def check_session(sm: dict[str, Any], mesh: Any, source: Any) -> None:
+def check_mesh(sm: dict[str, Any], mesh: Any, source: Any) -> None:
     """Refuse a saved noise α whose noise would push this mesh's coordinates past the
     coordinate limit (:func:`meshlap_core.noise.check_noise`); without it, 1e308 passes the
     section's check and the noisy mesh is then blamed ("vertex 0 has a NaN ...").
@@ -583,30 +585,17 @@ def replay_steps(sm: dict[str, Any]) -> list[list[Any]]:
 
 # ---------------------------------------------------------------- meshlap animate
 def _animation_from_session(opts: dict[str, Any], sm: dict[str, Any], source: Any) -> None:
-    """Fill the options not typed from the saved section: method, Laplacian, λ (and the λ of
-    every saved step unless ``--lam`` is typed), noise, seed, and the iterations (the last
-    frame is then the saved view)."""
+    """From the saved section (the settings' flags take method, Laplacian, λ, noise and seed
+    after this): the λ of every saved step unless ``--lam`` is typed, and the iterations (the
+    last frame is then the saved view; 0: the built-in default)."""
     opts["lam_steps"] = sm.get("lam_steps") if opts.get("lam") is None else None
-    saved = {
-        "method": sm["method"],
-        "laplacian": sm["laplacian"],
-        "lam": sm["lam"],
-        "noise": sm["noise_alpha"],
-        "seed": sm["seed"],
-        "iters": sm["iterations"] or None,  # 0: the built-in default
-    }
-    for name, value in saved.items():
-        if opts.get(name) is None:
-            opts[name] = value
+    if opts.get("iters") is None:
+        opts["iters"] = sm["iterations"] or None
 
 
 def _animation_check(opts: dict[str, Any]) -> None:
-    check_lam(opts["lam"], "--lam")
     if not 0 <= opts["iters"] <= MAX_FRAMES_ITERS:
         raise MeshError(f"must be 0 to {MAX_FRAMES_ITERS}, got {opts['iters']}", "--iters")
-    if not (math.isfinite(opts["noise"]) and opts["noise"] >= 0):
-        raise MeshError(f"must be a finite number >= 0, got {opts['noise']}", "--noise")
-    check_seed(opts["seed"], "--seed")
 
 
 def _animation_check_mesh(opts: dict[str, Any], mesh: Any) -> None:
@@ -616,16 +605,7 @@ def _animation_check_mesh(opts: dict[str, Any], mesh: Any) -> None:
 
 ANIMATION = Animation(
     summary="smoothing: one frame per iteration, the input beside the smoothed copy",
-    options=(
-        Option(
-            "--method", "smoothing method (default implicit)", "implicit", choices=SMOOTHING_METHODS
-        ),
-        Option("--laplacian", "default uniform", "uniform", choices=LAPLACIAN_KINDS),
-        Option("--lam", "smoothing step λ > 0 (default 1)", 1.0, float),
-        Option("--iters", "smoothing iterations (frames: iters+1; default 30)", 30, int),
-        Option("--noise", "noise α before smoothing (default 0)", 0.0, float),
-        Option("--seed", "noise seed (default 0)", 0, int),
-    ),
+    options=(Option("--iters", "smoothing iterations (frames: iters+1; default 30)", 30, int),),
     session_help=(
         "smoothing  method, laplacian, lambda, noise alpha and seed from the session; --iters\n"
         "           defaults to the session's iteration count when it is > 0 (else 30): the\n"
@@ -641,3 +621,18 @@ ANIMATION = Animation(
     colorbar=False,  # no colour map: the input and its smoothed copy
 )
 """``meshlap animate --panel smoothing``."""
+
+
+SPEC = PanelSpec(
+    name="smoothing",
+    title="Smoothing",
+    summary="explicit, implicit or Taubin smoothing stepped live from a (noisy) input, with its "
+    "stability limit and amplification curve",
+    panel="SmoothingPanel",
+    state=SmoothingState,
+    settings=SETTINGS,
+    check_section=check_section,
+    check_mesh=check_mesh,
+    animation=ANIMATION,
+)
+"""The Smoothing panel."""

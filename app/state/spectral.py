@@ -20,8 +20,9 @@ from meshlap_core.io.animation import parse_range
 from meshlap_core.spectral import SpectralBasis
 from meshlap_core.types import FloatArray, IntArray
 
+from ..panel_spec import PanelSpec
 from .animation import Animation, Option
-from .checks import Schema, boolean, integer, one_of
+from .settings import MAX_INT, Choice, Flag, Integer, Settings, Toggle
 
 PLAY_KINDS: tuple[str, ...] = ("k sweep", "modes")
 """What the Spectral panel plays: k = 1, 2, ... (one per frame) or the eigenmodes 1, 2, ..."""
@@ -33,6 +34,26 @@ SCREENSHOT_K = 30
 MODES_PER_SECOND = 1.5
 """Pace of the eigenmodes played on screen (a mode must be readable); the k sweep is one k
 per frame."""
+
+# fmt: off
+SETTINGS = Settings(
+    Toggle("computed", False, label="compute eigenbasis", widget="button",
+           tooltip="solve for the modes in the background (progress, Cancel)",
+           quiet=False),  # another panel's animation reads no basis
+    Integer("k_request", 100, lo=2, hi=MAX_INT, label="modes to compute",
+            tooltip="number of eigenpairs of -C u = lambda M u to compute; Enter applies"),
+    Integer("k", 10, lo=1, hi=MAX_INT, label="k (reconstruct)", widget="slider",
+            tooltip="x_k = sum_{i<k} u_i (u_i^T M x): the shape from its first k modes",
+            view=Flag("--k", "reconstruct from k eigenvectors (computed at start)")),
+    Integer("mode", 1, lo=0, hi=MAX_INT, label="eigenmode i", widget="slider",
+            tooltip="eigenfunction u_i shown as a colour map (i = 0 is constant)"),
+    Choice("play", "k sweep", choices=PLAY_KINDS, label="play what", added=True,
+           tooltip="k sweep: k = 1, 2, ... one per frame (as meshlap animate --k); modes: the "
+           "eigenmodes 1, 2, ... at 1.5 per second (as --modes); playing stops at the end"),
+)
+# fmt: on
+"""The Spectral panel's settings (the basis, k and mode are bounded by the mesh where they
+are applied: the requested modes clamped to the vertices, k and mode to the basis)."""
 
 
 def _finish_basis(basis: SpectralBasis, k: int, progress: Any) -> tuple[SpectralBasis, Any]:
@@ -59,9 +80,9 @@ def solve_basis(V: FloatArray, F: IntArray, k: int, progress: Any = None) -> tup
 class SpectralState:
     """Basis, selected eigenmode ``mode`` and reconstruction order ``k``."""
 
-    k_request: int = 100
-    mode: int = 1
-    k: int = 10
+    k_request: int = SETTINGS.default("k_request")
+    mode: int = SETTINGS.default("mode")
+    k: int = SETTINGS.default("k")
     progress: float = 0.0
     message: str = ""
     error: str = ""
@@ -72,7 +93,7 @@ class SpectralState:
     _job: Any = None  # the running job (meshlap_app.jobs.Job) computing the basis
     _jobs: Any = None  # the Jobs it runs in (the app's, or a private one)
     _fresh: bool = False  # a basis arrived that poll() has not reported yet
-    play_what: str = "k sweep"  # one of PLAY_KINDS
+    play_what: str = SETTINGS.default("play")  # one of PLAY_KINDS
     playing: bool = False
     clock: Callable[[], float] = time.monotonic  # seconds (a test gives its own)
     _due: float = 0.0  # when the next mode is due
@@ -287,37 +308,6 @@ class SpectralState:
         return True
 
 
-def make_state() -> SpectralState:
-    """The Spectral panel's slice of the :class:`~.app.AppState`."""
-    return SpectralState()
-
-
-def check_view_options(options: dict[str, Any], state: Any) -> None:
-    """``meshlap view --k``: at least 1.
-
-    Raises
-    ------
-    MeshError
-        ``k < 1``.
-    """
-    k = options.get("k")
-    if k is not None and k < 1:
-        raise MeshError(f"must be at least 1, got {k}", "--k")
-
-
-SESSION: Schema = {
-    "computed": (False, boolean),
-    "k_request": (100, integer(2)),
-    "k": (10, integer(1)),
-    "mode": (1, integer(0)),
-    "play": ("k sweep", one_of(PLAY_KINDS)),
-}
-"""The Spectral panel's section of a saved session (:mod:`.session`)."""
-SESSION_ADDED = ("play",)
-QUIET: dict[str, Any] = {"computed": False}
-"""Restored for another panel's animation: no eigenbasis read."""
-
-
 # ---------------------------------------------------------------- meshlap animate
 def _animation_from_session(opts: dict[str, Any], sp: dict[str, Any], source: Any) -> None:
     """Without ``--k``/``--modes``: the k sweep up to the session's k."""
@@ -366,3 +356,16 @@ ANIMATION = Animation(
     check_mesh=_animation_check_mesh,
 )
 """``meshlap animate --panel spectral``."""
+
+
+SPEC = PanelSpec(
+    name="spectral",
+    title="Spectral",
+    summary="the eigenbasis of -C u = lambda M u, an eigenmode browser and the shape rebuilt "
+    "from its first k modes",
+    panel="SpectralPanel",
+    state=SpectralState,
+    settings=SETTINGS,
+    animation=ANIMATION,
+)
+"""The Spectral panel."""

@@ -16,14 +16,43 @@ from meshlap_core import surfaces
 from meshlap_core.errors import MeshError
 from meshlap_core.types import FloatArray
 
+from ..panel_spec import PanelSpec
 from ..text_numbers import sig
 from .animation import Animation, Option
-from .checks import Schema, integer, number, one_of
+from .settings import Choice, Flag, Integer, Number, Settings
 
 MAX_RES = 512  # cells per direction the viewer meshes (512² cells: 0.5 M triangles)
 TURN_STEP_DEG = 5.0
 """θ step of the normal section turning (*turn*): one frame each, 72 frames per turn (as
 ``meshlap animate --panel surfaces --theta`` with its default ``--frames 72``)."""
+PARAM_LIMIT = 1e3
+"""The (u, v) a session may hold: beyond every surface's domain (the point is clamped into
+the surface's own domain when it is set)."""
+THETA_LIMIT = 3600.0
+"""The section's θ a session may hold, in degrees (ten turns either way; taken modulo 360)."""
+
+# fmt: off
+SETTINGS = Settings(
+    Choice("surface", "helicoid", choices=tuple(surfaces.SURFACES), label="surface",
+           tooltip="a parametric surface p(u, v)",
+           animate=Flag("--surface", "the parametric surface", default="saddle")),
+    Integer("res", 48, lo=1, hi=MAX_RES, label="resolution",
+            tooltip="cells per parameter direction; Enter applies"),
+    Number("u", 0.0, lo=-PARAM_LIMIT, hi=PARAM_LIMIT, label="u", example=0.75,
+           tooltip="first parameter of the point"),
+    Number("v", 0.0, lo=-PARAM_LIMIT, hi=PARAM_LIMIT, label="v", example=0.5,
+           tooltip="second parameter of the point"),
+    Number("theta", 0.0, lo=-THETA_LIMIT, hi=THETA_LIMIT, slider=(0.0, 360.0),
+           label="section theta", added=True, example=30.0,
+           tooltip="direction of the normal section (orange) as a parameter angle theta: degrees "
+           "in the (u, v) plane from the u axis towards v, i.e. the tangent p_u cos theta + "
+           "p_v sin theta (normalized). phi is the same direction measured in the tangent "
+           "plane from the first principal direction (the plot's axis). Drawn: its tangent "
+           "t and its osculating arc of curvature k_n"),
+)
+# fmt: on
+"""The Surfaces panel's settings: the surface, its resolution, the point (u, v) and the
+normal section's θ (degrees)."""
 
 
 def section_arc(
@@ -88,10 +117,10 @@ def euler_curve(p: surfaces.PointGeometry, n: int = 181) -> tuple[FloatArray, Fl
 class SurfaceState:
     """The chosen surface, its mesh at ``res`` and everything at ``(u, v)``."""
 
-    name: str = "helicoid"
-    res: int = 48
-    u: float = 0.0
-    v: float = 0.0
+    name: str = SETTINGS.default("surface")
+    res: int = SETTINGS.default("res")
+    u: float = SETTINGS.default("u")
+    v: float = SETTINGS.default("v")
     error: str = ""
     mesh: surfaces.SurfaceMesh | None = None
     point: surfaces.PointGeometry | None = None
@@ -100,7 +129,7 @@ class SurfaceState:
     phi: FloatArray = field(default_factory=lambda: np.zeros(0))  # geometric angles (radians)
     kn_phi: FloatArray = field(default_factory=lambda: np.zeros(0))  # κₙ at ``phi``
     version: int = 0  # bumped when the mesh changes (re-register), not when (u, v) moves
-    section_deg: float = 0.0  # θ of the normal section drawn in 3D, degrees in [0, 360)
+    section_deg: float = SETTINGS.default("theta")  # θ of the section in 3D, in [0, 360)
     turning: bool = False  # *turn*: θ advances TURN_STEP_DEG per frame
     _turn_left: int = 0  # steps left in this turn
 
@@ -250,22 +279,6 @@ class SurfaceState:
         return True
 
 
-def make_state() -> SurfaceState:
-    """The Surfaces panel's slice of the :class:`~.app.AppState`."""
-    return SurfaceState()
-
-
-SESSION: Schema = {
-    "surface": ("helicoid", one_of(tuple(surfaces.SURFACES))),
-    "res": (48, integer(1, MAX_RES)),
-    "u": (0.0, number()),
-    "v": (0.0, number()),
-    "theta": (0.0, number()),
-}
-"""The Surfaces panel's section of a saved session (:mod:`.session`)."""
-SESSION_ADDED = ("theta",)
-
-
 # ---------------------------------------------------------------- meshlap animate
 def parse_uv(text: str | None) -> tuple[float, float] | None:
     """``"U,V"`` as two finite numbers (``None`` stays ``None``).
@@ -287,20 +300,16 @@ def parse_uv(text: str | None) -> tuple[float, float] | None:
 
 
 def _animation_from_session(opts: dict[str, Any], sf: dict[str, Any], source: Any) -> None:
-    """The session's surface and (u, v) (unless another surface or a point is typed)."""
+    """``--theta`` implied, and the session's (u, v) unless another surface or a point is
+    typed (the surface's flag then takes the session's surface)."""
     opts["theta"] = True
-    if opts.get("surface") is None:
-        opts["surface"] = sf["surface"]
-    if opts.get("uv") is None and opts["surface"] == sf["surface"]:
+    if opts.get("uv") is None and opts.get("surface") in (None, sf["surface"]):
         opts["uv"] = f"{sf['u']!r},{sf['v']!r}"
 
 
 def _animation_check(opts: dict[str, Any]) -> None:
     if not opts.get("theta"):
         raise MeshError("the surfaces animation is the normal section: add --theta", "--panel")
-    if opts["surface"] not in surfaces.SURFACES:
-        names = ", ".join(surfaces.SURFACES)
-        raise MeshError(f"unknown surface {opts['surface']!r}; choose one of {names}", "--surface")
     if not 2 <= opts["frames"] <= 2000:
         raise MeshError(f"must be 2 to 2000, got {opts['frames']}", "--frames")
     if isinstance(opts.get("uv"), str):
@@ -311,7 +320,6 @@ ANIMATION = Animation(
     summary="a turning normal section of a parametric surface (--theta)",
     options=(
         Option("--theta", "surfaces: turn the normal section", store_true=True),
-        Option("--surface", "surfaces: the parametric surface (default saddle)", "saddle"),
         Option("--uv", "surfaces: the point (default: the surface's)", metavar="U,V"),
         Option("--frames", "surfaces: frames per turn (default 72)", 72, int),
     ),
@@ -327,3 +335,16 @@ ANIMATION = Animation(
     uses_mesh=False,
 )
 """``meshlap animate --panel surfaces --theta``."""
+
+
+SPEC = PanelSpec(
+    name="surfaces",
+    title="Surfaces",
+    summary="parametric surfaces with their exact first and second fundamental forms, "
+    "curvatures, principal directions and a normal section at theta",
+    panel="SurfacesPanel",
+    state=SurfaceState,
+    settings=SETTINGS,
+    animation=ANIMATION,
+)
+"""The Surfaces panel."""
