@@ -7,7 +7,6 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from meshlap_app.state.curvature_lab import (
-    STUDY_LEVELS,
     CurvatureLabState,
     cross_field,
     crosses_of,
@@ -173,73 +172,9 @@ def test_crosses_share_one_basis_and_equal_cross_field():
 # ---------------------------------------------------------------- widgets (openGL_mock)
 ps = pytest.importorskip("polyscope")
 
-import test_viewer_widgets as widgets  # noqa: E402
-
-drive = widgets.drive
-frames = widgets.frames
-mock = widgets.mock
-
-
-def drive_panel_curvature_lab(viewer, tmp_path=None) -> None:
-    """Every lab widget with good and bad values (also run by the every-widget tour)."""
-    from meshlap_app.panels.curvature_lab import LAB
-
-    viewer.set_panel("curvature_lab")
-    frames(viewer, 2)
-    lab = viewer.panels["curvature_lab"].state
-    assert lab.result is not None and ps.has_surface_mesh(LAB), viewer.state.errors
-    drive(viewer, "resolution", 12)
-    assert lab.res == 12 and lab.result.V.shape[0] == 2 * 12 * 12
-    # the log-log plot of the error against h, with the fitted order in the legend: a
-    # second job, kept per (surface, estimator, noise, jitter, flips)
-    conv = lab.convergence()
-    assert [row["res"] for row in conv] == list(STUDY_LEVELS)
-    order = conv[-1]["H_order"]
-    assert order == pytest.approx(2.0, abs=0.3)  # cotan on the regular torus grid
-    _kind, x, y = viewer.ui.plots[("curvature_lab", f"H, order {order:.2f}")]
-    np.testing.assert_allclose(x, np.log10([row["h"] for row in conv]))
-    assert len(x) == len(STUDY_LEVELS)
-    assert np.all(np.diff(x) < 0) and np.all(np.diff(y) < 0)  # finer: smaller
-    # a resolution move recomputes the error map, never the study (nor its figure)
-    drive(viewer, "resolution", 14)
-    assert lab.result.V.shape[0] == 2 * 14 * 14 and lab.convergence() is conv
-    assert len(lab.studies) == 1
-    drive(viewer, "resolution", 12)
-    drive(viewer, "vertex", 5)
-    assert lab.vertex == 5
-    # what the Euler plot draws (the plot itself is clipped when the panel is long)
-    so = lab.shape_operator()
-    assert so["kn"][0] == pytest.approx(lab.result.principal.k1[5])
-    assert so["exact_kn"] is not None
-    drive(viewer, "vertex", 10**6)
-    assert lab.vertex == 5 and "vertex" in viewer.state.errors["curvature_lab"]
-    drive(viewer, "noise", 0.001)
-    drive(viewer, "jitter", 0.2)
-    drive(viewer, "edge flips", 0.1)
-    assert lab.computed_for[-3:] == (0.001, 0.2, 0.1)
-    drive(viewer, "noise", -1.0)
-    assert lab.noise == 0.001 and "noise" in viewer.state.errors["curvature_lab"]
-    drive(viewer, "estimator", "rusinkiewicz")
-    principal = lab.result.principal
-    drive(viewer, "quantity", "k1")
-    assert lab.result.principal is principal  # recoloured, the estimator not run again
-    drive(viewer, "show", "estimate")
-    assert lab.result.label == "k1 (rusinkiewicz)"
-    np.testing.assert_allclose(lab.result.values, lab.result.principal.k1)
-    drive(viewer, "lab surface", "saddle")
-    assert lab.result.V.shape[0] == 13 * 13
-    drive(viewer, "lab surface", "ellipsoid")  # its exact curvature is the closed form
-    k1 = lab.result.exact[0]
-    assert np.isfinite(k1).sum() == len(k1) - 2  # all but the two poles
-    drive(viewer, "lab surface", "saddle")
-    drive(viewer, "crosses", False)
-    drive(viewer, "crosses", True)
-    drive(viewer, "source", "mesh")
-    drive(viewer, "show", "disagreement")
-    assert lab.result.V.shape == viewer.state.mesh.V.shape
-    assert "disagree" in lab.result.summary
-    drive(viewer, "source", "surface")
-    drive(viewer, "show", "error")
+from tests.support.drivers.curvature import drive_curvature_estimator  # noqa: E402
+from tests.support.drivers.curvature_lab import drive_panel_curvature_lab  # noqa: E402
+from tests.support.widgets import drive, frames  # noqa: E402
 
 
 def test_curvature_lab_widgets(viewer):
@@ -276,42 +211,6 @@ def test_a_new_estimate_on_the_same_faces_moves_the_registered_vertices(viewer, 
     drive(viewer, "crosses", True)
     drive(viewer, "resolution", 13)
     assert registered == [LAB] and ps.get_surface_mesh(LAB).n_vertices() == 2 * 13 * 13
-
-
-def drive_curvature_estimator(viewer) -> None:
-    """The Curvature view's estimator combo (k1, k2 from the chosen estimator, a bad name
-    refused) and the One-ring view's shape-operator row at a vertex (run by
-    ``drive_panel_curvature`` of the every-widget tour)."""
-    from meshlap_app.state.curvature import ESTIMATOR_HELP
-
-    viewer.set_panel("curvature")
-    c, mesh = viewer.state.curv, viewer.state.mesh
-    assert all(f"{e}:" in ESTIMATOR_HELP for e in ce.ESTIMATOR_FUNCTIONS)  # each with its paper
-    assert "Rusinkiewicz 2004" in ESTIMATOR_HELP and "Meyer et al. 2003" in ESTIMATOR_HELP
-    drive(viewer, "field", "k1")
-    drive(viewer, "estimator", "rusinkiewicz")
-    ref = ce.estimate_curvature(mesh.V, mesh.F, "rusinkiewicz")
-    np.testing.assert_allclose(c.values("k1"), ref.k1, atol=1e-12)
-    np.testing.assert_allclose(c.values("k2"), ref.k2, atol=1e-12)
-    assert c.summary("k1")["max"] == pytest.approx(ref.k1.max())
-    with pytest.raises(MeshError, match="estimator"):
-        c.set_estimator("magic")
-    assert c.estimator == "rusinkiewicz"
-    # the One-ring view's row: the estimator's 2x2 tensor at the vertex, in its basis
-    drive(viewer, "vertex", 7, panel="onering")
-    so = c.shape_operator(mesh, 7)
-    S, t1, _ = ref.shape_operator(7)
-    np.testing.assert_allclose(so["S"], S, atol=1e-12)
-    np.testing.assert_allclose(so["t1"], t1)
-    assert so["k1"] == pytest.approx(ref.k1[7]) and so["estimator"] == "rusinkiewicz"
-    drive(viewer, "estimator", "jet", panel="curvature")  # the whole mesh's run (inline here)
-    assert c.principal_current(mesh) and c.principal.estimator == "jet"
-    viewer.set_panel("onering")
-    frames(viewer, 1)
-    np.testing.assert_allclose(c.shape_operator(mesh, 7)["k1"], c.principal.k1[7])
-    drive(viewer, "estimator", "cotan", panel="curvature")
-    np.testing.assert_array_equal(c.values("k1"), c.fields["k1"])  # cotan: the course fields
-    drive(viewer, "field", "cotan")
 
 
 def test_curvature_estimator_widgets(viewer):

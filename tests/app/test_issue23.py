@@ -3,7 +3,6 @@ polyscope's openGL_mock backend, the ``viewer`` fixture)."""
 
 from __future__ import annotations
 
-import re
 from itertools import pairwise
 from pathlib import Path
 
@@ -13,6 +12,8 @@ import pytest
 ps = pytest.importorskip("polyscope")
 
 from meshlap_app.viewer import Viewer  # noqa: E402
+
+from tests.support.readme import README, readme_keys  # noqa: E402
 
 
 @pytest.fixture(scope="module")
@@ -191,10 +192,10 @@ def legend_problems(viewer: Viewer, ledger, where: str) -> list[str]:
 
 
 def test_every_visible_quantity_has_a_legend_and_belongs_to_the_view(viewer, sphere, monkeypatch):
-    from legend_ledger import Ledger
     from meshlap_app.registry import VIEWS
 
     from meshlap_core.options import CURVATURE_FIELD_LABELS
+    from tests.support.legend_ledger import Ledger
 
     ledger = Ledger().install(monkeypatch)
     assert viewer.open(sphere)  # everything registered again, through the ledger
@@ -244,7 +245,6 @@ def compute_basis(viewer: Viewer, modes: int = 12) -> None:
 
 
 def test_second_mesh_then_eigenbasis_shows_the_reconstruction(viewer):
-    from pathlib import Path
 
     recon = "reconstruction"
     compute_basis(viewer)
@@ -252,7 +252,7 @@ def test_second_mesh_then_eigenbasis_shows_the_reconstruction(viewer):
     viewer.set_panel("curvature")  # the copy is hidden with its view
     frames(viewer)
     assert not ps.get_surface_mesh(recon).is_enabled()
-    second = Path(__file__).parents[1] / "assets" / "icosphere.obj"
+    second = Path(__file__).parents[2] / "assets" / "icosphere.obj"
     assert viewer.open(second)
     frames(viewer)
     compute_basis(viewer)
@@ -290,33 +290,8 @@ def test_view_accepts_ui_scale_with_a_session(viewer, tmp_path, sphere, monkeypa
 
 
 # ---------------------------------------------------------------- class check: every key
-README = Path(__file__).parents[1] / "README.md"
-SYMBOLS = {"→": "right", "←": "left", "space": "space"}
 # where a key can act (the panel named in its help row, else this view)
 DEFAULT_VIEW = "onering"
-
-
-def readme_keys() -> list[str]:
-    """The keys in the README's **Keys:** item, as the adapter names them."""
-    text = README.read_text(encoding="utf-8")
-    start = text.index("**Keys:**")
-    item = text[start : text.index("\n\n", start)]
-    keys: list[str] = []
-    for token in re.findall(r"`([^`]+)`", item):
-        if re.fullmatch(r"\d", token):
-            keys.append(token)
-        elif token in SYMBOLS:
-            keys.append(SYMBOLS[token])
-        elif re.fullmatch(r"[A-Z]", token):
-            keys.append(token.lower())
-        elif token.startswith("--"):
-            continue  # an option, not a key
-        else:
-            raise AssertionError(f"README key {token!r} is not understood by this check")
-    digits = sorted(int(k) for k in keys if k.isdigit())
-    if len(digits) >= 2:  # `1`–`6`: the range
-        keys += [str(i) for i in range(digits[0], digits[-1] + 1)]
-    return sorted(set(keys))
 
 
 def help_keys(viewer: Viewer) -> list[tuple[str, str]]:
@@ -409,7 +384,7 @@ def test_genus_none_is_explained_and_small_texts(viewer, tmp_path):
 
 
 def test_k_sweep_error_colour_bar_keeps_one_range(viewer, monkeypatch):
-    from legend_ledger import Ledger
+    from tests.support.legend_ledger import Ledger
 
     ledger = Ledger().install(monkeypatch)
     compute_basis(viewer, 12)

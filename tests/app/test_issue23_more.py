@@ -1,5 +1,5 @@
 """Issue 23, the remaining items: the window fitted inside the screen and its title (pure
-parts; the real window in ``tests/test_window_open.py`` and the tour), the mesh's up axis
+parts; the real window in ``tests/window/test_open.py`` and the tour), the mesh's up axis
 (through the viewer on ``openGL_mock``), legends placed off the data."""
 
 from __future__ import annotations
@@ -59,7 +59,7 @@ def test_the_title_names_the_mesh_only_when_it_can_follow_it():
 
 
 # ---------------------------------------------------------------- item 10: the mesh's up axis
-NEFERTITI = Path(__file__).resolve().parents[2] / "shared" / "meshes" / "nefertiti.obj"
+NEFERTITI = Path(__file__).resolve().parents[3] / "shared" / "meshes" / "nefertiti.obj"
 
 
 @pytest.mark.parametrize("up", UP_AXES)
@@ -294,7 +294,7 @@ def test_a_second_mesh_after_side_by_side_and_an_eigenbasis_shows_no_error(mock,
     ("'values' should be a length n_vertices array") shown on every panel."""
     from meshlap_app.scene import MESH_B
 
-    assets = Path(__file__).resolve().parents[1] / "assets"
+    assets = Path(__file__).resolve().parents[2] / "assets"
     assert viewer.open(assets / "torus.obj")
     ps.frame_tick()
     viewer.set_panel("curvature")

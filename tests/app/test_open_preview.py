@@ -25,7 +25,6 @@ import pytest
 from meshlap_app.jobs import Jobs, in_child
 from meshlap_app.state.mesh import read_mesh_with_fields
 from meshlap_app.state.preview import PREVIEW_LABEL, make_preview, preview_field
-from test_viewer_widgets import frames
 
 from meshlap_core import primitives
 from meshlap_core.curvature import all_curvature_fields, mean_curvature_uniform
@@ -33,6 +32,7 @@ from meshlap_core.errors import MeshError
 from meshlap_core.io import load_mesh, save_mesh
 from meshlap_core.laplacian import uniform_laplacian
 from meshlap_core.options import CURVATURE_FIELD_LABELS
+from tests.support.widgets import frames
 
 
 def test_preview_field_is_the_uniform_laplacian_against_the_normals_on_a_closed_mesh():

@@ -261,6 +261,8 @@ def test_cli_refuses_bad_sessions_in_one_line(tmp_path, sphere, capsys, args, me
 # ---------------------------------------------------------------- the window (openGL_mock)
 ps = pytest.importorskip("polyscope")
 
+from tests.support.drivers.help import drive_session_widgets, tick  # noqa: E402
+
 
 @pytest.fixture(scope="module")
 def mock(polyscope_mock):
@@ -270,7 +272,8 @@ def mock(polyscope_mock):
 def new_viewer(path):
     from meshlap_app.state import AppState, MeshState
     from meshlap_app.viewer import Viewer
-    from scripted_ui import ScriptedUI
+
+    from tests.support.scripted_ui import ScriptedUI
 
     ps.remove_all_structures()
     mesh = MeshState()
@@ -280,44 +283,6 @@ def new_viewer(path):
     ps.set_user_callback(v.callback)
     ps.frame_tick()
     return v
-
-
-def tick(viewer, label=None, value=None):
-    """One frame; ``label`` (a widget of the Help and window section, opened) gets ``value``."""
-    if label is not None:
-        viewer.ui.script(label, value)
-        viewer.ui.script("Help and window (H)", True)
-    ps.frame_tick()
-    assert not viewer.ui.pending()
-    internal = {k: m for k, m in viewer.state.errors.items() if "internal error" in m}
-    assert not internal, internal
-
-
-def drive_session_widgets(viewer, tmp_path) -> None:
-    """Drive the session widgets (Help and window section) with good and bad values; the
-    every-widget tour of ``test_viewer_widgets.py`` runs this too."""
-    from meshlap_app import session
-
-    tick(viewer)
-    tick(viewer)  # a pending re-frame happens first
-    before = session.capture(viewer)
-    tick(viewer, "session file", str(tmp_path / "no-such-folder" / "s.json"))
-    tick(viewer, "save session", True)
-    assert "does not exist" in viewer.state.errors["help"]
-    tick(viewer, "session file", "")  # empty: <mesh>.session.json in the export folder
-    tick(viewer, "save session", True)
-    saved = viewer.state.folder / f"{viewer.state.mesh.path.stem}.session.json"
-    assert saved.is_file() and viewer.panels["help"].session.text == str(saved.resolve())
-    assert "help" not in viewer.state.errors
-    for bad in ("{", '{"format": "meshlap-session", "version": 3}', "[]"):
-        (tmp_path / "bad.json").write_text(bad)
-        tick(viewer, "session file", str(tmp_path / "bad.json"))
-        tick(viewer, "load session", True)
-        assert str(tmp_path / "bad.json") in viewer.state.errors["help"]  # red, in that section
-        assert session.capture(viewer) == before  # nothing changed
-    tick(viewer, "session file", str(saved))
-    tick(viewer, "load session", True)
-    assert "help" not in viewer.state.errors and session.capture(viewer).settings == before.settings
 
 
 def test_session_widgets_save_and_load(mock, tmp_path, sphere, monkeypatch):

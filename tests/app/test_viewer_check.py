@@ -1,11 +1,11 @@
 """The Check panel: its state headless, its widgets through the UI adapter (openGL_mock).
 
-:func:`drive_panel_check` is also part of the every-widget tour of ``test_viewer_widgets.py``.
+Its driver, :func:`tests.support.drivers.check.drive_panel_check`, is also part of the
+every-widget tour of ``tests/app/test_viewer_widgets.py``.
 """
 
 from __future__ import annotations
 
-from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
@@ -16,8 +16,7 @@ from meshlap_core import primitives
 from meshlap_core.errors import MeshError
 from meshlap_core.laplacian import cotan_stiffness, mass_matrix, vertex_areas
 from meshlap_core.options import EXERCISE_TASKS
-
-STUDENTS = Path(__file__).parent / "exercises"
+from tests.support.students import STUDENTS
 
 
 # ---------------------------------------------------------------- state (no polyscope)
@@ -131,56 +130,13 @@ def test_reconstruction_on_the_mesh_on_screen():
 # ---------------------------------------------------------------- widgets (openGL_mock)
 ps = pytest.importorskip("polyscope")
 
-import test_viewer_widgets as widgets  # noqa: E402
-from legend_ledger import Ledger  # noqa: E402
 from meshlap_app.scene import MESH  # noqa: E402
 
-mock = widgets.mock  # `sphere` and `viewer` come from conftest
-drive = widgets.drive
-
-
-def drive_panel_check(viewer, tmp_path: Path) -> None:
-    """Every Check widget with good and bad values (also run by the every-widget tour)."""
-    viewer.set_panel("check")
-    st = viewer.panels["check"].state
-    drive(viewer, "check", True)  # nothing typed: said in red, nothing checked
-    assert "student file" in viewer.state.errors["check"] and st.check is None
-    drive(viewer, "student file", str(STUDENTS / "wrong_cotan_full.py"))
-    for bad in ("eigenbase", "nonsense"):
-        drive(viewer, "task", bad)
-        assert st.task == "cotan_laplacian" and "check" in viewer.state.errors
-    drive(viewer, "task", "cotan_laplacian")
-    drive(viewer, "check", True)
-    assert st.check is not None and st.check.result.tasks[0].diagnosis == "cot_not_half"
-    assert "check" not in viewer.state.errors
-    drive(viewer, "vertex", 5)
-    table = viewer.ui.tables[("check", "check rows")]
-    assert table.headers == ["term", "student", "reference"]
-    assert table.rows and all(
-        float(s) == pytest.approx(2 * float(r), rel=1e-5) for _, s, r in table.rows
-    )
-    for bad in (-2, 10**6):
-        drive(viewer, "vertex", bad)
-        assert st.vertex == 5 and "out of range" in viewer.state.errors["check"]
-    drive(viewer, "vertex", 6)
-    from test_isolines import drive_check_isolines  # the map's isolines, while it is shown
-
-    drive_check_isolines(viewer)
-    # the eigenbasis on the mesh on screen: its rows are λ_j and u_j[i], the map is shown
-    drive(viewer, "student file", str(STUDENTS / "wrong_spectral.py"))
-    drive(viewer, "task", "eigenbasis")
-    drive(viewer, "check", True)
-    assert st.check.result.tasks[0].diagnosis == "ordinary_eigenproblem"
-    drive(viewer, "vertex", 3)
-    rows = viewer.ui.tables[("check", "check rows")].rows
-    assert [r[0] for r in rows[:2]] == ["λ0", "u0[3]"] and len(rows) == 12
-    assert st.check.difference is not None and st.check.difference.max() > 0
-    # a crashing student file: reported, the viewer and the last good map stay
-    drive(viewer, "student file", str(STUDENTS / "hostile_crash.py"))
-    drive(viewer, "task", "uniform_laplacian")
-    drive(viewer, "check", True)
-    assert st.check.result.tasks[0].status == "crashed"
-    assert st.verdict()[0].split()[-1] == "CRASHED"
+from tests.support import widgets  # noqa: E402
+from tests.support.drivers.check import drive_panel_check  # noqa: E402
+from tests.support.legend_ledger import Ledger  # noqa: E402
+from tests.support.students import ONE_VERTEX_WRONG, facing_vertex  # noqa: E402
+from tests.support.widgets import drive  # noqa: E402
 
 
 def test_check_widgets(viewer, tmp_path):
@@ -250,19 +206,6 @@ def test_a_saved_session_reopens_the_check(viewer, tmp_path):
 
 
 # ---------------------------------------------------------------- real pixels (EGL)
-ONE_VERTEX_WRONG = '''
-import numpy as np
-
-
-def barycentric_areas(V, F):
-    """A third of each face, and a mistake at vertex {target} only."""
-    P = V[F]
-    A = 0.5 * np.linalg.norm(np.cross(P[:, 1] - P[:, 0], P[:, 2] - P[:, 0]), axis=1)
-    a = np.bincount(F.ravel(), np.repeat(A / 3.0, 3), minlength=len(V))
-    if len(V) > {target}:
-        a[{target}] += 2.0 * a.max()
-    return a
-'''
 
 EGL_CHECK_SCRIPT = """
 import json, sys, time
@@ -300,19 +243,6 @@ if __name__ == "__main__":
 """
 
 
-def _facing_vertex() -> int:
-    """A vertex of the bundled mesh near the middle of the default view, facing the camera
-    (which looks along +z from −z), as in test_viewer's picking test."""
-    from meshlap_app.state import MeshState
-
-    from meshlap_core.curvature import vertex_normals
-
-    mesh = MeshState()
-    mesh.load(None)
-    N = vertex_normals(mesh.V, mesh.F)
-    return int(np.argmin(N[:, 2] + 0.2 * np.abs(mesh.V[:, 1]) + 0.2 * np.abs(mesh.V[:, 0])))
-
-
 @pytest.mark.egl
 def test_egl_difference_map_is_coloured_where_the_mistake_is(tmp_path, python_ok):
     """A wrong student file loaded in the Check panel, rendered by EGL: the difference map is
@@ -322,7 +252,7 @@ def test_egl_difference_map_is_coloured_where_the_mistake_is(tmp_path, python_ok
 
     import matplotlib.image as mpimg
 
-    target = _facing_vertex()
+    target = facing_vertex()
     student = tmp_path / "one_wrong.py"
     student.write_text(ONE_VERTEX_WRONG.replace("{target}", str(target)))
     script = tmp_path / "egl_check.py"

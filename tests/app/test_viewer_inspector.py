@@ -1,10 +1,11 @@
 """The vertex inspector in the viewer: its geometry (headless) and its widgets (openGL_mock).
 
 The geometry drawn in 3D is tied to the inspection it draws: the area cell's fan has the area
-``A_i`` that ``inspect_vertex`` lists (itself checked against ``M_ii`` in ``test_inspector.py``),
-the ring edges carry the listed weights, the arcs span the corner angles. The widgets (area kind,
-boundary rule, hover) are driven through the UI adapter with good and bad values;
-:func:`drive_inspector` is also part of the every-widget tour of ``test_viewer_widgets.py``.
+``A_i`` that ``inspect_vertex`` lists (itself checked against ``M_ii`` in
+``tests/core/test_inspector.py``), the ring edges carry the listed weights, the arcs span the
+corner angles. The widgets (area kind, boundary rule, hover) are driven through the UI adapter
+with good and bad values; their driver, :func:`tests.support.drivers.onering.drive_inspector`,
+is also part of the every-widget tour of ``tests/app/test_viewer_widgets.py``.
 """
 
 from __future__ import annotations
@@ -30,16 +31,7 @@ from meshlap_core import primitives
 from meshlap_core.errors import MeshError
 from meshlap_core.inspector import inspect_vertex
 from meshlap_core.io import save_mesh
-
-
-def perturbed_grid(seed: int = 3) -> tuple[np.ndarray, np.ndarray]:
-    """The screenshot's mesh (docs/make_screenshots.py): obtuse triangles, negative weights."""
-    V, F = primitives.grid(10, 10)
-    V = V.copy()
-    V[:, :2] += np.random.default_rng(seed).uniform(-0.3, 0.3, (len(V), 2)) / 9.0
-    V[:, 2] += 0.15 / 9.0 * np.sin(3 * V[:, 0]) * np.cos(2 * V[:, 1])
-    return V, F
-
+from tests.support.meshes import perturbed_grid
 
 MESHES = {
     "grid": perturbed_grid,
@@ -162,84 +154,10 @@ def test_isolated_vertex_has_no_inspection():
 # ---------------------------------------------------------------- widgets (openGL_mock)
 ps = pytest.importorskip("polyscope")
 
-import test_viewer_widgets as widgets  # noqa: E402
 from meshlap_app import scene  # noqa: E402
 
-# the fixtures and helpers of the every-widget tests (same backend, same viewer set-up)
-mock = widgets.mock  # `sphere` and `viewer` come from conftest
-drive = widgets.drive
-
-
-def inspector_names() -> set[str]:
-    return {
-        n
-        for n in scene.INSPECTOR
-        if ps.has_curve_network(n) or ps.has_point_cloud(n) or ps.has_surface_mesh(n)
-    }
-
-
-class FakeClock:
-    def __init__(self) -> None:
-        self.t = 0.0
-
-    def __call__(self) -> float:
-        return self.t
-
-
-def drive_inspector(viewer) -> None:
-    """Every inspector widget with good and bad values (also run by the every-widget tour)."""
-    viewer.set_panel("onering")
-    drive(viewer, "vertex", 7)
-    ins = viewer.panels["onering"].state.inspection
-    assert ins is not None and ins.vertex == 7
-    assert {scene.INSPECT_WEIGHTS, scene.INSPECT_ARCS, scene.INSPECT_CELL} <= inspector_names()
-    drive(viewer, "area kind", "voronoi")
-    assert (
-        viewer.state.curv.area == "voronoi"
-        and viewer.panels["onering"].state.inspection.area_kind == "voronoi"
-    )
-    cell = ps.get_surface_mesh(scene.INSPECT_CELL)
-    assert cell.n_faces() >= 2 * len(ins.faces)  # circumcentre paths on the acute sphere
-    for bad in ("", "nonsense", "VORONOI"):
-        drive(viewer, "area kind", bad)
-        assert viewer.state.curv.area == "voronoi" and "area kind" in viewer.state.errors["onering"]
-    drive(viewer, "area kind", "barycentric")
-    assert (
-        viewer.panels["onering"].state.inspection.area_kind == "barycentric"
-        and "onering" not in viewer.state.errors
-    )
-    for rule in ("zero", "2pi", "pi"):
-        drive(viewer, "boundary rule", rule)
-        assert (
-            viewer.state.curv.boundary
-            == rule
-            == viewer.panels["onering"].state.inspection.boundary_rule
-        )
-    for bad in ("", "4pi", "-1"):
-        drive(viewer, "boundary rule", bad)
-        assert (
-            viewer.state.curv.boundary == "pi" and "boundary rule" in viewer.state.errors["onering"]
-        )
-    drive_hover(viewer)
-
-
-def drive_hover(viewer) -> None:
-    panel = viewer.panels["onering"]
-    panel.clock, panel.throttle = (clock := FakeClock()), HoverThrottle()
-    picks0 = panel.picks
-    for _ in range(3):  # over nothing: one pick once the cursor rests, then idle
-        drive(viewer, "hover", (5.0, 5.0))
-        clock.t += 0.1
-    assert panel.picks == picks0 + 1 and panel.hovered == ""
-    for x in (6.0, 7.0, 8.0):  # moving: no picking
-        drive(viewer, "hover", (x, 5.0))
-        clock.t += 0.05
-    assert panel.picks == picks0 + 1
-    drive(viewer, "hover", (-1e9, 1e9))  # off-screen: no hit, no error
-    clock.t += 0.1
-    drive(viewer, "hover", (-1e9, 1e9))
-    assert panel.picks == picks0 + 2 and panel.hovered == ""
-    assert "labels" not in viewer.state.errors
+from tests.support.drivers.onering import drive_inspector, inspector_names  # noqa: E402
+from tests.support.widgets import FakeClock, drive  # noqa: E402
 
 
 def test_inspector_widgets(viewer):

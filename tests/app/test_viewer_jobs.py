@@ -12,7 +12,8 @@ import meshlap_app.state.mesh as mesh_module
 import polyscope as ps
 import pytest
 from meshlap_app.jobs import call_hooked
-from test_viewer_widgets import drive, frames
+
+from tests.support.widgets import drive, frames
 
 
 @pytest.fixture

@@ -1,6 +1,6 @@
 """The click protocol: every panel's ``pick`` hook gets a :class:`~meshlap_app.panels.base.Pick`
 with the modifier keys held (scripted clicks on polyscope's openGL_mock; the real keys are
-read from imgui, see ``tests/test_window_diffusion.py`` for a shift-click in a window)."""
+read from imgui, see ``tests/window/test_diffusion.py`` for a shift-click in a window)."""
 
 from __future__ import annotations
 
@@ -12,7 +12,8 @@ import pytest
 ps = pytest.importorskip("polyscope")
 
 from meshlap_app.panels.base import Pick  # noqa: E402
-from test_viewer_widgets import frames  # noqa: E402
+
+from tests.support.widgets import frames  # noqa: E402
 
 
 @pytest.fixture(scope="module")

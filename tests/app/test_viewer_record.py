@@ -27,32 +27,18 @@ from meshlap_core.errors import MeshError  # noqa: E402
 from meshlap_core.frames import caption_box  # noqa: E402
 from meshlap_core.io import save_mesh  # noqa: E402
 from meshlap_core.surfaces import normal_curvature  # noqa: E402
-
-RECORD_WIDGETS = ("record file", "record", "stop")
+from tests.support.drivers.record import (  # noqa: E402
+    RECORD_WIDGETS,
+    Clock,
+    basis,
+    drive_record_widgets,
+    tick,
+)
 
 
 @pytest.fixture(scope="module")
 def mock(polyscope_mock):
     return polyscope_mock
-
-
-def tick(viewer, label: str | None = None, value=None) -> None:
-    """One frame; ``label`` gets ``value`` (the record header is opened for its widgets)."""
-    if label is not None:
-        viewer.ui.script(label, value)
-        if label in RECORD_WIDGETS:
-            viewer.ui.script(RECORD_HEADER, True)
-    ps.frame_tick()
-    assert not viewer.ui.pending(), f"widget {label!r} was not drawn"
-    internal = {k: m for k, m in viewer.state.errors.items() if "internal error" in m}
-    assert not internal, internal
-
-
-def basis(viewer, k: int) -> None:
-    st = viewer.panels["spectral"].state
-    st.k_request = k
-    st.start(viewer.state.mesh.V, viewer.state.mesh.F, background=False)
-    tick(viewer)
 
 
 def read_gif(path) -> tuple[list[np.ndarray], int]:
@@ -72,16 +58,6 @@ def assert_captioned_and_distinct(frames: list[np.ndarray]) -> None:
         assert (f[y0:y1].sum(axis=2) < 200).sum() > 30  # text on the band
     for a, b in itertools.pairwise(frames):
         assert not np.array_equal(a, b)
-
-
-class Clock:
-    """A clock the test moves (seconds)."""
-
-    def __init__(self) -> None:
-        self.now = 100.0
-
-    def __call__(self) -> float:
-        return self.now
 
 
 # ---------------------------------------------------------------- Spectral: play and record
@@ -299,38 +275,6 @@ def test_cli_theta_frames_draw_with_the_panel(viewer):
 
 
 # ---------------------------------------------------------------- the every-widget tour
-def drive_record_widgets(viewer, tmp_path) -> None:
-    """Good and bad values for the play, θ and record widgets; ``test_every_widget_is_driven``
-    in ``test_viewer_widgets.py`` runs this too."""
-    viewer.set_panel("spectral")
-    basis(viewer, 8)
-    st = viewer.panels["spectral"].state
-    tick(viewer, "play what", "nonsense")
-    assert "nonsense" in viewer.state.errors["spectral"]
-    tick(viewer, "play what", "modes")
-    st.clock = Clock()
-    tick(viewer, "play", True)
-    tick(viewer, "pause", True)
-    tick(viewer, "play what", "k sweep")
-    viewer.set_panel("surfaces")
-    tick(viewer)
-    tick(viewer, "section theta", 30.0)
-    tick(viewer, "section theta", "nan")
-    assert (
-        viewer.panels["surfaces"].state.section_deg == 30.0
-        and "theta" in viewer.state.errors["surfaces"]
-    )
-    tick(viewer, "turn", True)
-    tick(viewer, "pause turn", True)
-    assert not viewer.panels["surfaces"].state.turning
-    tick(viewer, "record file", "bad.avi")
-    tick(viewer, "record", True)
-    assert ".avi" in viewer.state.errors["surfaces"]
-    tick(viewer, "record file", str(tmp_path / "tour.gif"))
-    tick(viewer, "record", True)
-    tick(viewer, "section theta", 60.0)
-    tick(viewer, "stop", True)
-    assert Image.open(tmp_path / "tour.gif").n_frames == 2
 
 
 def test_record_widgets_have_tooltips(viewer, tmp_path):
@@ -362,7 +306,7 @@ EGL_SCRIPT = textwrap.dedent(
     from meshlap_app.scene import save_screenshot
     from meshlap_app.state import AppState, CurvatureState, MeshState
     from meshlap_app.viewer import Viewer, init_polyscope
-    from scripted_ui import ScriptedUI
+    from tests.support.scripted_ui import ScriptedUI
 
     mesh_path, out = Path(sys.argv[1]), Path(sys.argv[2])
     init_polyscope("openGL3_egl")

@@ -22,16 +22,14 @@ from meshlap_core.io import save_mesh
 
 ps = pytest.importorskip("polyscope")
 
-import test_viewer_widgets as widgets  # noqa: E402
 from meshlap_app import scene  # noqa: E402
 from meshlap_app.panels.onering import NEGATIVE_RGBA  # noqa: E402
 from meshlap_app.state.onering import HoverThrottle  # noqa: E402
 from meshlap_app.text_numbers import sig  # noqa: E402
-from scripted_ui import ScriptedUI, TableRecord  # noqa: E402
-from test_viewer_inspector import FakeClock, perturbed_grid  # noqa: E402
 
-mock = widgets.mock  # `sphere` and `viewer` come from conftest
-drive = widgets.drive
+from tests.support.meshes import perturbed_grid  # noqa: E402
+from tests.support.scripted_ui import ScriptedUI, TableRecord  # noqa: E402
+from tests.support.widgets import FakeClock, drive  # noqa: E402
 
 VERTEX = 54  # the README's inspector vertex: two negative weights (rows 65 and 43)
 
@@ -230,7 +228,7 @@ import polyscope as ps
 from meshlap_app import scene
 from meshlap_app.state import AppState, CurvatureState, MeshState
 from meshlap_app.viewer import Viewer, init_polyscope
-from scripted_ui import ScriptedUI
+from tests.support.scripted_ui import ScriptedUI
 
 mesh = MeshState(); assert mesh.load(Path(sys.argv[1]))
 init_polyscope("openGL3_egl")

@@ -1,21 +1,17 @@
 """Every widget of every panel, driven through the UI adapter on polyscope's openGL_mock backend.
 
-The adapter (``meshlap_app.ui.UI``, as the tests' ``ScriptedUI`` in ``tests/scripted_ui.py``)
+The adapter (``meshlap_app.ui.UI``, as the tests' ``ScriptedUI`` in
+``tests/support/scripted_ui.py``)
 calls the real ``polyscope.imgui`` each frame and lets a test say what a widget returns on that
 frame ("combo ``field`` returns ``gaussian``", "field ``lambda`` receives ``0``, then ``0.5``").
 Each widget gets good values and bad ones (empty, 0, negative, NaN, 1e309, out of range): the
 session never ends, bad input is shown in red in its panel and the last good state stays.
 ``test_every_widget_is_driven`` runs ``drive_panel_<name>(viewer, tmp_path)`` of every registered
-panel (each panel's test module defines its own) and fails when a panel draws a widget that no
-driver drives.
+panel (each panel's driver is ``tests/support/drivers/<name>.py``) and fails when a panel draws a
+widget that no driver drives.
 """
 
 from __future__ import annotations
-
-import importlib
-import time
-from collections.abc import Callable
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -23,44 +19,27 @@ import pytest
 ps = pytest.importorskip("polyscope")
 
 from meshlap_app.ui import EXPECTED, UIApiMismatch, check_return  # noqa: E402
-from meshlap_app.viewer import Viewer  # noqa: E402
-from scripted_ui import parse_number  # noqa: E402
 
-from meshlap_core import primitives  # noqa: E402
-from meshlap_core.io import load_mesh, save_mesh  # noqa: E402
-
-BAD_NUMBERS = ["", "0", "-1", "nan", "1e309", "abc"]
-
-
-@pytest.fixture(scope="module")
-def mock(polyscope_mock):
-    return polyscope_mock
-
-
-def frames(viewer: Viewer, n: int = 1) -> None:
-    """Run ``n`` frames; no exception may end the session and nothing may be an internal error."""
-    for _ in range(n):
-        ps.frame_tick()
-    internal = {k: m for k, m in viewer.state.errors.items() if "internal error" in m}
-    assert not internal, internal
-
-
-def drive(viewer: Viewer, label: str, *values, panel: str | None = None) -> None:
-    """Give widget ``label`` one value per frame (with the Export header open if needed)."""
-    for value in values:
-        if panel is not None:
-            viewer.set_panel(panel)
-        viewer.ui.script(label, value)
-        if label in EXPORT_WIDGETS:
-            viewer.ui.script("Export", True)
-        if label in HELP_WIDGETS:
-            viewer.ui.script("Help and window (H)", True)
-        frames(viewer)
-        assert not viewer.ui.pending(), f"widget {label!r} was not drawn"
-
-
-EXPORT_WIDGETS = ("folder", "screenshot", "export what is shown")
-HELP_WIDGETS = ("polyscope's own panels", "UI scale")
+from tests.support.drivers import panel_drivers  # noqa: E402
+from tests.support.drivers.curvature import drive_curvature_widgets  # noqa: E402
+from tests.support.drivers.export import drive_export_writes_what_is_on_screen  # noqa: E402
+from tests.support.drivers.help import drive_help_widgets, drive_shortcuts  # noqa: E402
+from tests.support.drivers.host import (  # noqa: E402
+    drive_click_and_drop,
+    drive_view_combo_switches_every_panel,
+)
+from tests.support.drivers.isolines import drive_isolines  # noqa: E402
+from tests.support.drivers.mesh_info import drive_mesh_panel_list_path_and_bad_files  # noqa: E402
+from tests.support.drivers.onering import drive_onering_widgets  # noqa: E402
+from tests.support.drivers.record import drive_record_widgets  # noqa: E402
+from tests.support.drivers.smoothing import (  # noqa: E402
+    drive_smoothing_lambda_typed_keeps_the_mesh,
+    drive_smoothing_widgets,
+)
+from tests.support.drivers.spectral import drive_spectral_widgets  # noqa: E402
+from tests.support.drivers.surfaces import drive_surfaces_widgets  # noqa: E402
+from tests.support.scripted_ui import parse_number  # noqa: E402
+from tests.support.widgets import drive, frames, sphere_file  # noqa: E402
 
 
 # ---------------------------------------------------------------- the adapter itself
@@ -159,167 +138,36 @@ def test_parse_number_reads_like_imgui():
 
 # ---------------------------------------------------------------- the Mesh panel and view
 def test_mesh_panel_list_path_and_bad_files(viewer, tmp_path, sphere):
-    drive(viewer, "bundled / shared", "assets/bumpy.obj")
-    assert viewer.state.mesh.name == "bumpy.obj"
-    assert ps.get_surface_mesh("mesh").n_vertices() == len(viewer.state.mesh.V)
-    n = len(viewer.state.mesh.V)
-    bad = tmp_path / "broken.off"
-    bad.write_text("OFF\n10 5 0\n0 0 0\n")
-    for text in ("", str(tmp_path / "missing.obj"), str(bad), str(tmp_path)):
-        viewer.panels["mesh_info"].path_text = text
-        drive(viewer, "Open", True)
-        assert len(viewer.state.mesh.V) == n  # the last good mesh stays
-    assert viewer.state.mesh.error  # said in the Mesh panel
-    drive(viewer, "path", str(sphere))  # Enter in the path field opens it
-    assert viewer.state.mesh.name == "sphere.obj" and not viewer.state.mesh.error
-    # the recent-files entry appears in the list and opens the file again
-    drive(viewer, "bundled / shared", "assets/bumpy.obj", "recent: sphere.obj")
-    assert viewer.state.mesh.name == "sphere.obj"
-    viewer.ui.script("bundled / shared", "no such mesh")
-    ps.frame_tick()
-    assert "not in the list" in viewer.state.errors["mesh_info"]
+    drive_mesh_panel_list_path_and_bad_files(viewer, tmp_path, sphere)
 
 
 def test_view_combo_switches_every_panel(viewer):
-    for panel in ("onering", "spectral", "smoothing", "surfaces", "curvature"):
-        drive(viewer, "view", panel)
-        assert viewer.state.panel == panel
-    viewer.ui.script("view", "nonsense")
-    ps.frame_tick()
-    assert viewer.state.panel == "curvature" and "nonsense" in viewer.state.errors["view"]
+    drive_view_combo_switches_every_panel(viewer)
 
 
 # ---------------------------------------------------------------- Curvature
 def test_curvature_widgets(viewer):
-    c = viewer.state.curv
-    drive(viewer, "field", "gaussian")
-    assert c.field_name == "gaussian"
-    drive(viewer, "area", "voronoi")
-    assert c.area == "voronoi" and "gaussian" in c.fields
-    drive(viewer, "boundary rule", "pi")
-    for good in (5.0, 0.0, 49.0):
-        drive(viewer, "clip %", good)
-        assert c.percentile == good
-    drive(viewer, "clip %", 80.0, -3.0)  # out of range (Ctrl+click types any value): clamped
-    assert c.percentile == 0.0
-    drive(viewer, "clip %", "nan", "1e309")
-    assert c.percentile == 0.0 and "clip %" in viewer.state.errors["curvature"]
-    drive(viewer, "side by side", True)
-    assert ps.has_surface_mesh("mesh (second estimator)")
-    drive(viewer, "second field", "k1")
-    assert viewer.state.curv.second_field == "k1"
-    drive(viewer, "side by side", False)
-    assert not ps.has_surface_mesh("mesh (second estimator)")
-    lo, hi = c.color_range("gaussian")
-    assert lo < hi and np.isfinite(lo)
+    drive_curvature_widgets(viewer)
 
 
 # ---------------------------------------------------------------- One-ring
 def test_onering_widgets(viewer):
-    viewer.set_panel("onering")
-    drive(viewer, "vertex", 7)
-    assert (
-        viewer.panels["onering"].state.vertex == 7 and viewer.panels["onering"].state.valence >= 5
-    )
-    before = list(viewer.panels["onering"].state.neighbors)
-    for bad in ["", "-1", "nan", "1e309", "abc", str(len(viewer.state.mesh.V)), 10**9]:
-        drive(viewer, "vertex", bad)
-        assert viewer.panels["onering"].state.vertex == 7  # the selection stays
-        assert "vertex" in viewer.state.errors["onering"]
-    drive(viewer, "clockwise (reverse)", True)
-    assert viewer.panels["onering"].state.neighbors == before[::-1]
-    drive(viewer, "clockwise (reverse)", False)
-    assert (
-        viewer.panels["onering"].state.neighbors == before and "onering" not in viewer.state.errors
-    )
+    drive_onering_widgets(viewer)
 
 
 # ---------------------------------------------------------------- Spectral
-def wait_for_basis(viewer: Viewer) -> None:
-    st = viewer.panels["spectral"].state
-    t0 = time.monotonic()
-    while st.busy:
-        assert time.monotonic() - t0 < 300, "the eigen worker never finished"
-        time.sleep(0.02)
-    frames(viewer, 2)  # the panel adopts the finished basis
-
-
 def test_spectral_widgets(viewer):
-    viewer.set_panel("spectral")
-    st = viewer.panels["spectral"].state
-    n = len(viewer.state.mesh.V)
-    drive(viewer, "modes to compute", 30)
-    assert st.k_request == 30
-    for bad in ("", "nan", "1e309", "abc"):
-        drive(viewer, "modes to compute", bad)
-        assert st.k_request == 30
-    drive(viewer, "modes to compute", -5, 0, 10**9)  # clamped to [2, n]
-    assert st.k_request == n
-    drive(viewer, "modes to compute", 30)
-    drive(viewer, "compute eigenbasis", True)
-    wait_for_basis(viewer)
-    assert st.basis is not None and st.basis.k_max == 30
-    assert ps.has_surface_mesh("reconstruction")
-    drive(viewer, "eigenmode i", 3)
-    _, lam = st.eigenfunction()
-    assert st.mode == 3 and lam == pytest.approx(st.basis.eigenvalues[3])
-    drive(viewer, "eigenmode i", -1, 10**6)
-    assert st.mode == 29  # clamped
-    drive(viewer, "k (reconstruct)", 12)
-    assert st.k == 12
-    np.testing.assert_allclose(st.reconstruction, st.basis.reconstruct(12))
-    drive(viewer, "k (reconstruct)", 0, 10**6, "nan")
-    assert st.k == 30 and "k (reconstruct)" in viewer.state.errors["spectral"]
+    drive_spectral_widgets(viewer)
 
 
 # ---------------------------------------------------------------- Smoothing
 def test_smoothing_lambda_typed_keeps_the_mesh(viewer):
     """The crash of issue 13: typing ``0.5`` passes through ``0``; nothing may end the session."""
-    viewer.set_panel("smoothing")
-    st = viewer.panels["smoothing"].state
-    frames(viewer)
-    drive(viewer, "noise alpha", 0.01)
-    drive(viewer, "step", True, True, True)
-    smoother, V = st.smoother, np.array(st.V)
-    assert smoother.iteration == 3
-    for bad in BAD_NUMBERS:
-        drive(viewer, "lambda", bad)
-        assert st.lam == 0.5 and "lambda" in viewer.state.errors["smoothing"]
-    drive(viewer, "lambda", "0.25")
-    assert st.lam == 0.25 and "smoothing" not in viewer.state.errors
-    # a λ edit keeps the current mesh, its noise and the iteration count (set_lam only)
-    assert st.smoother is smoother and smoother.lam == 0.25 and smoother.iteration == 3
-    np.testing.assert_array_equal(st.V, V)
+    drive_smoothing_lambda_typed_keeps_the_mesh(viewer)
 
 
 def test_smoothing_widgets(viewer):
-    viewer.set_panel("smoothing")
-    st = viewer.panels["smoothing"].state
-    frames(viewer)
-    for method in ("explicit", "taubin", "implicit"):
-        drive(viewer, "method", method)
-        assert st.smoother.method == method
-    drive(viewer, "Laplacian", "cotan")
-    assert st.smoother.laplacian == "cotan"
-    drive(viewer, "noise alpha", 0.02)
-    assert st.noise_alpha == 0.02
-    start = np.array(st.V_start)
-    for bad in ("nan", "1e309", -0.5):
-        drive(viewer, "noise alpha", bad)
-        assert st.noise_alpha == 0.02 and "alpha" in viewer.state.errors["smoothing"]
-        np.testing.assert_array_equal(st.V_start, start)
-    drive(viewer, "noise seed", 3)
-    assert st.seed == 3
-    for bad in (-1, "", "1e309", "abc"):
-        drive(viewer, "noise seed", bad)
-        assert st.seed == 3
-    drive(viewer, "play", True)
-    assert st.playing
-    frames(viewer, 3)
-    drive(viewer, "pause", True)
-    assert not st.playing and st.smoother.iteration >= 3
-    drive(viewer, "reset", True)
-    assert st.smoother.iteration == 0
+    drive_smoothing_widgets(viewer)
 
 
 def test_diverging_explicit_run_stops_with_the_stable_lambda(viewer):
@@ -341,50 +189,12 @@ def test_diverging_explicit_run_stops_with_the_stable_lambda(viewer):
 
 # ---------------------------------------------------------------- Surfaces
 def test_surfaces_widgets(viewer):
-    viewer.set_panel("surfaces")
-    s = viewer.panels["surfaces"].state
-    frames(viewer)
-    drive(viewer, "surface", "torus")
-    assert s.name == "torus" and ps.has_surface_mesh("surface")
-    drive(viewer, "resolution", 24)
-    assert s.res == 24 and s.mesh is not None
-    for bad in (0, -3, 2, 10**6, "", "nan", "1e309"):
-        drive(viewer, "resolution", bad)
-        assert s.res == 24 and viewer.state.errors["surfaces"]
-    drive(viewer, "u", 1.0)
-    drive(viewer, "v", 0.5)
-    assert (s.u, s.v) == (1.0, 0.5)
-    _, u1, _, _ = s.domain
-    drive(viewer, "u", u1 + 10.0)  # out of range: clamped into the domain
-    assert s.u == u1
-    for bad in ("nan", "1e309"):
-        drive(viewer, "v", bad)
-        assert s.v == 0.5
+    drive_surfaces_widgets(viewer)
 
 
 # ---------------------------------------------------------------- Export
 def test_export_writes_what_is_on_screen(viewer, tmp_path):
-    out = tmp_path / "out"
-    out.mkdir()
-    drive(viewer, "folder", str(tmp_path / "does-not-exist"))
-    assert "export folder" in viewer.state.errors["export"]
-    drive(viewer, "folder", str(out))
-    assert viewer.state.folder == out.resolve()
-    # smoothing: the smoothed mesh as it is now, not the original vertices
-    viewer.set_panel("smoothing")
-    frames(viewer)
-    drive(viewer, "step", True, True)
-    drive(viewer, "export what is shown", True)
-    status = viewer.panels["export"].status
-    assert str(out.resolve()) in status
-    st = viewer.panels["smoothing"].state
-    name = f"sphere_{st.method}_{st.laplacian}_it{st.smoother.iteration}.ply"
-    assert status == f"wrote {name} in {out.resolve()}"
-    back = load_mesh(out / name)
-    np.testing.assert_allclose(back.V, st.V, atol=1e-6)
-    assert not np.allclose(back.V, viewer.state.mesh.V, atol=1e-6)
-    drive(viewer, "screenshot", True)
-    assert (out / "sphere_smoothing.png").is_file()
+    drive_export_writes_what_is_on_screen(viewer, tmp_path)
 
 
 def test_internal_error_is_shown_and_logged_once(viewer, capsys, monkeypatch):
@@ -406,75 +216,15 @@ def test_internal_error_is_shown_and_logged_once(viewer, capsys, monkeypatch):
 
 # ---------------------------------------------------------------- Help, shortcuts, mouse, drop
 def test_help_widgets(viewer):
-    help_panel = viewer.panels["help"]
-    frames(viewer)
-    before = help_panel.shown
-    drive(viewer, "key h", True)
-    frames(viewer)  # the header follows on the next frame
-    assert help_panel.shown == (not before)
-    drive(viewer, "polyscope's own panels", True)
-    assert help_panel.polyscope_panels
-    drive(viewer, "polyscope's own panels", False)
-    drive(viewer, "UI scale", 1.5)
-    assert viewer.state.ui_scale == 1.5 and viewer.ui.scale == 1.5
-    drive(viewer, "UI scale", 10.0)
-    assert viewer.state.ui_scale == 3.0  # clamped
-    for bad in ("nan", -1.0, "1e309"):
-        drive(viewer, "UI scale", bad)
-        assert viewer.state.ui_scale == 3.0 and "UI scale" in viewer.state.errors["help"]
-    drive(viewer, "UI scale", 1.0)
-    drive(viewer, "key h", True)
-    frames(viewer)
-    assert help_panel.shown == before
+    drive_help_widgets(viewer)
 
 
 def test_shortcuts(viewer):
-    from meshlap_app.registry import VIEWS as PANELS
-
-    for i, panel in enumerate(PANELS):
-        drive(viewer, f"key {i + 1}", True)
-        assert viewer.state.panel == panel
-    drive(viewer, "key 4", True)  # smoothing
-    st = viewer.panels["smoothing"].state
-    it0 = st.smoother.iteration
-    drive(viewer, "key right", True, True)
-    assert st.smoother.iteration == it0 + 2
-    drive(viewer, "key space", True)
-    assert st.playing
-    drive(viewer, "key space", True)
-    assert not st.playing
-    drive(viewer, "key r", True)
-    assert st.smoother.iteration == 0
-    drive(viewer, "key 3", True)  # spectral: arrows move k once a basis exists
-    spec = viewer.panels["spectral"].state
-    spec.k_request = 12
-    spec.start(viewer.state.mesh.V, viewer.state.mesh.F, background=False)
-    frames(viewer)
-    spec.set_k(5)
-    drive(viewer, "key right", True)
-    assert spec.k == 6
-    drive(viewer, "key left", True, True)
-    assert spec.k == 4
-    drive(viewer, "key f", True)
-    assert not viewer.reframe  # framed at the end of that frame
-    drive(viewer, "key 1", True)
-    drive(viewer, "key r", True)  # outside the smoothing panel: re-frame the camera
+    drive_shortcuts(viewer)
 
 
 def test_click_and_drop(viewer, tmp_path, sphere):
-    before = viewer.panels["onering"].state.vertex
-    drive(viewer, "click", (10.0, 10.0), (-5.0, 1e9))  # nothing there: nothing happens
-    assert viewer.panels["onering"].state.vertex == before
-    bad = tmp_path / "bad.obj"
-    bad.write_text("v 0 0 0\nf 1 2 3\n")
-    n = len(viewer.state.mesh.V)
-    viewer.files_dropped([str(bad)])
-    assert "bad.obj" in viewer.state.mesh.error and len(viewer.state.mesh.V) == n
-    viewer.files_dropped([])
-    viewer.files_dropped([str(tmp_path / "assets_missing.ply")])
-    frames(viewer)
-    viewer.files_dropped([str(sphere)])
-    assert viewer.state.mesh.name == "sphere.obj" and not viewer.state.mesh.error
+    drive_click_and_drop(viewer, tmp_path, sphere)
 
 
 def test_captions_name_what_is_side_by_side(viewer):
@@ -491,94 +241,20 @@ def test_captions_name_what_is_side_by_side(viewer):
 
 
 # ---------------------------------------------------------------- coverage
-def panel_drivers() -> dict[str, Callable[..., None]]:
-    """``drive_panel_<name>(viewer, tmp_path)`` of every registered panel, found in the test
-    module that defines it (``tests/test_*.py``): a new panel brings its driver in its own test
-    file and this tour runs it, without a line here. KeyError names a panel without one."""
-    from meshlap_app.registry import REGISTRY
-
-    sources = {p.stem: p.read_text() for p in sorted(Path(__file__).parent.glob("test_*.py"))}
-    drivers: dict[str, Callable[..., None]] = {}
-    for entry in REGISTRY:
-        name = f"drive_panel_{entry.name}"
-        homes = [stem for stem, text in sources.items() if f"\ndef {name}(" in text]
-        if len(homes) != 1:
-            raise KeyError(f"{entry.name}: {name} is defined in {homes or 'no test module'}")
-        drivers[entry.name] = getattr(importlib.import_module(homes[0]), name)
-    return drivers
-
-
 def test_every_panel_has_one_driver():
     from meshlap_app.registry import REGISTRY
 
     assert list(panel_drivers()) == [e.name for e in REGISTRY]
 
 
-def sphere_file(folder: Path) -> Path:
-    """An icosphere (level 2) written to ``folder`` (the ``sphere`` fixture's mesh)."""
-    path = folder / "sphere.obj"
-    if not path.is_file():
-        save_mesh(path, *primitives.icosphere(2))
-    return path
-
-
-def drive_panel_mesh_info(viewer, tmp_path: Path) -> None:
-    """The mesh section: the list, the path field and bad files."""
-    test_mesh_panel_list_path_and_bad_files(viewer, tmp_path, sphere_file(tmp_path))
-
-
-def drive_panel_curvature(viewer, tmp_path: Path) -> None:
-    test_view_combo_switches_every_panel(viewer)
-    test_curvature_widgets(viewer)
-    from test_curvature_lab import drive_curvature_estimator  # estimator, shape operator
-
-    drive_curvature_estimator(viewer)
-
-
-def drive_panel_onering(viewer, tmp_path: Path) -> None:
-    test_onering_widgets(viewer)
-    from test_viewer_inspector import drive_inspector  # the inspector's widgets
-
-    drive_inspector(viewer)
-
-
-def drive_panel_spectral(viewer, tmp_path: Path) -> None:
-    test_spectral_widgets(viewer)
-
-
-def drive_panel_smoothing(viewer, tmp_path: Path) -> None:
-    test_smoothing_widgets(viewer)
-    test_smoothing_lambda_typed_keeps_the_mesh(viewer)
-
-
-def drive_panel_surfaces(viewer, tmp_path: Path) -> None:
-    test_surfaces_widgets(viewer)
-
-
-def drive_panel_export(viewer, tmp_path: Path) -> None:
-    test_export_writes_what_is_on_screen(viewer, tmp_path)
-
-
-def drive_panel_help(viewer, tmp_path: Path) -> None:
-    test_help_widgets(viewer)
-    test_shortcuts(viewer)
-    from test_session import drive_session_widgets  # the session widgets (Help and window)
-
-    drive_session_widgets(viewer, tmp_path)
-
-
 def test_every_widget_is_driven(viewer, tmp_path):
     """Run every registered panel's driver on one adapter, then the widgets every panel shares
     (play/record, isolines): every widget label drawn must have been scripted."""
-    for drive in panel_drivers().values():
-        drive(viewer, tmp_path)
-    from test_viewer_record import drive_record_widgets  # play, θ and record widgets
-
-    drive_record_widgets(viewer, tmp_path)
-    from test_isolines import drive_isolines  # every view's isoline toggle and count
-
-    drive_isolines(viewer)
-    test_click_and_drop(viewer, tmp_path, sphere_file(tmp_path))  # a pick, a dropped file
+    for driver in panel_drivers().values():
+        driver(viewer, tmp_path)
+    drive_record_widgets(viewer, tmp_path)  # play, θ and record widgets
+    drive_isolines(viewer)  # every view's isoline toggle and count
+    drive_click_and_drop(viewer, tmp_path, sphere_file(tmp_path))  # a pick, a dropped file
     ui = viewer.ui
     undriven = sorted(set(ui.seen) - ui.driven)
     assert not undriven, f"widgets no test drives: {undriven}"

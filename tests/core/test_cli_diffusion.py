@@ -166,8 +166,8 @@ def test_several_components_are_unreachable_and_null_in_json(capsys, tmp_path):
     assert np.all(np.isinf(np.load(tmp_path / "d.npy")[len(V) :]))
 
 
-# ---------------------------------------------------------------- hostile inputs (tests/hostile.py)
-import hostile  # noqa: E402
+# ------------------------------------------------------- hostile inputs (tests/support/hostile.py)
+from tests.support import hostile  # noqa: E402
 
 DIFFUSION_ARGV = {
     "geodesic": lambda m, out: ["geodesic", m, "--vertex", 0, "--json", "--out", out / "d.npy"],

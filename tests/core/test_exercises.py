@@ -8,7 +8,6 @@ module (``checked``), and every test reads its verdicts.
 from __future__ import annotations
 
 import ast
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -25,8 +24,7 @@ from meshlap_core.exercises.meshes import Case, battery, case_named
 from meshlap_core.exercises.tasks import TASKS
 from meshlap_core.options import EXERCISE_TASKS
 from meshlap_core.topology.rings import one_ring
-
-STUDENTS = Path(__file__).parent / "exercises"
+from tests.support.students import STUDENTS
 
 WRONG = [  # (student file, task, the diagnosis it must get)
     ("wrong_uniform_sign", "uniform_laplacian", "sign_flip"),

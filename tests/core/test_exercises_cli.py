@@ -7,14 +7,12 @@ import io
 import json
 import shutil
 import xml.etree.ElementTree as ET
-from pathlib import Path
 
 import pytest
 
 from meshlap_core.cli import main
 from meshlap_core.options import EXERCISE_TASKS
-
-STUDENTS = Path(__file__).parent / "exercises"
+from tests.support.students import STUDENTS
 
 
 def test_init_writes_the_template_and_never_overwrites(tmp_path, capsys):

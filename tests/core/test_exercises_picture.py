@@ -109,6 +109,6 @@ def test_without_the_viewer_the_picture_says_so(two_wrong, monkeypatch):
 
 
 def test_a_passing_result_has_no_map(tmp_path):
-    path = Path(__file__).parent / "exercises" / "right_vectorized.py"
+    path = Path(__file__).parents[1] / "exercises" / "right_vectorized.py"
     pic = check_file(path, ["one_ring"]).picture()
     assert pic.renderer == "none" and pic.reason == "" and pic.png[:8] == PNG

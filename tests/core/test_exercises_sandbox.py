@@ -13,8 +13,7 @@ import pytest
 
 from meshlap_core.exercises import check_file
 from meshlap_core.exercises.diagnose import DIAGNOSES
-
-STUDENTS = Path(__file__).parent / "exercises"
+from tests.support.students import STUDENTS
 
 FENCED = [  # (student file, task, status, diagnosis, the line of the file named in its traceback)
     ("hostile_window", "uniform_laplacian", "import_error", "opens_window", "import polyscope"),

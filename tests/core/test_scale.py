@@ -141,7 +141,7 @@ def test_info_names_the_solver_backend(monkeypatch, spd_backend, capsys):
 
     from meshlap_core.cli import main
 
-    path = str(__import__("pathlib").Path(__file__).resolve().parents[1] / "assets" / "bumpy.obj")
+    path = str(__import__("pathlib").Path(__file__).resolve().parents[2] / "assets" / "bumpy.obj")
     assert main(["info", path, "--json"]) == 0
     solver = json.loads(capsys.readouterr().out)["solver"]
     assert solver["backend"] == spd_backend
@@ -199,7 +199,7 @@ def test_cancel_event_already_set_stops_before_any_work():
     with pytest.raises(Cancelled, match="smoothing cancelled"):
         s.run(5, cancel=ev)
     assert s.iteration == 0
-    bumpy = __import__("pathlib").Path(__file__).resolve().parents[1] / "assets" / "bumpy.obj"
+    bumpy = __import__("pathlib").Path(__file__).resolve().parents[2] / "assets" / "bumpy.obj"
     with pytest.raises(Cancelled, match="loading cancelled"):
         load_mesh(bumpy, cancel=ev)
 
@@ -221,7 +221,7 @@ def test_smoothing_run_reports_progress_and_cancels_between_iterations():
 def test_load_mesh_reports_its_phases():
     from meshlap_core import load_mesh
 
-    bumpy = __import__("pathlib").Path(__file__).resolve().parents[1] / "assets" / "bumpy.obj"
+    bumpy = __import__("pathlib").Path(__file__).resolve().parents[2] / "assets" / "bumpy.obj"
     seen = []
     mesh = load_mesh(bumpy, progress=lambda f, m: seen.append((f, m)))
     assert [f for f, _ in seen] == [0.0, 0.1, 0.5, 1.0] and mesh.n_faces > 0

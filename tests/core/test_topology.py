@@ -2,12 +2,12 @@
 
 import itertools
 
-import hostile
 import numpy as np
 import pytest
 
 from meshlap_core import primitives, topology
 from meshlap_core.errors import MeshError
+from tests.support import hostile
 
 
 def face_set(F):

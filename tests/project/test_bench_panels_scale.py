@@ -15,7 +15,7 @@ from meshlap_core.io import save_mesh
 
 pytest.importorskip("polyscope")
 
-SCRIPT = Path(__file__).resolve().parents[1] / "benchmarks" / "bench_panels_scale.py"
+SCRIPT = Path(__file__).resolve().parents[2] / "benchmarks" / "bench_panels_scale.py"
 PANELS = {"mesh", "curvature", "onering", "spectral", "smoothing", "surfaces", "export"}
 
 

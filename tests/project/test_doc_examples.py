@@ -12,7 +12,7 @@ from pathlib import Path
 import meshlap_core
 from meshlap_core import options
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_package_docstring_example_runs():

@@ -7,7 +7,7 @@ import pytest
 
 from meshlap_core import options
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 SHARED = {
     name
     for name in vars(options)

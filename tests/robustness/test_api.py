@@ -70,11 +70,11 @@ NO_MESH_ARRAYS = {
     "get_surface",
     "mesh_surface",
     "point_geometry",
-    "SpectralFilter",  # built from a SpectralBasis (tests/test_diffusion.py)
+    "SpectralFilter",  # built from a SpectralBasis (tests/core/test_diffusion.py)
     "heat_spectral",  # a SpectralBasis and a field
     "heat_kernel_signature",  # a SpectralBasis and times
     "transfer_function",  # eigenvalues only
-    "save_polylines",  # a file of curves: tests/test_isolines.py
+    "save_polylines",  # a file of curves: tests/app/test_isolines.py
 }
 USES_V = {"rmse", "add_noise"} | {
     n for n in CALLS if n not in ("one_ring", "boundary_loops", "uniform_laplacian")

@@ -3,7 +3,7 @@
 Each run either succeeds with a correct result (repairs and warnings reported) or exits 2 with
 exactly one stderr line ``meshlap: error: <file or argument>: <problem>`` and nothing on
 stdout; no partial output file is left behind and an existing output file survives a failed
-run. The corpus is written by ``tests/hostile.py`` into ``tmp_path``. A watchdog
+run. The corpus is written by ``tests/support/hostile.py`` into ``tmp_path``. A watchdog
 (``faulthandler``) aborts the session with a stack dump should a run ever hang.
 """
 
@@ -14,7 +14,6 @@ import json
 from collections.abc import Callable
 from pathlib import Path
 
-import hostile
 import numpy as np
 import pytest
 
@@ -22,6 +21,7 @@ from meshlap_core import primitives
 from meshlap_core.cli import COMMANDS, main
 from meshlap_core.io import load_mesh, save_mesh
 from meshlap_core.topology import one_ring
+from tests.support import hostile
 
 HANG_SECONDS = 120  # far above any run here (each takes well under a second)
 SENTINEL = b"an existing file that a failed run must not touch\n"

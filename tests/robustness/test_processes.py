@@ -14,8 +14,9 @@ import subprocess
 import sys
 from pathlib import Path
 
-import hostile
 import pytest
+
+from tests.support import hostile
 
 TIMEOUT = 120  # seconds; every run here takes a few
 

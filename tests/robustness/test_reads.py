@@ -15,7 +15,6 @@ import subprocess
 import sys
 from pathlib import Path
 
-import hostile
 import numpy as np
 import pytest
 
@@ -29,6 +28,7 @@ from meshlap_core.io.reader import (
     read_input,
     read_json,
 )
+from tests.support import hostile
 
 CORE = Path(meshlap_core.__file__).parent
 READER = CORE / "io" / "reader.py"
@@ -114,7 +114,7 @@ def test_the_scan_finds_reads():
 
 
 def test_the_limits_are_stated_in_the_docs():
-    doc = (Path(__file__).parents[1] / "docs" / "bad-input.md").read_text(encoding="utf-8")
+    doc = (Path(__file__).parents[2] / "docs" / "bad-input.md").read_text(encoding="utf-8")
     assert "8 GiB" in doc and "16 MiB" in doc
     assert MESH_SIZE_LIMIT == 8 * 2**30 and JSON_SIZE_LIMIT == 16 * 2**20
     assert SIZE_LIMITS["cache file"] == 8 * 2**30

@@ -3,10 +3,10 @@ corrupt course mesh fails its section only, named, and the report is still writt
 
 from __future__ import annotations
 
-import hostile
 import pytest
 
 from meshlap_core.cli import COMMANDS, main
+from tests.support import hostile
 
 pytestmark = pytest.mark.skipif(
     "report" not in COMMANDS, reason="the report command is not registered yet"

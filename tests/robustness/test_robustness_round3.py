@@ -13,12 +13,12 @@ import subprocess
 import sys
 from pathlib import Path
 
-import hostile
 import numpy as np
 import pytest
 
 from meshlap_core import MeshError, SpectralBasis, add_noise, primitives, save_mesh
 from meshlap_core.cli import main
+from tests.support import hostile
 
 V, F = primitives.icosphere(1)
 PY = shlex.quote(sys.executable)

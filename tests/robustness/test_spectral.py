@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import json
 
-import hostile
 import numpy as np
 import pytest
 import scipy.linalg as sla
@@ -20,6 +19,7 @@ from scipy.sparse.csgraph import connected_components
 from meshlap_core.cli import COMMANDS, main
 from meshlap_core.io import load_mesh
 from meshlap_core.laplacian import cotan_stiffness, vertex_areas
+from tests.support import hostile
 
 pytestmark = pytest.mark.skipif(
     "spectral" not in COMMANDS, reason="the spectral command is not registered yet"

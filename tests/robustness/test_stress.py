@@ -17,12 +17,12 @@ import sys
 import tracemalloc
 from pathlib import Path
 
-import hostile
 import numpy as np
 import pytest
 
 from meshlap_core import primitives
 from meshlap_core.io import save_mesh
+from tests.support import hostile
 
 MB = 2**20
 

@@ -20,13 +20,13 @@ import subprocess
 import sys
 from pathlib import Path
 
-import hostile
 import numpy as np
 import pytest
 
 from meshlap_core import primitives, save_mesh
 from meshlap_core.cli import main
 from meshlap_core.errors import MeshError, MeshWarning
+from tests.support import hostile
 
 V, F = primitives.icosphere(1)
 

@@ -10,7 +10,7 @@ two headers form a *section* (section 0 starts with the first header, "Mesh" tod
 Nothing depends on pixel positions of a particular build: positions are measured on every
 screenshot, so window size, panel width and row heights may change. What the tour assumes is
 the *order* of widgets inside a section (e.g. "the first combo of the Mesh section is the mesh
-list"); that order is stated once, in ``tests/test_window.py``.
+list"); that order is stated once, in ``tests/window/test_tour.py``.
 """
 
 from __future__ import annotations

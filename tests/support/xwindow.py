@@ -36,6 +36,11 @@ import numpy as np
 TOOLS = ("Xvfb", "xdotool", "xwd")
 LIBS = ("X11", "Xdamage")  # loaded with ctypes by Frames
 
+WINDOW_TEST = True
+"""Whether the running test may open a real window: ``tests/conftest.py`` sets it before each
+test (its ``window`` marker), so an unmarked test that starts Xvfb fails instead of running
+when ``pytest -m "not window"`` was asked for the fast tiers alone."""
+
 
 def missing_tools() -> list[str]:
     """Names of the X tools (on ``PATH``) and libraries the harness needs that are missing."""
@@ -164,6 +169,8 @@ class XServer:
     proc: subprocess.Popen | None = None
 
     def start(self, timeout: float = 20.0) -> XServer:
+        if not WINDOW_TEST:
+            raise RuntimeError("a test that starts Xvfb must be marked @pytest.mark.window")
         for _ in range(5):  # another process may take the number between check and start
             n = free_display()
             self.display = f":{n}"

@@ -1,5 +1,5 @@
 """The Check panel in a real window (``meshlap view`` under Xvfb, driven with xdotool like a
-user, as ``tests/test_window.py``): its number key, a student file typed into the path field,
+user, as ``tests/window/test_tour.py``): its number key, a student file typed into the path field,
 its task picked, *check*: the difference map appears on the mesh, red around the one vertex the
 student got wrong and nowhere else in the scene.
 
@@ -10,12 +10,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from imgui_screen import parse
-from test_viewer_check import ONE_VERTEX_WRONG, _facing_vertex
-from test_window import Session, keep_shots, scene_box
-from xwindow import missing_tools
 
 from meshlap_core.options import EXERCISE_TASKS
+from tests.support.imgui_screen import parse
+from tests.support.students import ONE_VERTEX_WRONG, facing_vertex
+from tests.support.window_session import Session, keep_shots, scene_box
+from tests.support.xwindow import missing_tools
 
 CHECK_KEY = 6  # the Check panel's number key (its place among the registry's views)
 
@@ -39,7 +39,7 @@ def test_check_panel_shows_where_the_student_is_wrong(tmp_path):
 
     assert VIEWS.index("check") + 1 == CHECK_KEY
     student = tmp_path / "one_wrong.py"
-    student.write_text(ONE_VERTEX_WRONG.replace("{target}", str(_facing_vertex())))
+    student.write_text(ONE_VERTEX_WRONG.replace("{target}", str(facing_vertex())))
     s = Session((1280, 720), None, tmp_path / "window")
     try:
         layout = s.goto(CHECK_KEY, "Check")

@@ -10,9 +10,17 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from imgui_screen import COLORBAR_BOX, Layout, changed_fraction, parse, subject_mask, subject_point
-from test_window import WAIT, Session, keep_shots, scene_box
-from xwindow import missing_tools
+
+from tests.support.imgui_screen import (
+    COLORBAR_BOX,
+    Layout,
+    changed_fraction,
+    parse,
+    subject_mask,
+    subject_point,
+)
+from tests.support.window_session import WAIT, Session, keep_shots, scene_box
+from tests.support.xwindow import missing_tools
 
 DIFFUSION_KEY = "7"  # the registry's seventh view (app/registry.py)
 

@@ -2,7 +2,7 @@
 and of the Help window's table (:func:`meshlap_app.panels.help.shortcut_rows`, the rows the
 Help pane draws), each pressed with xdotool in ``meshlap view`` under Xvfb at 1280×720, in the
 view its row names (a view's number from another view; F and R after the camera was turned
-with a drag); each must change the picture. ``tests/test_issue23.py`` checks the same keys
+with a drag); each must change the picture. ``tests/app/test_issue23.py`` checks the same keys
 through the widgets (which state each one changes).
 
 Set ``MESHLAP_WINDOW_SHOTS=<folder>`` to keep the screenshots (one after each key).
@@ -14,10 +14,11 @@ import time
 from types import SimpleNamespace
 
 import pytest
-from imgui_screen import changed_fraction, parse
-from test_issue23 import readme_keys
-from test_window import WAIT, Session, keep_shots, scene_box, spectral
-from xwindow import missing_tools
+
+from tests.support.imgui_screen import changed_fraction, parse
+from tests.support.readme import readme_keys
+from tests.support.window_session import WAIT, Session, keep_shots, scene_box, spectral
+from tests.support.xwindow import missing_tools
 
 XDOTOOL = {"right": "Right", "left": "Left", "space": "space"}
 CHANGED = 5e-4  # fraction of the window's pixels a key must change (a caption: ~1e-3)

@@ -2,7 +2,7 @@
 1920×1080, the window left where the viewer put it (no ``xdotool windowmove``): the whole
 window on the screen (polyscope opened it at (20, 20), cut at the edge of a 1280×720 screen),
 meshlap's panel whole inside it, and the title naming the mesh shown. The tour
-(``tests/test_window.py``) checks that the title follows a mesh picked later.
+(``tests/window/test_tour.py``) checks that the title follows a mesh picked later.
 
 Set ``MESHLAP_WINDOW_SHOTS=<folder>`` to keep the screenshots.
 """
@@ -16,9 +16,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from imgui_screen import parse, subjects
-from test_window import meshlap_command
-from xwindow import App, XServer, missing_tools, write_png
+
+from tests.support.imgui_screen import parse, subjects
+from tests.support.window_session import meshlap_command
+from tests.support.xwindow import App, XServer, missing_tools, write_png
 
 SIZES = ((1280, 720), (1920, 1080))
 

@@ -17,7 +17,7 @@ the issue asks, on screenshots and on ``/proc``:
   without input (``utime + stime`` of ``/proc/<pid>/stat``).
 
 It takes minutes on a loaded machine (the load alone is about 5 s of CPU); it is marked
-``window`` like ``tests/test_window.py`` and runs in CI (``.ci/run``).
+``window`` like ``tests/window/test_tour.py`` and runs in CI (``.ci/run``).
 """
 
 from __future__ import annotations
@@ -29,11 +29,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from imgui_screen import changed_fraction, parse, subject_mask, subjects
-from test_window import Session
-from xwindow import missing_tools
 
-ROOT = Path(__file__).resolve().parents[1]
+from tests.support.imgui_screen import changed_fraction, parse, subject_mask, subjects
+from tests.support.window_session import Session
+from tests.support.xwindow import missing_tools
+
+ROOT = Path(__file__).resolve().parents[2]
 SOURCE = ROOT.parent / "shared" / "meshes" / "armadillo_loop.obj"
 MAX_STILL_S = 2.0
 """Longest time the screen may stay the same while the scan loads (the issue: once a second;
