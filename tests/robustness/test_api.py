@@ -62,7 +62,7 @@ NO_MESH_ARRAYS = {
     "MeshReport",
     "OneRing",  # built by one_ring
     "EdgeTable",  # built by the topology functions
-    "load_mesh",  # a file: tests/test_robustness*.py
+    "load_mesh",  # a file: the other tests of tests/robustness/
     "icosphere",
     "torus_mesh",
     "grid",

@@ -2,7 +2,7 @@
 and of the Help window's table (:func:`meshlap_app.panels.help.shortcut_rows`, the rows the
 Help pane draws), each pressed with xdotool in ``meshlap view`` under Xvfb at 1280×720, in the
 view its row names (a view's number from another view; F and R after the camera was turned
-with a drag); each must change the picture. ``tests/app/test_issue23.py`` checks the same keys
+with a drag); each must change the picture. ``tests/app/test_keys.py`` checks the same keys
 through the widgets (which state each one changes).
 
 Set ``MESHLAP_WINDOW_SHOTS=<folder>`` to keep the screenshots (one after each key).
