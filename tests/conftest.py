@@ -111,6 +111,7 @@ def viewer(polyscope_mock, sphere, tmp_path, monkeypatch):
     mesh = MeshState()
     assert mesh.load(sphere)
     v = Viewer(AppState(mesh=mesh, folder=tmp_path), ui=ScriptedUI())
+    v.set_ui_scale(v.state.ui_scale)  # polyscope's UI scale is global: not the last module's
     v.sync_mesh()
     polyscope_mock.set_user_callback(v.callback)
     yield v
