@@ -91,6 +91,12 @@ SOURCES = {
 }
 
 
+@functools.cache
+def _tree(module: str) -> ast.Module:
+    """The parsed source of ``module`` (parsed once for every rule)."""
+    return ast.parse(SOURCES[module].read_text())
+
+
 def _absolute(module: str, is_package: bool, node: ast.ImportFrom) -> str:
     """The absolute name of the module a ``from ... import ...`` statement imports from."""
     if node.level:
@@ -110,7 +116,7 @@ def _resolve(module: str, is_package: bool, node: ast.ImportFrom) -> list[str]:
 
 def _imports(module: str, *, top_level_only: bool) -> set[str]:
     path = SOURCES[module]
-    tree = ast.parse(path.read_text())
+    tree = _tree(module)
     nodes = tree.body if top_level_only else list(ast.walk(tree))
     if top_level_only:  # include imports under `if TYPE_CHECKING:` only if not guarded
         nodes = [n for n in nodes if isinstance(n, (ast.Import, ast.ImportFrom))]
@@ -185,7 +191,7 @@ def test_only_a_panels_own_files_name_it(module):
     own = {parts[-1]} if parts[1:2] in (["panels"], ["state"]) else set()
     if module == "meshlap_app.registry":
         return
-    tree = ast.parse(SOURCES[module].read_text())
+    tree = _tree(module)
     bad = [(line, s) for line, s in _strings(tree) if s in names - own]
     assert not bad, f"{module} names panels: {bad}"
 
@@ -240,7 +246,7 @@ def test_import_graph_has_no_cycle():
 def _long_functions(module: str) -> list[str]:
     """Functions of ``module`` over ``WARN_FUNCTION_LINES`` (docstring excluded) whose
     docstring does not say why."""
-    tree = ast.parse(SOURCES[module].read_text())
+    tree = _tree(module)
     long = []
     for node in ast.walk(tree):
         if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
@@ -281,13 +287,14 @@ def _inside(module: str, package: str) -> bool:
     return module == package or module.startswith(package + ".")
 
 
-def _private_imports(module: str) -> set[str]:
+@functools.cache
+def _private_imports(module: str) -> frozenset[str]:
     """The private names of other modules that ``module`` imports: ``from m import _x`` (a
     function, class or value of ``m``), or a private module (``io/_scan.py``) imported from
     outside the package that holds it (its own package's modules may)."""
     path = SOURCES[module]
     found = set()
-    for node in ast.walk(ast.parse(path.read_text())):
+    for node in ast.walk(_tree(module)):
         if isinstance(node, ast.ImportFrom):
             target = _absolute(module, path.name == "__init__.py", node)
             names = [f"{target}.{a.name}" for a in node.names]
@@ -308,7 +315,7 @@ def _private_imports(module: str) -> set[str]:
                 if not _inside(module, ".".join(parts[:i])):  # a private module, from outside
                     found.add(full)
                     break
-    return found
+    return frozenset(found)
 
 
 @pytest.mark.parametrize("module", sorted(SOURCES))
@@ -326,11 +333,12 @@ def _component(module: str) -> str:
     return ".".join(module.split(".")[:2])
 
 
-def _split_imports(module: str) -> tuple[set[str], set[str]]:
+@functools.cache
+def _split_imports(module: str) -> tuple[frozenset[str], frozenset[str]]:
     """The modules ``module`` imports at run time (in functions too) and those it imports only
     for type checking (under ``if TYPE_CHECKING:``)."""
     path = SOURCES[module]
-    tree = ast.parse(path.read_text())
+    tree = _tree(module)
     guarded: set[int] = set()
     for node in ast.walk(tree):
         if isinstance(node, ast.If) and "TYPE_CHECKING" in ast.unparse(node.test):
@@ -344,7 +352,7 @@ def _split_imports(module: str) -> tuple[set[str], set[str]]:
         else:
             continue
         (typing if id(node) in guarded else runtime).update(_internal(names) - {module})
-    return runtime, typing
+    return frozenset(runtime), frozenset(typing)
 
 
 @functools.cache
