@@ -20,8 +20,8 @@ number (the ``0`` of ``0.5``) is never applied; a click selects the whole number
 and hover calls :meth:`UI._record` once per frame after imgui drew it; its return value, when not
 ``None``, replaces what the user did on that frame. Tables call :meth:`UI._record_table`,
 :meth:`UI._record_row` and :meth:`UI._record_table_end`. Here the hooks do nothing; the tests'
-``ScriptedUI`` (``tests/scripted_ui.py``) overrides them to script widgets ("this frame, combo
-``field`` returns ``gaussian``") and to record every widget and table drawn.
+``ScriptedUI`` (``tests/support/scripted_ui.py``) overrides them to script widgets ("this
+frame, combo ``field`` returns ``gaussian``") and to record every widget and table drawn.
 """
 
 from __future__ import annotations

@@ -16,7 +16,7 @@ In one process, best of ``--repeat`` wall times. The baseline a user would write
 ``igl.principal_curvature(V, F, radius)`` (radius 2 and 5 edge rings) and
 ``igl.cotmatrix + igl.massmatrix + igl.gaussian_curvature`` for cotangent H and K. The ratio
 column is our time over libigl's quadric fit at radius 5. The torus also reports the relative L2
-error of H against the exact value (its noise-free mesh; see tests/test_curvature_estimators.py
+error of H against the exact value (its noise-free mesh; see tests/core/test_curvature_estimators.py
 for the noisy one). pymeshlab is not a dependency: its row is skipped when it is absent.
 """
 

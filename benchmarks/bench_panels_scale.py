@@ -8,9 +8,9 @@ Usage::
 Without ``SCAN`` the 2.77M armadillo (two ``igl.upsample`` of
 ``../shared/meshes/armadillo_loop.obj``) is made once in the temp folder. The drive runs in a
 fresh child process (its peak RSS is the viewer's) on polyscope's ``openGL_mock`` backend,
-through the tests' scriptable UI adapter (``tests/scripted_ui.py``: the child gets ``tests/`` on
-its ``PYTHONPATH``, as pytest gives it to the tests), the same widgets
-``tests/test_viewer_widgets.py`` drives on a small sphere:
+through the tests' scriptable UI adapter (``tests/support/scripted_ui.py``: the child gets the
+checkout on its ``PYTHONPATH``, as pytest gives it to the tests), the same widgets
+``tests/app/test_viewer_widgets.py`` drives on a small sphere:
 
 - open the scan with its curvature fields (the Mesh section's job, inline here), first frame;
 - curvature: the Gaussian field, then the other vertex area (every field recomputed);
@@ -78,7 +78,8 @@ def child(scan: Path, k: int, wait_basis: bool, out: Path) -> list[dict[str, Any
     import polyscope as ps
     from meshlap_app.state import AppState, MeshState
     from meshlap_app.viewer import Viewer, init_polyscope
-    from scripted_ui import ScriptedUI
+
+    from tests.support.scripted_ui import ScriptedUI
 
     rows: list[dict[str, Any]] = []
     init_polyscope("openGL_mock")
@@ -217,7 +218,7 @@ def main() -> None:
     argv = [sys.executable, __file__, "--child", str(scan), "--k", str(args.k)]
     if args.wait_basis:
         argv.append("--wait-basis")
-    paths = [str(ROOT / "tests"), os.environ.get("PYTHONPATH", "")]
+    paths = [str(ROOT), os.environ.get("PYTHONPATH", "")]
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(p for p in paths if p)}
     # the child's rows stream to stderr as each step ends (a long drive shows its progress)
     proc = subprocess.run(argv, stdout=subprocess.PIPE, text=True, env=env, timeout=7200)

@@ -7,7 +7,7 @@ Usage::
     python benchmarks/bench_window_scale.py [SCAN.obj] [--repeat N]
 
 Without ``SCAN`` the 692k armadillo is made once in the temp folder (one ``igl.upsample`` of
-``../shared/meshes/armadillo_loop.obj``, as ``tests/test_window_scale.py`` does). Each run is
+``../shared/meshes/armadillo_loop.obj``, as ``tests/window/test_scale.py`` does). Each run is
 a fresh child process (``python benchmarks/bench_window_scale.py --child SCAN``) that renders
 with polyscope's EGL backend at 1280×720 through the viewer's own frame loop, paced as in the
 window (:class:`meshlap_app.pacing.Pacer`): it opens the bundled mesh, then opens ``SCAN`` as

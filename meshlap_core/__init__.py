@@ -4,7 +4,7 @@ Pure numpy / scipy / libigl; this package never imports polyscope (the viewer is
 ``meshlap_app`` package). The public API below is what scripts and notebooks use; every name is
 importable from ``meshlap_core`` directly and is loaded on first use, so ``import meshlap_core``
 stays cheap. On a file, start with ``mesh = load_mesh("bunny.obj")`` and use ``mesh.V, mesh.F``;
-here a generated unit sphere (``tests/test_doc_examples.py`` runs this example):
+here a generated unit sphere (``tests/project/test_doc_examples.py`` runs this example):
 
 >>> from meshlap_core import Smoother, SpectralBasis, curvature_field, icosphere
 >>> V, F = icosphere(2)

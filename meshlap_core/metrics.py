@@ -114,10 +114,10 @@ def signed_volume(V: FloatArray, F: IntArray) -> float:
     when the mesh is closed; use :func:`enclosed_volume` for the checked version.
     """
     V, F = as_mesh(V, F)
-    return _signed_volume_unchecked(V, F)
+    return signed_volume_unchecked(V, F)
 
 
-def _signed_volume_unchecked(V: FloatArray, F: IntArray, FT: IntArray | None = None) -> float:
+def signed_volume_unchecked(V: FloatArray, F: IntArray, FT: IntArray | None = None) -> float:
     """Divergence-theorem volume without checks; ``FT`` is an optional ``(3,m)`` copy of ``F.T``.
 
     Per-coordinate gathers and an in-place triple product: about twice as fast as
@@ -161,7 +161,7 @@ def enclosed_volume(V: FloatArray, F: IntArray) -> tuple[float | None, str | Non
     reason = volume_undefined_reason(F)
     if reason is not None:
         return None, reason
-    return _signed_volume_unchecked(V, F), None
+    return signed_volume_unchecked(V, F), None
 
 
 def volume_undefined_reason(F: IntArray) -> str | None:
@@ -222,7 +222,7 @@ def volume_change_pct(
     reason = volume_undefined_reason(F)
     if reason is not None:
         return None, reason
-    pct = percent_volume_change(_signed_volume_unchecked(V, F), _signed_volume_unchecked(V_ref, F))
+    pct = percent_volume_change(signed_volume_unchecked(V, F), signed_volume_unchecked(V_ref, F))
     if pct is None:
         return None, "undefined: the reference volume is 0"
     return pct, None
@@ -479,7 +479,7 @@ class Reference:
             out["volume_change_pct"] = None
             out["volume_note"] = self.volume_reason or "undefined: the reference volume is 0"
         else:
-            vol = _signed_volume_unchecked(V, self.F)
+            vol = signed_volume_unchecked(V, self.F)
             out["volume"] = vol
             out["volume_change_pct"] = percent_volume_change(vol, self.volume)
         d = _wrapped_abs_diff(_dihedral_unchecked(V, self.F, self.adjacency), self.dihedral)

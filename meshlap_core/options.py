@@ -1,7 +1,7 @@
 """The shared vocabulary: every option name, its choices, its default, and every tolerance.
 
 Each option and threshold is defined here once; modules import it from here and never restate
-it. ``tests/test_options.py`` checks that no other module defines one of these names again.
+it. ``tests/project/test_options.py`` checks that no other module defines one of these names again.
 
 Options
 -------

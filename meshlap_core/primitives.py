@@ -40,7 +40,7 @@ def icosphere(subdivisions: int = 2, radius: float = 1.0) -> tuple[FloatArray, I
     return np.ascontiguousarray(V, dtype=np.float64), np.ascontiguousarray(F, dtype=np.int64)
 
 
-def _grid_faces(nu: int, nv: int, wrap_u: bool, wrap_v: bool) -> IntArray:
+def grid_faces(nu: int, nv: int, wrap_u: bool, wrap_v: bool) -> IntArray:
     """Two triangles per cell of an ``nu × nv`` vertex grid (index ``i*nv + j``), CCW in (u,v)."""
     cu = nu if wrap_u else nu - 1
     cv = nv if wrap_v else nv - 1
@@ -68,7 +68,7 @@ def grid(nx: int = 10, ny: int = 10, size: float = 1.0) -> tuple[FloatArray, Int
         raise MeshError("a grid needs at least 2 x 2 vertices", "grid")
     x, y = np.meshgrid(np.linspace(0, size, nx), np.linspace(0, size, ny), indexing="ij")
     V = np.stack([x.ravel(), y.ravel(), np.zeros(nx * ny)], axis=1)
-    return V, _grid_faces(nx, ny, False, False)
+    return V, grid_faces(nx, ny, False, False)
 
 
 def torus_mesh(
@@ -101,7 +101,7 @@ def torus_mesh(
     V = np.stack(
         [(R + r * np.cos(v)) * np.cos(u), (R + r * np.cos(v)) * np.sin(u), r * np.sin(v)], 1
     )
-    return V, _grid_faces(n_major, n_minor, True, True)
+    return V, grid_faces(n_major, n_minor, True, True)
 
 
 def cube(subdivisions: int = 0, size: float = 1.0) -> tuple[FloatArray, IntArray]:

@@ -17,9 +17,9 @@ from pathlib import Path
 
 import pytest
 
-TESTS = Path(__file__).resolve().parent  # the test helpers' folder (imported as modules)
+ROOT = Path(__file__).resolve().parents[1]  # the checkout (tests/ is a package in it)
 
-SHARED_MESHES = Path(__file__).resolve().parents[1].parent / "shared" / "meshes"
+SHARED_MESHES = ROOT.parent / "shared" / "meshes"
 
 
 @pytest.fixture
@@ -79,6 +79,12 @@ def polyscope_mock(tmp_path_factory):
     os.chdir(old)
 
 
+@pytest.fixture(scope="module")
+def mock(polyscope_mock):
+    """polyscope on ``openGL_mock`` for the module (the widget tests' name for it)."""
+    return polyscope_mock
+
+
 @pytest.fixture
 def sphere(tmp_path: Path) -> Path:
     """An icosphere (level 2, 162 vertices) written to ``tmp_path/sphere.obj``."""
@@ -97,13 +103,15 @@ def viewer(polyscope_mock, sphere, tmp_path, monkeypatch):
     eigenbasis cache."""
     from meshlap_app.state import AppState, MeshState
     from meshlap_app.viewer import Viewer
-    from scripted_ui import ScriptedUI
+
+    from tests.support.scripted_ui import ScriptedUI
 
     monkeypatch.setenv("MESHLAP_CACHE_DIR", str(tmp_path / "cache"))
     polyscope_mock.remove_all_structures()
     mesh = MeshState()
     assert mesh.load(sphere)
     v = Viewer(AppState(mesh=mesh, folder=tmp_path), ui=ScriptedUI())
+    v.set_ui_scale(v.state.ui_scale)  # polyscope's UI scale is global: not the last module's
     v.sync_mesh()
     polyscope_mock.set_user_callback(v.callback)
     yield v
@@ -115,9 +123,9 @@ def python_ok(tmp_path: Path) -> Callable[..., subprocess.CompletedProcess]:
     """Run ``python ARGS...`` (a ``-c`` script or ``-m meshlap_core.cli ...``) in ``tmp_path``
     with a private eigenbasis cache, assert it exits 0 (showing its stderr otherwise) and
     return the completed process (text output). The child imports the test helpers
-    (``scripted_ui``, ...) as the tests do: ``tests/`` is on its ``PYTHONPATH``, as pytest
-    puts it on the tests' path."""
-    helpers = os.pathsep.join(p for p in (str(TESTS), os.environ.get("PYTHONPATH")) if p)
+    (``tests.support.scripted_ui``, ...) as the tests do: the checkout is on its
+    ``PYTHONPATH``, as pytest puts it on the tests' path."""
+    helpers = os.pathsep.join(p for p in (str(ROOT), os.environ.get("PYTHONPATH")) if p)
 
     def run(*args: object, timeout: float = 600) -> subprocess.CompletedProcess:
         env = dict(os.environ, MESHLAP_CACHE_DIR=str(tmp_path / "cache"), PYTHONPATH=helpers)
@@ -154,13 +162,11 @@ def egl_available() -> bool:
 
 
 def pytest_runtest_setup(item: pytest.Item) -> None:
-    """Tests marked ``egl`` skip, saying why, where the EGL backend cannot start."""
+    """Tests marked ``egl`` skip, saying why, where the EGL backend cannot start; only a test
+    marked ``window`` may start an X server (so ``-m "not window"`` leaves every real window
+    out: :class:`tests.support.xwindow.XServer` refuses to start otherwise)."""
+    from tests.support import xwindow
+
+    xwindow.WINDOW_TEST = item.get_closest_marker("window") is not None
     if item.get_closest_marker("egl") is not None and not egl_available():
         pytest.skip(EGL_SKIP)
-
-
-def pytest_configure(config: pytest.Config) -> None:
-    config.addinivalue_line(
-        "markers",
-        "window: drives `meshlap view` in a real X window (Xvfb + xdotool; skipped without them)",
-    )

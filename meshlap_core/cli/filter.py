@@ -89,9 +89,9 @@ def run(args: argparse.Namespace) -> int:
     V, F = mesh.V, mesh.F
     if not 1 <= args.k <= len(V):
         raise MeshError(f"must be between 1 and {len(V)} (the vertices), got {args.k}", "--k")
-    from .spectral import _compute
+    from .spectral import compute_basis
 
-    basis = _compute(args, V, F, args.k)
+    basis = compute_basis(args, V, F, args.k)
     name, h = _gains(args, basis.eigenvalues)
     X = SpectralFilter(basis).apply(h, residual=args.residual)
     print_report(args.mesh, mesh.report)

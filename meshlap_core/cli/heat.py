@@ -65,11 +65,11 @@ def run(args: argparse.Namespace) -> int:
             raise MeshError(exc.problem, "--t") from None
         result["steps"] = args.steps
     else:
-        from .spectral import _compute
+        from .spectral import compute_basis
 
         if not 1 <= args.k <= len(V):
             raise MeshError(f"must be between 1 and {len(V)} (the vertices), got {args.k}", "--k")
-        basis = _compute(args, V, F, args.k)
+        basis = compute_basis(args, V, F, args.k)
         u = heat_spectral(basis, u0, t)
         result["k"] = args.k
         result["truncation_bound"] = truncation_bound(basis.eigenvalues, t, args.k)

@@ -115,7 +115,7 @@ def _check_args(args: argparse.Namespace) -> tuple[int, list[int] | None, Path |
     return k, recon, out_dir
 
 
-def _compute(args: argparse.Namespace, V: Any, F: Any, k: int) -> SpectralBasis:
+def compute_basis(args: argparse.Namespace, V: Any, F: Any, k: int) -> SpectralBasis:
     """The basis, errors attributed to the mesh file or ``--k``; a cache file that failed its
     checks (and was recomputed) is said on stderr."""
     try:
@@ -158,7 +158,7 @@ def run(args: argparse.Namespace) -> int:
         recon = sorted({r for r in _DEFAULT_RECONSTRUCT if r < k} | {k})
     t_load = time.perf_counter() - t_start
 
-    basis = _compute(args, V, F, k)
+    basis = compute_basis(args, V, F, k)
     info = basis.info
 
     t0 = time.perf_counter()

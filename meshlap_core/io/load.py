@@ -14,10 +14,10 @@ from ..validate import Mesh, validate_mesh
 from ._scan import Parsed
 from .atomic import PathLike
 from .obj import parse_obj
-from .off import _parse_off
-from .ply import _parse_ply
+from .off import parse_off
+from .ply import parse_ply
 from .reader import READ_TIME_LIMIT, UNSIZED_READ_LIMIT, check_input, read_input
-from .stl import _parse_stl
+from .stl import parse_stl
 
 MESH_FORMATS: tuple[str, ...] = (".obj", ".off", ".ply", ".stl")
 __all__ = [
@@ -142,7 +142,7 @@ def load_vertex_scalars(path: PathLike, name: str = "quality") -> FloatArray:
         raise MeshError(
             f"per-vertex scalars can only be read from .ply files, not {p.suffix!r}", src
         )
-    parsed = _parse_ply(data, src)
+    parsed = parse_ply(data, src)
     if name not in parsed.vertex_props:
         have = ", ".join(sorted(parsed.vertex_props)) or "none"
         raise MeshError(f"the vertex element has no property {name!r} (properties: {have})", src)
@@ -180,10 +180,10 @@ def _parse(ext: str, data: bytes, src: str) -> Parsed:
     if ext == ".obj":
         return parse_obj(data, src)
     if ext == ".off":
-        return _parse_off(data, src)
+        return parse_off(data, src)
     if ext == ".ply":
-        return _parse_ply(data, src)
-    return _parse_stl(data, src)
+        return parse_ply(data, src)
+    return parse_stl(data, src)
 
 
 def read_bounded(path: PathLike, src: str) -> bytes:

@@ -48,7 +48,8 @@ _FACE_COLOUR = (0, 1, 3, 4)  # numbers after a face's indices
 _BREAK = re.compile(rb"\r\n|\r|\n")
 
 
-def _parse_off(data: bytes, src: str) -> Parsed:
+def parse_off(data: bytes, src: str) -> Parsed:
+    """The OFF file ``data`` (named ``src`` in errors), its header checked against its body."""
     if data.startswith(b"\xef\xbb\xbf"):
         data = data[3:]
     keyword, nv, nf, body_start = _off_header(data, src)

@@ -167,7 +167,8 @@ def _face_list_prop(face: _PlyElement) -> _PlyProp:
     return lists[0]
 
 
-def _parse_ply(data: bytes, src: str) -> Parsed:
+def parse_ply(data: bytes, src: str) -> Parsed:
+    """The PLY file ``data`` (ASCII or binary; named ``src`` in errors)."""
     fmt, elements, body_start = _ply_header(data, src)
     vert, face = _ply_mesh_parts(elements, src)
     if fmt == "ascii":

@@ -22,7 +22,8 @@ from ._scan import (
 _STL_DTYPE = np.dtype([("normal", "<f4", (3,)), ("v", "<f4", (3, 3)), ("attr", "<u2")])
 
 
-def _parse_stl(data: bytes, src: str) -> Parsed:
+def parse_stl(data: bytes, src: str) -> Parsed:
+    """The STL file ``data`` (binary when its size says so, else ASCII; named ``src`` in errors)."""
     n_bin = int.from_bytes(data[80:84], "little") if len(data) >= 84 else -1
     if n_bin >= 0 and len(data) == 84 + 50 * n_bin:
         if n_bin == 0:

@@ -90,7 +90,8 @@ def taubin_mu(lam: float, k_pb: float = DEFAULT_PASS_BAND) -> float:
     return 1.0 / (kpb - 1.0 / lam)
 
 
-def _resolve_nu(method: str, lam: float, nu: float | None, k_pb: float) -> float | None:
+def resolve_nu(method: str, lam: float, nu: float | None, k_pb: float) -> float | None:
+    """Taubin's ν: the one given, else from λ and the pass band ``k_pb``; None for the others."""
     if method != "taubin":
         return None
     if nu is None:

@@ -31,8 +31,8 @@ from ..options import (
 from ..types import FloatArray, IntArray, as_mesh
 from .params import (
     DEFAULT_PASS_BAND,
-    _resolve_nu,
     check_lam,
+    resolve_nu,
     taubin_mu,
 )
 
@@ -74,7 +74,7 @@ def operator_parts(
     return W, K
 
 
-def _gershgorin_mu_min(W: FloatArray, K: sp.csr_matrix, active: np.ndarray) -> float:
+def gershgorin_mu_min(W: FloatArray, K: sp.csr_matrix, active: np.ndarray) -> float:
     """A lower bound on the eigenvalues of ``W⁻¹K``: ``−max_i Σ_j |K_ij| / W_i``."""
     if not active.any():
         return 0.0
@@ -112,7 +112,7 @@ def most_negative_eigenvalue(
     """
     W = np.asarray(W, dtype=np.float64)
     active = W > 0
-    bound = _gershgorin_mu_min(W, K, active)
+    bound = gershgorin_mu_min(W, K, active)
     idx = np.flatnonzero(active)
     if len(idx) == 0:
         return 0.0, True
@@ -277,7 +277,7 @@ def _taubin_gain(lam: float, nu: float, mu: float) -> float:
     return (1.0 + lam * mu) * (1.0 + nu * mu)
 
 
-def _stability_from_mu(
+def stability_from_mu(
     method: str,
     laplacian: str,
     lam: float,
@@ -286,6 +286,8 @@ def _stability_from_mu(
     exact: bool,
     k_pb: float,
 ) -> Stability:
+    """The stability of ``method`` with step ``lam`` (and Taubin's ``nu``) given ``mu_min``, the
+    most negative eigenvalue of ``W⁻¹K`` (``exact``: computed, not bounded)."""
     k = -mu_min
     explicit_limit = 2.0 / k if k > 0 else math.inf
     if method == "explicit":
@@ -390,13 +392,13 @@ def stability(
     check_choice(method, SMOOTHING_METHODS, "method")
     lam = check_lam(lam)
     W, K = operator_parts(V, F, laplacian, area)
-    k_pb = check_lam(pass_band, "pass_band") * _diagonal_scale(W, K)
-    nu = _resolve_nu(method, lam, taubin_nu, k_pb)
+    k_pb = check_lam(pass_band, "pass_band") * diagonal_scale(W, K)
+    nu = resolve_nu(method, lam, taubin_nu, k_pb)
     mu_min, exact = most_negative_eigenvalue(W, K)
-    return _stability_from_mu(method, laplacian, lam, nu, mu_min, exact, k_pb)
+    return stability_from_mu(method, laplacian, lam, nu, mu_min, exact, k_pb)
 
 
-def _diagonal_scale(W: FloatArray, K: sp.csr_matrix) -> float:
+def diagonal_scale(W: FloatArray, K: sp.csr_matrix) -> float:
     """``mean_i(−L_ii) = mean_i(−K_ii / W_i)`` over active vertices: 1 for the uniform Laplacian,
     a typical squared inverse edge length for the cotan one."""
     active = W > 0

@@ -20,7 +20,7 @@ from ..errors import MeshError, MeshWarning, check_cancel
 from ..laplacian import vertex_areas
 from ..linalg.common import ProgressCallback
 from ..linalg.spd import SPDSolver, solver_backend
-from ..metrics import _signed_volume_unchecked, n_boundary_edges, percent_volume_change
+from ..metrics import n_boundary_edges, percent_volume_change, signed_volume_unchecked
 from ..noise import bbox_diagonal
 from ..options import (
     AREA_KINDS,
@@ -39,18 +39,18 @@ from ..topology import boundary_vertex_mask
 from ..types import FloatArray, IntArray, as_mesh, as_vertices
 from .params import (
     DEFAULT_PASS_BAND,
-    _resolve_nu,
     check_iters,
     check_lam,
+    resolve_nu,
     taubin_mu,
 )
 from .stability import (
     Stability,
-    _diagonal_scale,
-    _gershgorin_mu_min,
-    _stability_from_mu,
+    diagonal_scale,
+    gershgorin_mu_min,
     most_negative_eigenvalue,
     operator_parts,
+    stability_from_mu,
 )
 
 ILL_CONDITIONED = 1e10
@@ -241,7 +241,7 @@ class Smoother:
             self.volume_note = f"undefined: the mesh is open ({nb} boundary edges)"
         self.preserve_volume = preserve_volume
         self._FT = np.ascontiguousarray(self.F.T)
-        self.volume0 = _signed_volume_unchecked(self.V0, self.F) if self.closed else None
+        self.volume0 = signed_volume_unchecked(self.V0, self.F) if self.closed else None
         if self.preserve_volume:
             if not self.closed:
                 raise MeshError(
@@ -258,7 +258,7 @@ class Smoother:
         self.divergence_limit = self.diagonal * (1.0 if self.method == "explicit" else 1e3)
         W, K = operator_parts(self.V0, self.F, self.laplacian, self.area)
         self._W0, self._K = W, K
-        self.k_pb = self.pass_band * _diagonal_scale(W, K)
+        self.k_pb = self.pass_band * diagonal_scale(W, K)
         self.taubin_nu = self._nu_for(self.lam)
         fixed = (
             boundary_vertex_mask(self.F, self.n)
@@ -300,7 +300,7 @@ class Smoother:
             if self._mu_min is None:  # one eigensolve per stepper, whatever λ becomes
                 self._mu_min = most_negative_eigenvalue(self._W0, self._K)
             mu_min, exact = self._mu_min
-            self._stability = _stability_from_mu(
+            self._stability = stability_from_mu(
                 self.method,
                 self.laplacian,
                 self.lam,
@@ -453,7 +453,7 @@ class Smoother:
     def _nu_for(self, lam: float) -> float | None:
         """Taubin's ``ν`` for ``λ`` (``None`` for the other methods), with a useful message."""
         try:
-            return _resolve_nu(self.method, lam, self._nu_given, self.k_pb)
+            return resolve_nu(self.method, lam, self._nu_given, self.k_pb)
         except MeshError as exc:
             if exc.source != "pass_band":
                 raise
@@ -469,8 +469,8 @@ class Smoother:
         on ``μ_min`` when that settles it, so that no eigensolve is needed in the common case."""
         if self.method == "implicit":
             return True
-        bound = _gershgorin_mu_min(self._W0, self._K, self._W0 > 0)
-        quick = _stability_from_mu(
+        bound = gershgorin_mu_min(self._W0, self._K, self._W0 > 0)
+        quick = stability_from_mu(
             self.method, self.laplacian, self.lam, self.taubin_nu, bound, False, self.k_pb
         )
         return True if quick.stable else self.stability.stable
@@ -574,7 +574,7 @@ class Smoother:
         self._rhs_fixed = self.lam * (self._K_fp @ x[self._fixed]) if len(self._fixed) else None
 
     def _rescale_volume(self, x: FloatArray) -> FloatArray:
-        vol = _signed_volume_unchecked(x, self.F, self._FT)
+        vol = signed_volume_unchecked(x, self.F, self._FT)
         v0 = self.volume0 or 0.0  # preserve_volume requires a closed mesh with volume != 0
         if vol == 0.0 or not math.isfinite(vol) or (vol > 0) != (v0 > 0):
             return x  # an inverted or flat mesh cannot be rescaled; leave it
@@ -614,7 +614,7 @@ class Smoother:
             entry["step_max"] = float(np.sqrt(d2.max())) if d2.size else 0.0
         entry["drift_rms"] = drift  # RMS of x − V0, measured by step()
         if self.closed and self.volume0 is not None:
-            vol = _signed_volume_unchecked(x, self.F, self._FT)
+            vol = signed_volume_unchecked(x, self.F, self._FT)
             entry["volume"] = vol
             entry["volume_change_pct"] = percent_volume_change(vol, self.volume0)
         else:

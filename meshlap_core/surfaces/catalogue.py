@@ -97,10 +97,11 @@ class ParametricSurface:
     def __call__(self, u: Any, v: Any) -> FloatArray:
         """Points ``p(u, v)`` as real ``S + (3,)`` arrays (no domain check)."""
         uu, vv = np.asarray(u, dtype=np.float64), np.asarray(v, dtype=np.float64)
-        return np.real(_evaluate(self, uu, vv))
+        return np.real(evaluate_surface(self, uu, vv))
 
 
-def _evaluate(surface: ParametricSurface, u: np.ndarray, v: np.ndarray) -> np.ndarray:
+def evaluate_surface(surface: ParametricSurface, u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """``surface.p(u, v)`` broadcast, with the shape it must have checked: ``(*u.shape, 3)``."""
     u, v = np.broadcast_arrays(u, v)
     P = np.asarray(surface.p(u, v))
     if P.shape != (*u.shape, 3):

@@ -19,7 +19,7 @@ import numpy as np
 from ..errors import MeshError
 from ..options import DERIVATIVE_METHODS, DerivativeMethod, check_choice
 from ..types import FloatArray
-from .catalogue import ParametricSurface, _evaluate, get_surface
+from .catalogue import ParametricSurface, evaluate_surface, get_surface
 
 
 @dataclass(frozen=True)
@@ -96,7 +96,7 @@ def surface_derivatives(
     surface = get_surface(surface)
     check_choice(method, DERIVATIVE_METHODS, "method")
     u, v = np.broadcast_arrays(np.asarray(u, dtype=np.float64), np.asarray(v, dtype=np.float64))
-    P = np.real(_evaluate(surface, u, v)).astype(np.float64)
+    P = np.real(evaluate_surface(surface, u, v)).astype(np.float64)
     if method == "exact" and surface.derivatives is None:
         raise MeshError(f"the {surface.name} has no exact derivatives", "method")
     if method == "exact" or (method == "auto" and surface.derivatives is not None):

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import MeshError
-from ..primitives import _grid_faces
+from ..primitives import grid_faces
 from ..topology import boundary_vertex_mask
 from ..types import BoolArray, FloatArray, IntArray
 from .catalogue import ParametricSurface, get_surface
@@ -185,7 +185,7 @@ def mesh_surface(surface: ParametricSurface | str, res: int | Sequence[int] = 32
         idx[:, 0] = idx[0, 0]
     if "v1" in surface.poles:
         idx[:, -1] = idx[0, -1]
-    F = idx.ravel()[_grid_faces(Nu, Nv, surface.closed_u, surface.closed_v)]
+    F = idx.ravel()[grid_faces(Nu, Nv, surface.closed_u, surface.closed_v)]
     if surface.poles:
         F = F[(F[:, 0] != F[:, 1]) & (F[:, 1] != F[:, 2]) & (F[:, 2] != F[:, 0])]
         used, Fc = np.unique(F, return_inverse=True)

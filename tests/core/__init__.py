@@ -1,0 +1,1 @@
+"""Tests of the headless core (``meshlap_core``) and its command line."""

@@ -1,0 +1,34 @@
+"""The drivers of the every-widget tour: ``drivers/<name>.py`` defines
+``drive_panel_<name>(viewer, tmp_path)`` for the registered panel ``<name>``, driving every
+widget it draws with good values and bad. ``tests/app/test_viewer_widgets.py`` runs them all on
+one viewer and fails on a widget no driver drove; a panel's own tests call its driver too.
+
+A new panel brings its driver in its own file here; the tour finds it by the panel's name.
+"""
+
+from __future__ import annotations
+
+import importlib
+from collections.abc import Callable
+
+
+def panel_drivers() -> dict[str, Callable[..., None]]:
+    """``drive_panel_<name>(viewer, tmp_path)`` of every registered panel, in the registry's
+    order, from ``tests/support/drivers/<name>.py``. KeyError names a panel without one."""
+    from meshlap_app.registry import REGISTRY
+
+    drivers: dict[str, Callable[..., None]] = {}
+    for entry in REGISTRY:
+        name = f"drive_panel_{entry.name}"
+        module_name = f"{__name__}.{entry.name}"
+        try:
+            module = importlib.import_module(module_name)
+        except ModuleNotFoundError as exc:
+            if exc.name != module_name:
+                raise
+            where = f"tests/support/drivers/{entry.name}.py"
+            raise KeyError(f"{entry.name}: no driver module {where}") from None
+        if not hasattr(module, name):
+            raise KeyError(f"{entry.name}: {name} is not defined in {module_name}")
+        drivers[entry.name] = getattr(module, name)
+    return drivers
