@@ -138,7 +138,7 @@ def _reference_index(groups: list[Group]) -> str:
         "# API reference\n",
         "Every public name of `meshlap_core` (`from meshlap_core import NAME`), generated from the",
         "package's export map `meshlap_core._PUBLIC` and the docstrings when the site is built.",
-        "Each docstring's *Examples* run as tests (`tests/test_doc_examples.py`).\n",
+        "Each docstring's *Examples* run as tests (`tests/project/test_doc_examples.py`).\n",
     ]
     paths = {e.name: e.path for g in groups for e in g.entries}
     for g in groups:

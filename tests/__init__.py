@@ -1,7 +1,8 @@
 """meshlap's tests, by subject: ``core/`` (the headless core and its command line), ``app/``
 (the viewer headless, on polyscope's ``openGL_mock`` and with EGL pixels), ``window/`` (the real
 window under Xvfb + xdotool, marked ``window``), ``robustness/`` (hostile input, faults, stress),
-``project/`` (the repository's promises: architecture, README and CI, examples, public API).
+``project/`` (the repository's promises: architecture, README, docs and CI, examples, lessons,
+public API).
 
 Every folder is a package, so pytest imports a test file as ``tests.<folder>.<module>`` with the
 checkout on ``sys.path`` (its default ``prepend`` import mode); the helpers the tests share live

@@ -7,15 +7,15 @@ passes the suite.
 
 from __future__ import annotations
 
-import functools
 import os
 import subprocess
 import sys
-import tempfile
 from collections.abc import Callable
 from pathlib import Path
 
 import pytest
+
+from tests.support.egl import EGL_SKIP, egl_available
 
 ROOT = Path(__file__).resolve().parents[1]  # the checkout (tests/ is a package in it)
 
@@ -141,24 +141,6 @@ def python_ok(tmp_path: Path) -> Callable[..., subprocess.CompletedProcess]:
         return res
 
     return run
-
-
-EGL_SKIP = "polyscope's EGL backend cannot start on this machine (no EGL/Mesa)"
-
-
-@functools.cache
-def egl_available() -> bool:
-    """Whether polyscope's ``openGL3_egl`` backend starts here (probed once, in a subprocess:
-    a failing backend can abort the interpreter)."""
-    code = "import polyscope as ps; ps.set_allow_headless_backends(True); ps.init('openGL3_egl')"
-    try:
-        with tempfile.TemporaryDirectory() as tmp:  # polyscope writes .ini files into the cwd
-            res = subprocess.run(
-                [sys.executable, "-c", code], capture_output=True, timeout=120, cwd=tmp
-            )
-    except subprocess.TimeoutExpired:
-        return False
-    return res.returncode == 0
 
 
 def pytest_runtest_setup(item: pytest.Item) -> None:

@@ -10,7 +10,7 @@ and the notebook is regenerated:
     python docs/lessons/build_lessons.py --check  # exit 1 if a notebook is not its source's
 
 The notebooks are committed without outputs (executed outputs with their pictures would
-grow the repository by megabytes at each change); ``tests/test_lessons.py`` executes them,
+grow the repository by megabytes at each change); ``tests/project/test_lessons.py`` executes them,
 and a documentation build executes them to render the pages with their pictures.
 """
 

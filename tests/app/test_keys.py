@@ -11,8 +11,8 @@ ps = pytest.importorskip("polyscope")
 
 from meshlap_app.viewer import Viewer  # noqa: E402
 
-from tests.support.window_page import window_page_keys  # noqa: E402
 from tests.support.widgets import compute_basis, drive, frames  # noqa: E402
+from tests.support.window_page import window_page_keys  # noqa: E402
 
 # where a key can act (the panel named in its help row, else this view)
 DEFAULT_VIEW = "onering"

@@ -474,7 +474,7 @@ def test_the_docstring_examples_run():
 def test_open_viewer_opens_the_window_on_a_display():
     """Under Xvfb: the window appears titled after the mesh's file, the notebook's process
     goes on, and ``close`` ends the window."""
-    from xwindow import XServer, missing_tools
+    from tests.support.xwindow import XServer, missing_tools
 
     missing = missing_tools()
     if missing:

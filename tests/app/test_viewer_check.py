@@ -16,7 +16,6 @@ from meshlap_core import primitives
 from meshlap_core.errors import MeshError
 from meshlap_core.exercises.tasks import EXERCISE_TASKS
 from meshlap_core.laplacian import cotan_stiffness, mass_matrix, vertex_areas
-
 from tests.support.students import STUDENTS
 
 

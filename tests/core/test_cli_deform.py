@@ -2,7 +2,6 @@
 
 import json
 
-import hostile
 import numpy as np
 import pytest
 
@@ -16,6 +15,7 @@ from meshlap_core.deform import (
     rotation_matrix,
 )
 from meshlap_core.io import load_mesh, save_mesh
+from tests.support import hostile
 
 
 def run_cli(capsys, *argv):

@@ -3,7 +3,6 @@ rules: bad combinations refused by flag, hostile files one error line, outputs u
 
 import json
 
-import hostile
 import numpy as np
 import pytest
 
@@ -11,6 +10,7 @@ from meshlap_core import primitives
 from meshlap_core.cli import main
 from meshlap_core.flatten import Flattener, unit_square_uv
 from meshlap_core.io import load_mesh, save_mesh
+from tests.support import hostile
 
 SENTINEL = b"an existing file that a failed run must not touch\n"
 

@@ -16,9 +16,9 @@ import pytest
 from meshlap_core.cli import main
 from meshlap_core.exercises import grading
 from meshlap_core.exercises.grading import grade_folder
+from tests.support.students import STUDENTS
 
-STUDENTS = Path(__file__).parent / "exercises"
-BENCH = Path(__file__).resolve().parents[1] / "benchmarks" / "bench_grading.py"
+BENCH = Path(__file__).resolve().parents[2] / "benchmarks" / "bench_grading.py"
 TASKS = ["uniform_laplacian", "barycentric_areas"]
 
 

@@ -22,8 +22,8 @@ from meshlap_core.cli import main
 from meshlap_core.exercises.compare import COMPARE
 from meshlap_core.exercises.grading import grade_folder
 from meshlap_core.exercises.isolation import bwrap_problem
+from tests.support.students import STUDENTS
 
-STUDENTS = Path(__file__).parent / "exercises"
 BWRAP = pytest.param(
     "bwrap",
     marks=pytest.mark.skipif(bwrap_problem() is not None, reason=f"{bwrap_problem()}"),

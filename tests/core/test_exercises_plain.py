@@ -29,7 +29,7 @@ from meshlap_core.exercises.plain import (
 )
 from meshlap_core.primitives import icosphere
 
-PACKAGE = Path(__file__).resolve().parents[1] / "meshlap_core" / "exercises"
+PACKAGE = Path(__file__).resolve().parents[2] / "meshlap_core" / "exercises"
 STDLIB = set(sys.stdlib_module_names) | {"__future__"}
 
 

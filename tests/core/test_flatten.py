@@ -43,7 +43,7 @@ from meshlap_core.laplacian import cotan_stiffness
 from meshlap_core.primitives import grid, icosphere, torus_mesh
 from meshlap_core.topology import boundary_loops
 
-ASSETS = __import__("pathlib").Path(__file__).resolve().parents[1] / "assets"
+ASSETS = __import__("pathlib").Path(__file__).resolve().parents[2] / "assets"
 SHARED_DISKS = [
     "camelhead.obj",
     "lilium.obj",

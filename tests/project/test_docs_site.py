@@ -27,7 +27,7 @@ import meshlap_core
 
 pytest.importorskip("mkdocs", reason="mkdocs is not installed (it comes with the [test] extra)")
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 PUBLIC = sorted(n for n in meshlap_core.__all__ if not n.startswith("__"))
 
 

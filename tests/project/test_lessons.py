@@ -14,7 +14,7 @@ import pytest
 nbformat = pytest.importorskip("nbformat", reason="the test extra: pip install -e '.[test]'")
 nbclient = pytest.importorskip("nbclient", reason="the test extra: pip install -e '.[test]'")
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 LESSONS = ROOT / "docs" / "lessons"
 NOTEBOOKS = sorted(LESSONS.glob("[0-9][0-9]_*.ipynb"))
 
@@ -73,7 +73,7 @@ def _write(path: Path, text: str) -> Path:
 def test_the_lesson_runs_and_draws(path, tmp_path, monkeypatch):
     """Executed as a reader runs it (in a temporary working folder, with a private
     eigenbasis cache): nbclient raises on the first cell that errors."""
-    from conftest import egl_available
+    from tests.support.egl import egl_available
 
     monkeypatch.setenv("MESHLAP_CACHE_DIR", str(tmp_path / "cache"))
     nb = nbformat.read(path, as_version=4)

@@ -3,7 +3,7 @@
 What only a separate process can show: nothing hangs (a FIFO or ``/dev/zero`` given as MESH),
 no Python traceback reaches the terminal, and ``view --screenshot`` (polyscope, EGL) fails in
 one line on a bad file and renders the hostile-but-valid ones. The in-process tests in
-``test_robustness.py`` cover the whole corpus; here a few representatives run for real.
+``test_commands.py`` cover the whole corpus; here a few representatives run for real.
 """
 
 from __future__ import annotations
