@@ -244,12 +244,25 @@ def test_captions_name_what_is_side_by_side(viewer):
 def test_every_panel_has_one_driver():
     from meshlap_app.registry import REGISTRY
 
-    assert list(panel_drivers()) == [e.name for e in REGISTRY]
+    assert list(panel_drivers()) == [spec.name for spec in REGISTRY]
+
+
+def test_a_panel_without_a_driver_is_named(monkeypatch):
+    """A registered panel with no ``tests/support/drivers/<name>.py`` fails the tour naming the
+    panel and the file it needs (it is never skipped)."""
+    from types import SimpleNamespace
+
+    from meshlap_app import registry
+
+    monkeypatch.setattr(registry, "REGISTRY", [*registry.REGISTRY, SimpleNamespace(name="nope")])
+    with pytest.raises(KeyError, match=r"nope: no driver module tests/support/drivers/nope\.py"):
+        panel_drivers()
 
 
 def test_every_widget_is_driven(viewer, tmp_path):
     """Run every registered panel's driver on one adapter, then the widgets every panel shares
-    (play/record, isolines): every widget label drawn must have been scripted."""
+    (play/record, isolines): every widget label drawn must have been scripted, and every setting
+    a panel's spec declares must have had its own widget driven."""
     for driver in panel_drivers().values():
         driver(viewer, tmp_path)
     drive_record_widgets(viewer, tmp_path)  # play, θ and record widgets

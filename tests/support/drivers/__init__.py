@@ -1,9 +1,12 @@
 """The drivers of the every-widget tour: ``drivers/<name>.py`` defines
 ``drive_panel_<name>(viewer, tmp_path)`` for the registered panel ``<name>``, driving every
 widget it draws with good values and bad. ``tests/app/test_viewer_widgets.py`` runs them all on
-one viewer and fails on a widget no driver drove; a panel's own tests call its driver too.
+one viewer and fails on a widget no driver drove, or on a setting the panel's spec declares whose
+widget (its label, in the panel's section) no driver drove; a panel's own tests call its driver
+too.
 
-A new panel brings its driver in its own file here; the tour finds it by the panel's name.
+A new panel brings its driver in its own file here; the tour finds it by the panel's name, and
+fails naming the panel when the file or its ``drive_panel_<name>`` is missing.
 """
 
 from __future__ import annotations
@@ -18,17 +21,17 @@ def panel_drivers() -> dict[str, Callable[..., None]]:
     from meshlap_app.registry import REGISTRY
 
     drivers: dict[str, Callable[..., None]] = {}
-    for entry in REGISTRY:
-        name = f"drive_panel_{entry.name}"
-        module_name = f"{__name__}.{entry.name}"
+    for spec in REGISTRY:
+        name = f"drive_panel_{spec.name}"
+        module_name = f"{__name__}.{spec.name}"
         try:
             module = importlib.import_module(module_name)
         except ModuleNotFoundError as exc:
             if exc.name != module_name:
                 raise
-            where = f"tests/support/drivers/{entry.name}.py"
-            raise KeyError(f"{entry.name}: no driver module {where}") from None
+            where = f"tests/support/drivers/{spec.name}.py"
+            raise KeyError(f"{spec.name}: no driver module {where}") from None
         if not hasattr(module, name):
-            raise KeyError(f"{entry.name}: {name} is not defined in {module_name}")
-        drivers[entry.name] = getattr(module, name)
+            raise KeyError(f"{spec.name}: {name} is not defined in {module_name}")
+        drivers[spec.name] = getattr(module, name)
     return drivers
