@@ -33,7 +33,7 @@ import numpy as np
 from meshlap_core.errors import MeshError
 
 from . import ipc
-from .screenshots import _captured_output, _in_folder
+from .screenshots import captured_output, in_folder
 
 PICTURE_TIMEOUT = 120.0
 """Seconds a picture may take, the start of polyscope and EGL in a new process included."""
@@ -141,7 +141,7 @@ def _serve(conn: Any, folder: str) -> None:
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # a notebook's interrupt is the parent's
     work = Path(folder)
-    with _in_folder(work), _captured_output(work / "output.log"):
+    with in_folder(work), captured_output(work / "output.log"):
         import polyscope as ps
 
         from .viewer import init_polyscope

@@ -72,7 +72,7 @@ class ViewerScreenshots:
             if self._started_polyscope:
                 import polyscope as ps
 
-                with _in_folder(work), _captured_output(work / "shutdown.log"):
+                with in_folder(work), captured_output(work / "shutdown.log"):
                     ps.shutdown()
         finally:
             self._started_polyscope = False
@@ -103,7 +103,7 @@ class ViewerScreenshots:
         started_before = ps.is_initialized()
         log = work / "output.log"
         try:
-            with _in_folder(work), _captured_output(log):
+            with in_folder(work), captured_output(log):
                 code = run_viewer(path, screenshot=out, panel=panel, **dict(options))
         finally:
             self._started_polyscope |= ps.is_initialized() and not started_before
@@ -111,7 +111,7 @@ class ViewerScreenshots:
 
 
 @contextlib.contextmanager
-def _in_folder(folder: Path) -> Iterator[None]:
+def in_folder(folder: Path) -> Iterator[None]:
     """Work in ``folder`` (polyscope writes ``.polyscope.ini`` and ``imgui.ini`` into the
     working directory), then return to the previous one."""
     old = os.getcwd()
@@ -123,7 +123,7 @@ def _in_folder(folder: Path) -> Iterator[None]:
 
 
 @contextlib.contextmanager
-def _captured_output(log: Path) -> Iterator[None]:
+def captured_output(log: Path) -> Iterator[None]:
     """Send what is printed on the file descriptors 1 and 2 (polyscope's C++ messages) to
     ``log`` instead of the terminal; Python's own streams are flushed first."""
     try:
@@ -222,7 +222,7 @@ def render_difference(
     from .viewer import init_polyscope
 
     work = Path(folder)
-    with _in_folder(work), _captured_output(work / "output.log"):
+    with in_folder(work), captured_output(work / "output.log"):
         init_polyscope("openGL3_egl")
         ps.set_ground_plane_mode("none")
         ps.set_window_size(size, size)
