@@ -494,7 +494,7 @@ def test_non_manifold_vertices_are_split_into_their_fans():
 def test_needle_faces_make_a_clear_error_and_tutte_still_works(tmp_path):
     """Cotangent weights of needle faces break LSCM's system (found by the hostile corpus: a
     LinAlgError before); the uniform weights of Tutte's map do not mind them."""
-    import hostile
+    from tests.support import hostile
 
     case = next(h for h in hostile.LOADABLE if h.name == "needles.obj")
     mesh = load_mesh(case.build(tmp_path))
