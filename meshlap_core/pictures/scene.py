@@ -197,8 +197,8 @@ def check_vectors(vectors: Any, n: int, name: str = "vectors") -> dict[str, Any]
     if vectors is None:
         return {}
     if all(hasattr(vectors, a) for a in ("d1", "d2", "k1", "k2", "normal")):
-        c = {a: np.array(getattr(vectors, a), dtype=np.float64) for a in ("normal", "d1", "d2")}
-        c.update({a: np.array(getattr(vectors, a), dtype=np.float64) for a in ("k1", "k2")})
+        fields = ("normal", "d1", "d2", "k1", "k2")  # PrincipalCurvatures' arrays
+        c = {a: np.array(getattr(vectors, a), dtype=np.float64) for a in fields}
         if any(len(x) != n for x in c.values()):
             raise MeshError(f"principal curvatures of another mesh (not {n} vertices)", name)
         if not all(np.isfinite(x).all() for x in c.values()):
