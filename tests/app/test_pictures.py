@@ -298,6 +298,8 @@ def test_the_viewer_registers_the_scene_on_the_mock_backend(polyscope_mock):
     from meshlap_app.scene import MESH, RING_CENTER, RING_CURVE
 
     ps = polyscope_mock
+    # polyscope's window size and pane width are global: the next module's viewer needs its own
+    size, pane = tuple(ps.get_window_size()), ps.get_right_gui_pane_width()
     try:
         _viewer, points = pictures.set_up(_scene(pair=True))
         assert ps.has_surface_mesh(MESH) and ps.has_surface_mesh(pictures.SECOND)
@@ -318,6 +320,8 @@ def test_the_viewer_registers_the_scene_on_the_mock_backend(polyscope_mock):
         ps.clear_user_callback()
         ps.set_open_imgui_window_for_user_callback(True)
         ps.remove_all_structures()
+        ps.set_window_size(*size)
+        ps.set_right_gui_pane_width(pane)
 
 
 def test_matplotlib_draws_the_colour_maps_colours_without_a_reason_when_asked():
