@@ -679,6 +679,7 @@ def test_an_inaccurate_result_is_refined_to_the_promised_residual(monkeypatch):
     assert r.max() <= PROMISED_RESIDUAL and info.max_residual <= PROMISED_RESIDUAL
     np.testing.assert_allclose(lam, _dense_reference(V, F, 64), rtol=1e-9, atol=1e-12)
     assert _orth(U, m) < 1e-10
+
     # the refinement switched off: the spoiled result is refused
     def no_refinement(K, m, lam, U, labels, res, **kw):
         return lam, U, res, Refinement(0, 0)
