@@ -29,6 +29,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    if not args.dir.strip():  # (Path("") is the current folder: never chosen by accident)
+        raise MeshError("the folder name is empty; name the folder to write into", "DIR")
     folder = Path(args.dir)
     if folder.exists() and not folder.is_dir():
         raise MeshError("not a folder", os.fspath(folder))
