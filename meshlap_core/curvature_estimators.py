@@ -218,7 +218,10 @@ def cotan_curvatures(
 
 def quadric_curvatures(V: FloatArray, F: IntArray, radius: int = 5) -> PrincipalCurvatures:
     """libigl's ``principal_curvature`` (a quadric fitted over ``radius`` edge rings; Panozzo,
-    Puppo & Rocca, "Efficient multi-scale curvature and crease estimation", 2010).
+    Puppo & Rocca, "Efficient multi-scale curvature and crease estimation", 2010), on the mesh
+    scaled to a unit box (see
+    :func:`~meshlap_core.curvature.principal_curvature_quadric`: bounds of the radius, and a
+    failed fit refused, never reported as 0).
 
     libigl returns ``PV1 ≥ PV2`` (``PV1`` is the **max**) against the normal of the face
     orientation: ``k1 = PV1``, ``k2 = PV2``, ``d1 = PD1``, ``d2 = PD2`` in this convention.
@@ -228,9 +231,7 @@ def quadric_curvatures(V: FloatArray, F: IntArray, radius: int = 5) -> Principal
     PrincipalCurvatures
     """
     V, F = as_mesh(V, F)
-    if int(radius) < 1:
-        raise MeshError(f"the ring radius must be at least 1, got {radius}", "radius")
-    k1, k2, d1, d2 = principal_curvature_quadric(V, F, int(radius))
+    k1, k2, d1, d2 = principal_curvature_quadric(V, F, radius)  # (checks the radius)
     fn, theta = _face_geometry(V, F)
     return PrincipalCurvatures(k1, k2, d1, d2, _normals_from(F, len(V), fn, theta), "quadric")
 

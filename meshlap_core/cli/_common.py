@@ -30,6 +30,15 @@ def parse_list(text: str, kind: type, name: str) -> list[Any]:
     return values
 
 
+def number_text(text: str, flag: str) -> float:
+    """A number typed on the command line as a float (``nan`` and ``inf`` pass: the core's
+    check of the value names what is wrong); anything else refused naming ``flag``."""
+    try:
+        return float(text)
+    except (TypeError, ValueError):
+        raise MeshError(f"expected a number, got {text!r}", flag) from None
+
+
 def _jsonable(obj: Any) -> Any:
     if isinstance(obj, dict):
         return {str(k): _jsonable(v) for k, v in obj.items()}

@@ -11,11 +11,12 @@ units) and ``--directions FILE.npy`` the ``(n, 2, 3)`` principal directions ``d1
 from __future__ import annotations
 
 import argparse
+import os
 from pathlib import Path
 
 import numpy as np
 
-from ..curvature import curvature_field
+from ..curvature import check_ring_radius, curvature_field
 from ..curvature_estimators import estimate_curvature
 from ..errors import MeshError
 from ..io import check_output_path, load_mesh, save_mesh, save_scalars
@@ -87,9 +88,20 @@ def run(args: argparse.Namespace) -> int:
     out = Path(args.out) if args.out is not None else None
     if out is not None:  # checked first: a doomed run fails at once and writes nothing
         check_output_path(out, overwrite_inputs=(args.mesh,), suffixes=OUT_SUFFIXES)
+    if args.directions is not None and not args.directions.strip():
+        raise MeshError(
+            "the output path is empty (give a file name or leave --directions out)",
+            "--directions",
+        )
     dirs = Path(args.directions) if args.directions else None
     if dirs is not None:
         check_output_path(dirs, overwrite_inputs=(args.mesh,), suffixes=(".npy",))
+        if out is not None and os.path.abspath(dirs) == os.path.abspath(out):
+            raise MeshError(
+                "--out and --directions name the same file (one would replace the other); "
+                "give them different names",
+                "--directions",
+            )
     mesh = load_mesh(args.mesh)
     result = None
     if args.method is None:
@@ -101,7 +113,12 @@ def run(args: argparse.Namespace) -> int:
                 f"an estimator gives {', '.join(PRINCIPAL_FIELDS)}, not {args.method!r}",
                 "--method",
             )
-        result = estimate_curvature(mesh.V, mesh.F, args.estimator, **_options(args))
+        try:
+            result = estimate_curvature(mesh.V, mesh.F, args.estimator, **_options(args))
+        except MeshError as exc:
+            if exc.source == "radius":  # the flag the user typed
+                raise MeshError(exc.problem, "--radius") from None
+            raise
         values = result.field(args.method)
     else:
         if args.radius is not None or dirs is not None:
@@ -158,11 +175,7 @@ def _options(args: argparse.Namespace) -> dict[str, object]:
     if args.radius is None:
         return {}
     if args.estimator == "quadric":
-        if args.radius != int(args.radius) or args.radius < 1:
-            raise MeshError(
-                f"quadric: a whole number of edge rings >= 1, got {args.radius}", "--radius"
-            )
-        return {"radius": int(args.radius)}
+        return {"radius": check_ring_radius(args.radius, "--radius")}
     if args.estimator == "jet":
         return {"radius": args.radius}
     raise MeshError(f"the {args.estimator} estimator has no radius", "--radius")

@@ -16,7 +16,7 @@ from ..diffusion.heat import check_time
 from ..errors import MeshError
 from ..io import load_mesh, save_mesh, save_scalars
 from ..options import HEAT_METHODS, MASS_AREA
-from ._common import add_json_flag, emit_json, print_report, summary_stats
+from ._common import add_json_flag, emit_json, number_text, print_report, summary_stats
 from ._curves import add_curve_flags, curves_path, write_curves
 from ._sources import add_vertex_flag, output, vertices
 
@@ -42,7 +42,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    t = check_time(args.t, "--t")
+    t = check_time(number_text(args.t, "--t"), "--t")
     out = output(args.out, args.mesh, OUT_SUFFIXES, "--out")
     curves = curves_path(args)
     if args.method == "spectral" and args.k is None:
