@@ -16,7 +16,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from meshlap_core.errors import MeshError
+from meshlap_core.errors import MeshError, printable
 
 from ..state.animation import Animation, animations
 
@@ -126,9 +126,23 @@ def _read_session(args: argparse.Namespace) -> Any:
     return read_session(args.session)
 
 
+def _refuse_other_options(args: argparse.Namespace, panel: str, anim: Animation) -> None:
+    """An option of another panel's animation, typed beside this panel, is refused (it would
+    be ignored without a word)."""
+    own = {opt.dest for opt in anim.options}
+    for name, other in animations().items():
+        for opt in other.options:
+            if opt.dest not in own and getattr(args, opt.dest, None) is not None:
+                raise MeshError(
+                    f"{opt.flag} is an option of --panel {name}, not of --panel {panel}",
+                    opt.flag,
+                )
+
+
 def run(args: argparse.Namespace) -> int:
     session = _read_session(args) if args.session is not None else None
     panel, anim = _choose(args, session)
+    _refuse_other_options(args, panel, anim)
     options = {opt.dest: getattr(args, opt.dest) for opt in anim.options}
     if session is not None:
         anim.from_session(options, session.settings[panel], args.session)
@@ -162,5 +176,5 @@ def run(args: argparse.Namespace) -> int:
         mesh = MeshState()
         mesh.load(None)  # the frames do not show it; the viewer needs one
     out = render(spec, mesh, progress=True)
-    sys.stdout.write(f"wrote {out}\n")
+    sys.stdout.write(f"wrote {printable(str(out))}\n")
     return 0

@@ -92,7 +92,7 @@ class DiffusionPanel(Panel):
                 self.precompute(host)
             self.push(host, force=True)
         elif self.watch.seen("field") is not None and ps.has_surface_mesh(MESH):
-            ps.get_surface_mesh(MESH).remove_quantity(FIELD)
+            ps.get_surface_mesh(MESH).remove_quantity(self._field_label())
             self.watch.forget("field")
 
     def pick(self, host: Host, hit: Any, active: Panel) -> bool:
@@ -259,7 +259,7 @@ class DiffusionPanel(Panel):
         f, vr, cmap = self._field()
         sm = ps.get_surface_mesh(MESH)
         if f is None or len(f) != len(host.state.mesh.V):
-            sm.remove_quantity(FIELD)
+            sm.remove_quantity(self._field_label())
         else:
             if vr is None:
                 fin = f[np.isfinite(f)]
@@ -267,15 +267,19 @@ class DiffusionPanel(Panel):
             # unreachable vertices (another component) and undefined errors take the top
             # colour: polyscope refuses non-finite values
             shown = np.where(np.isfinite(f), f, vr[1])
+            values, vr, factor = scene.scalar_for_upload(shown, vr)  # float32-safe
+            if FIELD + factor != self._field_label():
+                sm.remove_quantity(self._field_label())
+            self._uploaded_field = FIELD + factor
             sm.add_scalar_quantity(
-                FIELD,
-                shown,
+                FIELD + factor,
+                values,
                 cmap=cmap,
                 vminmax=vr,
                 enabled=True,
                 onscreen_colorbar_enabled=True,
                 onscreen_colorbar_location=scene.COLORBAR_AT,
-                **self.isolines.options(str(name), f, name in ISOLINES_ON),
+                **self.isolines.options(str(name), values, name in ISOLINES_ON),
             )
         self._push_sources(host)
         self._push_filtered(host)
@@ -330,10 +334,16 @@ class DiffusionPanel(Panel):
                 ps.register_surface_mesh(name, X, F, smooth_shade=True)
                 host.request_frame()
             iso = "heat error" if which == "difference" else "heat"
+            values, vrs, factor = scene.scalar_for_upload(self.state.heat[which], vr)
             ps.get_surface_mesh(name).add_scalar_quantity(
-                which, self.state.heat[which], cmap="coolwarm", vminmax=vr, enabled=True,
-                **self.isolines.options(iso, self.state.heat[which], iso in ISOLINES_ON),
+                which + factor, values, cmap="coolwarm", vminmax=vrs, enabled=True,
+                **self.isolines.options(iso, values, iso in ISOLINES_ON),
             )  # fmt: skip
+
+    def _field_label(self) -> str:
+        """The name the field was last uploaded under: :data:`FIELD`, with the factor of
+        :func:`.scene.scalar_for_upload` when its range needed one (``" (x 1e-110)"``)."""
+        return getattr(self, "_uploaded_field", FIELD)
 
     def points(self, host: Host, name: str) -> np.ndarray | None:
         if name == FILTERED and self.state.filtered is not None:
@@ -634,10 +644,14 @@ class DiffusionPanel(Panel):
             st.compute_heat(mesh.V, mesh.F, h, None)
             f = st.heat["euler"]
             top = float(f.max()) or 1.0
+            values, vr, factor = scene.scalar_for_upload(f, (0.0, top))  # float32-safe
+            if FIELD + factor != self._field_label():
+                ps.get_surface_mesh(MESH).remove_quantity(self._field_label())
+            self._uploaded_field = FIELD + factor
             ps.get_surface_mesh(MESH).add_scalar_quantity(
-                FIELD, f, cmap="viridis", vminmax=(0.0, top), enabled=True,
+                FIELD + factor, values, cmap="viridis", vminmax=vr, enabled=True,
                 onscreen_colorbar_enabled=True, onscreen_colorbar_location=scene.COLORBAR_AT,
-                **self.isolines.options("distance", np.array([0.0, top]), True),
+                **self.isolines.options("distance", np.array(vr), True),
             )  # fmt: skip
             self._push_sources(host)
             yield f"heat from vertex {source}: t = {st.t(h):.3g} = 10^{x:.2f} h^2, peak {top:.3g}"

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import sys
 from typing import Any
 
@@ -28,6 +29,12 @@ def parse_list(text: str, kind: type, name: str) -> list[Any]:
     if kind is float and not all(math.isfinite(v) for v in values):
         raise MeshError(f"values must be finite, got {text!r}", name)
     return values
+
+
+def shown(path: Any) -> str:
+    """A file name as printed on a terminal: control characters, escape sequences and
+    undecodable bytes escaped (:func:`~meshlap_core.errors.printable`), never printed raw."""
+    return printable(os.fsdecode(path) if isinstance(path, bytes) else str(path))
 
 
 def number_text(text: str, flag: str) -> float:

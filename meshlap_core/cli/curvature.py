@@ -31,7 +31,7 @@ from ..options import (
     DEFAULT_CURVATURE_FIELD,
     PRINCIPAL_FIELDS,
 )
-from ._common import add_json_flag, emit_json, print_report, summary_stats
+from ._common import add_json_flag, emit_json, print_report, shown, summary_stats
 
 OUT_SUFFIXES = (".csv", ".npy", ".ply")
 METHODS: tuple[str, ...] = CURVATURE_METHODS + tuple(
@@ -162,7 +162,7 @@ def run(args: argparse.Namespace) -> int:
         for k, v in stats.items():
             print(f"  {k:<7}{v: .6g}")
         if out is not None:
-            print(f"wrote {out}")
+            print(f"wrote {shown(out)}")
     return 0
 
 

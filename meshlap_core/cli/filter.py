@@ -19,7 +19,7 @@ from ..errors import MeshError
 from ..io import WRITE_FORMATS, load_mesh, save_mesh
 from ..options import MASS_AREA, SMOOTHING_METHODS
 from ..smoothing.params import check_iters
-from ._common import add_json_flag, emit_json, print_report
+from ._common import add_json_flag, emit_json, print_report, shown
 from ._sources import output
 
 OUT_SUFFIXES = WRITE_FORMATS  # (what save_mesh writes: refused before the work otherwise)
@@ -156,5 +156,5 @@ def run(args: argparse.Namespace) -> int:
     else:
         print(f"{name} filter over {args.k} modes (gain {h.min():.3g} .. {h.max():.3g})")
         print(f"  vertex displacement: max {moved.max():.6g}, mean {moved.mean():.6g}")
-        print(f"wrote {out}")
+        print(f"wrote {shown(out)}")
     return 0

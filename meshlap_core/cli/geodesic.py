@@ -19,7 +19,7 @@ from ..errors import MeshError
 from ..io import load_mesh, save_mesh, save_scalars
 from ..options import DEFAULT_HEAT_BOUNDARY, GEODESIC_METHODS, HEAT_BOUNDARIES
 from ..progress import Progress
-from ._common import add_json_flag, emit_json, number_text, print_report, summary_stats
+from ._common import add_json_flag, emit_json, number_text, print_report, shown, summary_stats
 from ._curves import add_curve_flags, curves_path, write_curves
 from ._sources import add_vertex_flag, output, vertices
 
@@ -153,4 +153,4 @@ def _print_text(r: dict) -> None:
         )
     for key in ("out", "curves"):
         if r[key]:
-            print(f"wrote {r[key]}")
+            print(f"wrote {shown(r[key])}")
