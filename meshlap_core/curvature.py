@@ -386,17 +386,28 @@ def principal_curvatures(
     return f["k1"], f["k2"]
 
 
+MIN_QUADRIC_RINGS = 2
+"""libigl's quadric fit needs at least two rings (it raises 1 to 2 with a warning on stderr)."""
+
+
 def check_ring_radius(radius: object, name: str = "radius") -> int:
-    """A count of edge rings as an ``int >= 1`` (a bool, a fraction, NaN or an infinity
-    refused, naming ``name``)."""
+    """A count of edge rings for libigl's quadric as an ``int >= 2``
+    (:data:`MIN_QUADRIC_RINGS`; a bool, a fraction, NaN or an infinity refused, naming
+    ``name``)."""
+    want = f"a whole number of edge rings >= {MIN_QUADRIC_RINGS}"
     if isinstance(radius, bool | np.bool_):
-        raise MeshError(f"a whole number of edge rings >= 1, got {radius!r}", name)
+        raise MeshError(f"{want}, got {radius!r}", name)
     try:
         value = float(radius)  # type: ignore[arg-type]
     except (TypeError, ValueError, OverflowError):
-        raise MeshError(f"a whole number of edge rings >= 1, got {radius!r}", name) from None
-    if not (np.isfinite(value) and value >= 1 and value == int(value)):
-        raise MeshError(f"a whole number of edge rings >= 1, got {radius!r}", name)
+        raise MeshError(f"{want}, got {radius!r}", name) from None
+    if not (np.isfinite(value) and value == int(value)):
+        raise MeshError(f"{want}, got {radius!r}", name)
+    if value < MIN_QUADRIC_RINGS:
+        raise MeshError(
+            f"{want} (libigl's quadric fit would take {MIN_QUADRIC_RINGS} instead), got {radius!r}",
+            name,
+        )
     return int(value)
 
 
@@ -472,7 +483,7 @@ def principal_curvature_quadric(
     lo, hi = V.min(axis=0), V.max(axis=0)
     scale = float(np.linalg.norm((hi - lo) / 2.0) * 2.0)
     scale = scale if np.isfinite(scale) and scale > 0 else 1.0
-    PD1, PD2, PV1, PV2, _bad = igl.principal_curvature((V - lo) / scale, F, radius)
+    PD1, PD2, PV1, PV2, bad = igl.principal_curvature((V - lo) / scale, F, radius)
     # libigl fits against the angle-weighted normal of the face orientation and returns
     # PV1 = max ≥ PV2 = min, already this module's sign (positive on a sphere with CCW faces):
     # the sign is never taken from the data (a minimal surface has Σ H ≈ 0, any sign)
@@ -481,8 +492,13 @@ def principal_curvature_quadric(
     k2 = np.where(swap, PV1, PV2) / scale
     d1 = np.where(swap[:, None], PD2, PD1)
     d2 = np.where(swap[:, None], PD1, PD2)
-    failed = np.flatnonzero(
-        ~(np.isfinite(k1) & np.isfinite(k2) & np.isfinite(d1).all(1) & np.isfinite(d2).all(1))
+    # libigl lists the vertices whose fit failed (and gives them 0, not NaN); a NaN is a
+    # failure too
+    failed = np.union1d(
+        np.asarray(bad, dtype=np.int64).ravel(),
+        np.flatnonzero(
+            ~(np.isfinite(k1) & np.isfinite(k2) & np.isfinite(d1).all(1) & np.isfinite(d2).all(1))
+        ),
     )
     if len(failed):
         raise MeshError(

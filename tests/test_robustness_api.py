@@ -41,7 +41,8 @@ CALLS: dict[str, Callable[[Any, Any, Any], Any]] = {
     "vertex_normals": lambda V, F, t: mc.vertex_normals(V, F),
     "estimate_curvature": lambda V, F, t: mc.estimate_curvature(V, F, "rusinkiewicz"),
     "principal_curvature_quadric": lambda V, F, t: mc.principal_curvature_quadric(V, F),
-    "jet_curvatures": lambda V, F, t: mc.jet_curvatures(V, F),
+    # (an explicit radius: the automatic one, 3 edges, covers most of a 12-vertex mesh)
+    "jet_curvatures": lambda V, F, t: mc.jet_curvatures(V, F, 1.2),
     "SpectralBasis": lambda V, F, t: mc.SpectralBasis.compute(V, F, 3, cache=False),
     "Smoother": lambda V, F, t: mc.Smoother(V, F),
     "smooth": lambda V, F, t: mc.smooth(V, F, iters=1),
