@@ -114,7 +114,10 @@ def _filter(args: argparse.Namespace, lam: np.ndarray) -> tuple[str, str, np.nda
                 f"LAM in size), got LAM = {vals[0]}, MU = {vals[1]}",
                 flag,
             )
-        gains = transfer(name, lam, step=step, iters=iters, nu=nu)  # type: ignore[arg-type]
+        try:
+            gains = transfer(name, lam, step=step, iters=iters, nu=nu)  # type: ignore[arg-type]
+        except MeshError as exc:  # (the core names its argument; here it is the flag)
+            raise MeshError(exc.problem, flag) from None
         return name, flag, gains
     raise MeshError("choose a filter", "--low-pass")  # argparse requires one
 
