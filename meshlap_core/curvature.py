@@ -395,7 +395,7 @@ def check_ring_radius(radius: object, name: str = "radius") -> int:
     (:data:`MIN_QUADRIC_RINGS`; a bool, a fraction, NaN or an infinity refused, naming
     ``name``)."""
     want = f"a whole number of edge rings >= {MIN_QUADRIC_RINGS}"
-    if isinstance(radius, bool | np.bool_):
+    if isinstance(radius, bool | np.bool_ | str | bytes):
         raise MeshError(f"{want}, got {radius!r}", name)
     try:
         value = float(radius)  # type: ignore[arg-type]

@@ -48,6 +48,7 @@ from .curvature import (
     _geometry_of,
     _mixed_corner_areas,
     _normals_from,
+    check_ring_radius,
     principal_curvature_quadric,
 )
 from .curvature_fit import jet_curvatures
@@ -62,7 +63,7 @@ from .options import (
     check_choice,
 )
 from .principal import PrincipalCurvatures, eig_sym2, tangent_frames
-from .types import FloatArray, IntArray, as_mesh
+from .types import FloatArray, IntArray, as_index, as_mesh
 
 
 def _from_tensor(
@@ -499,24 +500,27 @@ def curvature_at_vertex(
     check_choice(estimator, CURVATURE_ESTIMATORS, "estimator")
     if estimator not in PATCH_RINGS:
         raise MeshError(f"the {estimator} estimator needs the whole mesh", "estimator")
-    if not 0 <= int(vertex) < len(V):
-        raise MeshError(f"vertex {vertex} is out of range (the mesh has {len(V)})", "vertex")
-    rings = PATCH_RINGS[estimator] or int(options.get("radius", 5)) + 2
+    vertex = as_index(vertex, len(V), "vertex")
+    rings = PATCH_RINGS[estimator] or check_ring_radius(options.get("radius", 5)) + 2
     topo = topology_for(F, len(V), topology)
-    keep = np.array([int(vertex)], dtype=np.int64)  # sorted: the patch keeps the mesh's order
+    keep = np.array([vertex], dtype=np.int64)  # sorted: the patch keeps the mesh's order
     faces = np.zeros(0, dtype=np.int64)
     for _ in range(rings):  # the faces touching the ring so far, then their vertices
         faces = topo.faces_around(keep)
         keep = np.union1d(keep, F[faces].ravel())
     local = np.searchsorted(keep, F[faces])
     p = estimate_curvature(V[keep], local, estimator, **options)
-    return p, int(np.searchsorted(keep, int(vertex)))
+    return p, int(np.searchsorted(keep, vertex))
 
 
 def disagreement(results: list[PrincipalCurvatures], field: str = "H") -> FloatArray:
     """Max pairwise difference of ``field`` among estimators at every vertex, ``(n,)``: where it
     is large, no estimator can be trusted (noise, sharp features, bad triangles)."""
-    if not results:
-        raise MeshError("needs at least one estimator's result", "results")
+    if isinstance(results, PrincipalCurvatures) or not results:
+        raise MeshError("needs a list of at least one estimator's result", "results")
+    if not all(isinstance(r, PrincipalCurvatures) for r in results):
+        raise MeshError("every result must be a PrincipalCurvatures", "results")
+    if len({len(r.k1) for r in results}) != 1:
+        raise MeshError("the results are of meshes with different vertex counts", "results")
     X = np.stack([r.field(field) for r in results])
     return X.max(axis=0) - X.min(axis=0)

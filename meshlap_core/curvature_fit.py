@@ -220,7 +220,7 @@ def jet_curvatures(V: FloatArray, F: IntArray, radius: float | None = None) -> P
     if auto:
         r = default_jet_radius(V, F)
     else:
-        if isinstance(radius, bool | np.bool_):
+        if isinstance(radius, bool | np.bool_ | str | bytes):
             raise MeshError(f"must be a positive number (world units), got {radius!r}", "radius")
         try:
             r = float(radius)  # type: ignore[arg-type]

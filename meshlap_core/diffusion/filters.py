@@ -282,6 +282,10 @@ def smoother_transfer(
     """
     from ..smoothing import Smoother
 
+    if not isinstance(basis, SpectralBasis):
+        raise MeshError(f"must be a SpectralBasis, got {type(basis).__name__}", "basis")
+    step = as_real(step, "step", positive=True)
+    iters = as_count(iters, "iters", 0, MAX_ITERS)
     s = Smoother(
         basis.V,
         basis.F,

@@ -57,7 +57,7 @@ from ..options import (
     HeatBoundary,
     check_choice,
 )
-from ..types import FloatArray, IntArray, as_mesh, as_real
+from ..types import FloatArray, IntArray, as_count, as_faces, as_mesh, as_real
 from .heat import check_time
 from .sources import check_sources
 
@@ -106,7 +106,12 @@ def _mean_length(V: FloatArray, count: sp.csr_matrix) -> float:
 
 
 def boundary_vertices(F: IntArray, n: int) -> IntArray:
-    """Vertices on a boundary edge (an edge of one face), sorted ``(b,)`` int."""
+    """Vertices on a boundary edge (an edge of one face), sorted ``(b,)`` int. ``n`` (the
+    vertex count) must hold every index of ``F``; more vertices than ``3·len(F)`` can hold
+    no boundary (none of them is in a face), so a larger ``n`` is refused rather than
+    allocated."""
+    F = as_faces(F)
+    n = as_count(n, "n", int(F.max(initial=-1)) + 1, max(len(F) * 3, 1))
     if len(F) == 0:
         return np.zeros(0, dtype=np.int64)
     return _boundary(edge_counts(F, n))

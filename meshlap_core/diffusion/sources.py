@@ -14,7 +14,7 @@ from ..errors import MeshError
 from ..types import IntArray, as_field, as_indices
 
 
-def check_sources(sources: int | Iterable[int], n: int, name: str = "vertex") -> IntArray:
+def check_sources(sources: int | Iterable[int], n: int, name: str = "sources") -> IntArray:
     """The distinct source vertices as a sorted ``(s,)`` int64 array.
 
     Parameters
@@ -24,7 +24,8 @@ def check_sources(sources: int | Iterable[int], n: int, name: str = "vertex") ->
     n : int
         Number of vertices.
     name : str
-        The argument an error is attributed to (the CLI passes ``"--vertex"``).
+        The argument an error is attributed to (default ``"sources"``; the CLI passes
+        ``"--vertex"``).
 
     Raises
     ------
