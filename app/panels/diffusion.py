@@ -267,20 +267,7 @@ class DiffusionPanel(Panel):
             # unreachable vertices (another component) and undefined errors take the top
             # colour: polyscope refuses non-finite values
             shown = np.where(np.isfinite(f), f, vr[1])
-            values, vr, factor = scene.scalar_for_upload(shown, vr)  # float32-safe
-            if FIELD + factor != self._field_label():
-                sm.remove_quantity(self._field_label())
-            self._uploaded_field = FIELD + factor
-            sm.add_scalar_quantity(
-                FIELD + factor,
-                values,
-                cmap=cmap,
-                vminmax=vr,
-                enabled=True,
-                onscreen_colorbar_enabled=True,
-                onscreen_colorbar_location=scene.COLORBAR_AT,
-                **self.isolines.options(str(name), values, name in ISOLINES_ON),
-            )
+            self._show_field(sm, shown, vr, cmap, str(name), name in ISOLINES_ON)
         self._push_sources(host)
         self._push_filtered(host)
         self._push_heat_copies(host)
@@ -341,9 +328,20 @@ class DiffusionPanel(Panel):
             )  # fmt: skip
 
     def _field_label(self) -> str:
-        """The name the field was last uploaded under: :data:`FIELD`, with the factor of
-        :func:`.scene.scalar_for_upload` when its range needed one (``" (x 1e-110)"``)."""
+        """The name the field was last uploaded under (:data:`FIELD` and its factor)."""
         return getattr(self, "_uploaded_field", FIELD)
+
+    def _show_field(self, sm: Any, f: Any, vr: Any, cmap: str, *iso: Any) -> None:
+        """``f`` float32-safe (:func:`.scene.scalar_for_upload`); ``iso``: name, on[, span]."""
+        values, vr, factor = scene.scalar_for_upload(f, vr)
+        if FIELD + factor != self._field_label():
+            sm.remove_quantity(self._field_label())
+        self._uploaded_field = FIELD + factor
+        sm.add_scalar_quantity(
+            FIELD + factor, values, cmap=cmap, vminmax=vr, enabled=True,
+            onscreen_colorbar_enabled=True, onscreen_colorbar_location=scene.COLORBAR_AT,
+            **self.isolines.options(iso[0], np.array(vr) if iso[2:] else values, iso[1]),
+        )  # fmt: skip
 
     def points(self, host: Host, name: str) -> np.ndarray | None:
         if name == FILTERED and self.state.filtered is not None:
@@ -644,15 +642,7 @@ class DiffusionPanel(Panel):
             st.compute_heat(mesh.V, mesh.F, h, None)
             f = st.heat["euler"]
             top = float(f.max()) or 1.0
-            values, vr, factor = scene.scalar_for_upload(f, (0.0, top))  # float32-safe
-            if FIELD + factor != self._field_label():
-                ps.get_surface_mesh(MESH).remove_quantity(self._field_label())
-            self._uploaded_field = FIELD + factor
-            ps.get_surface_mesh(MESH).add_scalar_quantity(
-                FIELD + factor, values, cmap="viridis", vminmax=vr, enabled=True,
-                onscreen_colorbar_enabled=True, onscreen_colorbar_location=scene.COLORBAR_AT,
-                **self.isolines.options("distance", np.array(vr), True),
-            )  # fmt: skip
+            self._show_field(ps.get_surface_mesh(MESH), f, (0.0, top), "viridis", "distance", 1, 1)
             self._push_sources(host)
             yield f"heat from vertex {source}: t = {st.t(h):.3g} = 10^{x:.2f} h^2, peak {top:.3g}"
 

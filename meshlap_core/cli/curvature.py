@@ -82,26 +82,33 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
-def run(args: argparse.Namespace) -> int:
-    if args.out is not None and not args.out.strip():
-        raise MeshError("the output path is empty (give a file name or leave --out out)", "--out")
-    out = Path(args.out) if args.out is not None else None
-    if out is not None:  # checked first: a doomed run fails at once and writes nothing
-        check_output_path(out, overwrite_inputs=(args.mesh,), suffixes=OUT_SUFFIXES)
-    if args.directions is not None and not args.directions.strip():
+def _outputs(args: argparse.Namespace) -> tuple[Path | None, Path | None]:
+    """``--out`` and ``--directions`` checked first (a doomed run fails at once and writes
+    nothing): not empty, writable, not the input, not one and the same file."""
+    paths = []
+    for flag, text, suffixes in (
+        ("--out", args.out, OUT_SUFFIXES),
+        ("--directions", args.directions, (".npy",)),
+    ):
+        if text is not None and not text.strip():
+            raise MeshError(
+                f"the output path is empty (give a file name or leave {flag} out)", flag
+            )
+        paths.append(None if text is None else Path(text))
+        if text is not None:
+            check_output_path(paths[-1], overwrite_inputs=(args.mesh,), suffixes=suffixes)
+    out, dirs = paths
+    if out is not None and dirs is not None and os.path.abspath(dirs) == os.path.abspath(out):
         raise MeshError(
-            "the output path is empty (give a file name or leave --directions out)",
+            "--out and --directions name the same file (one would replace the other); give "
+            "them different names",
             "--directions",
         )
-    dirs = Path(args.directions) if args.directions else None
-    if dirs is not None:
-        check_output_path(dirs, overwrite_inputs=(args.mesh,), suffixes=(".npy",))
-        if out is not None and os.path.abspath(dirs) == os.path.abspath(out):
-            raise MeshError(
-                "--out and --directions name the same file (one would replace the other); "
-                "give them different names",
-                "--directions",
-            )
+    return out, dirs
+
+
+def run(args: argparse.Namespace) -> int:
+    out, dirs = _outputs(args)
     mesh = load_mesh(args.mesh)
     result = None
     if args.method is None:
