@@ -383,7 +383,9 @@ def _check_result(
     if promised and not np.all(res <= PROMISED_RESIDUAL):
         before = float(np.nanmax(res))
         lam, U, res, done = refine_pairs(K, m, lam, U, labels, res, pencil=pencil)
-        fix_signs(U)
+        sub = U[:, done.columns]  # (the sign rule on the changed columns only)
+        fix_signs(sub)
+        U[:, done.columns] = sub
         info.messages.append(
             f"{done.pairs} eigenpair(s) refined in {done.rounds} round(s) (inverse iteration, "
             f"Rayleigh-Ritz): max relative residual {before:.1e} -> {float(np.nanmax(res)):.1e}"
