@@ -98,7 +98,9 @@ class ViewerScreenshots:
             V, F, name = mesh
             path = work / f"{name}.obj"  # the viewer's panel names the mesh after its file
             save_mesh(path, V, F)
-        out = Path(out_png).resolve()  # before the working directory changes
+        # before the working directory changes; absolute, not resolved (a link named as the
+        # output is replaced, not written through)
+        out = Path(out_png).absolute()
         path = Path(path).resolve() if path is not None else None
         started_before = ps.is_initialized()
         log = work / "output.log"

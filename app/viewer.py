@@ -573,7 +573,7 @@ def run(
         path, panel = saved.mesh, saved.panel
     cwd = Path.cwd()  # before polyscope.init(), which may change it: the export folder
     path = Path(path).resolve() if path is not None else None
-    shot = Path(screenshot).resolve() if screenshot is not None else None
+    shot = Path(screenshot).absolute() if screenshot is not None else None  # (a link: replaced)
     if shot is not None and not shot.parent.is_dir():
         raise MeshError(f"output directory {shot.parent} does not exist", shot)
     if shot is None:  # the fork server of the window's jobs starts while the window opens

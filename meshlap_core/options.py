@@ -321,6 +321,23 @@ EXERCISE_TIMEOUT = 60.0
 """Seconds one task of a student file may run before it is stopped (``meshlap check --timeout``)."""
 EXERCISE_MEMORY_MB = 2048
 """Address space a student file may add to the checker's worker, in MiB (``--memory``)."""
+MAX_FIT_PAIRS = 200_000_000
+"""Largest number of (vertex, neighbour) pairs a local fit may visit, summed over the vertices:
+the jet's ball of world radius and libigl's quadric over edge rings. libigl fits about 5e6
+pairs/s, the jet 1e6 (bunny, 2 cores under load): this is a minute or more of work. A larger
+radius is refused before any work, naming the largest that fits."""
+
+MAX_HEAT_STEPS = 1000
+"""Most backward Euler steps of one heat flow (``heat --steps``; the Diffusion panel's limit
+too): each is a solve, and each mode's damping ``(1 + λt/N)^−N`` is then within
+``max_x |e^−x − (1 + x/N)^−N| = 2.7e-4`` of the exact ``e^−λt`` (2.7e-3 at N = 100), below
+the 1/256 a colour map shows."""
+
+MAX_ISOLINES = 1000
+"""Most level curves of one field (``--isolines``, :func:`~meshlap_core.diffusion.isolines`):
+more than a window can tell apart (a 4K screen is 2160 pixels tall), and each level can cross
+every face: 100000 curves of a 162-vertex sphere wrote 229 MB."""
+
 MAX_STIFFNESS_RATIO = 1e14
 """Largest ``τ · max_i K_ii / m_i`` (about ``τ λ_max``) of a backward Euler heat step
 ``(M + τK) u' = M u``: beyond it the mass is round-off of ``τK`` and the total heat (the

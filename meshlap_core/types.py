@@ -151,21 +151,21 @@ def as_faces(F: Any, n_vertices: int | None = None, name: str = "F") -> IntArray
     return np.ascontiguousarray(raw.astype(np.int64))  # astype copies: never a view
 
 
-def _index_range(raw: np.ndarray, name: str) -> tuple[Any, Any]:
+def _index_range(raw: np.ndarray, name: str, what: str = "face indices") -> tuple[Any, Any]:
     """The smallest and largest index of a non-empty real array, exactly as given; refuses
     non-integral values (13.5, NaN, inf)."""
     if raw.dtype.kind == "O":
         for x in raw.flat:
             if isinstance(x, float | np.floating) and not float(x).is_integer():
-                raise MeshError(f"face indices must be integers, got {float(x)!r}", name)
+                raise MeshError(f"{what} must be integers, got {float(x)!r}", name)
         ints = [int(x) for x in raw.flat]
         return min(ints), max(ints)
     if raw.dtype.kind == "f":
         if not np.isfinite(raw).all():
-            raise MeshError("face indices must be integers, got NaN or infinity", name)
+            raise MeshError(f"{what} must be integers, got NaN or infinity", name)
         if not np.all(np.mod(raw, 1) == 0):
             bad = raw[np.mod(raw, 1) != 0].flat[0]
-            raise MeshError(f"face indices must be integers, got {float(bad)!r}", name)
+            raise MeshError(f"{what} must be integers, got {float(bad)!r}", name)
     return raw.min(), raw.max()
 
 
@@ -203,3 +203,121 @@ def as_mesh(V: Any, F: Any) -> tuple[FloatArray, IntArray]:
     """Coerce a ``(V, F)`` pair; indices are checked against ``len(V)``."""
     Vc = as_vertices(V)
     return Vc, as_faces(F, len(Vc))
+
+
+# ----------------------------------------------------------------- arguments other than V, F
+# (the same refusals as for V and F: no bool taken for 1, no 2.5 truncated to 2, no index
+# wrapped to the end, no complex number losing its imaginary part; each names the argument)
+
+
+def as_indices(values: Any, n: int, name: str, what: str = "vertex indices") -> IntArray:
+    """Indices into ``n`` items as a flat ``int64`` array, each checked as given (before a
+    cast could wrap ``2⁶³`` to a negative index or truncate ``2.5``) to lie in ``[0, n)``.
+
+    Raises
+    ------
+    MeshError
+        Booleans, complex numbers, strings, non-integral values, NaN, or an index out of
+        range (shown as given, with the range).
+    """
+    raw = np.atleast_1d(real_array(values, name, what))
+    if raw.size == 0:
+        return np.zeros(0, dtype=np.int64)
+    lo, hi = _index_range(raw, name, what)
+    if lo < 0 or hi >= n:
+        bad = lo if lo < 0 else hi
+        raise MeshError(
+            f"index {_show_index(bad)} is out of range (there are {n}: 0..{n - 1})"
+            if n > 0
+            else f"index {_show_index(bad)} is out of range (there are none)",
+            name,
+        )
+    return np.ascontiguousarray(raw.astype(np.int64).ravel())
+
+
+def as_index(value: Any, n: int, name: str, what: str = "vertex indices") -> int:
+    """One index into ``n`` items, as :func:`as_indices` checks it (a scalar, not a list)."""
+    if np.ndim(value) != 0:
+        raise MeshError(f"must be one index (an integer), got shape {np.shape(value)}", name)
+    return int(as_indices(value, n, name, what)[0])
+
+
+def _scalar(value: Any, name: str, what: str) -> int | float:
+    """A real scalar as given (``int`` or ``float``): booleans, complex numbers, strings,
+    arrays and other objects refused, saying what was expected."""
+    if isinstance(value, np.ndarray) and value.ndim == 0:
+        value = value.item()
+    if isinstance(value, bool | np.bool_):
+        raise MeshError(f"must be {what}, got {value!r}", name)
+    if isinstance(value, int | np.integer):
+        return int(value)
+    if isinstance(value, float | np.floating):
+        return float(value)
+    if isinstance(value, complex | np.complexfloating):
+        raise MeshError(f"must be {what} (a real number), got {value!r}", name)
+    raise MeshError(f"must be {what}, got {_shown(value)}", name)
+
+
+def as_count(value: Any, name: str, lo: int = 1, hi: int | None = None) -> int:
+    """A count (a number of modes, steps, curves...) as an ``int`` in ``[lo, hi]``: booleans,
+    fractions (``2.5``), NaN, strings refused, not rounded; a count above ``hi`` refused
+    saying the bound."""
+    x = _scalar(value, name, "an integer count")
+    if isinstance(x, float) and not (np.isfinite(x) and x.is_integer()):
+        raise MeshError(f"must be an integer count, got {x!r}", name)
+    count = int(x)
+    if count < lo:
+        raise MeshError(f"must be at least {lo}, got {count}", name)
+    if hi is not None and count > hi:
+        shown = str(count) if len(str(count)) <= 24 else f"a number of {len(str(count))} digits"
+        raise MeshError(f"must be at most {hi}, got {shown}", name)
+    return count
+
+
+def as_real(value: Any, name: str, *, positive: bool = False) -> float:
+    """A finite real number (``positive``: ``> 0``); booleans, complex numbers, strings, NaN
+    and infinities refused."""
+    x = _scalar(value, name, "a number")
+    try:
+        f = float(x)
+    except OverflowError:  # an int beyond the floats
+        raise MeshError(f"must be a finite number, got {_shown(value)}", name) from None
+    if not np.isfinite(f):
+        raise MeshError(f"must be a finite number, got {f!r}", name)
+    if positive and not f > 0:
+        raise MeshError(f"must be positive, got {f!r}", name)
+    return f
+
+
+def as_field(X: Any, n: int, name: str, columns: bool = True) -> FloatArray:
+    """A per-vertex field as a new ``float64`` array of shape ``(n,)`` (or ``(n,c)`` when
+    ``columns``): real numbers (no booleans, complex numbers or strings), finite.
+
+    Raises
+    ------
+    MeshError
+        The values are not real numbers, the shape is not ``(n,)`` / ``(n,c)``, or a value
+        is NaN or infinite (its vertex named).
+    """
+    raw = real_array(X, name, "values")
+    try:
+        arr = np.array(raw, dtype=np.float64, copy=True)
+    except (TypeError, ValueError, OverflowError) as exc:
+        raise MeshError(f"values are not numbers ({exc})", name) from None
+    ok = arr.shape == (n,) or (columns and arr.ndim == 2 and arr.shape[0] == n)
+    if not ok:
+        want = f"({n},) or ({n},c)" if columns else f"({n},)"
+        raise MeshError(
+            f"should have shape {want} (one value per vertex); shape is {arr.shape}", name
+        )
+    finite = np.isfinite(arr) if arr.ndim == 1 else np.isfinite(arr).all(axis=1)
+    if not finite.all():
+        bad = int(np.flatnonzero(~finite)[0])
+        raise MeshError(f"the value at vertex {bad} is NaN or infinite", name)
+    return arr
+
+
+def _shown(value: Any) -> str:
+    """``repr(value)``, or its type's name when that is long (a 400-digit int, an array)."""
+    text = repr(value)
+    return text if len(text) <= 40 else type(value).__name__

@@ -58,6 +58,18 @@ def spd_backend(request, monkeypatch) -> str:
     return solver_backend()
 
 
+@pytest.fixture(params=[1, 2], ids=["one-slice-worker", "two-slice-workers"])
+def slice_plan(request, monkeypatch) -> int:
+    """Run a test under each plan the eigensolver can choose by itself: one slice worker
+    (what a busy machine gets) and two (an idle one). The choice is made from the machine's
+    load (:func:`meshlap_core.linalg.slicing.default_workers`), so without this fixture the
+    load would pick which plan a test sees. Returns the forced number of workers."""
+    from meshlap_core.linalg import eigsolve
+
+    monkeypatch.setattr(eigsolve, "default_workers", lambda n, slice_size: request.param)
+    return request.param
+
+
 @pytest.fixture(scope="module")
 def polyscope_mock(tmp_path_factory):
     """polyscope on its ``openGL_mock`` backend for one test module, every frame running the

@@ -18,7 +18,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from meshlap_core.errors import MeshError
+from meshlap_core.errors import MeshError, printable
 
 from ..panel_spec import PanelSpec
 from ..registry import animated
@@ -146,10 +146,25 @@ def _read_session(args: argparse.Namespace) -> Any:
     return read_session(args.session)
 
 
+def _refuse_other_options(args: argparse.Namespace, panel: str, spec: PanelSpec) -> None:
+    """An option of another panel's animation, typed beside this panel, is refused (it would
+    be ignored without a word)."""
+    own = set(spec.animation_options({}))
+    for name, other in animated().items():
+        flags = [(f.name, f.dest) for _, f in other.flags("animate")]
+        flags += [(o.flag, o.dest) for o in other.animation_declared().options]
+        for flag, dest in flags:
+            if dest not in own and getattr(args, dest, None) is not None:
+                raise MeshError(
+                    f"{flag} is an option of --panel {name}, not of --panel {panel}", flag
+                )
+
+
 def run(args: argparse.Namespace) -> int:
     session = _read_session(args) if args.session is not None else None
     panel, declared = _choose(args, session)
     anim = declared.animation_declared()
+    _refuse_other_options(args, panel, declared)
     options = declared.animation_options(vars(args))
     saved = session.settings[panel] if session is not None else None
     declared.fill_options(options, saved, args.session)
@@ -182,5 +197,5 @@ def run(args: argparse.Namespace) -> int:
         mesh = MeshState()
         mesh.load(None)  # the frames do not show it; the viewer needs one
     out = render(spec, mesh, progress=True)
-    sys.stdout.write(f"wrote {out}\n")
+    sys.stdout.write(f"wrote {printable(str(out))}\n")
     return 0

@@ -16,7 +16,7 @@ from meshlap_core.options import (
 from ..host import Host
 from ..isolines import draw_isolines
 from ..panel_spec import PanelSpec
-from ..scene import COLORBAR_AT, picked_vertex
+from ..scene import COLORBAR_AT, picked_vertex, scalar_for_upload
 from ..setting_widgets import setting_widget
 from ..state.curvature_lab import (
     SETTINGS,
@@ -24,6 +24,7 @@ from ..state.curvature_lab import (
     CurvatureLabState,
     LabResult,
 )
+from ..state.display import Display
 from .base import Panel
 
 LAB = "curvature lab"
@@ -66,14 +67,26 @@ class CurvatureLabPanel(Panel):
 
     def points(self, host: Host, name: str) -> np.ndarray | None:
         r = self.state.result
-        return r.V if name == LAB and r is not None else None
+        return self._shown(r)[0] if name == LAB and r is not None else None
+
+    def _shown(self, r: LabResult) -> tuple[np.ndarray, float]:
+        """The lab mesh's positions as uploaded and the scale applied: centred and scaled by
+        a power of two to a diagonal near 1 (:class:`~..state.display.Display`), since
+        polyscope stores float32 (a mesh at 1e74 or 1e-55 would upload as inf or 0). Kept
+        per result (its ``V``)."""
+        cached = getattr(self, "_display_of", None)
+        if cached is None or cached[0] is not r.V:
+            d = Display()
+            d.fit(r.V)
+            cached = self._display_of = (r.V, d.points(r.V), d.scale)
+        return cached[1], cached[2]
 
     def pick(self, host: Host, hit: Any, active: Panel) -> bool:
         """A click on the lab's mesh picks the vertex whose shape operator is shown."""
         r = self.state.result
         if active is not self or r is None or hit.structure_name != LAB:
             return False
-        idx = picked_vertex(hit, r.V, r.F)
+        idx = picked_vertex(hit, self._shown(r)[0], r.F)
         if idx is None:
             return False
         self.state.pick(idx)
@@ -168,13 +181,14 @@ class CurvatureLabPanel(Panel):
         face array per exact surface and flips) moves the vertices of the registered mesh
         instead of registering it again (0.15 ms against 8 ms at 32k on ``openGL_mock``)."""
         crosses = ("k1 direction (max)", "k2 direction (min)", "exact k1 direction")
+        P, scale = self._shown(r)  # (float32-safe positions; the crosses scaled alike)
         if self._faces is r.F and ps.has_surface_mesh(LAB):
             sm = ps.get_surface_mesh(LAB)
-            sm.update_vertex_positions(r.V)
+            sm.update_vertex_positions(P)
             for name in crosses:
                 sm.remove_quantity(name)
         else:
-            sm = ps.register_surface_mesh(LAB, r.V, r.F, smooth_shade=True)
+            sm = ps.register_surface_mesh(LAB, P, r.F, smooth_shade=True)
             self._faces, self._field = r.F, None
         c = r.crosses
         if not self.state.crosses or c is None:
@@ -188,29 +202,33 @@ class CurvatureLabPanel(Panel):
         ):
             if vals is not None:
                 sm.add_tangent_vector_quantity(
-                    name, vals, c.basis_x, c.basis_y, n_sym=2, vectortype="ambient",
+                    name, vals * scale, c.basis_x, c.basis_y, n_sym=2, vectortype="ambient",
                     enabled=on, color=color, radius=0.0012,
                 )  # fmt: skip
 
     def _upload_field(self, r: LabResult) -> None:
         """The coloured field (the previous one removed: one scalar quantity at a time)."""
         sm = ps.get_surface_mesh(LAB)
-        if self._field is not None and self._field != r.label:
-            sm.remove_quantity(self._field)
-        self._field = r.label
         v = np.asarray(r.values, dtype=np.float64)
         top = float(np.percentile(np.abs(v), 98)) if v.size else 1.0
-        top = top if top > 0 else 1.0
+        top = top if top > 0 and np.isfinite(top) else 1.0
         signed = bool((v < 0).any())
+        # float32-safe: a range beyond [1e-30, 1e30] (a mesh at 1e-55: curvatures of 1e55)
+        # is uploaded scaled by a power of ten that the label names
+        values, vr, factor = scalar_for_upload(v, (-top, top) if signed else (0.0, top))
+        label = r.label + factor
+        if self._field is not None and self._field != label:
+            sm.remove_quantity(self._field)
+        self._field = label
         sm.add_scalar_quantity(
-            r.label,
-            v,
+            label,
+            values,
             cmap="coolwarm" if signed else "viridis",
-            vminmax=(-top, top) if signed else (0.0, top),
+            vminmax=vr,
             enabled=True,
             onscreen_colorbar_enabled=True,
             onscreen_colorbar_location=COLORBAR_AT,
-            **self.isolines.options(self.state.show, v),
+            **self.isolines.options(self.state.show, values),
         )
 
     def draw(self, host: Host) -> None:

@@ -91,7 +91,7 @@ class DiffusionPanel(Panel):
                 self.precompute(host)
             self.push(host, force=True)
         elif self.watch.seen("field") is not None and ps.has_surface_mesh(MESH):
-            ps.get_surface_mesh(MESH).remove_quantity(FIELD)
+            ps.get_surface_mesh(MESH).remove_quantity(self._field_label())
             self.watch.forget("field")
 
     def pick(self, host: Host, hit: Any, active: Panel) -> bool:
@@ -258,7 +258,7 @@ class DiffusionPanel(Panel):
         f, vr, cmap = self._field()
         sm = ps.get_surface_mesh(MESH)
         if f is None or len(f) != len(host.state.mesh.V):
-            sm.remove_quantity(FIELD)
+            sm.remove_quantity(self._field_label())
         else:
             if vr is None:
                 fin = f[np.isfinite(f)]
@@ -266,16 +266,7 @@ class DiffusionPanel(Panel):
             # unreachable vertices (another component) and undefined errors take the top
             # colour: polyscope refuses non-finite values
             shown = np.where(np.isfinite(f), f, vr[1])
-            sm.add_scalar_quantity(
-                FIELD,
-                shown,
-                cmap=cmap,
-                vminmax=vr,
-                enabled=True,
-                onscreen_colorbar_enabled=True,
-                onscreen_colorbar_location=scene.COLORBAR_AT,
-                **self.isolines.options(str(name), f, name in ISOLINES_ON),
-            )
+            self._show_field(sm, shown, vr, cmap, str(name), name in ISOLINES_ON)
         self._push_sources(host)
         self._push_filtered(host)
         self._push_heat_copies(host)
@@ -329,10 +320,27 @@ class DiffusionPanel(Panel):
                 ps.register_surface_mesh(name, X, F, smooth_shade=True)
                 host.request_frame()
             iso = "heat error" if which == "difference" else "heat"
+            values, vrs, factor = scene.scalar_for_upload(self.state.heat[which], vr)
             ps.get_surface_mesh(name).add_scalar_quantity(
-                which, self.state.heat[which], cmap="coolwarm", vminmax=vr, enabled=True,
-                **self.isolines.options(iso, self.state.heat[which], iso in ISOLINES_ON),
+                which + factor, values, cmap="coolwarm", vminmax=vrs, enabled=True,
+                **self.isolines.options(iso, values, iso in ISOLINES_ON),
             )  # fmt: skip
+
+    def _field_label(self) -> str:
+        """The name the field was last uploaded under (:data:`FIELD` and its factor)."""
+        return getattr(self, "_uploaded_field", FIELD)
+
+    def _show_field(self, sm: Any, f: Any, vr: Any, cmap: str, *iso: Any) -> None:
+        """``f`` float32-safe (:func:`.scene.scalar_for_upload`); ``iso``: name, on[, span]."""
+        values, vr, factor = scene.scalar_for_upload(f, vr)
+        if FIELD + factor != self._field_label():
+            sm.remove_quantity(self._field_label())
+        self._uploaded_field = FIELD + factor
+        sm.add_scalar_quantity(
+            FIELD + factor, values, cmap=cmap, vminmax=vr, enabled=True,
+            onscreen_colorbar_enabled=True, onscreen_colorbar_location=scene.COLORBAR_AT,
+            **self.isolines.options(iso[0], np.array(vr) if iso[2:] else values, iso[1]),
+        )  # fmt: skip
 
     def points(self, host: Host, name: str) -> np.ndarray | None:
         if name == FILTERED and self.state.filtered is not None:
@@ -614,10 +622,6 @@ class DiffusionPanel(Panel):
             st.compute_heat(mesh.V, mesh.F, h, None)
             f = st.heat["euler"]
             top = float(f.max()) or 1.0
-            ps.get_surface_mesh(MESH).add_scalar_quantity(
-                FIELD, f, cmap="viridis", vminmax=(0.0, top), enabled=True,
-                onscreen_colorbar_enabled=True, onscreen_colorbar_location=scene.COLORBAR_AT,
-                **self.isolines.options("distance", np.array([0.0, top]), True),
-            )  # fmt: skip
+            self._show_field(ps.get_surface_mesh(MESH), f, (0.0, top), "viridis", "distance", 1, 1)
             self._push_sources(host)
             yield f"heat from vertex {source}: t = {st.t(h):.3g} = 10^{x:.2f} h^2, peak {top:.3g}"

@@ -269,7 +269,7 @@ def read_session(path: str | os.PathLike) -> Session:
 
 
 def write_session(path: str | os.PathLike, session: Session) -> Path:
-    """Write ``session`` to ``path`` atomically (indented JSON). Returns the resolved path.
+    """Write ``session`` to ``path`` atomically (indented JSON). Returns the absolute path.
 
     Raises
     ------
@@ -278,7 +278,8 @@ def write_session(path: str | os.PathLike, session: Session) -> Path:
         the session's mesh; or a value that :func:`from_dict` would refuse.
     """
     inputs = [session.mesh] if session.mesh is not None else []
-    target = check_output_path(path, overwrite_inputs=inputs, suffixes=(".json",)).resolve()
+    # (absolute, not resolved: a link named as the session file is replaced, not followed)
+    target = check_output_path(path, overwrite_inputs=inputs, suffixes=(".json",)).absolute()
     from_dict(session.to_dict(), target)  # write only what reads back (no NaN, no bad value)
     text = json.dumps(session.to_dict(target.parent), indent=2, allow_nan=False)
     with atomic_write(target, overwrite_inputs=inputs) as f:

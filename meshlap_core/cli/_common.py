@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import sys
 from pathlib import Path
 from typing import Any
@@ -29,6 +30,21 @@ def parse_list(text: str, kind: type, name: str) -> list[Any]:
     if kind is float and not all(math.isfinite(v) for v in values):
         raise MeshError(f"values must be finite, got {text!r}", name)
     return values
+
+
+def shown(path: Any) -> str:
+    """A file name as printed on a terminal: control characters, escape sequences and
+    undecodable bytes escaped (:func:`~meshlap_core.errors.printable`), never printed raw."""
+    return printable(os.fsdecode(path) if isinstance(path, bytes) else str(path))
+
+
+def number_text(text: str, flag: str) -> float:
+    """A number typed on the command line as a float (``nan`` and ``inf`` pass: the core's
+    check of the value names what is wrong); anything else refused naming ``flag``."""
+    try:
+        return float(text)
+    except (TypeError, ValueError):
+        raise MeshError(f"expected a number, got {text!r}", flag) from None
 
 
 def _jsonable(obj: Any) -> Any:

@@ -12,6 +12,7 @@ import numpy as np
 
 from ..diffusion import isoline_values, isolines, save_polylines
 from ..errors import MeshError
+from ..options import MAX_ISOLINES
 from ._sources import output
 
 
@@ -21,7 +22,7 @@ def add_curve_flags(p: argparse.ArgumentParser, field: str) -> None:
         "--isolines",
         type=int,
         default=0,
-        help=f"number of level curves of the {field} (with --curves)",
+        help=f"number of level curves of the {field}, at most {MAX_ISOLINES} (with --curves)",
     )
     p.add_argument(
         "--curves",
@@ -40,6 +41,12 @@ def curves_path(args: argparse.Namespace) -> Path | None:
     curves = output(args.curves, args.mesh, (".obj",), "--curves")
     if args.isolines < 0:
         raise MeshError(f"must be 0 or more, got {args.isolines}", "--isolines")
+    if args.isolines > MAX_ISOLINES:  # (each level may cross every face: bounded first)
+        raise MeshError(
+            f"at most {MAX_ISOLINES} level curves (more than a window tells apart, and each "
+            f"can cross every face), got {args.isolines}",
+            "--isolines",
+        )
     if (args.isolines > 0) != (curves is not None):
         raise MeshError("--isolines N and --curves FILE go together", "--isolines")
     return curves

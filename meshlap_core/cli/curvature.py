@@ -11,11 +11,12 @@ units) and ``--directions FILE.npy`` the ``(n, 2, 3)`` principal directions ``d1
 from __future__ import annotations
 
 import argparse
+import os
 from pathlib import Path
 
 import numpy as np
 
-from ..curvature import curvature_field
+from ..curvature import check_ring_radius, curvature_field
 from ..curvature.estimators import estimate_curvature
 from ..errors import MeshError
 from ..io import check_output_path, load_mesh
@@ -30,7 +31,7 @@ from ..options import (
     DEFAULT_CURVATURE_FIELD,
     PRINCIPAL_FIELDS,
 )
-from ._common import add_json_flag, emit_json, print_report, save_field, summary_stats
+from ._common import add_json_flag, emit_json, print_report, save_field, shown, summary_stats
 
 OUT_SUFFIXES = (".csv", ".npy", ".ply")
 METHODS: tuple[str, ...] = CURVATURE_METHODS + tuple(
@@ -81,15 +82,33 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
+def _outputs(args: argparse.Namespace) -> tuple[Path | None, Path | None]:
+    """``--out`` and ``--directions`` checked first (a doomed run fails at once and writes
+    nothing): not empty, writable, not the input, not one and the same file."""
+    paths = []
+    for flag, text, suffixes in (
+        ("--out", args.out, OUT_SUFFIXES),
+        ("--directions", args.directions, (".npy",)),
+    ):
+        if text is not None and not text.strip():
+            raise MeshError(
+                f"the output path is empty (give a file name or leave {flag} out)", flag
+            )
+        paths.append(None if text is None else Path(text))
+        if text is not None:
+            check_output_path(paths[-1], overwrite_inputs=(args.mesh,), suffixes=suffixes)
+    out, dirs = paths
+    if out is not None and dirs is not None and os.path.abspath(dirs) == os.path.abspath(out):
+        raise MeshError(
+            "--out and --directions name the same file (one would replace the other); give "
+            "them different names",
+            "--directions",
+        )
+    return out, dirs
+
+
 def run(args: argparse.Namespace) -> int:
-    if args.out is not None and not args.out.strip():
-        raise MeshError("the output path is empty (give a file name or leave --out out)", "--out")
-    out = Path(args.out) if args.out is not None else None
-    if out is not None:  # checked first: a doomed run fails at once and writes nothing
-        check_output_path(out, overwrite_inputs=(args.mesh,), suffixes=OUT_SUFFIXES)
-    dirs = Path(args.directions) if args.directions else None
-    if dirs is not None:
-        check_output_path(dirs, overwrite_inputs=(args.mesh,), suffixes=(".npy",))
+    out, dirs = _outputs(args)
     mesh = load_mesh(args.mesh)
     result = None
     if args.method is None:
@@ -101,7 +120,12 @@ def run(args: argparse.Namespace) -> int:
                 f"an estimator gives {', '.join(PRINCIPAL_FIELDS)}, not {args.method!r}",
                 "--method",
             )
-        result = estimate_curvature(mesh.V, mesh.F, args.estimator, **_options(args))
+        try:
+            result = estimate_curvature(mesh.V, mesh.F, args.estimator, **_options(args))
+        except MeshError as exc:
+            if exc.source == "radius":  # the flag the user typed
+                raise MeshError(exc.problem, "--radius") from None
+            raise
         values = result.field(args.method)
     else:
         if args.radius is not None or dirs is not None:
@@ -141,7 +165,7 @@ def run(args: argparse.Namespace) -> int:
         for k, v in stats.items():
             print(f"  {k:<7}{v: .6g}")
         if out is not None:
-            print(f"wrote {out}")
+            print(f"wrote {shown(out)}")
     return 0
 
 
@@ -154,11 +178,7 @@ def _options(args: argparse.Namespace) -> dict[str, object]:
     if args.radius is None:
         return {}
     if args.estimator == "quadric":
-        if args.radius != int(args.radius) or args.radius < 1:
-            raise MeshError(
-                f"quadric: a whole number of edge rings >= 1, got {args.radius}", "--radius"
-            )
-        return {"radius": int(args.radius)}
+        return {"radius": check_ring_radius(args.radius, "--radius")}
     if args.estimator == "jet":
         return {"radius": args.radius}
     raise MeshError(f"the {args.estimator} estimator has no radius", "--radius")

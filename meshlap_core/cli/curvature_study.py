@@ -17,7 +17,7 @@ from ..io.atomic import atomic_write
 from ..noise import check_seed
 from ..options import CURVATURE_ESTIMATORS, check_choice
 from ..surfaces import SURFACES
-from ._common import add_json_flag, emit_json, parse_list
+from ._common import add_json_flag, emit_json, parse_list, shown
 
 DEFAULT_SURFACES = "sphere,torus,saddle,helicoid"
 DEFAULT_LEVELS = "16,32,64"
@@ -75,24 +75,41 @@ def _fmt(x: object) -> str:
     return f"{x:.6g}" if isinstance(x, float) else str(x)
 
 
+def _output(path: str | None, flag: str, suffix: str) -> Path | None:
+    """An output flag's path checked before the work (an empty name refused, not ignored)."""
+    if path is None:
+        return None
+    if not path.strip():
+        raise MeshError(f"the output path is empty (give a file name or leave {flag} out)", flag)
+    return check_output_path(Path(path), suffixes=(suffix,))
+
+
+def _fraction(value: float, lo: float, hi: float, flag: str, what: str) -> float:
+    """A finite number in ``[lo, hi]`` (NaN and negatives refused, never ignored)."""
+    if not (math.isfinite(value) and lo <= value <= hi):
+        raise MeshError(f"must be {lo:g} to {hi:g} ({what}), got {value}", flag)
+    return value
+
+
 def run(args: argparse.Namespace) -> int:
-    out = Path(args.csv) if args.csv else None
-    if out is not None:
-        check_output_path(out, suffixes=(".csv",))
-    figure = Path(args.figure) if args.figure else None
-    if figure is not None:
-        check_output_path(figure, suffixes=(".png",))
+    out = _output(args.csv, "--csv", ".csv")
+    figure = _output(args.figure, "--figure", ".png")
     surfaces = _names(args.surfaces, list(SURFACES), "--surfaces")
     estimators = _names(args.estimators, CURVATURE_ESTIMATORS, "--estimators")
-    levels = parse_list(args.levels, int, "--levels")
+    levels = list(dict.fromkeys(parse_list(args.levels, int, "--levels")))  # (each level once)
     if any(n < 3 or n > MAX_LEVEL for n in levels):
         raise MeshError(f"levels must be 3 to {MAX_LEVEL}, got {levels}", "--levels")
-    if not (math.isfinite(args.noise) and 0 <= args.noise <= 0.1):
-        raise MeshError(f"must be 0 to 0.1 of the diagonal, got {args.noise}", "--noise")
+    noise = _fraction(args.noise, 0.0, 0.1, "--noise", "of the bounding-box diagonal")
+    jitter = _fraction(args.jitter, 0.0, 0.45, "--jitter", "of a cell")
+    flips = _fraction(args.flips, 0.0, 1.0, "--flips", "of the interior edges")
     seed = check_seed(args.seed, "--seed")
-    rows = curvature_study(
-        surfaces, estimators, levels, args.noise, args.jitter, seed, flips=args.flips
-    )
+    try:
+        rows = curvature_study(surfaces, estimators, levels, noise, jitter, seed, flips=flips)
+    except MeshError as exc:
+        flag = {"noise": "--noise", "jitter": "--jitter", "flips": "--flips", "seed": "--seed"}
+        if exc.source in flag:
+            raise MeshError(exc.problem, flag[exc.source]) from None
+        raise
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
     w.writerow(STUDY_COLUMNS)
@@ -118,7 +135,7 @@ def run(args: argparse.Namespace) -> int:
         cells = [_fmt(r[c]) for c in show] + [_fmt(r["angle_p95_deg"])]
         print(" ".join(f"{c:>12}" for c in cells))
     if out is not None:
-        print(f"wrote {out}")
+        print(f"wrote {shown(out)}")
     if figure is not None:
-        print(f"wrote {figure}")
+        print(f"wrote {shown(figure)}")
     return 0

@@ -14,6 +14,7 @@ from pathlib import Path
 from ..errors import MeshError
 from ..exercises.templates import template
 from ..io.atomic import atomic_write, check_output_path
+from ._common import shown
 
 FILENAME = "exercises.py"
 
@@ -29,6 +30,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    if not args.dir.strip():  # (Path("") is the current folder: never chosen by accident)
+        raise MeshError("the folder name is empty; name the folder to write into", "DIR")
     folder = Path(args.dir)
     if folder.exists() and not folder.is_dir():
         raise MeshError("not a folder", os.fspath(folder))
@@ -39,6 +42,6 @@ def run(args: argparse.Namespace) -> int:
     check_output_path(target)
     with atomic_write(target) as f:
         f.write(template(FILENAME))
-    print(f"wrote {target}")
-    print(f"next: implement the functions, then run  meshlap check {target}")
+    print(f"wrote {shown(target)}")
+    print(f"next: implement the functions, then run  meshlap check {shown(target)}")
     return 0

@@ -16,12 +16,13 @@ import numpy as np
 
 from ..diffusion import SpectralFilter, transfer
 from ..errors import MeshError
-from ..io import load_mesh, save_mesh
+from ..io import WRITE_FORMATS, load_mesh, save_mesh
 from ..options import MASS_AREA, SMOOTHING_METHODS
-from ._common import add_json_flag, emit_json, print_report
+from ..smoothing.params import check_iters
+from ._common import add_json_flag, emit_json, print_report, shown
 from ._sources import output
 
-OUT_SUFFIXES = (".obj", ".off", ".ply", ".stl")
+OUT_SUFFIXES = WRITE_FORMATS  # (what save_mesh writes: refused before the work otherwise)
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -34,50 +35,90 @@ def register(sub: argparse._SubParsersAction) -> None:
     kind.add_argument("--explicit", nargs=2, metavar=("LAM", "N"), help="explicit smoother")
     kind.add_argument("--implicit", nargs=2, metavar=("LAM", "N"), help="implicit smoother")
     kind.add_argument("--taubin", nargs=3, metavar=("LAM", "MU", "N"), help="Taubin smoother")
-    p.add_argument("--gain", type=float, default=2.0, help="gain of --band (default 2)")
+    p.add_argument("--gain", type=float, default=None, help="gain of --band (default 2)")
     p.add_argument("--residual", action="store_true", help="add back X − U Uᵀ M X")
     p.add_argument("--no-cache", action="store_true", help="do not read or write the basis cache")
-    p.add_argument("--out", required=True, help="the filtered mesh (.obj, .off, .ply, .stl)")
+    p.add_argument("--out", required=True, help=f"the filtered mesh ({', '.join(OUT_SUFFIXES)})")
     add_json_flag(p)
     p.set_defaults(func=run, laplacian="cotan", area=MASS_AREA)
 
 
-def _number(text: str, kind: type, flag: str) -> float:
+def _float(text: str, flag: str) -> float:
+    """A finite float from the command line (``nan``, ``inf``, ``1e999`` refused)."""
     try:
-        value = kind(text)
+        value = float(text)
     except ValueError:
-        raise MeshError(f"expected {kind.__name__}, got {text!r}", flag) from None
+        raise MeshError(f"expected a number, got {text!r}", flag) from None
     if not np.isfinite(value):
         raise MeshError(f"must be finite, got {text!r}", flag)
     return value
 
 
+def _int(text: str, flag: str, what: str) -> int:
+    """An integer from the command line (``2.5``, ``1e3`` refused; any number of digits is
+    read without overflow: the range checks that follow say what fits)."""
+    digits = text.strip()
+    if len(digits) > 40 and digits.lstrip("+-").isdigit():  # int() refuses > 4300 digits
+        sign = "-" if digits.startswith("-") else ""
+        return int(sign + "9" * 41)  # (out of every range: the caller's check names it)
+    try:
+        return int(digits)
+    except ValueError:
+        raise MeshError(f"expected {what} (an integer), got {text!r}", flag) from None
+
+
 def _gains(args: argparse.Namespace, lam: np.ndarray) -> tuple[str, np.ndarray]:
-    """The filter's name and its gain per mode."""
+    """The filter's name and its gain per mode (every one finite, else refused naming the
+    flag)."""
+    name, flag, h = _filter(args, lam)
+    bad = np.flatnonzero(~np.isfinite(h))
+    if len(bad):
+        raise MeshError(
+            f"the filter's gain overflows at mode {int(bad[0])} (lambda = {lam[bad[0]]:.4g}): "
+            "fewer steps, a smaller step or fewer modes (--k)",
+            flag,
+        )
+    return name, h
+
+
+def _filter(args: argparse.Namespace, lam: np.ndarray) -> tuple[str, str, np.ndarray]:
+    """The filter's name, its flag and its gains (unchecked)."""
     k = len(lam)
     if args.low_pass is not None:
         if not 0 <= args.low_pass <= k:
             raise MeshError(f"must be between 0 and --k = {k}, got {args.low_pass}", "--low-pass")
-        return "low-pass", transfer("low-pass", lam, keep=args.low_pass)
+        return "low-pass", "--low-pass", transfer("low-pass", lam, keep=args.low_pass)
     if args.band is not None:
         parts = args.band.split(":")
         if len(parts) != 2:
             raise MeshError(f"expected A:B (mode indices), got {args.band!r}", "--band")
-        a, b = (int(_number(x, int, "--band")) for x in parts)
+        a, b = (_int(x, "--band", "a mode index") for x in parts)
         if not 0 <= a < b <= k:
             raise MeshError(f"needs 0 <= A < B <= --k = {k}, got {args.band!r}", "--band")
-        return "band", transfer("band", lam, band=(a, b), gain=args.gain)
+        if not np.isfinite(args.gain):
+            raise MeshError(f"must be finite, got {args.gain}", "--gain")
+        return "band", "--band", transfer("band", lam, band=(a, b), gain=args.gain)
     for name in SMOOTHING_METHODS:
         vals = getattr(args, name)
         if vals is None:
             continue
         flag = f"--{name}"
-        step = _number(vals[0], float, flag)
-        iters = int(_number(vals[-1], int, flag))
-        nu = _number(vals[1], float, flag) if name == "taubin" else 0.0
-        if step <= 0 or iters < 0:
-            raise MeshError("needs LAM > 0 and N >= 0", flag)
-        return name, transfer(name, lam, step=step, iters=iters, nu=nu)  # type: ignore[arg-type]
+        step = _float(vals[0], flag)
+        iters = check_iters(_int(vals[-1], flag, "N, a number of steps"), flag)
+        nu = _float(vals[1], flag) if name == "taubin" else 0.0
+        if step <= 0:
+            raise MeshError(f"needs LAM > 0, got {vals[0]!r}", flag)
+        if name == "taubin" and not nu < -step:
+            raise MeshError(
+                f"needs MU < -LAM (Taubin's second step inflates: MU negative and larger than "
+                f"LAM in size), got LAM = {vals[0]}, MU = {vals[1]}",
+                flag,
+            )
+        try:
+            gains = transfer(name, lam, step=step, iters=iters, nu=nu)  # type: ignore[arg-type]
+        except MeshError as exc:  # (the core names its argument; here it is the flag)
+            raise MeshError(exc.problem, flag) from None
+        return name, flag, gains
     raise MeshError("choose a filter", "--low-pass")  # argparse requires one
 
 
@@ -85,6 +126,11 @@ def run(args: argparse.Namespace) -> int:
     out = output(args.out, args.mesh, OUT_SUFFIXES, "--out")
     if out is None:  # --out is required: argparse has refused its absence already
         raise MeshError("give the output mesh", "--out")
+    if args.gain is not None and args.band is None:
+        raise MeshError("--gain is the gain of --band; it has no meaning here", "--gain")
+    args.gain = 2.0 if args.gain is None else args.gain
+    if not np.isfinite(args.gain):  # before the work (the eigenbasis)
+        raise MeshError(f"must be finite, got {args.gain}", "--gain")
     mesh = load_mesh(args.mesh)
     V, F = mesh.V, mesh.F
     if not 1 <= args.k <= len(V):
@@ -113,5 +159,5 @@ def run(args: argparse.Namespace) -> int:
     else:
         print(f"{name} filter over {args.k} modes (gain {h.min():.3g} .. {h.max():.3g})")
         print(f"  vertex displacement: max {moved.max():.6g}, mean {moved.mean():.6g}")
-        print(f"wrote {out}")
+        print(f"wrote {shown(out)}")
     return 0

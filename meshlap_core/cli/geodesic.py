@@ -13,13 +13,21 @@ import argparse
 
 import numpy as np
 
-from ..diffusion import HeatGeodesic, exact_distance, igl_heat_distance
+from ..diffusion import HeatGeodesic, exact_distance, igl_heat_distance, mean_edge_length
 from ..diffusion.geodesic import check_time_factor
 from ..errors import MeshError
 from ..io import load_mesh
 from ..options import DEFAULT_HEAT_BOUNDARY, GEODESIC_METHODS, HEAT_BOUNDARIES
 from ..progress import Progress
-from ._common import add_json_flag, emit_json, print_report, save_field, summary_stats
+from ._common import (
+    add_json_flag,
+    emit_json,
+    number_text,
+    print_report,
+    save_field,
+    shown,
+    summary_stats,
+)
 from ._curves import add_curve_flags, curves_path, write_curves
 from ._sources import add_vertex_flag, output, vertices
 
@@ -42,12 +50,17 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--exact", action="store_true", help="also compute the exact distance and report the error"
     )
-    p.add_argument("--m", default="1", help="heat time factor, t = m h^2 (default 1)")
+    p.add_argument(
+        "--m",
+        default=None,
+        help="heat time factor, t = m h^2 (default 1; heat and igl-heat methods)",
+    )
     p.add_argument(
         "--boundary",
         choices=HEAT_BOUNDARIES,
-        default=DEFAULT_HEAT_BOUNDARY,
-        help=f"heat-step boundary condition on open meshes (default {DEFAULT_HEAT_BOUNDARY})",
+        default=None,
+        help=f"heat-step boundary condition on open meshes (default {DEFAULT_HEAT_BOUNDARY}; "
+        "heat method only: libigl's averages the two conditions itself)",
     )
     p.add_argument("--out", help="write one distance per vertex: .npy, .csv or .ply")
     add_curve_flags(p, "distance")
@@ -56,31 +69,49 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _distance(args: argparse.Namespace, V: np.ndarray, F: np.ndarray, src: np.ndarray, method: str):
-    if method == "exact":
-        bar = Progress(
-            1.0,
-            lambda p: f"meshlap geodesic: {100 * p.done:3.0f}% {p.message}",
-            in_place=False,
-            after_s=1.0,
-            every_s=1.0,
-        )
-        d = exact_distance(V, F, src, progress=bar.update)
-        bar.close()
-        return d
-    if method == "igl-heat":
-        return igl_heat_distance(V, F, src)
+    m = 1.0 if args.m is None else check_time_factor(number_text(args.m, "--m"), "--m")
     try:
-        return HeatGeodesic(V, F, m=args.m, boundary=args.boundary).distance(src)
+        if method == "exact":
+            bar = Progress(
+                1.0,
+                lambda p: f"meshlap geodesic: {100 * p.done:3.0f}% {p.message}",
+                in_place=False,
+                after_s=1.0,
+                every_s=1.0,
+            )
+            d = exact_distance(V, F, src, progress=bar.update)
+            bar.close()
+            return d
+        if method == "igl-heat":
+            t = None if args.m is None else m * mean_edge_length(V, F) ** 2
+            return igl_heat_distance(V, F, src, t=t)
+        boundary = DEFAULT_HEAT_BOUNDARY if args.boundary is None else args.boundary
+        return HeatGeodesic(V, F, m=m, boundary=boundary).distance(src)
     except MeshError as exc:
-        if exc.source == "m":
+        if exc.source in ("m", "t"):
             raise MeshError(exc.problem, "--m") from None
+        if exc.source in ("V", "F"):  # the mesh's own problem: named by its file
+            raise MeshError(exc.problem, args.mesh) from None
         raise exc.with_source(args.mesh) from None
+
+
+def _check_method_flags(args: argparse.Namespace) -> None:
+    """Flags the chosen method would ignore are refused, not dropped without a word."""
+    if args.method == "exact" and args.m is not None:
+        raise MeshError("the exact distance has no heat time; --m is for the heat methods", "--m")
+    if args.method != "heat" and args.boundary is not None:
+        raise MeshError(
+            f"--boundary is for --method heat (the {args.method} method does not take it)",
+            "--boundary",
+        )
 
 
 def run(args: argparse.Namespace) -> int:
     out = output(args.out, args.mesh, OUT_SUFFIXES, "--out")
     curves = curves_path(args)
-    check_time_factor(args.m, "--m")
+    if args.m is not None:
+        check_time_factor(number_text(args.m, "--m"), "--m")
+    _check_method_flags(args)
     mesh = load_mesh(args.mesh)
     V, F = mesh.V, mesh.F
     src = vertices(args, len(V))
@@ -126,4 +157,4 @@ def _print_text(r: dict) -> None:
         )
     for key in ("out", "curves"):
         if r[key]:
-            print(f"wrote {r[key]}")
+            print(f"wrote {shown(r[key])}")

@@ -15,8 +15,16 @@ from ..diffusion import HeatDiffusion, heat_spectral, truncation_bound, unit_hea
 from ..diffusion.heat import check_time
 from ..errors import MeshError
 from ..io import load_mesh
-from ..options import HEAT_METHODS, MASS_AREA
-from ._common import add_json_flag, emit_json, print_report, save_field, summary_stats
+from ..options import HEAT_METHODS, MASS_AREA, MAX_HEAT_STEPS
+from ._common import (
+    add_json_flag,
+    emit_json,
+    number_text,
+    print_report,
+    save_field,
+    shown,
+    summary_stats,
+)
 from ._curves import add_curve_flags, curves_path, write_curves
 from ._sources import add_vertex_flag, output, vertices
 
@@ -32,7 +40,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_vertex_flag(p)
     p.add_argument("--t", required=True, help="diffusion time t > 0 (length^2)")
     p.add_argument("--method", choices=HEAT_METHODS, default="euler", help="default: euler")
-    p.add_argument("--steps", type=int, default=1, help="backward Euler steps (default 1)")
+    p.add_argument(
+        "--steps",
+        type=int,
+        default=None,
+        help=f"backward Euler steps, 1 to {MAX_HEAT_STEPS} (default 1; --method euler)",
+    )
     p.add_argument("--k", type=int, default=None, help="eigenmodes of --method spectral")
     p.add_argument("--no-cache", action="store_true", help="do not read or write the basis cache")
     p.add_argument("--out", help="write u: .npy, .csv or .ply")
@@ -42,13 +55,26 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    t = check_time(args.t, "--t")
+    t = check_time(number_text(args.t, "--t"), "--t")
     out = output(args.out, args.mesh, OUT_SUFFIXES, "--out")
     curves = curves_path(args)
     if args.method == "spectral" and args.k is None:
         raise MeshError("--method spectral needs --k (the number of eigenmodes)", "--k")
+    if args.method == "euler" and args.k is not None:
+        raise MeshError("--k is the number of eigenmodes of --method spectral", "--k")
+    if args.method == "euler" and args.no_cache:
+        raise MeshError("--no-cache is for --method spectral (euler uses no basis)", "--no-cache")
+    if args.method == "spectral" and args.steps is not None:
+        raise MeshError("--steps is for --method euler (the expansion takes none)", "--steps")
+    args.steps = 1 if args.steps is None else args.steps
     if args.steps < 1:
         raise MeshError(f"must be at least 1, got {args.steps}", "--steps")
+    if args.steps > MAX_HEAT_STEPS:
+        raise MeshError(
+            f"at most {MAX_HEAT_STEPS} steps (beyond, each step's damping is within 3e-4 of "
+            f"the exact flow's), got {args.steps}",
+            "--steps",
+        )
     mesh = load_mesh(args.mesh)
     V, F = mesh.V, mesh.F
     src = vertices(args, len(V))
@@ -92,5 +118,5 @@ def run(args: argparse.Namespace) -> int:
         )
     for path in (out, curves):
         if path is not None:
-            print(f"wrote {path}")
+            print(f"wrote {shown(path)}")
     return 0

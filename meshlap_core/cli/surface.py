@@ -35,7 +35,7 @@ from ..surfaces import (
     point_geometry,
     signs_note,
 )
-from ._common import add_json_flag, emit_json, parse_list
+from ._common import add_json_flag, emit_json, parse_list, shown
 
 DEFAULT_RES = {"grid": "8,16,32,64,128", "icosphere": "1,2,3,4,5"}
 PROGRESS_BYTES = 256 * 1024**2  # --mesh: a line on stderr before meshes estimated above this
@@ -241,7 +241,7 @@ def _run(args: argparse.Namespace) -> int:
         return 0
     _print_point(geo, surface)
     if plot is not None:
-        print(f"wrote {plot}")
+        print(f"wrote {shown(plot)}")
     if mesh_info is not None:
         print(
             f"wrote {args.mesh}: {mesh_info['n_vertices']} vertices, {mesh_info['n_faces']} faces"

@@ -48,7 +48,7 @@ from ..options import (
     CurvatureEstimator,
     check_choice,
 )
-from ..types import FloatArray, IntArray, as_mesh
+from ..types import FloatArray, IntArray, as_index, as_mesh
 from .fields import (
     _areas_from,
     _cotan_Cx,
@@ -59,6 +59,7 @@ from .fields import (
     _geometry_of,
     _mixed_corner_areas,
     _normals_from,
+    check_ring_radius,
     principal_curvature_quadric,
 )
 from .jet_fit import jet_curvatures
@@ -219,7 +220,10 @@ def cotan_curvatures(
 
 def quadric_curvatures(V: FloatArray, F: IntArray, radius: int = 5) -> PrincipalCurvatures:
     """libigl's ``principal_curvature`` (a quadric fitted over ``radius`` edge rings; Panozzo,
-    Puppo & Rocca, "Efficient multi-scale curvature and crease estimation", 2010).
+    Puppo & Rocca, "Efficient multi-scale curvature and crease estimation", 2010), on the mesh
+    scaled to a unit box (see
+    :func:`~meshlap_core.curvature.principal_curvature_quadric`: bounds of the radius, and a
+    failed fit refused, never reported as 0).
 
     libigl returns ``PV1 ≥ PV2`` (``PV1`` is the **max**) against the normal of the face
     orientation: ``k1 = PV1``, ``k2 = PV2``, ``d1 = PD1``, ``d2 = PD2`` in this convention.
@@ -229,9 +233,7 @@ def quadric_curvatures(V: FloatArray, F: IntArray, radius: int = 5) -> Principal
     PrincipalCurvatures
     """
     V, F = as_mesh(V, F)
-    if int(radius) < 1:
-        raise MeshError(f"the ring radius must be at least 1, got {radius}", "radius")
-    k1, k2, d1, d2 = principal_curvature_quadric(V, F, int(radius))
+    k1, k2, d1, d2 = principal_curvature_quadric(V, F, radius)  # (checks the radius)
     fn, theta = _face_geometry(V, F)
     return PrincipalCurvatures(k1, k2, d1, d2, _normals_from(F, len(V), fn, theta), "quadric")
 
@@ -509,24 +511,27 @@ def curvature_at_vertex(
     check_choice(estimator, CURVATURE_ESTIMATORS, "estimator")
     if estimator not in PATCH_RINGS:
         raise MeshError(f"the {estimator} estimator needs the whole mesh", "estimator")
-    if not 0 <= int(vertex) < len(V):
-        raise MeshError(f"vertex {vertex} is out of range (the mesh has {len(V)})", "vertex")
-    rings = PATCH_RINGS[estimator] or int(options.get("radius", 5)) + 2
+    vertex = as_index(vertex, len(V), "vertex")
+    rings = PATCH_RINGS[estimator] or check_ring_radius(options.get("radius", 5)) + 2
     topo = topology_for(F, len(V), topology)
-    keep = np.array([int(vertex)], dtype=np.int64)  # sorted: the patch keeps the mesh's order
+    keep = np.array([vertex], dtype=np.int64)  # sorted: the patch keeps the mesh's order
     faces = np.zeros(0, dtype=np.int64)
     for _ in range(rings):  # the faces touching the ring so far, then their vertices
         faces = topo.faces_around(keep)
         keep = np.union1d(keep, F[faces].ravel())
     local = np.searchsorted(keep, F[faces])
     p = estimate_curvature(V[keep], local, estimator, **options)
-    return p, int(np.searchsorted(keep, int(vertex)))
+    return p, int(np.searchsorted(keep, vertex))
 
 
 def disagreement(results: list[PrincipalCurvatures], field: str = "H") -> FloatArray:
     """Max pairwise difference of ``field`` among estimators at every vertex, ``(n,)``: where it
     is large, no estimator can be trusted (noise, sharp features, bad triangles)."""
-    if not results:
-        raise MeshError("needs at least one estimator's result", "results")
+    if isinstance(results, PrincipalCurvatures) or not results:
+        raise MeshError("needs a list of at least one estimator's result", "results")
+    if not all(isinstance(r, PrincipalCurvatures) for r in results):
+        raise MeshError("every result must be a PrincipalCurvatures", "results")
+    if len({len(r.k1) for r in results}) != 1:
+        raise MeshError("the results are of meshes with different vertex counts", "results")
     X = np.stack([r.field(field) for r in results])
     return X.max(axis=0) - X.min(axis=0)

@@ -26,6 +26,8 @@ from typing import NamedTuple
 
 import igl
 import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components, dijkstra
 
 from ..errors import MeshError
 from ..laplacian import cotangents_intrinsic, uniform_laplacian, vertex_areas
@@ -35,6 +37,7 @@ from ..options import (
     CURVATURE_AREA,
     CURVATURE_FIELDS,
     DEFAULT_BOUNDARY,
+    MAX_FIT_PAIRS,
     AreaKind,
     BoundaryRule,
     CurvatureField,
@@ -392,6 +395,46 @@ def principal_curvatures(
     return f["k1"], f["k2"]
 
 
+MIN_QUADRIC_RINGS = 2
+"""libigl's quadric fit needs at least two rings (it raises 1 to 2 with a warning on stderr)."""
+
+
+def check_ring_radius(radius: object, name: str = "radius") -> int:
+    """A count of edge rings for libigl's quadric as an ``int >= 2``
+    (:data:`MIN_QUADRIC_RINGS`; a bool, a fraction, NaN or an infinity refused, naming
+    ``name``)."""
+    want = f"a whole number of edge rings >= {MIN_QUADRIC_RINGS}"
+    if isinstance(radius, bool | np.bool_ | str | bytes):
+        raise MeshError(f"{want}, got {radius!r}", name)
+    try:
+        value = float(radius)  # type: ignore[arg-type]
+    except (TypeError, ValueError, OverflowError):
+        raise MeshError(f"{want}, got {radius!r}", name) from None
+    if not (np.isfinite(value) and value == int(value)):
+        raise MeshError(f"{want}, got {radius!r}", name)
+    if value < MIN_QUADRIC_RINGS:
+        raise MeshError(
+            f"{want} (libigl's quadric fit would take {MIN_QUADRIC_RINGS} instead), got {radius!r}",
+            name,
+        )
+    return int(value)
+
+
+def ring_reach(F: IntArray, n: int) -> int:
+    """An upper bound of the number of edge rings around any vertex: twice the largest
+    eccentricity (in edges) of one vertex per component (``ecc ≤ diameter ≤ 2·ecc``).
+    Rings beyond it hold nothing new; libigl's quadric still loops over each."""
+    if len(F) == 0:
+        return 0
+    a = np.concatenate([F[:, 0], F[:, 1], F[:, 2]])
+    b = np.concatenate([F[:, 1], F[:, 2], F[:, 0]])
+    graph = sp.coo_matrix((np.ones(len(a)), (a, b)), shape=(n, n)).tocsr()
+    _, labels = connected_components(graph, directed=False)
+    reps = np.unique(labels, return_index=True)[1]
+    dist = dijkstra(graph, directed=False, indices=reps, unweighted=True, min_only=True)
+    return int(2 * np.max(dist[np.isfinite(dist)], initial=0.0))
+
+
 def principal_curvature_quadric(
     V: FloatArray, F: IntArray, radius: int = 5
 ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
@@ -402,6 +445,11 @@ def principal_curvature_quadric(
     face orientation, positive on a sphere with counter-clockwise faces, and returns ``PV1`` as
     the maximum: ``k1 = PV1, k2 = PV2`` (reversing the faces negates and swaps both).
 
+    libigl's fit uses absolute tolerances: it runs on the mesh scaled to a unit bounding box
+    and the curvatures are scaled back (``κ(sV) = κ(V)/s``), so a mesh at 1e-55 or 1e74 gets
+    its curvature (1e110, 1e-148), not a failed fit. Where the fit still fails (libigl answers
+    NaN: too few or degenerate neighbours) the estimator says so instead of reporting 0.
+
     Call only on a validated mesh (libigl crashes on unreferenced vertices): this function
     refuses a mesh with unreferenced vertices.
 
@@ -411,6 +459,13 @@ def principal_curvature_quadric(
         ``κ₁ ≥ κ₂``, positive on a sphere with outward normals.
     d1, d2 : (n,3) float
         Unit principal directions of ``κ₁`` and ``κ₂``.
+
+    Raises
+    ------
+    MeshError
+        A bad radius, one reaching past every ring of the mesh or asking more fitting work than
+        :data:`~meshlap_core.options.MAX_FIT_PAIRS` (both checked before libigl runs), no
+        faces or unreferenced vertices, or a fit that fails at some vertices.
 
     Examples
     --------
@@ -423,21 +478,55 @@ def principal_curvature_quadric(
     (0.51, 0.51, True)
     """
     V, F = as_mesh(V, F)
+    radius = check_ring_radius(radius)
     used = np.zeros(len(V), dtype=bool)
     used[F.ravel()] = True
     if len(F) == 0 or not used.all():
         raise MeshError("the quadric fit needs a mesh with faces and no unreferenced vertices")
-    PD1, PD2, PV1, PV2, _bad = igl.principal_curvature(V, F, radius)
+    reach = ring_reach(F, len(V))
+    if radius > max(reach, 1):
+        raise MeshError(
+            f"{radius} edge rings reach past the whole mesh (no vertex has more than {reach} "
+            f"rings around it); use at most {max(reach, 1)}",
+            "radius",
+        )
+    ball = min(len(V), 1 + 3 * radius * (radius + 1))  # a ring k holds ~6k vertices
+    if len(V) * ball > MAX_FIT_PAIRS:
+        most = max(1, int((np.sqrt(1 + 4 * (MAX_FIT_PAIRS / len(V) - 1) / 3) - 1) / 2))
+        raise MeshError(
+            f"{radius} edge rings around each of the {len(V)} vertices is ~{len(V) * ball:.1e} "
+            f"vertex-neighbour pairs to fit, more than {MAX_FIT_PAIRS:.0e} (minutes of work); "
+            f"use at most {most} rings on this mesh",
+            "radius",
+        )
+    lo, hi = V.min(axis=0), V.max(axis=0)
+    scale = float(np.linalg.norm((hi - lo) / 2.0) * 2.0)
+    scale = scale if np.isfinite(scale) and scale > 0 else 1.0
+    PD1, PD2, PV1, PV2, bad = igl.principal_curvature((V - lo) / scale, F, radius)
     # libigl fits against the angle-weighted normal of the face orientation and returns
     # PV1 = max ≥ PV2 = min, already this module's sign (positive on a sphere with CCW faces):
     # the sign is never taken from the data (a minimal surface has Σ H ≈ 0, any sign)
     swap = PV2 > PV1
-    k1 = np.where(swap, PV2, PV1)
-    k2 = np.where(swap, PV1, PV2)
+    k1 = np.where(swap, PV2, PV1) / scale
+    k2 = np.where(swap, PV1, PV2) / scale
     d1 = np.where(swap[:, None], PD2, PD1)
     d2 = np.where(swap[:, None], PD1, PD2)
-    clean = lambda x: np.nan_to_num(x, nan=0.0, posinf=0.0, neginf=0.0)  # noqa: E731
-    return clean(k1), clean(k2), clean(d1), clean(d2)
+    # libigl lists the vertices whose fit failed (and gives them 0, not NaN); a NaN is a
+    # failure too
+    failed = np.union1d(
+        np.asarray(bad, dtype=np.int64).ravel(),
+        np.flatnonzero(
+            ~(np.isfinite(k1) & np.isfinite(k2) & np.isfinite(d1).all(1) & np.isfinite(d2).all(1))
+        ),
+    )
+    if len(failed):
+        raise MeshError(
+            f"libigl's quadric fit failed at {len(failed)} vertices (first: vertex "
+            f"{int(failed[0])}): too few or degenerate neighbours within {radius} rings; use "
+            "a larger radius or another estimator",
+            "radius",
+        )
+    return k1, k2, d1, d2
 
 
 def all_curvature_fields(

@@ -33,6 +33,7 @@ from scipy.spatial import cKDTree
 from ..errors import MeshError
 from ..laplacian import mean_edge_length, uniform_laplacian
 from ..noise import bbox_diagonal
+from ..options import MAX_FIT_PAIRS
 from ..types import FloatArray, IntArray, as_mesh
 from .fields import _face_geometry, _normals_from
 from .principal import PrincipalCurvatures, eig_sym2, tangent_frames
@@ -78,7 +79,11 @@ def default_jet_radius(V: FloatArray, F: IntArray) -> float:
     h = mean_edge_length(V, F)
     sigma = estimate_normal_noise(V, F)
     D = bbox_diagonal(V)
-    return max(JET_RADIUS_EDGES * h, JET_RADIUS_GAIN * (sigma * h * D**3) ** 0.2)
+    if not D > 0:
+        return JET_RADIUS_EDGES * h
+    # C (σ h D³)^(1/5) written as C D (σ h / D²)^(1/5): no overflow at 1e74 (D⁵ would be
+    # 1e370) nor underflow at 1e-55
+    return max(JET_RADIUS_EDGES * h, JET_RADIUS_GAIN * D * ((sigma / D) * (h / D)) ** 0.2)
 
 
 def _sums(S: sp.csr_matrix, cols: list[np.ndarray]) -> np.ndarray:
@@ -136,11 +141,17 @@ def _chunk(
     rhs = sums[:, len(powers) :]
     A += 1e-10 * np.eye(6) * (np.trace(A, axis1=1, axis2=2)[:, None, None] + 1e-300)
     cnt = np.bincount(i, minlength=m)
+    few = np.flatnonzero(cnt < 6)
+    if len(few):  # too few neighbours for a jet (6 unknowns): no estimate, said so
+        raise _TooFew(int(idx[few[0]]), int(cnt[few[0]]), len(few))
     coef = np.linalg.solve(A, rhs[:, :, None])[:, :, 0]
-    coef[cnt < 6] = 0.0  # too few neighbours for a jet: report a flat point
     c1, c2 = coef[:, 1], coef[:, 2]
     a, b, c = coef[:, 3] / r, coef[:, 4] / r, coef[:, 5] / r  # back to world units
     return c1, c2, a, b, c, t1, t2, nrm
+
+
+class _TooFew(Exception):
+    """A vertex of a chunk has fewer than 6 vertices in its ball (vertex, count, how many)."""
 
 
 def _shape_operator(c1, c2, a, b, c, t1, t2, nrm) -> tuple[FloatArray, ...]:
@@ -189,7 +200,12 @@ def jet_curvatures(V: FloatArray, F: IntArray, radius: float | None = None) -> P
     Raises
     ------
     MeshError
-        A radius that is not a positive finite number.
+        A radius that is not a positive finite number; one whose ball holds (nearly) the
+        whole mesh (at least half its bounding-box diagonal: the jet would fit one quadric
+        to all of it, not the surface around the vertex); one asking more fitting work than
+        :data:`~meshlap_core.options.MAX_FIT_PAIRS` (both checked before the fit); or a
+        vertex with fewer than 6 vertices in its ball (a radius below the edge length: the
+        jet has 6 unknowns). The automatic radius is named as such.
 
     Examples
     --------
@@ -202,26 +218,58 @@ def jet_curvatures(V: FloatArray, F: IntArray, radius: float | None = None) -> P
     (2.1, 2.1, 'jet')
     """
     V, F = as_mesh(V, F)
-    r = default_jet_radius(V, F) if radius is None else float(radius)
-    if not np.isfinite(r) or r <= 0:
-        raise MeshError(f"the fit radius must be a positive number, got {radius!r}", "radius")
+    auto = radius is None
+    what = "the automatic radius" if auto else "the fit radius"
+    if auto:
+        r = default_jet_radius(V, F)
+    else:
+        if isinstance(radius, bool | np.bool_ | str | bytes):
+            raise MeshError(f"must be a positive number (world units), got {radius!r}", "radius")
+        try:
+            r = float(radius)  # type: ignore[arg-type]
+        except (TypeError, ValueError, OverflowError):
+            raise MeshError(
+                f"must be a positive number (world units), got {radius!r}", "radius"
+            ) from None
+    if not (np.isfinite(r) and r > 0):
+        raise MeshError(f"{what} must be a positive finite number, got {r!r}", "radius")
     n = len(V)
+    D = bbox_diagonal(V)
+    if r >= 0.5 * D:
+        raise MeshError(
+            f"{what} {r:.4g} is at least half the mesh's bounding-box diagonal ({D:.4g}): each "
+            "ball holds (nearly) the whole mesh and the jet would fit one quadric to all of "
+            f"it; use a radius below {0.5 * D:.4g} (a few edge lengths to a tenth of the size)",
+            "radius",
+        )
     fn, theta = _face_geometry(V, F)
     Nv = _normals_from(F, n, fn, theta)
     tree = cKDTree(V)
     X = [np.ascontiguousarray(V[:, k]) for k in range(3)]
-    per = max(
-        1,
-        int(
-            tree.count_neighbors(cKDTree(V[:: max(1, n // 200)]), r)
-            / max(1, len(V[:: max(1, n // 200)]))
-        ),
-    )
+    sample = V[:: max(1, n // 200)]
+    per = max(1, int(tree.count_neighbors(cKDTree(sample), r) / max(1, len(sample))))
+    if n * per > MAX_FIT_PAIRS:
+        most = r * np.sqrt(MAX_FIT_PAIRS / (n * per))  # (a ball's count grows like r²)
+        raise MeshError(
+            f"{what} {r:.4g} holds ~{per} vertices per ball: ~{n * per:.1e} vertex-neighbour "
+            f"pairs to fit, more than {MAX_FIT_PAIRS:.0e} (minutes of work); use a radius "
+            f"below about {most:.3g} on this mesh",
+            "radius",
+        )
     step = max(1, MAX_PAIRS // per)
     out = [np.zeros(n), np.zeros(n), np.zeros((n, 3)), np.zeros((n, 3)), np.zeros((n, 3))]
     for s in range(0, n, step):
         idx = np.arange(s, min(n, s + step))
-        res = _shape_operator(*_chunk(X, Nv, tree, idx, r))
+        try:
+            res = _shape_operator(*_chunk(X, Nv, tree, idx, r))
+        except _TooFew as few:
+            vertex, count, _ = few.args
+            raise MeshError(
+                f"{what} {r:.4g} is too small: vertex {vertex} has {count} vertices within it "
+                f"and the jet needs 6 (the mean edge length is {mean_edge_length(V, F):.4g}); "
+                "use a larger radius",
+                "radius",
+            ) from None
         for o, x in zip(out, res, strict=True):
             o[idx] = x
     return PrincipalCurvatures(out[0], out[1], out[2], out[3], out[4], "jet")

@@ -25,7 +25,7 @@ from ..errors import MeshError
 from ..noise import add_noise, check_noise
 from ..options import CURVATURE_ESTIMATORS, PRINCIPAL_FIELDS, check_choice
 from ..surfaces import ParametricSurface, SurfaceMesh, get_surface, mesh_surface
-from ..types import FloatArray, IntArray
+from ..types import FloatArray, IntArray, as_real
 from .estimators import estimate_curvature
 from .principal import PrincipalCurvatures
 from .refinement import (
@@ -113,7 +113,8 @@ def jittered_mesh(
     ``jitter`` of a cell (uniform, ``seed``) and evaluated on the surface there: the vertices
     stay on the surface, so the exact values at them are exact (see :func:`perturbed_mesh`)."""
     s = get_surface(surface)
-    if not (0.0 <= float(jitter) <= 0.45):
+    jitter = as_real(jitter, "jitter")
+    if not (0.0 <= jitter <= 0.45):
         raise MeshError(f"must be between 0 and 0.45 of a cell, got {jitter!r}", "jitter")
     m = mesh_surface(s, res)
     if jitter > 0:
@@ -154,6 +155,12 @@ def flipped_and_noisy(
     V : (n,3) float
         The positions with the noise.
     """
+    flips = as_real(flips, "flips")
+    if not 0.0 <= flips <= 1.0:  # (checked here: a negative or NaN fraction is not "none")
+        raise MeshError(f"must be between 0 and 1, got {flips!r}", "flips")
+    noise = as_real(noise, "noise")
+    if noise < 0:
+        raise MeshError(f"must be 0 or more, got {noise!r}", "noise")
     if flips > 0:
         m = SurfaceMesh(
             m.V, flip_edges(m.V, m.F, flips, seed), m.uv, m.pole, m.boundary, m.surface, m.res

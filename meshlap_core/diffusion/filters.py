@@ -26,22 +26,29 @@ import numpy as np
 
 from ..errors import MeshError
 from ..options import FILTER_KINDS, FilterKind, check_choice
+from ..smoothing.params import MAX_ITERS
 from ..spectral.basis import SpectralBasis
-from ..types import FloatArray
+from ..types import FloatArray, as_count, as_field, as_real, real_array
+from .heat import _eigenvalues, _modes
 
 
 def low_pass(eigenvalues: FloatArray, keep: int) -> FloatArray:
-    """``h = 1`` on the ``keep`` lowest modes, 0 above (an ideal low-pass), ``(k,)``."""
-    h = np.zeros(len(eigenvalues))
-    h[: max(int(keep), 0)] = 1.0
+    """``h = 1`` on the ``keep`` lowest modes (``0 ≤ keep ≤ k``), 0 above (an ideal low-pass),
+    ``(k,)``."""
+    lam = _eigenvalues(eigenvalues)
+    h = np.zeros(len(lam))
+    h[: as_count(keep, "keep", 0, len(lam))] = 1.0
     return h
 
 
 def band_gain(eigenvalues: FloatArray, lo: int, hi: int, gain: float) -> FloatArray:
     """``h = gain`` on modes ``lo … hi−1`` and 1 elsewhere (band exaggeration for ``gain > 1``,
-    attenuation below 1), ``(k,)``."""
-    h = np.ones(len(eigenvalues))
-    h[max(int(lo), 0) : max(int(hi), 0)] = float(gain)
+    attenuation below 1), ``(k,)``; ``0 ≤ lo ≤ hi ≤ k`` and a finite gain, else refused."""
+    lam = _eigenvalues(eigenvalues)
+    a = as_count(lo, "lo", 0, len(lam))
+    b = as_count(hi, "hi", a, len(lam))
+    h = np.ones(len(lam))
+    h[a:b] = as_real(gain, "gain")
     return h
 
 
@@ -101,6 +108,14 @@ def transfer(
     -------
     h : (k,) float
 
+    Raises
+    ------
+    MeshError
+        An unknown kind; eigenvalues that are not a finite real ``(k,)`` array; a step that
+        is not a positive number, a count of steps that is not an integer in ``0 … MAX_ITERS``,
+        a Taubin ``ν`` not below ``−step``; a band or a ``keep`` out of range; or gains that
+        overflow (each named).
+
     Examples
     --------
     Two explicit steps of ``s = ¼`` scale mode ``λ`` by ``(1 − sλ)²``:
@@ -113,17 +128,33 @@ def transfer(
     [1.0, 1.0, 0.0, 0.0]
     """
     check_choice(kind, FILTER_KINDS, "filter")
-    lam = np.asarray(eigenvalues, dtype=np.float64)
+    lam = _eigenvalues(eigenvalues)
     if kind == "low-pass":
         return low_pass(lam, keep)
     if kind == "band":
+        if np.ndim(band) != 1 or np.size(band) != 2:
+            raise MeshError(f"should be (lo, hi), got {band!r}", "band")
         return band_gain(lam, band[0], band[1], gain)
-    n = int(iters)
-    if kind == "explicit":
-        return (1.0 - step * lam) ** n
-    if kind == "implicit":
-        return (1.0 + step * lam) ** (-n)
-    return ((1.0 - step * lam) * (1.0 - nu * lam)) ** n
+    s = as_real(step, "step", positive=True)
+    n = as_count(iters, "iters", 0, MAX_ITERS)
+    with np.errstate(over="ignore"):
+        if kind == "explicit":
+            h = (1.0 - s * lam) ** n
+        elif kind == "implicit":
+            h = (1.0 + s * lam) ** (-n)
+        else:
+            v = as_real(nu, "nu")
+            if not v < -s:
+                raise MeshError(f"Taubin's nu must be below -step = {-s:g}, got {v!r}", "nu")
+            h = ((1.0 - s * lam) * (1.0 - v * lam)) ** n
+    if not np.all(np.isfinite(h)):
+        bad = int(np.flatnonzero(~np.isfinite(h))[0])
+        raise MeshError(
+            f"the gain overflows at mode {bad} (lambda = {lam[bad]:.4g}): fewer steps or a "
+            "smaller step",
+            "iters",
+        )
+    return h
 
 
 class SpectralFilter:
@@ -166,12 +197,8 @@ class SpectralFilter:
 
     def __init__(self, basis: SpectralBasis, X: FloatArray | None = None, k: int | None = None):
         self.basis = basis
-        self.k = basis.k_max if k is None else int(k)
-        if not 1 <= self.k <= basis.k_max:
-            raise MeshError(
-                f"must be between 1 and {basis.k_max} (the modes computed), got {k}", "k"
-            )
-        X = basis.V if X is None else np.asarray(X, dtype=np.float64)
+        self.k = _modes(basis, k)
+        X = basis.V if X is None else as_field(X, len(basis.mass), "X")
         self.X = X.reshape(len(X), -1)
         self.U = basis.vectors[:, : self.k]
         self.eigenvalues = basis.eigenvalues[: self.k]
@@ -189,9 +216,10 @@ class SpectralFilter:
 
     def apply(self, h: FloatArray, residual: bool = False) -> FloatArray:
         """``U diag(h) Uᵀ M X`` (``+ X − U Uᵀ M X`` with ``residual``), ``(n,c)``."""
-        h = np.asarray(h, dtype=np.float64)
-        if h.shape != (self.k,):
-            raise MeshError(f"needs one gain per mode ({self.k}), got shape {h.shape}", "h")
+        raw = real_array(h, "h", "gains")
+        if raw.shape != (self.k,):
+            raise MeshError(f"needs one gain per mode ({self.k}), got shape {raw.shape}", "h")
+        h = as_field(raw, self.k, "h", columns=False)
         out = self._filtered(h)
         return out + self.residual if residual else out
 
@@ -251,11 +279,18 @@ def measured_amplification(
     g : (k,) float
         ``NaN`` for modes the signal does not contain (``|c_before| ≤ 1e-12 · max|c_before|``).
     """
-    k = basis.k_max if k is None else int(k)
+    k = _modes(basis, k)
+    n = len(basis.mass)
+    Xb = as_field(X_before, n, "X_before").reshape(n, -1)
+    Xa = as_field(X_after, n, "X_after").reshape(n, -1)
+    if Xa.shape != Xb.shape:
+        raise MeshError(
+            f"should have the shape of X_before {Xb.shape}; shape is {Xa.shape}", "X_after"
+        )
     U = basis.vectors[:, :k]
     m = basis.mass[:, None]
-    before = U.T @ (m * np.asarray(X_before, dtype=np.float64).reshape(len(U), -1))
-    after = U.T @ (m * np.asarray(X_after, dtype=np.float64).reshape(len(U), -1))
+    before = U.T @ (m * Xb)
+    after = U.T @ (m * Xa)
     j = np.argmax(np.abs(before), axis=1)
     rows = np.arange(k)
     b, a = before[rows, j], after[rows, j]
@@ -274,6 +309,10 @@ def smoother_transfer(
     """
     from ..smoothing import Smoother
 
+    if not isinstance(basis, SpectralBasis):
+        raise MeshError(f"must be a SpectralBasis, got {type(basis).__name__}", "basis")
+    step = as_real(step, "step", positive=True)
+    iters = as_count(iters, "iters", 0, MAX_ITERS)
     s = Smoother(
         basis.V,
         basis.F,

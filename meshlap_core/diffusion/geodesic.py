@@ -39,6 +39,7 @@ from typing import Any
 import igl
 import numpy as np
 import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
 
 from ..errors import MeshError, check_cancel
 from ..laplacian import mean_edge_length, vertex_areas
@@ -51,11 +52,13 @@ from ..options import (
     DEFAULT_HEAT_BOUNDARY,
     HEAT_BOUNDARIES,
     MASS_AREA,
+    MAX_STIFFNESS_RATIO,
     AreaKind,
     HeatBoundary,
     check_choice,
 )
-from ..types import FloatArray, IntArray, as_mesh
+from ..types import FloatArray, IntArray, as_count, as_faces, as_mesh, as_real
+from .heat import check_time
 from .sources import check_sources
 
 _ROUNDOFF = 64 * np.finfo(float).eps
@@ -95,7 +98,12 @@ def _table_edges(count: sp.csr_matrix) -> IntArray:
 
 
 def boundary_vertices(F: IntArray, n: int) -> IntArray:
-    """Vertices on a boundary edge (an edge of one face), sorted ``(b,)`` int."""
+    """Vertices on a boundary edge (an edge of one face), sorted ``(b,)`` int. ``n`` (the
+    vertex count) must hold every index of ``F``; more vertices than ``3·len(F)`` can hold
+    no boundary (none of them is in a face), so a larger ``n`` is refused rather than
+    allocated."""
+    F = as_faces(F)
+    n = as_count(n, "n", int(F.max(initial=-1)) + 1, max(len(F) * 3, 1))
     if len(F) == 0:
         return np.zeros(0, dtype=np.int64)
     return _boundary(edge_counts(F, n))
@@ -202,14 +210,9 @@ def _diagonal_positions(K: sp.csr_matrix) -> IntArray:
 
 
 def check_time_factor(m: float, name: str = "m") -> float:
-    """The heat method's ``m`` (``t = m·h²``) as a positive finite float."""
-    try:
-        value = float(m)
-    except (TypeError, ValueError):
-        raise MeshError(f"expected a number, got {m!r}", name) from None
-    if not (np.isfinite(value) and value > 0):
-        raise MeshError(f"must be positive and finite, got {m!r}", name)
-    return value
+    """The heat method's ``m`` (``t = m·h²``) as a positive finite float (booleans, complex
+    numbers and strings refused, not converted)."""
+    return as_real(m, name, positive=True)
 
 
 class HeatGeodesic:
@@ -283,6 +286,16 @@ class HeatGeodesic:
         count = edge_counts(self.F, n)  # one edge table: h and the boundary
         self.h = mean_edge_length(self.V, self.F, _table_edges(count))
         self.t = self.m * self.h**2
+        per_m = self.h**2 * float(np.max(K.diagonal() / self.mass))  # t·max K_ii/M_ii / m
+        stiff = self.m * per_m
+        if not stiff <= MAX_STIFFNESS_RATIO:
+            most = MAX_STIFFNESS_RATIO / per_m
+            raise MeshError(
+                f"m = {self.m:g} makes the heat time t = m·h² so long that M + tK is singular "
+                f"in double precision (t·max K_ii/M_ii = {stiff:.1e} > {MAX_STIFFNESS_RATIO:.0e}); "
+                f"on this mesh m must be at most {most:.3g}",
+                "m",
+            )
         self.boundary = _boundary(count)
         self.n_components, self.labels = components(K)
         self._face_label = self.labels[self.F[:, 0]]
@@ -423,20 +436,120 @@ class HeatGeodesic:
         return d
 
 
+def surface_components(F: IntArray, n: int) -> IntArray:
+    """The connected component of each vertex through the faces ``(n,)`` int: ``0 … c−1``
+    for the vertices of faces, ``−1`` for a vertex no face references (it has no surface
+    around it, so no path leaves it)."""
+    used = np.zeros(n, dtype=bool)
+    used[F.ravel()] = True
+    if len(F) == 0:
+        return np.full(n, -1, dtype=np.int64)
+    a = np.concatenate([F[:, 0], F[:, 1], F[:, 2]])
+    b = np.concatenate([F[:, 1], F[:, 2], F[:, 0]])
+    graph = sp.coo_matrix((np.ones(len(a)), (a, b)), shape=(n, n)).tocsr()
+    _, raw = connected_components(graph, directed=False)
+    labels = np.full(n, -1, dtype=np.int64)
+    _, labels[used] = np.unique(raw[used], return_inverse=True)
+    return labels
+
+
+def _component_meshes(
+    V: FloatArray, F: IntArray, src: IntArray
+) -> tuple[FloatArray, list[tuple[IntArray, IntArray, IntArray]]]:
+    """The components holding a source, each as ``(vertices, local faces, local sources)``,
+    and the distance array to fill: ``inf`` everywhere but at the sources (0). A source on a
+    vertex no face references is 0 at itself and reaches nothing."""
+    n = len(V)
+    labels = surface_components(F, n)
+    d = np.full(n, np.inf)
+    d[src] = 0.0
+    wanted = np.unique(labels[src])
+    parts = []
+    for c in wanted[wanted >= 0]:
+        verts = np.flatnonzero(labels == c)
+        local = np.full(n, -1, dtype=np.int64)
+        local[verts] = np.arange(len(verts))
+        faces = local[F[labels[F[:, 0]] == c]]
+        parts.append((verts, faces, local[src[labels[src] == c]]))
+    return d, parts
+
+
+def _repeated_corner(F: IntArray) -> int | None:
+    """The first face with a repeated vertex (not a triangle), or ``None``."""
+    bad = np.flatnonzero((F[:, 0] == F[:, 1]) | (F[:, 1] == F[:, 2]) | (F[:, 0] == F[:, 2]))
+    return int(bad[0]) if len(bad) else None
+
+
+def _normalized(V: FloatArray) -> tuple[FloatArray, float]:
+    """``V`` moved to its centroid and divided by its bounding box's diagonal (at most 1e300:
+    finite), and that diagonal: the distances of the scaled mesh times it are the mesh's.
+    libigl's geodesics use absolute tolerances; at 1e-55 MMP's windows never merge (4 GB in
+    27 s), at 1e160 squared lengths overflow."""
+    c = V.mean(axis=0)
+    lo, hi = V.min(axis=0), V.max(axis=0)
+    s = float(np.linalg.norm((hi - lo) / 2.0) * 2.0) if len(V) else 0.0
+    if not (np.isfinite(s) and s > 0):
+        return V - c, 1.0
+    return (V - c) / s, s
+
+
 def igl_heat_distance(
     V: FloatArray, F: IntArray, sources: Any, t: float | None = None
 ) -> FloatArray:
     """libigl's heat method (``igl.heat_geodesics_precompute`` / ``_solve``), the reference
     the tests and the benchmark compare :class:`HeatGeodesic` with; ``t`` defaults to
-    libigl's (``h²``)."""
+    libigl's (``h²``).
+
+    Run per connected component holding a source (libigl's one Poisson solve puts another
+    component at a finite distance), on that component's vertices only (a vertex no face
+    references made libigl's precomputation fail, or crash when it was a source); the other
+    components get ``inf``. A component that is one triangle (libigl's precomputation fails
+    on it: all its vertices are boundary) is flat: its distance is the straight one. The mesh
+    is scaled to a unit bounding box for libigl and the distances scaled back (``t`` with
+    it).
+
+    Raises
+    ------
+    MeshError
+        Bad sources, a bad ``t`` (NaN, ≤ 0), a face with a repeated vertex or of zero area
+        (libigl's cotangents are infinite there: it answers NaN), or a result that is not
+        finite where a path exists.
+    """
     V, F = as_mesh(V, F)
     src = check_sources(sources, len(V))
-    data = igl.HeatGeodesicsData()
-    if t is None:
-        igl.heat_geodesics_precompute(V, F, data)
-    else:
-        igl.heat_geodesics_precompute(V, F, float(t), data)
-    return np.asarray(igl.heat_geodesics_solve(data, src))
+    tt = None if t is None else check_time(t)
+    bad = _repeated_corner(F)
+    if bad is None and len(F):
+        double = np.linalg.norm(np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]), axis=1)
+        zero = np.flatnonzero(~(double > 0))
+        bad = int(zero[0]) if len(zero) else None
+    if bad is not None:
+        raise MeshError(
+            f"face {bad} {F[bad].tolist()} has zero area; libigl's heat method cannot take it "
+            "(its cotangents are infinite there): remove degenerate faces first (load_mesh "
+            "does)",
+            "F",
+        )
+    d, parts = _component_meshes(V, F, src)
+    for verts, faces, local_src in parts:
+        Vc, scale = _normalized(V[verts])
+        if len(faces) == 1:  # a flat triangle: the straight distance
+            dist = np.min(np.linalg.norm(Vc[:, None, :] - Vc[None, local_src, :], axis=2), axis=1)
+        else:
+            data = igl.HeatGeodesicsData()
+            if tt is None:
+                igl.heat_geodesics_precompute(Vc, faces, data)
+            else:
+                igl.heat_geodesics_precompute(Vc, faces, tt / scale**2, data)
+            dist = np.asarray(igl.heat_geodesics_solve(data, local_src))
+        if not np.all(np.isfinite(dist)):
+            raise MeshError(
+                "libigl's heat method gave a distance that is not finite (t too small for "
+                "this mesh?)",
+                "t" if tt is not None else "F",
+            )
+        d[verts] = dist * scale
+    return d
 
 
 def exact_distance(
@@ -449,10 +562,12 @@ def exact_distance(
 ) -> FloatArray:
     """The exact polyhedral geodesic distance (MMP, ``igl.exact_geodesic``).
 
-    Each component holding a source is solved on its own faces (libigl reports 0, not
-    ``inf``, across components); the others get ``inf``. ``cancel`` is checked between
-    components; one component's propagation cannot be interrupted (at 43k vertices it takes
-    18–39 s: the viewer runs it as a job).
+    Each component holding a source is solved on its own faces and vertices (libigl reports
+    0, not ``inf``, across components, and crashed on a source no face references); the
+    others get ``inf``, a source no face references 0 at itself. Each component is scaled to
+    a unit bounding box for libigl and its distances scaled back (libigl's tolerances are
+    absolute). ``cancel`` is checked between components; one component's propagation cannot
+    be interrupted (at 43k vertices it takes 18–39 s: the viewer runs it as a job).
 
     Parameters
     ----------
@@ -466,6 +581,13 @@ def exact_distance(
     Returns
     -------
     d : (n,) float
+
+    Raises
+    ------
+    MeshError
+        Bad sources, no faces, a face with a repeated vertex, or an edge of more than two
+        faces in a component holding a source (libigl's MMP crashes the process on both:
+        they are refused before it runs).
 
     Examples
     --------
@@ -483,22 +605,38 @@ def exact_distance(
     src = check_sources(sources, n)
     if len(F) == 0:
         raise MeshError("the mesh has no faces", "F")
-    labels = igl.vertex_components(F).astype(np.int64)
-    lab = np.full(n, -1)
-    lab[: len(labels)] = labels  # trailing unreferenced vertices: no component
-    d = np.full(n, np.inf)
-    wanted = np.unique(lab[src])
-    wanted = wanted[wanted >= 0]
-    for i, c in enumerate(wanted):
+    d, parts = _component_meshes(V, F, src)
+    for verts, faces, _ in parts:
+        _check_exact_component(faces, verts)
+    for i, (verts, faces, local_src) in enumerate(parts):
         check_cancel(cancel, "exact geodesic distance")
-        report_progress(progress, i / len(wanted), f"exact distance, component {i + 1}")
-        faces = F[lab[F[:, 0]] == c]
-        verts = np.flatnonzero(lab == c)
-        local = np.full(n, -1)
-        local[verts] = np.arange(len(verts))
-        d[verts] = igl.exact_geodesic(
-            V[verts], local[faces], VS=local[src[lab[src] == c]], VT=np.arange(len(verts))
-        )
-    d[src[lab[src] < 0]] = 0.0
+        report_progress(progress, i / len(parts), f"exact distance, component {i + 1}")
+        Vc, scale = _normalized(V[verts])
+        dist = igl.exact_geodesic(Vc, faces, VS=local_src, VT=np.arange(len(verts)))
+        d[verts] = np.asarray(dist) * scale
     report_progress(progress, 1.0, "exact distance done")
     return d
+
+
+def _check_exact_component(faces: IntArray, verts: IntArray) -> None:
+    """Refuse what crashes libigl's MMP: a face with a repeated vertex, an edge held by more
+    than two faces (a non-manifold edge, also made by a face listed twice). The message
+    names them in the mesh's own numbering."""
+    bad = _repeated_corner(faces)
+    if bad is not None:
+        raise MeshError(
+            f"a face {verts[faces[bad]].tolist()} repeats a vertex; the exact distance (libigl's "
+            "MMP) needs triangles (remove degenerate faces, as load_mesh does)",
+            "F",
+        )
+    count = edge_counts(faces, len(verts))
+    over = np.flatnonzero(count.data > 2)
+    if len(over):
+        rows = np.repeat(np.arange(count.shape[0]), np.diff(count.indptr))
+        a, b = int(verts[rows[over[0]]]), int(verts[count.indices[over[0]]])
+        raise MeshError(
+            f"edge ({a}, {b}) is shared by {int(count.data[over[0]])} faces ({len(over)} such "
+            "edge(s)); the exact distance (libigl's MMP) needs every edge in at most two "
+            "faces. The heat method (HeatGeodesic, --method heat) takes non-manifold meshes",
+            "F",
+        )

@@ -19,7 +19,7 @@ Crane, Weischedel & Wardetzky, "Geodesics in heat", ACM TOG 2013 (the backward E
 
 from __future__ import annotations
 
-import math
+from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
@@ -27,21 +27,30 @@ from scipy.sparse.linalg import expm_multiply
 
 from ..errors import MeshError
 from ..linalg.spd import SPDSolver
-from ..options import MASS_AREA, MAX_STIFFNESS_RATIO, AreaKind
+from ..options import MASS_AREA, MAX_HEAT_STEPS, MAX_STIFFNESS_RATIO, AreaKind
 from ..spectral.basis import SpectralBasis
 from ..spectral.operators import spectral_operators
-from ..types import FloatArray, IntArray, as_mesh
+from ..types import (
+    FloatArray,
+    IntArray,
+    as_count,
+    as_field,
+    as_index,
+    as_mesh,
+    as_real,
+    real_array,
+)
 
 
 def check_time(t: float, name: str = "t") -> float:
-    """``t`` as a positive finite float, else :class:`MeshError` naming ``name``."""
+    """``t`` as a positive finite float, else :class:`MeshError` naming ``name`` (booleans,
+    complex numbers and strings refused, not converted)."""
     try:
-        value = float(t)
-    except (TypeError, ValueError):
-        raise MeshError(f"expected a number, got {t!r}", name) from None
-    if not (math.isfinite(value) and value > 0):
-        raise MeshError(f"must be a positive finite time, got {t!r}", name)
-    return value
+        return as_real(t, name, positive=True)
+    except MeshError as exc:
+        raise MeshError(
+            f"must be a positive finite time, got {t!r} ({exc.problem})", name
+        ) from None
 
 
 class HeatDiffusion:
@@ -122,18 +131,16 @@ class HeatDiffusion:
         t : float
             ``> 0``.
         steps : int
-            ``>= 1``.
+            ``1 … MAX_HEAT_STEPS`` (1000).
 
         Returns
         -------
         u : same shape as ``u0``
         """
         t = check_time(t)
-        if int(steps) < 1:
-            raise MeshError(f"needs at least one step, got {steps}", "steps")
-        steps = int(steps)
+        steps = as_count(steps, "steps", 1, MAX_HEAT_STEPS)
+        u = as_field(u0, self.n_vertices, "u0")
         solver = self._solver(t / steps)
-        u = np.asarray(u0, dtype=np.float64)
         m = self.mass if u.ndim == 1 else self.mass[:, None]
         for _ in range(steps):
             u = solver.solve(m * u)
@@ -153,8 +160,9 @@ class HeatDiffusion:
         u : (n,) float
         """
         t = check_time(t)
+        u = as_field(u0, self.n_vertices, "u0", columns=False)
         A = (sp.diags(1.0 / self.mass) @ self.K).tocsr()
-        return np.asarray(expm_multiply(-t * A, np.asarray(u0, dtype=np.float64)))
+        return np.asarray(expm_multiply(-t * A, u))
 
 
 def truncation_bound(eigenvalues: FloatArray, t: float, k: int) -> float:
@@ -170,7 +178,24 @@ def truncation_bound(eigenvalues: FloatArray, t: float, k: int) -> float:
     k : int
         Modes used, ``1 <= k <= k_max``.
     """
-    return float(np.exp(-float(eigenvalues[k - 1]) * check_time(t)))
+    lam = _eigenvalues(eigenvalues)
+    k = as_count(k, "k", 1, len(lam))
+    return float(np.exp(-float(lam[k - 1]) * check_time(t)))
+
+
+def _eigenvalues(eigenvalues: Any) -> FloatArray:
+    """Frequencies as a finite real ``(k,)`` array (``k ≥ 1``), named ``eigenvalues``."""
+    lam = real_array(eigenvalues, "eigenvalues", "eigenvalues")
+    if lam.ndim != 1 or lam.size == 0:
+        raise MeshError(f"should have shape (k,), k >= 1; shape is {lam.shape}", "eigenvalues")
+    return as_field(lam, len(lam), "eigenvalues", columns=False)
+
+
+def _modes(basis: SpectralBasis, k: Any) -> int:
+    """``k`` (``None``: all) checked against the basis's computed modes."""
+    if not isinstance(basis, SpectralBasis):
+        raise MeshError(f"must be a SpectralBasis, got {type(basis).__name__}", "basis")
+    return basis.k_max if k is None else as_count(k, "k", 1, basis.k_max)
 
 
 def heat_spectral(
@@ -208,12 +233,11 @@ def heat_spectral(
     (True, 1.0)
     """
     t = check_time(t)
-    k = basis.k_max if k is None else int(k)
-    if not 1 <= k <= basis.k_max:
-        raise MeshError(f"must be between 1 and {basis.k_max} (the modes computed), got {k}", "k")
+    k = _modes(basis, k)
+    u = as_field(u0, len(basis.mass), "u0", columns=False)
     U = basis.vectors[:, :k]
     lam = basis.eigenvalues[:k]
-    c = U.T @ (basis.mass * np.asarray(u0, dtype=np.float64))
+    c = U.T @ (basis.mass * u)
     return U @ (np.exp(-lam * t) * c)
 
 
@@ -233,6 +257,7 @@ def heat_kernel_column(
     -------
     u : (n,) float
     """
-    k = basis.k_max if k is None else int(k)
+    k = _modes(basis, k)
+    s = as_index(source, len(basis.mass), "source")
     U = basis.vectors[:, :k]
-    return U @ (np.exp(-basis.eigenvalues[:k] * check_time(t)) * U[int(source)])
+    return U @ (np.exp(-basis.eigenvalues[:k] * check_time(t)) * U[s])

@@ -14,18 +14,23 @@ import numpy as np
 
 from ..errors import MeshError
 from ..spectral.basis import SpectralBasis
-from ..types import FloatArray
+from ..types import FloatArray, as_count, as_field, as_index, real_array
+from .heat import _eigenvalues, _modes
+
+MAX_HKS_TIMES = 1000
+"""Most times of one signature (columns of ``H``): a plot or a descriptor shows far fewer."""
 
 
 def hks_times(eigenvalues: FloatArray, count: int = 16) -> FloatArray:
     """``count`` times log-spaced over ``[4 ln10 / λ_max, 4 ln10 / λ_1]`` (``λ_1`` the first
     non-zero frequency), ``(count,)``."""
-    lam = np.asarray(eigenvalues, dtype=np.float64)
+    lam = _eigenvalues(eigenvalues)
+    count = as_count(count, "count", 1, MAX_HKS_TIMES)
     positive = lam[lam > 1e-10 * max(float(lam.max(initial=0.0)), 1e-300)]
-    if len(positive) < 2 or int(count) < 1:
-        raise MeshError("needs at least two non-zero eigenvalues and one time", "k")
+    if len(positive) < 2:
+        raise MeshError("needs at least two non-zero eigenvalues", "eigenvalues")
     lo, hi = 4 * np.log(10) / positive.max(), 4 * np.log(10) / positive.min()
-    return np.geomspace(lo, hi, int(count))
+    return np.geomspace(lo, hi, count)
 
 
 def heat_kernel_signature(
@@ -64,8 +69,13 @@ def heat_kernel_signature(
     >>> bool(np.allclose(basis.mass @ hks, trace))
     True
     """
-    k = basis.k_max if k is None else int(k)
-    t = np.atleast_1d(np.asarray(times, dtype=np.float64))
+    k = _modes(basis, k)
+    t = np.atleast_1d(real_array(times, "times", "times"))
+    if t.ndim != 1 or t.size == 0 or t.size > MAX_HKS_TIMES:
+        raise MeshError(
+            f"should have shape (s,), 1 <= s <= {MAX_HKS_TIMES}; shape is {t.shape}", "times"
+        )
+    t = t.astype(np.float64)
     if not np.all(np.isfinite(t) & (t > 0)):
         raise MeshError("times must be positive and finite", "times")
     U = basis.vectors[:, :k]
@@ -78,6 +88,11 @@ def hks_distance(H: FloatArray, vertex: int) -> FloatArray:
     """Distance of every vertex's signature to ``vertex``'s: ``‖log H(x,·) − log H(v,·)‖₂ /
     √s`` over the ``s`` scales (relative differences; points with similar signatures near 0),
     ``(n,)``."""
-    logH = np.log(np.maximum(np.asarray(H, dtype=np.float64), 1e-300))
-    diff = logH - logH[int(vertex)][None, :]
+    raw = real_array(H, "H", "signatures")
+    if raw.ndim != 2 or raw.shape[0] == 0 or raw.shape[1] == 0:
+        raise MeshError(f"should have shape (n,s) (vertices, times); shape is {raw.shape}", "H")
+    Hf = as_field(raw, raw.shape[0], "H")
+    v = as_index(vertex, len(Hf), "vertex")
+    logH = np.log(np.maximum(Hf, 1e-300))
+    diff = logH - logH[v][None, :]
     return np.sqrt(np.mean(diff * diff, axis=1))

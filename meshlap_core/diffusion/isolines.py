@@ -11,20 +11,21 @@ import numpy as np
 
 from ..errors import MeshError
 from ..io.atomic import atomic_write
-from ..types import FloatArray, IntArray, as_mesh
+from ..options import MAX_ISOLINES
+from ..types import FloatArray, IntArray, as_count, as_indices, as_mesh, as_vertices, real_array
 
 
 def isoline_values(values: FloatArray, count: int) -> FloatArray:
     """``count`` levels evenly spaced strictly inside the finite range of ``values``
     (``(max − min)·j/(count+1)`` above the minimum, ``j = 1 … count``), ``(count,)``."""
-    v = np.asarray(values, dtype=np.float64)
+    count = as_count(count, "count", 1, MAX_ISOLINES)
+    raw = real_array(values, "values", "values")
+    v = raw.astype(np.float64).ravel()
     v = v[np.isfinite(v)]
-    if int(count) < 1:
-        raise MeshError(f"needs at least one isoline, got {count}", "count")
     if v.size == 0:
         raise MeshError("the field has no finite value", "values")
     lo, hi = float(v.min()), float(v.max())
-    return lo + (hi - lo) * np.arange(1, int(count) + 1) / (int(count) + 1)
+    return lo + (hi - lo) * np.arange(1, count + 1) / (count + 1)
 
 
 def isolines(
@@ -63,10 +64,18 @@ def isolines(
     (True, [0.0, 0.25, 0.5, 0.75, 1.0], 4)
     """
     V, F = as_mesh(V, F)
-    s = np.asarray(values, dtype=np.float64)
+    s = real_array(values, "values", "values").astype(np.float64)
     if s.shape != (len(V),):
         raise MeshError(f"needs one value per vertex ({len(V)}), got shape {s.shape}", "values")
-    lv = np.asarray(levels, dtype=np.float64).ravel()
+    if np.isnan(s).any():
+        raise MeshError(
+            f"the value at vertex {int(np.flatnonzero(np.isnan(s))[0])} is NaN", "values"
+        )
+    lv = real_array(levels, "levels", "levels").astype(np.float64).ravel()
+    if not np.isfinite(lv).all():
+        raise MeshError("levels must be finite", "levels")
+    if lv.size > MAX_ISOLINES:
+        raise MeshError(f"at most {MAX_ISOLINES} levels, got {lv.size}", "levels")
     if lv.size == 0:
         return np.zeros((0, 3)), np.zeros((0, 2), np.int64), np.zeros(0, np.int64)
     top = float(max(np.nanmax(np.where(np.isfinite(s), s, -np.inf)), lv.max()))
@@ -80,6 +89,20 @@ def save_polylines(
 ) -> None:
     """Write curve segments as an OBJ of ``v`` and ``l`` lines (1-based), atomically.
 
+    Parameters
+    ----------
+    path : str or PathLike
+    P : (p,3) float
+        Finite curve points.
+    E : (e,2) int
+        Segments, indices into ``P``.
+
+    Raises
+    ------
+    MeshError
+        ``P`` or ``E`` of the wrong shape or type, a non-finite point, a segment index out of
+        range, or the output problems of :func:`~meshlap_core.io.atomic.atomic_write`.
+
     Examples
     --------
     >>> import tempfile
@@ -92,8 +115,13 @@ def save_polylines(
     >>> path.read_text().splitlines()[1:]
     ['v 0 0 0', 'v 1 0 0', 'v 1 1 0', 'l 1 2', 'l 2 3']
     """
-    P = np.asarray(P, dtype=np.float64)
-    E = np.asarray(E, dtype=np.int64)
+    P = as_vertices(np.zeros((0, 3)) if np.size(P) == 0 else P, "P")
+    raw = real_array(E, "E", "segment indices")
+    if raw.size == 0:
+        raw = raw.reshape(0, 2)
+    if raw.ndim != 2 or raw.shape[1] != 2:
+        raise MeshError(f"should have shape (e,2); shape is {raw.shape}", "E")
+    E = as_indices(raw, len(P), "E", "segment indices").reshape(-1, 2)
     with atomic_write(path, "wb", overwrite_inputs=overwrite_inputs) as f:
         f.write(b"# isolines written by meshlap\n")
         if len(P):

@@ -11,10 +11,10 @@ from collections.abc import Iterable
 import numpy as np
 
 from ..errors import MeshError
-from ..types import IntArray
+from ..types import IntArray, as_field, as_indices
 
 
-def check_sources(sources: int | Iterable[int], n: int, name: str = "vertex") -> IntArray:
+def check_sources(sources: int | Iterable[int], n: int, name: str = "sources") -> IntArray:
     """The distinct source vertices as a sorted ``(s,)`` int64 array.
 
     Parameters
@@ -24,25 +24,19 @@ def check_sources(sources: int | Iterable[int], n: int, name: str = "vertex") ->
     n : int
         Number of vertices.
     name : str
-        The argument an error is attributed to (the CLI passes ``"--vertex"``).
+        The argument an error is attributed to (default ``"sources"``; the CLI passes
+        ``"--vertex"``).
 
     Raises
     ------
     MeshError
-        No source, a non-integer, or an index out of range (the message gives the range).
+        No source, a non-integer (``2.5``, ``True``, a complex or a string: never rounded or
+        cast), or an index out of range (shown as given, ``2⁶³`` or ``1e20`` too, with the
+        range).
     """
-    arr = np.atleast_1d(np.asarray(sources))
+    arr = as_indices(sources, n, name)
     if arr.size == 0:
         raise MeshError("give at least one source vertex", name)
-    if arr.dtype.kind not in "iu":
-        if arr.dtype.kind != "f" or not np.all(np.isfinite(arr)) or np.any(arr != np.round(arr)):
-            raise MeshError(f"vertex indices must be integers, got {arr.tolist()!r}", name)
-    arr = arr.astype(np.int64).ravel()
-    bad = arr[(arr < 0) | (arr >= n)]
-    if bad.size:
-        raise MeshError(
-            f"vertex {int(bad[0])} is out of range (the mesh has {n} vertices: 0..{n - 1})", name
-        )
     return np.unique(arr)
 
 
@@ -59,7 +53,18 @@ def unit_heat(sources: IntArray, mass: np.ndarray) -> np.ndarray:
     Returns
     -------
     u0 : (n,) float
+
+    Raises
+    ------
+    MeshError
+        Bad sources (as :func:`check_sources`, naming ``sources``), masses that are not a
+        finite ``(n,)`` real array, or a source whose mass is not positive.
     """
-    u0 = np.zeros(len(mass))
-    np.add.at(u0, sources, 1.0 / mass[sources])
+    m = as_field(mass, len(np.asarray(mass).reshape(-1)), "mass", columns=False)
+    src = check_sources(sources, len(m), "sources")
+    if not np.all(m[src] > 0):
+        bad = int(src[np.flatnonzero(~(m[src] > 0))[0]])
+        raise MeshError(f"the mass at source {bad} is not positive", "mass")
+    u0 = np.zeros(len(m))
+    np.add.at(u0, src, 1.0 / m[src])
     return u0

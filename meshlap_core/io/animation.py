@@ -88,7 +88,8 @@ def check_animation_output(path: str | os.PathLike, overwrite_inputs: Any = ()) 
         raise MeshError(
             f"cannot write in this directory: {unwritable_cause(parent)}", os.fspath(parent)
         )
-    if target.exists() and not os.access(target, os.W_OK):
+    if target.is_file() and not target.is_symlink() and not os.access(target, os.W_OK):
+        # (a link is replaced, not written through: its target's permissions do not matter)
         raise MeshError("the output file is not writable", os.fspath(target))
     if target.suffix.lower() == ".mp4":
         require_video()

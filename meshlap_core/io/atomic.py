@@ -80,18 +80,54 @@ def _resolved(path: PathLike) -> Path:
     return Path(os.path.abspath(os.fspath(path))).resolve(strict=False)
 
 
+_SPECIAL = (
+    (stat.S_ISCHR, "a character device"),
+    (stat.S_ISBLK, "a block device"),
+    (stat.S_ISFIFO, "a FIFO (named pipe)"),
+    (stat.S_ISSOCK, "a socket"),
+)
+
+
+def _existing_kind(target: Path) -> str | None:
+    """What is at ``target`` without following a symbolic link: ``None`` (nothing), ``"file"``,
+    ``"link"``, ``"directory"`` or the kind of special file (``"a character device"``, ...)."""
+    try:
+        mode = os.lstat(target).st_mode
+    except (FileNotFoundError, NotADirectoryError):
+        return None
+    except OSError:
+        return None  # (not readable: the write will say why)
+    if stat.S_ISLNK(mode):
+        return "link"
+    if stat.S_ISDIR(mode):
+        return "directory"
+    if stat.S_ISREG(mode):
+        return "file"
+    return next((name for test, name in _SPECIAL if test(mode)), "a special file")
+
+
 def _check_output_path(path: PathLike, overwrite_inputs: Iterable[PathLike]) -> Path:
+    """The one rule for outputs: a new regular file replaces whatever name ``path`` is. A
+    symbolic link there is replaced itself (never written through: what it points to is left
+    alone); a directory, a device, a FIFO or a socket there is refused, as is an input."""
     target = Path(os.fspath(path))
     if not os.fspath(path):
         raise MeshError("the output path is empty", "path")
     parent = target.parent if str(target.parent) else Path(".")
     if not parent.is_dir():
         raise MeshError("the output directory does not exist", os.fspath(parent))
-    if target.is_dir():
+    kind = _existing_kind(target)
+    if kind == "directory":
         raise MeshError("the output path is a directory", os.fspath(target))
+    if kind not in (None, "file", "link"):
+        raise MeshError(
+            f"the output path is {kind}, not a regular file; meshlap writes only regular "
+            "files (choose another name)",
+            os.fspath(target),
+        )
     res = _resolved(target)
     for inp in overwrite_inputs:
-        same = _resolved(inp) == res
+        same = _resolved(inp) == res or _absolute(inp) == _absolute(target)
         if not same and target.exists() and Path(os.fspath(inp)).exists():
             with contextlib.suppress(OSError):
                 same = os.path.samefile(target, inp)
@@ -101,6 +137,11 @@ def _check_output_path(path: PathLike, overwrite_inputs: Iterable[PathLike]) -> 
                 os.fspath(target),
             )
     return target
+
+
+def _absolute(path: PathLike) -> Path:
+    """``path`` made absolute without resolving links (the name itself, not its target)."""
+    return Path(os.path.abspath(os.fspath(path)))
 
 
 def check_output_path(
@@ -124,7 +165,8 @@ def check_output_path(
     Raises
     ------
     MeshError
-        Empty path, a missing directory (named), a directory as target, an input as target,
+        Empty path, a missing directory (named), a directory, device, FIFO or socket as
+        target (a symbolic link is fine: it is replaced, not followed), an input as target,
         or an extension not in ``suffixes``.
     """
     target = _check_output_path(path, overwrite_inputs)
@@ -149,8 +191,11 @@ def atomic_write(
 ) -> Iterator[IO[Any]]:
     """Write a file atomically: the target appears complete or not at all.
 
-    A temporary file is created in the target's directory, written through the yielded file
-    object, flushed, fsync'ed and renamed over the target with ``os.replace``. If the ``with``
+    A temporary file is created in the target's directory (mode ``0666`` less the umask),
+    written through the yielded file object, flushed, fsync'ed and renamed over the target
+    with ``os.replace``. The one rule for outputs (:func:`check_output_path`): a symbolic
+    link at ``path`` is replaced itself, never written through; a directory, device, FIFO
+    or socket there is refused. If the ``with``
     body, the flush, the fsync or the rename raises, the temporary file is closed without
     depending on a flush (a full disk fails the flush again) and removed, and an existing
     target is left untouched.
@@ -165,9 +210,10 @@ def atomic_write(
         Paths that must not be written (e.g. the command's input mesh); compared after
         resolving symlinks.
     keep_mode : bool
-        Give the new file the permissions of the file it replaces (default); ``False`` creates
-        it with the default permissions (the cache does, so that an entry someone made
-        unreadable is replaced by a readable one).
+        Give the new file the permissions of the regular file it replaces (default; a
+        replaced link passes on nothing); ``False`` creates it with the default permissions
+        (the cache does, so that an entry someone made unreadable is replaced by a readable
+        one).
 
     Yields
     ------
@@ -197,9 +243,11 @@ def atomic_write(
         raise MeshError(
             f"cannot create a file in {os.fspath(parent)!r}: {os_cause(exc)}", os.fspath(target)
         ) from None
-    if keep_mode and target.exists():  # keep the permissions of the file being replaced
+    if keep_mode and _existing_kind(target) == "file":
+        # keep the permissions of the regular file being replaced; a link's target is not
+        # what is replaced, so its mode is not copied (the new file gets the umask's)
         with contextlib.suppress(OSError):
-            os.chmod(tmp, stat.S_IMODE(target.stat().st_mode))
+            os.chmod(tmp, stat.S_IMODE(os.lstat(target).st_mode))
     try:
         f: IO[Any] = (
             os.fdopen(fd, "wb")

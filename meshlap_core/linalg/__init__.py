@@ -9,5 +9,6 @@ Modules, bottom up: :mod:`.common` (array aliases, ``SolveInfo``, the progress c
 inertia, the shift-invert operator), :mod:`.lanczos` (block Lanczos, DCGS2, Cholesky QR),
 :mod:`.slice_worker` (one slice), :mod:`.slicing` (the slice plan and its inertia checks),
 :mod:`.components` (components, null space), :mod:`.checks` (residuals, orthonormality),
+:mod:`.refine` (pairs above the promised residual refined),
 :mod:`.eigsolve` (:func:`~meshlap_core.linalg.eigsolve.pencil_eigenpairs`: dense or sliced).
 """

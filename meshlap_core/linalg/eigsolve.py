@@ -23,6 +23,11 @@ symmetric scaled pencil ``A = M^-½ K M^-½`` (same eigenvalues, ``y = M^½ u``)
   more shift in a gap just above ``λ_k``, count the eigenvalues below it, which must equal the
   number found; a deficit is searched for again with the found vectors deflated. Slices are
   finally orthonormalized together (Löwdin, :func:`lowdin`).
+* Every pair's residual in the pencil is then measured; pairs above the promised 1e-8
+  (:data:`~meshlap_core.linalg.refine.PROMISED_RESIDUAL`) are refined by inverse iteration
+  and Rayleigh–Ritz (:mod:`~meshlap_core.linalg.refine`), and a result that still misses it
+  is refused. So the accuracy does not depend on the slice plan, which depends on the
+  number of workers, which depends on how busy the machine is.
 
 Mesh-free: the mesh pencil is assembled by :mod:`meshlap_core.spectral.operators`.
 
@@ -57,6 +62,7 @@ from .common import (
 )
 from .components import component_scales, components, null_space, scale_groups, solve_by_groups
 from .factor import ldl_backend
+from .refine import PROMISED_RESIDUAL, ScaledPencil, refine_pairs
 from .slicing import SlicedLanczos, default_workers
 
 # Dense solver below this many vertices (or when k is a large fraction of n).
@@ -142,18 +148,32 @@ def lowdin(Y: FloatArray, helper: Any | None = None) -> float:
     return err
 
 
-def fix_signs(U: FloatArray) -> None:
-    """Deterministic sign: the entry of largest magnitude of each column is positive.
+SIGN_TIE = 1e-6
+"""Entries within this relative distance of a column's largest magnitude count as tied for
+the sign rule (:func:`fix_signs`)."""
 
-    Column by column on an F-ordered ``U`` (no ``n × k`` temporary: 550 MB at 692k vertices
-    and k = 100), and only the columns that change sign are rewritten."""
+
+def fix_signs(U: FloatArray) -> None:
+    """Deterministic sign: the entry of largest magnitude of each column is positive; among
+    entries tied with it (within :data:`SIGN_TIE`, as on a symmetric mesh, where the largest
+    magnitude is reached at mirror vertices with opposite signs), the first one.
+
+    The tie rule makes the sign independent of round-off: two solves whose vectors differ by
+    1e-12 (another slice plan, a refined pair) would otherwise pick different vertices of a
+    tie and opposite signs. Column by column on an F-ordered ``U`` (no ``n × k`` temporary:
+    550 MB at 692k vertices and k = 100), and only the columns that change sign are
+    rewritten."""
     k = U.shape[1]
     if k == 0:
         return
     if U.flags.f_contiguous:
-        idx = np.array([int(np.argmax(np.abs(U[:, j]))) for j in range(k)], dtype=np.int64)
+        idx = np.empty(k, dtype=np.int64)
+        for j in range(k):
+            a = np.abs(U[:, j])
+            idx[j] = int(np.argmax(a >= (1.0 - SIGN_TIE) * a.max()))
     else:
-        idx = np.argmax(np.abs(U), axis=0)
+        a = np.abs(U)
+        idx = np.argmax(a >= (1.0 - SIGN_TIE) * a.max(axis=0)[None, :], axis=0)
     for j in np.flatnonzero(U[idx, np.arange(k)] < 0):
         U[:, j] *= -1.0
 
@@ -232,8 +252,10 @@ def pencil_eigenpairs(
     Components whose frequency scales differ by more than
     :data:`~meshlap_core.linalg.components.SCALE_GAP` are solved group by group, each with its
     own shifts. Every result is checked before it is returned: the residual of every pair
-    (at most :data:`~meshlap_core.linalg.checks.RESIDUAL_TOL`) and, for the dense solver,
-    Sylvester's inertia at a gap; a result that fails raises :class:`MeshError`.
+    (at most :data:`~meshlap_core.linalg.refine.PROMISED_RESIDUAL` for the sparse solver,
+    after refining the pairs above it; :data:`~meshlap_core.linalg.checks.RESIDUAL_TOL` for
+    the dense one) and, for the dense solver, Sylvester's inertia at a gap; a result that
+    fails raises :class:`MeshError`.
 
     (Over 80 lines only because of this docstring: the body is ~35 lines.)
     """
@@ -245,6 +267,7 @@ def pencil_eigenpairs(
     ncomp, labels = components(K)
     groups = scale_groups(component_scales(K, m, labels, ncomp)) if ncomp > 1 else []
     tuning = {"tol": tol, "block": block, "slice_size": slice_size, "first_slice": first_slice}
+    refine, pencil = False, None  # (each group refines its own sparse result)
     if len(groups) > 1:
         _use_dense(method, len(m), k)  # (checks the method's name)
         lam, U, info = _grouped_eigenpairs(
@@ -260,7 +283,7 @@ def pencil_eigenpairs(
             blas_threads_=blas_threads,
         )
     else:
-        lam, U, info = _solve(
+        lam, U, info, pencil = _solve(
             K,
             m,
             k,
@@ -274,11 +297,12 @@ def pencil_eigenpairs(
             blas_threads_=blas_threads,
             density=density,
         )
+        refine = not _use_dense(method, len(m), k)
     info.timings["eigensolve"] = time.perf_counter() - t0
     # (one BLAS thread, as in the solve: OpenBLAS's threads on these n × k products doubled
     # the check's time at 43k vertices on a busy machine, 0.35 s against 0.19 s)
     with limit_blas_threads(1 if blas_threads is None else max(1, int(blas_threads))):
-        _check_result(K, m, lam, U, labels, info)
+        lam, U = _check_result(K, m, lam, U, labels, info, refine=refine, pencil=pencil)
     return lam, U, info
 
 
@@ -344,24 +368,44 @@ def _check_result(
     U: FloatArray,
     labels: IntArray,
     info: SolveInfo,
-) -> None:
+    *,
+    refine: bool,
+    pencil: ScaledPencil | None = None,
+) -> tuple[FloatArray, FloatArray]:
     """Measure every pair's residual (one sparse product) and the orthonormality into
-    ``info``; refuse the result (:class:`MeshError`) if a pair misses :data:`RESIDUAL_TOL`."""
+    ``info``. With ``refine`` (a result of the sparse solver), pairs above
+    :data:`PROMISED_RESIDUAL` are refined (:func:`~meshlap_core.linalg.refine.refine_pairs`)
+    and a result still above it is refused; any result with a pair above
+    :data:`RESIDUAL_TOL` is refused (:class:`MeshError`). Returns ``(lam, U)`` (refined or not)."""
     t1 = time.perf_counter()
     res = pair_residuals(K, m, lam, U, labels)
+    promised = refine
+    if promised and not np.all(res <= PROMISED_RESIDUAL):
+        before = float(np.nanmax(res))
+        lam, U, res, done = refine_pairs(K, m, lam, U, labels, res, pencil=pencil)
+        sub = U[:, done.columns]  # (the sign rule on the changed columns only)
+        fix_signs(sub)
+        U[:, done.columns] = sub
+        info.messages.append(
+            f"{done.pairs} eigenpair(s) refined in {done.rounds} round(s) (inverse iteration, "
+            f"Rayleigh-Ritz): max relative residual {before:.1e} -> {float(np.nanmax(res)):.1e}"
+        )
+        info.timings["refinement"] = time.perf_counter() - t1
     info.max_residual = float(res.max(initial=0.0))
     info.orthogonality_error = orthogonality(U, m)
     info.timings["residual_check"] = time.perf_counter() - t1
-    bad = np.flatnonzero(~(res <= RESIDUAL_TOL))
+    limit = PROMISED_RESIDUAL if promised else RESIDUAL_TOL
+    bad = np.flatnonzero(~(res <= limit))
     if len(bad):
         j = int(bad[np.argmax(np.where(np.isfinite(res[bad]), res[bad], np.inf))])
         raise MeshError(
             f"the eigensolver's result fails its check: {len(bad)} of {len(lam)} eigenpairs "
-            f"have a relative residual above {RESIDUAL_TOL:.0e} (pair {j}, lambda = "
-            f"{lam[j]:.6g}: {res[j]:.1e}); the eigenproblem is too badly conditioned to "
-            "solve accurately, so no basis is given",
+            f"have a relative residual above {limit:.0e} (pair {j}, lambda = "
+            f"{lam[j]:.6g}: {res[j]:.1e}){' after refinement' if promised else ''}; the "
+            "eigenproblem is too badly conditioned to solve accurately, so no basis is given",
             "K",
         )
+    return lam, U
 
 
 def _solve(
@@ -378,13 +422,15 @@ def _solve(
     workers: int | None,
     blas_threads_: int | None,
     density: float | None,
-) -> tuple[FloatArray, FloatArray, SolveInfo]:
+) -> tuple[FloatArray, FloatArray, SolveInfo, ScaledPencil | None]:
     """:func:`pencil_eigenpairs` on a pencil whose components have comparable scales: the
-    exact null space, then the dense or the sparse solver; ``(lam, U, info)``."""
+    exact null space, then the dense or the sparse solver; ``(lam, U, info, pencil)``
+    (``pencil``: that of the sparse solver's slices, else ``None``)."""
     n = len(m)
     info = SolveInfo(n_vertices=n, k=k)
     Z = null_space(m, labels, ncomp)
     info.n_components = ncomp
+    pencil = None
     if _use_dense(method, n, k):
         info.method = "dense"
         report_progress(progress, 0.0, f"eigensolver: dense, {n} vertices")
@@ -396,7 +442,7 @@ def _solve(
             lowdin(Y)
         report_progress(progress, 1.0, "eigensolver: done")
     else:
-        lam, Y = _sparse_eigenpairs(
+        lam, Y, pencil = _sparse_eigenpairs(
             K,
             m,
             k,
@@ -410,7 +456,7 @@ def _solve(
             density=density,
         )
     lam, U = _finish(K, m, lam, Y, info)
-    return lam, U, info
+    return lam, U, info, pencil
 
 
 def _use_dense(method: str, n: int, k: int) -> bool:
@@ -460,15 +506,17 @@ def _sparse_eigenpairs(
     workers: int | None,
     blas_threads_: int | None,
     density: float | None,
-) -> tuple[FloatArray, FloatArray]:
+) -> tuple[FloatArray, FloatArray, ScaledPencil | None]:
     """The sparse path of :func:`pencil_eigenpairs`: sliced shift-invert block Lanczos (or
     the known pairs / the null space alone when they suffice), then Löwdin across slices.
-    Returns ``(lam, Y)`` with ``Y = M^½ U``."""
+    Returns ``(lam, Y, pencil)`` with ``Y = M^½ U`` and the slices' scaled pencil and
+    ordering (for the refinement; ``None`` when no slice ran)."""
     n, ncomp = len(m), Z.shape[1]
     d = np.sqrt(m)
     info.method = "shift-invert block Lanczos, spectrum slicing"
     nw = 1  # slice workers (also the cores the final orthonormalization may use)
     kn = None
+    pencil = None
     if known is not None and len(known[0]):
         lam0 = np.asarray(known[0], dtype=np.float64)
         U0 = np.asarray(known[1], dtype=np.float64)
@@ -490,7 +538,7 @@ def _sparse_eigenpairs(
         rho = float(density) if density else float(m.sum() / (4 * np.pi))
         try:
             with limit_blas_threads(nb):
-                lam, Y = SlicedLanczos(
+                solver = SlicedLanczos(
                     K,
                     m,
                     k,
@@ -501,7 +549,9 @@ def _sparse_eigenpairs(
                     workers=nw,
                     weyl_density=rho,
                     **tuning,
-                ).solve()
+                )
+                lam, Y = solver.solve()
+                pencil = ScaledPencil(solver.ctx.A, solver.ctx.ordering)
         except RuntimeError as exc:  # (inertia counts that cannot be reconciled, no factor)
             raise MeshError(
                 f"{exc}; the eigenproblem is too badly conditioned for the solver, so no "
@@ -522,7 +572,7 @@ def _sparse_eigenpairs(
             f"slices orthonormalized together (Lowdin; max|U^T M U - I| was {before:.1e})"
         )
     info.timings["orthonormalization"] = time.perf_counter() - t1
-    return lam, Y
+    return lam, Y, pencil
 
 
 def _finish(

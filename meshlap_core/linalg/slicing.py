@@ -261,38 +261,35 @@ class SlicedLanczos:
         return [max(s_, 4) for s_ in sizes]
 
     def plannable(self, i: int) -> bool:
-        """Slice ``i`` is planned from the inertia of slice ``i − 1``, known as soon as it is
-        factored (so the plan does not depend on which thread finishes first, and no thread
-        waits for a long slice to end)."""
-        if i < max(self.workers, 1) or (i - 1) in self.results:
+        """Slice ``i`` is planned from the inertia counts of every slice below it, known as
+        soon as each is factored (no thread waits for a long slice to end); the first
+        ``workers`` slices from Weyl's law alone. So the plan never depends on which thread
+        finishes first, nor on how busy the machine is."""
+        if i < max(self.workers, 1):
             return True
-        return (i - 1) in self.ctx.inertia
+        return all(j in self.ctx.inertia for j in range(i))
 
     def density_before(self, i: int) -> float:
         """Eigenvalue density for planning slice ``i``: between the last two inertia counts
-        at the shifts of slices ``< i`` (the first point is ``(0, base)``), else from the
-        finished slices ``<= i - workers``, else Weyl's."""
+        at the shifts of slices ``< i`` (the first point is ``(0, base)``), else over all of
+        them, else Weyl's. The first ``workers`` slices (planned at once, while the others
+        may or may not have been factored yet) use Weyl's alone."""
+        if i < max(self.workers, 1):
+            return self.weyl_density
         inertia = self.ctx.inertia
         pts = [(0.0, self.base if self.known is None else self.n_null)] + [
-            inertia[j] for j in range(i) if j in inertia
+            inertia[j] for j in range(i)
         ]
-        if len(pts) >= 2 and pts[-1][0] > pts[-2][0]:
-            (s0, n0), (s1, n1) = pts[-2], pts[-1]
-            if n1 - n0 >= 4:
+        pts.sort()
+        for (s0, n0), (s1, n1) in ((pts[-2], pts[-1]), (pts[0], pts[-1])):
+            if s1 > s0 and n1 - n0 >= 4:
                 return (n1 - n0) / (s1 - s0)
-        j = i - max(self.workers, 1)
-        while j >= 0:
-            r = self.results.get(j)
-            if r is not None:
-                lo = max(r.spec.lo, 0.0)
-                cnt = len(r.lam) + (self.base if r.spec.index == 0 and self.known is None else 0)
-                if cnt >= 4 and r.spec.hi > lo:
-                    return cnt / (r.spec.hi - lo)
-            j -= 1
         return self.weyl_density
 
-    def plan(self, i: int) -> SliceSpec:
-        """The interval, shift and expected count of slice ``i``."""
+    def plan(self, i: int, settled: bool = False) -> SliceSpec:
+        """The interval, shift and expected count of slice ``i``. ``settled``: every slice
+        below ``i`` has finished (so the last slice can ask for exactly what is missing);
+        true with one worker, and for the extra slices submitted after all others ended."""
         specs, results, known = self.specs, self.results, self.known
         # (the lowest slice starts just below 0: round-off can put a zero mode that the
         # component indicators do not cover a hair below 0)
@@ -307,7 +304,7 @@ class SlicedLanczos:
         # need the next slice for a few eigenvalues
         size = self.sizes[min(i, len(self.sizes) - 1)]
         count = None
-        if i >= self.n_total - 1 and all(j in results for j in range(i)):
+        if i >= self.n_total - 1 and (settled or self.workers <= 1):
             # the last slice, with every lower eigenvalue known: ask for exactly what is missing
             have = self.base + sum(len(results[j].lam) for j in range(i))
             count = max(self.target - have, 1)
@@ -345,9 +342,9 @@ class SlicedLanczos:
 
     # ---- running ---------------------------------------------------------------------------
 
-    def _submit(self, pool: Any, running: dict[Any, int]) -> None:
+    def _submit(self, pool: Any, running: dict[Any, int], settled: bool = False) -> None:
         """Plan the next slice and submit it to the pool."""
-        self.specs.append(self.plan(len(self.specs)))
+        self.specs.append(self.plan(len(self.specs), settled))
         running[pool.submit(run_slice, self.ctx, self.specs[-1], self.seed)] = len(self.specs) - 1
 
     def _run_slices(self) -> None:
@@ -371,7 +368,7 @@ class SlicedLanczos:
                         if got >= self.target or len(self.specs) > 4 * self.n_total + 20:
                             break
                         self.n_total += 1  # the density estimate was short: one more slice
-                        self._submit(pool, running)
+                        self._submit(pool, running, settled=True)
                         continue
                     # (a short timeout while the next slice waits for an inertia count)
                     waiting = len(running) < max(workers, 1) and len(self.specs) < self.n_total

@@ -21,9 +21,13 @@ from meshlap_core.io import load_mesh
 from meshlap_core.laplacian import cotan_stiffness, vertex_areas
 from tests.support import hostile
 
-pytestmark = pytest.mark.skipif(
-    "spectral" not in COMMANDS, reason="the spectral command is not registered yet"
-)
+pytestmark = [
+    pytest.mark.skipif(
+        "spectral" not in COMMANDS, reason="the spectral command is not registered yet"
+    ),
+    # each case under each plan of the eigensolver (one slice worker and two, forced)
+    pytest.mark.usefixtures("slice_plan"),
+]
 
 
 @pytest.fixture(autouse=True)

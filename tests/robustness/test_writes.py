@@ -14,6 +14,7 @@ left out (two minutes; it works inside its ``--out`` folder).
 
 from __future__ import annotations
 
+import functools
 import os
 import pwd
 import shutil
@@ -28,6 +29,40 @@ import pytest
 from meshlap_core import primitives, save_mesh
 
 AS_NOBODY = os.geteuid() == 0 and shutil.which("setpriv") is not None
+
+
+def _as_nobody() -> list[str]:
+    """The ``setpriv`` prefix that runs a command as ``nobody``."""
+    user = pwd.getpwnam("nobody")
+    return ["setpriv", f"--reuid={user.pw_uid}", f"--regid={user.pw_gid}", "--clear-groups"]
+
+
+@functools.cache
+def nobody_cannot_run_meshlap() -> str | None:
+    """Why ``nobody`` cannot run this checkout's meshlap (``None``: it can). A checkout
+    cloned into a private folder (``mktemp -d``: mode 700) keeps its interpreter, venv and
+    sources out of that user's reach; then the tests that run commands as ``nobody`` have
+    nothing to test and skip, saying so."""
+    if not AS_NOBODY:
+        return "needs root and setpriv to run as nobody"
+    try:
+        res = subprocess.run(
+            [*_as_nobody(), sys.executable, "-c", "import meshlap_core.cli"],
+            capture_output=True,
+            text=True,
+            timeout=120,
+            cwd="/",
+        )
+    except (OSError, subprocess.SubprocessError) as exc:
+        return f"cannot start Python as nobody: {exc}"
+    if res.returncode != 0:
+        last = (res.stderr.strip().splitlines() or ["(no message)"])[-1]
+        return (
+            f"the user nobody cannot run {sys.executable} with this checkout (a parent "
+            f"folder is private?): {last}"
+        )
+    return None
+
 
 COMMANDS: dict[str, list[str]] = {
     "info": ["info", "{mesh}", "--json"],
@@ -125,8 +160,9 @@ def _run(argv: list[str], places: dict[str, Path]) -> subprocess.CompletedProces
     env = {**os.environ, **_env(places)}
     prefix: list[str] = []
     if AS_NOBODY:
-        user = pwd.getpwnam("nobody")
-        prefix = ["setpriv", f"--reuid={user.pw_uid}", f"--regid={user.pw_gid}", "--clear-groups"]
+        if (why := nobody_cannot_run_meshlap()) is not None:
+            pytest.skip(why)
+        prefix = _as_nobody()
     return subprocess.run(
         [*prefix, sys.executable, "-m", "meshlap_core.cli", *args],
         capture_output=True,
@@ -174,5 +210,23 @@ def test_rendering_commands_write_only_where_named(name, places):
 @pytest.mark.skipif(not AS_NOBODY, reason="needs root and setpriv to run as nobody")
 @pytest.mark.parametrize("name", ["spectral", "surface", "info-missing"])
 def test_commands_work_in_a_read_only_directory(name, places):
+    if (why := nobody_cannot_run_meshlap()) is not None:
+        pytest.skip(why)
     places["cwd"].chmod(0o555)
     _check(name, COMMANDS[name], places)
+
+
+@pytest.mark.skipif(not AS_NOBODY, reason="needs root and setpriv to run as nobody")
+def test_a_checkout_nobody_cannot_reach_is_a_skip_with_its_reason(tmp_path, monkeypatch):
+    """A clone in a private folder (``mktemp -d``, mode 700): the interpreter is out of
+    nobody's reach, so the as-nobody tests skip saying why instead of failing."""
+    private = tmp_path / "private"
+    private.mkdir(mode=0o700)
+    (private / "python").symlink_to(sys.executable)
+    monkeypatch.setattr(sys, "executable", str(private / "python"))
+    nobody_cannot_run_meshlap.cache_clear()
+    try:
+        why = nobody_cannot_run_meshlap()
+    finally:
+        nobody_cannot_run_meshlap.cache_clear()
+    assert why is not None and "nobody cannot run" in why and str(private) in why
