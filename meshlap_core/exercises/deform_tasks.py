@@ -72,7 +72,7 @@ def arap_step(V, F, U, handles, targets):
        reflection: negate the column of B of the smallest singular value first (the
        reflection fix), so that det R_i = +1;
     3. global step: solve K x = b with K = −C and b_i = Σ_j (w_ij/2)(R_i + R_j)(p_i − p_j)
-       for the free vertices, x = targets at the handles (Q_ff x_f = b_f − K_fh targets).
+       for the free vertices, x = targets at the handles (K_ff x_f = b_f − K_fh targets).
 
     handles : (h,) int, sorted;  targets : (h,3) float;  U : (n,3) float.
     A vertex that no handle can reach (in no face, or on a piece without a handle) goes back
