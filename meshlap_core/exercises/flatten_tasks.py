@@ -107,8 +107,9 @@ def flattener(case: Case) -> Flattener:
         flat = Flattener(case.V, case.F, cut=False)
     except MeshError as exc:
         raise MeshError(
-            f"the flattening exercises need a disk (one outer boundary loop), and this mesh "
-            f"is not one: {exc.problem}",
+            f"the flattening exercises cannot use this mesh: "
+            f"{exc.problem.split(' and cutting is off')[0]} (they need a disk: "
+            "one connected piece with a boundary loop, no handle, no face of zero area)",
             "mesh",
         ) from None
     if flat.disk.n_vertices != len(case.V):
