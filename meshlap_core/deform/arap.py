@@ -122,7 +122,7 @@ class ArapDeformer(Deformer):
         self.rotations = check_choice(rotations, ROTATION_FITS, "rotation fit", "rotations")
         super().__init__(V, F, handles, fixed)
         phase(progress, cancel, 0.0, "deformation: ARAP energy (cotangent weights, covariances)")
-        self.terms = ArapEnergy(self.V, self.F, energy, solid=self.solid)
+        self.terms = ArapEnergy(self.V, self.F, energy, solid=self.solid, l2=self.l2)
         self.energy_name = "sum_i sum_j w_ij |(x_i - x_j) - R_i (p_i - p_j)|^2" + (
             " over spokes" if self.terms.kind == "spokes" else " over spokes and rims"
         )

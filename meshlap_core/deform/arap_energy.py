@@ -79,6 +79,10 @@ class ArapEnergy:
     kind : {"spokes", "spokes-and-rims"}
     absolute : bool
         Use ``|c|`` for the weights (a non-negative energy; :func:`rotation_error`'s choice).
+    solid : (m,) bool, optional
+        The faces that are not degenerate, when the caller has them.
+    l2 : (m,3) float, optional
+        The squared edge lengths, when the caller has them (a deformer does).
 
     Attributes
     ----------
@@ -95,16 +99,17 @@ class ArapEnergy:
         kind: ArapEnergyKind = DEFAULT_ARAP_ENERGY,
         absolute: bool = False,
         solid: BoolArray | None = None,
+        l2: FloatArray | None = None,
     ) -> None:
         self.kind = check_choice(kind, ARAP_ENERGIES, "ARAP energy", "energy")
         self.P = V
         n = self.n = len(V)
         self.multiplicity = 2 if self.kind == "spokes" else 3
         if self.kind == "spokes":
-            K = stiffness(V, F, solid_faces(V, F) if solid is None else solid)
+            K = stiffness(V, F, solid_faces(V, F) if solid is None else solid, l2)
             self.K, self.Z, self.terms = _spokes(V, K, absolute)
         else:
-            half = 0.5 * cotangents_intrinsic(squared_edge_lengths(V, F))
+            half = 0.5 * cotangents_intrinsic(squared_edge_lengths(V, F) if l2 is None else l2)
             if absolute:
                 half = np.abs(half)
             self.K = _graph_laplacian(F, half, n)

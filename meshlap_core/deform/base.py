@@ -13,12 +13,19 @@ from __future__ import annotations
 import time
 from typing import Any
 
+import igl
 import numpy as np
 
 from ..errors import check_cancel
 from ..linalg.common import ProgressCallback, report_progress
 from ..types import FloatArray, as_mesh
-from .constraints import Constraints, check_sets, check_targets, make_constraints, solid_faces
+from .constraints import (
+    Constraints,
+    check_sets,
+    check_targets,
+    make_constraints,
+    solid_from_lengths,
+)
 from .rigidity import rotation_error_checked
 from .system import SystemStats
 
@@ -51,6 +58,12 @@ class Deformer:
     constraints : Constraints
     handles, fixed : (h,) int, (f,) int
         Sorted; :meth:`update` takes targets in the order of ``handles``.
+    l2 : (m,3) float
+        Squared edge lengths (column ``k`` opposite corner ``k``), computed once: the
+        degenerate-face test (:attr:`solid`) and, on a mesh with a degenerate face, the
+        guarded cotangent weights share them.
+    solid : (m,) bool
+        The faces that are not degenerate.
     stats : SystemStats
         The factorized system's size, entries, factorization time and back end.
     setup_seconds : float
@@ -64,7 +77,8 @@ class Deformer:
         self._t0 = time.perf_counter()
         self.V, self.F = as_mesh(V, F)
         self.n = len(self.V)
-        self.solid = solid_faces(self.V, self.F)
+        self.l2 = igl.squared_edge_lengths(self.V, self.F)  # the degenerate test's, kept
+        self.solid = solid_from_lengths(self.l2)
         self.handles, self.fixed = check_sets(self.n, handles, fixed)
         self._targets = self.V[self.handles].copy()
         self._U = self.V.copy()

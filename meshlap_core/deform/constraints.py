@@ -16,6 +16,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
+import igl
 import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
@@ -98,11 +99,15 @@ def check_targets(targets: Any, count: int, name: str = "targets") -> FloatArray
 def solid_faces(V: FloatArray, F: IntArray) -> BoolArray:
     """Which faces are not degenerate, by the rule the cotangent weights use
     (:data:`~meshlap_core.options.DEGENERATE_REL`: ``16 A² > (2·DEGENERATE_REL)² (Σ l²)²``,
-    Heron's ``16 A²`` from the squared lengths); a degenerate face gets zero weights."""
-    P0, P1, P2 = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
-    a = np.einsum("ij,ij->i", P1 - P2, P1 - P2)
-    b = np.einsum("ij,ij->i", P2 - P0, P2 - P0)
-    c = np.einsum("ij,ij->i", P0 - P1, P0 - P1)
+    Heron's ``16 A²`` from libigl's ``squared_edge_lengths``); a degenerate face gets zero
+    weights."""
+    return solid_from_lengths(igl.squared_edge_lengths(V, F))
+
+
+def solid_from_lengths(l2: FloatArray) -> BoolArray:
+    """:func:`solid_faces` from the squared edge lengths ``(m,3)`` (a deformer computes them
+    once, for this test and for the weights)."""
+    a, b, c = l2[:, 0], l2[:, 1], l2[:, 2]
     area16 = 2.0 * (a * b + b * c + c * a) - (a * a + b * b + c * c)
     return area16 > (2.0 * DEGENERATE_REL) ** 2 * (a + b + c) ** 2
 
@@ -225,14 +230,20 @@ def make_constraints(
     """
     h, f = check_sets(n, handles, fixed)
     if graph is not None and solid.all():
-        count, labels = connected_components(graph, directed=False)
+        # the pattern is symmetric: its strong components are the components, found without
+        # the transpose an undirected search builds
+        count, labels = connected_components(graph, directed=True, connection="strong")
         labels = labels.astype(np.int64)
     else:
         count, labels = surface_components(F, n, solid)
     held = np.zeros(count, dtype=bool)
     held[labels[h]] = True
     held[labels[f]] = True
-    still = np.flatnonzero(~held[labels]).astype(np.int64)
-    known = np.union1d(np.union1d(h, f), still).astype(np.int64)
-    free = np.setdiff1d(np.arange(n, dtype=np.int64), known, assume_unique=True)
+    at_rest = ~held[labels]
+    still = np.flatnonzero(at_rest)
+    is_known = at_rest
+    is_known[h] = True
+    is_known[f] = True
+    known = np.flatnonzero(is_known)
+    free = np.flatnonzero(~is_known)
     return Constraints(n, h, f, still, known, free, int(count))

@@ -128,7 +128,7 @@ class HarmonicDeformer(Deformer):
         self.method = next(m for m, order in HARMONIC_ORDERS.items() if order == self.k)
         self.energy_name = ENERGY_NAMES[self.k]
         phase(progress, cancel, 0.0, "deformation: cotangent stiffness and mass")
-        K = stiffness(self.V, self.F, self.solid)
+        K = stiffness(self.V, self.F, self.solid, self.l2)
         mass = vertex_areas(self.V, self.F, MASS_AREA) if self.k > 1 else np.ones(self.n)
         self.Q = k_harmonic_operator(K, mass, self.k)
         c = self._constrain(K)

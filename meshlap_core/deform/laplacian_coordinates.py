@@ -111,7 +111,7 @@ class LaplacianCoordinates(Deformer):
             " + w sum_c q_c |x_c - u_c|^2" if self.kind == "soft" else ""
         )
         phase(progress, cancel, 0.0, "deformation: cotangent stiffness and mass")
-        K = stiffness(self.V, self.F, self.solid)
+        K = stiffness(self.V, self.F, self.solid, self.l2)
         self.Q = k_harmonic_operator(K, vertex_areas(self.V, self.F, MASS_AREA), 2)
         c = self._constrain(K)
         held = np.union1d(c.handles, c.fixed)

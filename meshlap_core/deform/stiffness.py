@@ -17,15 +17,19 @@ from ..laplacian import cotan_stiffness_intrinsic, squared_edge_lengths
 from ..types import BoolArray, FloatArray, IntArray
 
 
-def stiffness(V: FloatArray, F: IntArray, solid: BoolArray) -> sp.csr_matrix:
+def stiffness(
+    V: FloatArray, F: IntArray, solid: BoolArray, l2: FloatArray | None = None
+) -> sp.csr_matrix:
     """The cotangent stiffness ``K = −C`` ``(n,n)``: libigl's ``cotmatrix`` negated (its CSC
     arrays read as CSR: the same symmetric matrix, no conversion); with a degenerate face
     (``solid`` false somewhere), where libigl's cotangents blow up, the guarded
-    :func:`~meshlap_core.laplacian.cotan_stiffness_intrinsic` (zero weights there)."""
+    :func:`~meshlap_core.laplacian.cotan_stiffness_intrinsic` (zero weights there) from the
+    squared edge lengths ``l2`` ``(m,3)`` (computed when not given)."""
     n = len(V)
     if len(F) == 0:
         return sp.csr_matrix((n, n))
     C = None if not solid.all() else igl.cotmatrix(V, F)
     if C is None or C.shape != (n, n) or not np.isfinite(C.data).all():
-        return (-cotan_stiffness_intrinsic(squared_edge_lengths(V, F), F, n)).tocsr()
+        l2 = squared_edge_lengths(V, F) if l2 is None else l2
+        return (-cotan_stiffness_intrinsic(l2, F, n)).tocsr()
     return sp.csr_matrix((-C.data, C.indices, C.indptr), shape=(n, n))

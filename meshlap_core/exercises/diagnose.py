@@ -55,7 +55,8 @@ DIAGNOSES: dict[str, str] = {
     "corner half its area and the others a quarter (Meyer et al. 2003)",
     "missing_mass": "missing mass matrix: the pointwise Laplacian is M⁻¹C (and the implicit "
     "step solves (M − λC) x′ = M x)",
-    "uniform_not_cotan": "uniform Laplacian used instead of the cotangent one",
+    "uniform_not_cotan": "uniform weights (the uniform Laplacian) used instead of the "
+    "cotangent ones",
     "missing_boundary_term": "missing boundary term: a boundary vertex's angle sum is compared "
     "with π (rule 'pi'), not 2π",
     "wrong_boundary_rule": "the boundary rule argument was not applied (each rule gives another "
@@ -83,6 +84,36 @@ DIAGNOSES: dict[str, str] = {
     "from the source; X = −∇u/|∇u| points away from it and K φ = Gᵀ A X",
     "not_shifted": "not shifted: the distance must be 0 at the source (subtract φ[source]); "
     "the Poisson solution is only defined up to a constant",
+    "positions_not_displacement": "positions instead of the displacement: solve Δ²d = 0 for "
+    "d = U − V (d given at the handles) and return V + d; solving for the positions smooths "
+    "the surface's own details away",
+    "biharmonic_without_mass": "no mass matrix between the two Laplacians: Δ² = M⁻¹C M⁻¹C, so "
+    "the system is C M⁻¹ C d = 0 at the free vertices, not C C d = 0",
+    "harmonic_not_biharmonic": "harmonic, not biharmonic: C d = 0 (Δd = 0) bends sharply at "
+    "the handles; the task asks for Δ²d = 0 (C M⁻¹ C d = 0 at the free vertices)",
+    "no_reflection_fix": "rotations without the reflection fix: where det(B Aᵀ) < 0 the best "
+    "orthogonal fit is a reflection (a folded one-ring); negate the column of B of the "
+    "smallest singular value, R = B diag(1, 1, det(B Aᵀ)) Aᵀ, so that det R = +1",
+    "rotation_transposed": "the rotation is transposed: with S_i = Σ_j w_ij (p_i − p_j)(u_i − "
+    "u_j)ᵀ = A Σ Bᵀ, R_i = B Aᵀ takes rest edges to current ones; A Bᵀ is its inverse",
+    "rotation_not_averaged": "the right-hand side uses R_i alone: b_i = Σ_j (w_ij/2)(R_i + "
+    "R_j)(p_i − p_j), each edge turned by the average of its two ends' rotations",
+    "handles_not_placed": "the local step did not see the handles at their targets: set "
+    "U[handles] = targets first, then fit the rotations",
+    "boundary_by_index": "the boundary is spaced evenly by index (2πk/b): place loop[k] at the "
+    "angle 2π s_k / L, s_k the loop's length from loop[0] to loop[k] (arc length)",
+    "boundary_turned": "right up to a rotation or a mirror of the disk: loop[0] goes to (1, 0) "
+    "and the loop runs counter-clockwise in the order given (a loop of your own that starts "
+    "elsewhere, or runs backwards?)",
+    "boundary_not_on_circle": "the boundary is not on the unit circle: every vertex of loop "
+    "goes on the circle of radius 1 around the origin, by arc length",
+    "no_area_term": "no area term: the Dirichlet energy alone, with both pins on the u axis, "
+    "gives v = 0 everywhere (a map onto a line); LSCM minimizes E_D − A, L_C = diag(K, K) − Q_A",
+    "area_sign": "the area term has the wrong sign (E_D + A): the map is mirrored, every face "
+    "flipped; with the boundary half-edges' faces on their left, L_C = diag(K, K) − Q_A",
+    "unpinned": "not pinned: the map collapses (the conformal energy is 0 for a map to a "
+    "point) or the pins are not at pin_uv; fix both coordinates of both pins (4 unknowns) "
+    "and solve for the others",
     "sized_by_faces": "the answer is sized by F.max()+1: a vertex in no face (the last one here) "
     "still has its row; use n = len(V)",
     "constant_factor": "a constant factor: the answer is {factor} × the expected one on every "

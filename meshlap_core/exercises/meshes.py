@@ -20,6 +20,14 @@ case                   what it catches
 ``large``              an icosphere of 2562 vertices, perturbed: correctness at size and speed
 ``huge``               a bumpy torus of 20,480 vertices: a dense n×n array there needs 3.4 GB
                        (fails on memory or time, and is named so)
+``bumpy_grid``         an open 9×7 grid, jittered and bumpy: a disk for the maps, an open patch
+                       for the deformations
+``jittered_disk``      a Delaunay disk whose boundary vertices are unevenly spaced: arc length,
+                       not index, on the circle
+``cap``                a curved disk cut from a bumpy sphere (not developable: LSCM distorts)
+``scaled_cap``         the cap scaled by 250 and moved: units of the maps
+``large_disk``         a disk of ~1900 vertices (a bumpy sphere below its top): the maps at size,
+                       and their speed
 =====================  ==========================================================================
 
 Every mesh is generated here (seeded), never read from disk, and oriented counter-clockwise
@@ -33,9 +41,10 @@ import functools
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.spatial import Delaunay
 
 from ..laplacian import mean_edge_length
-from ..primitives import icosphere, torus_mesh
+from ..primitives import grid, icosphere, torus_mesh
 from ..types import FloatArray, IntArray
 
 
@@ -125,6 +134,51 @@ def _huge() -> tuple[FloatArray, IntArray]:
     return centre + (V - centre) * (1.0 + 0.02 * rng.uniform(-1.0, 1.0, (len(V), 1))), F
 
 
+def _bumpy_grid() -> tuple[FloatArray, IntArray]:
+    """A 9×7 grid over ``[0, 1.6] × [0, 1.2]``, its interior vertices jittered in the plane, every
+    vertex lifted by a bump and a little noise."""
+    V, F = grid(9, 7)
+    V[:, 0] *= 1.6
+    V[:, 1] *= 1.2
+    rng = np.random.default_rng(5)
+    inner = (V[:, 0] > 0) & (V[:, 0] < 1.6) & (V[:, 1] > 0) & (V[:, 1] < 1.2)
+    V[inner, :2] += rng.uniform(-0.06, 0.06, (int(inner.sum()), 2))
+    V[:, 2] = 0.25 * np.sin(2.5 * V[:, 0]) * np.cos(2.0 * V[:, 1])
+    V[:, 2] += 0.05 * rng.uniform(-1.0, 1.0, len(V))
+    return V, F
+
+
+def _jittered_disk(b: int = 26, inside: int = 70) -> tuple[FloatArray, IntArray]:
+    """The Delaunay triangulation of ``b`` points on the unit circle at unevenly spaced angles
+    and ``inside`` points in it (at least 0.12 apart), lifted onto a saddle with a ripple;
+    faces counter-clockwise seen from above."""
+    rng = np.random.default_rng(13)
+    t = 2.0 * np.pi * (np.arange(b) + rng.uniform(-0.35, 0.35, b)) / b
+    points = [*np.stack([np.cos(t), np.sin(t)], axis=1)]
+    while len(points) < b + inside:
+        p = rng.uniform(-0.88, 0.88, 2)
+        if np.linalg.norm(p) < 0.88 and all(np.linalg.norm(p - q) > 0.12 for q in points[b:]):
+            points.append(p)
+    P = np.array(points)
+    F = Delaunay(P).simplices.astype(np.int64)
+    e1, e2 = P[F[:, 1]] - P[F[:, 0]], P[F[:, 2]] - P[F[:, 0]]
+    clockwise = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0] < 0
+    F[clockwise] = F[clockwise][:, ::-1]
+    z = 0.3 * P[:, 0] ** 2 - 0.2 * P[:, 1] ** 2 + 0.1 * np.sin(4.0 * P[:, 0] + 1.0)
+    return np.column_stack([P, z]), F
+
+
+def _cap(subdivisions: int, below: float, seed: int, amount: float):
+    """The faces of a bumpy sphere above the height ``below`` (every corner above it), the
+    vertices renumbered: a curved disk."""
+    V, F = _bumpy_sphere(subdivisions, seed, amount)
+    F = F[(V[F][:, :, 2] > below).all(axis=1)]
+    used = np.unique(F)
+    renumber = np.zeros(len(V), dtype=np.int64)
+    renumber[used] = np.arange(len(used))
+    return np.ascontiguousarray(V[used]), renumber[F]
+
+
 @functools.cache
 def battery() -> tuple[Case, ...]:
     """All cases, in the order they are tried (the small hand-checkable ones first); built once,
@@ -186,6 +240,16 @@ def _cases() -> list[Case]:
     cases.append(Case("large", V, F, "correct at size, and the speed", True, ("speed",)))
     V, F = _huge()
     cases.append(Case("huge", V, F, "20,480 vertices: sparse, not dense n×n", True, ("huge",)))
+    V, F = _bumpy_grid()
+    cases.append(Case("bumpy_grid", V, F, "an open bumpy patch: uniform vs cot weights"))
+    V, F = _jittered_disk()
+    cases.append(Case("jittered_disk", V, F, "a boundary unevenly spaced: arc length, not index"))
+    V, F = _cap(3, 0.25, seed=4, amount=0.05)
+    cases.append(Case("cap", V, F, "a curved disk (not developable)"))
+    V = 250.0 * V + [40.0, -7.0, 3.0]
+    cases.append(Case("scaled_cap", V, F, "units: a disk scaled by 250"))
+    V, F = _cap(4, -0.5, seed=8, amount=0.02)
+    cases.append(Case("large_disk", V, F, "a disk at size, and the maps' speed", tags=("speed",)))
     return cases
 
 

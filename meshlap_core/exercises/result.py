@@ -61,7 +61,7 @@ class TaskResult:
         The largest failing mesh and its difference map (the notebook picture); ``signed``:
         a scalar per vertex (coolwarm around 0), else a magnitude (viridis from 0).
     speed : Speed or None
-        The speed line (a right task timed on the large mesh); ``speed_required``: a slow one
+        The speed line (a right task timed on its speed mesh); ``speed_required``: a slow one
         fails (``--require-speed``).
     repro : (case, label, args) or None
         The first failing call: the mesh and arguments a student can export.

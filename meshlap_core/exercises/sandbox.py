@@ -16,10 +16,10 @@ inputs, sends the command, and waits for the reply up to a deadline of its own:
 
 An answer is read back as plain arrays (:mod:`.plain`) and compared at once: a task wrong on
 the small meshes is not run on the big ones (its diagnosis comes from the small ones; the big
-ones would only cost time). Every right task is then timed on the
-``large`` mesh in :data:`SPEED_RUNS` runs, each beside the reference's best of three in the
-checker, in CPU seconds (the worker's from ``/proc``, the reference's thread time): a busy
-machine slows the wall clock, not the CPU time a loop needs.
+ones would only cost time). Every right task is then timed on its speed mesh (the ``large``
+sphere; ``large_disk`` for the maps of a disk) in :data:`SPEED_RUNS` runs, each beside the
+reference's best of three in the checker, in CPU seconds (the worker's from ``/proc``, the
+reference's thread time): a busy machine slows the wall clock, not the CPU time a loop needs.
 """
 
 from __future__ import annotations
@@ -39,7 +39,7 @@ from .guard import scan
 from .isolation import Isolation, Limits
 from .meshes import Case, battery
 from .plain import BadAnswer, Tampered, read_answer, unpack
-from .tasks import SPEED_CASE, TASKS, Task
+from .tasks import TASKS, Task
 from .worker import Session, Worker, WorkerGone, default_session
 
 TIME_FACTOR = 2000.0
@@ -235,7 +235,7 @@ def _lost(run: TaskRun, plan: _Plan, where: tuple[str, str], over_budget: bool, 
 
 def _timed_runs(worker: Worker, plan: _Plan, task: Task, run: TaskRun, counter: list[int]) -> None:
     """The speed runs (see module); a run that fails or overruns ends them quietly."""
-    case = plan.cases[SPEED_CASE]
+    case = plan.cases[task.speed_case]
     first = next((s for c, _, a, s in run.calls if c == case.name), None)
     if first is None or run.status != "ran" or run.failing:
         return

@@ -1,14 +1,14 @@
 """Speed is its own verdict: a band of ratios to the reference, the same rule for every task,
 and the loop where a slow answer spends its time.
 
-Every task is timed on the ``large`` mesh in several runs (:mod:`.sandbox`), each beside the
-reference's best of three. A run's student time is the worker's CPU seconds (read by the
-checker from ``/proc``: a loaded machine stretches the wall clock, not the CPU time a loop
-needs), or for a call under :data:`CPU_RESOLUTION` (below the clock tick's resolution) its wall
-time beside the reference's. The band is the lowest and the highest ratio; the answer is *slow*
-when even the lowest is ``EXERCISE_SLOW_RATIO`` or more and the call takes at least
-``EXERCISE_SLOW_MIN_SECONDS``. A slow right answer passes, with the line saying so, unless
-the teacher asks (``meshlap check --require-speed``).
+Every task is timed on its speed mesh (``large``; ``large_disk`` for the maps of a disk) in
+several runs (:mod:`.sandbox`), each beside the reference's best of three. A run's student time
+is the worker's CPU seconds (read by the checker from ``/proc``: a loaded machine stretches the
+wall clock, not the CPU time a loop needs), or for a call under :data:`CPU_RESOLUTION` (below
+the clock tick's resolution) its wall time beside the reference's. The band is the lowest and
+the highest ratio; the answer is *slow* when even the lowest is ``EXERCISE_SLOW_RATIO`` or more
+and the call takes at least ``EXERCISE_SLOW_MIN_SECONDS``. A slow right answer passes, with the
+line saying so, unless the teacher asks (``meshlap check --require-speed``).
 """
 
 from __future__ import annotations

@@ -17,6 +17,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
+from . import deform_tasks as dt
+from . import flatten_tasks as ft
 from . import geodesic_task as geo
 from . import task_formulas as tf
 from .meshes import Case
@@ -46,7 +48,8 @@ STEP_CASES = (
     "scaled", "large", "huge",
 )  # fmt: skip
 SPEED_CASE = "large"
-"""Every task is timed on this mesh (its cases all include it)."""
+"""Every task is timed on this mesh (its cases all include it), unless it names another
+(:attr:`Task.speed_case`: the maps of a disk are timed on ``large_disk``)."""
 
 
 @dataclass(frozen=True)
@@ -75,7 +78,7 @@ class Task:
     power : int
         Units of the answer, length^power (scale of the tolerance).
     cases : tuple of str
-        Battery cases it is checked on (they include :data:`SPEED_CASE`).
+        Battery cases it is checked on (they include :attr:`speed_case`).
     calls : callable
         ``calls(case) -> [(label, args)]``: the student is called ``f(*args)``.
     reference : callable
@@ -92,6 +95,9 @@ class Task:
     not_judged : callable or None
         ``not_judged(case, args) -> reason or None``: a failing call that the mesh cannot
         judge (the reason is reported as a note, the call is not counted as failed).
+    speed_case : str
+        The case its speed is measured on (:data:`SPEED_CASE` unless the task needs a mesh
+        the sphere is not: a disk).
     """
 
     name: str
@@ -105,6 +111,7 @@ class Task:
     generic: bool = True
     uses: tuple[str, ...] = ()
     not_judged: Callable[[Case, Args], str | None] | None = None
+    speed_case: str = SPEED_CASE
 
 
 def _table() -> list[Task]:
@@ -345,14 +352,51 @@ def taubin_step(V, F, lam, mu):
              M("not_shifted", geo.heat_unshifted, geo.fits_shifted)),
             uses=("cotan_laplacian", "mass_matrix"), not_judged=geo.heat_not_judged,
         ),
+        Task(
+            "biharmonic_displacement", "array", 1, dt.DEFORM_CASES, dt.biharmonic_calls,
+            dt.biharmonic_reference, dt.BIHARMONIC_STUB,
+            (M("positions_not_displacement", dt.bi_positions),
+             M("uniform_not_cotan", dt.bi_uniform("uniform")),
+             M("uniform_not_cotan", dt.bi_uniform("uniform-normalised")),
+             M("biharmonic_without_mass", dt.bi_without_mass),
+             M("harmonic_not_biharmonic", dt.bi_harmonic)),
+            generic=False, uses=("cotan_laplacian", "mass_matrix"),
+        ),
+        Task(
+            "arap_step", "array", 1, dt.DEFORM_CASES, dt.arap_calls, dt.arap_reference,
+            dt.ARAP_STUB,
+            (M("no_reflection_fix", dt.arap_mistake(reflection_fix=False)),
+             M("uniform_not_cotan", dt.arap_mistake(weights="uniform")),
+             M("rotation_transposed", dt.arap_mistake(transposed=True)),
+             M("rotation_not_averaged", dt.arap_mistake(averaged=False)),
+             M("handles_not_placed", dt.arap_mistake(place=False))),
+            generic=False, uses=("cotan_laplacian",),
+        ),
+        Task(
+            "tutte_map", "array", 0, ft.FLATTEN_CASES, ft.tutte_calls, ft.tutte_reference,
+            ft.TUTTE_STUB,
+            (M("uniform_not_cotan", ft.tutte_uniform),
+             M("boundary_by_index", ft.tutte_by_index),
+             M("boundary_turned", ft.tutte_turned, ft.fits_rotated),
+             M("boundary_not_on_circle", ft.tutte_square, ft.fits_off_circle)),
+            generic=False, uses=("cotan_laplacian",), speed_case=ft.FLATTEN_SPEED_CASE,
+        ),
+        Task(
+            "lscm", "array", 1, ft.FLATTEN_CASES, ft.lscm_calls, ft.lscm_reference, ft.LSCM_STUB,
+            (M("no_area_term", ft.lscm_no_area),
+             M("area_sign", ft.lscm_area_sign),
+             M("uniform_not_cotan", ft.lscm_uniform),
+             M("unpinned", ft.lscm_collapsed, ft.fits_unpinned)),
+            generic=False, uses=("cotan_laplacian",), speed_case=ft.FLATTEN_SPEED_CASE,
+        ),
     ]  # fmt: skip
 
 
 def _checked(tasks: list[Task]) -> dict[str, Task]:
     table = {t.name: t for t in tasks}
     for t in tasks:
-        if len(table) != len(tasks) or SPEED_CASE not in t.cases:
-            raise RuntimeError(f"task {t.name}: a name given twice, or {SPEED_CASE} not checked")
+        if len(table) != len(tasks) or t.speed_case not in t.cases:
+            raise RuntimeError(f"task {t.name}: a name given twice, or {t.speed_case} not checked")
         if f"def {t.name}(" not in t.stub or any(u not in table for u in t.uses):
             raise RuntimeError(f"task {t.name}: its stub or what it uses names another task")
     return table

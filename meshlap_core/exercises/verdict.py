@@ -21,7 +21,7 @@ from .meshes import Case
 from .result import TaskResult
 from .sandbox import TaskRun
 from .speed import hot_loop, measure
-from .tasks import SPEED_CASE, TASKS, Task
+from .tasks import TASKS, Task
 
 _STOPPED = {
     "missing": "no function of this name in the file",
@@ -167,12 +167,12 @@ def _failed(task: Task, run: TaskRun, failures: list, comparisons: list, notes: 
 
 def _passed(task: Task, run: TaskRun, cases: dict[str, Case], notes: list[str],
             require_speed: bool, source: Path | None) -> TaskResult:  # fmt: skip
-    speed = measure(run.speed, len(cases[SPEED_CASE].V))
+    speed = measure(run.speed, len(cases[task.speed_case].V))
     if speed is not None and speed.slow and source is not None:
         speed = type(speed)(**{**speed.to_dict(), "loop": hot_loop(run.hot, source)})
     if speed is not None and speed.slow and require_speed:
         text = describe("slow_loop", ratio=speed.low, n=speed.vertices, seconds=speed.seconds)
-        return TaskResult(task.name, "failed", SPEED_CASE, diagnosis="slow_loop",
+        return TaskResult(task.name, "failed", task.speed_case, diagnosis="slow_loop",
                           diagnosis_text=text, n_calls=len(run.calls), speed=speed,
                           speed_required=True, note="; ".join(notes))  # fmt: skip
     return TaskResult(task.name, "passed", n_calls=len(run.calls), speed=speed,

@@ -271,8 +271,10 @@ def pivots_sound(A: sp.csr_matrix, factor: Any) -> bool:
     (and simplicial ``LDLᵀ`` not even there), so a pivot that cancelled to round-off of its
     own diagonal entry (``W − λK`` with ``λ`` beyond double precision, where cholespy's
     reference BLAS happens to meet a negative one) is refused; relative to its own row, so
-    components of very different scales are not refused."""
-    if surely_positive_definite(A):
-        return True
+    components of very different scales are not refused. The pivots are read first (a
+    diagonal's worth of work); the Gershgorin proof, a product with the whole matrix, only
+    when one is small."""
     D = factor.D()  # in the factor's order P: pivot k eliminates row P[k]
-    return bool(np.all(np.isfinite(D)) and np.all(D > PIVOT_RATIO * A.diagonal()[factor.P()]))
+    if np.all(np.isfinite(D)) and np.all(D > PIVOT_RATIO * A.diagonal()[factor.P()]):
+        return True
+    return surely_positive_definite(A)

@@ -17,7 +17,10 @@ from meshlap_core import curvature as cv
 from meshlap_core import laplacian as lap
 from meshlap_core import primitives
 from meshlap_core.diffusion import mean_edge_length
+from meshlap_core.errors import MeshError
 from meshlap_core.exercises import check_file, guard, template
+from meshlap_core.exercises import deform_tasks as dt
+from meshlap_core.exercises import flatten_tasks as ft
 from meshlap_core.exercises import geodesic_task as geo
 from meshlap_core.exercises.compare import COMPARE, degenerate_vertices
 from meshlap_core.exercises.diagnose import DIAGNOSES, candidates, constant_factor, diagnose
@@ -77,6 +80,24 @@ WRONG = [  # (student file, task, the diagnosis it must get)
     ("wrong_complex", "barycentric_areas", "complex_values"),
     ("wrong_complex", "eigenbasis", "complex_values"),
     ("wrong_dependency", "mean_curvature_normal", "failed_dependency"),
+    # deforming (biharmonic displacement, an ARAP step) and flattening (Tutte, LSCM)
+    ("wrong_biharmonic_positions", "biharmonic_displacement", "positions_not_displacement"),
+    ("wrong_biharmonic_uniform", "biharmonic_displacement", "uniform_not_cotan"),
+    ("wrong_biharmonic_no_mass", "biharmonic_displacement", "biharmonic_without_mass"),
+    ("wrong_biharmonic_harmonic", "biharmonic_displacement", "harmonic_not_biharmonic"),
+    ("wrong_arap_reflection", "arap_step", "no_reflection_fix"),
+    ("wrong_arap_uniform", "arap_step", "uniform_not_cotan"),
+    ("wrong_arap_transposed", "arap_step", "rotation_transposed"),
+    ("wrong_arap_not_averaged", "arap_step", "rotation_not_averaged"),
+    ("wrong_arap_handles", "arap_step", "handles_not_placed"),
+    ("wrong_tutte_uniform", "tutte_map", "uniform_not_cotan"),
+    ("wrong_tutte_index", "tutte_map", "boundary_by_index"),
+    ("wrong_tutte_turned", "tutte_map", "boundary_turned"),
+    ("wrong_tutte_off_circle", "tutte_map", "boundary_not_on_circle"),
+    ("wrong_lscm_no_area", "lscm", "no_area_term"),
+    ("wrong_lscm_area_sign", "lscm", "area_sign"),
+    ("wrong_lscm_uniform", "lscm", "uniform_not_cotan"),
+    ("wrong_lscm_unpinned", "lscm", "unpinned"),
 ]
 STOPPED = {"dense_at_size": "memory"}
 """Diagnoses of a task the sandbox stopped (not a compared value)."""
@@ -114,7 +135,8 @@ def test_the_suites_are_as_large_as_the_issue_asks():
         "missing_boundary_term", "transposed", "row_normalised", "wrong_orientation",
         "ordinary_eigenproblem", "projection_without_mass", "constant_factor",
         "single_precision", "clamped_weights", "wrong_shape", "failed_dependency",
-        "dense_at_size", "nan_on_degenerate", "complex_values",
+        "dense_at_size", "nan_on_degenerate", "complex_values", "positions_not_displacement",
+        "uniform_not_cotan", "no_reflection_fix", "unpinned", "boundary_not_on_circle",
     }  # fmt: skip
 
 
@@ -153,13 +175,15 @@ def test_a_right_but_slow_answer_passes_with_its_speed_line_unless_speed_is_requ
 
 
 def test_every_task_gets_the_same_speed_line(checked):
-    """Every right task is timed on the large mesh in the same runs, with the same rule (before,
-    one task had no speed check at all)."""
+    """Every right task is timed on its speed mesh (the large sphere; the large disk for the
+    maps of a disk) in the same runs, with the same rule (before, one task had no speed check
+    at all)."""
     result = checked("right_vectorized")
     for t in result.tasks:
         assert t.speed is not None and t.speed.runs == 3, t.lines()
-        assert t.speed.vertices == len(case_named("large").V)
+        assert t.speed.vertices == len(case_named(TASKS[t.task].speed_case).V)
         assert t.lines()[1].startswith("  speed: ")
+    assert {TASKS[t.task].speed_case for t in result.tasks} == {"large", "large_disk"}
 
 
 def test_a_wrong_value_names_the_mesh_the_vertex_expected_and_got(checked):
@@ -232,6 +256,131 @@ def test_the_heat_steps_without_a_mistake_are_the_reference():
         assert ref[args[2]] == 0 and ref.min() == 0 and ref.max() > 0
         answers[name] = ref
     np.testing.assert_allclose(answers["scaled"], 250.0 * answers["small_sphere"], rtol=1e-9)
+
+
+STEPS = {
+    "biharmonic_displacement": dt.biharmonic_steps,
+    "arap_step": dt.arap_steps,
+    "tutte_map": ft.tutte_steps,
+    "lscm": ft.lscm_steps,
+}
+
+
+@pytest.mark.parametrize("name", list(STEPS))
+def test_the_deform_and_flatten_steps_without_a_mistake_are_the_reference(name):
+    """The mistakes of the four tasks are written with their ``*_steps`` (the template's
+    formulas with a switch per mistake): with no switch they give the lab's answer on every
+    call of the battery."""
+    task = TASKS[name]
+    for case in (case_named(c) for c in task.cases):
+        for label, args in task.calls(case):
+            cmp = COMPARE["array"](STEPS[name](*args), task.reference(case, args), case, task.power)
+            assert cmp.ok, (case.name, label, cmp.error, cmp.tol)
+
+
+def _signed_areas(T: np.ndarray) -> np.ndarray:
+    """Twice the signed area of each triangle ``T`` ``(m,3,2)`` in the plane."""
+    a, b = T[:, 1] - T[:, 0], T[:, 2] - T[:, 0]
+    return a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+
+
+def test_tutte_on_the_obtuse_fan_by_hand():
+    """Five boundary vertices on the unit circle by arc length from loop[0] (at (1, 0),
+    counter-clockwise), the one interior vertex at their average (uniform weights)."""
+    case = case_named("obtuse_fan")
+    (label, args), _ = TASKS["tutte_map"].calls(case)
+    loop = args[2]
+    assert label == "weights=uniform" and sorted(loop.tolist()) == [1, 2, 3, 4, 5]
+    P = case.V[loop]
+    edges = [float(np.linalg.norm(P[(k + 1) % 5] - P[k])) for k in range(5)]
+    s = [sum(edges[:k]) / sum(edges) for k in range(5)]
+    ring = np.array([[np.cos(2 * np.pi * t), np.sin(2 * np.pi * t)] for t in s])
+    uv = TASKS["tutte_map"].reference(case, args)
+    np.testing.assert_allclose(uv[loop], ring, atol=1e-15)
+    np.testing.assert_allclose(uv[0], ring.mean(axis=0), atol=1e-15)
+    # the loop runs counter-clockwise: the fan's faces keep their orientation
+    assert (_signed_areas(uv[case.F]) > 0).all()
+
+
+def test_the_flatten_battery_is_disks_and_tutte_never_flips_on_them():
+    """Each flattening mesh is a disk of its own vertices; Tutte's map (convex boundary,
+    positive weights) flips no face there (Floater 2003); its pins and units are as stated."""
+    from meshlap_core.flatten import make_disk
+
+    for name in ft.FLATTEN_CASES:
+        case = case_named(name)
+        disk = make_disk(case.V, case.F, cut=False)
+        assert disk.how == "disk" and disk.n_vertices == len(case.V), name
+        (_, args), _ = TASKS["tutte_map"].calls(case)
+        assert (_signed_areas(TASKS["tutte_map"].reference(case, args)[case.F]) > 0).all(), name
+        ((_, (V, F, pins, pin_uv)),) = TASKS["lscm"].calls(case)
+        uv = TASKS["lscm"].reference(case, (V, F, pins, pin_uv))
+        assert np.array_equal(uv[pins], pin_uv) and pin_uv[1, 0] > 0
+    ref = {c: TASKS["lscm"].reference(case_named(c), TASKS["lscm"].calls(case_named(c))[0][1])
+           for c in ("cap", "scaled_cap")}  # fmt: skip
+    np.testing.assert_allclose(ref["scaled_cap"], 250.0 * ref["cap"], rtol=0, atol=1e-9 * 250)
+    jittered = case_named("jittered_disk")
+    (_, args), _ = TASKS["tutte_map"].calls(jittered)
+    by_index = ft.tutte_by_index(jittered, args)
+    assert not COMPARE["array"](
+        by_index, TASKS["tutte_map"].reference(jittered, args), jittered, 0
+    ).ok
+
+
+def test_the_flatten_references_are_libigls():
+    """An independent reference: libigl's harmonic map on libigl's circle, and its LSCM."""
+    import igl
+
+    case = case_named("cap")
+    _, (_, cotan) = TASKS["tutte_map"].calls(case)
+    V, F, loop, _ = cotan
+    at = igl.map_vertices_to_circle(np.asfortranarray(V), loop.astype(np.int32))
+    harmonic = igl.harmonic(V, F, loop, at, 1)
+    np.testing.assert_allclose(TASKS["tutte_map"].reference(case, cotan), harmonic, atol=1e-10)
+    ((_, args),) = TASKS["lscm"].calls(case)
+    uv, _ = igl.lscm(*args)
+    np.testing.assert_allclose(TASKS["lscm"].reference(case, args), uv, atol=1e-10)
+
+
+def test_the_deform_calls_and_references():
+    """Biharmonic: libigl's ``harmonic(..., k=2)`` on the displacement, and no move gives the
+    rest pose exactly; ARAP: from the rest pose with the handles at rest nothing moves; the
+    ARAP call's current positions hold one-rings whose best fit is a reflection."""
+    import igl
+
+    bi, arap = TASKS["biharmonic_displacement"], TASKS["arap_step"]
+    for case in (case_named(c) for c in dt.DEFORM_CASES if c != "huge"):
+        ((_, (V, F, h, d)),) = bi.calls(case)
+        U = bi.reference(case, (V, F, h, d))
+        np.testing.assert_allclose(U, V + igl.harmonic(V, F, h, d, 2), atol=1e-8 * case.scale)
+        assert np.array_equal(U[h], V[h] + d)
+        assert np.array_equal(bi.reference(case, (V, F, h, 0.0 * d)), V)
+        ((_, (V, F, U0, h, targets)),) = arap.calls(case)
+        rest = arap.reference(case, (V, F, V.copy(), h, V[h].copy()))
+        assert np.abs(rest - V).max() <= 1e-9 * case.scale, case.name
+        i, j, w = (lambda K: (K.row, K.col, K.data))((-lap.cotan_stiffness(V, F)).tocoo())
+        off = i != j
+        X = U0.copy()
+        X[h] = targets
+        S = np.zeros((len(V), 3, 3))
+        e, e2 = V[i[off]] - V[j[off]], X[i[off]] - X[j[off]]
+        np.add.at(S, i[off], -w[off, None, None] * e[:, :, None] * e2[:, None, :])
+        assert (np.linalg.det(S) < 0).sum() >= 2, case.name
+
+
+def test_a_map_task_on_a_mesh_that_is_not_a_disk_says_so():
+    """The Check panel's mesh may be closed: the flattening tasks refuse it with a sentence,
+    before any student code runs; a deformation task runs on any mesh."""
+    from meshlap_core.exercises.check import check_on_mesh
+
+    V, F = primitives.icosphere(1)
+    with pytest.raises(MeshError, match="they need a disk"):
+        check_on_mesh(STUDENTS / "right_vectorized.py", "tutte_map", V, F)
+    V, F = primitives.grid(6, 5)
+    V[:, 2] = 0.2 * np.sin(3 * V[:, 0]) * V[:, 1]
+    shown = check_on_mesh(STUDENTS / "right_vectorized.py", "arap_step", V, F)
+    assert shown.result.passed, shown.result.format_text()
+    assert shown.difference is not None and len(shown.difference) == len(V)
 
 
 def test_heat_reference_on_an_open_mesh_is_the_templates_neumann_step():
@@ -407,7 +556,7 @@ def test_adding_a_task_is_one_declaration():
     assert tuple(TASKS) == EXERCISE_TASKS
     text = template()
     for task in TASKS.values():
-        assert task.stub.strip() in text and "large" in task.cases
+        assert task.stub.strip() in text and task.speed_case in task.cases
         assert set(task.uses) <= set(TASKS)
 
 
@@ -426,6 +575,58 @@ def test_a_hostile_task_is_stopped_and_the_next_one_still_runs(name, status, san
     )  # fmt: skip
     assert result["uniform_laplacian"].status == status
     assert result["barycentric_areas"].passed
+
+
+HOSTILE_MAPS = """
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+
+def lscm(V, F, pins, pin_uv):
+    while True:
+        pass
+
+
+def arap_step(V, F, U, handles, targets):
+    return np.ones((10**6, 10**4))  # 80 GB
+
+
+def tutte_map(V, F, loop, weights):
+    n = len(V)
+    if weights == "uniform":
+        e = np.sort(np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]]), axis=1)
+        e = np.unique(e, axis=0)
+        i, j, w = e[:, 0], e[:, 1], np.ones(len(e))
+    else:  # corner c's half cotangent weighs the edge opposite it
+        i, j = F[:, [1, 2, 0]].T.ravel(), F[:, [2, 0, 1]].T.ravel()
+        a, b = V[i] - V[F.T.ravel()], V[j] - V[F.T.ravel()]
+        w = 0.5 * np.einsum("ij,ij->i", a, b) / np.linalg.norm(np.cross(a, b), axis=1)
+    W = sp.coo_matrix((w, (i, j)), shape=(n, n)).tocsr()
+    W = W + W.T
+    K = (sp.diags(np.asarray(W.sum(axis=1)).ravel()) - W).tocsr()
+    seg = np.linalg.norm(V[np.roll(loop, -1)] - V[loop], axis=1)
+    t = 2 * np.pi * np.concatenate([[0.0], np.cumsum(seg[:-1])]) / seg.sum()
+    uv = np.zeros((n, 2))
+    uv[loop] = np.stack([np.cos(t), np.sin(t)], axis=1)
+    free = np.setdiff1d(np.arange(n), loop)
+    uv[free] = spla.spsolve(K[free][:, free].tocsc(), -(K[free][:, loop] @ uv[loop]))
+    return uv
+"""
+
+
+@pytest.mark.parametrize("sandbox", ["auto", "process"])
+def test_a_hostile_deform_or_map_task_is_stopped_and_the_next_one_still_runs(tmp_path, sandbox):
+    """The harness's limits hold for the new tasks as for the others: an endless LSCM is
+    stopped at the time limit, an 80 GB ARAP step at the memory limit, and the file's right
+    Tutte map still passes."""
+    path = tmp_path / "maps.py"
+    path.write_text(HOSTILE_MAPS)
+    result = check_file(path, ["lscm", "arap_step", "tutte_map"], timeout=HOSTILE_TIMEOUT,
+                        sandbox=sandbox, speed=False)  # fmt: skip
+    assert result["lscm"].status == "timeout"
+    assert result["arap_step"].status == "memory"
+    assert result["tutte_map"].passed, result["tutte_map"].lines()
 
 
 def test_the_workers_own_start_up_is_not_the_students_time():

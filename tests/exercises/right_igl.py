@@ -68,3 +68,60 @@ def heat_geodesic(V, F, source, m):
     phi = np.zeros(len(V))
     phi[1:] = spla.splu(K[1:, 1:].tocsc()).solve(b[1:])  # vertex 0 pinned
     return phi - phi[source]
+
+
+def biharmonic_displacement(V, F, handles, handle_displacement):
+    return V + igl.harmonic(V, F, handles, handle_displacement, 2)
+
+
+def _solve_fixed(Q, known_rows, known, b=None):
+    n = Q.shape[0]
+    free = np.setdiff1d(np.arange(n), known_rows)
+    Q = sp.csc_matrix(Q)
+    x = np.zeros((n, known.shape[1]))
+    x[known_rows] = known
+    rhs = -(Q[free][:, known_rows] @ known) + (0 if b is None else b[free])
+    x[free] = spla.splu(Q[free][:, free].tocsc()).solve(np.asarray(rhs))
+    return x
+
+
+def arap_step(V, F, U, handles, targets):
+    n = len(V)
+    C = sp.csr_matrix(igl.cotmatrix(V, F))
+    W = (C - sp.diags(C.diagonal())).tocsr()  # the spoke weights w_ij, off the diagonal
+    deg = np.asarray(W.sum(axis=1)).ravel()
+    X = U.copy()
+    X[handles] = targets
+    # S_i[a, c] = Σ_j w_ij (p_i − p_j)_a (x_i − x_j)_c, as sparse products
+    S = np.zeros((n, 3, 3))
+    for a in range(3):
+        p = V[:, a]
+        for c in range(3):
+            x = X[:, c]
+            S[:, a, c] = deg * p * x - p * (W @ x) - x * (W @ p) + W @ (p * x)
+    # libigl takes the rows S_i[a, :] at a·n + i, and returns (3, 3n), block i being R_i
+    stacked = np.ascontiguousarray(S.transpose(1, 0, 2).reshape(3 * n, 3))
+    R = igl.fit_rotations(stacked, False).reshape(3, n, 3).transpose(1, 0, 2)
+    b = np.zeros((n, 3))  # b_i = Σ_j (w_ij/2)(R_i + R_j)(p_i − p_j)
+    for a in range(3):
+        for c in range(3):
+            r, p = R[:, a, c], V[:, c]
+            b[:, a] += 0.5 * (r * (deg * p - W @ p) + p * (W @ r) - W @ (r * p))
+    return _solve_fixed(-C, handles, targets, b)
+
+
+def _graph_stiffness(F, n):
+    A = sp.csr_matrix(igl.adjacency_matrix(F), shape=(n, n), dtype=float)
+    return sp.diags(np.asarray(A.sum(axis=1)).ravel()) - A
+
+
+def tutte_map(V, F, loop, weights):
+    at = igl.map_vertices_to_circle(np.asfortranarray(V), loop.astype(np.int32))
+    if weights == "cotan":
+        return igl.harmonic(V, F, loop, at, 1)
+    return _solve_fixed(_graph_stiffness(F, len(V)), loop, at)
+
+
+def lscm(V, F, pins, pin_uv):
+    uv, _ = igl.lscm(V, F, pins, pin_uv)
+    return uv

@@ -5,6 +5,7 @@ import math
 
 import numpy as np
 import scipy.sparse as sp
+import scipy.sparse.linalg as spla
 
 
 def _sub(p, q):
@@ -126,3 +127,123 @@ def angle_defect(V, F, boundary):
 
 def explicit_step(V, F, lam):
     return V + lam * (uniform_laplacian(V, F) @ V)
+
+
+def _spokes(V, F):
+    """{(i, j): w_ij} over every directed edge, w_ij = ½(cot α + cot β), summed face by face."""
+    P = V.tolist()
+    w = {}
+    for f in F.tolist():
+        for k in range(3):
+            o, i, j = f[k], f[(k + 1) % 3], f[(k + 2) % 3]
+            u, v = _sub(P[i], P[o]), _sub(P[j], P[o])
+            twice_area = _cross_norm(u, v)
+            h = 0.0 if twice_area == 0.0 else 0.5 * _dot(u, v) / twice_area
+            w[i, j] = w.get((i, j), 0.0) + h
+            w[j, i] = w.get((j, i), 0.0) + h
+    return w
+
+
+def _stiffness(w, n):
+    """K = −C from the spoke weights: K_ij = −w_ij, K_ii = Σ_j w_ij."""
+    rows, cols, vals = [], [], []
+    for (i, j), x in w.items():
+        rows += [i, i]
+        cols += [j, i]
+        vals += [-x, x]
+    return sp.coo_matrix((vals, (rows, cols)), shape=(n, n)).tocsr()
+
+
+def _solve_with_known(Q, known_rows, known, b=None):
+    n = Q.shape[0]
+    is_known = [False] * n
+    for r in known_rows:
+        is_known[r] = True
+    free = [r for r in range(n) if not is_known[r]]
+    x = np.zeros((n, known.shape[1]))
+    for r, value in zip(known_rows, known, strict=True):
+        x[r] = value
+    rhs = -(Q[free][:, list(known_rows)] @ known)
+    if b is not None:
+        rhs = rhs + b[free]
+    x[free] = spla.splu(sp.csc_matrix(Q[free][:, free])).solve(rhs)
+    return x
+
+
+def biharmonic_displacement(V, F, handles, handle_displacement):
+    n = len(V)
+    K = _stiffness(_spokes(V, F), n)
+    area = voronoi_areas(V, F)
+    inv = sp.diags([1.0 / a if a > 0 else 0.0 for a in area])
+    return V + _solve_with_known(K @ inv @ K, list(handles), handle_displacement)
+
+
+def _closest_rotation(S):
+    A, _, Bt = np.linalg.svd(S)
+    R = Bt.T @ A.T
+    if np.linalg.det(R) < 0:  # a reflection: flip the smallest singular value's direction
+        B = Bt.T.copy()
+        B[:, 2] = -B[:, 2]
+        R = B @ A.T
+    return R
+
+
+def arap_step(V, F, U, handles, targets):
+    n = len(V)
+    w = _spokes(V, F)
+    X = np.array(U, dtype=float)
+    for h, t in zip(handles, targets, strict=True):
+        X[h] = t
+    S = [np.zeros((3, 3)) for _ in range(n)]
+    for (i, j), x in w.items():
+        S[i] += x * np.outer(V[i] - V[j], X[i] - X[j])
+    R = [_closest_rotation(s) for s in S]
+    b = np.zeros((n, 3))
+    for (i, j), x in w.items():
+        b[i] += 0.5 * x * ((R[i] + R[j]) @ (V[i] - V[j]))
+    return _solve_with_known(_stiffness(w, n), list(handles), targets, b)
+
+
+def tutte_map(V, F, loop, weights):
+    n = len(V)
+    if weights == "uniform":
+        w = {}
+        for f in F.tolist():
+            for k in range(3):
+                w[f[k], f[(k + 1) % 3]] = w[f[(k + 1) % 3], f[k]] = 1.0
+    else:
+        w = _spokes(V, F)
+    P = V.tolist()
+    walked, lengths = 0.0, []
+    for k in range(len(loop)):
+        lengths.append(walked)
+        a, b = P[loop[k]], P[loop[(k + 1) % len(loop)]]
+        walked += math.sqrt(_dot(_sub(a, b), _sub(a, b)))
+    at = np.array([[math.cos(2 * math.pi * s / walked), math.sin(2 * math.pi * s / walked)]
+                   for s in lengths])  # fmt: skip
+    return _solve_with_known(_stiffness(w, n), list(loop), at)
+
+
+def lscm(V, F, pins, pin_uv):
+    n = len(V)
+    w = _spokes(V, F)
+    rows, cols, vals = [], [], []
+    for (i, j), x in w.items():  # the Dirichlet part, diag(K, K)
+        for shift in (0, n):
+            rows += [i + shift, i + shift]
+            cols += [j + shift, i + shift]
+            vals += [-x, x]
+    halfedges = set()
+    for f in F.tolist():
+        for k in range(3):
+            halfedges.add((f[k], f[(k + 1) % 3]))
+    for a, b in halfedges:
+        if (b, a) not in halfedges:  # a boundary half-edge, its face on the left: −Q_A
+            rows += [a, n + b, b, n + a]
+            cols += [n + b, a, n + a, b]
+            vals += [-0.5, -0.5, 0.5, 0.5]
+    L = sp.coo_matrix((vals, (rows, cols)), shape=(2 * n, 2 * n)).tocsr()
+    known_rows = [pins[0], pins[1], n + pins[0], n + pins[1]]
+    known = np.array([[pin_uv[0][0]], [pin_uv[1][0]], [pin_uv[0][1]], [pin_uv[1][1]]])
+    x = _solve_with_known(L, known_rows, known)[:, 0]
+    return np.stack([x[:n], x[n:]], axis=1)

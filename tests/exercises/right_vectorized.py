@@ -208,3 +208,78 @@ def heat_geodesic(V, F, source, m):
     phi = np.zeros(n)
     phi[keep] = spla.spsolve(K[keep][:, keep].tocsc(), div[keep])
     return phi - phi[source]
+
+
+def _pinned_solve(Q, known_rows, known, b=None):
+    """Minimize ½xᵀQx − bᵀx with the rows ``known_rows`` given: Q_ff x_f = b_f − Q_fk known."""
+    n = Q.shape[0]
+    known_rows = np.asarray(known_rows)
+    free = np.setdiff1d(np.arange(n), known_rows)
+    Q = sp.csr_matrix(Q)
+    x = np.zeros((n, known.shape[1]))
+    x[known_rows] = known
+    rhs = -(Q[free][:, known_rows] @ known)
+    if b is not None:
+        rhs = rhs + b[free]
+    x[free] = spla.spsolve(Q[free][:, free].tocsc(), rhs).reshape(len(free), -1)
+    return x
+
+
+def biharmonic_displacement(V, F, handles, handle_displacement):
+    C = cotan_laplacian(V, F)
+    m = voronoi_areas(V, F)
+    Q = C @ sp.diags(np.divide(1.0, m, out=np.zeros_like(m), where=m > 0)) @ C
+    return V + _pinned_solve(Q, handles, handle_displacement)
+
+
+def arap_step(V, F, U, handles, targets):
+    n = len(V)
+    C = cotan_laplacian(V, F).tocsr().tocoo()
+    off = C.row != C.col
+    i, j, w = C.row[off], C.col[off], C.data[off]  # each directed spoke once, w_ij = C_ij
+    X = np.array(U, dtype=float)
+    X[handles] = targets
+    e, e2 = V[i] - V[j], X[i] - X[j]
+    S = np.zeros((n, 3, 3))
+    np.add.at(S, i, w[:, None, None] * e[:, :, None] * e2[:, None, :])
+    A, _, Bt = np.linalg.svd(S)
+    B = Bt.transpose(0, 2, 1)
+    flip = np.linalg.det(B @ A.transpose(0, 2, 1)) < 0
+    B[flip, :, 2] *= -1.0  # the reflection fix
+    R = B @ A.transpose(0, 2, 1)
+    b = np.zeros((n, 3))
+    np.add.at(b, i, 0.5 * w[:, None] * np.einsum("kab,kb->ka", R[i] + R[j], e))
+    return _pinned_solve(-C, handles, targets, b)
+
+
+def _graph_stiffness(F, n):
+    e = np.unique(np.sort(_edges(F), axis=1), axis=0)
+    i, j = np.concatenate([e[:, 0], e[:, 1]]), np.concatenate([e[:, 1], e[:, 0]])
+    A = sp.csr_matrix((np.ones(len(i)), (i, j)), shape=(n, n))
+    return sp.diags(np.asarray(A.sum(axis=1)).ravel()) - A
+
+
+def tutte_map(V, F, loop, weights):
+    K = _graph_stiffness(F, len(V)) if weights == "uniform" else -cotan_laplacian(V, F)
+    seg = np.linalg.norm(V[np.roll(loop, -1)] - V[loop], axis=1)
+    theta = 2 * np.pi * np.concatenate([[0.0], np.cumsum(seg[:-1])]) / seg.sum()
+    return _pinned_solve(K, loop, np.stack([np.cos(theta), np.sin(theta)], axis=1))
+
+
+def lscm(V, F, pins, pin_uv):
+    n = len(V)
+    K = -cotan_laplacian(V, F)
+    he = _edges(F)  # half-edges a -> b, their face on the left
+    inner = np.isin(he[:, 1] * n + he[:, 0], he[:, 0] * n + he[:, 1])
+    a, b = he[~inner, 0], he[~inner, 1]
+    half = np.full(len(a), 0.5)
+    QA = sp.coo_matrix(
+        (np.concatenate([half, half, -half, -half]),
+         (np.concatenate([a, n + b, b, n + a]), np.concatenate([n + b, a, n + a, b]))),
+        shape=(2 * n, 2 * n),
+    )  # fmt: skip
+    L = sp.block_diag([K, K]) - QA
+    rows = [pins[0], pins[1], n + pins[0], n + pins[1]]
+    known = np.array([[pin_uv[0, 0]], [pin_uv[1, 0]], [pin_uv[0, 1]], [pin_uv[1, 1]]])
+    x = _pinned_solve(L, rows, known)[:, 0]
+    return np.stack([x[:n], x[n:]], axis=1)
