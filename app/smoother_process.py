@@ -172,6 +172,8 @@ def _snapshot(sm: Any) -> dict[str, Any]:
         "volume_note": sm.volume_note,
         "closed": sm.closed,
         "box": [sm.V.min(axis=0).tolist(), sm.V.max(axis=0).tolist()] if len(sm.V) else None,
+        "solver": sm.solver_report(),
+        "solver_line": sm.solver_line(),
     }
 
 
@@ -310,6 +312,8 @@ class RemoteSmoother:
         self._arrived = False  # a step's answer read, not yet collected by poll
         self.error = ""
         self.history: list[dict[str, Any]] = []
+        self._solver: dict[str, Any] = {}
+        self._solver_line = ""
 
     # ------------------------------------------------------------------ start
     @classmethod
@@ -377,6 +381,7 @@ class RemoteSmoother:
         self._divergence = snap["divergence"]
         self.volume_note, self.closed = snap["volume_note"], snap["closed"]
         self.history = [snap["last"]] if snap["last"] else []
+        self._solver, self._solver_line = snap["solver"], snap["solver_line"]
         self.box = None if snap["box"] is None else np.array(snap["box"])
         cur, nrm, shown = self._slots[snap["slot"]]
         self._V = np.array(cur)
@@ -412,6 +417,15 @@ class RemoteSmoother:
 
     def divergence_message(self) -> str | None:
         return self._divergence if self._diverged else None
+
+    def solver_report(self) -> dict[str, Any]:
+        """The child's stepper's :meth:`~meshlap_core.smoothing.Smoother.solver_report` (as of
+        its last answer)."""
+        return self._solver
+
+    def solver_line(self) -> str:
+        """The child's stepper's solver line (as of its last answer)."""
+        return self._solver_line
 
     def prepare(self) -> None:
         """Nothing: the child factorized while it built the stepper."""

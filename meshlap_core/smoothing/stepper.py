@@ -19,7 +19,7 @@ import scipy.sparse as sp
 from ..errors import MeshError, MeshWarning, check_cancel
 from ..laplacian import vertex_areas
 from ..linalg.common import ProgressCallback
-from ..linalg.spd import SPDSolver, solver_backend
+from ..linalg.spd import solver_backend
 from ..metrics import _signed_volume_unchecked, n_boundary_edges, percent_volume_change
 from ..noise import bbox_diagonal
 from ..options import (
@@ -37,6 +37,7 @@ from ..options import (
 )
 from ..topology import boundary_vertex_mask
 from ..types import FloatArray, IntArray, as_mesh, as_vertices
+from .implicit_solver import SOLVER_CHOICES, ImplicitSolver
 from .params import (
     DEFAULT_PASS_BAND,
     _resolve_nu,
@@ -114,6 +115,16 @@ class Smoother:
         ``history_limit``.
     warn : bool
         Emit a :class:`MeshWarning` when an explicit or Taubin ``λ`` is unstable on this mesh.
+    steps : int, optional
+        How many steps the caller means to take (``None``: open-ended, e.g. the window's
+        *play*; :meth:`run` says it for its own steps). It picks the implicit system's
+        solver (:mod:`~meshlap_core.smoothing.implicit_solver`): on a scan CHOLMOD answers
+        the first step and, for a run long enough (or open-ended), a cholespy
+        factorization built meanwhile in a helper process answers the later ones (its solves
+        are 2–3× faster); :meth:`solver_report` says which and why.
+    implicit_solver : {"auto", "direct", "handover"}
+        ``auto`` as just said; ``direct``: one factorization in this process, never a helper;
+        ``handover``: a helper takes over whenever it can start (tests, comparisons).
 
     Attributes
     ----------
@@ -146,7 +157,8 @@ class Smoother:
     volume_note : str or None
         Why the volume is undefined (open mesh), else ``None``.
     n_factorizations : int
-        How many times a linear system was factorized (1 for a frozen implicit smoother).
+        How many times a linear system was factorized (1 for a frozen implicit smoother; the
+        helper's factorization of the same system is not counted).
 
     Notes
     -----
@@ -187,8 +199,12 @@ class Smoother:
         history_limit: int | None = None,
         history_samples: int | None = None,
         warn: bool = True,
+        steps: int | None = None,
+        implicit_solver: str = "auto",
     ) -> None:
         self.V0, self.F = as_mesh(V, F)
+        self.implicit_solver = check_choice(implicit_solver, SOLVER_CHOICES, "implicit_solver")
+        self._planned = None if steps is None else check_iters(steps, "steps")
         self._init_history(history_limit, history_samples)
         self.n = len(self.V0)
         self.method = check_choice(method, SMOOTHING_METHODS, "method")
@@ -276,8 +292,9 @@ class Smoother:
         self._stability: Stability | None = None
         self._mu_min: tuple[float, bool] | None = None  # W and K are frozen: kept across λ
         self.n_factorizations = 0
-        self._solver: SPDSolver | None = None
+        self._solver: ImplicitSolver | None = None
         self._solver_key: tuple[float, int] | None = None
+        self._generation = 0  # bumped by reset: a prefetched solve of an older run is stale
         self._rhs_fixed: FloatArray | None = None
         self._explicit_cache: dict[float, sp.csr_matrix] = {}
 
@@ -310,11 +327,52 @@ class Smoother:
 
     def prepare(self) -> None:
         """Do now the one-time work of the next step: the implicit system's factorization
-        (nothing for the explicit and Taubin steppers, or when it is current). A caller that
-        builds the stepper in a job calls it there, so that the first :meth:`step` on the
-        window's thread is as cheap as the others."""
+        (nothing for the explicit and Taubin steppers, or when it is current), and start the
+        helper that will take the solves over (:meth:`solver_report`), if planned. A caller
+        that builds the stepper in a job calls it there, so that the first :meth:`step` on
+        the window's thread is as cheap as the others."""
         if self.method == "implicit" and len(self._free) and not self.diverged:
             self._factorize(self._V)
+            assert self._solver is not None
+            self._solver.warm()  # an open-ended run's helper starts now
+
+    def solver_report(self) -> dict[str, Any]:
+        """Which factorization answers the implicit steps, since which step, and why
+        (:meth:`ImplicitSolver.report`; ``meshlap smooth --json``'s ``"solver"``).
+
+        Returns
+        -------
+        dict
+            ``answering`` is ``None`` with no linear system (explicit and Taubin steps, or
+            before the first implicit factorization); see :meth:`ImplicitSolver.report`.
+        """
+        if self._solver is None:
+            why = (
+                "no linear system (explicit steps)"
+                if self.method != "implicit"
+                else "not factorized yet"
+            )
+            return {"answering": None, "reason": why, "handover_iteration": None}
+        return self._solver.report()
+
+    def solver_line(self) -> str:
+        """:meth:`solver_report` in one line (the Smoothing panel's solver line)."""
+        if self._solver is None:
+            return self.solver_report()["reason"]
+        return self._solver.line()
+
+    def wait_handover(self, timeout: float | None = None) -> bool:
+        """Wait until the helper's factorization is ready: the next implicit step is then
+        answered by it (tests and benchmarks). False when no helper is at work."""
+        return self._solver is not None and self._solver.wait_handover(timeout)
+
+    def close(self) -> None:
+        """End the helper process of the implicit solves, if any (also while it factorizes);
+        a later implicit step factorizes again in this process. Garbage collection does the
+        same."""
+        if self._solver is not None:
+            self._solver.close()
+            self._solver, self._solver_key = None, None
 
     def set_lam(self, lam: float) -> None:
         """Change ``λ`` (and Taubin's ``ν`` if it was derived from it) without losing the state.
@@ -358,6 +416,7 @@ class Smoother:
         """
         self._V = self.V0.copy()
         self._W = self._W0
+        self._generation = getattr(self, "_generation", 0) + 1
         self.iteration = 0
         self.diverged = False
         self.history_stride = 1
@@ -389,10 +448,16 @@ class Smoother:
         drift = math.sqrt(float(np.einsum("ij,ij->", d0, d0)) / max(self.n, 1))
         if not drift <= self.divergence_limit:  # also catches NaN and inf
             self.diverged = True
+            if self._solver is not None:
+                self._solver.discard()  # a solve started from the discarded step
             return self.V
         old = self._V
         self._V = new
         self.iteration += 1
+        if self.preserve_volume and self.method == "implicit" and self._solver is not None:
+            # the next step's solve starts in the helper (once it has taken over) while this
+            # step's figures are measured and the caller draws or publishes
+            self._solver.prefetch(new[self._free], self._token())
         if self.track_history:
             self._record(self._metrics(new, old, elapsed, drift))
         return self.V
@@ -419,13 +484,17 @@ class Smoother:
             with :class:`~meshlap_core.errors.Cancelled`, keeping the iterations done.
         """
         n = check_iters(n, "n")
-        for i in range(n):
-            check_cancel(cancel, "smoothing")
-            if progress is not None:
-                progress(i / n, self._progress_message(i, n))
-            self.step()
-            if self.diverged:
-                break
+        planned, self._planned = self._planned, self.iteration + n
+        try:
+            for i in range(n):
+                check_cancel(cancel, "smoothing")
+                if progress is not None:
+                    progress(i / n, self._progress_message(i, n))
+                self.step()
+                if self.diverged:
+                    break
+        finally:
+            self._planned = planned
         if progress is not None:
             progress(1.0, f"smoothing: {self.iteration} iterations")
         return self.V
@@ -534,14 +603,19 @@ class Smoother:
         self._factorize(x)
         solver = self._solver
         assert solver is not None
+        token = self._token()
+        # the next step starts from this answer unchanged unless the volume is rescaled
+        then = None if self.preserve_volume else (token[0], token[1] + 1)
         if len(self._fixed) == 0:  # nothing pinned: no gathers or scatters
-            return solver.solve(self._W[:, None] * x)
-        rhs = self._W[free][:, None] * x[free]
-        if self._rhs_fixed is not None:
-            rhs = rhs + self._rhs_fixed
+            return solver.solve(x, token, then)
         new = x.copy()
-        new[free] = solver.solve(rhs)
+        new[free] = solver.solve(x[free], token, then)
         return new
+
+    def _token(self) -> tuple[int, int]:
+        """Names the positions the next implicit step starts from (see
+        :meth:`ImplicitSolver.prefetch`)."""
+        return (self._generation, self.iteration)
 
     def _factorize(self, x: FloatArray) -> None:
         """Factorize ``W − λK`` (free block) unless the current factor is for this ``λ`` (and,
@@ -555,8 +629,17 @@ class Smoother:
         A.data *= -self.lam
         A.setdiag(A.diagonal() + Wf)
         spent, self._solver = self._solver, None  # refactorized in place (same pattern)
+        reuse = None
+        if spent is not None:
+            spent.close()  # its helper ends (also in the middle of its factorization)
+            reuse = spent.direct
+        self._rhs_fixed = self.lam * (self._K_fp @ x[self._fixed]) if len(self._fixed) else None
+        steps_left = None if self._planned is None else max(self._planned - self.iteration, 1)
+        choice = "direct" if self._recompute_mass else self.implicit_solver
         try:
-            self._solver = SPDSolver(A, reuse=spent)
+            self._solver = ImplicitSolver(
+                A, Wf, self._rhs_fixed, steps_left=steps_left, choice=choice, reuse=reuse
+            )
         except np.linalg.LinAlgError:
             stiff = float(np.max(-self._K_ff.diagonal() / Wf)) if len(free) else 0.0
             raise MeshError(
@@ -568,7 +651,6 @@ class Smoother:
             ) from None
         self._solver_key = key
         self.n_factorizations += 1
-        self._rhs_fixed = self.lam * (self._K_fp @ x[self._fixed]) if len(self._fixed) else None
 
     def _rescale_volume(self, x: FloatArray) -> FloatArray:
         vol = _signed_volume_unchecked(x, self.F, self._FT)
