@@ -28,6 +28,7 @@ from meshlap_core.errors import MeshError
 from meshlap_core.options import UP_AXES, check_choice
 
 from . import opening, scene, window
+from .heap import release_freed
 from .jobs import Job, Reporter, prefer_gil_free_solvers, warm_up
 from .pacing import Pacer
 from .panels.base import Panel, Pick
@@ -584,7 +585,7 @@ def run(
     state = AppState(folder=cwd)
     state.panel = state.check_panel(panel or VIEWS[0], "--panel")
     later = path if opens_later(path, shot, saved, options) else None
-    if not state.mesh.load(None if later is not None else path):
+    if not opening.load_now(state, None if later is not None else path):
         raise MeshError(state.mesh.error)
     if saved is not None:
         check_session_mesh(saved, state.mesh, session)
@@ -605,6 +606,7 @@ def run(
     if ui_scale is not None and ui_scale != 1.0:
         viewer.set_ui_scale(ui_scale)
     viewer.sync_mesh()
+    release_freed()  # the registration's temporaries (a scan: before the first frame's buffers)
     if shot is not None:
         ps.set_window_size(1600, 900)
     if saved is not None:

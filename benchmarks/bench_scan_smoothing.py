@@ -165,11 +165,12 @@ chol = SPDSolver(A, "cholmod")
 espy = CholeskySolverD(A.shape[0], A.indptr.astype(np.int32), A.indices.astype(np.int32),
                        A.data, MatrixType.CSR)
 B = np.ascontiguousarray(w[:, None] * s.V[free]); X = np.empty_like(B)
-steps, cs, ch, cs_cpu, ch_cpu, loads = [], [], [], [], [], []
+steps, cs, ch, cs_cpu, ch_cpu, loads, step_cpu = [], [], [], [], [], [], []
 for r in range(rounds * 4):
     s.step(); last = time.perf_counter()
     for _ in range(5):
-        s.step(); now = time.perf_counter(); steps.append(now - last); last = now
+        c = time.thread_time(); s.step(); step_cpu.append(time.thread_time() - c)
+        now = time.perf_counter(); steps.append(now - last); last = now
     for _ in range(3):
         t = time.perf_counter(); c = time.thread_time(); espy.solve(B, X)
         cs.append(time.perf_counter() - t); cs_cpu.append(time.thread_time() - c)
@@ -180,7 +181,8 @@ rep2 = s.solver_report()
 print(json.dumps({"before": before, "steps": steps, "cholespy": cs, "cholmod": ch,
                   "cholespy_cpu": cs_cpu, "cholmod_cpu": ch_cpu, "loads": loads,
                   "handover": rep["handover_iteration"], "helper_factor_s": rep["helper_factor_s"],
-                  "factor_s": rep["factor_s"], "helper_solve_ms": rep2["solve_ms"]}))
+                  "factor_s": rep["factor_s"], "helper_solve_ms": rep2["solve_ms"],
+                  "helper_solve_cpu_ms": rep2["helper_solve_cpu_ms"], "step_cpu": step_cpu}))
 """
 
 WINDOW = """
@@ -255,7 +257,9 @@ def fig_steps(scan: Path, rounds: int) -> tuple[list[list[str]], float]:
             f"{len(r['steps'])} steps in blocks of 5 alternating with the solves; CPU of the "
             f"solves: cholespy {med(r['cholespy_cpu']):.3f} s, CHOLMOD "
             f"{med(r['cholmod_cpu']):.3f} s; the helper's own solve "
-            f"{r['helper_solve_ms']['cholespy (helper)']:.0f} ms",
+            f"{r['helper_solve_ms']['cholespy (helper)']:.0f} ms, CPU "
+            f"{r['helper_solve_cpu_ms']:.0f} ms; step CPU (this process) "
+            f"{med(r['step_cpu']):.3f} s",
         ],
     ]
     for iters in (10, 300):

@@ -185,10 +185,12 @@ class ImplicitSolver:
             answered the first step), ``helper`` (``None``, ``"factorizing"``, ``"ready"``,
             ``"failed"``), ``handover_iteration`` (the first step the helper answered, or
             ``None``), ``reason``, ``factor_s`` (in-process), ``helper_factor_s``,
-            ``solve_ms`` (median in-process solve, median helper solve, either ``None``).
+            ``solve_ms`` (median in-process solve, median helper solve, either ``None``),
+            ``helper_solve_cpu_ms`` (the helper's median solve in CPU time).
         """
         h = self.helper
         helper_solves = h.solve_s if h is not None else []
+        helper_cpu = h.solve_cpu_s if h is not None else []
         return {
             "answering": self.answering,
             "first": self.backend,
@@ -201,6 +203,7 @@ class ImplicitSolver:
                 self.backend: _median_ms(self.direct_solve_s),
                 "cholespy (helper)": _median_ms(helper_solves),
             },
+            "helper_solve_cpu_ms": _median_ms(helper_cpu),
         }
 
     def line(self) -> str:
