@@ -147,6 +147,8 @@ class RemoteCholesky:
         counts the time the helper waited for a core.
     error : str
         Why the helper failed ("" while it has not).
+    waited_s : float
+        How long the last :meth:`result` waited for its answer.
 
     Raises
     ------
@@ -169,6 +171,7 @@ class RemoteCholesky:
         self.factor_s: float | None = None
         self.solve_s: list[float] = []
         self.solve_cpu_s: list[float] = []
+        self.waited_s = 0.0
         self.error = ""
         self._state = "factorizing"  # -> ready | failed | closed
         self._buffer = b""
@@ -291,10 +294,12 @@ class RemoteCholesky:
         """
         if self._pending is None:
             raise HelperError("no solve was submitted")
+        t = time.perf_counter()
         while self._pending is not None:
             if self._state in ("failed", "closed"):
                 raise HelperError(self.error or "the helper process ended")
             self._read(None)
+        self.waited_s = time.perf_counter() - t
         view = self._slots[self._last].view()
         view.flags.writeable = False
         return view

@@ -162,6 +162,7 @@ class ImplicitSolver:
         self.helper: RemoteCholesky | None = None
         self.handover_at: int | None = None  # the first iteration the helper answered
         self.direct_solve_s: list[float] = []
+        self.hidden_s = 0.0  # of the last solve, the time it ran before it was asked for
         self._steps_left = steps_left
         self._prefetched: Any = None  # the token of the solve the helper is working on
         self._d = 1.0 / np.sqrt(w)
@@ -240,6 +241,7 @@ class ImplicitSolver:
             except HelperError as exc:  # the helper ended after taking over: factor again
                 self._lost(str(exc))
         self._prefetched = None
+        self.hidden_s = 0.0
         t = time.perf_counter()
         rhs = self.w[:, None] * x
         if self.r is not None:
@@ -296,8 +298,11 @@ class ImplicitSolver:
         if not (h.pending and token is not None and self._prefetched == token):
             h.discard()
             h.submit(x / self._d[:, None], add=self.r is not None)
+        ahead = self._prefetched is not None
         self._prefetched = None
         z = h.result()
+        # a solve started ahead ran partly before this call: counted whole in the step's time
+        self.hidden_s = max(0.0, h.solve_s[-1] - h.waited_s) if ahead and h.solve_s else 0.0
         if then is not None:  # the next solve starts now, from this answer as it is
             h.submit(None, add=self.r is not None)
             self._prefetched = then
