@@ -28,7 +28,6 @@ from meshlap_core.errors import MeshError
 from meshlap_core.options import UP_AXES, check_choice
 
 from . import opening, scene, window
-from .heap import release_freed
 from .jobs import Job, Reporter, prefer_gil_free_solvers, warm_up
 from .pacing import Pacer
 from .panels.base import Panel, Pick
@@ -606,7 +605,6 @@ def run(
     if ui_scale is not None and ui_scale != 1.0:
         viewer.set_ui_scale(ui_scale)
     viewer.sync_mesh()
-    release_freed()  # the registration's temporaries (a scan: before the first frame's buffers)
     if shot is not None:
         ps.set_window_size(1600, 900)
     if saved is not None:
