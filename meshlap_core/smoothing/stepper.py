@@ -20,7 +20,7 @@ from ..errors import MeshError, MeshWarning, check_cancel
 from ..laplacian import vertex_areas
 from ..linalg.common import ProgressCallback
 from ..linalg.spd import solver_backend
-from ..metrics import _signed_volume_unchecked, n_boundary_edges, percent_volume_change
+from ..metrics import _signed_volume_unchecked, n_boundary_edges
 from ..noise import bbox_diagonal
 from ..options import (
     AREA_KINDS,
@@ -37,6 +37,7 @@ from ..options import (
 )
 from ..topology import boundary_vertex_mask
 from ..types import FloatArray, IntArray, as_mesh, as_vertices
+from .history import check_history_options, displacement_sums, keep, step_entry
 from .implicit_solver import SOLVER_CHOICES, ImplicitSolver
 from .params import (
     DEFAULT_PASS_BAND,
@@ -50,13 +51,10 @@ from .stability import (
     _diagonal_scale,
     _gershgorin_mu_min,
     _stability_from_mu,
+    ill_conditioning,
     most_negative_eigenvalue,
     operator_parts,
 )
-
-ILL_CONDITIONED = 1e10
-"""Implicit smoothing warns when ``λ · max_i(−L_ii)`` exceeds this: its solve may then lose
-more than about 7 of 16 digits."""
 
 
 class DivergenceError(MeshError):
@@ -116,15 +114,13 @@ class Smoother:
     warn : bool
         Emit a :class:`MeshWarning` when an explicit or Taubin ``λ`` is unstable on this mesh.
     steps : int, optional
-        How many steps the caller means to take (``None``: open-ended, e.g. the window's
-        *play*; :meth:`run` says it for its own steps). It picks the implicit system's
-        solver (:mod:`~meshlap_core.smoothing.implicit_solver`): on a scan CHOLMOD answers
-        the first step and, for a run long enough (or open-ended), a cholespy
-        factorization built meanwhile in a helper process answers the later ones (its solves
-        are 2–3× faster); :meth:`solver_report` says which and why.
+        Steps the caller means to take (``None``: open-ended, e.g. *play*; :meth:`run` says
+        it for its own): on a scan CHOLMOD answers the first implicit step and, for a run
+        long enough, a cholespy factorization built meanwhile in a helper process the later
+        ones (:mod:`~.implicit_solver`; :meth:`solver_report` says which and why).
     implicit_solver : {"auto", "direct", "handover"}
-        ``auto`` as just said; ``direct``: one factorization in this process, never a helper;
-        ``handover``: a helper takes over whenever it can start (tests, comparisons).
+        ``auto`` as just said; ``direct``: never a helper; ``handover``: a helper takes over
+        whenever it can start (tests, comparisons).
 
     Attributes
     ----------
@@ -233,14 +229,7 @@ class Smoother:
 
     def _init_history(self, limit: int | None, samples: int | None) -> None:
         """Check and store ``history_limit`` / ``history_samples``."""
-        if limit is not None and check_iters(limit, "history_limit", None) < 2:
-            raise MeshError(f"must be at least 2, got {limit}", "history_limit")
-        if samples is not None and check_iters(samples, "history_samples", None) < 4:
-            raise MeshError(f"must be at least 4, got {samples}", "history_samples")
-        if limit is not None and samples is not None:
-            raise MeshError("give history_limit or history_samples, not both", "history_samples")
-        self.history_limit = limit
-        self.history_samples = None if samples is None else int(samples)
+        self.history_limit, self.history_samples = check_history_options(limit, samples)
         self.history_stride = 1
 
     def _init_volume(self, preserve_volume: bool) -> None:
@@ -339,38 +328,23 @@ class Smoother:
 
     def solver_report(self) -> dict[str, Any]:
         """Which factorization answers the implicit steps, since which step, and why
-        (:meth:`ImplicitSolver.report`; ``meshlap smooth --json``'s ``"solver"``).
-
-        Returns
-        -------
-        dict
-            ``answering`` is ``None`` with no linear system (explicit and Taubin steps, or
-            before the first implicit factorization); see :meth:`ImplicitSolver.report`.
-        """
+        (:meth:`ImplicitSolver.report`; ``answering`` is ``None`` with no linear system)."""
         if self._solver is None:
-            why = (
-                "no linear system (explicit steps)"
-                if self.method != "implicit"
-                else "not factorized yet"
-            )
+            why = "not factorized yet" if self.method == "implicit" else "no linear system"
             return {"answering": None, "reason": why, "handover_iteration": None}
         return self._solver.report()
 
     def solver_line(self) -> str:
         """:meth:`solver_report` in one line (the Smoothing panel's solver line)."""
-        if self._solver is None:
-            return self.solver_report()["reason"]
-        return self._solver.line()
+        return self._solver.line() if self._solver else self.solver_report()["reason"]
 
     def wait_handover(self, timeout: float | None = None) -> bool:
-        """Wait until the helper's factorization is ready: the next implicit step is then
-        answered by it (tests and benchmarks). False when no helper is at work."""
+        """Wait until the helper's factorization is ready (tests, benchmarks); False when no
+        helper is at work. The next implicit step is then answered by it."""
         return self._solver is not None and self._solver.wait_handover(timeout)
 
     def close(self) -> None:
-        """End the helper process of the implicit solves, if any (also while it factorizes);
-        a later implicit step factorizes again in this process. Garbage collection does the
-        same."""
+        """End the implicit solves' helper process, if any (also while it factorizes)."""
         if self._solver is not None:
             self._solver.close()
             self._solver, self._solver_key = None, None
@@ -423,7 +397,7 @@ class Smoother:
         self.history_stride = 1
         self.history: list[dict[str, Any]] = []
         if self.track_history:
-            self.history.append(self._metrics(self._V, None, 0.0))
+            self.history.append(self._entry(self._V, None, 0.0))
 
     # ---------------------------------------------------------------- stepping
 
@@ -447,7 +421,8 @@ class Smoother:
         elapsed = time.perf_counter() - t0
         if self.method == "implicit" and self._solver is not None:
             elapsed += self._solver.hidden_s  # a solve the helper started ahead, counted whole
-        sums = _displacements(new, self.V0, self._V if self.track_history else None, self.reference)
+        start = self._V if self.track_history else None
+        sums = displacement_sums(new, self.V0, start, self.reference)
         drift = math.sqrt(sums[0] / max(self.n, 1))
         if not drift <= self.divergence_limit:  # also catches NaN and inf
             self.diverged = True
@@ -460,9 +435,15 @@ class Smoother:
         if self.preserve_volume and self.method == "implicit" and self._solver is not None:
             # the next step's solve starts in the helper (once it has taken over) while this
             # step's figures are measured and the caller draws or publishes
-            self._solver.prefetch(new[self._free], self._token())
+            self._solver.prefetch(new[self._free], (self._generation, self.iteration))
         if self.track_history:
-            self._record(self._metrics(new, old, elapsed, drift, sums))
+            self.history_stride = keep(
+                self.history,
+                self._entry(new, old, elapsed, sums),
+                self.history_limit,
+                self.history_samples,
+                self.history_stride,
+            )
         return self.V
 
     def run(
@@ -553,29 +534,13 @@ class Smoother:
             warnings.warn(MeshWarning(msg), stacklevel=3)
 
     def _warn_if_ill_conditioned(self) -> None:
-        """Warn when ``λ · max_i(−L_ii)`` exceeds :data:`ILL_CONDITIONED`.
-
-        The condition number of ``W⁻¹(W − λK)`` is ``1 + λ|μ_min| ≈ 1 + 2λ max_i(−L_ii)``; the
-        weighted centroid ``Σ W_i x_i``, which an exact implicit step conserves, was measured
-        to drift by about ``2e-17 · λ max(−L_ii)`` relative on spheres (2e-5 at 1e12, 1e-3 at
-        1e14, 20–50 % at 5e15: a silently wrong mesh without this warning).
-        """
-        free = self._free
-        if len(free) == 0:
-            return
-        stiff = float(np.max(-self._K_ff.diagonal() / self._W0[free]))
-        x = self.lam * stiff
-        if x > ILL_CONDITIONED:
-            warnings.warn(
-                MeshWarning(
-                    f"implicit smoothing with lam={self.lam:g} is ill-conditioned on this mesh: "
-                    f"lam times the stiffest vertex's -L_ii = {stiff:.3g} is {x:.3g} > "
-                    f"{ILL_CONDITIONED:.0e}, so the result may carry relative errors of order "
-                    f"{x:.0e} x 1e-16; lam below {ILL_CONDITIONED / stiff:.3g} already collapses "
-                    "the mesh to a point in a few steps"
-                ),
-                stacklevel=3,
-            )
+        """Warn when ``λ · max_i(−L_ii)`` exceeds :data:`~.stability.ILL_CONDITIONED`
+        (:func:`~.stability.ill_conditioning`)."""
+        if len(self._free):
+            stiff = float(np.max(-self._K_ff.diagonal() / self._W0[self._free]))
+            message = ill_conditioning(self.lam, stiff)
+            if message:
+                warnings.warn(MeshWarning(message), stacklevel=3)
 
     def _explicit_operator(self, lam: float) -> sp.csr_matrix:
         """``S = I + λ P W⁻¹K`` (``P`` zeroes pinned rows) for the frozen mass, cached per λ."""
@@ -606,7 +571,7 @@ class Smoother:
         self._factorize(x)
         solver = self._solver
         assert solver is not None
-        token = self._token()
+        token = (self._generation, self.iteration)
         # the next step starts from this answer unchanged unless the volume is rescaled
         then = None if self.preserve_volume else (token[0], token[1] + 1)
         if len(self._fixed) == 0:  # nothing pinned: no gathers or scatters
@@ -614,11 +579,6 @@ class Smoother:
         new = x.copy()
         new[free] = solver.solve(x[free], token, then)
         return new
-
-    def _token(self) -> tuple[int, int]:
-        """Names the positions the next implicit step starts from (see
-        :meth:`ImplicitSolver.prefetch`)."""
-        return (self._generation, self.iteration)
 
     def _factorize(self, x: FloatArray) -> None:
         """Factorize ``W − λK`` (free block) unless the current factor is for this ``λ`` (and,
@@ -667,74 +627,21 @@ class Smoother:
         out[free] = c + s * (x[free] - c)
         return out
 
-    def _record(self, entry: dict[str, Any]) -> None:
-        """Append a history entry, keeping the list within ``history_limit``/``history_samples``."""
-        h = self.history
-        if self.history_samples is not None:
-            if len(h) > 1 and h[-1]["iteration"] % self.history_stride:
-                h.pop()  # the previous latest entry is off the sampling grid
-            h.append(entry)
-            if len(h) > self.history_samples:
-                self.history_stride *= 2
-                kept = [e for e in h[:-1] if e["iteration"] % self.history_stride == 0]
-                h[:] = [*kept, h[-1]]
-            return
-        h.append(entry)
-        if self.history_limit is not None and len(h) > self.history_limit:
-            del h[1]  # keep the input's entry and the latest ones
-
-    def _metrics(
-        self,
-        x: FloatArray,
-        old: FloatArray | None,
-        elapsed: float,
-        drift: float = 0.0,
-        sums: tuple[float, float, float, float] | None = None,
+    def _entry(
+        self, x: FloatArray, old: FloatArray | None, elapsed: float, sums: Any = None
     ) -> dict[str, Any]:
         """The history entry of positions ``x`` (``old``: the step's start; ``sums``: their
-        :func:`_displacements`, measured by :meth:`step`)."""
+        :func:`~.history.displacement_sums`, when :meth:`step` measured them)."""
         if sums is None:
-            sums = _displacements(x, self.V0, old, self.reference)
-        n = max(self.n, 1)
-        entry: dict[str, Any] = {"iteration": self.iteration, "time_ms": 1e3 * elapsed}
-        entry["step_rms"] = math.sqrt(sums[1] / n) if old is not None else 0.0
-        entry["step_max"] = math.sqrt(sums[2]) if old is not None else 0.0
-        entry["drift_rms"] = drift  # RMS of x − V0, measured by step()
-        if self.closed and self.volume0 is not None:
-            vol = _signed_volume_unchecked(x, self.F, self._FT)
-            entry["volume"] = vol
-            entry["volume_change_pct"] = percent_volume_change(vol, self.volume0)
-        else:
-            entry["volume"] = None
-            entry["volume_change_pct"] = None
-        if self.reference is not None:
-            entry["rmse"] = math.sqrt(sums[3] / n)
-        return entry
-
-
-ROWS_CHUNK = 16384
-"""Vertices per block of :func:`_displacements` (the block's differences stay in the cache)."""
-
-
-def _displacements(
-    x: FloatArray, x0: FloatArray, old: FloatArray | None, ref: FloatArray | None
-) -> tuple[float, float, float, float]:
-    """``Σ|x − x0|²``, ``Σ|x − old|²``, ``max |x − old|²`` and ``Σ|x − ref|²`` (0 for a
-    missing ``old`` or ``ref``) in one pass over blocks of :data:`ROWS_CHUNK` vertices: the
-    figures of every step, without ``(n,3)`` temporaries (three full passes over memory less
-    at 692k vertices)."""
-    drift = step = top = dev = 0.0
-    for s in range(0, len(x), ROWS_CHUNK):
-        e = s + ROWS_CHUNK
-        xs = x[s:e]
-        d = xs - x0[s:e]
-        drift += float(np.einsum("ij,ij->", d, d))
-        if old is not None:
-            np.subtract(xs, old[s:e], out=d)
-            d2 = np.einsum("ij,ij->i", d, d)
-            step += float(d2.sum())
-            top = max(top, float(d2.max()))
-        if ref is not None:
-            np.subtract(xs, ref[s:e], out=d)
-            dev += float(np.einsum("ij,ij->", d, d))
-    return drift, step, top, dev
+            sums = displacement_sums(x, self.V0, old, self.reference)
+        faces = (self.F, self._FT) if self.closed else None
+        return step_entry(
+            self.iteration,
+            elapsed,
+            x,
+            sums,
+            stepped=old is not None,
+            faces=faces,
+            volume0=self.volume0,
+            reference=self.reference is not None,
+        )
