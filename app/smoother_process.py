@@ -87,19 +87,37 @@ def vertex_normals(V: FloatArray, F: IntArray, incidence: Any = None) -> np.ndar
     F = np.asarray(F, dtype=np.int64)
     if incidence is None:
         incidence = face_incidence(F, len(V))
-    if len(F):  # coordinate by coordinate on contiguous arrays: 3x quicker than np.cross
-        x, y, z = np.ascontiguousarray(V.T)
-        i, j, k = np.ascontiguousarray(F.T)
-        ux, uy, uz = x[j] - x[i], y[j] - y[i], z[j] - z[i]
-        vx, vy, vz = x[k] - x[i], y[k] - y[i], z[k] - z[i]
-        cross = np.stack([uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx], axis=1)
-        N = np.asarray(incidence @ cross)
+    if len(F):
+        N = np.asarray(incidence @ _face_cross(V, F))
     else:
         N = np.zeros((len(V), 3))
     norm = np.sqrt(np.einsum("ij,ij->i", N, N))
     ok = norm > 0
     N[ok] /= norm[ok, None]
     return N.astype(np.float32)
+
+
+NORMALS_CHUNK = 8192
+"""Faces per block of :func:`_face_cross` (its gathered coordinates stay in the cache: 130
+instead of 200 ms of CPU for the normals of the 692k scan, made for every step shown)."""
+
+
+def _face_cross(V: FloatArray, F: IntArray) -> np.ndarray:
+    """``(b − a) × (c − a)`` of every face ``(m,3)``, coordinate by coordinate on contiguous
+    arrays (3× quicker than ``np.cross``), over blocks of :data:`NORMALS_CHUNK` faces."""
+    x, y, z = np.ascontiguousarray(V.T)
+    FT = np.ascontiguousarray(F.T)
+    cross = np.empty((len(F), 3))
+    for s in range(0, len(F), NORMALS_CHUNK):
+        i, j, k = FT[:, s : s + NORMALS_CHUNK]
+        xi, yi, zi = x.take(i), y.take(i), z.take(i)
+        ux, uy, uz = x.take(j) - xi, y.take(j) - yi, z.take(j) - zi
+        vx, vy, vz = x.take(k) - xi, y.take(k) - yi, z.take(k) - zi
+        c = cross[s : s + NORMALS_CHUNK]
+        c[:, 0] = uy * vz - uz * vy
+        c[:, 1] = uz * vx - ux * vz
+        c[:, 2] = ux * vy - uy * vx
+    return cross
 
 
 def face_incidence(F: IntArray, n: int) -> sp.csr_matrix:
@@ -223,10 +241,15 @@ def _serve(
                 return
             try:
                 if cmd == "step":  # args: how many (stops at a divergence), the view
-                    for _ in range(args[0] if args else 1):
+                    count = args[0] if args else 1
+                    for i in range(count):
                         if sm.diverged:
                             break
+                        # the window shows the last step's figures only: an implicit step
+                        # (which cannot diverge) is measured only when it is the last
+                        sm.track_history = sm.method != "implicit" or i == count - 1
                         sm.step()
+                    sm.track_history = True
                     view = args[1] if len(args) > 1 and args[1] is not None else view
                 elif cmd == "reset":
                     sm.reset()

@@ -26,8 +26,9 @@ Figures (implicit cotan smoothing, ``λ = 1e-5``, as ``meshlap smooth SCAN --met
   <= 1.0x the faster solve); the choice and reason ``meshlap smooth --json`` reports for 10
   and for 300 steps;
 * ``window``: the window's stepper child (``meshlap_app.smoother_process.RemoteSmoother``,
-  asked for steps as *play* asks) after the hand-over: steps computed per second, beside the
-  ``steps`` figure's steps per second (target: equal);
+  asked for steps as *play* asks) and the CLI's stepper (``Smoother`` as ``meshlap smooth``
+  makes it) in one process, both after their hand-over, stepping in alternate 10 s spans:
+  steps computed per second (target: equal);
 * ``screenshot``: ``meshlap view SCAN --screenshot OUT.png`` as a whole process: wall time and
   peak RSS (target < 1 GB);
 * ``curvature``: ``meshlap curvature SCAN --method cotan`` against the libigl script of
@@ -188,10 +189,17 @@ print(json.dumps({"before": before, "steps": steps, "cholespy": cs, "cholmod": c
 WINDOW = """
 import json, sys, time, threading, os, numpy as np
 from meshlap_core.io import load_mesh
+from meshlap_core.cli.smooth import HISTORY_SAMPLES
+from meshlap_core.smoothing import Smoother
 from meshlap_app.jobs import Reporter
 from meshlap_app.smoother_process import RemoteSmoother
 m = load_mesh(sys.argv[1]); lam = float(sys.argv[2]); seconds = float(sys.argv[3])
+rounds = int(sys.argv[4])
 r = RemoteSmoother.start(m.V, m.F, ("implicit", "cotan", lam, 0.0, 0), Reporter(threading.Event()))
+# the CLI's stepper (meshlap smooth: history_samples, no reference), open-ended
+cli = Smoother(m.V, m.F, "implicit", "cotan", lam=lam, warn=False,
+               history_samples=HISTORY_SAMPLES)
+cli.step()
 view = (0.0, 0.0, 0.0, 1.0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0.0, 0.0, 0.0)
 def play(until):
     # as *play* asks: up to PIPELINE requests on their way, a few steps each
@@ -199,17 +207,25 @@ def play(until):
         r.request_step(4, view)
         r.poll()
         time.sleep(0.002)
+    r.finish(); r.poll()
 t0 = time.perf_counter()
 play(lambda: r.solver_report().get("answering") == "cholespy (helper)"
      or time.perf_counter() - t0 > 900)
-r.finish(); r.poll()
-it0, t1 = r.iteration, time.perf_counter()
-play(lambda: time.perf_counter() - t1 > seconds)
-r.finish(); r.poll()
-rate = (r.iteration - it0) / (time.perf_counter() - t1)
-rep = r.solver_report(); r.close()
-print(json.dumps({"rate": rate, "handover": rep["handover_iteration"], "load": os.getloadavg()[0],
-                  "helper_solve_ms": rep["solve_ms"]}))
+while cli.solver_report()["answering"] != "cholespy (helper)" and time.perf_counter() - t0 < 900:
+    cli.step()
+window, steps, loads = [], [], []
+for _ in range(rounds):
+    it0, t1 = r.iteration, time.perf_counter()
+    play(lambda: time.perf_counter() - t1 > seconds)
+    window.append((r.iteration - it0) / (time.perf_counter() - t1))
+    it0, t1 = cli.iteration, time.perf_counter()
+    while time.perf_counter() - t1 < seconds:
+        cli.step()
+    steps.append((cli.iteration - it0) / (time.perf_counter() - t1))
+    loads.append(os.getloadavg()[0])
+rep = r.solver_report(); r.close(); cli.close()
+print(json.dumps({"window": window, "cli": steps, "loads": loads,
+                  "handover": rep["handover_iteration"], "helper_solve_ms": rep["solve_ms"]}))
 """
 
 
@@ -231,7 +247,7 @@ def fig_first(scan: Path, rounds: int) -> list[list[str]]:
     ]
 
 
-def fig_steps(scan: Path, rounds: int) -> tuple[list[list[str]], float]:
+def fig_steps(scan: Path, rounds: int) -> list[list[str]]:
     r = python(STEPS, str(scan), str(LAM), str(rounds))
     step, cs, ch = med(r["steps"]), med(r["cholespy"]), med(r["cholmod"])
     fast = min(cs, ch)
@@ -291,24 +307,23 @@ def fig_steps(scan: Path, rounds: int) -> tuple[list[list[str]], float]:
                 f"{sol['answering']} (hand-over at {sol['handover_iteration']}): {sol['reason']}",
             ]
         )
-    return rows, 1.0 / step
+    return rows
 
 
-def fig_window(scan: Path, rounds: int, cli_rate: float | None) -> list[list[str]]:
-    res = [python(WINDOW, str(scan), str(LAM), "20") for _ in range(rounds)]
-    rate = med([r["rate"] for r in res])
-    loads = f"{min(r['load'] for r in res):.1f}-{max(r['load'] for r in res):.1f}"
-    base = f"{cli_rate:.2f} steps/s" if cli_rate else "-"
+def fig_window(scan: Path, rounds: int) -> list[list[str]]:
+    r = python(WINDOW, str(scan), str(LAM), "10", str(2 * rounds))
+    win, cli = med(r["window"]), med(r["cli"])
     return [
         [
             "window's stepper child after the hand-over: steps computed per second",
-            f"{rate:.2f} steps/s",
-            f"the run of steps above: {base}",
-            f"{rate / cli_rate:.2f}x" if cli_rate else "-",
-            loads,
-            f"rates {span([r['rate'] for r in res], 'steps/s')}; hand-over at step "
-            f"{res[0]['handover']}; the helper's solve "
-            f"{res[0]['helper_solve_ms']['cholespy (helper)']:.0f} ms",
+            f"{win:.2f} steps/s",
+            f"the CLI's stepper in the same process, alternating: {cli:.2f} steps/s",
+            f"{win / cli:.2f}x",
+            f"{min(r['loads']):.1f}-{max(r['loads']):.1f}",
+            f"{len(r['window'])} spans of 10 s each; window {span(r['window'], 'steps/s')}, "
+            f"CLI {span(r['cli'], 'steps/s')}; the child's hand-over at step "
+            f"{r['handover']}, its helper's solve "
+            f"{r['helper_solve_ms']['cholespy (helper)']:.0f} ms",
         ]
     ]
 
@@ -373,11 +388,10 @@ def main() -> None:
     print(f"load average before: {os.getloadavg()}", flush=True)
     scan = make_scan(args.scans)
     rows: list[list[str]] = []
-    cli_rate = None
     figures = [
         ("first", lambda: fig_first(scan, args.rounds)),
         ("steps", lambda: fig_steps(scan, args.rounds)),
-        ("window", lambda: fig_window(scan, args.rounds, cli_rate)),
+        ("window", lambda: fig_window(scan, args.rounds)),
         ("screenshot", lambda: fig_screenshot(scan, args.rounds)),
         ("curvature", lambda: fig_curvature(scan, args.rounds)),
     ]
@@ -385,8 +399,6 @@ def main() -> None:
         if name not in only:
             continue
         out = fn()
-        if name == "steps":
-            out, cli_rate = out
         for row in out:
             print(" | ".join(row), flush=True)
         rows += out
