@@ -213,18 +213,36 @@ play(lambda: r.solver_report().get("answering") == "cholespy (helper)"
      or time.perf_counter() - t0 > 900)
 while cli.solver_report()["answering"] != "cholespy (helper)" and time.perf_counter() - t0 < 900:
     cli.step()
-window, steps, loads = [], [], []
+def cpu(pid):  # user + system seconds of a process
+    with open(f"/proc/{pid}/stat") as fh:
+        f = fh.read().rsplit(")", 1)[1].split()
+    return (int(f[11]) + int(f[12])) / os.sysconf("SC_CLK_TCK")
+def children(pid):
+    with open(f"/proc/{pid}/task/{pid}/children") as fh:
+        return [int(x) for x in fh.read().split()]
+child = r.process.pid
+grand = children(child)  # the child's helper process
+mine = cli._solver.helper.process.pid
+window, steps, loads, wcpu, ccpu = [], [], [], [], []
 for _ in range(rounds):
     it0, t1 = r.iteration, time.perf_counter()
+    c0 = (cpu(child), sum(cpu(g) for g in grand), time.process_time())
     play(lambda: time.perf_counter() - t1 > seconds)
-    window.append((r.iteration - it0) / (time.perf_counter() - t1))
+    k = r.iteration - it0
+    window.append(k / (time.perf_counter() - t1))
+    c1 = (cpu(child), sum(cpu(g) for g in grand), time.process_time())
+    wcpu.append([(b - a) / k for a, b in zip(c0, c1)])
     it0, t1 = cli.iteration, time.perf_counter()
+    c0 = (time.process_time(), cpu(mine))
     while time.perf_counter() - t1 < seconds:
         cli.step()
-    steps.append((cli.iteration - it0) / (time.perf_counter() - t1))
+    k = cli.iteration - it0
+    steps.append(k / (time.perf_counter() - t1))
+    c1 = (time.process_time(), cpu(mine))
+    ccpu.append([(b - a) / k for a, b in zip(c0, c1)])
     loads.append(os.getloadavg()[0])
 rep = r.solver_report(); r.close(); cli.close()
-print(json.dumps({"window": window, "cli": steps, "loads": loads,
+print(json.dumps({"window": window, "cli": steps, "loads": loads, "wcpu": wcpu, "ccpu": ccpu,
                   "handover": rep["handover_iteration"], "helper_solve_ms": rep["solve_ms"]}))
 """
 
@@ -313,6 +331,8 @@ def fig_steps(scan: Path, rounds: int) -> list[list[str]]:
 def fig_window(scan: Path, rounds: int) -> list[list[str]]:
     r = python(WINDOW, str(scan), str(LAM), "10", str(2 * rounds))
     win, cli = med(r["window"]), med(r["cli"])
+    wc = [1e3 * med([c[i] for c in r["wcpu"]]) for i in range(3)]
+    cc = [1e3 * med([c[i] for c in r["ccpu"]]) for i in range(2)]
     return [
         [
             "window's stepper child after the hand-over: steps computed per second",
@@ -323,7 +343,10 @@ def fig_window(scan: Path, rounds: int) -> list[list[str]]:
             f"{len(r['window'])} spans of 10 s each; window {span(r['window'], 'steps/s')}, "
             f"CLI {span(r['cli'], 'steps/s')}; the child's hand-over at step "
             f"{r['handover']}, its helper's solve "
-            f"{r['helper_solve_ms']['cholespy (helper)']:.0f} ms",
+            f"{r['helper_solve_ms']['cholespy (helper)']:.0f} ms; CPU per step: window "
+            f"child {wc[0]:.0f} + its helper {wc[1]:.0f} + window side {wc[2]:.0f} ms, CLI "
+            f"{cc[0]:.0f} + its helper {cc[1]:.0f} ms (the larger share of each is the step "
+            "rate's bound on two idle cores)",
         ]
     ]
 
