@@ -80,6 +80,22 @@ def test_closing_a_helper_while_it_factorizes_ends_it_at_once():
         helper.submit(np.zeros((n, 3)))
 
 
+def test_helper_never_imports_a_module_from_the_working_folder(tmp_path, monkeypatch):
+    """A folder named ``meshlap_core`` where the command runs is not imported by the helper
+    (``python -P``): it starts and factorizes as anywhere else."""
+    fake = tmp_path / "meshlap_core"
+    (fake / "linalg").mkdir(parents=True)
+    (fake / "__init__.py").write_text("raise SystemExit(3)\n")
+    (fake / "linalg" / "__init__.py").write_text("")
+    (fake / "linalg" / "remote_cholesky.py").write_text("raise SystemExit(3)\n")
+    monkeypatch.chdir(tmp_path)
+    helper = RemoteCholesky(sp.identity(4, format="csr") * 2.0, 3)
+    try:
+        assert helper.wait_ready(60), helper.error
+    finally:
+        helper.close()
+
+
 # ---------------------------------------------------------------------- the choice
 def test_plan_hand_computed_choices():
     assert IS.plan("cholmod", 700_000, None)[0] is True  # open-ended: hand over

@@ -11,10 +11,11 @@ three columns cost more than they save; ``benchmarks/bench_scan_smoothing.py``),
 CHOLMOD on OpenBLAS factorizes 2–3× faster. So a caller answers its first solves from
 CHOLMOD and hands the rest over to this one (:mod:`meshlap_core.smoothing.implicit_solver`).
 
-The helper is ``python -m meshlap_core.linalg.remote_cholesky`` (a fresh interpreter
-importing numpy and cholespy only). Plain data crosses the boundary, never a pickle: the
-matrix's CSR arrays and the right-hand sides live in two anonymous shared-memory files
-(``memfd``) passed as file descriptors; commands and answers are text lines on two pipes::
+The helper is ``python -P -m meshlap_core.linalg.remote_cholesky`` (a fresh interpreter
+importing numpy and cholespy only; ``-P``: nothing from the working folder). Plain data
+crosses the boundary, never a pickle: the matrix's CSR arrays and the right-hand sides live
+in two anonymous shared-memory files (``memfd``) passed as file descriptors; commands and
+answers are text lines on two pipes::
 
     matrix file:  [ data f8 (nnz) | scale f8 (n) | indptr i4 (n+1) | indices i4 (nnz) ]
     vector file:  [ c (n,k) | slot 0 (n,k) | slot 1 (n,k) | work (n,k) ]   all f8
@@ -211,7 +212,9 @@ class RemoteCholesky:
             }
             env = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
             self.process = subprocess.Popen(
-                [sys.executable, "-m", __name__, json.dumps(header)],
+                # -P: the working folder is not put on the path (a folder named like a module
+                # there is never imported instead of meshlap's own)
+                [sys.executable, "-P", "-m", __name__, json.dumps(header)],
                 stdin=subprocess.PIPE,
                 stdout=subprocess.DEVNULL,
                 stderr=subprocess.DEVNULL,
