@@ -213,9 +213,10 @@ class ImplicitSolver:
         ms = rep["solve_ms"]
         first = NAMES.get(self.backend, self.backend)
         if self.direct is None:
+            mine = ms["cholespy (helper)"]
             return (
                 f"cholespy (helper process) since step {self.handover_at}: solve "
-                f"{ms['cholespy (helper)']:.0f} ms"
+                + (f"{mine:.0f} ms" if mine is not None else "(timing)")
                 + (f" vs {first} {ms[self.backend]:.0f} ms" if ms[self.backend] else "")
                 + f" ({first} answered first: factorized in {self.factor_s:.1f} s)"
             )
@@ -295,10 +296,10 @@ class ImplicitSolver:
     def _helper_solve(self, x: FloatArray, token: Any, then: Any) -> FloatArray:
         h = self.helper
         assert h is not None
-        if not (h.pending and token is not None and self._prefetched == token):
+        ahead = h.pending and token is not None and self._prefetched == token
+        if not ahead:  # (a solve started ahead from other positions is dropped)
             h.discard()
             h.submit(x / self._d[:, None], add=self.r is not None)
-        ahead = self._prefetched is not None
         self._prefetched = None
         z = h.result()
         # a solve started ahead ran partly before this call: counted whole in the step's time
