@@ -165,8 +165,9 @@ class RemoteCholesky:
         scale: FloatArray | None = None,
     ) -> None:
         A = sp.csr_matrix(A)
-        A.sum_duplicates()
-        A.sort_indices()
+        if not A.has_canonical_format:  # (a copy: the caller's matrix is never changed)
+            A = A.copy()
+            A.sum_duplicates()
         n, nnz, k = A.shape[0], A.nnz, int(columns)
         self.n, self.k = n, k
         self.factor_s: float | None = None
