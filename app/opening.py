@@ -73,6 +73,33 @@ def open_mesh(viewer: Any, path: Path | None) -> bool:
     return bool(viewer.background) or job.status == "done"
 
 
+def load_now(state: Any, path: Path | None) -> bool:
+    """Load ``path`` (the bundled default when ``None``) in this thread with its curvature
+    fields (the window's first mesh, ``--screenshot``): computed here, before any structure
+    is registered with polyscope, with the mesh's own edge table, the fields' temporaries
+    (about 400 MB at 692k vertices) never sit on top of polyscope's buffers; what they freed
+    goes back to the system (:func:`.heap.release_freed`). A failure is kept in
+    ``state.mesh.error`` (False)."""
+    from meshlap_core.errors import MeshError
+
+    from .heap import release_freed
+    from .state.mesh import read_mesh_with_fields
+
+    curv = state.curv
+    try:
+        loaded, fields = read_mesh_with_fields(path, curv.area, curv.boundary)
+    except MeshError as exc:
+        state.mesh.error = str(exc)
+        return False
+    except OSError as exc:
+        state.mesh.error = f"{path}: {exc.strerror or exc}"
+        return False
+    state.mesh.adopt(loaded)
+    curv.adopt(state.mesh, fields)
+    release_freed()
+    return True
+
+
 def fit_of(display: Any) -> tuple[Any, ...]:
     """What the display positions of a mesh depend on besides its vertices."""
     return (display.scale, *np.asarray(display.centre).tolist(), display.up)

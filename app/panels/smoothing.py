@@ -469,6 +469,8 @@ class SmoothingPanel(Panel):
         )
         if fig["warning"]:
             ui.error(fig["warning"])
+        if fig.get("solver"):
+            ui.text(f"solver: {fig['solver']}")
         mu, g = st.amplification()
         with ui.plot(
             "amplification g(mu) per step", 170, "mu (eigenvalue of L)", "g(mu)", fit_y=False

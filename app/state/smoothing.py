@@ -488,7 +488,8 @@ class SmoothingState:
         return self.smoother.V if self.smoother is not None else self.V_original
 
     def figures(self) -> dict[str, Any]:
-        """Iteration, volume change (or why it is undefined), RMSE against the original."""
+        """Iteration, volume change (or why it is undefined), RMSE against the original, and
+        the solver line (which factorization answers the implicit steps, and why)."""
         s = self.smoother
         if s is None:
             return {}
@@ -500,6 +501,7 @@ class SmoothingState:
             "rmse": last.get("rmse"),
             "warning": s.stability.message(),
             "stable_limit": s.stability.max_stable_lam,
+            "solver": s.solver_line() if s.method == "implicit" else None,
         }
 
     def amplification(self, n: int = 200) -> tuple[FloatArray, FloatArray]:

@@ -12,15 +12,17 @@ from __future__ import annotations
 
 import argparse
 import os
+import threading
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from ..curvature import check_ring_radius, curvature_field
-from ..curvature.estimators import estimate_curvature
 from ..errors import MeshError
 from ..io import check_output_path, load_mesh
 from ..io.atomic import atomic_write
+from ..mesh import Mesh
 from ..options import (
     AREA_KINDS,
     BOUNDARY_RULES,
@@ -109,11 +111,17 @@ def _outputs(args: argparse.Namespace) -> tuple[Path | None, Path | None]:
 
 def run(args: argparse.Namespace) -> int:
     out, dirs = _outputs(args)
-    mesh = load_mesh(args.mesh)
     result = None
     if args.method is None:
         args.method = DEFAULT_CURVATURE_FIELD if args.estimator is None else "H"
-    if args.estimator is not None or args.method not in CURVATURE_METHODS:
+    if args.estimator is None and args.method in CURVATURE_METHODS:
+        if args.radius is not None or dirs is not None:
+            raise MeshError("--radius and --directions need --estimator", "--estimator")
+        mesh, values = load_with_field(args.mesh, args.method, args.area, args.boundary)
+    else:
+        from ..curvature.estimators import estimate_curvature  # (scipy's trees: when asked)
+
+        mesh = load_mesh(args.mesh)
         args.estimator = args.estimator or "cotan"
         if args.method not in PRINCIPAL_FIELDS:
             raise MeshError(
@@ -127,10 +135,6 @@ def run(args: argparse.Namespace) -> int:
                 raise MeshError(exc.problem, "--radius") from None
             raise
         values = result.field(args.method)
-    else:
-        if args.radius is not None or dirs is not None:
-            raise MeshError("--radius and --directions need --estimator", "--estimator")
-        values = curvature_field(mesh.V, mesh.F, args.method, args.area, args.boundary)
     if not np.isfinite(values).all():  # never write or summarize a broken field
         bad = int(np.count_nonzero(~np.isfinite(values)))
         raise MeshError(f"the {args.method} curvature is not finite at {bad} vertices", args.mesh)
@@ -167,6 +171,46 @@ def run(args: argparse.Namespace) -> int:
         if out is not None:
             print(f"wrote {shown(out)}")
     return 0
+
+
+def load_with_field(path: str, method: str, area: str, boundary: str) -> tuple[Mesh, np.ndarray]:
+    """``load_mesh(path)`` and its curvature field ``method``, the field computed in a thread
+    from the parsed arrays while the mesh is validated (the two take about as long: on two
+    cores the command takes the longer of them, not their sum). When the validation
+    changed the geometry (a repair), the field is computed again from the validated mesh.
+
+    Returns
+    -------
+    mesh : Mesh
+    values : (n,) float
+    """
+    work: dict[str, Any] = {}
+
+    def compute(V: np.ndarray, F: np.ndarray) -> None:
+        try:
+            work["values"] = curvature_field(V, F, method, area, boundary)  # type: ignore[arg-type]
+        except Exception:  # e.g. what the validation repairs: computed again below
+            work.pop("values", None)
+
+    def start(V: np.ndarray, F: np.ndarray) -> None:
+        work["VF"] = (V, F)
+        work["thread"] = threading.Thread(target=compute, args=(V, F), daemon=True)
+        work["thread"].start()
+
+    try:
+        mesh = load_mesh(path, on_parsed=start)
+    finally:
+        if "thread" in work:
+            work["thread"].join()
+    V, F = work.get("VF", (None, None))
+    same = V is not None and _same(V, mesh.V) and _same(F, mesh.F)
+    if same and "values" in work:
+        return mesh, work["values"]
+    return mesh, curvature_field(mesh.V, mesh.F, method, area, boundary)  # type: ignore[arg-type]
+
+
+def _same(a: np.ndarray, b: np.ndarray) -> bool:
+    return a is b or (a.shape == b.shape and bool(np.array_equal(a, b)))
 
 
 def _options(args: argparse.Namespace) -> dict[str, object]:

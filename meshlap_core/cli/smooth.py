@@ -143,7 +143,7 @@ def run(args: argparse.Namespace) -> int:
     V, F = mesh.V, mesh.F
     msgs: list[str] = list(getattr(mesh.report, "warnings", []))
     t0 = time.perf_counter()
-    s, caught = _make_smoother(args, V, F, lam, nu, pass_band)
+    s, caught = _make_smoother(args, V, F, lam, nu, pass_band, iters)
     setup_s = time.perf_counter() - t0
     msgs += caught
 
@@ -154,6 +154,8 @@ def run(args: argparse.Namespace) -> int:
     stab = s.stability
     stab_s = time.perf_counter() - t2
 
+    solver = s.solver_report()
+    s.close()  # the helper process of the implicit solves, if any, ends here
     if s.diverged:
         raise MeshError(f"{s.divergence_message()}; nothing written", "--lam")
     out_path = None
@@ -185,6 +187,7 @@ def run(args: argparse.Namespace) -> int:
         "drift_rms": last["drift_rms"],
         "stability": stab.as_dict(),
         "n_factorizations": s.n_factorizations,
+        "solver": solver,
         "timings": {
             "setup_s": setup_s,
             "smoothing_s": run_s,
@@ -210,9 +213,16 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _make_smoother(
-    args: argparse.Namespace, V: Any, F: Any, lam: float, nu: float | None, pass_band: float
+    args: argparse.Namespace,
+    V: Any,
+    F: Any,
+    lam: float,
+    nu: float | None,
+    pass_band: float,
+    iters: int,
 ) -> tuple[Smoother, list[str]]:
-    """The stepper of the command's options and the warnings its construction gave."""
+    """The stepper of the command's options and the warnings its construction gave; the
+    number of steps asked for picks the implicit solver (:meth:`Smoother.solver_report`)."""
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", MeshWarning)
         try:
@@ -229,6 +239,7 @@ def _make_smoother(
                 mass_update=args.mass_update,
                 area=args.area,
                 history_samples=HISTORY_SAMPLES,
+                steps=iters,
             )
         except MeshError as exc:
             raise _cli_error(exc, args.mesh) from None
@@ -341,6 +352,9 @@ def format_smooth(r: dict[str, Any]) -> str:
         + (f" (median {step['median']:.3f} ms/step)" if step else "")
         + f", {r['n_factorizations']} factorization(s)"
     )
+    solver = r["solver"]
+    if solver.get("answering") is not None:
+        lines.append(f"solver      {solver['answering']}: {solver['reason']}")
     hist = r["iterations"]
     if len(hist) > 1:
         lines.append("")

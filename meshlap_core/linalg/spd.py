@@ -40,7 +40,10 @@ factorization wins on scans (9.8 s against 22.5 s at 692k), but its solves for a
 right-hand sides are 2–4× slower (17–24 ms against 4–7 ms at 43k; 0.59 s against 0.19 s at
 692k), and below this size the factorization takes about a second either way, so the live
 smoother's steps decide (measured by ``benchmarks/bench_scale.py`` and ``bench_viewer.py``).
-Those solve times are CHOLMOD's *supernodal* factor's; the heat method's own factors
+Above it, implicit smoothing answers the first step from CHOLMOD's factor and hands the later
+ones to a cholespy factorization of the same system built in a helper process
+(:mod:`meshlap_core.smoothing.implicit_solver`). Those solve times are CHOLMOD's
+*supernodal* factor's; the heat method's own factors
 (:mod:`meshlap_core.diffusion.geodesic`) call CHOLMOD directly and pick its *simplicial*
 mode below 200k vertices (a click at 43k: 12–13 ms against libigl's 13–15 ms)."""
 #: how to get the fast back end (README, "Fast solver")

@@ -63,13 +63,14 @@ from .params import (
     taubin_mu,
 )
 from .stability import (
+    ILL_CONDITIONED,
     Stability,
     amplification_curve,
     most_negative_eigenvalue,
     operator_parts,
     stability,
 )
-from .stepper import ILL_CONDITIONED, DivergenceError, Smoother
+from .stepper import DivergenceError, Smoother
 
 __all__ = [
     "DEFAULT_PASS_BAND",

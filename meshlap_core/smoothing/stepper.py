@@ -19,8 +19,8 @@ import scipy.sparse as sp
 from ..errors import MeshError, MeshWarning, check_cancel
 from ..laplacian import vertex_areas
 from ..linalg.common import ProgressCallback
-from ..linalg.spd import SPDSolver, solver_backend
-from ..metrics import n_boundary_edges, percent_volume_change, signed_volume_unchecked
+from ..linalg.spd import solver_backend
+from ..metrics import n_boundary_edges, signed_volume_unchecked
 from ..noise import bbox_diagonal
 from ..options import (
     AREA_KINDS,
@@ -37,6 +37,8 @@ from ..options import (
 )
 from ..topology import boundary_vertex_mask
 from ..types import FloatArray, IntArray, as_mesh, as_vertices
+from .history import check_history_options, displacement_sums, keep, step_entry
+from .implicit_solver import SOLVER_CHOICES, ImplicitSolver
 from .params import (
     DEFAULT_PASS_BAND,
     check_iters,
@@ -48,14 +50,11 @@ from .stability import (
     Stability,
     diagonal_scale,
     gershgorin_mu_min,
+    ill_conditioning,
     most_negative_eigenvalue,
     operator_parts,
     stability_from_mu,
 )
-
-ILL_CONDITIONED = 1e10
-"""Implicit smoothing warns when ``λ · max_i(−L_ii)`` exceeds this: its solve may then lose
-more than about 7 of 16 digits."""
 
 
 class DivergenceError(MeshError):
@@ -114,6 +113,14 @@ class Smoother:
         ``history_limit``.
     warn : bool
         Emit a :class:`MeshWarning` when an explicit or Taubin ``λ`` is unstable on this mesh.
+    steps : int, optional
+        Steps the caller means to take (``None``: open-ended, e.g. *play*; :meth:`run` says
+        it for its own): on a scan CHOLMOD answers the first implicit step and, for a run
+        long enough, a cholespy factorization built meanwhile in a helper process the later
+        ones (:mod:`~.implicit_solver`; :meth:`solver_report` says which and why).
+    implicit_solver : {"auto", "direct", "handover"}
+        ``auto`` as just said; ``direct``: never a helper; ``handover``: a helper takes over
+        whenever it can start (tests, comparisons).
 
     Attributes
     ----------
@@ -122,7 +129,8 @@ class Smoother:
     history : list of dict
         ``history[k]`` describes the mesh after ``k`` iterations (``history[0]`` the input;
         with ``history_limit`` only the latest iterations are kept, so use ``iteration``):
-        ``iteration``, ``time_ms`` (the step alone), ``step_rms``/``step_max`` (displacement of
+        ``iteration``, ``time_ms`` (the step alone; a solve the helper started ahead, while
+        the caller was busy, is counted whole), ``step_rms``/``step_max`` (displacement of
         this step), ``drift_rms`` (from the input), ``volume`` and ``volume_change_pct`` (both
         ``None`` on open meshes, see :attr:`volume_note`), and ``rmse`` with a reference.
     history_stride : int
@@ -146,7 +154,8 @@ class Smoother:
     volume_note : str or None
         Why the volume is undefined (open mesh), else ``None``.
     n_factorizations : int
-        How many times a linear system was factorized (1 for a frozen implicit smoother).
+        How many times a linear system was factorized (1 for a frozen implicit smoother; the
+        helper's factorization of the same system is not counted).
 
     Notes
     -----
@@ -190,8 +199,12 @@ class Smoother:
         history_limit: int | None = None,
         history_samples: int | None = None,
         warn: bool = True,
+        steps: int | None = None,
+        implicit_solver: str = "auto",
     ) -> None:
         self.V0, self.F = as_mesh(V, F)
+        self.implicit_solver = check_choice(implicit_solver, SOLVER_CHOICES, "implicit_solver")
+        self._planned = None if steps is None else check_iters(steps, "steps")
         self._init_history(history_limit, history_samples)
         self.n = len(self.V0)
         self.method = check_choice(method, SMOOTHING_METHODS, "method")
@@ -219,14 +232,7 @@ class Smoother:
 
     def _init_history(self, limit: int | None, samples: int | None) -> None:
         """Check and store ``history_limit`` / ``history_samples``."""
-        if limit is not None and check_iters(limit, "history_limit", None) < 2:
-            raise MeshError(f"must be at least 2, got {limit}", "history_limit")
-        if samples is not None and check_iters(samples, "history_samples", None) < 4:
-            raise MeshError(f"must be at least 4, got {samples}", "history_samples")
-        if limit is not None and samples is not None:
-            raise MeshError("give history_limit or history_samples, not both", "history_samples")
-        self.history_limit = limit
-        self.history_samples = None if samples is None else int(samples)
+        self.history_limit, self.history_samples = check_history_options(limit, samples)
         self.history_stride = 1
 
     def _init_volume(self, preserve_volume: bool) -> None:
@@ -279,8 +285,9 @@ class Smoother:
         self._stability: Stability | None = None
         self._mu_min: tuple[float, bool] | None = None  # W and K are frozen: kept across λ
         self.n_factorizations = 0
-        self._solver: SPDSolver | None = None
+        self._solver: ImplicitSolver | None = None
         self._solver_key: tuple[float, int] | None = None
+        self._generation = 0  # bumped by reset: a prefetched solve of an older run is stale
         self._rhs_fixed: FloatArray | None = None
         self._explicit_cache: dict[float, sp.csr_matrix] = {}
 
@@ -313,11 +320,37 @@ class Smoother:
 
     def prepare(self) -> None:
         """Do now the one-time work of the next step: the implicit system's factorization
-        (nothing for the explicit and Taubin steppers, or when it is current). A caller that
-        builds the stepper in a job calls it there, so that the first :meth:`step` on the
-        window's thread is as cheap as the others."""
+        (nothing for the explicit and Taubin steppers, or when it is current), and start the
+        helper that will take the solves over (:meth:`solver_report`), if planned. A caller
+        that builds the stepper in a job calls it there, so that the first :meth:`step` on
+        the window's thread is as cheap as the others."""
         if self.method == "implicit" and len(self._free) and not self.diverged:
             self._factorize(self._V)
+            assert self._solver is not None
+            self._solver.warm()  # an open-ended run's helper starts now
+
+    def solver_report(self) -> dict[str, Any]:
+        """Which factorization answers the implicit steps, since which step, and why
+        (:meth:`ImplicitSolver.report`; ``answering`` is ``None`` with no linear system)."""
+        if self._solver is None:
+            why = "not factorized yet" if self.method == "implicit" else "no linear system"
+            return {"answering": None, "reason": why, "handover_iteration": None}
+        return self._solver.report()
+
+    def solver_line(self) -> str:
+        """:meth:`solver_report` in one line (the Smoothing panel's solver line)."""
+        return self._solver.line() if self._solver else self.solver_report()["reason"]
+
+    def wait_handover(self, timeout: float | None = None) -> bool:
+        """Wait until the helper's factorization is ready (tests, benchmarks); False when no
+        helper is at work. The next implicit step is then answered by it."""
+        return self._solver is not None and self._solver.wait_handover(timeout)
+
+    def close(self) -> None:
+        """End the implicit solves' helper process, if any (also while it factorizes)."""
+        if self._solver is not None:
+            self._solver.close()
+            self._solver, self._solver_key = None, None
 
     def set_lam(self, lam: float) -> None:
         """Change ``λ`` (and Taubin's ``ν`` if it was derived from it) without losing the state.
@@ -361,12 +394,13 @@ class Smoother:
         """
         self._V = self.V0.copy()
         self._W = self._W0
+        self._generation = getattr(self, "_generation", 0) + 1
         self.iteration = 0
         self.diverged = False
         self.history_stride = 1
         self.history: list[dict[str, Any]] = []
         if self.track_history:
-            self.history.append(self._metrics(self._V, None, 0.0))
+            self.history.append(self._entry(self._V, None, 0.0))
 
     # ---------------------------------------------------------------- stepping
 
@@ -388,16 +422,31 @@ class Smoother:
         if self.preserve_volume:
             new = self._rescale_volume(new)
         elapsed = time.perf_counter() - t0
-        d0 = new - self.V0
-        drift = math.sqrt(float(np.einsum("ij,ij->", d0, d0)) / max(self.n, 1))
+        if self.method == "implicit" and self._solver is not None:
+            elapsed += self._solver.hidden_s  # a solve the helper started ahead, counted whole
+        start = self._V if self.track_history else None
+        sums = displacement_sums(new, self.V0, start, self.reference)
+        drift = math.sqrt(sums[0] / max(self.n, 1))
         if not drift <= self.divergence_limit:  # also catches NaN and inf
             self.diverged = True
+            if self._solver is not None:
+                self._solver.discard()  # a solve started from the discarded step
             return self.V
         old = self._V
         self._V = new
         self.iteration += 1
+        if self.preserve_volume and self.method == "implicit" and self._solver is not None:
+            # the next step's solve starts in the helper (once it has taken over) while this
+            # step's figures are measured and the caller draws or publishes
+            self._solver.prefetch(new[self._free], (self._generation, self.iteration))
         if self.track_history:
-            self._record(self._metrics(new, old, elapsed, drift))
+            self.history_stride = keep(
+                self.history,
+                self._entry(new, old, elapsed, sums),
+                self.history_limit,
+                self.history_samples,
+                self.history_stride,
+            )
         return self.V
 
     def run(
@@ -422,13 +471,17 @@ class Smoother:
             with :class:`~meshlap_core.errors.Cancelled`, keeping the iterations done.
         """
         n = check_iters(n, "n")
-        for i in range(n):
-            check_cancel(cancel, "smoothing")
-            if progress is not None:
-                progress(i / n, self._progress_message(i, n))
-            self.step()
-            if self.diverged:
-                break
+        planned, self._planned = self._planned, self.iteration + n
+        try:
+            for i in range(n):
+                check_cancel(cancel, "smoothing")
+                if progress is not None:
+                    progress(i / n, self._progress_message(i, n))
+                self.step()
+                if self.diverged:
+                    break
+        finally:
+            self._planned = planned
         if progress is not None:
             progress(1.0, f"smoothing: {self.iteration} iterations")
         return self.V
@@ -484,29 +537,13 @@ class Smoother:
             warnings.warn(MeshWarning(msg), stacklevel=3)
 
     def _warn_if_ill_conditioned(self) -> None:
-        """Warn when ``λ · max_i(−L_ii)`` exceeds :data:`ILL_CONDITIONED`.
-
-        The condition number of ``W⁻¹(W − λK)`` is ``1 + λ|μ_min| ≈ 1 + 2λ max_i(−L_ii)``; the
-        weighted centroid ``Σ W_i x_i``, which an exact implicit step conserves, was measured
-        to drift by about ``2e-17 · λ max(−L_ii)`` relative on spheres (2e-5 at 1e12, 1e-3 at
-        1e14, 20–50 % at 5e15: a silently wrong mesh without this warning).
-        """
-        free = self._free
-        if len(free) == 0:
-            return
-        stiff = float(np.max(-self._K_ff.diagonal() / self._W0[free]))
-        x = self.lam * stiff
-        if x > ILL_CONDITIONED:
-            warnings.warn(
-                MeshWarning(
-                    f"implicit smoothing with lam={self.lam:g} is ill-conditioned on this mesh: "
-                    f"lam times the stiffest vertex's -L_ii = {stiff:.3g} is {x:.3g} > "
-                    f"{ILL_CONDITIONED:.0e}, so the result may carry relative errors of order "
-                    f"{x:.0e} x 1e-16; lam below {ILL_CONDITIONED / stiff:.3g} already collapses "
-                    "the mesh to a point in a few steps"
-                ),
-                stacklevel=3,
-            )
+        """Warn when ``λ · max_i(−L_ii)`` exceeds :data:`~.stability.ILL_CONDITIONED`
+        (:func:`~.stability.ill_conditioning`)."""
+        if len(self._free):
+            stiff = float(np.max(-self._K_ff.diagonal() / self._W0[self._free]))
+            message = ill_conditioning(self.lam, stiff)
+            if message:
+                warnings.warn(MeshWarning(message), stacklevel=3)
 
     def _explicit_operator(self, lam: float) -> sp.csr_matrix:
         """``S = I + λ P W⁻¹K`` (``P`` zeroes pinned rows) for the frozen mass, cached per λ."""
@@ -537,13 +574,13 @@ class Smoother:
         self._factorize(x)
         solver = self._solver
         assert solver is not None
+        token = (self._generation, self.iteration)
+        # the next step starts from this answer unchanged unless the volume is rescaled
+        then = None if self.preserve_volume else (token[0], token[1] + 1)
         if len(self._fixed) == 0:  # nothing pinned: no gathers or scatters
-            return solver.solve(self._W[:, None] * x)
-        rhs = self._W[free][:, None] * x[free]
-        if self._rhs_fixed is not None:
-            rhs = rhs + self._rhs_fixed
+            return solver.solve(x, token, then)
         new = x.copy()
-        new[free] = solver.solve(rhs)
+        new[free] = solver.solve(x[free], token, then)
         return new
 
     def _factorize(self, x: FloatArray) -> None:
@@ -558,8 +595,17 @@ class Smoother:
         A.data *= -self.lam
         A.setdiag(A.diagonal() + Wf)
         spent, self._solver = self._solver, None  # refactorized in place (same pattern)
+        reuse = None
+        if spent is not None:
+            spent.close()  # its helper ends (also in the middle of its factorization)
+            reuse = spent.direct
+        self._rhs_fixed = self.lam * (self._K_fp @ x[self._fixed]) if len(self._fixed) else None
+        steps_left = None if self._planned is None else max(self._planned - self.iteration, 1)
+        choice = "direct" if self._recompute_mass else self.implicit_solver
         try:
-            self._solver = SPDSolver(A, reuse=spent)
+            self._solver = ImplicitSolver(
+                A, Wf, self._rhs_fixed, steps_left=steps_left, choice=choice, reuse=reuse
+            )
         except np.linalg.LinAlgError:
             stiff = float(np.max(-self._K_ff.diagonal() / Wf)) if len(free) else 0.0
             raise MeshError(
@@ -571,7 +617,6 @@ class Smoother:
             ) from None
         self._solver_key = key
         self.n_factorizations += 1
-        self._rhs_fixed = self.lam * (self._K_fp @ x[self._fixed]) if len(self._fixed) else None
 
     def _rescale_volume(self, x: FloatArray) -> FloatArray:
         vol = signed_volume_unchecked(x, self.F, self._FT)
@@ -585,42 +630,21 @@ class Smoother:
         out[free] = c + s * (x[free] - c)
         return out
 
-    def _record(self, entry: dict[str, Any]) -> None:
-        """Append a history entry, keeping the list within ``history_limit``/``history_samples``."""
-        h = self.history
-        if self.history_samples is not None:
-            if len(h) > 1 and h[-1]["iteration"] % self.history_stride:
-                h.pop()  # the previous latest entry is off the sampling grid
-            h.append(entry)
-            if len(h) > self.history_samples:
-                self.history_stride *= 2
-                kept = [e for e in h[:-1] if e["iteration"] % self.history_stride == 0]
-                h[:] = [*kept, h[-1]]
-            return
-        h.append(entry)
-        if self.history_limit is not None and len(h) > self.history_limit:
-            del h[1]  # keep the input's entry and the latest ones
-
-    def _metrics(
-        self, x: FloatArray, old: FloatArray | None, elapsed: float, drift: float = 0.0
+    def _entry(
+        self, x: FloatArray, old: FloatArray | None, elapsed: float, sums: Any = None
     ) -> dict[str, Any]:
-        entry: dict[str, Any] = {"iteration": self.iteration, "time_ms": 1e3 * elapsed}
-        if old is None:
-            entry["step_rms"] = entry["step_max"] = 0.0
-        else:
-            d = x - old
-            d2 = np.einsum("ij,ij->i", d, d)
-            entry["step_rms"] = float(np.sqrt(d2.mean())) if d2.size else 0.0
-            entry["step_max"] = float(np.sqrt(d2.max())) if d2.size else 0.0
-        entry["drift_rms"] = drift  # RMS of x − V0, measured by step()
-        if self.closed and self.volume0 is not None:
-            vol = signed_volume_unchecked(x, self.F, self._FT)
-            entry["volume"] = vol
-            entry["volume_change_pct"] = percent_volume_change(vol, self.volume0)
-        else:
-            entry["volume"] = None
-            entry["volume_change_pct"] = None
-        if self.reference is not None:
-            dr = x - self.reference
-            entry["rmse"] = float(np.sqrt(np.einsum("ij,ij->", dr, dr) / max(self.n, 1)))
-        return entry
+        """The history entry of positions ``x`` (``old``: the step's start; ``sums``: their
+        :func:`~.history.displacement_sums`, when :meth:`step` measured them)."""
+        if sums is None:
+            sums = displacement_sums(x, self.V0, old, self.reference)
+        faces = (self.F, self._FT) if self.closed else None
+        return step_entry(
+            self.iteration,
+            elapsed,
+            x,
+            sums,
+            stepped=old is not None,
+            faces=faces,
+            volume0=self.volume0,
+            reference=self.reference is not None,
+        )

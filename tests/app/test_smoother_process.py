@@ -480,3 +480,22 @@ def test_the_child_makes_the_display_arrays_of_the_view_asked_for(mesh):
         assert np.abs(P - (d.points(remote.V0) + shift)).max() <= 1e-5
     finally:
         remote.close()
+
+
+def test_a_batch_of_steps_shows_the_figures_of_its_last_step_and_the_solver(mesh):
+    """The child measures only the step it shows (an implicit batch); the figures are those
+    of the last step, as the same steps taken here give them; the solver line comes along."""
+    V, F = mesh
+    remote = RemoteSmoother.start(V, F, OPTIONS, reporter())
+    try:
+        local = SmoothingState.build(V, F, OPTIONS)
+        remote.steps(5)
+        local.run(5)
+        last, want = remote.history[-1], local.history[-1]
+        assert last["iteration"] == remote.iteration == want["iteration"] == 5
+        for key in ("step_rms", "drift_rms", "volume", "rmse"):
+            assert last[key] == pytest.approx(want[key], rel=1e-9, abs=1e-14)
+        assert remote.solver_line() == local.solver_line() and remote.solver_line()
+        assert remote.solver_report()["answering"] == local.solver_report()["answering"]
+    finally:
+        remote.close()

@@ -221,3 +221,13 @@ def test_smoothing_an_inside_out_sphere_reports_shrinkage():
             s.step()
         out[flip] = s.history[-1]["volume_change_pct"]
     assert out[True] < 0 and out[True] == pytest.approx(out[False], rel=1e-12)
+
+
+def test_volume_blocks_of_any_size_give_the_same_volume(monkeypatch):
+    """The volume is summed over blocks of faces (cache-sized): any block size, including
+    one that splits the faces unevenly, gives the convex hull's volume."""
+    V, F = icosphere(3)
+    want = ConvexHull(V).volume
+    for size in (1, 7, 8192):
+        monkeypatch.setattr(M, "VOLUME_CHUNK", size)
+        assert M.signed_volume(V, F) == pytest.approx(want, rel=1e-12)
