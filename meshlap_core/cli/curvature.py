@@ -18,7 +18,8 @@ from typing import Any
 
 import numpy as np
 
-from ..curvature import check_ring_radius, curvature_field
+from ..curvature import curvature_field
+from ..curvature.fields import check_ring_radius
 from ..errors import MeshError
 from ..io import check_output_path, load_mesh
 from ..io.atomic import atomic_write

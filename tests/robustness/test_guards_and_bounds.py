@@ -370,7 +370,7 @@ def test_vertex_indices_out_of_range_are_shown_as_typed(sphere, capsys):
 def test_filter_checks_gain_stl_and_taubin_before_the_work(sphere, tmp_path, capsys, monkeypatch):
     from meshlap_core.cli import spectral
 
-    monkeypatch.setattr(spectral, "_compute", lambda *a: pytest.fail("work started"))
+    monkeypatch.setattr(spectral, "compute_basis", lambda *a: pytest.fail("work started"))
     out = str(tmp_path / "f.obj")
     base = ["filter", str(sphere), "--k", "10", "--no-cache"]
     _refused([*base, "--band", "2:5", "--gain", "nan", "--out", out], capsys, "--gain", "finite")
@@ -392,9 +392,10 @@ def test_heat_refuses_flags_of_the_other_method(sphere, capsys):
 def test_animate_refuses_another_panels_options(sphere, tmp_path, capsys):
     pytest.importorskip("polyscope")
     args = ["animate", str(sphere), "--panel", "smoothing", "--out", str(tmp_path / "a.gif")]
-    from meshlap_app.state.animation import animations
+    from meshlap_app.registry import animated
 
-    heat_flag = next(o.flag for o in animations()["diffusion"].options if "heat" in o.flag)
+    options = animated()["diffusion"].animation_declared().options
+    heat_flag = next(o.flag for o in options if "heat" in o.flag)
     value = "0" if heat_flag != "--heat" else None
     argv = [*args, heat_flag] + ([value] if value is not None else [])
     line = _refused(argv, capsys, heat_flag, "--panel diffusion")
