@@ -1,0 +1,747 @@
+"""The Deform panel: click vertices to make handles (geodesic discs), hold a region, drag a
+handle with polyscope's transformation gizmo (translate and rotate) or with the mouse in the
+screen plane, and watch Laplacian coordinates, k-harmonic displacement and ARAP follow, two
+methods side by side with one colour map. State in :mod:`..state.deform`.
+
+The handle set's precomputation (discs, fixed region, each method's factorization) is a job
+(progress and Cancel; the last deformation stays on screen); each move is then one
+back-substitution, or ARAP iterations running frame after frame until they converge. On a mesh
+above :data:`~..state.deform.INLINE_SOLVE_MAX` vertices each solve is a job too.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+from typing import Any
+
+import numpy as np
+import polyscope as ps
+
+from .. import scene
+from ..host import Host
+from ..panel_spec import PanelSpec
+from ..scene import front_view, picked_vertex, side_offset
+from ..setting_widgets import setting_widget
+from ..state.deform import (
+    ARAP_TOLERANCE,
+    INLINE_SOLVE_MAX,
+    QUANTITY,
+    SETTINGS,
+    DeformState,
+    build_set,
+    diagonal,
+    move_matrix,
+    move_of,
+)
+from ..text_numbers import plural
+from .base import ExportItem, Panel
+
+DEFORMED = "deformed"
+COMPARED = "deformed (second method)"
+HANDLES = "deform handles"
+HELD = "deform fixed region"
+GIZMO = "deform gizmo"
+HANDLE_COLOR = (0.9, 0.15, 0.1)
+ACTIVE_COLOR = (1.0, 0.75, 0.0)
+HELD_COLOR = (0.25, 0.3, 0.8)
+DEFORMED_COLOR = (0.82, 0.78, 0.7)
+CLICK_SLOP = 5.0
+"""A press and release this many pixels apart or fewer is a click (more: the camera turned)."""
+DRAG_TIP = (
+    "press on a handle (red) and drag: it moves in the screen plane; press elsewhere and drag: "
+    "the camera turns"
+)
+
+
+class DeformPanel(Panel):
+    """Handles, fixed region, moves; the methods side by side with their numbers."""
+
+    shows_mesh = False  # the deformed copy replaces it
+    framed = (DEFORMED, COMPARED)
+    keys = ("z", "y", "r")
+    shortcuts = (
+        (
+            "mouse",
+            "deform: click a vertex for a handle, shift-click adds one, ctrl-click holds a "
+            "disc; drag a handle (or its gizmo) to move it",
+        ),
+        ("Z / Y", "deform: undo / redo a handle move"),
+        ("R", "deform: every handle back at rest"),
+    )
+
+    def __init__(self, spec: PanelSpec, state: DeformState) -> None:
+        super().__init__(spec, state)
+        self.state: DeformState = state
+        self._building: Any = None  # the setup key of the build job under way
+        self._press: tuple[int, frozenset[str], tuple[float, float]] | None = None
+        self._drag: dict[str, Any] | None = None  # a handle dragged in the screen plane
+        self._gizmo_T: np.ndarray | None = None  # the transform the gizmo was last set to
+        self._gizmo_for: Any = None  # (handle, its move) the gizmo shows
+        self._gesture = False  # a gizmo gesture under way (one undo step)
+        self._turn = 0.0  # the turn slider's last value (degrees)
+
+    # ------------------------------------------------------------------ the scene
+    def animating(self) -> bool:
+        """ARAP iterating, a drag, or solves to show: the window keeps its full rate."""
+        return bool(self.state.due()) or self._drag is not None
+
+    def on_new_mesh(self, host: Host) -> None:
+        host.state.jobs.cancel(self.name)
+        self.state.clear()
+        self.watch.forget()
+        self._building, self._press, self._drag = None, None, None
+        self._end_drag()
+        for name in (DEFORMED, COMPARED, HANDLES, HELD):
+            scene.remove_structure(name)
+        self._remove_gizmo()
+
+    def show(self, host: Host, active: Panel) -> None:
+        mine = active is self
+        for name in (DEFORMED, COMPARED):
+            if ps.has_surface_mesh(name):
+                ps.get_surface_mesh(name).set_enabled(mine)
+        for name in (HANDLES, HELD):
+            if ps.has_point_cloud(name):
+                ps.get_point_cloud(name).set_enabled(mine)
+        if not mine:
+            self._remove_gizmo()
+            self._end_drag()
+            return
+        if not ps.has_surface_mesh(DEFORMED):
+            self.push(host, force=True)
+
+    def _mesh_ok(self, host: Host) -> bool:
+        mesh = host.state.mesh
+        return len(mesh.V) > 0 and len(mesh.F) > 0
+
+    # ------------------------------------------------------------------ builds and solves
+    def sync(self, host: Host) -> None:
+        """Every frame, the view active: build the handle set when it changed (a job), solve
+        the moves, upload what changed."""
+        if host.active() is not self or not self._mesh_ok(host):
+            return
+        st, mesh = self.state, host.state.mesh
+        if st.handles and not st.ready(mesh.version):
+            self.build(host)
+        elif not st.handles and st.built is not None:
+            st.drop()
+        if st.built is not None and st.ready(mesh.version):
+            self.solve(host)
+        self.push(host)
+
+    def build(self, host: Host) -> None:
+        """Build the handle set the settings describe, as a job (the deformation on screen
+        stays until it is done); not restarted while the same build runs."""
+        st, mesh, jobs = self.state, host.state.mesh, host.state.jobs
+        key = st.setup_key(mesh.version)
+        job = jobs.running(self.name)
+        if job is not None and self._building == key:
+            return
+        if st.error and self._building == key:
+            return  # this set failed: said in red until a setting changes
+        V, F, graph = mesh.V, mesh.F, st.graph_for(mesh.version)
+        self._building = key
+        st.error = ""
+
+        def apply(built: Any) -> None:
+            st.adopt(built)
+            self.push(host, force=True)
+            host.request_frame()
+
+        def fail(message: str) -> None:
+            st.error = message
+
+        n = len(st.methods)
+        jobs.start(
+            self.name,
+            f"deformation set-up ({plural(len(st.handles), 'handle')}, {plural(n, 'method')})",
+            lambda reporter: build_set(V, F, key, graph, reporter, reporter.cancel),
+            apply,
+            fail,
+            background=host.background,
+        )
+
+    def solve(self, host: Host) -> None:
+        """Bring each shown method up to the moves: here on a small mesh (one
+        back-substitution, or this frame's ARAP iterations), else as a job (one at a time; the
+        next follows the moves of its time)."""
+        st, jobs = self.state, host.state.jobs
+        due = st.due()
+        if not due:
+            return
+        if len(host.state.mesh.V) <= INLINE_SOLVE_MAX or not host.background:
+            for m in due:
+                st.solve(m)
+            return
+        if jobs.running(self.name) is not None:
+            return
+        m = due[0]
+        b = st.built
+        assert b is not None
+        d, targets, moved = b.deformers[m], st.targets(m), st.moved
+        iters = st.iterations_for(m)
+        if iters == 0:
+            st.solve(m)  # (nothing to compute: marked converged)
+            return
+
+        def apply(result: Any) -> None:
+            if st.built is b:
+                st.adopt_solve(m, moved, *result)
+
+        jobs.start(
+            self.name,
+            f"{m}: solving the move",
+            lambda reporter: st.solve_work(d, targets, iters, ARAP_TOLERANCE),
+            apply,
+            lambda message: setattr(st, "error", message),
+            replace=False,
+            background=True,
+        )
+
+    # ------------------------------------------------------------------ uploads
+    def _offset(self, host: Host) -> np.ndarray:
+        mesh = host.state.mesh
+        return self.watch.cached(
+            "offset",
+            (mesh.version, host.state.display.scale),
+            lambda: side_offset(host.mesh_points(), front_view(mesh.name)),
+        )
+
+    def _positions(self, host: Host, method: str) -> np.ndarray:
+        """Display positions of ``method``'s copy (the rest pose before any build)."""
+        st = self.state
+        shown = st.shown.get(method)
+        P = host.mesh_points() if shown is None else host.state.display.points(shown.positions)
+        if len(st.methods) > 1 and method == st.methods[1]:
+            P = P + self._offset(host)
+        return P
+
+    def push(self, host: Host, force: bool = False) -> None:
+        """Upload the deformed copies, their colour map and the handle / fixed points."""
+        if host.active() is not self or not self._mesh_ok(host):
+            return
+        st, mesh = self.state, host.state.mesh
+        key = (st.version, st.colour, st.methods, mesh.version, st.active)
+        if not self.watch.changed("pushed", *key) and not force:
+            return
+        names = dict(zip(st.methods, (DEFORMED, COMPARED), strict=False))
+        if len(st.methods) < 2:
+            scene.remove_structure(COMPARED)
+        fields = {m: st.field(m) for m in names}
+        top = max([float(np.max(f)) for f in fields.values() if f is not None and len(f)] + [0.0])
+        for m, name in names.items():
+            P = self._positions(host, m)
+            if ps.has_surface_mesh(name) and ps.get_surface_mesh(name).n_vertices() == len(P):
+                sm = ps.get_surface_mesh(name)
+                sm.update_vertex_positions(P)
+            else:
+                scene.remove_structure(name)
+                sm = ps.register_surface_mesh(name, P, mesh.F, smooth_shade=True)
+                sm.set_color(DEFORMED_COLOR)
+                host.request_frame()
+            f = fields[m]
+            if f is None:
+                sm.remove_all_quantities()
+            else:
+                sm.add_scalar_quantity(
+                    QUANTITY[st.colour],
+                    np.nan_to_num(f),
+                    cmap="viridis" if st.colour == "displacement" else "reds",
+                    vminmax=(0.0, top or 1.0),
+                    enabled=True,
+                    onscreen_colorbar_enabled=name == DEFORMED,
+                    onscreen_colorbar_location=scene.COLORBAR_AT,
+                )
+        self._push_points(host)
+
+    def _push_points(self, host: Host) -> None:
+        st = self.state
+        b = st.built
+        if b is None or not len(b.regions.vertices):
+            for name in (HANDLES, HELD):
+                scene.remove_structure(name)
+            return
+        main = st.methods[0]
+        P = self._positions(host, main)
+        radius = 0.004
+        pc = ps.register_point_cloud(HANDLES, P[b.regions.vertices], color=HANDLE_COLOR)
+        pc.set_radius(radius, relative=True)
+        active = np.zeros(len(b.regions.vertices))
+        if 0 <= st.active < len(st.handles) and st.handles[st.active] in b.regions.seeds:
+            seed_index = int(np.searchsorted(b.regions.seeds, st.handles[st.active]))
+            active[b.regions.region == seed_index] = 1.0
+        pc.add_color_quantity(
+            "handle", np.where(active[:, None] > 0, ACTIVE_COLOR, HANDLE_COLOR), enabled=True
+        )
+        if len(b.fixed):
+            held = ps.register_point_cloud(HELD, P[b.fixed], color=HELD_COLOR)
+            held.set_radius(radius * 0.6, relative=True)
+        else:
+            scene.remove_structure(HELD)
+
+    def points(self, host: Host, name: str) -> np.ndarray | None:
+        st = self.state
+        if name == DEFORMED:
+            return self._positions(host, st.methods[0])
+        if name == COMPARED and len(st.methods) > 1:
+            return self._positions(host, st.methods[1])
+        return None
+
+    def captions(self, host: Host) -> dict[str, str]:
+        st = self.state
+        if len(st.methods) < 2:
+            return {}
+        return {DEFORMED: st.methods[0], COMPARED: st.methods[1]}
+
+    def export_items(self, host: Host) -> list[ExportItem]:
+        """Each deformed copy (PLY) with the colour map's values."""
+        st, stem = self.state, host.state.mesh.stem
+        return [
+            (f"{stem}_deform_{m}.ply", np.array(s.positions), host.state.mesh.F, st.field(m))
+            for m, s in st.shown.items()
+        ]
+
+    # ------------------------------------------------------------------ the gizmo
+    def _display(self, host: Host) -> tuple[np.ndarray, float, np.ndarray]:
+        d = host.state.display
+        return np.asarray(d.rotation, dtype=float), float(d.scale), np.asarray(d.centre)
+
+    def _centroid(self, index: int) -> np.ndarray | None:
+        """The rest centroid (mesh coordinates) of handle ``index``'s disc."""
+        b, st = self.state.built, self.state
+        if b is None or not 0 <= index < len(st.handles):
+            return None
+        seed = st.handles[index]
+        hits = np.flatnonzero(b.regions.seeds == seed)
+        if not len(hits):
+            return None
+        V = next(iter(b.deformers.values())).V
+        return V[b.regions.vertices[b.regions.region == hits[0]]].mean(axis=0)
+
+    def gizmo_transform(self, host: Host, index: int) -> np.ndarray | None:
+        """The gizmo's 4×4 transform (display coordinates) showing handle ``index``'s move: its
+        rotation, at the moved centroid."""
+        c = self._centroid(index)
+        if c is None:
+            return None
+        Rd, s, centre = self._display(host)
+        R, t = move_matrix(self.state.moves[index])
+        T = np.eye(4)
+        T[:3, :3] = Rd @ R @ Rd.T
+        T[:3, 3] = Rd @ ((c + t - centre) * s)
+        return T
+
+    def move_from_gizmo(self, host: Host, index: int, T: np.ndarray) -> dict[str, Any] | None:
+        """The move of handle ``index`` a gizmo transform ``T (4,4)`` shows (its rotation part
+        made orthonormal: the gizmo scales nothing, float32 rounds)."""
+        c = self._centroid(index)
+        if c is None:
+            return None
+        Rd, s, centre = self._display(host)
+        U, _, Vt = np.linalg.svd(np.asarray(T, dtype=float)[:3, :3])
+        Rg = U @ Vt
+        if np.linalg.det(Rg) < 0:
+            return None
+        R = Rd.T @ Rg @ Rd
+        moved_centroid = Rd.T @ np.asarray(T, dtype=float)[:3, 3] / s + centre
+        return move_of(R, moved_centroid - c)
+
+    def _remove_gizmo(self) -> None:
+        self._gizmo_T, self._gizmo_for = None, None
+        try:
+            ps.remove_transformation_gizmo(GIZMO)
+        except Exception:  # polyscope raises when it has none of that name
+            pass
+
+    def _gizmo(self) -> Any:
+        try:
+            return ps.get_transformation_gizmo(GIZMO)
+        except Exception:  # none of that name yet
+            g = ps.add_transformation_gizmo(GIZMO)
+            g.set_allow_scaling(False)
+            return g
+
+    def sync_gizmo(self, host: Host, held: bool) -> None:
+        """Read the gizmo (a drag of it moves the active handle: one undo step per gesture)
+        and put it where the active handle's move says (after undo, a drag, the turn)."""
+        st = self.state
+        i = st.active
+        if st.built is None or not 0 <= i < len(st.handles) or self._centroid(i) is None:
+            self._remove_gizmo()
+            return
+        g = self._gizmo()
+        if self._gizmo_T is not None and self._gizmo_for is not None and self._gizmo_for[0] == i:
+            T = np.asarray(g.get_transform(), dtype=float)
+            if not np.allclose(T, self._gizmo_T, atol=1e-6):
+                move = self.move_from_gizmo(host, i, T)
+                if move is not None:
+                    if not self._gesture:
+                        st.checkpoint()
+                        self._gesture = True
+                    st.set_move(i, move)
+                self._gizmo_T, self._gizmo_for = T, (i, st.moves[i])
+        if not held:
+            self._gesture = False
+        if self._gizmo_for != (i, st.moves[i]):
+            T = self.gizmo_transform(host, i)
+            if T is not None:
+                g.set_transform(T)
+                g.set_enabled(True)
+                self._gizmo_T, self._gizmo_for = T, (i, st.moves[i])
+
+    # ------------------------------------------------------------------ mouse
+    def pick(self, host: Host, hit: Any, active: Panel) -> bool:
+        """A press on a deformed copy: on a handle it starts a screen-plane drag; elsewhere
+        it is kept and becomes a click (a handle, shift: one more, ctrl: a fixed disc) if the
+        mouse is released where it was pressed."""
+        if active is not self or hit.structure_name not in (DEFORMED, COMPARED):
+            return False
+        st = self.state
+        method = st.methods[0 if hit.structure_name == DEFORMED else -1]
+        P = self._positions(host, method)
+        idx = picked_vertex(hit, P, host.state.mesh.F)
+        if idx is None:
+            return False
+        io = host.ui.im.GetIO()
+        at = (float(io.MousePos[0]), float(io.MousePos[1]))
+        mods = frozenset(getattr(hit, "modifiers", ()))
+        b = st.built
+        if not mods and b is not None and idx in set(b.regions.vertices.tolist()):
+            seed = int(b.regions.seeds[b.regions.region[np.searchsorted(b.regions.vertices, idx)]])
+            if seed in st.handles:
+                self.start_drag(host, st.handles.index(seed), np.asarray(hit.position), at)
+                return True
+        self._press = (idx, mods, at)
+        return True
+
+    def start_drag(
+        self, host: Host, index: int, anchor: np.ndarray, at: tuple[float, float]
+    ) -> None:
+        """Drag handle ``index`` in the screen plane from the display point ``anchor`` (the
+        camera stays put meanwhile)."""
+        st = self.state
+        st.active = index
+        st.checkpoint()
+        self._drag = {"index": index, "anchor": anchor, "move": dict(st.moves[index]), "at": at}
+        ps.set_do_default_mouse_interaction(False)
+
+    def _end_drag(self) -> None:
+        if self._drag is not None:
+            self._drag = None
+        ps.set_do_default_mouse_interaction(True)
+
+    def screen_point(self, xy: tuple[float, float], anchor: np.ndarray) -> np.ndarray | None:
+        """Where the mouse at window pixel ``xy`` points in the plane through ``anchor``
+        (display coordinates) facing the camera."""
+        cam = ps.get_view_camera_parameters()
+        eye = np.asarray(cam.get_position(), dtype=float)
+        look = np.asarray(cam.get_look_dir(), dtype=float)
+        ray = np.asarray(ps.screen_coords_to_world_ray(xy), dtype=float)
+        denom = float(ray @ look)
+        if not np.all(np.isfinite(ray)) or abs(denom) < 1e-12:
+            return None
+        t = float((anchor - eye) @ look) / denom
+        return eye + t * ray
+
+    def follow_drag(self, host: Host, xy: tuple[float, float]) -> None:
+        """The dragged handle follows the mouse in the screen plane (its turn kept)."""
+        drag = self._drag
+        assert drag is not None
+        p = self.screen_point(xy, drag["anchor"])
+        if p is None:
+            return
+        Rd, s, _ = self._display(host)
+        delta = Rd.T @ (p - drag["anchor"]) / s
+        base = drag["move"]
+        move = {"rotate": list(base["rotate"]), "move": list(np.asarray(base["move"]) + delta)}
+        self.state.set_move(drag["index"], move)
+
+    def handle_mouse(self, host: Host) -> bool:
+        """This frame's mouse: follow a drag, end it, or turn a press released in place into a
+        click. Returns whether the left button is held."""
+        xy, held = host.ui.scene_drag(DRAG_TIP)
+        st = self.state
+        if self._drag is not None:
+            if held:
+                self.follow_drag(host, xy)
+            else:
+                a = self._drag["at"]
+                if math.dist(a, xy) <= CLICK_SLOP and st.moves == st.undo_stack[-1]["moves"]:
+                    st.undo_stack.pop()  # a click on a handle: it is the active one now
+                self._end_drag()
+        elif self._press is not None and not held:
+            vertex, mods, at = self._press
+            self._press = None
+            if math.dist(at, xy) <= CLICK_SLOP:
+                self.click(host, vertex, mods)
+        return held
+
+    def click(self, host: Host, vertex: int, mods: frozenset[str] = frozenset()) -> bool:
+        """A vertex clicked: the handle (shift: one more; ctrl: a fixed disc, again: let go)."""
+        n = len(host.state.mesh.V)
+        if "ctrl" in mods:
+            return self.state.add_fixed(n, vertex)
+        return self.state.select(n, vertex, add="shift" in mods)
+
+    # ------------------------------------------------------------------ keys
+    def on_key(self, host: Host, key: str) -> bool:
+        st = self.state
+        if key == "z":
+            st.undo()
+        elif key == "y":
+            st.redo()
+        elif key == "r":
+            st.reset_moves()
+        else:
+            return False
+        return True
+
+    # ------------------------------------------------------------------ sessions, start
+    def configure(self, host: Host, values: dict[str, Any]) -> None:
+        super().configure(host, values)
+        st = self.state
+        st.active = len(st.handles) - 1
+        st.undo_stack, st.redo_stack = [], []
+        st.drop()
+        st.moved += 1
+
+    def restore(self, host: Host, values: dict[str, Any], active: bool) -> None:
+        self.configure(host, values)
+        if active and st_has(self.state):
+            self.build(host)
+
+    def start(self, host: Host, options: dict[str, Any], shown: bool, screenshot: bool) -> None:
+        """``--deform-method``, ``--deform-compare``, ``--handle-radius``; shown first with
+        ``--vertex``: that vertex is the handle. A headless picture with no handle: the top
+        vertex lifted and turned (ARAP iterated to convergence)."""
+        st = self.state
+        for key, dest in (("method", "deform_method"), ("compare", "deform_compare")):
+            if options.get(dest) is not None:
+                setattr(st, key, options[dest])
+        if options.get("handle_radius") is not None:
+            st.radius = float(options["handle_radius"])
+        if not shown:
+            return
+        mesh = host.state.mesh
+        if options.get("vertex") is not None:
+            st.select(len(mesh.V), int(options["vertex"]))
+        elif screenshot and not st.handles:
+            st.select(len(mesh.V), top_vertex(host))
+            st.set_move(0, demo_move(host))
+        if screenshot and st.handles:
+            self.settle(host)
+
+    def settle(self, host: Host, most: int = 2000) -> None:
+        """Build and solve right here until nothing is due (a headless picture, a test)."""
+        self.build(host)
+        for _ in range(most):
+            if not self.state.due():
+                break
+            self.solve(host)
+        self.push(host, force=True)
+        host.refresh()
+
+    # ------------------------------------------------------------------ widgets
+    def draw(self, host: Host) -> None:
+        ui = host.ui
+        if not ui.header(self.title):
+            return
+        st = self.state
+        host.draw_job(self.name)
+        held = self.handle_mouse(host)
+        self.sync_gizmo(host, held)
+        for key in ("method", "compare"):
+            ch, value = setting_widget(ui, SETTINGS[key], getattr(st, key))
+            if ch:
+                setattr(st, key, SETTINGS[key].checked(value, SETTINGS[key].label))
+        ch, r = setting_widget(ui, SETTINGS["radius"], st.radius)
+        if ch:
+            st.radius = SETTINGS["radius"].checked(SETTINGS["radius"].clamp(r), "handle radius %")
+        ch, region = setting_widget(ui, SETTINGS["fixed_region"], st.fixed_region)
+        if ch:
+            st.fixed_region = SETTINGS["fixed_region"].checked(region, "fixed region")
+        if st.fixed_region == "farthest":
+            ch, share = setting_widget(ui, SETTINGS["fixed_fraction"], st.fixed_fraction)
+            if ch:
+                s = SETTINGS["fixed_fraction"]
+                st.fixed_fraction = s.checked(min(max(share, 0.01), s.hi), s.label)
+        elif st.fixed_region == "clicked" and not st.fixed:
+            ui.note("ctrl-click a vertex to hold a disc around it")
+        if "arap" in st.methods:
+            self.draw_arap_settings(host)
+        ch, colour = setting_widget(ui, SETTINGS["colour"], st.colour)
+        if ch:
+            st.colour = SETTINGS["colour"].checked(colour, "colour")
+        self.draw_handles(host)
+        if st.error:
+            ui.error(st.error)
+        self.draw_numbers(host)
+
+    def draw_arap_settings(self, host: Host) -> None:
+        ui, st = host.ui, self.state
+        ch, energy = setting_widget(ui, SETTINGS["arap_energy"], st.arap_energy)
+        if ch:
+            st.arap_energy = SETTINGS["arap_energy"].checked(energy, "ARAP energy")
+        ch, per = setting_widget(ui, SETTINGS["arap_per_frame"], st.arap_per_frame)
+        if ch:
+            st.arap_per_frame = SETTINGS["arap_per_frame"].clamp(per)
+        ch, most = setting_widget(ui, SETTINGS["arap_max"], st.arap_max)
+        if ch:
+            s = SETTINGS["arap_max"]
+            st.arap_max = s.checked(most, s.label)
+            st.converged = {m: False for m in st.converged}
+
+    def draw_handles(self, host: Host) -> None:
+        """The seeds, the active handle's turn, undo / redo / reset / clear."""
+        ui, st = host.ui, self.state
+        if not st.handles:
+            ui.note("click a vertex to make it a handle (shift-click: one more)")
+        else:
+            held = (
+                f"; fixed: {', '.join(map(str, st.fixed))}" if st.fixed_region == "clicked" else ""
+            )
+            ui.text(f"handles at {', '.join(map(str, st.handles))}{held}")
+        i = st.active
+        if 0 <= i < len(st.handles):
+            deg = st.moves[i]["rotate"][3]
+            ch, turn = ui.slider_float(
+                "turn (deg)",
+                deg,
+                -180.0,
+                180.0,
+                "%.0f",
+                "turn the active handle (yellow) about the view axis through its centroid; the "
+                "gizmo turns about any axis",
+            )
+            if ch:
+                self.turn(host, i, turn)
+        if ui.button("undo", "the last handle move taken back (Z)", ("redo",)):
+            st.undo()
+        ui.same_line()
+        if ui.button("redo", "the move undo took back (Y)"):
+            st.redo()
+        ui.same_line()
+        if ui.button("reset", "every handle back at rest (R)"):
+            st.reset_moves()
+        ui.same_line()
+        if ui.button("clear handles", "no handle, no clicked fixed disc"):
+            st.clear_handles()
+            self._remove_gizmo()
+
+    def turn(self, host: Host, index: int, degrees: float) -> None:
+        """Turn handle ``index`` about the camera's view axis by ``degrees`` (its move kept)."""
+        st = self.state
+        if not math.isfinite(degrees):
+            st.error = "turn: not a number"
+            return
+        degrees = min(max(float(degrees), -180.0), 180.0)
+        Rd, _, _ = self._display(host)
+        look = np.asarray(ps.get_view_camera_parameters().get_look_dir(), dtype=float)
+        axis = Rd.T @ look
+        m = st.moves[index]
+        st.checkpoint()
+        st.set_move(index, {"rotate": [*map(float, axis), degrees], "move": list(m["move"])})
+        st.error = ""
+
+    def draw_numbers(self, host: Host) -> None:
+        """Per method: the energy it minimizes and its value, the system, the timings; ARAP's
+        energy against the iterations."""
+        ui, st = host.ui, self.state
+        if st.built is None:
+            return
+        figs = [st.figures(m) for m in st.methods if m in st.built.deformers]
+        if not figs:
+            return
+        rate = st.update_rate()
+        if rate:
+            ui.text(f"{rate:.1f} updates/s shown")
+        for f in figs:
+            ui.text(f"{f['method']} minimizes {f['minimizes']}")
+        headers = ["", *(f["method"] for f in figs)]
+        tips = ["", *(f["energy_name"] for f in figs)]
+        rows = [
+            ("energy", [f"{f['energy']:.4g}" for f in figs]),
+            ("unknowns", [f"{f['n_unknowns']:,}" for f in figs]),
+            ("nonzeros", [f"{f['nnz']:,}" for f in figs]),
+            ("factorize s", [f"{f['factor_seconds']:.3f}" for f in figs]),
+            ("set-up s", [f"{f['setup_seconds']:.3f}" for f in figs]),
+            ("update ms", [f"{1e3 * f['solve_seconds']:.1f}" for f in figs]),
+            ("handle error", [f"{f['handle_error']:.2g}" for f in figs]),
+        ]
+        with ui.table("deform numbers", headers, tips):
+            for name, cells in rows:
+                ui.row([name, *cells])
+        if st.colour == "rotation error":
+            worst = []
+            for f in figs:
+                e = st.field(f["method"])
+                worst.append(f"{f['method']} {float(np.max(e)) if e is not None else 0.0:.3g}")
+            ui.text("largest rotation error: " + ", ".join(worst))
+        for f in figs:
+            if "energies" not in f:
+                continue
+            state = "converged" if st.converged.get("arap") else "iterating"
+            ui.text(f"ARAP: iteration {f['iteration']} since the last move ({state})")
+            E = np.asarray(f["energies"], dtype=float)
+            if len(E):
+                with ui.plot("ARAP energy", 150, "iteration", "energy", y_log=True) as ok:
+                    if ok:
+                        ui.plot_line("E(x, R)", np.arange(1, len(E) + 1), np.maximum(E, 1e-300))
+
+    # ------------------------------------------------------------------ meshlap animate
+    def frames(self, host: Host, options: dict[str, Any]) -> Iterator[str]:
+        """A drag: each frame moves the handle(s) a step of the way (ARAP iterating
+        ``--arap-per-frame`` times per frame), the deformation following."""
+        st, mesh = self.state, host.state.mesh
+        st.method = options["deform_method"]
+        st.compare = "none"
+        st.radius = float(options["handle_radius"])
+        st.arap_per_frame = int(options["arap_per_frame"])
+        if options.get("drag_session") and st.handles:
+            finals = [dict(m) for m in st.moves]
+        else:
+            v = int(options["drag_vertex"])
+            st.handles, st.moves = [], []
+            st.select(len(mesh.V), v if v >= 0 else top_vertex(host))
+            diag = diagonal(mesh.V)
+            move = [diag * float(x) for x in options["drag_move"]]
+            finals = [{"rotate": list(map(float, options["drag_rotate"])), "move": move}]
+        st.moves = [{"rotate": [0.0, 0.0, 1.0, 0.0], "move": [0.0, 0.0, 0.0]} for _ in finals]
+        st.moved += 1
+        self.settle(host)
+        host.frame(scene.COLORBAR_STRIP)
+        count = int(options["drag_frames"])
+        for k in range(count):
+            t = k / (count - 1)
+            for i, m in enumerate(finals):
+                _, move = move_matrix(m)
+                ax, ay, az, deg = m["rotate"]
+                st.set_move(i, {"rotate": [ax, ay, az, deg * t], "move": list(t * move)})
+            for _ in range(st.arap_per_frame if st.method == "arap" else 1):
+                for method in st.due():
+                    st.solve(method)
+            self.push(host, force=True)
+            f = st.figures(st.method)
+            it = f"   iteration {f['iteration']}" if "iteration" in f else ""
+            yield f"{st.method}: step {k + 1}/{count} of the drag{it}   energy {f['energy']:.3g}"
+
+
+def st_has(st: DeformState) -> bool:
+    """A restored state holds handles (its set is built when its view is shown)."""
+    return bool(st.handles)
+
+
+def top_vertex(host: Host) -> int:
+    """The vertex highest on screen (display y): a handle that lifts the shape visibly."""
+    P = host.mesh_points()
+    return int(np.argmax(P[:, 1])) if len(P) else 0
+
+
+def demo_move(host: Host) -> dict[str, Any]:
+    """A move that shows the methods apart: up on screen by a sixth of the diagonal and a
+    40° turn about the screen's depth axis (mesh coordinates)."""
+    R = np.asarray(host.state.display.rotation, dtype=float)
+    up, depth = R.T @ [0.0, 1.0, 0.0], R.T @ [0.0, 0.0, 1.0]
+    lift = up * diagonal(host.state.mesh.V) / 6.0
+    return {"rotate": [*map(float, depth), 40.0], "move": [*map(float, lift)]}
