@@ -76,6 +76,7 @@ class DeformPanel(Panel):
         self._building: Any = None  # the setup key of the build job under way
         self._press: tuple[int, frozenset[str], tuple[float, float]] | None = None
         self._drag: dict[str, Any] | None = None  # a handle dragged in the screen plane
+        self._gizmo_obj: Any = None  # polyscope's transformation gizmo (while a handle is active)
         self._gizmo_T: np.ndarray | None = None  # the transform the gizmo was last set to
         self._gizmo_for: Any = None  # (handle, its move) the gizmo shows
         self._gesture = False  # a gizmo gesture under way (one undo step)
@@ -135,11 +136,8 @@ class DeformPanel(Panel):
         stays until it is done); not restarted while the same build runs."""
         st, mesh, jobs = self.state, host.state.mesh, host.state.jobs
         key = st.setup_key(mesh.version)
-        job = jobs.running(self.name)
-        if job is not None and self._building == key:
-            return
-        if st.error and self._building == key:
-            return  # this set failed: said in red until a setting changes
+        if self._building == key:
+            return  # under way, or it failed (said in red) or was cancelled: not again
         V, F, graph = mesh.V, mesh.F, st.graph_for(mesh.version)
         self._building = key
         st.error = ""
@@ -349,18 +347,17 @@ class DeformPanel(Panel):
 
     def _remove_gizmo(self) -> None:
         self._gizmo_T, self._gizmo_for = None, None
-        try:
-            ps.remove_transformation_gizmo(GIZMO)
-        except Exception:  # polyscope raises when it has none of that name
-            pass
+        if self._gizmo_obj is not None:
+            self._gizmo_obj.remove()
+            self._gizmo_obj = None
 
     def _gizmo(self) -> Any:
-        try:
-            return ps.get_transformation_gizmo(GIZMO)
-        except Exception:  # none of that name yet
-            g = ps.add_transformation_gizmo(GIZMO)
-            g.set_allow_scaling(False)
-            return g
+        """The one gizmo (made on first use: translation and rotation, no scaling)."""
+        if self._gizmo_obj is None:
+            # each panel its own name (a gizmo outlives a panel that was not shut down)
+            self._gizmo_obj = ps.add_transformation_gizmo(f"{GIZMO} {id(self):x}")
+            self._gizmo_obj.set_allow_scaling(False)
+        return self._gizmo_obj
 
     def sync_gizmo(self, host: Host, held: bool) -> None:
         """Read the gizmo (a drag of it moves the active handle: one undo step per gesture)
@@ -500,6 +497,7 @@ class DeformPanel(Panel):
     # ------------------------------------------------------------------ sessions, start
     def configure(self, host: Host, values: dict[str, Any]) -> None:
         super().configure(host, values)
+        self._building = None
         st = self.state
         st.active = len(st.handles) - 1
         st.undo_stack, st.redo_stack = [], []
@@ -576,6 +574,10 @@ class DeformPanel(Panel):
         self.draw_handles(host)
         if st.error:
             ui.error(st.error)
+        mesh = host.state.mesh
+        idle = host.state.jobs.running(self.name) is None
+        if st.handles and idle and not st.ready(mesh.version) and not st.error:
+            ui.note("set-up cancelled: change a setting (or click a handle) to build again")
         self.draw_numbers(host)
 
     def draw_arap_settings(self, host: Host) -> None:
@@ -707,10 +709,14 @@ class DeformPanel(Panel):
             diag = diagonal(mesh.V)
             move = [diag * float(x) for x in options["drag_move"]]
             finals = [{"rotate": list(map(float, options["drag_rotate"])), "move": move}]
-        st.moves = [{"rotate": [0.0, 0.0, 1.0, 0.0], "move": [0.0, 0.0, 0.0]} for _ in finals]
+        st.moves = [dict(m) for m in finals]  # framed on the last frame's shape
         st.moved += 1
         self.settle(host)
         host.frame(scene.COLORBAR_STRIP)
+        for i in range(len(finals)):
+            st.set_move(i, {"rotate": [0.0, 0.0, 1.0, 0.0], "move": [0.0, 0.0, 0.0]})
+        if "arap" in st.built.deformers if st.built is not None else False:
+            st.built.deformers["arap"].reset()  # the drag starts from the rest pose
         count = int(options["drag_frames"])
         for k in range(count):
             t = k / (count - 1)

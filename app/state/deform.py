@@ -34,6 +34,7 @@ from meshlap_core.deform import (
     grow_handles,
     make_deformer,
     rigid_targets,
+    rotation_error,
     rotation_matrix,
 )
 from meshlap_core.errors import MeshError
@@ -159,7 +160,7 @@ SETTINGS = Settings(
     Choice("compare", "none", choices=COMPARE, label="side by side",
            tooltip="a second method on the same handles, on a copy beside the first",
            view=Flag("--deform-compare", "a second method beside the first")),
-    Number("radius", 2.0, lo=0.0, hi=50.0, slider=(0.0, 10.0), fmt="%.2f",
+    Number("radius", 5.0, lo=0.0, hi=50.0, slider=(0.0, 10.0), fmt="%.2f",
            label="handle radius %",
            tooltip="each clicked vertex grows into a geodesic disc of this radius, in % of "
            "the bounding-box diagonal (0: the vertex alone)",
@@ -191,7 +192,7 @@ SETTINGS = Settings(
            "spokes and rims (libigl's default)"),
     Integer("arap_per_frame", 1, lo=1, hi=100, label="ARAP iterations per frame",
             tooltip="local/global iterations done each frame while ARAP has not converged",
-            animate=Flag("--arap-per-frame", "ARAP iterations per frame")),
+            animate=Flag("--arap-per-frame", "ARAP iterations per frame", default=10)),
     Integer("arap_max", 200, lo=1, hi=100_000, widget="input", label="ARAP iterations per move",
             tooltip="ARAP stops after this many iterations since the handles last moved (or "
             f"once an iteration lowers the energy by less than {ARAP_TOLERANCE:g} of it)"),
@@ -425,6 +426,7 @@ class DeformState:
     redo_stack: list[list[dict[str, Any]]] = field(default_factory=list)
     updates: list[float] = field(default_factory=list)  # perf_counter of recent updates
     _graph: Any = None  # (mesh version, edge graph)
+    _terms: dict[str, Any] = field(default_factory=dict)  # rotation error's terms per method
 
     # ------------------------------------------------------------------ lifetime
     def clear(self) -> None:
@@ -440,6 +442,7 @@ class DeformState:
         self.built = None
         self.shown = {}
         self.solved, self.converged = {}, {}
+        self._terms = {}
         self.error = ""
         self.version += 1
 
@@ -528,6 +531,7 @@ class DeformState:
         self.shown = {m: Shown(d.V.copy()) for m, d in built.deformers.items()}
         self.solved = {m: -1 for m in built.deformers}
         self.converged = {m: False for m in built.deformers}
+        self._terms = {}
         self.error = ""
         self.version += 1
 
@@ -727,9 +731,8 @@ class DeformState:
         U = self.shown[method].positions
         if self.colour == "displacement":
             return np.linalg.norm(U - d.V, axis=1)
-        from meshlap_core.deform import rotation_error
-
-        return rotation_error(d.V, d.F, U)
+        err, self._terms[method] = rotation_error(d.V, d.F, U, terms=self._terms.get(method))
+        return err
 
 
 # ---------------------------------------------------------------- meshlap animate
