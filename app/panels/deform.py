@@ -227,7 +227,10 @@ class DeformPanel(Panel):
         if len(st.methods) < 2:
             scene.remove_structure(COMPARED)
         fields = {m: st.field(m) for m in names}
-        top = max([float(np.max(f)) for f in fields.values() if f is not None and len(f)] + [0.0])
+        # one range for both copies, never below a thousandth of the diagonal (or of a unit
+        # rotation error): the rest pose is one colour, not round-off stretched over the map
+        floor = 1e-3 * (diagonal(mesh.V) if st.colour == "displacement" else 1.0)
+        top = max([float(np.max(f)) for f in fields.values() if f is not None and len(f)] + [floor])
         for m, name in names.items():
             P = self._positions(host, m)
             if ps.has_surface_mesh(name) and ps.get_surface_mesh(name).n_vertices() == len(P):
@@ -246,7 +249,7 @@ class DeformPanel(Panel):
                     QUANTITY[st.colour],
                     np.nan_to_num(f),
                     cmap="viridis" if st.colour == "displacement" else "reds",
-                    vminmax=(0.0, top or 1.0),
+                    vminmax=(0.0, top),
                     enabled=True,
                     onscreen_colorbar_enabled=name == DEFORMED,
                     onscreen_colorbar_location=scene.COLORBAR_AT,
@@ -392,12 +395,10 @@ class DeformPanel(Panel):
         """A press on a deformed copy: on a handle it starts a screen-plane drag; elsewhere
         it is kept and becomes a click (a handle, shift: one more, ctrl: a fixed disc) if the
         mouse is released where it was pressed."""
-        if active is not self or hit.structure_name not in (DEFORMED, COMPARED):
+        if active is not self or hit.structure_name not in (DEFORMED, COMPARED, HANDLES, HELD):
             return False
         st = self.state
-        method = st.methods[0 if hit.structure_name == DEFORMED else -1]
-        P = self._positions(host, method)
-        idx = picked_vertex(hit, P, host.state.mesh.F)
+        idx = self._picked(host, hit)
         if idx is None:
             return False
         io = host.ui.im.GetIO()
@@ -411,6 +412,19 @@ class DeformPanel(Panel):
                 return True
         self._press = (idx, mods, at)
         return True
+
+    def _picked(self, host: Host, hit: Any) -> int | None:
+        """The mesh vertex a pick hit: on a copy, or a handle's or the fixed region's point."""
+        st, b = self.state, self.state.built
+        data = hit.structure_data
+        if hit.structure_name in (HANDLES, HELD):
+            if b is None or "index" not in data:
+                return None
+            points = b.regions.vertices if hit.structure_name == HANDLES else b.fixed
+            i = int(data.get("index", -1))
+            return int(points[i]) if 0 <= i < len(points) else None
+        method = st.methods[0 if hit.structure_name == DEFORMED else -1]
+        return picked_vertex(hit, self._positions(host, method), host.state.mesh.F)
 
     def start_drag(
         self, host: Host, index: int, anchor: np.ndarray, at: tuple[float, float]
