@@ -164,8 +164,8 @@ SETTINGS = Settings(
            label="handle radius %",
            tooltip="each clicked vertex grows into a geodesic disc of this radius, in % of "
            "the bounding-box diagonal (0: the vertex alone)",
-           view=Flag("--handle-radius", "handle disc radius, % of the bounding-box diagonal"),
-           animate=Flag("--handle-radius", "handle disc radius, % of the diagonal")),
+           view=Flag("--handle-radius", "handle disc radius in percent of the box diagonal"),
+           animate=Flag("--handle-radius", "handle disc radius in percent of the diagonal")),
     Choice("fixed_region", "farthest", choices=FIXED_REGIONS, label="fixed region",
            tooltip="farthest: the vertices farthest from every handle; clicked: discs around "
            "ctrl-clicked vertices; none: nothing held (a lone handle then moves its part "
