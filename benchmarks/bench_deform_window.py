@@ -27,7 +27,8 @@ import time
 
 import numpy as np
 from _util import print_table, shared_mesh
-from meshlap_app.state.deform import DeformState, build_set
+from meshlap_app.state.deform import DeformState
+from meshlap_app.state.handle_sets import build_set
 
 from meshlap_core.io import load_mesh
 from meshlap_core.options import DEFORM_METHODS

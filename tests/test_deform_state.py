@@ -8,17 +8,9 @@ import math
 
 import numpy as np
 import pytest
-from meshlap_app.state.deform import (
-    SETTINGS,
-    SPEC,
-    DeformState,
-    build_set,
-    check_section,
-    diagonal,
-    move_matrix,
-    move_of,
-    move_problem,
-)
+from meshlap_app.state.deform import SETTINGS, SPEC, DeformState, check_section
+from meshlap_app.state.handle_sets import build_set
+from meshlap_app.state.moves import diagonal, move_matrix, move_of, move_problem
 
 from meshlap_core import grid
 from meshlap_core.deform import make_deformer, rigid_targets, rotation_matrix
@@ -98,7 +90,7 @@ def test_targets_are_each_disc_rotated_about_its_centroid_then_moved():
     # hand check: the disc's centroid goes exactly by the move
     second = ~first
     c = V[d.handles[second]].mean(axis=0)
-    np.testing.assert_allclose(T[second].mean(axis=0), c + [0.1, 0.2, 0.3], atol=1e-12)
+    np.testing.assert_allclose(T[second].mean(axis=0), c + np.array([0.1, 0.2, 0.3]), atol=1e-12)
 
 
 def test_undo_redo_of_moves_and_reset():

@@ -81,9 +81,9 @@ def drive_panel_deform(viewer, tmp_path=None) -> None:
     assert set(st.built.fixed.tolist()) >= {150}
 
     # the gizmo: moved as a user drags it (translation and a turn), the handle follows
-    gizmo = panel._gizmo_obj
-    assert gizmo is not None
-    T = np.array(gizmo.get_transform())
+    gizmo = panel.gizmo
+    assert gizmo.shown
+    T = gizmo.transform()
     T2 = T.copy()
     T2[:3, 3] += [0.0, 0.2, 0.0]
     c, s = np.cos(np.radians(30)), np.sin(np.radians(30))

@@ -20,21 +20,21 @@ import numpy as np
 import polyscope as ps
 
 from .. import scene
+from ..handle_mouse import HandleMouse
 from ..host import Host
 from ..panel_spec import PanelSpec
-from ..scene import front_view, picked_vertex, side_offset
-from ..setting_widgets import setting_widget
-from ..state.deform import (
-    ARAP_TOLERANCE,
-    INLINE_SOLVE_MAX,
-    QUANTITY,
-    SETTINGS,
-    DeformState,
-    build_set,
-    diagonal,
-    move_matrix,
-    move_of,
+from ..rigid_drag import (
+    Gizmo,
+    display_frame,
+    gizmo_of,
+    move_of_gizmo,
+    view_axis,
 )
+from ..scene import front_view, side_offset
+from ..setting_widgets import setting_widget
+from ..state.deform import ARAP_TOLERANCE, INLINE_SOLVE_MAX, QUANTITY, SETTINGS, DeformState
+from ..state.handle_sets import build_set
+from ..state.moves import diagonal, move_matrix, move_of
 from ..text_numbers import plural
 from .base import ExportItem, Panel
 
@@ -50,15 +50,9 @@ DEFORMED_COLOR = (0.82, 0.78, 0.7)
 SLOW_FIELD_EVERY = 0.5
 """Seconds between two rotation-error maps while the shape moves (each costs an SVD per
 vertex); the map of the shape at rest is always computed."""
-CLICK_SLOP = 5.0
-"""A press and release this many pixels apart or fewer is a click (more: the camera turned)."""
-DRAG_TIP = (
-    "press on a handle (red) and drag: it moves in the screen plane; press elsewhere and drag: "
-    "the camera turns"
-)
 
 
-class DeformPanel(Panel):
+class DeformPanel(HandleMouse, Panel):
     """Handles, fixed region, moves; the methods side by side with their numbers."""
 
     shows_mesh = False  # the deformed copy replaces it
@@ -74,15 +68,16 @@ class DeformPanel(Panel):
         ("R", "deform: every handle back at rest"),
     )
 
+    copies = (DEFORMED, COMPARED)
+    dots = (HANDLES, HELD)
+
     def __init__(self, spec: PanelSpec, state: DeformState) -> None:
         super().__init__(spec, state)
         self.state: DeformState = state
         self._building: Any = None  # the setup key of the build job under way
         self._press: tuple[int, frozenset[str], tuple[float, float]] | None = None
         self._drag: dict[str, Any] | None = None  # a handle dragged in the screen plane
-        self._gizmo_obj: Any = None  # polyscope's transformation gizmo (while a handle is active)
-        self._gizmo_T: np.ndarray | None = None  # the transform the gizmo was last set to
-        self._gizmo_for: Any = None  # (handle, its move) the gizmo shows
+        self.gizmo = Gizmo(GIZMO)  # at the active handle: (index, its move) as its key
         self._gesture = False  # a gizmo gesture under way (one undo step)
         self._kept_fields: Any = None  # (what, when, values) of the last colour map
 
@@ -99,7 +94,7 @@ class DeformPanel(Panel):
         self._end_drag()
         for name in (DEFORMED, COMPARED, HANDLES, HELD):
             scene.remove_structure(name)
-        self._remove_gizmo()
+        self.gizmo.remove()
 
     def show(self, host: Host, active: Panel) -> None:
         mine = active is self
@@ -110,7 +105,7 @@ class DeformPanel(Panel):
             if ps.has_point_cloud(name):
                 ps.get_point_cloud(name).set_enabled(mine)
         if not mine:
-            self._remove_gizmo()
+            self.gizmo.remove()
             self._end_drag()
             return
         if not ps.has_surface_mesh(DEFORMED):
@@ -146,10 +141,9 @@ class DeformPanel(Panel):
         self._building = key
         st.error = ""
 
-        def apply(built: Any) -> None:
+        def apply(built: Any) -> None:  # (the camera stays: the user just clicked there)
             st.adopt(built)
             self.push(host, force=True)
-            host.request_frame()
 
         def fail(message: str) -> None:
             st.error = message
@@ -322,196 +316,36 @@ class DeformPanel(Panel):
         ]
 
     # ------------------------------------------------------------------ the gizmo
-    def _display(self, host: Host) -> tuple[np.ndarray, float, np.ndarray]:
-        d = host.state.display
-        return np.asarray(d.rotation, dtype=float), float(d.scale), np.asarray(d.centre)
-
     def _centroid(self, index: int) -> np.ndarray | None:
         """The rest centroid (mesh coordinates) of handle ``index``'s disc."""
         b, st = self.state.built, self.state
         if b is None or not 0 <= index < len(st.handles):
             return None
-        seed = st.handles[index]
-        hits = np.flatnonzero(b.regions.seeds == seed)
+        hits = np.flatnonzero(b.regions.seeds == st.handles[index])
         if not len(hits):
             return None
         V = next(iter(b.deformers.values())).V
         return V[b.regions.vertices[b.regions.region == hits[0]]].mean(axis=0)
 
-    def gizmo_transform(self, host: Host, index: int) -> np.ndarray | None:
-        """The gizmo's 4×4 transform (display coordinates) showing handle ``index``'s move: its
-        rotation, at the moved centroid."""
-        c = self._centroid(index)
-        if c is None:
-            return None
-        Rd, s, centre = self._display(host)
-        R, t = move_matrix(self.state.moves[index])
-        T = np.eye(4)
-        T[:3, :3] = Rd @ R @ Rd.T
-        T[:3, 3] = Rd @ ((c + t - centre) * s)
-        return T
-
-    def move_from_gizmo(self, host: Host, index: int, T: np.ndarray) -> dict[str, Any] | None:
-        """The move of handle ``index`` a gizmo transform ``T (4,4)`` shows (its rotation part
-        made orthonormal: the gizmo scales nothing, float32 rounds)."""
-        c = self._centroid(index)
-        if c is None:
-            return None
-        Rd, s, centre = self._display(host)
-        U, _, Vt = np.linalg.svd(np.asarray(T, dtype=float)[:3, :3])
-        Rg = U @ Vt
-        if np.linalg.det(Rg) < 0:
-            return None
-        R = Rd.T @ Rg @ Rd
-        moved_centroid = Rd.T @ np.asarray(T, dtype=float)[:3, 3] / s + centre
-        return move_of(R, moved_centroid - c)
-
-    def _remove_gizmo(self) -> None:
-        self._gizmo_T, self._gizmo_for = None, None
-        if self._gizmo_obj is not None:
-            self._gizmo_obj.remove()
-            self._gizmo_obj = None
-
-    def _gizmo(self) -> Any:
-        """The one gizmo (made on first use: translation and rotation, no scaling)."""
-        if self._gizmo_obj is None:
-            # each panel its own name (a gizmo outlives a panel that was not shut down)
-            self._gizmo_obj = ps.add_transformation_gizmo(f"{GIZMO} {id(self):x}")
-            self._gizmo_obj.set_allow_scaling(False)
-        return self._gizmo_obj
-
     def sync_gizmo(self, host: Host, held: bool) -> None:
         """Read the gizmo (a drag of it moves the active handle: one undo step per gesture)
         and put it where the active handle's move says (after undo, a drag, the turn)."""
-        st = self.state
-        i = st.active
-        if st.built is None or not 0 <= i < len(st.handles) or self._centroid(i) is None:
-            self._remove_gizmo()
+        st, g, i = self.state, self.gizmo, self.state.active
+        c = self._centroid(i)
+        if c is None:
+            g.remove()
             return
-        g = self._gizmo()
-        if self._gizmo_T is not None and self._gizmo_for is not None and self._gizmo_for[0] == i:
-            T = np.asarray(g.get_transform(), dtype=float)
-            if not np.allclose(T, self._gizmo_T, atol=1e-6):
-                move = self.move_from_gizmo(host, i, T)
-                if move is not None:
-                    if not self._gesture:
-                        st.checkpoint()
-                        self._gesture = True
-                    st.set_move(i, move)
-                self._gizmo_T, self._gizmo_for = T, (i, st.moves[i])
+        T = g.moved() if g.key is not None and g.key[0] == i else None
+        if T is not None and (rigid := move_of_gizmo(host.state.display, c, T)) is not None:
+            if not self._gesture:
+                st.checkpoint()
+                self._gesture = True
+            st.set_move(i, move_of(*rigid))
+            g.key = (i, st.moves[i])
         if not held:
             self._gesture = False
-        if self._gizmo_for != (i, st.moves[i]):
-            T = self.gizmo_transform(host, i)
-            if T is not None:
-                g.set_transform(T)
-                g.set_enabled(True)
-                self._gizmo_T, self._gizmo_for = T, (i, st.moves[i])
-
-    # ------------------------------------------------------------------ mouse
-    def pick(self, host: Host, hit: Any, active: Panel) -> bool:
-        """A press on a deformed copy: on a handle it starts a screen-plane drag; elsewhere
-        it is kept and becomes a click (a handle, shift: one more, ctrl: a fixed disc) if the
-        mouse is released where it was pressed."""
-        if active is not self or hit.structure_name not in (DEFORMED, COMPARED, HANDLES, HELD):
-            return False
-        st = self.state
-        idx = self._picked(host, hit)
-        if idx is None:
-            return False
-        io = host.ui.im.GetIO()
-        at = (float(io.MousePos[0]), float(io.MousePos[1]))
-        mods = frozenset(getattr(hit, "modifiers", ()))
-        b = st.built
-        if not mods and b is not None and idx in set(b.regions.vertices.tolist()):
-            seed = int(b.regions.seeds[b.regions.region[np.searchsorted(b.regions.vertices, idx)]])
-            if seed in st.handles:
-                self.start_drag(host, st.handles.index(seed), np.asarray(hit.position), at)
-                return True
-        self._press = (idx, mods, at)
-        return True
-
-    def _picked(self, host: Host, hit: Any) -> int | None:
-        """The mesh vertex a pick hit: on a copy, or a handle's or the fixed region's point."""
-        st, b = self.state, self.state.built
-        data = hit.structure_data
-        if hit.structure_name in (HANDLES, HELD):
-            if b is None or "index" not in data:
-                return None
-            points = b.regions.vertices if hit.structure_name == HANDLES else b.fixed
-            i = int(data.get("index", -1))
-            return int(points[i]) if 0 <= i < len(points) else None
-        method = st.methods[0 if hit.structure_name == DEFORMED else -1]
-        return picked_vertex(hit, self._positions(host, method), host.state.mesh.F)
-
-    def start_drag(
-        self, host: Host, index: int, anchor: np.ndarray, at: tuple[float, float]
-    ) -> None:
-        """Drag handle ``index`` in the screen plane from the display point ``anchor`` (the
-        camera stays put meanwhile)."""
-        st = self.state
-        st.active = index
-        st.checkpoint()
-        self._drag = {"index": index, "anchor": anchor, "move": dict(st.moves[index]), "at": at}
-        ps.set_do_default_mouse_interaction(False)
-
-    def _end_drag(self) -> None:
-        if self._drag is not None:
-            self._drag = None
-        ps.set_do_default_mouse_interaction(True)
-
-    def screen_point(self, xy: tuple[float, float], anchor: np.ndarray) -> np.ndarray | None:
-        """Where the mouse at window pixel ``xy`` points in the plane through ``anchor``
-        (display coordinates) facing the camera."""
-        cam = ps.get_view_camera_parameters()
-        eye = np.asarray(cam.get_position(), dtype=float)
-        look = np.asarray(cam.get_look_dir(), dtype=float)
-        ray = np.asarray(ps.screen_coords_to_world_ray(xy), dtype=float)
-        denom = float(ray @ look)
-        if not np.all(np.isfinite(ray)) or abs(denom) < 1e-12:
-            return None
-        t = float((anchor - eye) @ look) / denom
-        return eye + t * ray
-
-    def follow_drag(self, host: Host, xy: tuple[float, float]) -> None:
-        """The dragged handle follows the mouse in the screen plane (its turn kept)."""
-        drag = self._drag
-        assert drag is not None
-        p = self.screen_point(xy, drag["anchor"])
-        if p is None:
-            return
-        Rd, s, _ = self._display(host)
-        delta = Rd.T @ (p - drag["anchor"]) / s
-        base = drag["move"]
-        move = {"rotate": list(base["rotate"]), "move": list(np.asarray(base["move"]) + delta)}
-        self.state.set_move(drag["index"], move)
-
-    def handle_mouse(self, host: Host) -> bool:
-        """This frame's mouse: follow a drag, end it, or turn a press released in place into a
-        click. Returns whether the left button is held."""
-        xy, held = host.ui.scene_drag(DRAG_TIP)
-        st = self.state
-        if self._drag is not None:
-            if held:
-                self.follow_drag(host, xy)
-            else:
-                a = self._drag["at"]
-                if math.dist(a, xy) <= CLICK_SLOP and st.moves == st.undo_stack[-1]["moves"]:
-                    st.undo_stack.pop()  # a click on a handle: it is the active one now
-                self._end_drag()
-        elif self._press is not None and not held:
-            vertex, mods, at = self._press
-            self._press = None
-            if math.dist(at, xy) <= CLICK_SLOP:
-                self.click(host, vertex, mods)
-        return held
-
-    def click(self, host: Host, vertex: int, mods: frozenset[str] = frozenset()) -> bool:
-        """A vertex clicked: the handle (shift: one more; ctrl: a fixed disc, again: let go)."""
-        n = len(host.state.mesh.V)
-        if "ctrl" in mods:
-            return self.state.add_fixed(n, vertex)
-        return self.state.select(n, vertex, add="shift" in mods)
+        if g.key != (i, st.moves[i]):
+            g.place(gizmo_of(host.state.display, c, *move_matrix(st.moves[i])), (i, st.moves[i]))
 
     # ------------------------------------------------------------------ keys
     def on_key(self, host: Host, key: str) -> bool:
@@ -661,7 +495,7 @@ class DeformPanel(Panel):
         ui.same_line()
         if ui.button("clear handles", "no handle, no clicked fixed disc"):
             st.clear_handles()
-            self._remove_gizmo()
+            self.gizmo.remove()
 
     def turn(self, host: Host, index: int, degrees: float) -> None:
         """Turn handle ``index`` about the camera's view axis by ``degrees`` (its move kept)."""
@@ -670,9 +504,8 @@ class DeformPanel(Panel):
             st.error = "turn: not a number"
             return
         degrees = min(max(float(degrees), -180.0), 180.0)
-        Rd, _, _ = self._display(host)
-        look = np.asarray(ps.get_view_camera_parameters().get_look_dir(), dtype=float)
-        axis = Rd.T @ look
+        Rd, _, _ = display_frame(host.state.display)
+        axis = Rd.T @ view_axis()
         m = st.moves[index]
         st.checkpoint()
         st.set_move(index, {"rotate": [*map(float, axis), degrees], "move": list(m["move"])})

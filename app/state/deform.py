@@ -28,34 +28,44 @@ import numpy as np
 from meshlap_core.deform import (
     ArapDeformer,
     Deformer,
-    HandleRegions,
-    edge_graph,
-    farthest_region,
-    grow_handles,
-    make_deformer,
     rigid_targets,
     rotation_error,
-    rotation_matrix,
 )
 from meshlap_core.errors import MeshError
 from meshlap_core.options import ARAP_ENERGIES, DEFAULT_ARAP_ENERGY, DEFORM_METHODS
-from meshlap_core.types import FloatArray, IntArray
+from meshlap_core.types import FloatArray
 
 from ..panel_spec import PanelSpec
 from .animation import Animation, Option
+from .handle_sets import Built
+from .moves import (
+    IDENTITY,
+    MAX_HANDLES,
+    check_moves,
+    check_seeds,
+    diagonal,
+    distinct,
+    identity,
+    move_matrix,
+    move_problem,
+    normal_moves,
+)
 from .settings import (
-    MAX_INT,
     Choice,
     Custom,
     Flag,
     Integer,
     Number,
     Settings,
-    integer_problem,
-    number_problem,
     shown,
 )
 
+ARAP_TOLERANCE = 1e-9
+"""ARAP stops iterating once an iteration lowers the energy by less than this fraction."""
+INLINE_SOLVE_MAX = 120_000
+"""Up to this many vertices a move is solved on the UI thread (at 43k vertices: a harmonic
+update 3.5 ms, biharmonic 13 ms, triharmonic 20–50 ms, an ARAP iteration 32 ms); above, each
+solve is a job and the window keeps drawing (about a second per update at 692k)."""
 COMPARE: tuple[str, ...] = ("none", *DEFORM_METHODS)
 """The second method shown beside the first on the same handles (``none``: one copy)."""
 COLOURS: tuple[str, ...] = ("displacement", "rotation error", "none")
@@ -76,79 +86,6 @@ ENERGY_FORMULA = {
     "arap": "sum_i sum_j w_ij |(x_i - x_j) - R_i (p_i - p_j)|^2 (local rotations R_i)",
 }
 """What each method minimizes, in one line (the core's ``energy_name`` is shown beside it)."""
-MAX_HANDLES = 64
-"""Most handle seeds (and fixed seeds) the panel holds: each is a disc and a gizmo."""
-MAX_MOVE = 1e6
-"""Largest move coordinate a session may hold (in units of the mesh's bounding-box diagonal
-it is checked against the mesh: :func:`check_mesh`)."""
-ARAP_TOLERANCE = 1e-9
-"""ARAP stops iterating once an iteration lowers the energy by less than this fraction."""
-INLINE_SOLVE_MAX = 120_000
-"""Up to this many vertices a move is solved on the UI thread (at 43k vertices: a harmonic
-update 3.5 ms, biharmonic 13 ms, triharmonic 20–50 ms, an ARAP iteration 32 ms); above, each
-solve is a job and the window keeps drawing (about a second per update at 692k)."""
-IDENTITY: dict[str, list[float]] = {"rotate": [0.0, 0.0, 1.0, 0.0], "move": [0.0, 0.0, 0.0]}
-"""A handle not moved."""
-
-
-# ---------------------------------------------------------------- the settings' checks
-def check_seeds(x: Any) -> str | None:
-    """A list of at most :data:`MAX_HANDLES` vertex indices (the session's mesh bounds them
-    further: :func:`check_mesh`)."""
-    if not isinstance(x, list):
-        return f"must be a list of vertices, got {shown(x)}"
-    if len(x) > MAX_HANDLES:
-        return f"holds {len(x)} vertices; at most {MAX_HANDLES}"
-    for v in x:
-        if integer_problem(v, 0, MAX_INT - 1):
-            return f"has {shown(v)}; a seed is a vertex index (an integer >= 0)"
-    return None
-
-
-def distinct(seeds: list[int]) -> list[int]:
-    """The seeds without repeats, in their order."""
-    return [int(v) for v in dict.fromkeys(seeds)]
-
-
-def move_problem(m: Any) -> str | None:
-    """What is wrong with one move ``{"rotate": [ax, ay, az, deg], "move": [dx, dy, dz]}``."""
-    if not (isinstance(m, dict) and set(m) == {"rotate", "move"}):
-        form = '{"rotate": [ax, ay, az, deg], "move": [dx, dy, dz]}'
-        return f"each move must be {form}, got {shown(m)}"
-    rot, mv = m["rotate"], m["move"]
-    if not (isinstance(rot, list) and len(rot) == 4 and isinstance(mv, list) and len(mv) == 3):
-        return "rotate takes 4 numbers (axis and degrees), move 3"
-    for x in (*rot[:3], *mv):
-        if number_problem(x, -MAX_MOVE, MAX_MOVE):
-            return f"has {shown(x)}; coordinates are finite numbers within ±{MAX_MOVE:g}"
-    if number_problem(rot[3], -360.0, 360.0):
-        return f"has the angle {shown(rot[3])}; degrees are -360 to 360"
-    if rot[3] != 0 and not any(float(a) != 0 for a in rot[:3]):
-        return "rotates about the zero axis"
-    return None
-
-
-def check_moves(x: Any) -> str | None:
-    """A list of moves (:func:`move_problem`), one per handle seed (:func:`check_section`)."""
-    if not isinstance(x, list):
-        return f"must be a list of moves, got {shown(x)}"
-    if len(x) > MAX_HANDLES:
-        return f"holds {len(x)} moves; at most {MAX_HANDLES}"
-    for m in x:
-        problem = move_problem(m)
-        if problem:
-            return problem
-    return None
-
-
-def normal_moves(x: list[dict[str, Any]]) -> list[dict[str, Any]]:
-    """Moves as the state keeps them (floats)."""
-    return [
-        {"rotate": [float(a) for a in m["rotate"]], "move": [float(a) for a in m["move"]]}
-        for m in x
-    ]
-
-
 # fmt: off
 SETTINGS = Settings(
     Choice("method", "arap", choices=DEFORM_METHODS, label="method",
@@ -220,7 +157,7 @@ def check_section(values: dict[str, Any], source: Any) -> None:
             f'"deform.moves" holds {len(m)} moves for {len(h)} handle seeds (one each)', source
         )
     if not m:
-        values["moves"] = [_identity() for _ in h]
+        values["moves"] = [identity() for _ in h]
     both = sorted(set(h) & set(values["fixed"]))
     if both:
         raise MeshError(f'"deform.fixed" has {both[0]}, a handle seed too', source)
@@ -254,140 +191,6 @@ def check_start(options: dict[str, Any], state: Any) -> None:
     method, compare = options.get("deform_method"), options.get("deform_compare")
     if compare is not None and compare != "none" and compare == method:
         raise MeshError(f"{compare} is the method itself; pick another", "--deform-compare")
-
-
-def _identity() -> dict[str, list[float]]:
-    return {"rotate": list(IDENTITY["rotate"]), "move": list(IDENTITY["move"])}
-
-
-def diagonal(V: FloatArray) -> float:
-    """The bounding-box diagonal of ``V (n,3)`` (1 for an empty or flat-to-a-point mesh)."""
-    if len(V) == 0:
-        return 1.0
-    V = np.asarray(V, dtype=np.float64)
-    d = float(np.linalg.norm(V.max(axis=0) - V.min(axis=0)))
-    return d if d > 0 and math.isfinite(d) else 1.0
-
-
-# ---------------------------------------------------------------- moves
-def move_matrix(m: dict[str, Any]) -> tuple[FloatArray, FloatArray]:
-    """The rotation ``(3,3)`` and translation ``(3,)`` of one move."""
-    ax, ay, az, deg = m["rotate"]
-    R = np.eye(3) if deg == 0 else rotation_matrix([ax, ay, az], deg)
-    return R, np.asarray(m["move"], dtype=np.float64)
-
-
-def move_of(R: FloatArray, t: FloatArray) -> dict[str, list[float]]:
-    """The move of the rotation ``R (3,3)`` (axis and angle, Rodrigues' formula read back) and
-    translation ``t (3,)``."""
-    R = np.asarray(R, dtype=np.float64)
-    c = min(max((float(np.trace(R)) - 1.0) / 2.0, -1.0), 1.0)
-    theta = math.acos(c)
-    axis = np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
-    s = float(np.linalg.norm(axis))
-    if theta < 1e-12:
-        rot = [0.0, 0.0, 1.0, 0.0]
-    elif s > 1e-9:
-        a = axis / s
-        rot = [float(a[0]), float(a[1]), float(a[2]), math.degrees(theta)]
-    else:  # a half turn: the axis from the symmetric part R + I = 2 a a^T
-        B = (R + np.eye(3)) / 2.0
-        k = int(np.argmax(np.diag(B)))
-        a = B[:, k] / math.sqrt(max(B[k, k], 1e-300))
-        rot = [float(a[0]), float(a[1]), float(a[2]), 180.0]
-    return {"rotate": rot, "move": [float(x) for x in np.asarray(t, dtype=np.float64)]}
-
-
-# ---------------------------------------------------------------- one handle set, built
-@dataclass
-class Built:
-    """What a build job made for one handle set (any thread; adopted on the UI thread).
-
-    Attributes
-    ----------
-    key : tuple
-        What it was built from (:meth:`DeformState.setup_key`).
-    regions : HandleRegions
-        The seeds' discs.
-    fixed : (f,) int
-        The vertices held at rest.
-    deformers : dict
-        method name -> its :class:`~meshlap_core.deform.Deformer`.
-    region_of : dict
-        method name -> ``(h,)`` the seed index of each of that deformer's handles (its order).
-    graph : sparse matrix
-        The mesh's edge graph (kept for the next build).
-    seconds : float
-        The whole build.
-    """
-
-    key: tuple[Any, ...]
-    regions: HandleRegions
-    fixed: IntArray
-    deformers: dict[str, Deformer]
-    region_of: dict[str, IntArray]
-    graph: Any
-    seconds: float
-
-
-def build_set(
-    V: FloatArray,
-    F: IntArray,
-    key: tuple[Any, ...],
-    graph: Any = None,
-    progress: Any = None,
-    cancel: Any = None,
-) -> Built:
-    """Grow the handles, find the fixed region and build each method's deformer (any thread:
-    touches no state; ``progress(fraction, message)`` and ``cancel`` between phases).
-
-    Parameters
-    ----------
-    V : (n,3) float
-    F : (m,3) int
-    key : tuple
-        :meth:`DeformState.setup_key`: ``(mesh version, methods, seeds, radius %, fixed
-        region, fixed seeds, share, ARAP energy)``.
-    """
-    t0 = time.perf_counter()
-    _, methods, seeds, radius, region, fixed_seeds, share, energy = key
-
-    def report(fraction: float, message: str) -> None:
-        if progress is not None:
-            progress(fraction, message)
-
-    report(0.0, "edge graph")
-    if graph is None:
-        graph = edge_graph(V, F)
-    r = radius / 100.0 * diagonal(V)
-    report(0.05, f"growing {len(seeds)} handle disc(s)")
-    regions = grow_handles(V, F, list(seeds), r, graph=graph, cancel=cancel)
-    if region == "farthest":
-        report(0.15, "the farthest region")
-        fixed = farthest_region(V, F, regions.vertices, share, graph=graph)
-    elif region == "clicked" and fixed_seeds:
-        held = grow_handles(V, F, list(fixed_seeds), r, graph=graph, cancel=cancel).vertices
-        fixed = np.setdiff1d(held, regions.vertices).astype(np.int64)
-    else:
-        fixed = np.zeros(0, dtype=np.int64)
-    deformers: dict[str, Deformer] = {}
-    region_of: dict[str, IntArray] = {}
-    share_each = 0.8 / max(len(methods), 1)
-    for k, method in enumerate(methods):
-        lo = 0.2 + k * share_each
-
-        def sub(fraction: float, message: str = "", lo: float = lo, name: str = method) -> None:
-            report(lo + share_each * float(fraction or 0.0), f"{name}: {message}")
-
-        opts = {"energy": energy} if method == "arap" else {}
-        d = make_deformer(
-            method, V, F, regions.vertices, fixed, progress=sub, cancel=cancel, **opts
-        )
-        deformers[method] = d
-        slot = np.searchsorted(regions.vertices, d.handles)
-        region_of[method] = regions.region[slot]
-    report(1.0, "ready")
-    return Built(key, regions, fixed, deformers, region_of, graph, time.perf_counter() - t0)
 
 
 @dataclass
@@ -469,9 +272,9 @@ class DeformState:
         self.checkpoint()
         if add:
             self.handles = [*self.handles, v]
-            self.moves = [*self.moves, _identity()]
+            self.moves = [*self.moves, identity()]
         else:
-            self.handles, self.moves = [v], [_identity()]
+            self.handles, self.moves = [v], [identity()]
         self.fixed = [f for f in self.fixed if f != v]
         self.active = len(self.handles) - 1
         self.moved += 1
@@ -590,7 +393,7 @@ class DeformState:
         """Every handle back at rest (an undo step)."""
         if any(m != IDENTITY for m in self.moves):
             self.checkpoint()
-            self.moves = [_identity() for _ in self.handles]
+            self.moves = [identity() for _ in self.handles]
             self.moved += 1
 
     # ------------------------------------------------------------------ targets, solves
