@@ -548,7 +548,10 @@ class DeformPanel(HandleMouse, Panel):
         for f in figs:
             if "energies" not in f:
                 continue
-            state = "converged" if st.converged.get("arap") else "iterating"
+            state = "iterating"
+            if st.converged.get("arap"):
+                capped = f["iteration"] >= st.arap_max
+                state = f"stopped at the cap of {st.arap_max}" if capped else "converged"
             ui.text(f"ARAP: iteration {f['iteration']} since the last move ({state})")
             E = np.asarray(f["energies"], dtype=float)
             if len(E):
