@@ -123,7 +123,7 @@ def drive_panel_deform(viewer, tmp_path=None) -> None:
     assert panel.captions(viewer) == {"deformed": "arap", "deformed (second method)": "biharmonic"}
     drive(viewer, "colour", "rotation error")
     err = st.field("arap")
-    assert st.colour == "rotation error" and 0 < float(err.max()) < 2  # relative, no unit
+    assert st.colour == "rotation error" and np.isfinite(err).all() and float(err.max()) > 0
     drive(viewer, "colour", "displacement")
     drive(viewer, "handle radius %", 8.0, 99.0)
     settle(viewer)
