@@ -335,3 +335,38 @@ def test_view_screenshot_and_animate_a_drag(tmp_path, python_ok, sphere):
     im.seek(3)
     last = np.asarray(im.convert("RGB")).astype(int)
     assert np.abs(first[:150] - last[:150]).sum(axis=2).astype(bool).mean() > 0.01
+
+
+def test_a_big_mesh_keeps_its_deformers_in_a_child_process(viewer, monkeypatch):
+    """Above the inline size (patched to 0 here) the window builds the handle set in a child
+    process and each move is a job solved there (CHOLMOD holds the GIL: a thread would freeze
+    the window); the shape, energy and rotation-error map are those of a deformer built here,
+    and a new set ends the old child."""
+    import meshlap_app.panels.deform as mod
+
+    monkeypatch.setattr(mod, "INLINE_SOLVE_MAX", 0)
+    viewer.background = True
+    viewer.state.jobs.processes = True
+    V, F = viewer.state.mesh.V, viewer.state.mesh.F
+    st = viewer.panels["deform"].state
+    viewer.set_panel("deform")
+    drive(viewer, "method", "biharmonic")
+    frames(viewer)
+    click(viewer, 12)
+    settle(viewer)
+    b = st.built
+    assert getattr(b, "remote", False) and b.child.alive
+    st.set_move(0, {"rotate": [0.0, 0.0, 1.0, 20.0], "move": [0.0, 0.3, 0.0]})
+    drive(viewer, "colour", "rotation error")
+    settle(viewer)
+    ref = make_deformer("biharmonic", V, F, b.regions.vertices, b.fixed)
+    U = ref.update(st.targets("biharmonic"))
+    np.testing.assert_allclose(st.shown["biharmonic"].positions, U, atol=1e-10)
+    assert st.figures("biharmonic")["energy"] == pytest.approx(ref.energy(), rel=1e-9)
+    np.testing.assert_allclose(st.field("biharmonic"), ref.rotation_error(), atol=1e-10)
+    drive(viewer, "handle radius %", 7.0)  # a new set: the old child ends
+    settle(viewer)
+    assert st.built is not b and not b.child.alive
+    drive(viewer, "colour", "displacement")
+    drive(viewer, "method", "arap")
+    settle(viewer)

@@ -20,8 +20,10 @@ import numpy as np
 import polyscope as ps
 
 from .. import scene
+from ..deformer_process import build_remote
 from ..handle_mouse import HandleMouse
 from ..host import Host
+from ..ipc import NoChildProcess
 from ..panel_spec import PanelSpec
 from ..rigid_drag import (
     Gizmo,
@@ -152,11 +154,30 @@ class DeformPanel(HandleMouse, Panel):
         jobs.start(
             self.name,
             f"deformation set-up ({plural(len(st.handles), 'handle')}, {plural(n, 'method')})",
-            lambda reporter: build_set(V, F, key, graph, reporter, reporter.cancel),
+            self._builder(host, V, F, key, graph),
             apply,
             fail,
             background=host.background,
         )
+
+    def _builder(self, host: Host, V: Any, F: Any, key: Any, graph: Any) -> Any:
+        """The build job's work: above :data:`INLINE_SOLVE_MAX` vertices in the window, in a
+        child process that keeps the deformers (CHOLMOD holds the GIL: a thread would freeze
+        the window); else in the job's thread."""
+
+        def here(reporter: Any) -> Any:
+            return build_set(V, F, key, graph, reporter, reporter.cancel)
+
+        if not (host.background and host.state.jobs.processes and len(V) > INLINE_SOLVE_MAX):
+            return here
+
+        def there(reporter: Any) -> Any:
+            try:
+                return build_remote(V, F, key, reporter)
+            except NoChildProcess:
+                return here(reporter)
+
+        return there
 
     def solve(self, host: Host) -> None:
         """Bring each shown method up to the moves: here on a small mesh (one
@@ -175,7 +196,7 @@ class DeformPanel(HandleMouse, Panel):
         m = due[0]
         b = st.built
         assert b is not None
-        d, targets, moved = b.deformers[m], st.targets(m), st.moved
+        d, targets, moved, colour = b.deformers[m], st.targets(m), st.moved, st.colour
         iters = st.iterations_for(m)
         if iters == 0:
             st.solve(m)  # (nothing to compute: marked converged)
@@ -188,7 +209,7 @@ class DeformPanel(HandleMouse, Panel):
         jobs.start(
             self.name,
             f"{m}: solving the move",
-            lambda reporter: st.solve_work(d, targets, iters, ARAP_TOLERANCE),
+            lambda reporter: st.solve_work(d, targets, iters, ARAP_TOLERANCE, colour),
             apply,
             lambda message: setattr(st, "error", message),
             replace=False,
@@ -437,6 +458,8 @@ class DeformPanel(HandleMouse, Panel):
         ch, colour = setting_widget(ui, SETTINGS["colour"], st.colour)
         if ch:
             st.colour = SETTINGS["colour"].checked(colour, "colour")
+            if getattr(st.built, "remote", False):  # the child computes the map with a solve
+                st.solved = {m: -1 for m in st.solved}
         self.draw_handles(host)
         if st.error:
             ui.error(st.error)

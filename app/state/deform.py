@@ -1,19 +1,12 @@
 """Deform panel state: handles grown from clicked vertices, the region held fixed, each handle's
 rigid move, and the deformers that follow (no polyscope import).
 
-A *handle set* is the clicked seeds grown into geodesic discs of one radius
-(:func:`meshlap_core.deform.grow_handles`) and the fixed region (the vertices farthest from
-every handle, clicked discs, or nothing). For each handle set one deformer per shown method is
-built (:func:`meshlap_core.deform.make_deformer`: the operators and the factorization, the slow
-part, run as a job by the panel: :meth:`DeformState.build` touches no state); every move of a
-handle is then one cheap call (:meth:`DeformState.solve`: one back-substitution, or ARAP
-iterations, :meth:`DeformState.iterate`).
-
-A handle's *move* is a rigid motion of its disc, as ``meshlap deform --rotate --move`` says
-it: rotated about the disc's centroid by ``rotate = [ax, ay, az, degrees]``, then moved by
-``move = [dx, dy, dz]`` (mesh units, mesh axes). The panel's gizmo and screen-plane drag write
-moves; a session saves the seeds, the radius, the fixed region and the moves (so a session
-reopens the same deformation), and the undo history holds whole lists of moves.
+A *handle set* (seeds grown into geodesic discs, the region held, one deformer per shown
+method: :mod:`.handle_sets`) is built once, by a job of the panel; every move of a handle is
+then one cheap call (:meth:`DeformState.solve`: one back-substitution, or ARAP iterations).
+A handle's *move* (:mod:`.moves`) is a rigid motion of its disc, as ``meshlap deform --rotate
+--move`` says it. A session saves the seeds, the radius, the fixed region and the moves (it
+reopens the same deformation); the undo history holds whole lists of moves.
 """
 
 from __future__ import annotations
@@ -37,7 +30,7 @@ from meshlap_core.types import FloatArray
 
 from ..panel_spec import PanelSpec
 from .animation import Animation, Option
-from .handle_sets import Built
+from .handle_sets import Built, close_set
 from .moves import (
     IDENTITY,
     MAX_HANDLES,
@@ -242,6 +235,7 @@ class DeformState:
 
     def drop(self) -> None:
         """Forget the built handle set (the settings, seeds and moves stay)."""
+        close_set(self.built)
         self.built = None
         self.shown = {}
         self.solved, self.converged = {}, {}
@@ -329,8 +323,11 @@ class DeformState:
     def adopt(self, built: Built) -> None:
         """Show a handle set a build made (UI thread): each deformer at its rest pose, the
         moves solved next."""
+        if self.built is not built:
+            close_set(self.built)
         self.built = built
-        self._graph = (built.key[0], built.graph)
+        if built.graph is not None:
+            self._graph = (built.key[0], built.graph)
         self.shown = {m: Shown(d.V.copy()) for m, d in built.deformers.items()}
         self.solved = {m: -1 for m in built.deformers}
         self.converged = {m: False for m in built.deformers}
@@ -429,11 +426,18 @@ class DeformState:
 
     @staticmethod
     def solve_work(
-        deformer: Deformer, targets: FloatArray, iterations: int, tolerance: float
+        deformer: Deformer,
+        targets: FloatArray,
+        iterations: int,
+        tolerance: float,
+        colour: str = "none",
     ) -> tuple[FloatArray, bool, float]:
         """One solve of ``deformer`` for ``targets`` (any thread, the deformer used by nobody
         else meanwhile): a back-substitution, or ``iterations`` ARAP iterations (stopping
         early once converged). Returns ``(positions copy, converged, seconds)``."""
+        remote = getattr(deformer, "solve", None)
+        if remote is not None:  # in a child process (:mod:`meshlap_app.deformer_process`)
+            return remote(targets, iterations, tolerance, colour)
         t0 = time.perf_counter()
         if isinstance(deformer, ArapDeformer):
             rest = deformer.V[deformer.handles]
@@ -456,7 +460,7 @@ class DeformState:
     def iterations_for(self, method: str) -> int:
         """ARAP iterations to do now (this frame's share, within the cap per move)."""
         d = self.built.deformers[method] if self.built is not None else None
-        if not isinstance(d, ArapDeformer):
+        if not getattr(d, "method", "") == "arap":
             return 1
         fresh = self.solved.get(method) != self.moved
         done = 0 if fresh else d.iteration
@@ -473,7 +477,7 @@ class DeformState:
             self.solved[method], self.converged[method] = moved, True
             return False
         U, done, seconds = self.solve_work(
-            b.deformers[method], self.targets(method), iters, ARAP_TOLERANCE
+            b.deformers[method], self.targets(method), iters, ARAP_TOLERANCE, self.colour
         )
         self.adopt_solve(method, moved, U, done, seconds)
         return True
@@ -487,7 +491,7 @@ class DeformState:
         d = self.built.deformers[method] if self.built is not None else None
         self.shown[method] = Shown(U, seconds)
         self.solved[method] = moved
-        capped = isinstance(d, ArapDeformer) and d.iteration >= self.arap_max
+        capped = getattr(d, "method", "") == "arap" and d.iteration >= self.arap_max
         self.converged[method] = done or capped
         now = time.perf_counter()
         self.updates = [t for t in self.updates[-59:] if now - t < 2.0] + [now]
@@ -525,7 +529,7 @@ class DeformState:
             if method in self.shown
             else 0.0,
         }
-        if isinstance(d, ArapDeformer):
+        if getattr(d, "method", "") == "arap":
             out["iteration"] = int(d.iteration)
             out["energies"] = list(d.energies)
         return out
@@ -539,6 +543,8 @@ class DeformState:
         U = self.shown[method].positions
         if self.colour == "displacement":
             return np.linalg.norm(U - d.V, axis=1)
+        if hasattr(d, "remote_field"):  # computed in the child with the positions
+            return d.remote_field[1] if d.remote_field is not None else None
         err, self._terms[method] = rotation_error(d.V, d.F, U, terms=self._terms.get(method))
         return err
 

@@ -116,3 +116,10 @@ def build_set(
         region_of[method] = regions.region[slot]
     report(1.0, "ready")
     return Built(key, regions, fixed, deformers, region_of, graph, time.perf_counter() - t0)
+
+
+def close_set(built: Any) -> None:
+    """End a handle set's child process, if it has one."""
+    close = getattr(built, "close", None)
+    if close is not None:
+        close()
