@@ -296,23 +296,26 @@ class DeformPanel(HandleMouse, Panel):
             for name in (HANDLES, HELD):
                 scene.remove_structure(name)
             return
-        main = st.methods[0]
-        P = self._positions(host, main)
-        radius = 0.004
-        pc = ps.register_point_cloud(HANDLES, P[b.regions.vertices], color=HANDLE_COLOR)
-        pc.set_radius(radius, relative=True)
-        active = np.zeros(len(b.regions.vertices))
-        if 0 <= st.active < len(st.handles) and st.handles[st.active] in b.regions.seeds:
-            seed_index = int(np.searchsorted(b.regions.seeds, st.handles[st.active]))
-            active[b.regions.region == seed_index] = 1.0
-        pc.add_color_quantity(
-            "handle", np.where(active[:, None] > 0, ACTIVE_COLOR, HANDLE_COLOR), enabled=True
-        )
-        if len(b.fixed):
-            held = ps.register_point_cloud(HELD, P[b.fixed], color=HELD_COLOR)
-            held.set_radius(radius * 0.6, relative=True)
-        else:
-            scene.remove_structure(HELD)
+        P = self._positions(host, st.methods[0])
+        # registered (and coloured) once per handle set and active handle; later pushes only
+        # move the points (a disc on a big scan holds thousands)
+        fresh = self.watch.changed("points", id(b), st.active, len(st.methods))
+        for name, rows, rgb, size in ((HANDLES, b.regions.vertices, HANDLE_COLOR, 0.004),
+                                      (HELD, b.fixed, HELD_COLOR, 0.0024)):  # fmt: skip
+            if not len(rows):
+                scene.remove_structure(name)
+            elif fresh or not ps.has_point_cloud(name):
+                ps.register_point_cloud(name, P[rows], color=rgb).set_radius(size, relative=True)
+            else:
+                ps.get_point_cloud(name).update_point_positions(P[rows])
+        if fresh:
+            active = np.zeros(len(b.regions.vertices), dtype=bool)
+            if 0 <= st.active < len(st.handles) and st.handles[st.active] in b.regions.seeds:
+                active[
+                    b.regions.region == np.searchsorted(b.regions.seeds, st.handles[st.active])
+                ] = True
+            colours = np.where(active[:, None], ACTIVE_COLOR, HANDLE_COLOR)
+            ps.get_point_cloud(HANDLES).add_color_quantity("handle", colours, enabled=True)
 
     def points(self, host: Host, name: str) -> np.ndarray | None:
         st = self.state
