@@ -19,6 +19,7 @@ from .state import (
     check,
     curvature,
     curvature_lab,
+    deform,
     diffusion,
     export,
     help,
@@ -39,6 +40,7 @@ REGISTRY: tuple[PanelSpec, ...] = (
     check.SPEC,
     diffusion.SPEC,
     curvature_lab.SPEC,
+    deform.SPEC,
     export.SPEC,
     help.SPEC,
 )

@@ -124,7 +124,7 @@ class UI(FieldErrors, Plots):
             for the scene).
         kind : str
             ``button``, ``checkbox``, ``combo``, ``choose``, ``slider``, ``input``, ``header``,
-            ``key``, ``click`` or ``hover``.
+            ``key``, ``click``, ``hover`` or ``mouse`` (:meth:`scene_drag`).
         tooltip : str
             The widget's tooltip (already shown by the adapter; ``""`` for none).
         current : optional
@@ -140,7 +140,7 @@ class UI(FieldErrors, Plots):
             that replaces it: for a button, header or key whether it was pressed; for a
             checkbox, combo, drop-down, slider or field the new value; for a hover the window
             position ``(x, y)``; for a click ``(x, y)`` followed by the modifier keys held
-            (``"shift"``, ``"ctrl"``, ``"alt"``), if any.
+            (``"shift"``, ``"ctrl"``, ``"alt"``), if any; for a mouse drag ``(x, y, held)``.
         """
         return None
 
@@ -500,6 +500,17 @@ class UI(FieldErrors, Plots):
         held = (bool(io.KeyShift), bool(io.KeyCtrl), bool(io.KeyAlt))
         mods = frozenset(m for m, down in zip(MODIFIERS, held, strict=True) if down)
         return (float(io.MousePos[0]), float(io.MousePos[1])), mods
+
+    def scene_drag(self, tooltip: str = "") -> tuple[tuple[float, float], bool]:
+        """The mouse this frame for a drag that a panel follows in the 3D view: its window
+        position and whether the left button is held (a drag that started on the view goes on
+        over the panel). The hook sees it as the widget ``"scene drag"`` of kind ``mouse``
+        with ``tooltip`` (what the drag does); a scripted ``(x, y, held)`` replaces it."""
+        v = self._record("scene drag", "mouse", tooltip)
+        if v is not None:
+            return (float(v[0]), float(v[1])), bool(v[2])
+        io = self.im.GetIO()
+        return (float(io.MousePos[0]), float(io.MousePos[1])), bool(self.im.IsMouseDown(0))
 
     def hover(self) -> tuple[float, float] | None:
         """Window position of the mouse over the 3D view this frame (``None`` over a panel).

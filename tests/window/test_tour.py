@@ -8,7 +8,8 @@ serves two tests, in this order:
   eigenbasis and drag k, open another mesh and compute its eigenbasis, type λ and press Enter,
   space to play and to pause, a surface and its u slider), export what is shown, the Help pane
   (H), and at 1280×720 a recording of the normal section turning (record, turn, stop: a GIF of
-  several frames). After each step the test checks what a user sees on a screenshot: the
+  several frames), then the Deform view (a handle clicked and dragged: the shape changes on
+  screen; Z undoes it). After each step the test checks what a user sees on a screenshot: the
   subject left of meshlap's panel and not running behind it, the second mesh (side by side,
   reconstruction, smoothed copy) beside it, λ applied on Enter and not before, the export
   message, the window's title naming the mesh shown, and that the process is alive with
@@ -388,6 +389,14 @@ def record_turn(s: Session) -> None:
     s.drawn()  # the section goes on turning after stop: no steady picture to wait for
 
 
+def deform(s: Session) -> None:
+    """The Deform view: a handle clicked and dragged up, the shape read from the screen, Z
+    undoing it (the step lives with the view's own window test)."""
+    from test_window_deform import drag_a_handle
+
+    drag_a_handle(s)
+
+
 TOUR: list[tuple[str, Callable[[Session], None]]] = [
     ("window", opened),
     ("pick_mesh", pick_mesh),
@@ -400,6 +409,7 @@ TOUR: list[tuple[str, Callable[[Session], None]]] = [
     ("export", export),
     ("help", help_pane),
     ("record", record_turn),
+    ("deform", deform),
 ]
 
 
