@@ -392,7 +392,7 @@ def record_turn(s: Session) -> None:
 def deform(s: Session) -> None:
     """The Deform view: a handle clicked and dragged up, the shape read from the screen, Z
     undoing it (the step lives with the view's own window test)."""
-    from test_window_deform import drag_a_handle
+    from tests.support.drivers.deform import drag_a_handle
 
     drag_a_handle(s)
 

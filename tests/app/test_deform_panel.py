@@ -1,176 +1,26 @@
 """The Deform panel through its widgets (ScriptedUI on polyscope's openGL_mock), a handle
 dragged in real pixels (EGL), and ``meshlap view`` / ``meshlap animate`` on it.
-``drive_panel_deform`` is also part of the widget tour of ``tests/test_viewer_widgets.py``
-(every widget driven)."""
+``drive_panel_deform`` (:mod:`tests.support.drivers.deform`) is also part of the widget tour of
+``tests/app/test_viewer_widgets.py`` (every widget driven)."""
 
 from __future__ import annotations
 
 import json
 import time
-from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
 ps = pytest.importorskip("polyscope")
 
-from test_viewer_widgets import drive, frames  # noqa: E402
-
 from meshlap_core.deform import make_deformer  # noqa: E402
+from tests.support.drivers.deform import click, drive_panel_deform, settle  # noqa: E402
+from tests.support.widgets import drive, frames  # noqa: E402
 
 
 @pytest.fixture(scope="module")
 def mock(polyscope_mock):
     return polyscope_mock
-
-
-def settle(viewer) -> None:
-    """Wait for the panel's jobs, then frames until nothing is due (ARAP converged)."""
-    st = viewer.panels["deform"].state
-    t0 = time.monotonic()
-    while viewer.state.jobs.running("deform") is not None or st.due():
-        assert time.monotonic() - t0 < 120, "the deform panel never settled"
-        viewer.state.jobs.wait("deform", 1.0)
-        frames(viewer, 1)
-    frames(viewer, 1)
-
-
-def press(viewer, vertex: int, *held: str, structure: str = "deformed") -> None:
-    """A scripted press on the scene that polyscope's pick answers with ``vertex`` of the
-    deformed copy (the modifier keys ``held``)."""
-    P = viewer.panels["deform"]._positions(viewer, viewer.panels["deform"].state.methods[0])
-    hit = SimpleNamespace(
-        is_hit=True,
-        structure_name=structure,
-        structure_data={"element_type": "vertex", "index": vertex},
-        position=P[vertex],
-    )
-    real = ps.pick
-    ps.pick = lambda screen_coords: hit
-    try:
-        viewer.ui.script("click", (10.0, 10.0, *held))
-        frames(viewer, 1)
-    finally:
-        ps.pick = real
-
-
-def click(viewer, vertex: int, *held: str) -> None:
-    """A press and a release in place: a click (the release is read on the next frame)."""
-    press(viewer, vertex, *held)
-    frames(viewer, 1)
-
-
-def drive_panel_deform(viewer, tmp_path=None) -> None:
-    """Every widget of the Deform panel, with good and bad values."""
-    V, F = viewer.state.mesh.V, viewer.state.mesh.F
-    panel = viewer.panels["deform"]
-    st = panel.state
-    viewer.set_panel("deform")
-    frames(viewer)
-    assert ps.has_surface_mesh("deformed") and not ps.has_surface_mesh("deform handles")
-    click(viewer, 7)
-    settle(viewer)
-    assert st.handles == [7] and st.built is not None and ps.has_point_cloud("deform handles")
-    np.testing.assert_allclose(st.shown["arap"].positions, V, atol=1e-9)  # nothing moved yet
-    click(viewer, 100, "shift")  # one more handle
-    settle(viewer)
-    assert st.handles == [7, 100] and st.active == 1
-    click(viewer, 150, "ctrl")  # a fixed disc: the region becomes "clicked"
-    settle(viewer)
-    assert st.fixed == [150] and st.fixed_region == "clicked"
-    assert set(st.built.fixed.tolist()) >= {150}
-
-    # the gizmo: moved as a user drags it (translation and a turn), the handle follows
-    gizmo = panel.gizmo
-    assert gizmo.shown
-    T = gizmo.transform()
-    T2 = T.copy()
-    T2[:3, 3] += [0.0, 0.2, 0.0]
-    c, s = np.cos(np.radians(30)), np.sin(np.radians(30))
-    T2[:3, :3] = np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]]) @ T[:3, :3]
-    gizmo.set_transform(T2)
-    frames(viewer, 1)
-    m = st.moves[1]
-    assert m["rotate"][3] == pytest.approx(30.0, abs=1e-3)
-    d = viewer.state.display
-    assert np.asarray(m["move"]) @ (d.rotation.T @ [0, 1, 0]) == pytest.approx(0.2 / d.scale)
-    settle(viewer)
-    b = st.built
-    ref = make_deformer("arap", V, F, b.regions.vertices, b.fixed)
-    ref.set_targets(st.targets("arap"))
-    ref.run(b.deformers["arap"].iteration)
-    np.testing.assert_allclose(st.shown["arap"].positions, ref.positions, atol=1e-9)
-    moved = np.array(st.shown["arap"].positions)
-    assert np.abs(moved - V).max() > 0.1
-
-    # a handle dragged with the mouse in the screen plane (the camera stays put)
-    seed = st.handles[0]
-    press(viewer, seed)
-    assert panel._drag is not None and st.active == 0
-    drive(viewer, "scene drag", (10.0, 10.0, True), (60.0, 10.0, True), (60.0, 10.0, False))
-    assert panel._drag is None
-    assert np.linalg.norm(st.moves[0]["move"]) > 0  # moved, along the screen's x
-    settle(viewer)
-    undo_depth = len(st.undo_stack)
-
-    for method in ("laplacian", "harmonic", "biharmonic", "triharmonic", "arap"):
-        drive(viewer, "method", method)
-        settle(viewer)
-        assert st.handles == [7, 100] and method in st.shown  # the handles stay
-    drive(viewer, "side by side", "biharmonic")
-    settle(viewer)
-    assert ps.has_surface_mesh("deformed (second method)")
-    assert panel.captions(viewer) == {"deformed": "arap", "deformed (second method)": "biharmonic"}
-    drive(viewer, "colour", "rotation error")
-    err = st.field("arap")
-    assert st.colour == "rotation error" and np.isfinite(err).all() and float(err.max()) > 0
-    drive(viewer, "colour", "displacement")
-    drive(viewer, "handle radius %", 8.0, 99.0)
-    settle(viewer)
-    assert st.radius == 50.0  # clamped
-    drive(viewer, "handle radius %", 6.0)
-    drive(viewer, "fixed region", "farthest")
-    drive(viewer, "farthest share", 0.2, 0.0)
-    assert st.fixed_fraction == 0.01  # not 0: a region to hold
-    drive(viewer, "farthest share", 0.15)
-    settle(viewer)
-    drive(viewer, "ARAP energy", "spokes-and-rims")
-    drive(viewer, "ARAP iterations per frame", 5, 0)
-    assert st.arap_per_frame == 1  # clamped
-    drive(viewer, "ARAP iterations per move", 50)
-    for bad in (0, -3, "abc"):
-        drive(viewer, "ARAP iterations per move", bad)
-        assert st.arap_max == 50
-    settle(viewer)
-    f = st.figures("arap")
-    assert 0 < f["iteration"] <= 50 and f["n_unknowns"] > 0 and f["factor_seconds"] >= 0
-    table = viewer.ui.tables[("deform", "deform numbers")]
-    assert table.headers == ["", "arap", "biharmonic"]
-    assert table.column("arap")[0] == f"{f['energy']:.4g}"
-    assert "ARAP energy" in viewer.ui.legend_at  # the energy against the iterations, plotted
-    drive(viewer, "turn (deg)", 45.0, float("nan"))
-    assert st.moves[st.active]["rotate"][3] == 45.0
-    assert "turn" in st.error
-    drive(viewer, "turn (deg)", 20.0)
-    assert st.error == ""
-    settle(viewer)
-    before = [dict(m) for m in st.moves]
-    drive(viewer, "undo", True)
-    assert st.moves != before
-    drive(viewer, "redo", True)
-    assert st.moves == before
-    assert len(st.undo_stack) > undo_depth
-    drive(viewer, "key z", True)
-    drive(viewer, "key y", True)
-    assert st.moves == before
-    drive(viewer, "reset", True)
-    settle(viewer)
-    np.testing.assert_allclose(st.shown["arap"].positions, V, atol=1e-6)
-    drive(viewer, "key r", True)
-    drive(viewer, "clear handles", True)
-    frames(viewer, 2)
-    assert st.handles == [] and not ps.has_point_cloud("deform handles")
-    drive(viewer, "side by side", "none")
 
 
 def test_deform_widgets(viewer):
@@ -238,7 +88,7 @@ import polyscope as ps
 from meshlap_app.camera import project_to_screen
 from meshlap_app.state import AppState, MeshState
 from meshlap_app.viewer import Viewer, init_polyscope
-from scripted_ui import ScriptedUI
+from tests.support.scripted_ui import ScriptedUI
 
 mesh = MeshState(); mesh.load(None)
 init_polyscope("openGL3_egl")
