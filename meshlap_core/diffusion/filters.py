@@ -29,13 +29,13 @@ from ..options import FILTER_KINDS, FilterKind, check_choice
 from ..smoothing.params import MAX_ITERS
 from ..spectral.basis import SpectralBasis
 from ..types import FloatArray, as_count, as_field, as_real, real_array
-from .heat import _eigenvalues, _modes
+from .heat import check_eigenvalues, check_modes
 
 
 def low_pass(eigenvalues: FloatArray, keep: int) -> FloatArray:
     """``h = 1`` on the ``keep`` lowest modes (``0 ≤ keep ≤ k``), 0 above (an ideal low-pass),
     ``(k,)``."""
-    lam = _eigenvalues(eigenvalues)
+    lam = check_eigenvalues(eigenvalues)
     h = np.zeros(len(lam))
     h[: as_count(keep, "keep", 0, len(lam))] = 1.0
     return h
@@ -44,7 +44,7 @@ def low_pass(eigenvalues: FloatArray, keep: int) -> FloatArray:
 def band_gain(eigenvalues: FloatArray, lo: int, hi: int, gain: float) -> FloatArray:
     """``h = gain`` on modes ``lo … hi−1`` and 1 elsewhere (band exaggeration for ``gain > 1``,
     attenuation below 1), ``(k,)``; ``0 ≤ lo ≤ hi ≤ k`` and a finite gain, else refused."""
-    lam = _eigenvalues(eigenvalues)
+    lam = check_eigenvalues(eigenvalues)
     a = as_count(lo, "lo", 0, len(lam))
     b = as_count(hi, "hi", a, len(lam))
     h = np.ones(len(lam))
@@ -128,7 +128,7 @@ def transfer(
     [1.0, 1.0, 0.0, 0.0]
     """
     check_choice(kind, FILTER_KINDS, "filter")
-    lam = _eigenvalues(eigenvalues)
+    lam = check_eigenvalues(eigenvalues)
     if kind == "low-pass":
         return low_pass(lam, keep)
     if kind == "band":
@@ -197,7 +197,7 @@ class SpectralFilter:
 
     def __init__(self, basis: SpectralBasis, X: FloatArray | None = None, k: int | None = None):
         self.basis = basis
-        self.k = _modes(basis, k)
+        self.k = check_modes(basis, k)
         X = basis.V if X is None else as_field(X, len(basis.mass), "X")
         self.X = X.reshape(len(X), -1)
         self.U = basis.vectors[:, : self.k]
@@ -279,7 +279,7 @@ def measured_amplification(
     g : (k,) float
         ``NaN`` for modes the signal does not contain (``|c_before| ≤ 1e-12 · max|c_before|``).
     """
-    k = _modes(basis, k)
+    k = check_modes(basis, k)
     n = len(basis.mass)
     Xb = as_field(X_before, n, "X_before").reshape(n, -1)
     Xa = as_field(X_after, n, "X_after").reshape(n, -1)

@@ -178,12 +178,12 @@ def truncation_bound(eigenvalues: FloatArray, t: float, k: int) -> float:
     k : int
         Modes used, ``1 <= k <= k_max``.
     """
-    lam = _eigenvalues(eigenvalues)
+    lam = check_eigenvalues(eigenvalues)
     k = as_count(k, "k", 1, len(lam))
     return float(np.exp(-float(lam[k - 1]) * check_time(t)))
 
 
-def _eigenvalues(eigenvalues: Any) -> FloatArray:
+def check_eigenvalues(eigenvalues: Any) -> FloatArray:
     """Frequencies as a finite real ``(k,)`` array (``k ≥ 1``), named ``eigenvalues``."""
     lam = real_array(eigenvalues, "eigenvalues", "eigenvalues")
     if lam.ndim != 1 or lam.size == 0:
@@ -191,7 +191,7 @@ def _eigenvalues(eigenvalues: Any) -> FloatArray:
     return as_field(lam, len(lam), "eigenvalues", columns=False)
 
 
-def _modes(basis: SpectralBasis, k: Any) -> int:
+def check_modes(basis: SpectralBasis, k: Any) -> int:
     """``k`` (``None``: all) checked against the basis's computed modes."""
     if not isinstance(basis, SpectralBasis):
         raise MeshError(f"must be a SpectralBasis, got {type(basis).__name__}", "basis")
@@ -233,7 +233,7 @@ def heat_spectral(
     (True, 1.0)
     """
     t = check_time(t)
-    k = _modes(basis, k)
+    k = check_modes(basis, k)
     u = as_field(u0, len(basis.mass), "u0", columns=False)
     U = basis.vectors[:, :k]
     lam = basis.eigenvalues[:k]
@@ -257,7 +257,7 @@ def heat_kernel_column(
     -------
     u : (n,) float
     """
-    k = _modes(basis, k)
+    k = check_modes(basis, k)
     s = as_index(source, len(basis.mass), "source")
     U = basis.vectors[:, :k]
     return U @ (np.exp(-basis.eigenvalues[:k] * check_time(t)) * U[s])

@@ -15,7 +15,7 @@ import numpy as np
 from ..errors import MeshError
 from ..spectral.basis import SpectralBasis
 from ..types import FloatArray, as_count, as_field, as_index, real_array
-from .heat import _eigenvalues, _modes
+from .heat import check_eigenvalues, check_modes
 
 MAX_HKS_TIMES = 1000
 """Most times of one signature (columns of ``H``): a plot or a descriptor shows far fewer."""
@@ -24,7 +24,7 @@ MAX_HKS_TIMES = 1000
 def hks_times(eigenvalues: FloatArray, count: int = 16) -> FloatArray:
     """``count`` times log-spaced over ``[4 ln10 / λ_max, 4 ln10 / λ_1]`` (``λ_1`` the first
     non-zero frequency), ``(count,)``."""
-    lam = _eigenvalues(eigenvalues)
+    lam = check_eigenvalues(eigenvalues)
     count = as_count(count, "count", 1, MAX_HKS_TIMES)
     positive = lam[lam > 1e-10 * max(float(lam.max(initial=0.0)), 1e-300)]
     if len(positive) < 2:
@@ -69,7 +69,7 @@ def heat_kernel_signature(
     >>> bool(np.allclose(basis.mass @ hks, trace))
     True
     """
-    k = _modes(basis, k)
+    k = check_modes(basis, k)
     t = np.atleast_1d(real_array(times, "times", "times"))
     if t.ndim != 1 or t.size == 0 or t.size > MAX_HKS_TIMES:
         raise MeshError(
