@@ -21,6 +21,7 @@ from .state import (
     curvature_lab,
     diffusion,
     export,
+    flatten,
     help,
     mesh_info,
     onering,
@@ -39,6 +40,7 @@ REGISTRY: tuple[PanelSpec, ...] = (
     check.SPEC,
     diffusion.SPEC,
     curvature_lab.SPEC,
+    flatten.SPEC,
     export.SPEC,
     help.SPEC,
 )
