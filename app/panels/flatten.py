@@ -7,6 +7,7 @@ ellipse it maps a circle to. The disk's cut and a clicked seam are drawn on the 
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Iterator
 from typing import Any
 
@@ -17,6 +18,7 @@ from meshlap_core.options import FLATTEN_METHOD_BOUNDARIES
 
 from .. import scene
 from ..host import Host
+from ..jobs import in_child
 from ..panel_spec import PanelSpec
 from ..scene import MESH, front_view, picked_vertex
 from ..setting_widgets import setting_widget
@@ -26,9 +28,9 @@ from ..state.flatten import (
     SETTINGS,
     FlattenState,
     MapView,
-    arap_map,
+    Request,
     boundary_for,
-    describe,
+    compute,
     face_of,
     place_row,
 )
@@ -55,6 +57,10 @@ OUTER_COLOR = (0.1, 0.75, 0.3)
 SEAM_COLOR = (0.9, 0.15, 0.15)
 ELLIPSE_COLOR = (0.05, 0.05, 0.05)
 CMAPS = {"angle": "viridis", "area": "coolwarm"}
+PROCESS_ABOVE = 200_000
+"""Above this many vertices the window computes the maps in a child process: CHOLMOD's
+factorizations hold the GIL (up to 6 s measured on the 692k scan from a thread, 0.3 s at
+43k vertices), and the window must keep drawing."""
 LIFT = 2e-3
 """How far (a fraction of the mesh's size) the flipped faces are drawn in front of the faces
 they cover, so that they are not hidden by them."""
@@ -83,7 +89,7 @@ class FlattenPanel(Panel):
     # ------------------------------------------------------------------ the scene
     def animating(self) -> bool:
         """ARAP iterates live: the window keeps its full frame rate."""
-        return self._job is not None and self._job[0] == "arap"
+        return self._job is not None and self._job[1][0] == "arap"
 
     def on_new_mesh(self, host: Host) -> None:
         host.state.jobs.cancel(self.name)
@@ -154,101 +160,66 @@ class FlattenPanel(Panel):
         ]
 
     # ------------------------------------------------------------------ jobs
-    def want(self, host: Host) -> None:
-        """Bring what is shown to what the settings ask for: the disk (a job), then the map
-        (from the cache, or a job); what is on screen stays meanwhile."""
-        st, mesh, jobs = self.state, host.state.mesh, host.state.jobs
+    def want(self, host: Host, run: bool = False) -> None:
+        """Bring what is shown to what the settings ask for: the map from the cache, or as a
+        job (``run``: ARAP's next iterations even when it has a map); what is on screen stays
+        meanwhile."""
+        st, mesh = self.state, host.state.mesh
         if len(mesh.F) == 0:
             return
         disk = st.disk_wanted(mesh.version)
-        running = jobs.running(self.name) is not None
         if st.disk_key != disk:
-            if st.failed != disk and not (running and self._job == ("disk", disk)):
-                self.start_disk(host, disk)
-            return
+            host.state.jobs.cancel(self.name)
+            st.new_disk(disk)
         key = st.key
-        if key in st.maps:
+        if key in st.maps and not run:
             if st.shown is not st.maps[key]:
                 st.shown = st.maps[key]
                 st.version += 1
             return
-        busy = running and self._job is not None and self._job[1:] == (disk, key)
-        if st.failed != (disk, key) and not busy:
-            self.start_map(host)
-
-    def _fail(self, host: Host, key: Any) -> Any:
-        def fail(message: str) -> None:
-            host.state.errors[self.name] = message
-            self.state.failed = key
-
-        return fail
-
-    def start_disk(self, host: Host, key: tuple[Any, ...]) -> None:
-        """The disk of the mesh and the seam as a job; the map asked for follows."""
-        st, mesh = self.state, host.state.mesh
-        V, F, clicks = mesh.V, mesh.F, key[1]
-
-        def apply(flat: Any) -> None:
-            st.adopt_disk(flat, key)
-            self.want(host)
-
-        self._job = ("disk", key)
-        host.state.jobs.start(
-            self.name, "flatten: the disk", lambda r: st.disk_work(V, F, clicks, r), apply,
-            self._fail(host, key), background=host.background,
-        )  # fmt: skip
+        running = host.state.jobs.running(self.name) is not None
+        if running and self._job == (disk, key) and not run:
+            return  # under way
+        if st.failed == (disk, key) and not run:
+            return  # said in red; a change of the settings tries again
+        self.start_map(host)
 
     def start_map(self, host: Host) -> None:
-        """The map the settings ask for as a job (ARAP: :meth:`run_arap`)."""
-        st = self.state
-        method, boundary = st.key
-        if method == "arap":
-            self.run_arap(host)
-            return
-        flat, disk = st.flattener, st.disk_key
-        assert flat is not None
+        """The map the settings ask for as a job: in a child process in the window on a big
+        mesh (:data:`PROCESS_ABOVE`), else with the disk's flattener reused;
+        ARAP's maps shown live as they come (Cancel keeps the last one shown)."""
+        st, mesh, jobs = self.state, host.state.mesh, host.state.jobs
+        req = st.request(mesh.V, mesh.F, mesh.version)
+        key = (req.method, req.boundary)
+        disk = req.disk
+        if jobs.processes and host.background and len(mesh.V) > PROCESS_ABOVE:
+            work = in_child(compute, req)
+        else:
+            flat, arap, lock = st.flattener, st.arap.get(req.boundary), st.lock
+            work = lambda r: compute(req, flat, arap, lock, progress=r)  # noqa: E731
 
-        def apply(view: MapView) -> None:
-            st.adopt_map(view)
+        def apply(result: Any) -> None:
+            st.adopt(result, disk)
             self.push(host)
 
-        self._job = ("map", disk, (method, boundary))
-        host.state.jobs.start(
-            self.name, f"flatten: {MAP_NAMES[method]} map",
-            lambda r: st.map_work(flat, method, boundary, r), apply,
-            self._fail(host, (disk, (method, boundary))), background=host.background,
-        )  # fmt: skip
+        def fail(message: str) -> None:
+            host.state.errors[self.name] = message
+            st.failed = (disk, key)
 
-    def run_arap(self, host: Host) -> None:
-        """``iters`` more ARAP iterations as a job, each new map shown as it comes (the
-        object of the last run continues; Cancel keeps the last map shown)."""
-        st = self.state
-        flat, disk = st.flattener, st.disk_key
-        if flat is None:
-            return
-        boundary = boundary_for("arap", st.boundary)
-        arap = st.arap.get(boundary)
-        before = st.maps.get(("arap", boundary))
-        spent = before.uvmap.seconds if before is not None and arap is not None else 0.0
-        iters = st.iters
-
-        def adopt(result: Any) -> None:
-            st.adopt_arap(result)
-            self.push(host)
-
-        self._job = ("arap", disk, ("arap", boundary))
-        host.state.jobs.start(
-            self.name, f"flatten: ARAP, {iters} iterations",
-            lambda r: st.arap_work(flat, boundary, iters, r, arap, spent), adopt,
-            self._fail(host, (disk, ("arap", boundary))), background=host.background,
-            preview=adopt,
+        title = f"flatten: {MAP_NAMES[req.method]} map" + (
+            f", {req.iters} iterations" if req.method == "arap" else ""
+        )
+        self._job = (disk, key)
+        jobs.start(
+            self.name, title, work, apply, fail, background=host.background,
+            preview=apply if req.method == "arap" else None,
         )  # fmt: skip
 
     def reset_arap(self, host: Host) -> None:
         """Forget ARAP's run on this boundary; it starts again from its start map."""
         st = self.state
         boundary = boundary_for("arap", st.boundary)
-        if self._job is not None and self._job[0] == "arap":
+        if self.animating():
             host.state.jobs.cancel(self.name)
         st.arap.pop(boundary, None)
         st.maps.pop(("arap", boundary), None)
@@ -507,7 +478,7 @@ class FlattenPanel(Panel):
         if ch:
             st.set_iters(n)
         if ui.button("run ARAP", f"{st.iters} more local/global iterations, shown live"):
-            self.run_arap(host)
+            self.want(host, run=True)
         ui.same_line()
         if ui.button("restart ARAP", "forget the iterations: start again from the start map"):
             self.reset_arap(host)
@@ -588,25 +559,26 @@ class FlattenPanel(Panel):
         st, mesh = self.state, host.state.mesh
         boundary = boundary_for("arap", options["map_boundary"])
         st.method, st.boundary, st.checker = "arap", boundary, float(options["checker"])
-        key = st.disk_wanted(mesh.version)
-        if st.disk_key != key:
-            st.adopt_disk(st.disk_work(mesh.V, mesh.F, key[1], lambda *a: None), key)
-        flat = st.flattener
-        assert flat is not None
-        arap = flat.arap(boundary)
-        st.adopt_map(describe(arap_map(flat, arap, boundary, 0.0)))
+        disk = st.disk_wanted(mesh.version)
+        if st.disk_key != disk:
+            st.new_disk(disk)
+        st.arap.pop(boundary, None)
+        st.maps.pop(st.key, None)
+        req = Request(mesh.V, mesh.F, disk, "arap", boundary, iters=0)
+        flat, arap, view, rate = compute(req, st.flattener, None, st.lock)
+        st.adopt((flat, arap, view, rate), disk)
         host.refresh()
         self.push(host, force=True)
         host.frame(scene.COLORBAR_STRIP)
         for it in range(int(options["arap_iters"]) + 1):
             if it:
-                arap.step()
-                st.adopt_map(describe(arap_map(flat, arap, boundary, 0.0)))
+                st.adopt(compute(dataclasses.replace(req, iters=1), flat, arap, st.lock), disk)
                 self.push(host)
-            flips = len(st.shown.flipped) if st.shown is not None else 0
+            view = st.shown
+            assert view is not None
             yield (
                 f"ARAP ({boundary} boundary), iteration {it}: E = {arap.energy:.4g}, "
-                f"{flips} flipped"
+                f"{len(view.flipped)} flipped"
             )
 
 

@@ -5,17 +5,21 @@ histograms and its row of the table), and ARAP stepped live. No polyscope import
 
 The heavy objects are the core's: one :class:`~meshlap_core.flatten.Flattener` per disk (its
 factorizations shared by every map of that disk), one :class:`~meshlap_core.flatten.ARAP` per
-boundary. Work runs as jobs of the panel (:meth:`FlattenState.disk_work`,
-:meth:`FlattenState.map_work`, :meth:`FlattenState.arap_work`: any thread, touching no state);
-their results are adopted on the UI thread.
+boundary. A map is one job of the panel, :func:`compute` of a :class:`Request` (plain data),
+adopted on the UI thread (:meth:`FlattenState.adopt`). On a big scan the window runs the job
+in a child process (CHOLMOD's factorizations hold the GIL for seconds there: from a thread
+they froze the window); the flattener then stays in the child and each job remakes the disk,
+an ARAP run continuing from the last run's map. Otherwise the job runs in a thread (or right
+away: headless renders, animations, tests) and the flattener and ARAP objects are reused.
 """
 
 from __future__ import annotations
 
+import contextlib
+import dataclasses
 import itertools
 import threading
 import time
-from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -23,7 +27,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import dijkstra
 
-from meshlap_core.errors import MeshError
+from meshlap_core.errors import MeshError, check_cancel
 from meshlap_core.flatten import ARAP, Flattener, UVMap, unit_square_uv
 from meshlap_core.options import (
     FLATTEN_BOUNDARIES,
@@ -53,7 +57,11 @@ MAX_SEAM_CLICKS = 10_000
 """Most vertices a clicked seam holds (each joined to the next by a shortest edge path)."""
 HISTOGRAM_BINS = 40
 LIVE_EVERY_S = 0.1
-"""ARAP hands the window its map at most this often (each hand-over measures the map)."""
+"""ARAP hands the window its map at most this often."""
+LIVE_SHARE = 0.25
+"""At most this share of a live ARAP run goes to measuring and handing over its maps (the
+distortion of every face, and from a child process the arrays sent): the next map is handed
+over once three times the last hand-over's cost has passed."""
 
 
 def check_seam(x: Any) -> str | None:
@@ -291,8 +299,10 @@ class FlattenState:
     ``maps`` holds every map computed on the current disk by ``(method, boundary)``;
     ``shown`` is the one on screen (the last good one stays while another is computed);
     ``arap`` keeps an ARAP object per boundary, so a run continues where the last one
-    stopped. ``lock`` serializes the jobs' use of the flattener and the ARAP objects (a
-    cancelled job may still be finishing its step when the next one starts).
+    stopped (``None`` when it ran in a child process: the next run starts from its map).
+    ``flattener`` is the disk's when the maps are computed in this process. ``lock``
+    serializes the jobs' use of the flattener and the ARAP objects (a cancelled job may
+    still be finishing its step when the next one starts).
     """
 
     method: str = SETTINGS.default("method")
@@ -304,11 +314,11 @@ class FlattenState:
     seam: list[int] = field(default_factory=list)
     face: int = -1  # the clicked face (-1: none)
     flattener: Flattener | None = None
-    disk_key: tuple[Any, ...] | None = None  # (mesh version, seam clicks) of the flattener
-    failed: tuple[Any, ...] | None = None  # the disk or map key whose job failed
+    disk_key: tuple[Any, ...] | None = None  # (mesh version, seam clicks) of the maps
+    failed: tuple[Any, ...] | None = None  # the (disk, map) whose job failed
     maps: dict[tuple[str, str], MapView] = field(default_factory=dict)
     shown: MapView | None = None
-    arap: dict[str, ARAP] = field(default_factory=dict)
+    arap: dict[str, ARAP | None] = field(default_factory=dict)
     live_rate: float = 0.0  # ARAP iterations per second of the current (or last) run
     lock: threading.Lock = field(default_factory=threading.Lock, repr=False)
     version: int = 0  # bumped whenever what is shown changes
@@ -316,13 +326,8 @@ class FlattenState:
     # ------------------------------------------------------------------ lifetime
     def clear(self) -> None:
         """Forget the mesh's disk, maps and ARAP runs (a new mesh); the settings stay."""
-        self.flattener, self.disk_key, self.failed = None, None, None
-        self.forget_maps()
-
-    def forget_maps(self) -> None:
-        """Forget the maps of the disk (a new disk)."""
-        self.maps, self.shown, self.arap, self.face, self.live_rate = {}, None, {}, -1, 0.0
-        self.version += 1
+        self.new_disk(None)
+        self.shown, self.face = None, -1
 
     # ------------------------------------------------------------------ settings
     @property
@@ -371,69 +376,31 @@ class FlattenState:
         self.seam = self.seam[:-1]
         return True
 
-    # ------------------------------------------------------------------ jobs' work
-    def disk_work(self, V: FloatArray, F: IntArray, clicks: tuple[int, ...], reporter: Any) -> Any:
-        """The flattener of ``(V, F)`` cut along the clicked seam (any thread)."""
-        reporter(0.0, "joining the seam" if clicks else "cutting to a disk")
-        path = seam_path(V, F, list(clicks)) if clicks else None
-        cancel = getattr(reporter, "cancel", None)
-        return Flattener(V, F, path, progress=reporter, cancel=cancel)
+    # ------------------------------------------------------------------ jobs
+    def request(self, V: FloatArray, F: IntArray, version: int) -> Request:
+        """What a job computes for the settings now (the disk of the mesh ``version``; an
+        ARAP run continues the map of the last run on its boundary)."""
+        method, boundary = self.key
+        last = self.maps.get(self.key) if method == "arap" else None
+        return Request(
+            V, F, self.disk_wanted(version), method, boundary, int(self.iters),
+            None if last is None else last.uvmap.uv,
+            [] if last is None else list(last.uvmap.energies),
+            0.0 if last is None else last.uvmap.seconds,
+        )  # fmt: skip
 
-    def map_work(self, flat: Flattener, method: str, boundary: str, reporter: Any) -> MapView:
-        """A map other than ARAP and what the panel draws of it (any thread)."""
-        cancel = getattr(reporter, "cancel", None)
-        with self.lock:
-            uvmap = flat.map(method, boundary, progress=reporter, cancel=cancel)
-            reporter(None, "measuring the distortion")
-            return describe(uvmap)
-
-    def arap_work(
-        self,
-        flat: Flattener,
-        boundary: str,
-        iters: int,
-        reporter: Any,
-        arap: ARAP | None = None,
-        spent: float = 0.0,
-        clock: Callable[[], float] = time.perf_counter,
-    ) -> tuple[ARAP, MapView, float]:
-        """``iters`` ARAP iterations from ``arap`` (``None``: a new one from the flattener's
-        start map; ``spent``: the seconds it took so far): ``(arap, map drawn, iterations per
-        second)``. Each map is handed to the window at most every :data:`LIVE_EVERY_S`
-        (``reporter.partial`` with the same triple); any thread."""
-        cancel = getattr(reporter, "cancel", None)
-        t0 = clock()
-        with self.lock:
-            if arap is None:
-                reporter(0.0, "ARAP: its start map and factorization")
-                arap = flat.arap(boundary, cancel=cancel)
-        spent += clock() - t0
-        start, begun, last = arap.iterations, clock(), -np.inf
-        partial = getattr(reporter, "partial", None)
-        rate, view = 0.0, None
-        for i in range(int(iters)):
-            with self.lock:
-                getattr(reporter, "check", lambda: None)()  # Cancel: between iterations
-                energy = arap.step()
-            now = clock()
-            rate = (arap.iterations - start) / max(now - begun, 1e-9)
-            reporter((i + 1) / iters, f"iteration {arap.iterations}: E = {energy:.6g}")
-            if partial is not None and now - last >= LIVE_EVERY_S and i + 1 < iters:
-                last = now
-                view = describe(arap_map(flat, arap, boundary, spent + now - begun))
-                partial((arap, view, rate))
-        view = describe(arap_map(flat, arap, boundary, spent + clock() - begun))
-        return arap, view, rate
-
-    # ------------------------------------------------------------------ adopting results
-    def adopt_disk(self, flat: Flattener, key: tuple[Any, ...]) -> None:
-        """A new disk: its maps start afresh."""
-        self.flattener, self.disk_key, self.failed = flat, key, None
-        self.forget_maps()
-
-    def adopt_map(self, view: MapView) -> None:
-        """Keep a computed map; show it when it is the one asked for (a late job's map is
-        kept for the table but leaves the screen alone)."""
+    def adopt(self, result: Computed, disk: tuple[Any, ...]) -> None:
+        """A job's map (or an ARAP run's latest), computed on the disk ``disk``: kept, and
+        shown when it is the one asked for; its flattener and ARAP object (a job in this
+        process) kept for the next maps."""
+        flat, arap, view, rate = result
+        if disk != self.disk_key:  # (a job of another seam or mesh: not this disk's)
+            return
+        if flat is not None:
+            self.flattener = flat
+        if view.uvmap.method == "arap":
+            self.arap[view.uvmap.boundary] = arap  # (None: the next run starts from the map)
+            self.live_rate = rate
         self.maps[view.key] = view
         if view.key == self.key:
             self.shown = view
@@ -441,12 +408,12 @@ class FlattenState:
                 self.face = -1
         self.version += 1
 
-    def adopt_arap(self, result: tuple[ARAP, MapView, float]) -> None:
-        """A live ARAP map: its object kept (a later run continues it) and its map shown."""
-        arap, view, rate = result
-        self.arap[view.uvmap.boundary] = arap
-        self.live_rate = rate
-        self.adopt_map(view)
+    def new_disk(self, disk: tuple[Any, ...] | None) -> None:
+        """The mesh or the seam changed: the maps of the old disk go (the one on screen
+        stays until the new disk's arrives)."""
+        self.flattener, self.disk_key, self.failed = None, disk, None
+        self.maps, self.arap, self.live_rate = {}, {}, 0.0
+        self.version += 1
 
     # ------------------------------------------------------------------ what is shown
     def rows(self) -> list[dict[str, Any]]:
@@ -468,6 +435,135 @@ class FlattenState:
         radius = max(radius_factor * float(np.sqrt(d.face_area[self.face])), 0.02 * diag)
         circle, image = e.polylines(radius)
         return e, circle, to_unit(view.uvmap.uv, image)
+
+
+Computed = tuple[Any, Any, "MapView", float]
+"""What a job returns: ``(flattener, ARAP object, map drawn, ARAP's iterations per second)``,
+the first two ``None`` from a child process (they stay there)."""
+
+
+@dataclass(frozen=True)
+class Request:
+    """One map asked of a job, as plain data (it may cross to a child process).
+
+    Attributes
+    ----------
+    V : (n,3) float
+    F : (m,3) int
+    disk : tuple
+        ``(mesh version, seam clicks)``: the disk the map is of.
+    method, boundary : str
+    iters : int
+        ARAP's iterations.
+    start : (n',2) float or None
+        ARAP's map to continue from (``None``: its start map).
+    energies : list of float
+        ARAP's energies so far (continued).
+    spent : float
+        ARAP's seconds so far.
+    """
+
+    V: FloatArray
+    F: IntArray
+    disk: tuple[Any, ...]
+    method: str
+    boundary: str
+    iters: int = 1
+    start: FloatArray | None = None
+    energies: list[float] = field(default_factory=list)
+    spent: float = 0.0
+
+
+def compute(
+    req: Request,
+    flat: Flattener | None = None,
+    arap: ARAP | None = None,
+    lock: Any = None,
+    *,
+    progress: Any = None,
+) -> Computed:
+    """The map ``req`` asks for and what the panel draws of it (any thread, or a child
+    process: :func:`meshlap_app.jobs.in_child`). ``flat`` (the disk's flattener) and
+    ``arap`` (the last run's object) are reused when given, else made; ``lock`` serializes
+    their use (a cancelled job may still be finishing a step). ARAP hands its maps to the
+    window as it goes (``progress.partial``; at most every :data:`LIVE_EVERY_S`, and within
+    :data:`LIVE_SHARE` of its time)."""
+    cancel = getattr(progress, "cancel", None)
+    remote = bool(getattr(progress, "remote", False))
+    report = progress if progress is not None else (lambda *a: None)
+    with lock if lock is not None else contextlib.nullcontext():
+        if flat is None:
+            clicks = req.disk[1]
+            report(0.0, "joining the seam" if clicks else "cutting to a disk")
+            path = seam_path(req.V, req.F, list(clicks)) if clicks else None
+            flat = Flattener(req.V, req.F, path, progress=progress, cancel=cancel)
+        if req.method != "arap":
+            view = describe(flat.map(req.method, req.boundary, progress=progress, cancel=cancel))
+            return (None, None, portable(view), 0.0) if remote else (flat, None, view, 0.0)
+    return _arap_run(req, flat, arap, lock, progress, remote)
+
+
+def _arap_run(
+    req: Request, flat: Flattener, arap: ARAP | None, lock: Any, progress: Any, remote: bool
+) -> Computed:
+    """``req.iters`` iterations of ARAP, continuing ``arap`` or ``req.start`` (see
+    :func:`compute`)."""
+    cancel = getattr(progress, "cancel", None)
+    report = progress if progress is not None else (lambda *a: None)
+    partial = getattr(progress, "partial", None)
+    guard = lock if lock is not None else contextlib.nullcontext()
+    t0 = time.perf_counter()
+    with guard:
+        if arap is None:
+            report(0.0, "ARAP: its start map and factorization")
+            arap = flat.arap(req.boundary, cancel=cancel)
+            if req.start is not None:  # continue the last run (its map and energies)
+                arap = continued(flat, arap, req)
+    spent, begun, last = req.spent + time.perf_counter() - t0, time.perf_counter(), -np.inf
+    start, rate, cost = arap.iterations, 0.0, 0.0
+
+    def drawn() -> Computed:
+        now = time.perf_counter()
+        view = describe(arap_map(flat, arap, req.boundary, spent + now - begun))
+        return (None, None, portable(view), rate) if remote else (flat, arap, view, rate)
+
+    for i in range(req.iters):
+        with guard:
+            check_cancel(cancel, "ARAP")  # Cancel: between iterations
+            energy = arap.step()
+        now = time.perf_counter()
+        rate = (arap.iterations - start) / max(now - begun, 1e-9)
+        report((i + 1) / req.iters, f"iteration {arap.iterations}: E = {energy:.6g}")
+        wait = max(LIVE_EVERY_S, cost * (1.0 - LIVE_SHARE) / LIVE_SHARE)
+        if partial is not None and now - last >= wait and i + 1 < req.iters:
+            partial(drawn())
+            last = time.perf_counter()
+            cost = last - now
+    return drawn()
+
+
+def continued(flat: Flattener, fresh: ARAP, req: Request) -> ARAP:
+    """An ARAP object at the map ``req.start`` of a run made elsewhere (a child process
+    that ended), with that run's energies and iteration count: the next iteration is the
+    one that run would have made (the local step depends on the map alone; the pinned
+    vertices are where the start map put them)."""
+    arap = ARAP(
+        flat.disk.V, flat.disk.F, req.start, pinned=fresh.pinned, frames=flat.frames,
+        cot=flat.cotangents, K=flat.stiffness("cotan"),
+    )  # fmt: skip
+    if req.energies:
+        arap.energies = [*req.energies[:-1], arap.energy]
+        arap.iterations = len(req.energies) - 1
+    return arap
+
+
+def portable(view: MapView) -> MapView:
+    """``view`` without what stays in the process that made it (the flattener and its
+    factorizations, the disk's edge table): what a child process sends back."""
+    view.uvmap.distortion()  # (measured here, with the flattener's frames)
+    view.uvmap.flattener = None
+    view.uvmap.disk = dataclasses.replace(view.uvmap.disk, table=None)
+    return view
 
 
 def to_unit(uv: FloatArray, points: FloatArray) -> FloatArray:
