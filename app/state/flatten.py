@@ -177,8 +177,9 @@ class MapView:
     uv01 : (n',2) float
         The map moved and scaled uniformly into ``[0, 1]²`` (the checkerboard's and the
         layout's coordinates).
-    corners : (3m,2) float
-        ``uv01`` at every face corner (polyscope's corner parameterization of the input).
+    corners : (3m,2) float32
+        ``uv01`` at every face corner (polyscope's corner parameterization of the input; it
+        keeps single precision).
     values : dict
         Per face ``(m,)``: ``"angle"`` σ₁/σ₂ and ``"area"`` log σ₁σ₂, infinite (collapsed
         faces) replaced by the colour range's end.
@@ -238,7 +239,7 @@ def describe(uvmap: UVMap) -> MapView:
     return MapView(
         uvmap=uvmap,
         uv01=uv01,
-        corners=uv01[uvmap.disk.F].reshape(-1, 2),
+        corners=uv01[uvmap.disk.F].reshape(-1, 2).astype(np.float32),
         values=values,
         ranges=ranges,
         histograms=histograms,
