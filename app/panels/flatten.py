@@ -267,7 +267,8 @@ class FlattenPanel(Panel):
             return
         st = self.state
         P = host.mesh_points()
-        if self.watch.changed("cut", id(st.flattener), id(P), tuple(st.seam)) or force:
+        disk = st.shown.uvmap.disk if st.shown is not None else None
+        if self.watch.changed("cut", id(disk), id(P), tuple(st.seam)) or force:
             self._push_cut(host, P)
         view = st.shown
         key = (st.version, id(view), id(P), st.distortion, st.copy, st.checker)
@@ -294,9 +295,10 @@ class FlattenPanel(Panel):
         st = self.state
         for name in (CUT, OUTER, SEAM):
             scene.remove_structure(name)
-        disk = st.flattener.disk if st.flattener is not None else None
+        disk = st.shown.uvmap.disk if st.shown is not None else None
         if disk is not None and len(disk.cut_edges):
-            cn = ps.register_curve_network(CUT, P, disk.cut_edges, color=CUT_COLOR)
+            nodes, edges = np.unique(disk.cut_edges, return_inverse=True)  # its vertices only
+            cn = ps.register_curve_network(CUT, P[nodes], edges.reshape(-1, 2), color=CUT_COLOR)
             cn.set_radius(0.003, relative=True)
         if disk is not None and disk.holes:
             loop = disk.source[disk.outer]
@@ -449,15 +451,14 @@ class FlattenPanel(Panel):
     def _draw_disk(self, host: Host) -> None:
         """What was cut to make the disk, and the seam's buttons."""
         ui, st = host.ui, self.state
-        flat = st.flattener
-        if flat is not None:
-            d = flat.disk
+        if st.shown is not None:
+            d = st.shown.uvmap.disk
             loops = 1 + len(d.holes)
             ui.text(
                 f"disk ({d.how}): {len(d.V)} vertices, {len(d.F)} faces, {loops} boundary "
                 + ("loop" if loops == 1 else "loops")
             )
-            for line in flat.messages:
+            for line in d.messages:
                 ui.text_whole_words(line)
         ui.text(
             f"seam: {len(st.seam)} clicked vertices" if st.seam
@@ -500,7 +501,7 @@ class FlattenPanel(Panel):
         ui, st = host.ui, self.state
         view = st.shown
         if view is None:
-            ui.note("no map yet" if st.flattener is None else "computing the map ...")
+            ui.note("computing the map ..." if self._job is not None else "no map yet")
             return
         flips = len(view.flipped)
         if flips:
@@ -541,13 +542,16 @@ class FlattenPanel(Panel):
             return
         e = found[0]
         J = e.jacobian
-        ui.text(
+        ui.text_whole_words(
             f"face {e.face}: sigma1 = {e.sigma1:.4g}, sigma2 = {e.sigma2:.4g}, "
             f"sigma1/sigma2 = {e.sigma1 / max(e.sigma2, 1e-300):.4g}, "
             f"log sigma1 sigma2 = {np.log(max(e.sigma1 * e.sigma2, 1e-300)):.4g}"
             + (" (flipped)" if e.flipped else "")
         )
-        ui.text(f"J = [[{J[0, 0]:.4g}, {J[0, 1]:.4g}], [{J[1, 0]:.4g}, {J[1, 1]:.4g}]]")
+        ui.text_whole_words(
+            f"J = [[{J[0, 0]:.4g}, {J[0, 1]:.4g}], [{J[1, 0]:.4g}, {J[1, 1]:.4g}]] (face frame "
+            "to the layout, area normalized): a circle on the face maps to the black ellipse"
+        )
         if ui.button("clear face", "forget the clicked face"):
             st.face = -1
             st.version += 1
