@@ -4,6 +4,7 @@
 
 from __future__ import annotations
 
+import itertools
 import sys
 from types import SimpleNamespace
 
@@ -75,7 +76,7 @@ def drive_maps(viewer) -> None:
     drive(viewer, "map", "mercator")
     assert st.method == "arap" and "map" in viewer.state.errors["flatten"]
     table = viewer.ui.tables[("flatten", "flatten maps")]
-    assert [r[0].split(" (")[0] for r in table.rows] == [
+    assert [r[0].split(",")[0] for r in table.rows] == [
         "Tutte", "harmonic", "LSCM", "spectral conformal", "ARAP",
     ]  # fmt: skip
     assert table.highlighted == [4] and not table.flagged()  # the sphere: no face flipped
@@ -219,7 +220,7 @@ def drive_flipped(viewer) -> None:
         sm = ps.get_surface_mesh(name)
         assert sm.n_faces() == len(view.flipped) and sm.n_vertices() == 3 * len(view.flipped)
     table = viewer.ui.tables[("flatten", "flatten maps")]
-    assert table.flagged()[0][6] == str(len(view.flipped))
+    assert table.flagged()[0][5] == str(len(view.flipped))
     assert f"{len(view.flipped)} flipped" in viewer.captions()["flat layout"]
 
 
@@ -353,3 +354,29 @@ def test_egl_checkerboard_layout_and_flipped_faces(tmp_path, python_ok):
     assert _magenta(flipped[:, m0:m1]).sum() > 30  # over the mesh
     assert _magenta(flipped[:, l0:l1]).sum() > 30  # over the layout
     assert sys.platform  # (the script ran in its own process: EGL and the mock never meet)
+
+
+@pytest.mark.egl
+def test_meshlap_view_and_animate_of_the_flatten_panel(tmp_path, python_ok):
+    """``meshlap view --panel flatten --map lscm --checker 0.1 --screenshot``: the panel's
+    flags apply; ``meshlap animate --panel flatten --arap-iters 3``: four frames, the map
+    changing from one to the next (ARAP's iterations)."""
+    from PIL import Image
+
+    shot = tmp_path / "v.png"
+    cli = ("-m", "meshlap_core.cli")
+    python_ok(*cli, "view", "--panel", "flatten", "--map", "lscm", "--checker", "0.1",
+              "--distortion", "area", "--screenshot", shot, timeout=300)  # fmt: skip
+    img = np.asarray(Image.open(shot).convert("RGB"))
+    scene = img[300:, : int(0.6 * img.shape[1])]  # below the colour bar, left of the panel
+    assert len(_objects(scene)) == 3  # the mesh, the layout, the copy
+    gif = tmp_path / "a.gif"
+    python_ok(*cli, "animate", "--panel", "flatten", "--arap-iters", "3", "--size", "480x270",
+              "--out", gif, timeout=300)  # fmt: skip
+    frames = []
+    with Image.open(gif) as im:
+        for i in range(im.n_frames):
+            im.seek(i)
+            frames.append(np.asarray(im.convert("RGB"), dtype=int))
+    assert len(frames) == 4
+    assert all(np.abs(a - b).sum() > 0 for a, b in itertools.pairwise(frames))

@@ -509,25 +509,26 @@ class FlattenPanel(Panel):
         else:
             ui.text("no face flipped")
         self._draw_face(host, view)
-        heads = ("map", "boundary", "angle mean", "angle max", "area mean", "area max",
-                 "flips", "time (s)")  # fmt: skip
-        tips = ("", "", "area-weighted mean of sigma1/sigma2", "largest sigma1/sigma2",
+        heads = ("map", "angle mean", "angle max", "area mean", "area max", "flips", "s")
+        tips = ("the map and its boundary (ARAP: its iterations)",
+                "area-weighted mean of sigma1/sigma2", "largest sigma1/sigma2",
                 "area-weighted mean of |log sigma1 sigma2|", "largest |log sigma1 sigma2|",
-                "faces whose orientation the map reverses", "the map's own time")  # fmt: skip
+                "faces whose orientation the map reverses",
+                "the map's own time, seconds")  # fmt: skip
+        numbers = ("angle_mean", "angle_max", "area_mean", "area_max")
         with ui.table("flatten maps", heads, tips):
             for row in st.rows():
-                name = MAP_NAMES[row["method"]]
+                name = f"{MAP_NAMES[row['method']]}, {row['boundary']}"
                 if row["method"] == "arap":
-                    name += f" ({row['iterations']} it)"
-                numbers = ("angle_mean", "angle_max", "area_mean", "area_max")
-                cells = [name, row["boundary"], *(f"{row[k]:.4g}" for k in numbers),
-                         str(row["flipped"]), f"{row['seconds']:.3g}"]  # fmt: skip
+                    name += f", {row['iterations']} it"
+                cells = [name, *(f"{row[k]:.3g}" for k in numbers), str(row["flipped"]),
+                         f"{row['seconds']:.2g}"]  # fmt: skip
                 mine = (row["method"], row["boundary"]) == view.key
                 ui.row(cells, (*FLIP_COLOR, 1.0) if row["flipped"] else None, highlight=mine)
         for kind in ("angle", "area"):
             centers, counts, width = view.histograms[kind]
             label = DISTORTION_LABELS[kind]
-            with ui.plot(f"{kind} distortion histogram", 110, label, "faces") as ok:
+            with ui.plot(f"{kind} distortion histogram", 140, label, "faces") as ok:
                 if ok:
                     colors = self.watch.cached(
                         f"{kind} bars", (id(view),), lambda c=centers, k=kind: _bars(view, k, c)
