@@ -151,7 +151,11 @@ def drive_display(viewer, tmp_path) -> None:
         assert st.shown.histograms[kind][1].sum() == len(F)
         assert plot is None or (plot[0] == "bars" and plot[2].sum() == len(F))
     caps = viewer.captions()
-    assert caps["mesh"] == "checkerboard through LSCM" and "no face flipped" in caps["flat layout"]
+    assert caps == {
+        "mesh": "checkerboard through LSCM",
+        "flat layout": "layout (free)",  # no face flipped
+        "distortion on the surface": "angle distortion",
+    }
     from meshlap_app.panels.export import ExportPanel
 
     status = ExportPanel.export(viewer, tmp_path)

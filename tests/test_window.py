@@ -7,12 +7,13 @@ serves two tests, in this order:
   with its widgets (curvature field and side by side, click a vertex and type one, compute the
   eigenbasis and drag k, open another mesh and compute its eigenbasis, type λ and press Enter,
   space to play and to pause, a surface and its u slider), export what is shown, the Help pane
-  (H), and at 1280×720 a recording of the normal section turning (record, turn, stop: a GIF of
-  several frames). After each step the test checks what a user sees on a screenshot: the
-  subject left of meshlap's panel and not running behind it, the second mesh (side by side,
-  reconstruction, smoothed copy) beside it, λ applied on Enter and not before, the export
-  message, the window's title naming the mesh shown, and that the process is alive with
-  nothing on stderr but polyscope's own ``[polyscope]`` lines. A failing step is recorded (the
+  (H), at 1280×720 a recording of the normal section turning (record, turn, stop: a GIF of
+  several frames), and the Flatten view (the checkerboard, the layout, another map). After
+  each step the test checks what a user sees on a screenshot: the subject left of meshlap's
+  panel and not running behind it, the second mesh (side by side, reconstruction, smoothed
+  copy, layout) beside it, λ applied on Enter and not before, the export message, the
+  window's title naming the mesh shown, and that the process is alive with nothing on stderr
+  but polyscope's own ``[polyscope]`` lines. A failing step is recorded (the
   viewer is restarted if it died) and the tour goes on, so one run reports every failing step.
 - ``test_monkey``: ``MESHLAP_MONKEY_ACTIONS`` (default 40, about 20 s when idle) random clicks,
   drags and keys anywhere, drawn from ``MESHLAP_MONKEY_SEED``; the viewer survives. A failure
@@ -669,6 +670,59 @@ def record_turn(s: Session) -> None:
     s.drawn()  # the section goes on turning after stop: no steady picture to wait for
 
 
+def checkerboard(img: np.ndarray, box: tuple[int, int]) -> bool:
+    """The Flatten view's checkerboard on the object between the columns ``box``: its blue
+    and its light squares (each at least 400 pixels, shaded by the lighting), alternating
+    along the object's middle row."""
+    x0, x1 = box
+    c = img[:, x0:x1].astype(np.int16)
+    r, g, b = c[..., 0], c[..., 1], c[..., 2]
+    blue = (b > r + 60) & (b > g + 20)
+    light = (r > 190) & (g > 190) & (b > 190) & (np.abs(r - b) < 30)
+    ys = np.flatnonzero(blue.any(axis=1))
+    if blue.sum() < 400 or light.sum() < 400 or len(ys) == 0:
+        return False
+    row = blue[(ys[0] + ys[-1]) // 2]
+    return int(np.count_nonzero(np.diff(row.astype(np.int8)))) >= 6
+
+
+def flatten(s: Session) -> None:
+    """The Flatten view (its number key; the view combo when it has none): the checkerboard
+    through Tutte's map on the mesh, the flat layout and the copy coloured by the distortion
+    beside it (three objects, none behind the panel); the map combo (the view's first) to
+    LSCM (its third entry): the layout changes and the checkerboard stays."""
+    from meshlap_app.registry import VIEWS
+
+    number = VIEWS.index("flatten") + 1
+    if number <= 9:
+        layout = s.goto(number, "Flatten")
+    else:
+        s.choose(0, -1, number - 1)  # the view combo, the Mesh section's last
+        s.panel = number
+        layout = parse(s.settled((0, 0, *s.size)))
+
+    def shown(img: np.ndarray) -> bool:
+        try:
+            objects = subjects(img, parse(img))
+        except LookupError:
+            return False
+        return len(objects) >= 3 and checkerboard(img, objects[0])
+
+    s.until(shown, 60, "the checkerboard on the mesh, the layout and the copy beside it")
+    layout = parse(s.settled((0, 0, *s.size)))
+    s.subject_ok(layout, 3, "the mesh, its layout and the distortion copy")
+    before = s.img
+    flat = subjects(before, layout)[1]
+    s.choose(1, 0, 2)  # map → lscm
+
+    def remapped(img: np.ndarray) -> bool:
+        box = (flat[0], 0, flat[1], s.size[1])
+        return changed_fraction(before, img, box) > 0.02 and shown(img)
+
+    s.until(remapped, 60, "a new layout after choosing LSCM, the checkerboard still on the mesh")
+    s.subject_ok(parse(s.settled((0, 0, *s.size))), 3, "after LSCM")
+
+
 TOUR: list[tuple[str, Callable[[Session], None]]] = [
     ("window", opened),
     ("pick_mesh", pick_mesh),
@@ -681,6 +735,7 @@ TOUR: list[tuple[str, Callable[[Session], None]]] = [
     ("export", export),
     ("help", help_pane),
     ("record", record_turn),
+    ("flatten", flatten),
 ]
 
 

@@ -6,11 +6,12 @@ histograms and its row of the table), and ARAP stepped live. No polyscope import
 The heavy objects are the core's: one :class:`~meshlap_core.flatten.Flattener` per disk (its
 factorizations shared by every map of that disk), one :class:`~meshlap_core.flatten.ARAP` per
 boundary. A map is one job of the panel, :func:`compute` of a :class:`Request` (plain data),
-adopted on the UI thread (:meth:`FlattenState.adopt`). On a big scan the window runs the job
-in a child process (CHOLMOD's factorizations hold the GIL for seconds there: from a thread
-they froze the window); the flattener then stays in the child and each job remakes the disk,
-an ARAP run continuing from the last run's map. Otherwise the job runs in a thread (or right
-away: headless renders, animations, tests) and the flattener and ARAP objects are reused.
+adopted on the UI thread (:meth:`FlattenState.adopt`). The window runs the job in a child
+process (CHOLMOD's factorizations hold the GIL, for seconds on a big scan: from a thread they
+froze the window); the flattener then stays in the child and each job remakes the disk, an
+ARAP run continuing from the last run's map. Elsewhere (headless renders, animations, tests,
+a machine without child processes) the job runs in this process and the flattener and ARAP
+objects are reused.
 """
 
 from __future__ import annotations
