@@ -51,6 +51,9 @@ STRUCTURES = (LAYOUT, COPY, CUT, OUTER, SEAM, FLIPPED, FLIPPED_LAYOUT, CIRCLE, E
 
 FLIP_COLOR = (1.0, 0.0, 0.85)
 """Flipped triangles: magenta, in none of the colour maps nor the checkerboard."""
+FLIP_TEXT = (1.0, 0.55, 0.95, 1.0)
+"""A map with flipped faces in the panel's text and table (a light magenta: readable on the
+highlighted row too)."""
 CHECKER_COLORS = ((0.97, 0.97, 0.97), (0.16, 0.40, 0.75))
 CUT_COLOR = (1.0, 0.55, 0.0)
 OUTER_COLOR = (0.1, 0.75, 0.3)
@@ -81,6 +84,8 @@ class FlattenPanel(Panel):
         self._layout: np.ndarray | None = None  # the layout's display positions (n',3)
         self._offset = np.zeros(3)  # the copy's offset from the mesh
         self._frame = (np.zeros(3), np.zeros((2, 3)))  # the layout: origin + uv01 @ axes
+        self._due = False  # the map is brought up to date at the next sync (not before the
+        # start options and the window's job settings apply: no map computed for nothing)
 
     # ------------------------------------------------------------------ the scene
     def animating(self) -> bool:
@@ -106,7 +111,7 @@ class FlattenPanel(Panel):
                 if has(name):
                     get(name).set_enabled(mine)
         if mine:
-            self.want(host)
+            self._due = True
             self.push(host, force=True)
         elif self.watch.seen("map") is not None and ps.has_surface_mesh(MESH):
             ps.get_surface_mesh(MESH).remove_quantity(CHECKER)
@@ -115,6 +120,9 @@ class FlattenPanel(Panel):
     def sync(self, host: Host) -> None:
         if self._job is not None and host.state.jobs.running(self.name) is None:
             self._job = None  # done, failed or cancelled
+        if self._due and host.active() is self:
+            self._due = False
+            self.want(host)
         self.push(host)
 
     def points(self, host: Host, name: str) -> np.ndarray | None:
@@ -392,21 +400,17 @@ class FlattenPanel(Panel):
 
     def restore(self, host: Host, values: dict[str, Any], active: bool) -> None:
         self.configure(host, values)
-        if active:
-            self.want(host)
-            self.push(host, force=True)
+        self._due = active
 
     def start(self, host: Host, options: dict[str, Any], shown: bool, screenshot: bool) -> None:
         """``meshlap view --panel flatten --map M --map-boundary B --checker X --distortion
-        D``: the map is computed at once when this is the first view."""
+        D``: the map is computed at the first frame when this is the first view."""
         st = self.state
         for flag, key in (("map", "method"), ("map_boundary", "boundary"), ("checker", "checker"),
                           ("distortion", "distortion")):  # fmt: skip
             if options.get(flag) is not None:
                 setattr(st, key, options[flag])
-        if shown:
-            self.want(host)
-            self.push(host, force=True)
+        self._due = shown
 
     # ------------------------------------------------------------------ widgets
     def draw(self, host: Host) -> None:
@@ -451,8 +455,9 @@ class FlattenPanel(Panel):
         if st.shown is not None:
             d = st.shown.uvmap.disk
             loops = 1 + len(d.holes)
+            opened = "" if d.how == "disk" else f" ({d.how})"
             ui.text(
-                f"disk ({d.how}): {len(d.V)} vertices, {len(d.F)} faces, {loops} boundary "
+                f"disk{opened}: {len(d.V)} vertices, {len(d.F)} faces, {loops} boundary "
                 + ("loop" if loops == 1 else "loops")
             )
             for line in d.messages:
@@ -491,7 +496,7 @@ class FlattenPanel(Panel):
         )
         with ui.plot("ARAP energy", 120, "iteration", "E", y_log=bool(energies.min() > 0)) as ok:
             if ok:
-                ui.plot_line("E", np.arange(len(energies)), energies)
+                ui.plot_line("##E", np.arange(len(energies)), energies)
 
     def _draw_map(self, host: Host) -> None:
         """The shown map's flips, the clicked face, the table and the histograms."""
@@ -502,26 +507,26 @@ class FlattenPanel(Panel):
             return
         flips = len(view.flipped)
         if flips:
-            ui.colored(f"{flips} flipped faces (magenta)", (*FLIP_COLOR, 1.0))
+            ui.colored(f"{flips} flipped faces (magenta)", FLIP_TEXT)
         else:
             ui.text("no face flipped")
         self._draw_face(host, view)
-        heads = ("map", "angle mean", "angle max", "area mean", "area max", "flips", "s")
+        heads = ("map", "flips", "s", "angle", "max", "area", "max")
         tips = ("the map and its boundary (ARAP: its iterations)",
-                "area-weighted mean of sigma1/sigma2", "largest sigma1/sigma2",
-                "area-weighted mean of |log sigma1 sigma2|", "largest |log sigma1 sigma2|",
-                "faces whose orientation the map reverses",
-                "the map's own time, seconds")  # fmt: skip
+                "faces whose orientation the map reverses", "the map's own time, seconds",
+                "area-weighted mean of sigma1/sigma2 (1: conformal)", "largest sigma1/sigma2",
+                "area-weighted mean of |log sigma1 sigma2| (0: areas kept)",
+                "largest |log sigma1 sigma2|")  # fmt: skip
         numbers = ("angle_mean", "angle_max", "area_mean", "area_max")
         with ui.table("flatten maps", heads, tips):
             for row in st.rows():
                 name = f"{MAP_NAMES[row['method']]}, {row['boundary']}"
                 if row["method"] == "arap":
                     name += f", {row['iterations']} it"
-                cells = [name, *(f"{row[k]:.3g}" for k in numbers), str(row["flipped"]),
-                         f"{row['seconds']:.2g}"]  # fmt: skip
+                cells = [name, str(row["flipped"]), f"{row['seconds']:.2g}",
+                         *(f"{row[k]:.3g}" for k in numbers)]  # fmt: skip
                 mine = (row["method"], row["boundary"]) == view.key
-                ui.row(cells, (*FLIP_COLOR, 1.0) if row["flipped"] else None, highlight=mine)
+                ui.row(cells, FLIP_TEXT if row["flipped"] else None, highlight=mine)
         for kind in ("angle", "area"):
             centers, counts, width = view.histograms[kind]
             label = DISTORTION_LABELS[kind]

@@ -51,7 +51,7 @@ DISTORTIONS = ("angle", "area")
 """What the layout and the copy of the mesh are coloured by."""
 DISTORTION_LABELS = {
     "angle": "angle distortion sigma1/sigma2 [ratio; 1 = conformal]",
-    "area": "area distortion log(sigma1 sigma2) [log of the area ratio; 0 = kept]",
+    "area": "area distortion log(sigma1 sigma2) [log area ratio; 0 = kept]",
 }
 """Each distortion's quantity and unit: its colour bar's title and its histogram's x axis."""
 MAX_SEAM_CLICKS = 10_000
@@ -91,9 +91,10 @@ SETTINGS = Settings(
            "pinned vertices; scp: spectral conformal (Mullen et al. 2008); arap: as rigid as "
            "possible, local/global iterations (Liu et al. 2008)",
            view=Flag("--map", "the map to the plane")),
-    Choice("boundary", "circle", choices=FLATTEN_BOUNDARIES, label="boundary",
+    Choice("boundary", "free", choices=FLATTEN_BOUNDARIES, label="boundary",
            tooltip="where the outer boundary goes, for the maps that take a shape: the unit "
-           "circle or square by arc length, or free (the map's own)",
+           "circle or square by arc length, or free (the map's own; Tutte's and the harmonic "
+           "map have none: they take the circle)",
            view=Flag("--map-boundary", "the boundary shape, where the map takes one"),
            animate=Flag("--map-boundary", "ARAP's boundary", default="free")),
     Integer("iters", 50, lo=1, hi=MAX_FLATTEN_ITERS, label="ARAP iterations", widget="input",
@@ -212,15 +213,20 @@ class MapView:
         return self.uvmap.method, self.uvmap.boundary
 
 
+RANGE_QUANTILE = 0.95
+"""A distortion's colour range ends at this quantile of its faces: a few folded faces (ARAP's
+can reach σ₁/σ₂ of thousands) would leave the rest of the map one colour."""
+
+
 def color_range(kind: str, values: FloatArray) -> tuple[float, float]:
-    """The colour range of a distortion: ``[1, q]`` for the angle (``q`` its 99th
-    percentile), ``[−r, r]`` for the area (``r`` the 99th percentile of ``|log σ₁σ₂|``);
-    never empty."""
+    """The colour range of a distortion: ``[1, q]`` for the angle (``q`` its
+    :data:`RANGE_QUANTILE`), ``[−r, r]`` for the area (``r`` that quantile of
+    ``|log σ₁σ₂|``); never empty."""
     v = values[np.isfinite(values)]
     if kind == "angle":
-        hi = float(np.quantile(v, 0.99)) if v.size else 1.0
+        hi = float(np.quantile(v, RANGE_QUANTILE)) if v.size else 1.0
         return 1.0, max(hi, 1.0 + 1e-3)
-    r = float(np.quantile(np.abs(v), 0.99)) if v.size else 0.0
+    r = float(np.quantile(np.abs(v), RANGE_QUANTILE)) if v.size else 0.0
     return -max(r, 1e-3), max(r, 1e-3)
 
 
