@@ -59,10 +59,10 @@ MAX_SEAM_CLICKS = 10_000
 HISTOGRAM_BINS = 40
 LIVE_EVERY_S = 0.1
 """ARAP hands the window its map at most this often."""
-LIVE_SHARE = 0.25
+LIVE_SHARE = 0.2
 """At most this share of a live ARAP run goes to measuring and handing over its maps (the
 distortion of every face, and from a child process the arrays sent): the next map is handed
-over once three times the last hand-over's cost has passed."""
+over once four times the last hand-over's cost has passed."""
 
 
 def check_seam(x: Any) -> str | None:
