@@ -120,19 +120,9 @@ def main() -> None:
     V, F = disk.V, disk.F
     print(f"{args.mesh}: {mesh.n_vertices} vertices -> disk of {len(V)} vertices, {len(F)} "
           f"faces in {t:.2f} s ({'; '.join(disk.messages)})")  # fmt: skip
-    print_table(
-        [
-            "map",
-            "libigl (s)",
-            "core (s)",
-            "panel, kept disk (s)",
-            "panel, window job (s)",
-            "core / libigl",
-            "kept / libigl",
-            "window / libigl",
-        ],  # fmt: skip
-        map_rows(V, F, args.repeat),
-    )
+    header = ["map", "libigl (s)", "core (s)", "panel, kept disk (s)", "panel, window job (s)"]
+    header += ["core / libigl", "kept / libigl", "window / libigl"]
+    print_table(header, map_rows(V, F, args.repeat))
     print()
     print_table(["ARAP", "value"], arap_rows(V, F, args.iters, args.repeat))
     print(f"load average: {os.getloadavg()}")
