@@ -60,6 +60,12 @@ OUTER_COLOR = (0.1, 0.75, 0.3)
 SEAM_COLOR = (0.9, 0.15, 0.15)
 ELLIPSE_COLOR = (0.05, 0.05, 0.05)
 CMAPS = {"angle": "viridis", "area": "coolwarm"}
+STAGED_ABOVE = 100_000
+"""In the window, a newly registered structure of more faces (or corners) than this ends the
+frame's uploads: the next one follows at the next frame (polyscope makes a structure's
+buffers at its first draw, on the UI thread: at 692k vertices the checkerboard, the layout and
+the copy in one frame kept the window still for 12.6 s at load 11; one per frame, 6.5-6.7 s
+each at load 9-10, the progress of the others shown between them)."""
 LIFT = 2e-3
 """How far (a fraction of the mesh's size) the flipped faces are drawn in front of the faces
 they cover, so that they are not hidden by them."""
@@ -84,6 +90,7 @@ class FlattenPanel(Panel):
         self._layout: np.ndarray | None = None  # the layout's display positions (n',3)
         self._offset = np.zeros(3)  # the copy's offset from the mesh
         self._frame = (np.zeros(3), np.zeros((2, 3)))  # the layout: origin + uv01 @ axes
+        self._stages: list[str] = []  # what is still to upload of the map shown
         self._due = False  # the map is brought up to date at the next sync (not before the
         # start options and the window's job settings apply: no map computed for nothing)
 
@@ -277,22 +284,38 @@ class FlattenPanel(Panel):
             self._push_cut(host, P)
         view = st.shown
         key = (st.version, id(view), id(P), st.distortion, st.copy, st.checker)
-        if not self.watch.changed("map", *key) and not force:
-            return
+        if self.watch.changed("map", *key) or force:
+            self._stages = ["checker", "layout", "copy", "marks"]
         if view is None:
             ps.get_surface_mesh(MESH).remove_quantity(CHECKER)
             for name in (LAYOUT, COPY, FLIPPED, FLIPPED_LAYOUT, CIRCLE, ELLIPSE):
                 scene.remove_structure(name)
-            self._layout = None
+            self._layout, self._stages = None, []
             return
+        stage = {
+            "checker": self._push_checker, "layout": self._push_layout,
+            "copy": self._push_copy, "marks": self._push_marks,
+        }  # fmt: skip
+        while self._stages:
+            registered = stage[self._stages.pop(0)](host, P, view)
+            if registered and host.background:
+                break  # one new big structure per frame: its first draw is the frame's
+
+    def _push_checker(self, host: Host, P: np.ndarray, view: MapView) -> bool:
+        """The checkerboard through the map on the mesh (a new one: True)."""
+        new = self.watch.changed("checker map", id(view.corners))
         ps.get_surface_mesh(MESH).add_parameterization_quantity(
             CHECKER, view.corners, defined_on="corners", coords_type="unit",
-            viz_style="checker", checker_size=st.checker, checker_colors=CHECKER_COLORS,
-            enabled=True,
+            viz_style="checker", checker_size=self.state.checker,
+            checker_colors=CHECKER_COLORS, enabled=True,
         )  # fmt: skip
-        self._push_layout(host, P, view)
+        return new and len(view.corners) > STAGED_ABOVE
+
+    def _push_marks(self, host: Host, P: np.ndarray, view: MapView) -> bool:
+        """The flipped faces and the clicked face's ellipse."""
         self._push_flipped(host, P, view)
         self._push_face(host, view)
+        return False
 
     def _push_cut(self, host: Host, P: np.ndarray) -> None:
         """The disk's cut edges and, with holes, its outer loop on the mesh; the clicked seam
@@ -313,37 +336,48 @@ class FlattenPanel(Panel):
             pc = ps.register_point_cloud(SEAM, P[np.asarray(st.seam)], color=SEAM_COLOR)
             pc.set_radius(0.008, relative=True)
 
-    def _push_layout(self, host: Host, P: np.ndarray, view: MapView) -> None:
-        """The layout beside the mesh and the copy beside it, coloured by the distortion
-        shown (one colour range, the colour bar on the layout)."""
+    def _push_layout(self, host: Host, P: np.ndarray, view: MapView) -> bool:
+        """The layout beside the mesh, coloured by the distortion shown, with the colour bar
+        (registered anew: True)."""
         st, disk = self.state, view.uvmap.disk
         origin, axes, self._offset = place_row(P, front_view(host.state.mesh.name))
         self._frame = (origin, axes)
         layout = self._layout = origin + view.uv01 @ axes
-        if self.watch.changed("layout faces", id(disk)) or not ps.has_surface_mesh(LAYOUT):
+        new = self.watch.changed("layout faces", id(disk)) or not ps.has_surface_mesh(LAYOUT)
+        if new:
             scene.remove_structure(LAYOUT)
             ps.register_surface_mesh(LAYOUT, layout, disk.F, edge_width=0.0)
             host.request_frame()
         else:
             ps.get_surface_mesh(LAYOUT).update_vertex_positions(layout)
         kind = st.distortion
-        args = dict(defined_on="faces", cmap=CMAPS[kind], vminmax=view.ranges[kind], enabled=True)
         ps.get_surface_mesh(LAYOUT).add_scalar_quantity(
-            DISTORTION_LABELS[kind], view.values[kind], onscreen_colorbar_enabled=True,
-            onscreen_colorbar_location=scene.colorbar_at(0, host.state.ui_scale), **args,
+            DISTORTION_LABELS[kind], view.values[kind], defined_on="faces", cmap=CMAPS[kind],
+            vminmax=view.ranges[kind], enabled=True, onscreen_colorbar_enabled=True,
+            onscreen_colorbar_location=scene.colorbar_at(0, host.state.ui_scale),
         )  # fmt: skip
-        if not st.copy:
+        return new and len(disk.F) > STAGED_ABOVE
+
+    def _push_copy(self, host: Host, P: np.ndarray, view: MapView) -> bool:
+        """The copy of the mesh right of the layout, coloured the same (no colour bar of its
+        own; registered anew: True)."""
+        if not self.state.copy:
             scene.remove_structure(COPY)
-            return
+            return False
         X = P + self._offset
-        if self.watch.changed("copy", id(P)) or not ps.has_surface_mesh(COPY):
+        new = self.watch.changed("copy", id(P)) or not ps.has_surface_mesh(COPY)
+        if new:
             scene.remove_structure(COPY)
             ps.register_surface_mesh(COPY, X, host.state.mesh.F, smooth_shade=True)
             host.request_frame()
         elif self.watch.changed("copy offset", *self._offset.tolist()):
             ps.get_surface_mesh(COPY).update_vertex_positions(X)
-        label = DISTORTION_LABELS[kind].split(" [")[0]  # (one colour bar: the layout's)
-        ps.get_surface_mesh(COPY).add_scalar_quantity(label, view.values[kind], **args)
+        kind = self.state.distortion
+        ps.get_surface_mesh(COPY).add_scalar_quantity(
+            DISTORTION_LABELS[kind].split(" [")[0], view.values[kind], defined_on="faces",
+            cmap=CMAPS[kind], vminmax=view.ranges[kind], enabled=True,
+        )  # fmt: skip
+        return new and len(host.state.mesh.F) > STAGED_ABOVE
 
     def _push_flipped(self, host: Host, P: np.ndarray, view: MapView) -> None:
         """The flipped faces in :data:`FLIP_COLOR`, over the mesh and over the layout (each
