@@ -56,7 +56,7 @@ def pick(viewer, structure: str, kind: str, index: int, position=(0.0, 0.0, 0.0)
 
 def lines(viewer) -> str:
     """The panel's wrapped text of the last frames."""
-    return "\n".join(t for sec, t in viewer.ui.lines if sec == "flatten")
+    return " ".join(t for sec, t in viewer.ui.lines if sec == "flatten")  # (wrapped at spaces)
 
 
 def drive_maps(viewer) -> None:
@@ -282,6 +282,27 @@ def test_a_session_brings_back_the_map_and_the_seam(mock, viewer, tmp_path):
     frames(viewer, 3)
     assert (st.method, st.boundary, st.checker, st.seam) == ("harmonic", "square", 0.08, [0, 30])
     assert st.shown.key == ("harmonic", "square") and st.shown.uvmap.disk.how.startswith("seam")
+
+
+def test_several_boundary_loops_the_longest_is_the_outer_one(mock, viewer, tmp_path):
+    """A grid with a square hole: the panel says the longest loop is the outer boundary (the
+    hole stays free) and draws that loop; Tutte's map puts it on the circle."""
+    from meshlap_core import grid
+    from meshlap_core.io import save_mesh
+
+    V, F = grid(9, 9)
+    centre = V[F].mean(axis=1)
+    keep = np.abs(centre[:, :2] - 0.5).max(axis=1) > 0.2  # a hole in the middle
+    path = tmp_path / "holed.obj"
+    save_mesh(path, V, F[keep])
+    assert viewer.open(path)
+    viewer.set_panel("flatten")
+    frames(viewer, 3)
+    st = viewer.panels["flatten"].state
+    disk = st.shown.uvmap.disk
+    assert len(disk.holes) == 1 and "is the outer boundary" in lines(viewer)
+    assert ps.get_curve_network("outer boundary").n_nodes() == len(disk.outer)
+    np.testing.assert_allclose(np.linalg.norm(st.shown.uvmap.uv[disk.outer], axis=1), 1.0)
 
 
 # ---------------------------------------------------------------- pixels (EGL)
