@@ -61,6 +61,8 @@ def test_a_seam_across_two_pieces_is_refused():
     F2 = np.vstack([F, F + len(V)])
     with pytest.raises(MeshError, match="no edge path joins vertices 0 and 9"):
         seam_path(V2, F2, [0, 9])
+    with pytest.raises(MeshError, match="vertex 18 is out of range; the mesh has 18"):
+        seam_path(V2, F2, [0, 18])
 
 
 def test_seam_values_are_checked_and_kept_without_repeats():
@@ -81,6 +83,9 @@ def test_the_state_adds_and_undoes_seam_vertices():
     assert st.seam == [3, 4] and st.disk_wanted(7) == (7, (3, 4))
     assert st.undo_seam() and st.seam == [3] and st.disk_wanted(7) == (7, ())  # one: no seam
     assert st.undo_seam() and not st.undo_seam()
+    st.seam = [1, 2]
+    st.clear()  # a new mesh: the seam was the old one's
+    assert st.seam == [] and st.shown is None and st.disk_key is None
 
 
 # ---------------------------------------------------------------- settings

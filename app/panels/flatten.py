@@ -120,8 +120,13 @@ class FlattenPanel(Panel):
         if mine:
             self._due = True
             self.push(host, force=True)
-        elif self.watch.seen("map") is not None and ps.has_surface_mesh(MESH):
-            ps.get_surface_mesh(MESH).remove_quantity(CHECKER)
+        elif self.watch.seen("map") is not None:
+            # (polyscope draws an enabled quantity's colour bar even on a hidden structure)
+            if ps.has_surface_mesh(MESH):
+                ps.get_surface_mesh(MESH).remove_quantity(CHECKER)
+            for name in (LAYOUT, COPY):
+                if ps.has_surface_mesh(name):
+                    ps.get_surface_mesh(name).remove_all_quantities()
             self.watch.forget("map")
 
     def sync(self, host: Host) -> None:
@@ -359,8 +364,8 @@ class FlattenPanel(Panel):
         return new and len(disk.F) > STAGED_ABOVE
 
     def _push_copy(self, host: Host, P: np.ndarray, view: MapView) -> bool:
-        """The copy of the mesh right of the layout, coloured the same (no colour bar of its
-        own; registered anew: True)."""
+        """The copy of the mesh right of the layout, coloured the same (its colour bar below
+        the layout's; registered anew: True)."""
         if not self.state.copy:
             scene.remove_structure(COPY)
             return False
@@ -374,8 +379,9 @@ class FlattenPanel(Panel):
             ps.get_surface_mesh(COPY).update_vertex_positions(X)
         kind = self.state.distortion
         ps.get_surface_mesh(COPY).add_scalar_quantity(
-            DISTORTION_LABELS[kind].split(" [")[0], view.values[kind], defined_on="faces",
-            cmap=CMAPS[kind], vminmax=view.ranges[kind], enabled=True,
+            DISTORTION_LABELS[kind], view.values[kind], defined_on="faces", cmap=CMAPS[kind],
+            vminmax=view.ranges[kind], enabled=True, onscreen_colorbar_enabled=True,
+            onscreen_colorbar_location=scene.colorbar_at(1, host.state.ui_scale),
         )  # fmt: skip
         return new and len(host.state.mesh.F) > STAGED_ABOVE
 

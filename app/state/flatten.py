@@ -147,9 +147,13 @@ def seam_path(V: FloatArray, F: IntArray, clicks: list[int]) -> IntArray:
     Raises
     ------
     MeshError
-        A clicked vertex no edge path reaches from the one before (another component).
+        A clicked vertex the mesh does not have, or one no edge path reaches from the one
+        before (another component).
     """
     clicks = without_repeats(list(clicks))
+    bad = next((v for v in clicks if not 0 <= v < len(V)), None)
+    if bad is not None:
+        raise MeshError(f"vertex {bad} is out of range; the mesh has {len(V)} vertices", "seam")
     if len(clicks) < 2:
         return np.zeros(0, dtype=np.int64)
     E = np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]])
@@ -333,9 +337,10 @@ class FlattenState:
 
     # ------------------------------------------------------------------ lifetime
     def clear(self) -> None:
-        """Forget the mesh's disk, maps and ARAP runs (a new mesh); the settings stay."""
+        """Forget the mesh's disk, maps, ARAP runs and seam (a new mesh: its vertices are not
+        the seam's); the other settings stay."""
         self.new_disk(None)
-        self.shown, self.face = None, -1
+        self.shown, self.face, self.seam = None, -1, []
 
     # ------------------------------------------------------------------ settings
     @property
