@@ -395,7 +395,7 @@ def test_meshlap_view_and_animate_of_the_flatten_panel(tmp_path, python_ok):
     python_ok(*cli, "view", "--panel", "flatten", "--map", "lscm", "--checker", "0.1",
               "--distortion", "area", "--screenshot", shot, timeout=300)  # fmt: skip
     img = np.asarray(Image.open(shot).convert("RGB"))
-    scene = img[300:, : int(0.6 * img.shape[1])]  # below the colour bar, left of the panel
+    scene = img[:, 180 : int(0.6 * img.shape[1])]  # right of the colour bars, left of the panel
     assert len(_objects(scene)) == 3  # the mesh, the layout, the copy
     gif = tmp_path / "a.gif"
     python_ok(*cli, "animate", "--panel", "flatten", "--arap-iters", "3", "--size", "480x270",
