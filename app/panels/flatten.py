@@ -364,8 +364,9 @@ class FlattenPanel(Panel):
         return new and len(disk.F) > STAGED_ABOVE
 
     def _push_copy(self, host: Host, P: np.ndarray, view: MapView) -> bool:
-        """The copy of the mesh right of the layout, coloured the same (its colour bar below
-        the layout's; registered anew: True)."""
+        """The copy of the mesh right of the layout, in the layout's colours (the layout's
+        colour bar reads both: the copy's are those colours as RGB, no second bar; registered
+        anew: True)."""
         if not self.state.copy:
             scene.remove_structure(COPY)
             return False
@@ -378,11 +379,10 @@ class FlattenPanel(Panel):
         elif self.watch.changed("copy offset", *self._offset.tolist()):
             ps.get_surface_mesh(COPY).update_vertex_positions(X)
         kind = self.state.distortion
-        ps.get_surface_mesh(COPY).add_scalar_quantity(
-            DISTORTION_LABELS[kind], view.values[kind], defined_on="faces", cmap=CMAPS[kind],
-            vminmax=view.ranges[kind], enabled=True, onscreen_colorbar_enabled=True,
-            onscreen_colorbar_location=scene.colorbar_at(1, host.state.ui_scale),
-        )  # fmt: skip
+        rgb = self.watch.cached("copy colours", (id(view), kind), lambda: _colours(view, kind))
+        ps.get_surface_mesh(COPY).add_color_quantity(
+            DISTORTION_LABELS[kind].split(" [")[0], rgb, defined_on="faces", enabled=True
+        )
         return new and len(host.state.mesh.F) > STAGED_ABOVE
 
     def _push_flipped(self, host: Host, P: np.ndarray, view: MapView) -> None:
@@ -636,3 +636,9 @@ def _bars(view: MapView, kind: str, centers: np.ndarray) -> np.ndarray:
     lo, hi = view.ranges[kind]
     t = np.clip((np.asarray(centers) - lo) / (hi - lo), 0.0, 1.0)
     return colormaps[CMAPS[kind]](t)
+
+
+def _colours(view: MapView, kind: str) -> np.ndarray:
+    """Each face's RGB ``(m,3)`` in the colour its distortion has on the layout (the same
+    colour map and range, clipped the same)."""
+    return _bars(view, kind, view.values[kind])[:, :3]
