@@ -22,6 +22,7 @@ from .state import (
     deform,
     diffusion,
     export,
+    flatten,
     help,
     mesh_info,
     onering,
@@ -41,6 +42,7 @@ REGISTRY: tuple[PanelSpec, ...] = (
     diffusion.SPEC,
     curvature_lab.SPEC,
     deform.SPEC,
+    flatten.SPEC,
     export.SPEC,
     help.SPEC,
 )

@@ -2,8 +2,8 @@
 
 Run: ``python docs/make_screenshots.py [NAME ...]`` (names: the keys of :data:`SHOTS`,
 ``inspector``, ``diffusion_distance``, ``diffusion_heat``; all when none). Uses
-../shared/meshes/armadillo.obj for the spectral panel when present, the bundled assets
-otherwise. The inspector shot is taken on a perturbed grid
+../shared/meshes/armadillo.obj for the spectral panel and nefertiti.obj for the flatten panel
+when present, the bundled assets otherwise. The inspector shot is taken on a perturbed grid
 (:func:`perturbed_grid`, seeded) at a vertex whose ring has a negative cotangent weight.
 """
 
@@ -24,6 +24,7 @@ ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "docs" / "img"
 ARMADILLO = ROOT.parent / "shared" / "meshes" / "armadillo.obj"
 SCAN = ROOT.parent / "shared" / "meshes" / "armadillo_igl.obj"
+NEFERTITI = ROOT.parent / "shared" / "meshes" / "nefertiti.obj"
 
 SHOTS = {
     "curvature": [str(ROOT / "assets" / "bumpy.obj"), "--panel", "curvature", "--field", "cotan"],
@@ -38,6 +39,15 @@ SHOTS = {
     "smoothing": [str(ROOT / "assets" / "bumpy.obj"), "--panel", "smoothing"],
     "surfaces": ["--panel", "surfaces"],
     "curvature_lab": ["--panel", "curvature_lab"],
+    "flatten": [  # the checkerboard through LSCM, the layout and the copy by area distortion
+        str(NEFERTITI if NEFERTITI.is_file() else ROOT / "assets" / "bumpy.obj"),
+        "--panel",
+        "flatten",
+        "--map",
+        "lscm",
+        "--distortion",
+        "area",
+    ],
 }
 
 

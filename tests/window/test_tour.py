@@ -9,11 +9,12 @@ serves two tests, in this order:
   space to play and to pause, a surface and its u slider), export what is shown, the Help pane
   (H), and at 1280×720 a recording of the normal section turning (record, turn, stop: a GIF of
   several frames), then the Deform view (a handle clicked and dragged: the shape changes on
-  screen; Z undoes it). After each step the test checks what a user sees on a screenshot: the
-  subject left of meshlap's panel and not running behind it, the second mesh (side by side,
-  reconstruction, smoothed copy) beside it, λ applied on Enter and not before, the export
-  message, the window's title naming the mesh shown, and that the process is alive with
-  nothing on stderr but polyscope's own ``[polyscope]`` lines. A failing step is recorded (the
+  screen; Z undoes it) and the Flatten view (the checkerboard, the layout, another map). After
+  each step the test checks what a user sees on a screenshot: the subject left of meshlap's
+  panel and not running behind it, the second mesh (side by side, reconstruction, smoothed
+  copy, layout) beside it, λ applied on Enter and not before, the export message, the
+  window's title naming the mesh shown, and that the process is alive with nothing on stderr
+  but polyscope's own ``[polyscope]`` lines. A failing step is recorded (the
   viewer is restarted if it died) and the tour goes on, so one run reports every failing step.
 - ``test_monkey``: ``MESHLAP_MONKEY_ACTIONS`` (default 40, about 20 s when idle) random clicks,
   drags and keys anywhere, drawn from ``MESHLAP_MONKEY_SEED``; the viewer survives. A failure
@@ -397,6 +398,14 @@ def deform(s: Session) -> None:
     drag_a_handle(s)
 
 
+def flatten(s: Session) -> None:
+    """The Flatten view: the checkerboard, the layout and the distortion copy, then LSCM
+    (the step lives with the view's widget driver)."""
+    from tests.support.drivers.flatten import checkerboard_step
+
+    checkerboard_step(s)
+
+
 TOUR: list[tuple[str, Callable[[Session], None]]] = [
     ("window", opened),
     ("pick_mesh", pick_mesh),
@@ -410,6 +419,7 @@ TOUR: list[tuple[str, Callable[[Session], None]]] = [
     ("help", help_pane),
     ("record", record_turn),
     ("deform", deform),
+    ("flatten", flatten),
 ]
 
 
