@@ -198,6 +198,8 @@ class Jobs:
         self.cancelled = 0  # jobs cancelled so far (superseded or by the user)
         self.processes = False  # offload() may use child processes (the window sets it)
         self.news = threading.Event()  # a result or a partial result waits for poll()
+        # also told of news, from the job's thread: the window's wait for events ends on it
+        self.wake: Callable[[], None] | None = None
 
     # ------------------------------------------------------------------ start / cancel
     def start(
@@ -230,7 +232,7 @@ class Jobs:
             if not replace:
                 return None
             self.cancel(owner)
-        reporter = Reporter(threading.Event(), self.clock, self._reported, self.news.set)
+        reporter = Reporter(threading.Event(), self.clock, self._reported, self._news)
         job = Job(owner, title, work, apply, fail, reporter, self.clock(), self.clock, preview)
         self._jobs[owner] = job
         if self.background if background is None else background:
@@ -245,7 +247,13 @@ class Jobs:
         job.run()
         with self._lock:
             self._finished.append(job)
+        self._news()
+
+    def _news(self) -> None:
+        """Something waits for :meth:`poll` (any thread): set :attr:`news`, call :attr:`wake`."""
         self.news.set()
+        if self.wake is not None:
+            self.wake()
 
     def _reported(self) -> None:
         self.last_report = self.clock()

@@ -10,8 +10,16 @@ gets the core). The rule:
   recording): :data:`FULL_FPS`;
 - a job runs: :data:`BUSY_FPS` (the progress line still moves several times a second);
 - otherwise *idle*: :data:`IDLE_FPS`, and :data:`DEEP_IDLE_FPS` after :data:`DEEP_IDLE_AFTER_S`
-  (each idle frame still costs tens of milliseconds of CPU with a software OpenGL); the first
-  input event wakes it within one idle frame.
+  (each idle frame still costs tens of milliseconds of CPU with a software OpenGL).
+
+Input is never kept waiting by the pause: in the window the pause is GLFW's wait for events
+(:func:`.window.wait_events`), which ends as soon as input (or a job's news, posted as an
+empty event) arrives, and a frame that starts with input pending (``wait(input_now=True)``:
+the key or the mouse arrived during the last frame's drawing) does not pause at all. Before,
+the pause was a plain sleep placed before the frame read its input: a key pressed at 2
+frames/s waited out the rest of one pause, then a whole second one, and showed 1–2 s later.
+With ``MESHLAP_PACING_TRACE=<file>`` the window appends one JSON line per frame (see
+:meth:`Pacer.wait`), to see why a frame came late.
 """
 
 from __future__ import annotations
@@ -58,6 +66,8 @@ class Pacer:
     last_frame: float | None = None
     max_busy_gap: float = 0.0  # longest time between two frames while a job ran
     mode: str = "active"
+    trace: Callable[[dict[str, float | str | bool]], None] | None = None  # one call per wait
+    frames: int = 0  # waits so far (one per frame)
 
     def __post_init__(self) -> None:
         self.last_input = self.clock()
@@ -78,17 +88,40 @@ class Pacer:
             return self.busy_fps
         return self.deep_fps if quiet >= self.deep_after else self.idle_fps
 
-    def wait(self, busy: bool, animating: bool = False) -> float:
-        """Sleep what is left of this frame's period; returns the seconds slept."""
+    def wait(self, busy: bool, animating: bool = False, input_now: bool = False) -> float:
+        """Sleep what is left of this frame's period; returns the pause asked of the sleep.
+
+        ``input_now``: the frame starts with input to answer (it counts as :meth:`touch`, and
+        nothing is slept: the answer is drawn in this frame). The sleep given to the pacer may
+        end early (the window's ends on any input event); the next frame then reads that input.
+        :attr:`trace`, when set, gets one record per call: ``frame`` (its number), ``start`` /
+        ``end`` (the clock before and after the pause), ``pause`` (the seconds it was meant
+        to last), ``fps``, ``mode`` and ``input`` (``input_now``).
+        """
+        if input_now:
+            self.touch()
         fps = self.rate(busy, animating)
-        now = self.clock()
+        start = self.clock()
         pause = 0.0
-        if self.last_frame is not None and fps > 0:
-            pause = max(0.0, 1.0 / fps - (now - self.last_frame))
+        if self.last_frame is not None and fps > 0 and not input_now:
+            pause = max(0.0, 1.0 / fps - (start - self.last_frame))
             if pause > 0:
                 self.sleep(pause)
         now = self.clock()
         if busy and self.last_frame is not None:
             self.max_busy_gap = max(self.max_busy_gap, now - self.last_frame)
         self.last_frame = now
+        self.frames += 1
+        if self.trace is not None:
+            self.trace(
+                {
+                    "frame": self.frames,
+                    "start": start,
+                    "end": now,
+                    "pause": pause,
+                    "fps": fps,
+                    "mode": self.mode,
+                    "input": input_now,
+                }
+            )
         return pause

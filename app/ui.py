@@ -528,6 +528,18 @@ class UI(FieldErrors, Plots):
             bool(im.IsAnyItemActive()),
         )
 
+    def keys_down(self) -> bool:
+        """Is any key of the keyboard down this frame (a key press waiting to be answered)?"""
+        im = self.im
+        keys = self.__dict__.get("_keyboard")
+        if keys is None:  # imgui's named keys (ImGuiKey_NamedKey_BEGIN .. END), made once
+            known = {int(k) for k in im.ImGuiKey}
+            first, end = int(im.ImGuiKey_NamedKey_BEGIN), int(im.ImGuiKey_NamedKey_END)
+            keys = self.__dict__["_keyboard"] = [
+                im.ImGuiKey(k) for k in range(first, end) if k in known
+            ]
+        return any(im.IsKeyDown(k) for k in keys)
+
     def overlay_text(self, pos: tuple[float, float], text: str) -> None:
         """Text drawn over the 3D view at window pixel ``pos``, moved left to end before
         :attr:`overlay_right` (meshlap's panel), not drawn when it has no room there."""

@@ -14,6 +14,7 @@ changed), hands clicks and keys to the panels, and frames the scene when asked. 
 
 from __future__ import annotations
 
+import json
 import os
 import sys
 import traceback
@@ -104,7 +105,8 @@ class Viewer:
         self.panels = make_panels(state)
         self.background = False  # long operations run as jobs (the window; False: inline)
         self.pace = False  # the window sleeps between frames (Pacer); tests tick freely
-        self.pacer = Pacer(sleep=state.jobs.nap)  # woken when a job has something to show
+        self.pacer = Pacer(sleep=self.pause)  # woken by input and when a job has news
+        self.events = False  # pause in GLFW's wait for the window's events (the window)
         self._activity: tuple[Any, ...] = ()
         self.reframe = True  # frame the visible structures at the end of the next frame
         self.whole = False  # R: the next framing shows the whole subject (no view's focus)
@@ -282,7 +284,8 @@ class Viewer:
         ui = self.ui
         jobs = self.state.jobs
         if self.pace:
-            self.pacer.wait(jobs.busy, self.active().animating())  # idle is idle, play is not
+            # idle is idle, play is not; input pending is answered in this frame
+            self.pacer.wait(jobs.busy, self.active().animating(), self.input_pending())
         self.draw_guarded("jobs", lambda host: host.poll_jobs())
         ui.push_width(200)
         try:
@@ -307,6 +310,33 @@ class Viewer:
         self.draw_guarded("pacing", lambda host: host.note_activity())
 
     # ------------------------------------------------------------------ jobs, pacing
+    def pause(self, seconds: float) -> None:
+        """The pause between two frames: GLFW's wait for the window's events (any input ends
+        it; a job's news ends it through :func:`.window.wake`), else a nap that a job's news
+        ends (no window: tests, the animator)."""
+        jobs = self.state.jobs
+        if jobs.news.is_set():
+            return  # a result waits: show it now
+        if not (self.events and window.wait_events(seconds)):
+            jobs.nap(seconds)
+
+    def input_pending(self) -> bool:
+        """This frame starts with input to answer (the mouse moved or a button, the wheel, a
+        modifier or an active widget changed since the last frame ended, or a key is down):
+        the pacer does not pause before answering it."""
+        return self.ui.activity() != self._activity or self.ui.keys_down()
+
+    def listen(self) -> None:
+        """Pause between frames in GLFW's wait for the window's events, woken by jobs' news
+        (the window, once it exists; nothing changes without a GLFW window)."""
+        if window.title_follows():
+            self.events = True
+            self.state.jobs.wake = window.wake
+        trace = os.environ.get("MESHLAP_PACING_TRACE")
+        if trace:
+            out = open(trace, "a", buffering=1, encoding="utf-8")  # open while the window is
+            self.pacer.trace = lambda record: out.write(json.dumps(record) + "\n")
+
     def poll_jobs(self) -> None:
         """Apply what the finished jobs computed (here, on the UI thread)."""
         if self.state.jobs.poll():
@@ -620,6 +650,7 @@ def run(
         state.jobs.processes = True  # load and fields in child processes: no shared GIL
         prefer_gil_free_solvers()  # an eigenbasis job in a thread must not hold the GIL
         ps.set_max_fps(-1)  # polyscope's limit spins a core; the Pacer sleeps instead
+        viewer.listen()  # ... in GLFW's wait for events: input ends the pause at once
         if later is not None:
             viewer.open(later)
     if shot is not None:
