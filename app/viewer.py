@@ -287,6 +287,8 @@ class Viewer:
             # idle is idle, play is not; input pending is answered in this frame
             self.pacer.wait(jobs.busy, self.active().animating(), self.input_pending())
         self.draw_guarded("jobs", lambda host: host.poll_jobs())
+        # the keys before the panels draw: the frame that reads a key draws its answer
+        self.draw_guarded("keys", lambda host: host.handle_keys())
         ui.push_width(200)
         try:
             self.draw_guarded("jobs", lambda host: host.draw_other_jobs())
@@ -303,7 +305,6 @@ class Viewer:
         for name, p in self.panels.items():
             self.draw_guarded(name, p.sync, show=False)
         self.draw_guarded("picking", lambda host: host.handle_click())
-        self.draw_guarded("keys", lambda host: host.handle_keys())
         self.draw_guarded("labels", lambda host: host.limit_overlays())
         self.draw_guarded("labels", self.active().overlay)
         self.draw_guarded("layout", lambda host: host.layout())

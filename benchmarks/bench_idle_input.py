@@ -9,11 +9,15 @@ Each mesh gets a ``meshlap view`` under Xvfb at 1280×720 (the tests' real-windo
 ``tests/xwindow.py``: the child gets ``tests/`` on its ``PYTHONPATH``, as pytest gives it to
 the tests). Once the mesh is on screen and the picture still, the viewer is left alone for
 ``--idle`` seconds (default 6: past the deep idle rate of :mod:`meshlap_app.pacing`), its CPU
-time measured over the last 5 of them (``/proc/<pid>/stat``), then a view key is pressed with
-``xdotool`` (2, then 1, alternately). The latency is the time from the key press to the first
+time measured over the last 5 of them (``/proc/<pid>/stat``), then a key is pressed with
+``xdotool``: ``H`` (the Help pane: the panel changes, the scene is not redrawn) and ``2`` (the
+one-ring view: the scene is redrawn, which costs a software OpenGL a few tenths of a second
+whatever the pacing); each is then pressed back (``H``, ``1``) right after a mouse move, at
+the full frame rate, for comparison. The latency is the time from the key press to the first
 frame that differs from the picture before it: each frame the viewer draws is counted with X
-DAMAGE and read at once with ``XGetImage`` (a few milliseconds). Also printed: the frames
-drawn from the key to that frame, and the load average before and after (timings on a shared
+DAMAGE and read at once with ``XGetImage`` (a few milliseconds). Also printed: when the frame
+that read the key ended its pause (from the viewer's ``MESHLAP_PACING_TRACE``), the frames
+drawn from the key to the changed one, and the load average before and after (timings on a shared
 machine are noisy). No threshold is checked.
 
 Without ``SCAN`` the 692k armadillo is made once in the temp folder (one ``igl.upsample`` of
@@ -95,23 +99,28 @@ def measure(mesh: Path | None, presses: int, idle: float, tmp: Path) -> dict[str
             )
         s.settled((0, 0, *SIZE), timeout=600)
         pid = s.app.proc.pid
-        out: dict[str, list[Any]] = {k: [] for k in ("idle", "active", "read", "frames", "cpu")}
+        keys = {"panel": ("h", "h"), "view": ("2", "1")}  # after idle, then at full rate
+        out: dict[str, Any] = {
+            f"{kind}_{k}": [] for kind in keys for k in ("idle", "active", "read", "frames")
+        }
+        out["cpu"] = []
         for _ in range(presses):
-            s.park()
-            time.sleep(max(idle - 5.0, 0.0))
-            c0, w0 = cpu_seconds(pid), time.monotonic()
-            time.sleep(min(idle, 5.0))
-            out["cpu"].append((cpu_seconds(pid) - c0) / (time.monotonic() - w0))
-            latency, n, t0 = press_latency(s, "2")  # the one-ring view
-            out["idle"].append(latency)
-            out["frames"].append(n)
-            out["read"].append(read_after(trace, t0))
-            s.settled((0, 0, *SIZE), timeout=600)
-            # the same key at the full rate: the mouse moves, the key follows at once
-            s.x.xdotool("mousemove", "5", str(SIZE[1] - 5))
-            s.drawn(1)
-            out["active"].append(press_latency(s, "1")[0])  # back to the curvature view
-            s.settled((0, 0, *SIZE), timeout=600)
+            for kind, (key, back) in keys.items():
+                s.park()
+                time.sleep(max(idle - 5.0, 0.0))
+                c0, w0 = cpu_seconds(pid), time.monotonic()
+                time.sleep(min(idle, 5.0))
+                out["cpu"].append((cpu_seconds(pid) - c0) / (time.monotonic() - w0))
+                latency, n, t0 = press_latency(s, key)
+                out[f"{kind}_idle"].append(latency)
+                out[f"{kind}_frames"].append(n)
+                out[f"{kind}_read"].append(read_after(trace, t0))
+                s.settled((0, 0, *SIZE), timeout=600)
+                # the key back at the full rate: the mouse moves, the key follows at once
+                s.x.xdotool("mousemove", "5", str(SIZE[1] - 5))
+                s.drawn(1)
+                out[f"{kind}_active"].append(press_latency(s, back)[0])
+                s.settled((0, 0, *SIZE), timeout=600)
         problem = s.problem()
     finally:
         s.close()
@@ -154,20 +163,25 @@ def main() -> None:
         rows.append(json.loads(proc.stdout.strip().splitlines()[-1]))
         print(f"load average now: {os.getloadavg()}", flush=True)
     print(
-        "| mesh | key after idle → changed frame [s] | → the frame that reads it [s] "
-        "| key at full rate → changed frame [s] | frames | idle CPU [% of a core] |"
+        "| mesh | key | after idle → changed frame [s] | → the frame that reads it [s] "
+        "| at full rate → changed frame [s] | frames after idle | idle CPU [% of a core] |"
     )
-    print("|---|---|---|---|---|---:|")
+    print("|---|---|---|---|---|---|---:|")
 
     def cell(xs: list[float]) -> str:
         return f"{statistics.median(xs):.3f} ({', '.join(f'{x:.2f}' for x in xs)})"
 
     for r in rows:
-        print(
-            f"| {r['mesh']} | {cell(r['idle'])} | {cell(r['read'])} | {cell(r['active'])} "
-            f"| {r['frames']} | {100 * statistics.median(r['cpu']):.1f} |"
-            + (f" {r['problem']}" if r["problem"] else "")
-        )
+        for kind, what in (
+            ("panel", "H (the panel only)"),
+            ("view", "2 / 1 (a view: redraws the scene)"),
+        ):
+            print(
+                f"| {r['mesh']} | {what} | {cell(r[kind + '_idle'])} | {cell(r[kind + '_read'])} "
+                f"| {cell(r[kind + '_active'])} | {r[kind + '_frames']} "
+                f"| {100 * statistics.median(r['cpu']):.1f} |"
+                + (f" {r['problem']}" if r["problem"] else "")
+            )
     print(f"load average after: {os.getloadavg()}")
 
 

@@ -47,10 +47,11 @@ class SmoothingPanel(Panel):
 
     shows_mesh = False  # the input and the smoothed copy replace it
     framed = (SMOOTHED, SMOOTH_INPUT)
-    keys = ("space", "right", "r")
+    keys = ("space", "right", "left", "r")
     shortcuts = (
         ("space", "smoothing: play / pause"),
         ("right", "smoothing: one step"),
+        ("left", "smoothing: one step back (the last steps are kept: all on a small mesh)"),
         ("R", "smoothing: back to the input"),
     )
 
@@ -307,6 +308,8 @@ class SmoothingPanel(Panel):
             st.toggle_play()
         elif key == "right":
             st.advance()
+        elif key == "left":
+            st.step_back()
         elif key == "r":
             st.reset()
             self.push(host, force=True)
@@ -403,6 +406,14 @@ class SmoothingPanel(Panel):
         ch, seed = setting_widget(ui, SETTINGS["seed"], st.seed)
         if ch:
             self.start_build(host, seed=seed)
+        kept, oldest = st.kept_steps()
+        if ui.button(
+            "back",
+            f"one step back (left arrow): the positions of the last {kept} steps are kept"
+            + (f", back to iteration {oldest}" if oldest > 1 else ""),
+        ):
+            st.step_back()
+        ui.same_line()
         step = SETTINGS["iterations"]  # a step: one more iteration of the run
         if ui.button(step.label, step.tooltip):
             st.advance()
@@ -411,6 +422,7 @@ class SmoothingPanel(Panel):
             "pause" if st.playing else "play",
             "step every frame (space); beyond the stable lambda, play stops at the first step "
             "that grows",
+            width_of=("play", "pause"),  # the same width: reset keeps its place
         ):
             st.toggle_play()
         ui.same_line()
