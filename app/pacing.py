@@ -37,9 +37,11 @@ IDLE_FPS = 4.0
 """Frames per second with nothing happening (< 10 % of a core on a 692k-vertex mesh)."""
 IDLE_AFTER_S = 1.0
 """Seconds without input after which the window drops to the idle rate."""
-DEEP_IDLE_FPS = 2.0
-"""Frames per second after :data:`DEEP_IDLE_AFTER_S` without input (< 10 % of a core with
-Mesa's llvmpipe at 1280×720; the first input is answered within half a second)."""
+DEEP_IDLE_FPS = 1.0
+"""Frames per second after :data:`DEEP_IDLE_AFTER_S` without input (a few % of a core with
+Mesa's llvmpipe at 1280×720). Input does not wait for the next idle frame (the pause is a
+wait for events, see the module docstring), so this rate costs no answer time: it was 2 while
+the first input waited out the pause."""
 DEEP_IDLE_AFTER_S = 4.0
 
 
