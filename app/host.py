@@ -16,6 +16,7 @@ import numpy as np
 
 if TYPE_CHECKING:
     from .state.app import AppState
+    from .state.preview import MeshPreview
     from .ui import UI
 
 
@@ -97,6 +98,11 @@ class Host(Protocol):
     background: bool
     """Long operations run as jobs of ``state.jobs`` (the window); ``False``: right away (the
     animator, headless renders, tests)."""
+
+    def loading(self) -> tuple[str, MeshPreview | None] | None:
+        """The mesh file being opened (a job of the Mesh section): its name, and its preview
+        once it is parsed (then shown in place of the mesh); ``None`` when none is."""
+        ...
 
     def draw_job(self, owner: str) -> bool:
         """Draw the progress line and Cancel button of ``owner``'s running job (a panel passes

@@ -59,6 +59,7 @@ def open_mesh(viewer: Any, path: Path | None) -> bool:
         state.mesh.error = message
 
     name = Path(path).name if path is not None else "the default mesh"
+    viewer.opening = name  # the Mesh section says so while the job runs (Viewer.loading)
     job = state.jobs.start(
         section,
         f"opening {name}",

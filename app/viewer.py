@@ -117,6 +117,7 @@ class Viewer:
         self._logged: set[tuple[str, str]] = set()
         self._caption_boxes: dict[str, tuple[np.ndarray, np.ndarray]] = {}
         self.preview: MeshPreview | None = None  # a mesh being opened, shown as parsed
+        self.opening = ""  # the name of the file a job of the Mesh section opens
         self.preview_fit: tuple[Any, ...] = ()  # the display fit its points were made with
         self.no_shadow = False  # the ground's shadow is off for a big mesh (scene.shadow_for)
 
@@ -352,6 +353,12 @@ class Viewer:
         if now != self._activity or ps.get_redraw_requested():
             self.pacer.touch()
         self._activity = now
+
+    def loading(self) -> tuple[str, MeshPreview | None] | None:
+        """The file being opened and its preview once parsed (see :class:`.host.Host`)."""
+        if not self.opening or self.state.jobs.running(REGISTRY[0].name) is None:
+            return None
+        return self.opening, self.preview
 
     def draw_job(self, owner: str) -> bool:
         """The progress line and a Cancel button of ``owner``'s running job (drawn in the

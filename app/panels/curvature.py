@@ -209,6 +209,10 @@ class CurvaturePanel(Panel):
             host.request_frame()
         if c.field_name not in c.fields:
             return
+        loading = host.loading()
+        if loading is not None and loading[1] is not None:  # another mesh's preview shown
+            ui.note(f"statistics and histogram once {loading[0]} has loaded")
+            return
         st = c.summary()
         lo, hi = st["range"]
         ui.text(f"min {st['min']:.4g}  max {st['max']:.4g}  colour range [{lo:.4g}, {hi:.4g}]")
