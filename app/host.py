@@ -78,9 +78,10 @@ class Host(Protocol):
         """Frame what is shown again at the end of this frame."""
         ...
 
-    def frame(self, strip: float | None = None) -> None:
+    def frame(self, strip: float | None = None) -> bool:
         """Frame what is shown now (``strip``: an animation frame, that left fraction of the
-        width kept for the colour bar; a kept camera is not moved)."""
+        width kept for the colour bar; a kept camera is not moved); False when nothing is
+        shown yet (the camera is not moved)."""
         ...
 
     def flush_frame(self) -> None:

@@ -390,9 +390,11 @@ class Viewer:
             if size != self.window_size:
                 self.fit_panel()
             self.window_size = size
-            self.reframe = False
-            self.frame(whole=self.whole)
-            self.whole = False
+            # nothing shown yet (a view's structures still being computed): frame them when
+            # they appear (before, polyscope's home view put the camera inside the lab's torus)
+            self.reframe = not self.frame(whole=self.whole)
+            if not self.reframe:
+                self.whole = False
         self.draw_captions()
 
     def limit_overlays(self) -> None:
@@ -505,32 +507,36 @@ class Viewer:
         own = getattr(self.active(), "view_direction", None)
         return own or scene.FRONT_VIEWS.get(self.state.mesh.name, scene.DEFAULT_VIEW)
 
-    def frame(self, strip: float | None = None, whole: bool = False) -> None:
+    def frame(self, strip: float | None = None, whole: bool = False) -> bool:
         """Frame what the active view shows in the part of the window left of meshlap's panel
         (a view may frame its own way: the one-ring its selected vertex; ``whole``: not that
         way, the whole subject, as R does). ``strip``: an animation frame (no panel), keeping
         that left fraction of the width clear for the colour bar; nothing happens when the
-        animation keeps a saved camera."""
+        animation keeps a saved camera. False when the view shows nothing yet (its structures
+        come from a job): the camera is not moved."""
         if strip is not None:
             if not self.keep_camera:
                 scene.frame_scene_left(
                     self.framed_names(), self.structure_box, 0.95, self.view_direction(), strip
                 )
-            return
+            return True
         if not whole and self.active().focus(self):
-            return
+            return True
         w, _ = ps.get_window_size()
         pane = ps.get_right_gui_pane_width() * self.state.ui_scale  # at most half (fit_panel)
         fraction = max(scene.scene_fraction(w, self.state.ui_scale), 0.95 * (1 - pane / w))
         left = scene.COLORBAR_PX * self.state.ui_scale / max(w, 1)  # clear of the colour bar
         names = self.framed_names()
-        scene.frame_scene_left(names, self.structure_box, fraction, self.view_direction(), left)
+        framed = scene.frame_scene_left(
+            names, self.structure_box, fraction, self.view_direction(), left
+        )
         self._caption_boxes = {}
         for name in names:
             if ps.has_surface_mesh(name) and ps.get_surface_mesh(name).is_enabled():
                 box = self.structure_box(name)
                 if box is not None and len(box):
                     self._caption_boxes[name] = (box[0], box[1])
+        return framed
 
     def captions(self) -> dict[str, str]:
         """Caption of each structure the active view shows side by side."""

@@ -9,6 +9,7 @@ import polyscope as ps
 
 from meshlap_core.options import CURVATURE_FIELD_LABELS, PRINCIPAL_FIELDS
 
+from .. import scene
 from ..host import Host
 from ..isolines import draw_isolines
 from ..scene import MESH, MESH_B, colorbar_at, front_view, scalar_for_upload, side_offset
@@ -114,7 +115,7 @@ class CurvaturePanel(Panel):
             if not ps.has_surface_mesh(MESH_B):
                 V = host.mesh_points()
                 X = V + side_offset(V, front_view(mesh.name))
-                ps.register_surface_mesh(MESH_B, X, mesh.F, smooth_shade=True)
+                scene.register_surface(MESH_B, X, mesh.F, host.active() is self)
             # its own labelled colour bar, below the first one
             mine = host.active() is self  # polyscope draws a hidden copy's bar too
             self._add_field(host, ps.get_surface_mesh(MESH_B), curv.second_field, mine, 1)

@@ -13,6 +13,7 @@ from meshlap_core.options import (
     PRINCIPAL_FIELDS,
 )
 
+from .. import scene
 from ..host import Host
 from ..isolines import draw_isolines
 from ..panel_spec import PanelSpec
@@ -174,7 +175,7 @@ class CurvatureLabPanel(Panel):
             for name in crosses:
                 sm.remove_quantity(name)
         else:
-            sm = ps.register_surface_mesh(LAB, r.V, r.F, smooth_shade=True)
+            sm = scene.register_surface(LAB, r.V, r.F, True)  # (registered when shown)
             self._faces, self._field = r.F, None
         c = r.crosses
         if not self.state.crosses or c is None:

@@ -298,7 +298,7 @@ class DiffusionPanel(Panel):
         if ps.has_surface_mesh(FILTERED):
             ps.get_surface_mesh(FILTERED).update_vertex_positions(X)
         else:
-            ps.register_surface_mesh(FILTERED, X, mesh.F, smooth_shade=True)
+            scene.register_surface(FILTERED, X, mesh.F, host.active() is self)
             host.request_frame()
 
     def _offset(self, host: Host, slot: int = 1) -> np.ndarray:
@@ -326,7 +326,7 @@ class DiffusionPanel(Panel):
             if ps.has_surface_mesh(name):
                 ps.get_surface_mesh(name).update_vertex_positions(X)
             else:
-                ps.register_surface_mesh(name, X, F, smooth_shade=True)
+                scene.register_surface(name, X, F, host.active() is self)
                 host.request_frame()
             iso = "heat error" if which == "difference" else "heat"
             ps.get_surface_mesh(name).add_scalar_quantity(

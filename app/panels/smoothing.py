@@ -232,7 +232,7 @@ class SmoothingPanel(Panel):
             return
         for name in (SMOOTH_INPUT, SMOOTHED):
             scene.remove_structure(name)  # (another mesh's copies, if any)
-        sm = ps.register_surface_mesh(SMOOTHED, shown.P, st.F, smooth_shade=True)
+        sm = scene.register_surface(SMOOTHED, shown.P, st.F, host.active() is self)
         sm.set_color(SMOOTHED_COLOR)  # (its normals are derived at its first draw: a
         # buffer that polyscope has not filled yet refuses data)
         self._pending_input = shown.P_in
@@ -247,9 +247,9 @@ class SmoothingPanel(Panel):
         P_in, self._pending_input = self._pending_input, None
         if P_in is None or self.state.smoother is None:
             return
-        inp = ps.register_surface_mesh(SMOOTH_INPUT, P_in, self.state.F, smooth_shade=True)
+        shown = ps.get_surface_mesh(SMOOTHED).is_enabled() and not self._hidden_input()
+        inp = scene.register_surface(SMOOTH_INPUT, P_in, self.state.F, shown)
         inp.set_color(INPUT_COLOR)
-        inp.set_enabled(ps.get_surface_mesh(SMOOTHED).is_enabled() and not self._hidden_input())
 
     def _hidden_input(self) -> bool:
         """The input copy is hidden while *play* runs on a big mesh: the renderer then draws
