@@ -101,9 +101,7 @@ def test_a_view_with_nothing_to_show_keeps_the_camera_and_frames_later(windowed)
     assert not v.reframe and on_screen(v, "mesh")
 
 
-def test_smoothing_copies_come_back_shown_after_a_mesh_opened_in_another_view(
-    windowed, tmp_path
-):
+def test_smoothing_copies_come_back_shown_after_a_mesh_opened_in_another_view(windowed, tmp_path):
     v = windowed
     v.set_panel("smoothing")
     settle(v)
