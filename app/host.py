@@ -105,7 +105,8 @@ class Host(Protocol):
         once it is parsed (then shown in place of the mesh); ``None`` when none is."""
         ...
 
-    def draw_job(self, owner: str) -> bool:
-        """Draw the progress line and Cancel button of ``owner``'s running job (a panel passes
-        its name); True when one runs."""
+    def draw_job(self, *owners: str, reserve: bool = True) -> bool:
+        """Draw the progress row (bar and Cancel button) of the running job of each of
+        ``owners`` (a panel passes its name); True when one runs. With none running an empty
+        row keeps its place (``reserve=False``: where a button of the same height takes it)."""
         ...

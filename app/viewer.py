@@ -292,7 +292,6 @@ class Viewer:
         self.draw_guarded("keys", lambda host: host.handle_keys())
         ui.push_width(200)
         try:
-            self.draw_guarded("jobs", lambda host: host.draw_other_jobs())
             viewed = False
             for e in REGISTRY:
                 if not e.view:
@@ -301,6 +300,8 @@ class Viewer:
                     viewed = True
                     self.draw_guarded("view", lambda host: host.draw_view_combo())
                     self.draw_guarded(self.state.panel, self.active().draw)
+            # last: a job row that comes and goes here moves no widget
+            self.draw_guarded("jobs", lambda host: host.draw_other_jobs())
         finally:
             ui.pop_width()
         for name, p in self.panels.items():
@@ -360,24 +361,30 @@ class Viewer:
             return None
         return self.opening, self.preview
 
-    def draw_job(self, owner: str) -> bool:
-        """The progress line and a Cancel button of ``owner``'s running job (drawn in the
-        panel that owns it); True when one runs."""
-        job = self.state.jobs.running(owner)
-        if job is None:
-            return False
-        self._draw_job_line(job)
-        return True
+    def draw_job(self, *owners: str, reserve: bool = True) -> bool:
+        """The row of the running job of each of ``owners`` (a panel passes its name): its
+        progress bar and Cancel button; True when one runs. With none running the row's
+        place is kept (``reserve``; False where a button of the same height takes it): the
+        widgets below never move when a job starts or ends."""
+        jobs = self.state.jobs
+        running = [j for o in owners if (j := jobs.running(o)) is not None]
+        for job in running:
+            self._draw_job_line(job)
+        if not running and reserve:  # the row says how the last one ended (or is empty)
+            self.ui.status_row(jobs.last_outcome(*owners))
+        return bool(running)
 
     def _draw_job_line(self, job: Job) -> None:
         r: Reporter = job.reporter
-        self.ui.progress(r.fraction if r.fraction is not None else 0.0, job.line())
-        if self.ui.button(f"Cancel##{job.owner}", f"stop: {job.title} (what is shown stays)"):
+        head, tail = job.line_parts()
+        fraction = r.fraction if r.fraction is not None else 0.0
+        tooltip = f"stop: {job.title} (what is shown stays)"
+        if self.ui.job_row(fraction, head, tail, f"Cancel##{job.owner}", tooltip):
             self.state.jobs.cancel(job.owner)
 
     def draw_other_jobs(self) -> None:
         """A status line for each job whose panel is not on screen (so a job is seen whatever
-        view is active)."""
+        view is active), at the panel's end (where it moves nothing when it comes or goes)."""
         shown = {self.state.panel, *(e.name for e in REGISTRY if not e.view)}
         for job in self.state.jobs.all_running():
             if job.owner not in shown:

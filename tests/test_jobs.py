@@ -326,3 +326,28 @@ def test_jobs_news_calls_the_wake_hook_from_the_jobs_thread():
     go.set()
     assert jobs.wait("j", timeout=30)
     assert len(woken) == 2  # the result
+
+
+def test_the_last_outcome_of_an_owners_job_for_its_kept_row():
+    """A job's row, kept when no job runs, says how the owner's last job ended."""
+    clock = Clock()
+    jobs = Jobs(clock=clock, background=False)
+    assert jobs.last_outcome("a") == ""
+
+    def work(reporter):
+        clock.t += 1.25
+        return 1
+
+    jobs.start("a", "computing a", work, lambda r: None)
+    assert jobs.last_outcome("a") == "done: computing a (1.2 s)"
+    go = threading.Event()
+    threaded = Jobs(clock=clock)
+    threaded.start("b", "computing b", lambda r: go.wait(30), lambda r: None)
+    clock.t += 2.0
+    threaded.cancel("b")
+    go.set()
+    assert threaded.last_outcome("b") == "cancelled: computing b (after 2.0 s)"
+    clock.t += 1.0
+    threaded.start("c", "computing c", lambda r: (_ for _ in ()).throw(MeshError("no")), None)
+    assert threaded.wait("c", timeout=30)
+    assert threaded.last_outcome("b", "c").startswith("failed: computing c")  # the latest

@@ -185,8 +185,9 @@ class CurvaturePanel(Panel):
         ui = host.ui
         if not ui.header(self.title):
             return
-        host.draw_job(self.name)  # new area or boundary rule: the fields' progress, Cancel
-        host.draw_job(PRINCIPAL_JOB)  # the estimator's run (k1, k2 and directions)
+        # new area or boundary rule: the fields' progress, Cancel; the estimator's run (k1,
+        # k2 and directions): one row kept for either
+        host.draw_job(self.name, PRINCIPAL_JOB)
         c = host.state.curv
         ch1, c.field_name = setting_widget(ui, SETTINGS["field"], c.field_name)
         ch7, estimator = setting_widget(ui, SETTINGS["estimator"], c.estimator)

@@ -218,8 +218,7 @@ class CurvatureLabPanel(Panel):
         ui = host.ui
         if not ui.header(self.title):
             return
-        host.draw_job(self.name)
-        host.draw_job(self.study_owner)
+        host.draw_job(self.name, self.study_owner)  # one row kept for either
         lab = self.state
         changed = False
         for what in ("source", "estimator", "quantity", "show"):

@@ -235,7 +235,10 @@ class SpectralPanel(Panel):
         if ch:
             st.set_k_request(k_request, n)
         computed = SETTINGS["computed"]  # the button that computes the basis
-        if not host.draw_job(self.name) and ui.button(computed.label, computed.tooltip):
+        # the job's row takes the button's place (the same height: nothing below moves)
+        if not host.draw_job(self.name, reserve=False) and ui.button(
+            computed.label, computed.tooltip
+        ):
             self.compute(host)
         if st.error:
             ui.error(st.error)
