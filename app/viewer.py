@@ -14,7 +14,6 @@ changed), hands clicks and keys to the panels, and frames the scene when asked. 
 
 from __future__ import annotations
 
-import json
 import os
 import sys
 import traceback
@@ -28,8 +27,9 @@ import polyscope as ps
 from meshlap_core.errors import MeshError
 from meshlap_core.options import UP_AXES, check_choice
 
-from . import opening, scene, window
-from .jobs import Job, Reporter, prefer_gil_free_solvers, warm_up
+from . import job_rows, opening, scene, window
+from .frame_wait import FrameWait
+from .jobs import prefer_gil_free_solvers, warm_up
 from .pacing import Pacer
 from .panels.base import Panel, Pick
 from .registry import REGISTRY, VIEWS
@@ -43,11 +43,6 @@ NO_DISPLAY = (
     "no display could be opened for the viewer window; render headless with "
     "`meshlap view MESH --screenshot out.png`"
 )
-
-ASYNC_OPEN_BYTES = 8 * 2**20
-"""``meshlap view FILE`` with a larger file opens the window on the bundled mesh at once and
-loads FILE as a job (progress and Cancel in the Mesh section); a smaller file is loaded before
-the window opens (a bad one exits 2 as every command does)."""
 
 
 def init_polyscope(backend: str) -> None:
@@ -105,8 +100,8 @@ class Viewer:
         self.panels = make_panels(state)
         self.background = False  # long operations run as jobs (the window; False: inline)
         self.pace = False  # the window sleeps between frames (Pacer); tests tick freely
-        self.pacer = Pacer(sleep=self.pause)  # woken by input and when a job has news
-        self.events = False  # pause in GLFW's wait for the window's events (the window)
+        self.wait = FrameWait(state.jobs)  # the pause: ended by input and by jobs' news
+        self.pacer = Pacer(sleep=self.wait)
         self._activity: tuple[Any, ...] = ()
         self.reframe = True  # frame the visible structures at the end of the next frame
         self.whole = False  # R: the next framing shows the whole subject (no view's focus)
@@ -313,32 +308,11 @@ class Viewer:
         self.draw_guarded("pacing", lambda host: host.note_activity())
 
     # ------------------------------------------------------------------ jobs, pacing
-    def pause(self, seconds: float) -> None:
-        """The pause between two frames: GLFW's wait for the window's events (any input ends
-        it; a job's news ends it through :func:`.window.wake`), else a nap that a job's news
-        ends (no window: tests, the animator)."""
-        jobs = self.state.jobs
-        if jobs.news.is_set():
-            return  # a result waits: show it now
-        if not (self.events and window.wait_events(seconds)):
-            jobs.nap(seconds)
-
     def input_pending(self) -> bool:
         """This frame starts with input to answer (the mouse moved or a button, the wheel, a
         modifier or an active widget changed since the last frame ended, or a key is down):
         the pacer does not pause before answering it."""
         return self.ui.activity() != self._activity or self.ui.keys_down()
-
-    def listen(self) -> None:
-        """Pause between frames in GLFW's wait for the window's events, woken by jobs' news
-        (the window, once it exists; nothing changes without a GLFW window)."""
-        if window.title_follows():
-            self.events = True
-            self.state.jobs.wake = window.wake
-        trace = os.environ.get("MESHLAP_PACING_TRACE")
-        if trace:
-            out = open(trace, "a", buffering=1, encoding="utf-8")  # open while the window is
-            self.pacer.trace = lambda record: out.write(json.dumps(record) + "\n")
 
     def poll_jobs(self) -> None:
         """Apply what the finished jobs computed (here, on the UI thread)."""
@@ -362,33 +336,13 @@ class Viewer:
         return self.opening, self.preview
 
     def draw_job(self, *owners: str, reserve: bool = True) -> bool:
-        """The row of the running job of each of ``owners`` (a panel passes its name): its
-        progress bar and Cancel button; True when one runs. With none running the row's
-        place is kept (``reserve``; False where a button of the same height takes it): the
-        widgets below never move when a job starts or ends."""
-        jobs = self.state.jobs
-        running = [j for o in owners if (j := jobs.running(o)) is not None]
-        for job in running:
-            self._draw_job_line(job)
-        if not running and reserve:  # the row says how the last one ended (or is empty)
-            self.ui.status_row(jobs.last_outcome(*owners))
-        return bool(running)
-
-    def _draw_job_line(self, job: Job) -> None:
-        r: Reporter = job.reporter
-        head, tail = job.line_parts()
-        fraction = r.fraction if r.fraction is not None else 0.0
-        tooltip = f"stop: {job.title} (what is shown stays)"
-        if self.ui.job_row(fraction, head, tail, f"Cancel##{job.owner}", tooltip):
-            self.state.jobs.cancel(job.owner)
+        """The row of ``owners``' running job, kept when none runs (:mod:`.job_rows`)."""
+        return job_rows.draw_job(self.ui, self.state.jobs, owners, reserve)
 
     def draw_other_jobs(self) -> None:
-        """A status line for each job whose panel is not on screen (so a job is seen whatever
-        view is active), at the panel's end (where it moves nothing when it comes or goes)."""
+        """A row for each job whose panel is not on screen, at the panel's end."""
         shown = {self.state.panel, *(e.name for e in REGISTRY if not e.view)}
-        for job in self.state.jobs.all_running():
-            if job.owner not in shown:
-                self._draw_job_line(job)
+        job_rows.draw_others(self.ui, self.state.jobs, shown)
 
     def layout(self) -> None:
         """Re-frame after a change of what is shown or of the window size; draw captions."""
@@ -576,20 +530,6 @@ class Viewer:
             self.ui.overlay_text((x, y), text)
 
 
-def opens_later(path: Path | None, shot: Path | None, saved: Any, options: dict[str, Any]) -> bool:
-    """Whether ``meshlap view`` opens the window first and loads ``path`` as a job: a window
-    (no screenshot, no session, no option that needs the mesh) and a file larger than
-    :data:`ASYNC_OPEN_BYTES`."""
-    if path is None or shot is not None or saved is not None:
-        return False
-    if any(v is not None for v in options.values()):
-        return False
-    try:
-        return path.stat().st_size > ASYNC_OPEN_BYTES
-    except OSError:
-        return False  # said by the load, before the window
-
-
 def check_options(options: dict[str, Any], state: AppState) -> None:
     """Each panel's ``meshlap view`` options, checked before any window opens
     (:meth:`.panel_spec.PanelSpec.check_view`: parsed in place, then against the mesh)."""
@@ -631,7 +571,7 @@ def run(
         warm_up()
     state = AppState(folder=cwd)
     state.panel = state.check_panel(panel or VIEWS[0], "--panel")
-    later = path if opens_later(path, shot, saved, options) else None
+    later = path if opening.opens_later(path, shot, saved, options) else None
     if not state.mesh.load(None if later is not None else path):
         raise MeshError(state.mesh.error)
     if saved is not None:
@@ -671,7 +611,7 @@ def run(
         state.jobs.processes = True  # load and fields in child processes: no shared GIL
         prefer_gil_free_solvers()  # an eigenbasis job in a thread must not hold the GIL
         ps.set_max_fps(-1)  # polyscope's limit spins a core; the Pacer sleeps instead
-        viewer.listen()  # ... in GLFW's wait for events: input ends the pause at once
+        viewer.wait.listen(viewer.pacer)  # ... in GLFW's wait for events: input ends it
         if later is not None:
             viewer.open(later)
     if shot is not None:

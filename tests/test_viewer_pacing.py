@@ -72,18 +72,18 @@ def test_a_mouse_move_is_input_pending_a_still_mouse_is_not(viewer, monkeypatch)
 def test_without_a_glfw_window_the_pause_is_a_nap_and_the_trace_is_written(
     viewer, tmp_path, monkeypatch
 ):
-    """On the headless backends there is no GLFW window: ``listen`` keeps the nap (woken by
+    """On the headless backends there is no GLFW window: ``FrameWait.listen`` keeps the nap (woken by
     jobs' news) and sets no wake hook; ``MESHLAP_PACING_TRACE`` gets one JSON line a frame."""
     trace = tmp_path / "pacing.jsonl"
     monkeypatch.setenv("MESHLAP_PACING_TRACE", str(trace))
-    viewer.listen()
-    assert not viewer.events and viewer.state.jobs.wake is None
+    viewer.wait.listen(viewer.pacer)
+    assert not viewer.wait.events and viewer.state.jobs.wake is None
     napped: list[float] = []
     monkeypatch.setattr(viewer.state.jobs, "nap", napped.append)
-    viewer.pause(0.25)
+    viewer.wait(0.25)
     assert napped == [0.25]
     viewer.state.jobs.news.set()  # a result waits: no pause at all
-    viewer.pause(0.25)
+    viewer.wait(0.25)
     assert napped == [0.25]
     viewer.state.jobs.news.clear()
     viewer.pace = True

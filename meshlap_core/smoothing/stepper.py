@@ -370,11 +370,8 @@ class Smoother:
 
     def rewind(self, V: FloatArray, iteration: int) -> None:
         """Go back to the positions ``V (n,3)`` this smoother had at ``iteration`` (kept by the
-        caller: the smoother keeps no positions, see the Notes), e.g. a viewer stepping back.
-
-        The next step starts from ``V``; the history entries after ``iteration`` are dropped,
-        ``λ`` and a frozen factorization are kept, and a divergence is forgotten (``V`` was a
-        good state). ``rewind(V0, 0)`` is :meth:`reset`.
+        caller: a viewer stepping back); the history after it is dropped, ``λ`` and a frozen
+        factorization kept, a divergence forgotten. ``rewind(V0, 0)`` is :meth:`reset`.
 
         Raises
         ------
@@ -382,19 +379,14 @@ class Smoother:
             ``V`` is not ``(n,3)`` finite, or ``iteration`` is not an integer in
             ``[0, self.iteration]``; nothing changes.
         """
-        if isinstance(iteration, bool) or not isinstance(iteration, (int, np.integer)):
-            raise MeshError(f"must be an integer, got {iteration!r}", "iteration")
-        if not 0 <= int(iteration) <= self.iteration:
-            raise MeshError(
-                f"must be between 0 and the current {self.iteration}, got {iteration}",
-                "iteration",
-            )
+        whole = isinstance(iteration, (int, np.integer)) and not isinstance(iteration, bool)
+        if not (whole and 0 <= int(iteration) <= self.iteration):
+            problem = f"must be an integer in [0, {self.iteration}], got {iteration!r}"
+            raise MeshError(problem, "iteration")
         V = as_vertices(V, "V")  # (a new array: the caller's is never kept)
         if V.shape != self.V0.shape:
             raise MeshError(f"has {len(V)} vertices but the mesh has {self.n}", "V")
-        self._V = V
-        self.iteration = int(iteration)
-        self.diverged = False
+        self._V, self.iteration, self.diverged = V, int(iteration), False
         if self.iteration == 0:
             self._W = self._W0  # (a recomputed mass starts again from the input's)
         if self.track_history:
