@@ -16,6 +16,7 @@ import numpy as np
 
 if TYPE_CHECKING:
     from .state.app import AppState
+    from .state.preview import MeshPreview
     from .ui import UI
 
 
@@ -77,9 +78,10 @@ class Host(Protocol):
         """Frame what is shown again at the end of this frame."""
         ...
 
-    def frame(self, strip: float | None = None) -> None:
+    def frame(self, strip: float | None = None) -> bool:
         """Frame what is shown now (``strip``: an animation frame, that left fraction of the
-        width kept for the colour bar; a kept camera is not moved)."""
+        width kept for the colour bar; a kept camera is not moved); False when nothing is
+        shown yet (the camera is not moved)."""
         ...
 
     def flush_frame(self) -> None:
@@ -98,7 +100,13 @@ class Host(Protocol):
     """Long operations run as jobs of ``state.jobs`` (the window); ``False``: right away (the
     animator, headless renders, tests)."""
 
-    def draw_job(self, owner: str) -> bool:
-        """Draw the progress line and Cancel button of ``owner``'s running job (a panel passes
-        its name); True when one runs."""
+    def loading(self) -> tuple[str, MeshPreview | None] | None:
+        """The mesh file being opened (a job of the Mesh section): its name, and its preview
+        once it is parsed (then shown in place of the mesh); ``None`` when none is."""
+        ...
+
+    def draw_job(self, *owners: str, reserve: bool = True) -> bool:
+        """Draw the progress row (bar and Cancel button) of the running job of each of
+        ``owners`` (a panel passes its name); True when one runs. With none running an empty
+        row keeps its place (``reserve=False``: where a button of the same height takes it)."""
         ...

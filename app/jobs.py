@@ -155,10 +155,16 @@ class Job:
     def line(self) -> str:
         """``title: phase, 3.2 s (40 %)``: the progress line (the tenths make it move on every
         frame)."""
+        head, tail = self.line_parts()
+        return head + tail
+
+    def line_parts(self) -> tuple[str, str]:
+        """The progress line as ``("title: phase", ", 3.2 s (40 %)")``: what the job does,
+        and what moves (a bar too narrow for both cuts the first at its end)."""
         r = self.reporter
         frac = f" ({100 * r.fraction:.0f} %)" if r.fraction is not None else ""
         phase = f": {r.phase}" if r.phase else ""
-        return f"{self.title}{phase}, {self.elapsed():.1f} s{frac}"
+        return f"{self.title}{phase}", f", {self.elapsed():.1f} s{frac}"
 
     def run(self) -> None:
         """The worker's body: ``work(reporter)``, its outcome kept for :meth:`Jobs.poll`."""
@@ -198,6 +204,10 @@ class Jobs:
         self.cancelled = 0  # jobs cancelled so far (superseded or by the user)
         self.processes = False  # offload() may use child processes (the window sets it)
         self.news = threading.Event()  # a result or a partial result waits for poll()
+        # owner -> (title, how it ended, seconds it ran, when): the last job of each owner
+        self.ended: dict[str, tuple[str, str, float, float]] = {}
+        # also told of news, from the job's thread: the window's wait for events ends on it
+        self.wake: Callable[[], None] | None = None
 
     # ------------------------------------------------------------------ start / cancel
     def start(
@@ -230,7 +240,7 @@ class Jobs:
             if not replace:
                 return None
             self.cancel(owner)
-        reporter = Reporter(threading.Event(), self.clock, self._reported, self.news.set)
+        reporter = Reporter(threading.Event(), self.clock, self._reported, self._news)
         job = Job(owner, title, work, apply, fail, reporter, self.clock(), self.clock, preview)
         self._jobs[owner] = job
         if self.background if background is None else background:
@@ -245,7 +255,13 @@ class Jobs:
         job.run()
         with self._lock:
             self._finished.append(job)
+        self._news()
+
+    def _news(self) -> None:
+        """Something waits for :meth:`poll` (any thread): set :attr:`news`, call :attr:`wake`."""
         self.news.set()
+        if self.wake is not None:
+            self.wake()
 
     def _reported(self) -> None:
         self.last_report = self.clock()
@@ -258,6 +274,7 @@ class Jobs:
             return False
         job.cancel_event.set()
         job.status = CANCELLED
+        self.ended[owner] = (job.title, CANCELLED, job.elapsed(), self.clock())
         self.cancelled += 1
         self._jobs.pop(owner, None)
         return True
@@ -297,11 +314,21 @@ class Jobs:
             return False
         del self._jobs[job.owner]
         job.status = job.outcome
+        self.ended[job.owner] = (job.title, job.status, job.elapsed(), self.clock())
         if job.outcome == DONE:
             job.apply(job.result)
         elif job.outcome == FAILED and job.fail is not None:
             job.fail(job.error)
         return True
+
+    def last_outcome(self, *owners: str) -> str:
+        """How the last job of ``owners`` ended, as the row it had says it
+        (``done: title (1.2 s)``, ``cancelled: title (after 2.0 s)``); ``""`` when none ran."""
+        ends = [self.ended[o] for o in owners if o in self.ended]
+        if not ends:
+            return ""
+        title, how, seconds, _ = max(ends, key=lambda e: e[3])
+        return f"{how}: {title} ({'after ' if how != DONE else ''}{seconds:.1f} s)"
 
     def running(self, owner: str | None = None) -> Job | None:
         """``owner``'s running job (any owner's when ``None``), else ``None``."""

@@ -10,6 +10,8 @@ preview if validation left the geometry as parsed (no second registration and up
 millions of triangles; the child sends the mesh back without that geometry, the window holds
 it already), and the Curvature panel uploads the final colours. A job that fails or is
 cancelled after its preview brings the previous mesh back (:func:`restore_mesh`).
+:func:`opens_later` says when ``meshlap view FILE`` opens the window first and loads the
+file that way.
 
 Imports polyscope.
 """
@@ -28,6 +30,11 @@ from .jobs import Reporter
 from .registry import REGISTRY
 from .scene import MESH
 from .state.preview import PREVIEW_LABEL, MeshPreview
+
+ASYNC_OPEN_BYTES = 8 * 2**20
+"""``meshlap view FILE`` with a larger file opens the window on the bundled mesh at once and
+loads FILE as a job (progress and Cancel in the Mesh section); a smaller file is loaded before
+the window opens (a bad one exits 2 as every command does)."""
 
 
 def open_mesh(viewer: Any, path: Path | None) -> bool:
@@ -59,6 +66,7 @@ def open_mesh(viewer: Any, path: Path | None) -> bool:
         state.mesh.error = message
 
     name = Path(path).name if path is not None else "the default mesh"
+    viewer.opening = name  # the Mesh section says so while the job runs (Viewer.loading)
     job = state.jobs.start(
         section,
         f"opening {name}",
@@ -153,3 +161,17 @@ def restore_mesh(viewer: Any) -> None:
     window.set_title(window.window_title(mesh.name, True))
     viewer.refresh()
     viewer.reframe = True
+
+
+def opens_later(path: Path | None, shot: Path | None, saved: Any, options: dict[str, Any]) -> bool:
+    """Whether ``meshlap view`` opens the window first and loads ``path`` as a job: a window
+    (no screenshot, no session, no option that needs the mesh) and a file larger than
+    :data:`ASYNC_OPEN_BYTES`."""
+    if path is None or shot is not None or saved is not None:
+        return False
+    if any(v is not None for v in options.values()):
+        return False
+    try:
+        return path.stat().st_size > ASYNC_OPEN_BYTES
+    except OSError:
+        return False  # said by the load, before the window

@@ -10,8 +10,16 @@ gets the core). The rule:
   recording): :data:`FULL_FPS`;
 - a job runs: :data:`BUSY_FPS` (the progress line still moves several times a second);
 - otherwise *idle*: :data:`IDLE_FPS`, and :data:`DEEP_IDLE_FPS` after :data:`DEEP_IDLE_AFTER_S`
-  (each idle frame still costs tens of milliseconds of CPU with a software OpenGL); the first
-  input event wakes it within one idle frame.
+  (each idle frame still costs tens of milliseconds of CPU with a software OpenGL).
+
+Input is never kept waiting by the pause: in the window the pause is GLFW's wait for events
+(:func:`.window.wait_events`), which ends as soon as input (or a job's news, posted as an
+empty event) arrives, and a frame that starts with input pending (``wait(input_now=True)``:
+the key or the mouse arrived during the last frame's drawing) does not pause at all. Before,
+the pause was a plain sleep placed before the frame read its input: a key pressed at 2
+frames/s waited out the rest of one pause, then a whole second one, and showed 1–2 s later.
+With ``MESHLAP_PACING_TRACE=<file>`` the window appends one JSON line per frame (see
+:meth:`Pacer.wait`), to see why a frame came late.
 """
 
 from __future__ import annotations
@@ -29,9 +37,11 @@ IDLE_FPS = 4.0
 """Frames per second with nothing happening (< 10 % of a core on a 692k-vertex mesh)."""
 IDLE_AFTER_S = 1.0
 """Seconds without input after which the window drops to the idle rate."""
-DEEP_IDLE_FPS = 2.0
-"""Frames per second after :data:`DEEP_IDLE_AFTER_S` without input (< 10 % of a core with
-Mesa's llvmpipe at 1280×720; the first input is answered within half a second)."""
+DEEP_IDLE_FPS = 1.0
+"""Frames per second after :data:`DEEP_IDLE_AFTER_S` without input (a few % of a core with
+Mesa's llvmpipe at 1280×720). Input does not wait for the next idle frame (the pause is a
+wait for events, see the module docstring), so this rate costs no answer time: it was 2 while
+the first input waited out the pause."""
 DEEP_IDLE_AFTER_S = 4.0
 
 
@@ -58,6 +68,8 @@ class Pacer:
     last_frame: float | None = None
     max_busy_gap: float = 0.0  # longest time between two frames while a job ran
     mode: str = "active"
+    trace: Callable[[dict[str, float | str | bool]], None] | None = None  # one call per wait
+    frames: int = 0  # waits so far (one per frame)
 
     def __post_init__(self) -> None:
         self.last_input = self.clock()
@@ -78,17 +90,40 @@ class Pacer:
             return self.busy_fps
         return self.deep_fps if quiet >= self.deep_after else self.idle_fps
 
-    def wait(self, busy: bool, animating: bool = False) -> float:
-        """Sleep what is left of this frame's period; returns the seconds slept."""
+    def wait(self, busy: bool, animating: bool = False, input_now: bool = False) -> float:
+        """Sleep what is left of this frame's period; returns the pause asked of the sleep.
+
+        ``input_now``: the frame starts with input to answer (it counts as :meth:`touch`, and
+        nothing is slept: the answer is drawn in this frame). The sleep given to the pacer may
+        end early (the window's ends on any input event); the next frame then reads that input.
+        :attr:`trace`, when set, gets one record per call: ``frame`` (its number), ``start`` /
+        ``end`` (the clock before and after the pause), ``pause`` (the seconds it was meant
+        to last), ``fps``, ``mode`` and ``input`` (``input_now``).
+        """
+        if input_now:
+            self.touch()
         fps = self.rate(busy, animating)
-        now = self.clock()
+        start = self.clock()
         pause = 0.0
-        if self.last_frame is not None and fps > 0:
-            pause = max(0.0, 1.0 / fps - (now - self.last_frame))
+        if self.last_frame is not None and fps > 0 and not input_now:
+            pause = max(0.0, 1.0 / fps - (start - self.last_frame))
             if pause > 0:
                 self.sleep(pause)
         now = self.clock()
         if busy and self.last_frame is not None:
             self.max_busy_gap = max(self.max_busy_gap, now - self.last_frame)
         self.last_frame = now
+        self.frames += 1
+        if self.trace is not None:
+            self.trace(
+                {
+                    "frame": self.frames,
+                    "start": start,
+                    "end": now,
+                    "pause": pause,
+                    "fps": fps,
+                    "mode": self.mode,
+                    "input": input_now,
+                }
+            )
         return pause

@@ -209,6 +209,14 @@ FRONT_VIEWS: dict[str, tuple[float, float, float]] = {
 OBLIQUE_VIEW = (0.55, 0.75, -1.0)
 
 
+def register_surface(name: str, P: np.ndarray, F: np.ndarray, shown: bool) -> Any:
+    """``ps.register_surface_mesh`` (smooth shading) shown or hidden as told: polyscope
+    remembers a structure's enabled flag by its name, so a copy removed while hidden (a new
+    mesh opened in another view) came back hidden when registered again (the Smoothing view
+    stayed empty until re-entered)."""
+    return ps.register_surface_mesh(name, P, F, smooth_shade=True, enabled=bool(shown))
+
+
 def box_of(P: np.ndarray) -> np.ndarray:
     """``[min, max]`` ``(2,3)`` of the points ``P (k,3)`` (``(0,3)`` when there are none): what
     :func:`frame_points` reads of a structure (its bounding box's corners frame the same)."""
@@ -296,17 +304,23 @@ def frame_scene_left(
     fraction: float = 0.6,
     toward_eye: tuple[float, float, float] = DEFAULT_VIEW,
     left: float = 0.0,
-) -> None:
+) -> bool:
     """Frame the enabled structures among ``names`` between ``left`` and ``fraction`` of the
     width (:func:`frame_points`); ``points(name)`` gives a structure's display positions
-    ``(k,3)`` (``None``: unknown)."""
+    ``(k,3)`` (``None``: unknown). False, and the camera untouched, when none is shown yet
+    (a view whose structures a job still computes): the caller frames again when they are
+    (polyscope's home view, fitted to whatever else is registered, could put the camera
+    inside the surface that comes next)."""
     pts = []
     for name in names:
         if ps.has_surface_mesh(name) and ps.get_surface_mesh(name).is_enabled():
             P = points(name)
-            if P is not None:
+            if P is not None and len(P):
                 pts.append(P)
-    frame_points(np.vstack(pts) if pts else np.zeros((0, 3)), toward_eye, fraction, left)
+    if not pts:
+        return False
+    frame_points(np.vstack(pts), toward_eye, fraction, left)
+    return True
 
 
 def save_screenshot(path: Path) -> None:

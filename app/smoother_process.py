@@ -42,6 +42,7 @@ garbage-collected ends its child and frees the block. Where no child process can
 from __future__ import annotations
 
 import weakref
+from collections import deque
 from typing import Any
 
 import numpy as np
@@ -63,6 +64,7 @@ from .ipc import (
     unpack,
 )
 from .jobs import Reporter
+from .state.kept_steps import KeptSteps
 
 
 def vertex_normals(V: FloatArray, F: IntArray, incidence: Any = None) -> np.ndarray:
@@ -190,9 +192,12 @@ def display_arrays(
             out[1][:, i] = N[:, p] if g > 0 else -N[:, p]
 
 
-def _snapshot(sm: Any) -> dict[str, Any]:
-    """What the proxy mirrors of the stepper after each command (small: no per-vertex data)."""
+def _snapshot(sm: Any, kept: KeptSteps | None = None) -> dict[str, Any]:
+    """What the proxy mirrors of the stepper after each command (small: no per-vertex data);
+    ``kept``: the steps the child keeps for stepping back (how many, from which iteration)."""
     return {
+        "kept": kept.capacity if kept is not None else 0,
+        "kept_from": kept.oldest if kept is not None else 0,
         "iteration": sm.iteration,
         "lam": sm.lam,
         "taubin_nu": sm.taubin_nu,
@@ -219,9 +224,12 @@ def _serve(
     depth: int = PIPELINE,
 ) -> None:
     """Body of the child: build the stepper (reporting each phase), then answer commands
-    (``step`` with a count, ``reset``, ``set_lam``, ``diverge``, ``close``) until ``close`` or
-    the pipe ends; after each one the positions (and normals) are in the shared block (the
-    file ``path``) and a snapshot is sent. ``inputs``: ``(V, F)`` packed by the parent."""
+    (``step`` with a count, ``rewind`` to an iteration, ``reset``, ``set_lam``, ``diverge``,
+    ``close``) until ``close`` or the pipe ends; after each one the positions (and normals)
+    are in the shared block (the file ``path``) and a snapshot is sent. The positions of the
+    last steps are kept (:class:`~.state.kept_steps.KeptSteps`) for ``rewind``; a command
+    other than a step that arrives during a batch of steps ends the batch (a pause is not
+    kept waiting by steps nobody will see). ``inputs``: ``(V, F)`` packed by the parent."""
     from .state.smoothing import SmoothingState
 
     V, F = unpack(inputs)
@@ -229,6 +237,7 @@ def _serve(
     start, slots = _blocks(block, len(V), depth)
     view: tuple[float, ...] | None = None  # the window's display transform, once sent
     answers = 0  # answers published: the next goes to slot answers % depth
+    kept = KeptSteps(len(V))
     try:
         sm = SmoothingState.build(V, F, options, ChildReporter(conn))
         start[...] = sm.V0
@@ -238,7 +247,7 @@ def _serve(
             nonlocal answers
             slot = answers % depth
             cur, nrm, shown = slots[slot]
-            snap = _publish(sm, cur, nrm, incidence)
+            snap = _publish(sm, cur, nrm, incidence, kept)
             if view is not None:
                 display_arrays(sm.V, nrm if normals else None, view, shown)
             snap["view"], snap["slot"] = view, slot
@@ -246,28 +255,25 @@ def _serve(
             return snap
 
         reply: tuple[Any, ...] = ("ready", publish())
+        held: tuple[Any, ...] | None = None  # a command read during a batch of steps
         while True:
             conn.send(reply)
             try:
-                cmd, *args = conn.recv()
+                cmd, *args = held if held is not None else conn.recv()
             except (EOFError, OSError):
                 return
+            held = None
             if cmd == "close":
                 return
             try:
                 if cmd == "step":  # args: how many (stops at a divergence), the view
-                    count = args[0] if args else 1
-                    for i in range(count):
-                        if sm.diverged:
-                            break
-                        # the window shows the last step's figures only: an implicit step
-                        # (which cannot diverge) is measured only when it is the last
-                        sm.track_history = sm.method != "implicit" or i == count - 1
-                        sm.step()
-                    sm.track_history = True
+                    held = _steps(sm, kept, args[0] if args else 1, conn)
                     view = args[1] if len(args) > 1 and args[1] is not None else view
+                elif cmd == "rewind":
+                    kept.rewind(sm, args[0])
                 elif cmd == "reset":
                     sm.reset()
+                    kept.clear()
                 elif cmd == "set_lam":
                     sm.set_lam(args[0])
                 elif cmd == "diverge":
@@ -284,6 +290,36 @@ def _serve(
         conn.close()
 
 
+def _steps(sm: Any, kept: KeptSteps, count: int, conn: Any) -> tuple[Any, ...] | None:
+    """Up to ``count`` steps (stopping at a divergence), each kept; between two steps a
+    command that arrived is read: another step request waits its turn, anything else ends
+    the batch. Returns the command read, if any (``("close",)`` when the pipe ended)."""
+    held: tuple[Any, ...] | None = None
+    n = max(1, int(count))
+    try:
+        for i in range(n):
+            if sm.diverged:
+                break
+            if i and held is None and conn.poll():
+                try:
+                    held = tuple(conn.recv())
+                except (EOFError, OSError):
+                    return ("close",)
+                if held[0] != "step":
+                    break
+            # the window shows the batch's last step's figures only: an implicit step (which
+            # cannot diverge) is measured only when it may be the last (the count's end, or a
+            # command waiting that ends the batch after it)
+            last = i == n - 1 or (held is None and conn.poll())
+            sm.track_history = sm.method != "implicit" or last
+            sm.step()
+            if not sm.diverged:
+                kept.record(sm.iteration, sm.V)
+    finally:
+        sm.track_history = True
+    return held
+
+
 def _send(conn: Any, message: tuple[Any, ...]) -> None:
     try:
         conn.send(message)
@@ -291,13 +327,15 @@ def _send(conn: Any, message: tuple[Any, ...]) -> None:
         pass
 
 
-def _publish(sm: Any, cur: np.ndarray, nrm: np.ndarray, incidence: Any) -> dict[str, Any]:
+def _publish(
+    sm: Any, cur: np.ndarray, nrm: np.ndarray, incidence: Any, kept: KeptSteps | None = None
+) -> dict[str, Any]:
     """Write the stepper's positions (and, given the face ``incidence``, its normals) into
     the shared block; its snapshot."""
     cur[...] = sm.V
     if incidence is not None:
         nrm[...] = vertex_normals(sm.V, sm.F, incidence)
-    return _snapshot(sm)
+    return _snapshot(sm, kept)
 
 
 def _shutdown(child: Child, block: SharedBlock) -> None:
@@ -337,7 +375,7 @@ class RemoteSmoother:
         self.n = len(V)
         self.F = F
         self.reference = V
-        self._depth = depth  # requests on their way at most (the child's slots)
+        self.depth = depth  # requests on their way at most (the child's slots)
         self._start, self._slots = _blocks(block, self.n, depth)
         self._view: tuple[float, ...] | None = None  # the view of the display arrays held
         self._display: np.ndarray | None = None  # (2,n,3) float32 copied with each step
@@ -346,8 +384,10 @@ class RemoteSmoother:
         self.V0 = self._V
         self.normals: np.ndarray | None = None
         self.box: np.ndarray | None = None  # (2,3) min and max of V (the child's)
-        self._pending = 0  # step requests on their way, their answers not read yet
+        self._queue: deque[str] = deque()  # requests on their way ("step", "rewind"), in order
         self._arrived = False  # a step's answer read, not yet collected by poll
+        self.kept = 0  # steps the child keeps for stepping back, and from which iteration
+        self.kept_from = 0
         self.error = ""
         self.history: list[dict[str, Any]] = []
         self._solver: dict[str, Any] = {}
@@ -413,7 +453,8 @@ class RemoteSmoother:
 
     def _adopt(self, snap: dict[str, Any]) -> None:
         """Mirror a snapshot and copy the positions (and normals) out of the shared block."""
-        for key in ("iteration", "lam", "taubin_nu", "k_pb", "stability", "n_factorizations"):
+        keys = ("iteration", "lam", "taubin_nu", "k_pb", "stability", "n_factorizations")
+        for key in (*keys, "kept", "kept_from"):
             setattr(self, key, snap[key])
         self._diverged = snap["diverged"]
         self._divergence = snap["divergence"]
@@ -494,46 +535,67 @@ class RemoteSmoother:
     # ------------------------------------------------------------------ asynchronous steps
     @property
     def pending(self) -> bool:
-        """A step was asked for and its answer has not been read."""
-        return self._pending > 0
+        """A step (or a rewind) was asked for and its answer has not been read."""
+        return bool(self._queue)
 
     def request_step(self, count: int = 1, view: tuple[float, ...] | None = None) -> bool:
         """Ask for ``count`` steps (shown together) and return at once (False: already
         :data:`PIPELINE` requests on their way: the child has work queued). ``view``: the
         window's display transform (:func:`display_arrays`): the child then also writes the
         positions and normals as the window uploads them."""
-        if self._pending >= self._depth:
+        if len(self._queue) >= self.depth:
             return False
         self._child.send(("step", max(1, int(count)), view))
-        self._pending += 1
+        self._queue.append("step")
         return True
 
+    def request_rewind(self, iteration: int) -> None:
+        """Ask the child to go back to the positions of ``iteration`` (kept there, see
+        :class:`~.state.kept_steps.KeptSteps`) and return at once: *pause* (the iteration on
+        screen) and *step back*. The answers of the requests sent before it are thrown away
+        unread when they arrive: the steps the child ran ahead are never shown. Always sent,
+        also with :data:`PIPELINE` requests on their way (the slot its answer overwrites
+        belongs to one of those, which is never read)."""
+        self._child.send(("rewind", int(iteration)))
+        self._queue.append("rewind")
+
     def poll(self) -> bool:
-        """Read the answers of the steps asked for that are there (never waits). True when a
-        step's answer arrived since the last poll (read here or by a synchronous call).
+        """Read the answers of the requests that are there (never waits). True when a step's
+        (or a rewind's) answer arrived since the last poll (read here or by a synchronous
+        call).
 
         Raises
         ------
         MeshError
-            The step failed (e.g. ``W − λK`` could not be factorized) or the child ended.
+            The step failed (e.g. ``W − λK`` could not be factorized), the rewind found no
+            kept positions, or the child ended.
         """
-        while self._pending and self._child.ready():
-            self._pending -= 1
-            self._wait()
-            self._arrived = True
+        while self._queue and self._child.ready():
+            self._read_next()
         arrived, self._arrived = self._arrived, False
         return arrived
+
+    def _read_next(self) -> None:
+        """Read the oldest answer on its way: adopt it, or throw it away when a rewind was
+        asked for after it (its positions would never be the ones shown)."""
+        self._queue.popleft()
+        if "rewind" in self._queue:
+            try:
+                self._child.receive(None)
+            except MeshError:
+                pass  # a step that failed, superseded by the rewind anyway
+            return
+        self._wait()
+        self._arrived = True
 
     def finish(self) -> None:
         """Wait for the steps on their way (:meth:`poll` then reports them)."""
         self._drain()
 
     def _drain(self) -> None:
-        """Wait for the steps on their way (a synchronous call comes after them)."""
-        while self._pending:
-            self._pending -= 1
-            self._wait()
-            self._arrived = True
+        """Wait for the requests on their way (a synchronous call comes after them)."""
+        while self._queue:
+            self._read_next()
 
     def close(self) -> None:
         """End the child and free the shared block (the proxy is unusable afterwards)."""

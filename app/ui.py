@@ -48,6 +48,21 @@ MODIFIERS = ("shift", "ctrl", "alt")
 RGBA = tuple[float, float, float, float]
 
 
+def fit_text(text: str, width: float, measure: Any) -> str:
+    """``text`` cut at its end to ``width`` pixels with ``...`` (``measure(s)[0]``: a string's
+    width); the whole text when it fits."""
+    if float(measure(text)[0]) <= width:
+        return text
+    lo, hi = 0, len(text)  # the longest prefix that fits with the dots
+    while lo < hi:
+        mid = (lo + hi + 1) // 2
+        if float(measure(text[:mid].rstrip() + "...")[0]) <= width:
+            lo = mid
+        else:
+            hi = mid - 1
+    return text[:lo].rstrip() + "..."
+
+
 class UI(FieldErrors, Plots):
     """imgui/implot for the panels (see the module docstring).
 
@@ -217,10 +232,42 @@ class UI(FieldErrors, Plots):
     def separator(self) -> None:
         self.im.Separator()
 
-    def progress(self, fraction: float, text: str) -> None:
-        """A progress bar (``fraction`` in [0, 1]) with ``text`` on it."""
-        self.im.ProgressBar(float(fraction), (-1, 0), text)
-        self._record_progress(float(fraction), text)
+    def progress(self, fraction: float, text: str, tail: str = "", width: float = -1.0) -> None:
+        """A progress bar (``fraction`` in [0, 1]) with ``text`` and ``tail`` on it, ``width``
+        pixels wide (-1: to the panel's edge). Text too long for the bar is cut at its end
+        (``...``), keeping ``tail`` (the elapsed time and the percentage: the line still
+        moves); ImGui would cut its beginning, what the bar is about."""
+        im = self.im
+        bar = float(width) if width > 0 else float(im.GetContentRegionAvail()[0])
+        room = bar - 2 * float(im.GetStyle().FramePadding[0])
+        shown = fit_text(text, room - float(im.CalcTextSize(tail)[0]), im.CalcTextSize) + tail
+        if float(im.CalcTextSize(shown)[0]) > room:  # not even the tail fits: cut it too
+            shown = fit_text(text + tail, room, im.CalcTextSize)
+        im.ProgressBar(float(fraction), (bar, 0), shown)
+        self._record_progress(float(fraction), text + tail)
+
+    def job_row(self, fraction: float, text: str, tail: str, button: str, tooltip: str) -> bool:
+        """A job's row: its progress bar and, on the same row, a button (Cancel); True when
+        the button was pressed. One row, as high as :meth:`status_row`."""
+        im = self.im
+        label = button.split("##")[0]
+        size = float(im.CalcTextSize(label)[0]) + 2 * float(im.GetStyle().FramePadding[0])
+        spacing = float(im.GetStyle().ItemSpacing[0])
+        avail = float(im.GetContentRegionAvail()[0])
+        self.progress(fraction, text, tail, max(avail - size - spacing, 1.0))
+        im.SameLine()
+        return self.button(button, tooltip)
+
+    def status_row(self, text: str) -> None:
+        """A row as high as a widget's with ``text`` in grey, cut to one line (empty: a blank
+        row): the place a job's row takes when it runs, so the widgets below never move when
+        a job starts or ends."""
+        im = self.im
+        if not text:
+            im.Dummy((1.0, float(im.GetFrameHeight())))
+            return
+        im.AlignTextToFramePadding()  # the line as high as a framed widget's
+        im.TextColored(GREY, fit_text(text, float(im.GetContentRegionAvail()[0]), im.CalcTextSize))
 
     def _record_progress(self, fraction: float, text: str) -> None:
         """Hook called after :meth:`progress` drew a bar (a job's progress line)."""
@@ -538,6 +585,18 @@ class UI(FieldErrors, Plots):
             int(io.KeyMods),
             bool(im.IsAnyItemActive()),
         )
+
+    def keys_down(self) -> bool:
+        """Is any key of the keyboard down this frame (a key press waiting to be answered)?"""
+        im = self.im
+        keys = self.__dict__.get("_keyboard")
+        if keys is None:  # imgui's named keys (ImGuiKey_NamedKey_BEGIN .. END), made once
+            known = {int(k) for k in im.ImGuiKey}
+            first, end = int(im.ImGuiKey_NamedKey_BEGIN), int(im.ImGuiKey_NamedKey_END)
+            keys = self.__dict__["_keyboard"] = [
+                im.ImGuiKey(k) for k in range(first, end) if k in known
+            ]
+        return any(im.IsKeyDown(k) for k in keys)
 
     def overlay_text(self, pos: tuple[float, float], text: str) -> None:
         """Text drawn over the 3D view at window pixel ``pos``, moved left to end before

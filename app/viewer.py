@@ -27,8 +27,9 @@ import polyscope as ps
 from meshlap_core.errors import MeshError
 from meshlap_core.options import UP_AXES, check_choice
 
-from . import opening, scene, window
-from .jobs import Job, Reporter, prefer_gil_free_solvers, warm_up
+from . import job_rows, opening, scene, window
+from .frame_wait import FrameWait
+from .jobs import prefer_gil_free_solvers, warm_up
 from .pacing import Pacer
 from .panels.base import Panel, Pick
 from .registry import REGISTRY, VIEWS
@@ -42,11 +43,6 @@ NO_DISPLAY = (
     "no display could be opened for the viewer window; render headless with "
     "`meshlap view MESH --screenshot out.png`"
 )
-
-ASYNC_OPEN_BYTES = 8 * 2**20
-"""``meshlap view FILE`` with a larger file opens the window on the bundled mesh at once and
-loads FILE as a job (progress and Cancel in the Mesh section); a smaller file is loaded before
-the window opens (a bad one exits 2 as every command does)."""
 
 
 def init_polyscope(backend: str) -> None:
@@ -104,7 +100,8 @@ class Viewer:
         self.panels = make_panels(state)
         self.background = False  # long operations run as jobs (the window; False: inline)
         self.pace = False  # the window sleeps between frames (Pacer); tests tick freely
-        self.pacer = Pacer(sleep=state.jobs.nap)  # woken when a job has something to show
+        self.wait = FrameWait(state.jobs)  # the pause: ended by input and by jobs' news
+        self.pacer = Pacer(sleep=self.wait)
         self._activity: tuple[Any, ...] = ()
         self.reframe = True  # frame the visible structures at the end of the next frame
         self.whole = False  # R: the next framing shows the whole subject (no view's focus)
@@ -115,6 +112,7 @@ class Viewer:
         self._logged: set[tuple[str, str]] = set()
         self._caption_boxes: dict[str, tuple[np.ndarray, np.ndarray]] = {}
         self.preview: MeshPreview | None = None  # a mesh being opened, shown as parsed
+        self.opening = ""  # the name of the file a job of the Mesh section opens
         self.preview_fit: tuple[Any, ...] = ()  # the display fit its points were made with
         self.no_shadow = False  # the ground's shadow is off for a big mesh (scene.shadow_for)
 
@@ -282,11 +280,13 @@ class Viewer:
         ui = self.ui
         jobs = self.state.jobs
         if self.pace:
-            self.pacer.wait(jobs.busy, self.active().animating())  # idle is idle, play is not
+            # idle is idle, play is not; input pending is answered in this frame
+            self.pacer.wait(jobs.busy, self.active().animating(), self.input_pending())
         self.draw_guarded("jobs", lambda host: host.poll_jobs())
+        # the keys before the panels draw: the frame that reads a key draws its answer
+        self.draw_guarded("keys", lambda host: host.handle_keys())
         ui.push_width(200)
         try:
-            self.draw_guarded("jobs", lambda host: host.draw_other_jobs())
             viewed = False
             for e in REGISTRY:
                 if not e.view:
@@ -295,18 +295,25 @@ class Viewer:
                     viewed = True
                     self.draw_guarded("view", lambda host: host.draw_view_combo())
                     self.draw_guarded(self.state.panel, self.active().draw)
+            # last: a job row that comes and goes here moves no widget
+            self.draw_guarded("jobs", lambda host: host.draw_other_jobs())
         finally:
             ui.pop_width()
         for name, p in self.panels.items():
             self.draw_guarded(name, p.sync, show=False)
         self.draw_guarded("picking", lambda host: host.handle_click())
-        self.draw_guarded("keys", lambda host: host.handle_keys())
         self.draw_guarded("labels", lambda host: host.limit_overlays())
         self.draw_guarded("labels", self.active().overlay)
         self.draw_guarded("layout", lambda host: host.layout())
         self.draw_guarded("pacing", lambda host: host.note_activity())
 
     # ------------------------------------------------------------------ jobs, pacing
+    def input_pending(self) -> bool:
+        """This frame starts with input to answer (the mouse moved or a button, the wheel, a
+        modifier or an active widget changed since the last frame ended, or a key is down):
+        the pacer does not pause before answering it."""
+        return self.ui.activity() != self._activity or self.ui.keys_down()
+
     def poll_jobs(self) -> None:
         """Apply what the finished jobs computed (here, on the UI thread)."""
         if self.state.jobs.poll():
@@ -322,28 +329,20 @@ class Viewer:
             self.pacer.touch()
         self._activity = now
 
-    def draw_job(self, owner: str) -> bool:
-        """The progress line and a Cancel button of ``owner``'s running job (drawn in the
-        panel that owns it); True when one runs."""
-        job = self.state.jobs.running(owner)
-        if job is None:
-            return False
-        self._draw_job_line(job)
-        return True
+    def loading(self) -> tuple[str, MeshPreview | None] | None:
+        """The file being opened and its preview once parsed (see :class:`.host.Host`)."""
+        if not self.opening or self.state.jobs.running(REGISTRY[0].name) is None:
+            return None
+        return self.opening, self.preview
 
-    def _draw_job_line(self, job: Job) -> None:
-        r: Reporter = job.reporter
-        self.ui.progress(r.fraction if r.fraction is not None else 0.0, job.line())
-        if self.ui.button(f"Cancel##{job.owner}", f"stop: {job.title} (what is shown stays)"):
-            self.state.jobs.cancel(job.owner)
+    def draw_job(self, *owners: str, reserve: bool = True) -> bool:
+        """The row of ``owners``' running job, kept when none runs (:mod:`.job_rows`)."""
+        return job_rows.draw_job(self.ui, self.state.jobs, owners, reserve)
 
     def draw_other_jobs(self) -> None:
-        """A status line for each job whose panel is not on screen (so a job is seen whatever
-        view is active)."""
+        """A row for each job whose panel is not on screen, at the panel's end."""
         shown = {self.state.panel, *(e.name for e in REGISTRY if not e.view)}
-        for job in self.state.jobs.all_running():
-            if job.owner not in shown:
-                self._draw_job_line(job)
+        job_rows.draw_others(self.ui, self.state.jobs, shown)
 
     def layout(self) -> None:
         """Re-frame after a change of what is shown or of the window size; draw captions."""
@@ -352,9 +351,11 @@ class Viewer:
             if size != self.window_size:
                 self.fit_panel()
             self.window_size = size
-            self.reframe = False
-            self.frame(whole=self.whole)
-            self.whole = False
+            # nothing shown yet (a view's structures still being computed): frame them when
+            # they appear (before, polyscope's home view put the camera inside the lab's torus)
+            self.reframe = not self.frame(whole=self.whole)
+            if not self.reframe:
+                self.whole = False
         self.draw_captions()
 
     def limit_overlays(self) -> None:
@@ -467,32 +468,36 @@ class Viewer:
         own = getattr(self.active(), "view_direction", None)
         return own or scene.FRONT_VIEWS.get(self.state.mesh.name, scene.DEFAULT_VIEW)
 
-    def frame(self, strip: float | None = None, whole: bool = False) -> None:
+    def frame(self, strip: float | None = None, whole: bool = False) -> bool:
         """Frame what the active view shows in the part of the window left of meshlap's panel
         (a view may frame its own way: the one-ring its selected vertex; ``whole``: not that
         way, the whole subject, as R does). ``strip``: an animation frame (no panel), keeping
         that left fraction of the width clear for the colour bar; nothing happens when the
-        animation keeps a saved camera."""
+        animation keeps a saved camera. False when the view shows nothing yet (its structures
+        come from a job): the camera is not moved."""
         if strip is not None:
             if not self.keep_camera:
                 scene.frame_scene_left(
                     self.framed_names(), self.structure_box, 0.95, self.view_direction(), strip
                 )
-            return
+            return True
         if not whole and self.active().focus(self):
-            return
+            return True
         w, _ = ps.get_window_size()
         pane = ps.get_right_gui_pane_width() * self.state.ui_scale  # at most half (fit_panel)
         fraction = max(scene.scene_fraction(w, self.state.ui_scale), 0.95 * (1 - pane / w))
         left = scene.COLORBAR_PX * self.state.ui_scale / max(w, 1)  # clear of the colour bar
         names = self.framed_names()
-        scene.frame_scene_left(names, self.structure_box, fraction, self.view_direction(), left)
+        framed = scene.frame_scene_left(
+            names, self.structure_box, fraction, self.view_direction(), left
+        )
         self._caption_boxes = {}
         for name in names:
             if ps.has_surface_mesh(name) and ps.get_surface_mesh(name).is_enabled():
                 box = self.structure_box(name)
                 if box is not None and len(box):
                     self._caption_boxes[name] = (box[0], box[1])
+        return framed
 
     def captions(self) -> dict[str, str]:
         """Caption of each structure the active view shows side by side."""
@@ -523,20 +528,6 @@ class Viewer:
             x = float(xy[:, 0].mean()) - 3.5 * len(text) * self.ui.scale
             y = float(min(xy[:, 1].max() + 8, h - 24))
             self.ui.overlay_text((x, y), text)
-
-
-def opens_later(path: Path | None, shot: Path | None, saved: Any, options: dict[str, Any]) -> bool:
-    """Whether ``meshlap view`` opens the window first and loads ``path`` as a job: a window
-    (no screenshot, no session, no option that needs the mesh) and a file larger than
-    :data:`ASYNC_OPEN_BYTES`."""
-    if path is None or shot is not None or saved is not None:
-        return False
-    if any(v is not None for v in options.values()):
-        return False
-    try:
-        return path.stat().st_size > ASYNC_OPEN_BYTES
-    except OSError:
-        return False  # said by the load, before the window
 
 
 def check_options(options: dict[str, Any], state: AppState) -> None:
@@ -580,7 +571,7 @@ def run(
         warm_up()
     state = AppState(folder=cwd)
     state.panel = state.check_panel(panel or VIEWS[0], "--panel")
-    later = path if opens_later(path, shot, saved, options) else None
+    later = path if opening.opens_later(path, shot, saved, options) else None
     if not opening.load_now(state, None if later is not None else path):
         raise MeshError(state.mesh.error)
     if saved is not None:
@@ -620,6 +611,7 @@ def run(
         state.jobs.processes = True  # load and fields in child processes: no shared GIL
         prefer_gil_free_solvers()  # an eigenbasis job in a thread must not hold the GIL
         ps.set_max_fps(-1)  # polyscope's limit spins a core; the Pacer sleeps instead
+        viewer.wait.listen(viewer.pacer)  # ... in GLFW's wait for events: input ends it
         if later is not None:
             viewer.open(later)
     if shot is not None:

@@ -1,4 +1,4 @@
-"""The window itself: its title and its place on the screen.
+"""The window itself: its title, its place on the screen, and the wait for its events.
 
 polyscope 2.6's Python API sets the title once, when the window is created
 (``set_program_name``), and has no call that places the window or tells the screen's size: it
@@ -9,6 +9,11 @@ module calls those functions on polyscope's own window (the current GLFW context
 :mod:`ctypes`, with no new dependency. Where they cannot be reached (another build of
 polyscope, a headless backend) nothing is called: :func:`can_follow` is then False and
 the viewer keeps a title that names no mesh (:func:`window_title`), so the title never lies.
+
+Between two frames the window waits for its events (``glfwWaitEventsTimeout``,
+:func:`wait_events`): a key or a mouse move ends the wait at once, where a sleep would keep
+it waiting out the idle frame period (:mod:`.pacing`); another thread ends it with
+:func:`wake` (``glfwPostEmptyEvent``, which GLFW allows from any thread).
 
 The placement rule (:func:`fit_window`, pure): the window with its frame fits inside the
 monitor's work area (the screen less panels and docks); a wanted size that does not fit
@@ -80,6 +85,8 @@ def _glfw() -> Any:
         lib.glfwGetWindowFrameSize.argtypes = [ctypes.c_void_p, *ints]
         lib.glfwSetWindowPos.argtypes = [ctypes.c_void_p, ctypes.c_int, ctypes.c_int]
         lib.glfwGetWindowPos.argtypes = [ctypes.c_void_p, *ints[:2]]
+        lib.glfwWaitEventsTimeout.argtypes = [ctypes.c_double]
+        lib.glfwPostEmptyEvent.argtypes = []
     except (ImportError, OSError, AttributeError):
         return None
     return lib
@@ -113,6 +120,27 @@ def set_title(text: str) -> bool:
     lib, win = found
     lib.glfwSetWindowTitle(win, text.encode("utf-8"))
     return True
+
+
+def wait_events(seconds: float) -> bool:
+    """Wait up to ``seconds`` for an event of polyscope's window (input, an expose, a
+    :func:`wake`) and hand what arrived to its callbacks (ImGui queues the input for the next
+    frame). The GIL is released meanwhile (a :mod:`ctypes` call): jobs' threads run. False
+    when there is no GLFW window (nothing waited: the caller sleeps its own way)."""
+    found = _window()
+    if found is None:
+        return False
+    lib, _ = found
+    lib.glfwWaitEventsTimeout(max(float(seconds), 0.0))
+    return True
+
+
+def wake() -> None:
+    """End the window's :func:`wait_events` now (from any thread: GLFW posts an empty event).
+    Only once the window is open (:func:`title_follows`, on the UI thread)."""
+    lib = _glfw()
+    if lib is not None:
+        lib.glfwPostEmptyEvent()
 
 
 def _four(fn: Any, handle: int) -> tuple[int, int, int, int]:

@@ -153,7 +153,7 @@ class CheckPanel(Panel):
         changed, task = setting_widget(ui, SETTINGS["task"], st.task)
         if changed:
             st.set_task(task)
-        running = host.draw_job(self.name)
+        running = host.draw_job(self.name, reserve=False)  # in the button's place
         check = SETTINGS["checked"]  # the button: a check shown is what a session keeps
         if not running and ui.button(check.label, check.tooltip):
             self.start_check(host)

@@ -9,6 +9,7 @@ import polyscope as ps
 
 from meshlap_core.options import CURVATURE_FIELD_LABELS, PRINCIPAL_FIELDS
 
+from .. import scene
 from ..host import Host
 from ..isolines import draw_isolines
 from ..scene import MESH, MESH_B, colorbar_at, front_view, scalar_for_upload, side_offset
@@ -114,7 +115,7 @@ class CurvaturePanel(Panel):
             if not ps.has_surface_mesh(MESH_B):
                 V = host.mesh_points()
                 X = V + side_offset(V, front_view(mesh.name))
-                ps.register_surface_mesh(MESH_B, X, mesh.F, smooth_shade=True)
+                scene.register_surface(MESH_B, X, mesh.F, host.active() is self)
             # its own labelled colour bar, below the first one
             mine = host.active() is self  # polyscope draws a hidden copy's bar too
             self._add_field(host, ps.get_surface_mesh(MESH_B), curv.second_field, mine, 1)
@@ -184,8 +185,9 @@ class CurvaturePanel(Panel):
         ui = host.ui
         if not ui.header(self.title):
             return
-        host.draw_job(self.name)  # new area or boundary rule: the fields' progress, Cancel
-        host.draw_job(PRINCIPAL_JOB)  # the estimator's run (k1, k2 and directions)
+        # new area or boundary rule: the fields' progress, Cancel; the estimator's run (k1,
+        # k2 and directions): one row kept for either
+        host.draw_job(self.name, PRINCIPAL_JOB)
         c = host.state.curv
         ch1, c.field_name = setting_widget(ui, SETTINGS["field"], c.field_name)
         ch7, estimator = setting_widget(ui, SETTINGS["estimator"], c.estimator)
@@ -208,6 +210,10 @@ class CurvaturePanel(Panel):
         if ch5:
             host.request_frame()
         if c.field_name not in c.fields:
+            return
+        loading = host.loading()
+        if loading is not None and loading[1] is not None:  # another mesh's preview shown
+            ui.note(f"statistics and histogram once {loading[0]} has loaded")
             return
         st = c.summary()
         lo, hi = st["range"]

@@ -13,6 +13,7 @@ from meshlap_core.options import (
     PRINCIPAL_FIELDS,
 )
 
+from .. import scene
 from ..host import Host
 from ..isolines import draw_isolines
 from ..panel_spec import PanelSpec
@@ -188,7 +189,7 @@ class CurvatureLabPanel(Panel):
             for name in crosses:
                 sm.remove_quantity(name)
         else:
-            sm = ps.register_surface_mesh(LAB, P, r.F, smooth_shade=True)
+            sm = scene.register_surface(LAB, P, r.F, True)  # (registered when shown)
             self._faces, self._field = r.F, None
         c = r.crosses
         if not self.state.crosses or c is None:
@@ -235,8 +236,7 @@ class CurvatureLabPanel(Panel):
         ui = host.ui
         if not ui.header(self.title):
             return
-        host.draw_job(self.name)
-        host.draw_job(self.study_owner)
+        host.draw_job(self.name, self.study_owner)  # one row kept for either
         lab = self.state
         changed = False
         for what in ("source", "estimator", "quantity", "show"):

@@ -289,7 +289,7 @@ class DiffusionPanel(Panel):
         if ps.has_surface_mesh(FILTERED):
             ps.get_surface_mesh(FILTERED).update_vertex_positions(X)
         else:
-            ps.register_surface_mesh(FILTERED, X, mesh.F, smooth_shade=True)
+            scene.register_surface(FILTERED, X, mesh.F, host.active() is self)
             host.request_frame()
 
     def _offset(self, host: Host, slot: int = 1) -> np.ndarray:
@@ -317,7 +317,7 @@ class DiffusionPanel(Panel):
             if ps.has_surface_mesh(name):
                 ps.get_surface_mesh(name).update_vertex_positions(X)
             else:
-                ps.register_surface_mesh(name, X, F, smooth_shade=True)
+                scene.register_surface(name, X, F, host.active() is self)
                 host.request_frame()
             iso = "heat error" if which == "difference" else "heat"
             values, vrs, factor = scene.scalar_for_upload(self.state.heat[which], vr)

@@ -9,6 +9,8 @@ from typing import Any
 from ..host import Host
 from ..panel_spec import PanelSpec
 from ..state.mesh import list_meshes
+from ..state.preview import MeshPreview
+from ..ui import UI
 from .base import Panel
 
 
@@ -48,22 +50,11 @@ class MeshPanel(Panel):
         if not ui.header(self.title):
             return
         mesh = host.state.mesh
-        info = mesh.info
-        genus = info.get("genus")
-        # the name and sizes on their own line: a long file name never splits "genus = 0"
-        ui.text(
-            f"{mesh.name}: {info.get('n_vertices', 0)} vertices, {info.get('n_faces', 0)} faces"
-        )
-        ui.text(
-            f"chi = {info.get('euler_characteristic')}, "
-            + (f"genus = {genus}" if genus is not None else "genus undefined (see below)")
-            + f", boundary loops {info.get('n_boundary_loops')}, components "
-            f"{info.get('n_components')}, {'' if info.get('manifold') else 'non-'}manifold"
-        )
-        if genus is None:
-            ui.note(genus_reason(info))
-        for r in info.get("repairs", []):
-            ui.text(f"repaired: {r}")
+        loading = host.loading()
+        if loading is not None:  # not the mesh's figures beside another mesh's preview
+            draw_loading(ui, mesh.name, *loading)
+        else:
+            draw_figures(ui, mesh.name, mesh.info)
         entered, self.path_text = ui.input_text(
             "path",
             self.path_text,
@@ -96,6 +87,36 @@ class MeshPanel(Panel):
         """Put ``path`` first in the recent-files list (at most 8)."""
         path = Path(path).resolve()
         self.recent = [path, *(p for p in self.recent if p != path)][:8]
+
+
+def draw_figures(ui: UI, name: str, info: dict[str, Any]) -> None:
+    """The mesh's name, sizes and topology (and why a genus is undefined, the repairs)."""
+    genus = info.get("genus")
+    # the name and sizes on their own line: a long file name never splits "genus = 0"
+    ui.text(f"{name}: {info.get('n_vertices', 0)} vertices, {info.get('n_faces', 0)} faces")
+    ui.text(
+        f"chi = {info.get('euler_characteristic')}, "
+        + (f"genus = {genus}" if genus is not None else "genus undefined (see below)")
+        + f", boundary loops {info.get('n_boundary_loops')}, components "
+        f"{info.get('n_components')}, {'' if info.get('manifold') else 'non-'}manifold"
+    )
+    if genus is None:
+        ui.note(genus_reason(info))
+    for r in info.get("repairs", []):
+        ui.text(f"repaired: {r}")
+
+
+def draw_loading(ui: UI, shown: str, name: str, preview: MeshPreview | None) -> None:
+    """While ``name`` is being opened: its name, and its sizes as parsed once its preview is
+    on screen (until then the mesh ``shown`` stays, and says so)."""
+    ui.text(f"{name}: loading...")
+    if preview is None:
+        ui.note(f"{shown} stays on screen until {name} is read")
+    else:
+        ui.note(
+            f"{len(preview.V):,} vertices, {len(preview.F):,} faces as read: a preview, "
+            "the checks and curvature fields are still running"
+        )
 
 
 def _load_session(host: Host, path: Path) -> None:

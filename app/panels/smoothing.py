@@ -47,10 +47,11 @@ class SmoothingPanel(Panel):
 
     shows_mesh = False  # the input and the smoothed copy replace it
     framed = (SMOOTHED, SMOOTH_INPUT)
-    keys = ("space", "right", "r")
+    keys = ("space", "right", "left", "r")
     shortcuts = (
         ("space", "smoothing: play / pause"),
         ("right", "smoothing: one step"),
+        ("left", "smoothing: one step back (the last steps are kept: all on a small mesh)"),
         ("R", "smoothing: back to the input"),
     )
 
@@ -231,7 +232,7 @@ class SmoothingPanel(Panel):
             return
         for name in (SMOOTH_INPUT, SMOOTHED):
             scene.remove_structure(name)  # (another mesh's copies, if any)
-        sm = ps.register_surface_mesh(SMOOTHED, shown.P, st.F, smooth_shade=True)
+        sm = scene.register_surface(SMOOTHED, shown.P, st.F, host.active() is self)
         sm.set_color(SMOOTHED_COLOR)  # (its normals are derived at its first draw: a
         # buffer that polyscope has not filled yet refuses data)
         self._pending_input = shown.P_in
@@ -246,9 +247,9 @@ class SmoothingPanel(Panel):
         P_in, self._pending_input = self._pending_input, None
         if P_in is None or self.state.smoother is None:
             return
-        inp = ps.register_surface_mesh(SMOOTH_INPUT, P_in, self.state.F, smooth_shade=True)
+        shown = ps.get_surface_mesh(SMOOTHED).is_enabled() and not self._hidden_input()
+        inp = scene.register_surface(SMOOTH_INPUT, P_in, self.state.F, shown)
         inp.set_color(INPUT_COLOR)
-        inp.set_enabled(ps.get_surface_mesh(SMOOTHED).is_enabled() and not self._hidden_input())
 
     def _hidden_input(self) -> bool:
         """The input copy is hidden while *play* runs on a big mesh: the renderer then draws
@@ -307,6 +308,8 @@ class SmoothingPanel(Panel):
             st.toggle_play()
         elif key == "right":
             st.advance()
+        elif key == "left":
+            st.step_back()
         elif key == "r":
             st.reset()
             self.push(host, force=True)
@@ -403,6 +406,14 @@ class SmoothingPanel(Panel):
         ch, seed = setting_widget(ui, SETTINGS["seed"], st.seed)
         if ch:
             self.start_build(host, seed=seed)
+        kept, oldest = st.kept_steps()
+        if ui.button(
+            "back",
+            f"one step back (left arrow): the positions of the last {kept} steps are kept"
+            + (f", back to iteration {oldest}" if oldest > 1 else ""),
+        ):
+            st.step_back()
+        ui.same_line()
         step = SETTINGS["iterations"]  # a step: one more iteration of the run
         if ui.button(step.label, step.tooltip):
             st.advance()
@@ -411,6 +422,7 @@ class SmoothingPanel(Panel):
             "pause" if st.playing else "play",
             "step every frame (space); beyond the stable lambda, play stops at the first step "
             "that grows",
+            width_of=("play", "pause"),  # the same width: reset keeps its place
         ):
             st.toggle_play()
         ui.same_line()

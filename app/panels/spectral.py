@@ -113,10 +113,8 @@ class SpectralPanel(Panel):
             return
         X = host.state.display.points(st.reconstruction) + self._offset(host)
         if not ps.has_surface_mesh(RECON):
-            sm = ps.register_surface_mesh(RECON, X, host.state.mesh.F, smooth_shade=True)
-            # polyscope remembers a structure's enabled flag by name: a copy removed while
-            # hidden (a new mesh opened in another view) would come back hidden
-            sm.set_enabled(host.active() is self)
+            # shown or not as told (polyscope would restore the flag of a removed copy)
+            scene.register_surface(RECON, X, host.state.mesh.F, host.active() is self)
             host.request_frame()  # a new copy beside the mesh
         else:
             ps.get_surface_mesh(RECON).update_vertex_positions(X)
@@ -237,7 +235,10 @@ class SpectralPanel(Panel):
         if ch:
             st.set_k_request(k_request, n)
         computed = SETTINGS["computed"]  # the button that computes the basis
-        if not host.draw_job(self.name) and ui.button(computed.label, computed.tooltip):
+        # the job's row takes the button's place (the same height: nothing below moves)
+        if not host.draw_job(self.name, reserve=False) and ui.button(
+            computed.label, computed.tooltip
+        ):
             self.compute(host)
         if st.error:
             ui.error(st.error)

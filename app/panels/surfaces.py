@@ -106,7 +106,7 @@ class SurfacesPanel(Panel):
         if sm is None:
             return
         if self.watch.changed("surface", surf.version, repr(self.isolines)):
-            s = ps.register_surface_mesh(SURFACE, sm.V, sm.F, smooth_shade=True)
+            s = scene.register_surface(SURFACE, sm.V, sm.F, host.active() is self)
             s.set_transform(Z_TO_Y)
             from meshlap_core.surfaces import surface_curvature_fields as surface_curvature
 

@@ -5,7 +5,6 @@ noise first, live figures and the amplification curve. No polyscope import.
 from __future__ import annotations
 
 import json
-import time
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -19,6 +18,7 @@ from meshlap_core.types import FloatArray, IntArray
 
 from ..panel_spec import PanelSpec
 from .animation import Animation, Option
+from .kept_steps import KeptSteps
 from .play_meter import PlayMeter
 from .settings import (
     FLOAT_MAX,
@@ -31,10 +31,9 @@ from .settings import (
     number_problem,
     shown,
 )
+from .smoothing_play import MAX_BATCH as MAX_BATCH  # (where the tests read it)
+from .smoothing_play import SmoothingPlay
 
-MAX_BATCH = 8
-"""Most steps *play* asks a child-process stepper for at once
-(:meth:`SmoothingState.play_batch`)."""
 MAX_FRAMES_ITERS = 5000
 """Most smoothing iterations an animation renders (one frame each), and the most a session may
 hold (``smoothing.iterations``): opening a session replays every step before the first frame,
@@ -100,8 +99,9 @@ SETTINGS = Settings(
 
 
 @dataclass
-class SmoothingState:
-    """Options, the stepper built from them, and what the panel shows.
+class SmoothingState(SmoothingPlay):
+    """Options, the stepper built from them, and what the panel shows (*play*, *pause*,
+    *step back*: :class:`~.smoothing_play.SmoothingPlay`).
 
     ``lam_steps`` is the ``λ`` of every step the stepper has taken since it was built or reset,
     run-length encoded: ``[[0.5, 10], [2.0, 5]]`` is 10 steps at 0.5, then 5 at 2.0. Only ``λ``
@@ -122,126 +122,10 @@ class SmoothingState:
     version: int = 0  # bumped when the stepper is rebuilt (connectivity may need re-upload)
     lam_steps: list[list[Any]] = field(default_factory=list)  # [[λ, steps], ...] of this run
     last_move: float | None = None  # RMS displacement of the last step *play* took
-    asked_at: int = 0  # iteration when a child-process stepper was last asked for a step
     show_s: float = 0.0  # how long the window's last frame showing a new step took
     meter: PlayMeter = field(default_factory=PlayMeter)  # steps/s and frames/s of play
     view: tuple[float, ...] | None = None  # the window's display transform, for the child
-
-    def toggle_play(self) -> None:
-        """*play* / *pause* (the button and ``space``)."""
-        self.playing = not self.playing
-        self.last_move = None
-        if self.playing:
-            self.meter.start(time.perf_counter())
-
-    def play_step(self) -> bool:
-        """One step of *play*. Beyond the stable ``λ`` (the stability warning is shown), *play*
-        stops at the first step that moves the vertices farther (RMS) than the step before (the
-        unstable high-frequency modes have taken over: the flow grows from there) and says why;
-        that step stays on screen and the run counts as diverged (``smoother.diverged``: a
-        smaller ``λ`` goes on from there, as after any divergence).
-
-        With a stepper in a child process (:mod:`meshlap_app.smoother_process`) the step is
-        only asked for here (unless one is on its way); :meth:`poll` takes it and checks it.
-
-        Returns
-        -------
-        bool
-            Whether *play* goes on.
-        """
-        s = self.smoother
-        if s is None:
-            return False
-        if self.asynchronous:
-            self.advance(self.play_batch())
-            return self.playing
-        before = np.array(s.V, dtype=float)
-        if not self.step():
-            return False
-        self.meter.stepped(time.perf_counter(), 1)
-        move = float(np.sqrt(np.mean(np.sum((np.asarray(s.V) - before) ** 2, axis=1))))
-        return self._check_growth(move)
-
-    def _check_growth(self, move: float) -> bool:
-        """*play*'s rule after a step that moved the vertices ``move`` (RMS): go on, or stop
-        beyond the stable λ when the move grew (see :meth:`play_step`)."""
-        s = self.smoother
-        assert s is not None
-        stab = s.stability
-        if stab.stable or self.last_move is None or move <= self.last_move:
-            self.last_move = move
-            return True
-        limit = "" if stab.max_stable_lam is None else f" {stab.max_stable_lam:.4g}"
-        self.playing, self.last_move = False, None
-        s.diverged = True  # a growing step beyond the limit: the run diverges from here on
-        self.error = (
-            f"play stopped at iteration {s.iteration}: the run diverged (that step moved the "
-            f"vertices {move:.3g} RMS, more than the step before) because lam = {s.lam:g} is "
-            f"beyond the stable limit{limit}: the highest mode grows "
-            f"x{abs(stab.high_freq_gain):.3g} per step and the mesh would blow up. Lower lambda "
-            "(or use implicit) to go on, or press reset"
-        )
-        return False
-
-    @property
-    def asynchronous(self) -> bool:
-        """The stepper runs in a child process and takes steps asked for ahead
-        (:meth:`advance`, :meth:`poll`)."""
-        return bool(getattr(self.smoother, "asynchronous", False))
-
-    def play_batch(self) -> int:
-        """Steps *play* asks a child-process stepper for at once: as many as it solves while
-        the window draws the last ones (:attr:`show_s` over the last step's own time, at most
-        :data:`MAX_BATCH`), so neither side waits for the other on a big mesh; 1 when drawing
-        is quicker than a step."""
-        s = self.smoother
-        last = s.history[-1] if s is not None and s.history else {}
-        step_s = float(last.get("time_ms") or 0.0) / 1e3
-        if step_s <= 0.0 or self.show_s <= step_s:
-            return 1
-        return int(min(MAX_BATCH, round(self.show_s / step_s)))
-
-    def advance(self, count: int = 1) -> None:
-        """``count`` steps from the window (the *step* button, ``right``, *play*): asked for
-        from a child-process stepper (taken by :meth:`poll`, the window keeps drawing
-        meanwhile), else one done at once (:meth:`step`)."""
-        s = self.smoother
-        if s is None:
-            return
-        if not self.asynchronous:
-            self.step()
-        elif not s.diverged:
-            self.asked_at = s.iteration
-            try:
-                s.request_step(count, self.view)
-            except MeshError as exc:
-                self.error, self.playing = str(exc), False
-
-    def poll(self) -> bool:
-        """Take the step a child-process stepper finished, if any (never waits): count it,
-        stop on divergence, and apply *play*'s rule beyond the stable λ. True when the
-        positions changed."""
-        s = self.smoother
-        if s is None or not self.asynchronous:
-            return False
-        try:
-            arrived = s.poll()
-        except MeshError as exc:
-            self.error, self.playing = str(exc), False
-            return False
-        if not arrived:
-            return False
-        stepped = s.iteration > self.asked_at
-        self._count_steps(s.lam, s.iteration - self.asked_at)
-        if stepped and self.playing:
-            self.meter.stepped(time.perf_counter(), s.iteration - self.asked_at)
-        self.asked_at = s.iteration
-        if s.diverged:
-            self._stop_diverged()
-        elif stepped and self.playing:
-            move = s.history[-1].get("step_rms", 0.0) if s.history else 0.0
-            self._check_growth(float(move))
-        return stepped
+    kept: KeptSteps | None = None  # the last steps' positions (an in-process stepper's)
 
     def drop(self) -> None:
         """Forget the stepper (a new mesh); a child process's ends."""
@@ -306,6 +190,9 @@ class SmoothingState:
         old, self.smoother = self.smoother, smoother
         if old is not smoother and hasattr(old, "close"):
             old.close()
+        # a child-process stepper keeps its own (in the child, where the positions are)
+        asynchronous = getattr(smoother, "asynchronous", False)
+        self.kept = None if asynchronous else KeptSteps(len(smoother.V0))
         self.error = ""
         self.version += 1
         self.lam_steps = []
@@ -431,6 +318,8 @@ class SmoothingState:
             done = s.iteration
             s.step()
             self._count_steps(s.lam, s.iteration - done)  # a diverging step is discarded
+            if self.kept is not None and s.iteration > done:
+                self.kept.record(s.iteration, s.V)
         if s.diverged:
             self._stop_diverged()
             return False
@@ -479,6 +368,8 @@ class SmoothingState:
         """Back to the noisy input (the noise itself stays)."""
         if self.smoother is not None:
             self.smoother.reset()
+        if self.kept is not None:
+            self.kept.clear()
         self.lam_steps = []
         self.playing = False
         self.error = ""

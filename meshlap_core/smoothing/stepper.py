@@ -402,6 +402,30 @@ class Smoother:
         if self.track_history:
             self.history.append(self._entry(self._V, None, 0.0))
 
+    def rewind(self, V: FloatArray, iteration: int) -> None:
+        """Go back to the positions ``V (n,3)`` this smoother had at ``iteration`` (kept by the
+        caller: a viewer stepping back); the history after it is dropped, ``λ`` and a frozen
+        factorization kept, a divergence forgotten. ``rewind(V0, 0)`` is :meth:`reset`.
+
+        Raises
+        ------
+        MeshError
+            ``V`` is not ``(n,3)`` finite, or ``iteration`` is not an integer in
+            ``[0, self.iteration]``; nothing changes.
+        """
+        whole = isinstance(iteration, (int, np.integer)) and not isinstance(iteration, bool)
+        if not (whole and 0 <= int(iteration) <= self.iteration):
+            problem = f"must be an integer in [0, {self.iteration}], got {iteration!r}"
+            raise MeshError(problem, "iteration")
+        V = as_vertices(V, "V")  # (a new array: the caller's is never kept)
+        if V.shape != self.V0.shape:
+            raise MeshError(f"has {len(V)} vertices but the mesh has {self.n}", "V")
+        self._V, self.iteration, self.diverged = V, int(iteration), False
+        if self.iteration == 0:
+            self._W = self._W0  # (a recomputed mass starts again from the input's)
+        if self.track_history:
+            self.history = [e for e in self.history if e["iteration"] <= self.iteration]
+
     # ---------------------------------------------------------------- stepping
 
     def step(self) -> FloatArray:

@@ -246,3 +246,108 @@ def test_nap_is_woken_by_a_partial_result_and_by_a_finished_job():
     assert jobs.news.is_set()
     jobs.poll()
     assert done == ["whole"] and not jobs.busy
+
+
+def test_pacer_never_pauses_a_frame_that_starts_with_input():
+    """A frame that starts with input pending (the key arrived while the last frame was
+    drawn, or ended the last pause) is answered at once: no pause, the full rate from then on.
+    Before, the pause came before the frame read its input: a key at 2 frames/s waited out
+    a whole idle period more."""
+    clock = Clock()
+    slept: list[float] = []
+
+    def sleep(s: float) -> None:
+        slept.append(s)
+        clock.t += s
+
+    records: list[dict] = []
+    p = Pacer(clock=clock, sleep=sleep, trace=records.append)
+    p.wait(busy=False)
+    clock.t += p.deep_after + 1.0  # long idle
+    p.wait(busy=False)
+    p.wait(busy=False)
+    assert p.mode == "idle" and slept[-1] == pytest.approx(1 / p.deep_fps)
+    n = len(slept)
+    assert p.wait(busy=False, input_now=True) == 0.0
+    assert len(slept) == n and p.mode == "active"  # no pause at all
+    clock.t += 0.001
+    p.wait(busy=False)  # the frames after it: the full rate
+    assert p.mode == "active" and slept[-1] == pytest.approx(1 / p.full_fps - 0.001)
+    # the trace: one record per frame, the input frame's pause 0, the idle ones 1/deep_fps
+    assert [r["frame"] for r in records] == list(range(1, 6))
+    assert records[3]["input"] and records[3]["pause"] == 0.0
+    assert records[3]["end"] == records[3]["start"]
+    assert records[2]["pause"] == pytest.approx(1 / p.deep_fps) and records[2]["mode"] == "idle"
+    assert records[2]["end"] - records[2]["start"] == pytest.approx(records[2]["pause"])
+
+
+def test_a_pause_that_ends_early_leaves_the_next_frame_to_answer():
+    """The window's pause may end early (GLFW's wait returns on an input event): the pacer
+    does not sleep the rest, and the next frame, reading the input, does not pause."""
+    clock = Clock()
+
+    def woken(s: float) -> None:
+        clock.t += s / 10  # an event a tenth of the way in
+
+    p = Pacer(clock=clock, sleep=woken)
+    p.wait(busy=False)
+    clock.t += 60.0
+    p.wait(busy=False)
+    start = clock.t
+    p.wait(busy=False)
+    assert clock.t - start == pytest.approx(0.1 / p.deep_fps)  # ended on the event
+    assert p.wait(busy=False, input_now=True) == 0.0
+
+
+def test_jobs_news_calls_the_wake_hook_from_the_jobs_thread():
+    """What ends the window's wait for events: a partial result and a finished job call
+    ``Jobs.wake`` (from the job's thread), besides setting ``news``."""
+    jobs = Jobs()
+    woken: list[str] = []
+    called = threading.Event()
+
+    def wake() -> None:
+        woken.append(threading.current_thread().name)
+        called.set()
+
+    jobs.wake = wake
+    go = threading.Event()
+
+    def work(reporter):
+        reporter(0.5, "a progress line: no news")
+        reporter.partial("half")
+        go.wait(30)
+        return 1
+
+    jobs.start("j", "t", work, lambda r: None, preview=lambda v: None)
+    assert called.wait(30) and jobs.news.is_set()
+    assert len(woken) == 1 and woken[0] != threading.current_thread().name
+    jobs.poll()
+    go.set()
+    assert jobs.wait("j", timeout=30)
+    assert len(woken) == 2  # the result
+
+
+def test_the_last_outcome_of_an_owners_job_for_its_kept_row():
+    """A job's row, kept when no job runs, says how the owner's last job ended."""
+    clock = Clock()
+    jobs = Jobs(clock=clock, background=False)
+    assert jobs.last_outcome("a") == ""
+
+    def work(reporter):
+        clock.t += 1.25
+        return 1
+
+    jobs.start("a", "computing a", work, lambda r: None)
+    assert jobs.last_outcome("a") == "done: computing a (1.2 s)"
+    go = threading.Event()
+    threaded = Jobs(clock=clock)
+    threaded.start("b", "computing b", lambda r: go.wait(30), lambda r: None)
+    clock.t += 2.0
+    threaded.cancel("b")
+    go.set()
+    assert threaded.last_outcome("b") == "cancelled: computing b (after 2.0 s)"
+    clock.t += 1.0
+    threaded.start("c", "computing c", lambda r: (_ for _ in ()).throw(MeshError("no")), None)
+    assert threaded.wait("c", timeout=30)
+    assert threaded.last_outcome("b", "c").startswith("failed: computing c")  # the latest

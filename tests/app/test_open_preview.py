@@ -364,3 +364,60 @@ def test_after_a_cancelled_preview_the_next_mesh_opened_goes_to_the_recent_list(
     frames(viewer, 2)
     assert viewer.state.mesh.name == "sphere.obj"
     assert section.recent == [sphere]
+
+
+def test_the_mesh_section_names_the_file_loading_not_the_previous_mesh(
+    viewer, held, ellipsoid, monkeypatch
+):
+    """Issue 33: while a file loads, the Mesh section said the previous mesh's name and
+    figures (and the Curvature section its histogram) beside the new file's preview. Now:
+    the file's name and "loading...", its sizes as parsed once previewed, no histogram of
+    another mesh; the mesh's own figures once it has loaded."""
+    texts: list[tuple[str, str]] = []
+    ui = viewer.ui
+    for name in ("text", "note"):
+        plain = getattr(ui, name)
+
+        def recorded(text, plain=plain):
+            texts.append((ui.section, text))
+            plain(text)
+
+        monkeypatch.setattr(ui, name, recorded)
+
+    def drawn(section: str) -> str:
+        return " | ".join(t for s, t in texts if s == section)
+
+    old = viewer.state.mesh.name
+    frames(viewer, 2)  # (ImPlot draws a plot from its second frame)
+    assert old in drawn("mesh_info") and "loading" not in drawn("mesh_info")
+    assert ("curvature", "##vertices") in ui.plots  # the histogram of the mesh shown
+    texts.clear()
+    viewer.background = True
+    with monkeypatch.context() as m:  # the preview not shown yet: the old mesh is on screen
+        m.setattr(viewer, "show_preview", lambda preview: None)
+        viewer.open(ellipsoid)
+        ui.plots.clear()
+        frames(viewer, 2)
+    assert viewer.preview is None
+    assert "ellipsoid.obj: loading..." in drawn("mesh_info")
+    assert f"{old} stays on screen until ellipsoid.obj is read" in drawn("mesh_info")
+    assert ("curvature", "##vertices") in ui.plots  # (the mesh on screen: its histogram)
+    open_until_preview(viewer, ellipsoid)  # (a new job: the first is replaced)
+    texts.clear()
+    ui.plots.clear()
+    frames(viewer, 2)
+    p = viewer.preview
+    mesh_text = drawn("mesh_info")
+    assert "ellipsoid.obj: loading..." in mesh_text and old not in mesh_text
+    assert f"{len(p.V):,} vertices, {len(p.F):,} faces as read" in mesh_text
+    assert "chi =" not in mesh_text  # no topology of the previous mesh
+    assert ("curvature", "##vertices") not in ui.plots
+    assert "histogram once ellipsoid.obj has loaded" in drawn("curvature")
+    held.set()
+    assert viewer.state.jobs.wait(timeout=120)
+    texts.clear()
+    ui.plots.clear()
+    frames(viewer, 2)
+    n, m = len(viewer.state.mesh.V), len(viewer.state.mesh.F)
+    assert f"ellipsoid.obj: {n} vertices, {m} faces" in drawn("mesh_info")
+    assert "loading" not in drawn("mesh_info") and ("curvature", "##vertices") in ui.plots

@@ -117,6 +117,9 @@ class ScriptedUI(UI):
         self.drawn: dict[tuple[str, str], Any] = {}  # (section, label) -> value last drawn with
         self.lines: list[tuple[str, str]] = []  # (section, line) of text wrapped at spaces
         self.overlays: list[tuple[tuple[float, float], str]] = []  # text over the 3D view
+        # (section, label) -> (x0, y0, x1, y1): where each widget (and header) was last drawn
+        # in the window, as imgui laid it out (the layout a user sees, headless)
+        self.rects: dict[tuple[str, str], tuple[float, float, float, float]] = {}
 
     # ------------------------------------------------------------------ the script
     def script(self, label: str, *values: Any) -> None:
@@ -140,6 +143,9 @@ class ScriptedUI(UI):
         value, read as the widget reads it (the type of ``current``; one of ``choices``)."""
         key = (SECTION_OF_KIND.get(kind, self.section), label)
         self._last_label = label
+        if kind not in SECTION_OF_KIND:  # a widget just drawn: its rectangle
+            lo, hi = self.im.GetItemRectMin(), self.im.GetItemRectMax()
+            self.rects[key] = (float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]))
         if kind != "header":
             self.seen[key] = kind
             self.drawn[key] = current

@@ -228,6 +228,25 @@ def _ignore_x_error(_display: int, _event: int) -> int:
     return 0
 
 
+class _XImage(ctypes.Structure):
+    """The head of Xlib's ``XImage`` (the fields :meth:`Frames.grab` reads)."""
+
+    _fields_ = [
+        ("width", ctypes.c_int),
+        ("height", ctypes.c_int),
+        ("xoffset", ctypes.c_int),
+        ("format", ctypes.c_int),
+        ("data", ctypes.c_void_p),
+        ("byte_order", ctypes.c_int),
+        ("bitmap_unit", ctypes.c_int),
+        ("bitmap_bit_order", ctypes.c_int),
+        ("bitmap_pad", ctypes.c_int),
+        ("depth", ctypes.c_int),
+        ("bytes_per_line", ctypes.c_int),
+        ("bits_per_pixel", ctypes.c_int),
+    ]
+
+
 class Frames:
     """Count the frames a window draws (X DAMAGE: each buffer swap damages the window).
 
@@ -267,6 +286,7 @@ class Frames:
         if not xd.XDamageQueryExtension(self._dpy, ctypes.byref(base), ctypes.byref(err)):
             raise RuntimeError(f"X display {display} has no DAMAGE extension")
         self._notify = base.value  # XDamageNotify is the extension's first event
+        self._window = window
         self._damage = xd.XDamageCreate(self._dpy, window, _XDAMAGE_REPORT_NON_EMPTY)
         self._event = (ctypes.c_long * 24)()  # an XEvent (a union of 24 longs)
         self.count = 0  # damage reports since the last mark()
@@ -305,6 +325,39 @@ class Frames:
             if left <= 0 or not alive():
                 return False
             select.select([fd], [], [], min(left, 0.25))
+
+    def grab(self) -> np.ndarray:
+        """The window's pixels now, ``(h, w, 3) uint8`` (``XGetImage`` on this connection:
+        milliseconds, where ``xwd`` takes a process; right after a damage report it shows the
+        frame that report stands for)."""
+        x11 = self._x11
+        if not getattr(self, "_typed_get_image", False):
+            x11.XGetImage.restype = ctypes.POINTER(_XImage)
+            x11.XGetImage.argtypes = [ctypes.c_void_p, ctypes.c_ulong, *[ctypes.c_int] * 2]
+            x11.XGetImage.argtypes += [ctypes.c_uint, ctypes.c_uint, ctypes.c_ulong, ctypes.c_int]
+            x11.XGetWindowAttributes.argtypes = [ctypes.c_void_p, ctypes.c_ulong, ctypes.c_void_p]
+            x11.XFree.argtypes = [ctypes.c_void_p]
+            self._typed_get_image = True
+        attrs = (ctypes.c_int * 64)()  # XWindowAttributes: x, y, width, height first
+        x11.XGetWindowAttributes(self._dpy, self._window, attrs)
+        w, h = attrs[2], attrs[3]
+        ptr = x11.XGetImage(self._dpy, self._window, 0, 0, w, h, 0xFFFFFFFF, 2)  # ZPixmap
+        if not ptr:
+            raise RuntimeError("XGetImage failed (the window is gone?)")
+        im = ptr.contents
+        try:
+            if im.bits_per_pixel != 32:
+                raise RuntimeError(f"XGetImage gave {im.bits_per_pixel} bits per pixel")
+            size = im.bytes_per_line * im.height
+            raw = np.ctypeslib.as_array(
+                ctypes.cast(im.data, ctypes.POINTER(ctypes.c_uint8)), (size,)
+            )
+            rows = raw.reshape(im.height, im.bytes_per_line)[:, : 4 * im.width]
+            out = np.ascontiguousarray(rows.reshape(im.height, im.width, 4)[..., 2::-1])
+        finally:
+            x11.XFree(im.data)
+            x11.XFree(ptr)
+        return out
 
     def close(self) -> None:
         if self._dpy:

@@ -31,7 +31,7 @@ import numpy as np
 import pytest
 
 from tests.support.imgui_screen import changed_fraction, parse, subject_mask, subjects
-from tests.support.window_session import Session
+from tests.support.window_session import STILL, Session
 from tests.support.xwindow import missing_tools
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -250,10 +250,22 @@ def test_a_692k_scan_smooths_without_freezing(tmp_path):
         assert gaps[-1] <= MAX_SHOW_S, f"the copies took {gaps[-1]:.2f} s to appear"
         layout = parse(s.settled((0, 0, *s.size), timeout=LOAD_TIMEOUT_S))
         box = (0, 0, layout.left, s.size[1])
+        row = layout.find(1, "buttons", 0)  # back / step / play / reset
+        row_box = (row.x0, row.y0, min(row.x1 + 60, layout.right), row.y1)
         before = s.img
         s.key("space")  # play: the child solves, the window shows each batch of steps
         s.until(lambda img: changed_fraction(before, img, box) > 0.002, 300, "a smoothing step")
-        s.key("space")
+        playing = s.screenshot()
+        s.key("space")  # pause, with steps on their way (the child runs ahead of the window)
+        paused = s.until(
+            lambda img: changed_fraction(playing, img, row_box) > 0.01, 300, "'play' again"
+        )
+        # issue 33: the steps the child computed after the press never reach the screen
+        # (before, four more were applied after the pause)
+        after = s.settled(box, timeout=LOAD_TIMEOUT_S)
+        assert changed_fraction(paused, after, box) <= STILL, "steps shown after the pause"
+        s.key("Left")  # one step back: the last 8 steps of the scan are kept
+        s.until(lambda img: changed_fraction(after, img, box) > STILL, 300, "a step back")
         problem = s.problem()
         assert problem is None, problem
     finally:

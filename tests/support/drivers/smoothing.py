@@ -54,6 +54,9 @@ def drive_smoothing_widgets(viewer):
     frames(viewer, 3)
     drive(viewer, "pause", True)
     assert not st.playing and st.smoother.iteration >= 3
+    shown = st.smoother.iteration
+    drive(viewer, "back", True)  # one step back through the kept positions
+    assert st.smoother.iteration == shown - 1
     drive(viewer, "reset", True)
     assert st.smoother.iteration == 0
 
