@@ -9,7 +9,7 @@ from meshlap_core.io import save_mesh, save_scalars
 
 from ..host import Host
 from ..panel_spec import PanelSpec
-from ..scene import save_screenshot
+from ..scene import write_png
 from .base import ExportItem, Panel
 
 
@@ -38,7 +38,11 @@ class ExportPanel(Panel):
         )
         if entered:
             self.set_folder(host, self.folder_text)
-        if ui.button("screenshot", "save the window as a PNG in the folder"):
+        if ui.button(
+            "screenshot",
+            "save the 3D view as a PNG in the folder: what the window shows left of this "
+            "panel, with its colour bars and captions",
+        ):
             self.status = self.screenshot(host)
         ui.same_line()
         if ui.button("export what is shown", "write the shown mesh / field to the folder"):
@@ -61,12 +65,15 @@ class ExportPanel(Panel):
             raise
 
     def screenshot(self, host: Host) -> str:
+        """Write the view as on screen (:meth:`~meshlap_app.host.Host.picture`) to
+        ``<mesh>_<view>.png`` in the folder; returns where it wrote (or why not)."""
         path = host.state.folder / f"{host.state.mesh.stem}_{host.state.panel}.png"
         try:
-            save_screenshot(path)
+            rgb = host.picture()
+            write_png(path, rgb)
         except (MeshError, OSError) as exc:
             return f"screenshot failed: {exc}"
-        return f"wrote {path}"
+        return f"wrote {path} ({rgb.shape[1]}×{rgb.shape[0]})"
 
     @staticmethod
     def export(host: Host, folder: Path) -> str:
