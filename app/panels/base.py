@@ -30,6 +30,18 @@ ExportItem = tuple[str, "np.ndarray | None", "np.ndarray | None", "np.ndarray | 
 the scalars) when V is given, else the scalars alone (CSV)."""
 
 
+def shown_field(
+    stem: str, V: np.ndarray, F: np.ndarray, field: np.ndarray | None
+) -> list[ExportItem]:
+    """A mesh on screen as *export* writes it: ``<stem>.ply`` (``V (n,3)``, ``F (m,3)`` in
+    the mesh's own coordinates, the colour field ``field (n,)`` as its vertex ``quality``)
+    and, with a field, the field alone as ``<stem>.csv``."""
+    items: list[ExportItem] = [(f"{stem}.ply", V, F, field)]
+    if field is not None:
+        items.append((f"{stem}.csv", None, None, field))
+    return items
+
+
 @dataclass(frozen=True)
 class Pick:
     """A click on the 3D view as a panel's :meth:`Panel.pick` sees it: what polyscope's pick
@@ -158,7 +170,10 @@ class Panel:
 
     # -------------------------------------------------------------- files
     def export_items(self, host: Host) -> list[ExportItem]:
-        """What *export what is shown* writes for this view (``[]``: the default export)."""
+        """What *export what is shown* writes for this view: every mesh it shows (its
+        ``framed`` copies and the main mesh when it ``shows_mesh``) with the field on it
+        (:func:`shown_field`). ``[]``: the default export (the mesh with the curvature field
+        when the view ``shows_curvature``, else the plain mesh)."""
         return []
 
     def capture(self, host: Host) -> dict[str, Any]:

@@ -21,7 +21,7 @@ from ..scene import MESH, colorbar_at, picked_vertex, scalar_for_upload
 from ..setting_widgets import setting_widget
 from ..state.check import SETTINGS, CheckState
 from ..ui import RED
-from .base import Panel
+from .base import ExportItem, Panel, shown_field
 
 DIFF = "student - reference"
 
@@ -81,6 +81,15 @@ class CheckPanel(Panel):
             onscreen_colorbar_location=colorbar_at(0, host.state.ui_scale),
             **self.isolines.options("difference", values),
         )
+
+    def export_items(self, host: Host) -> list[ExportItem]:
+        """The mesh with the difference map student − reference on it (PLY, and the map as
+        CSV), once a check of this mesh shows one; before, the plain mesh (the default)."""
+        st, mesh = self.state, host.state.mesh
+        if st.check is None or st.check.difference is None or not st.current(mesh.version):
+            return []
+        d = np.asarray(st.check.difference, dtype=np.float64)
+        return shown_field(f"{mesh.stem}_{st.task}_student-reference", mesh.V, mesh.F, d)
 
     def capture(self, host: Host) -> dict[str, Any]:
         st = self.state

@@ -14,7 +14,7 @@ from ..isolines import draw_isolines
 from ..scene import MESH, MESH_B, colorbar_at, front_view, scalar_for_upload, side_offset
 from ..setting_widgets import setting_widget
 from ..state.curvature import PRINCIPAL_JOB, SETTINGS
-from .base import Panel
+from .base import ExportItem, Panel, shown_field
 
 
 class CurvaturePanel(Panel):
@@ -54,6 +54,16 @@ class CurvaturePanel(Panel):
             MESH: CURVATURE_FIELD_LABELS[c.field_name][0],
             MESH_B: CURVATURE_FIELD_LABELS[c.second_field][0],
         }
+
+    def export_items(self, host: Host) -> list[ExportItem]:
+        """The mesh with its field, and side by side the copy with the second field."""
+        c, mesh = host.state.curv, host.state.mesh
+        c.update(mesh)
+        items = shown_field(f"{mesh.stem}_{c.field_name}", mesh.V, mesh.F, c.values(c.field_name))
+        if c.side_by_side and c.second_field != c.field_name:
+            second = c.values(c.second_field)
+            items += shown_field(f"{mesh.stem}_{c.second_field}", mesh.V, mesh.F, second)
+        return items
 
     def capture(self, host: Host) -> dict[str, Any]:
         c = host.state.curv

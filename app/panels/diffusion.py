@@ -29,7 +29,7 @@ from ..state.diffusion import (
     symmetric_range,
 )
 from ..state.isolines import DEFAULT_COUNT
-from .base import ExportItem, Panel
+from .base import ExportItem, Panel, shown_field
 
 FIELD = "diffusion field"
 SOURCES = "heat sources"
@@ -355,13 +355,21 @@ class DiffusionPanel(Panel):
         return {}
 
     def export_items(self, host: Host) -> list[ExportItem]:
+        """The mesh with the field on it, the heat copies with theirs, the filtered copy
+        (each PLY with its field, the field as CSV)."""
+        st, mesh = self.state, host.state.mesh
         f, _, _ = self._field()
-        stem = host.state.mesh.stem
+        stem = mesh.stem
         items: list[ExportItem] = []
-        if f is not None:
-            items.append((f"{stem}_{self.state.show}.csv", None, None, f))
-        if self.state.filtered is not None and self.state.show == "filter":
-            items.append((f"{stem}_filtered.ply", self.state.filtered, host.state.mesh.F, None))
+        if f is not None and len(f) == len(mesh.V):
+            name = f"{stem}_{self.iso_field()}".replace(" ", "_")
+            items += shown_field(name, mesh.V, mesh.F, f)
+        else:
+            items.append((f"{stem}.ply", mesh.V, mesh.F, None))
+        for which in self._copy_fields():
+            items += shown_field(f"{stem}_heat_{which}", mesh.V, mesh.F, st.heat[which])
+        if st.filtered is not None and st.show == "filter":
+            items.append((f"{stem}_filtered_{st.filter}.ply", st.filtered, mesh.F, None))
         return items
 
     # ------------------------------------------------------------------ sessions

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 from meshlap_core.errors import MeshError
 from meshlap_core.io import save_mesh, save_scalars
@@ -10,7 +11,7 @@ from meshlap_core.io import save_mesh, save_scalars
 from ..host import Host
 from ..panel_spec import PanelSpec
 from ..scene import write_png
-from .base import ExportItem, Panel
+from .base import ExportItem, Panel, shown_field
 
 
 class ExportPanel(Panel):
@@ -79,13 +80,17 @@ class ExportPanel(Panel):
     def export(host: Host, folder: Path) -> str:
         """Write what the active view shows into ``folder``; returns where it wrote.
 
-        The view's own files (:meth:`~.base.Panel.export_items`: the k-reconstruction, the
-        smoothed mesh, the parametric surface...), or by default the mesh as PLY with the shown
-        curvature field and the field as CSV.
+        The view's own files (:meth:`~.base.Panel.export_items`: each mesh it shows, with the
+        field on it, as PLY and the field as CSV), or by default (:func:`default_items`) the
+        mesh as the view shows it.
         """
         files = []
+        active = host.active()
         try:
-            for name, V, F, scalars in host.active().export_items(host) or field_items(host):
+            items = active.export_items(host) or default_items(host, active)
+            if not items:
+                return f"nothing to export: the {active.title} view shows no mesh yet"
+            for name, V, F, scalars in items:
                 path = Path(folder) / name
                 if V is None:
                     save_scalars(path, scalars)
@@ -97,13 +102,21 @@ class ExportPanel(Panel):
         return f"wrote {', '.join(files)} in {Path(folder).resolve()}"
 
 
+def default_items(host: Host, active: Any) -> list[ExportItem]:
+    """The export of a view without its own: the mesh with the curvature field when the view
+    shows it (``shows_curvature``), the plain mesh when it shows the mesh alone, else
+    nothing."""
+    mesh = host.state.mesh
+    if active.shows_curvature:
+        return field_items(host)
+    if active.shows_mesh:
+        return [(f"{mesh.stem}.ply", mesh.V, mesh.F, None)]
+    return []
+
+
 def field_items(host: Host) -> list[ExportItem]:
-    """The default export: the mesh (PLY with the shown curvature field) and the field (CSV)."""
+    """The mesh (PLY with the shown curvature field) and the field (CSV)."""
     mesh, curv = host.state.mesh, host.state.curv
     curv.update(mesh)
-    field = curv.fields.get(curv.field_name)
-    stem = mesh.stem
-    return [
-        (f"{stem}_{curv.field_name}.ply", mesh.V, mesh.F, field),
-        (f"{stem}_{curv.field_name}.csv", None, None, field),
-    ]
+    field = curv.values(curv.field_name)
+    return shown_field(f"{mesh.stem}_{curv.field_name}", mesh.V, mesh.F, field)
