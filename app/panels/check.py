@@ -98,11 +98,13 @@ class CheckPanel(Panel):
             "task": st.task,
             "vertex": int(st.vertex),
             "checked": st.current(host.state.mesh.version),
+            **self.isolines_section(),
         }
 
     def configure(self, host: Host, values: dict[str, Any]) -> None:
         self.state.file = values["file"]
         self.state.set_task(values["task"])
+        self.configure_isolines(values)
 
     def restore(self, host: Host, values: dict[str, Any], active: bool) -> None:
         """The clicked vertex, and the check run again when one was shown (a job in the

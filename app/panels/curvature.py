@@ -75,6 +75,7 @@ class CurvaturePanel(Panel):
             "side_by_side": bool(c.side_by_side),
             "second_field": c.second_field,
             "estimator": c.estimator,
+            **self.isolines_section(),
         }
 
     def configure(self, host: Host, values: dict[str, Any]) -> None:
@@ -83,6 +84,7 @@ class CurvaturePanel(Panel):
         c.set_percentile(values["clip"])
         c.side_by_side, c.second_field = values["side_by_side"], values["second_field"]
         c.set_estimator(values["estimator"])
+        self.configure_isolines(values)
 
     def start(self, host: Host, options: dict[str, Any], shown: bool, screenshot: bool) -> None:
         if options.get("field") is not None:

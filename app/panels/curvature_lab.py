@@ -60,11 +60,11 @@ class CurvatureLabPanel(Panel):
         return shown_field(f"{where}_{lab.quantity}_{lab.show}", r.V, r.F, values)
 
     def capture(self, host: Host) -> dict[str, Any]:
-        return self.state.settings()
+        return {**self.state.settings(), **self.isolines_section()}
 
     def configure(self, host: Host, values: dict[str, Any]) -> None:
         self.state.configure(values)
-        self.watch.forget()
+        self.configure_isolines(values)
 
     def show(self, host: Host, active: Panel) -> None:
         if active is self:

@@ -177,6 +177,7 @@ class SpectralPanel(Panel):
             "k": int(st.k),
             "mode": int(st.mode),
             "play": st.play_what,
+            **self.isolines_section(),
         }
 
     def configure(self, host: Host, values: dict[str, Any]) -> None:
@@ -184,6 +185,7 @@ class SpectralPanel(Panel):
         st.k_request = min(values["k_request"], max(len(host.state.mesh.V), 2))
         st.k, st.mode = values["k"], values["mode"]
         st.set_play_what(values["play"])
+        self.configure_isolines(values)
 
     def restore(self, host: Host, values: dict[str, Any], active: bool) -> None:
         """The basis (from the cache when it was computed before), mode and k."""

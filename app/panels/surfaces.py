@@ -88,10 +88,18 @@ class SurfacesPanel(Panel):
 
     def capture(self, host: Host) -> dict[str, Any]:
         s = self.state
-        return {"surface": s.name, "res": int(s.res), "u": s.u, "v": s.v, "theta": s.section_deg}
+        return {
+            "surface": s.name,
+            "res": int(s.res),
+            "u": s.u,
+            "v": s.v,
+            "theta": s.section_deg,
+            **self.isolines_section(),
+        }
 
     def configure(self, host: Host, values: dict[str, Any]) -> None:
-        """Nothing before the mesh: :meth:`restore` meshes the surface and sets the point."""
+        """The isolines; :meth:`restore` meshes the surface and sets the point."""
+        self.configure_isolines(values)
 
     def restore(self, host: Host, values: dict[str, Any], active: bool) -> None:
         s = self.state
