@@ -88,6 +88,11 @@ class Host(Protocol):
         """Frame now if a re-frame was requested (before a recorded picture)."""
         ...
 
+    def picture(self) -> np.ndarray:
+        """The 3D view as it is on screen, left of meshlap's panel, with its colour bars and
+        captions: ``(h, w, 3) uint8`` (a screenshot, a recorded frame)."""
+        ...
+
     def set_ui_scale(self, scale: float) -> None:
         """Set the UI scale (text, widgets, the panel's width) everywhere it applies."""
         ...

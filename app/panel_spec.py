@@ -67,6 +67,12 @@ class PanelSpec:
         against the loaded mesh, naming the flag.
     animation : Animation or None
         ``meshlap animate --panel <name>`` (``None``: not animatable).
+    unsaved : dict of str to str
+        Each widget label of the panel that sets none of its settings, and why it is not a
+        setting (an action such as *play* or *export*, a value a session keeps elsewhere, a
+        setting another panel declares). With its settings' ``labels`` these are all its
+        widgets (``tests/test_viewer_widgets.py`` audits them): a widget a user can change is
+        declared, and so kept by a session, or says here why not.
     """
 
     name: str = UNSET
@@ -80,6 +86,7 @@ class PanelSpec:
     check_mesh: Callable[[dict[str, Any], Any, Any], None] | None = None
     check_start: Callable[[dict[str, Any], Any], None] | None = None
     animation: Animation | None = None
+    unsaved: dict[str, str] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         name = self.name if isinstance(self.name, str) else "?"
@@ -107,6 +114,11 @@ class PanelSpec:
                 raise SpecError(f"panel {name!r}: two {command} flags share a name")
         if self.flags("animate") and self.animation is None:
             raise SpecError(f"panel {name!r}: animate flags without an animation")
+        for label, why in self.unsaved.items():
+            if not (isinstance(why, str) and why.strip()):
+                raise SpecError(f"panel {name!r}: unsaved widget {label!r} needs its reason")
+            if any(label in s.labels for s in self.settings):
+                raise SpecError(f"panel {name!r}: {label!r} is a setting's widget, not unsaved")
 
     # -------------------------------------------------------------- the panel
     def panel_class(self) -> type:

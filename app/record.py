@@ -22,7 +22,7 @@ import polyscope as ps
 from meshlap_core.errors import MeshError
 from meshlap_core.io.animation import FrameWriter, burn_caption
 
-from .scene import scene_width
+from .scene import crop_to_scene
 
 if TYPE_CHECKING:
     from .host import Host
@@ -166,7 +166,7 @@ class Recorder:
         self._capturing = True
         try:
             host.flush_frame()  # a copy appeared this frame: frame it before the picture
-            buf = crop_scene(host, ps.screenshot_to_buffer(transparent_bg=False, include_UI=False))
+            buf = host.picture()  # the view as on screen: its colour bars and captions
             if self.last is None:  # the frame on screen when *record* was pressed
                 self._held = (buf, caption)
             else:
@@ -198,10 +198,8 @@ class Recorder:
 
 def crop_scene(host: Host, buf: np.ndarray) -> np.ndarray:
     """The part of a window buffer ``(h, w, 4)`` left of meshlap's panel (where the viewer
-    frames the scene; :func:`.scene.scene_width`)."""
-    width = ps.get_window_size()[0]
-    keep = scene_width(width, host.state.ui_scale) * buf.shape[1] // max(width, 1)
-    return buf[:, : max(keep // 2 * 2, 2)]
+    frames the scene; :func:`.scene.crop_to_scene`)."""
+    return crop_to_scene(buf, ps.get_window_size()[0], host.state.ui_scale)
 
 
 def draw_record(

@@ -324,8 +324,20 @@ def frame_scene_left(
 
 
 def save_screenshot(path: Path) -> None:
-    """Render the window (with meshlap's panel) into the PNG ``path``, atomically."""
+    """Render the window (with meshlap's panel) into the PNG ``path``, atomically: the
+    headless ``meshlap view --screenshot`` (outside any frame; a window's *screenshot* button
+    writes its view instead, :meth:`meshlap_app.viewer.Viewer.picture`)."""
     write_png(path, ps.screenshot_to_buffer(transparent_bg=False, include_UI=True))
+
+
+def crop_to_scene(buf: np.ndarray, window_width: int, ui_scale: float) -> np.ndarray:
+    """The part of a window's picture ``buf (h, w, c)`` left of meshlap's panel, where the
+    viewer frames the scene (:func:`scene_width`, an even width): what a screenshot of the
+    view and a recorded frame keep. ``buf`` may have more pixels than the window
+    (``w != window_width`` on a high-density screen): the same fraction is kept."""
+    width = max(int(window_width), 1)
+    keep = scene_width(width, ui_scale) * buf.shape[1] // width
+    return buf[:, : max(keep // 2 * 2, 2)]
 
 
 def write_png(path: Path, rgba: np.ndarray) -> None:

@@ -80,6 +80,7 @@ class UI(FieldErrors, Plots):
         self.wrap_width = wrap_width
         # window pixel x where meshlap's panel starts: text over the 3D view ends left of it
         self.overlay_right: float | None = None
+        self.pointer = True  # False: no hover (a picture of the view is being drawn)
         self.scale = 1.0
         self.section = ""
         self.changed = False  # some widget reported a change since begin_section
@@ -561,7 +562,10 @@ class UI(FieldErrors, Plots):
 
     def hover(self) -> tuple[float, float] | None:
         """Window position of the mouse over the 3D view this frame (``None`` over a panel).
-        The hook sees it as the label ``"hover"``."""
+        The hook sees it as the label ``"hover"``; ``None`` while :attr:`pointer` is off (a
+        picture of the view has no pointer)."""
+        if not self.pointer:
+            return None
         v = self._record("hover", "hover", "")
         if v is not None:
             return tuple(v)

@@ -115,6 +115,7 @@ class Viewer:
         self.opening = ""  # the name of the file a job of the Mesh section opens
         self.preview_fit: tuple[Any, ...] = ()  # the display fit its points were made with
         self.no_shadow = False  # the ground's shadow is off for a big mesh (scene.shadow_for)
+        self.picturing = False  # picture() is rendering the view: the callback draws its overlays
 
     # ------------------------------------------------------------------ Host
     def active(self) -> Panel:
@@ -277,6 +278,9 @@ class Viewer:
         Every step runs guarded (:meth:`draw_guarded`): no exception of a widget handler
         leaves this function, so none ends the session.
         """
+        if self.picturing:  # picture() renders the view: what lies over it, no panel, no input
+            self.draw_overlays()
+            return
         ui = self.ui
         jobs = self.state.jobs
         if self.pace:
@@ -375,6 +379,42 @@ class Viewer:
         if self.reframe:
             self.reframe = False
             self.frame()
+
+    def picture(self) -> np.ndarray:
+        """The 3D view as it is on screen: what the window shows left of meshlap's panel
+        (:func:`.scene.crop_to_scene`), with its colour bars, captions and labels, at the
+        window's height; ``(h, w, 3) uint8`` RGB. The *screenshot* button and the recorder's
+        frames.
+
+        polyscope draws its colour bars with imgui, so the picture is rendered with its UI
+        (``screenshot_to_buffer(include_UI=True)``: a fresh imgui frame in which this
+        viewer's callback draws only what lies over the view, :meth:`draw_overlays`, and
+        polyscope opens no window for it). polyscope refuses that inside ``ps.show()``; the
+        window runs its own frame loop instead (:func:`run_frames`).
+        """
+        self.flush_frame()
+        self.picturing = True
+        ps.set_open_imgui_window_for_user_callback(False)
+        try:
+            buf = ps.screenshot_to_buffer(transparent_bg=False, include_UI=True)
+        finally:
+            ps.set_open_imgui_window_for_user_callback(True)
+            self.picturing = False
+        if buf.size == 0:  # polyscope said why (a frame it could not render)
+            raise MeshError("the renderer returned no picture", "screenshot")
+        crop = scene.crop_to_scene(buf, ps.get_window_size()[0], self.state.ui_scale)
+        return np.ascontiguousarray(crop[..., :3])
+
+    def draw_overlays(self) -> None:
+        """What lies over the 3D view: the active view's labels (no hover: a picture has no
+        pointer) and the captions under the structures."""
+        hover, self.ui.pointer = self.ui.pointer, False
+        try:
+            self.draw_guarded("labels", lambda host: host.limit_overlays())
+            self.draw_guarded("labels", self.active().overlay)
+            self.draw_guarded("layout", lambda host: host.draw_captions())
+        finally:
+            self.ui.pointer = hover
 
     def draw_view_combo(self) -> None:
         changed, panel = self.ui.combo(
@@ -635,5 +675,15 @@ def show_window(viewer: Viewer) -> None:
     saved = config.read_layout()
     if saved:
         viewer.ui.load_layout(saved)
-    ps.show()
+    run_frames()
     config.write_layout(viewer.ui.layout())
+
+
+def run_frames() -> None:
+    """The window's frame loop, until the window is closed: ``ps.frame_tick`` rather than
+    ``ps.show()``, inside which polyscope refuses a picture with its UI (the colour bars of
+    :meth:`Viewer.picture`: "Screenshot with includeUI=true is not supported within show()").
+    Each tick is one frame of the same loop ``show()`` runs (input, the user callback, the
+    drawing); the pacing sleeps in the callback (:class:`.pacing.Pacer`)."""
+    while not ps.window_requests_close():
+        ps.frame_tick()

@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING, Any, ClassVar
 import numpy as np
 
 from ..host import Host
-from ..state.isolines import Isolines
+from ..state.isolines import IsolineFields, Isolines
 from ..state.watch import Watch
 
 if TYPE_CHECKING:
@@ -28,6 +28,18 @@ if TYPE_CHECKING:
 ExportItem = tuple[str, "np.ndarray | None", "np.ndarray | None", "np.ndarray | None"]
 """(file name, V or ``None``, F or ``None``, per-vertex scalars or ``None``): a mesh (PLY with
 the scalars) when V is given, else the scalars alone (CSV)."""
+
+
+def shown_field(
+    stem: str, V: np.ndarray, F: np.ndarray, field: np.ndarray | None
+) -> list[ExportItem]:
+    """A mesh on screen as *export* writes it: ``<stem>.ply`` (``V (n,3)``, ``F (m,3)`` in
+    the mesh's own coordinates, the colour field ``field (n,)`` as its vertex ``quality``)
+    and, with a field, the field alone as ``<stem>.csv``."""
+    items: list[ExportItem] = [(f"{stem}.ply", V, F, field)]
+    if field is not None:
+        items.append((f"{stem}.csv", None, None, field))
+    return items
 
 
 @dataclass(frozen=True)
@@ -158,20 +170,51 @@ class Panel:
 
     # -------------------------------------------------------------- files
     def export_items(self, host: Host) -> list[ExportItem]:
-        """What *export what is shown* writes for this view (``[]``: the default export)."""
+        """What *export what is shown* writes for this view: every mesh it shows (its
+        ``framed`` copies and the main mesh when it ``shows_mesh``) with the field on it
+        (:func:`shown_field`). ``[]``: the default export (the mesh with the curvature field
+        when the view ``shows_curvature``, else the plain mesh)."""
         return []
 
     def capture(self, host: Host) -> dict[str, Any]:
         """Its settings for a saved session: its section, one value per key of its spec's
-        ``settings``; by default each its state's attribute of the same name (a panel whose
-        state names them otherwise, or derives one, overrides this)."""
-        return {s.key: s.coerce(getattr(self.state, s.key)) for s in self.spec.settings}
+        ``settings``; by default each its state's attribute of the same name, and its
+        isolines (:class:`~meshlap_app.state.isolines.IsolineFields`) from :attr:`isolines`
+        (a panel whose state names them otherwise, or derives one, overrides this)."""
+        out = {}
+        for s in self.spec.settings:
+            if isinstance(s, IsolineFields):
+                out[s.key] = s.capture(self.isolines)
+            else:
+                out[s.key] = s.coerce(getattr(self.state, s.key))
+        return out
 
     def configure(self, host: Host, values: dict[str, Any]) -> None:
         """Restore settings of a session before the mesh is registered (no computation); by
-        default each declared setting's value goes to its state's attribute of that name."""
+        default each declared setting's value goes to its state's attribute of that name
+        (its isolines to :attr:`isolines`)."""
         for s in self.spec.settings:
-            setattr(self.state, s.key, values[s.key])
+            if isinstance(s, IsolineFields):
+                s.apply(self.isolines, values[s.key])
+            else:
+                setattr(self.state, s.key, values[s.key])
+
+    def isolines_section(self) -> dict[str, Any]:
+        """Its declared isoline settings by key (for a panel that writes its own
+        :meth:`capture`)."""
+        return {
+            s.key: s.capture(self.isolines)
+            for s in self.spec.settings
+            if isinstance(s, IsolineFields)
+        }
+
+    def configure_isolines(self, values: dict[str, Any]) -> None:
+        """Set :attr:`isolines` from a session section (for a panel that writes its own
+        :meth:`configure`)."""
+        for s in self.spec.settings:
+            if isinstance(s, IsolineFields):
+                s.apply(self.isolines, values[s.key])
+        self.watch.forget()  # the fields are uploaded again with them
 
     def restore(self, host: Host, values: dict[str, Any], active: bool) -> None:
         """Restore the rest of a session once the mesh is registered (``active``: the session's

@@ -21,7 +21,7 @@ from ..scene import MESH, colorbar_at, picked_vertex, scalar_for_upload
 from ..setting_widgets import setting_widget
 from ..state.check import SETTINGS, CheckState
 from ..ui import RED
-from .base import Panel
+from .base import ExportItem, Panel, shown_field
 
 DIFF = "student - reference"
 
@@ -82,6 +82,15 @@ class CheckPanel(Panel):
             **self.isolines.options("difference", values),
         )
 
+    def export_items(self, host: Host) -> list[ExportItem]:
+        """The mesh with the difference map student − reference on it (PLY, and the map as
+        CSV), once a check of this mesh shows one; before, the plain mesh (the default)."""
+        st, mesh = self.state, host.state.mesh
+        if st.check is None or st.check.difference is None or not st.current(mesh.version):
+            return []
+        d = np.asarray(st.check.difference, dtype=np.float64)
+        return shown_field(f"{mesh.stem}_{st.task}_student-reference", mesh.V, mesh.F, d)
+
     def capture(self, host: Host) -> dict[str, Any]:
         st = self.state
         return {
@@ -89,11 +98,13 @@ class CheckPanel(Panel):
             "task": st.task,
             "vertex": int(st.vertex),
             "checked": st.current(host.state.mesh.version),
+            **self.isolines_section(),
         }
 
     def configure(self, host: Host, values: dict[str, Any]) -> None:
         self.state.file = values["file"]
         self.state.set_task(values["task"])
+        self.configure_isolines(values)
 
     def restore(self, host: Host, values: dict[str, Any], active: bool) -> None:
         """The clicked vertex, and the check run again when one was shown (a job in the

@@ -15,7 +15,7 @@ from ..isolines import draw_isolines
 from ..scene import MESH, MESH_B, colorbar_at, front_view, scalar_for_upload, side_offset
 from ..setting_widgets import setting_widget
 from ..state.curvature import PRINCIPAL_JOB, SETTINGS
-from .base import Panel
+from .base import ExportItem, Panel, shown_field
 
 
 class CurvaturePanel(Panel):
@@ -56,6 +56,16 @@ class CurvaturePanel(Panel):
             MESH_B: CURVATURE_FIELD_LABELS[c.second_field][0],
         }
 
+    def export_items(self, host: Host) -> list[ExportItem]:
+        """The mesh with its field, and side by side the copy with the second field."""
+        c, mesh = host.state.curv, host.state.mesh
+        c.update(mesh)
+        items = shown_field(f"{mesh.stem}_{c.field_name}", mesh.V, mesh.F, c.values(c.field_name))
+        if c.side_by_side and c.second_field != c.field_name:
+            second = c.values(c.second_field)
+            items += shown_field(f"{mesh.stem}_{c.second_field}", mesh.V, mesh.F, second)
+        return items
+
     def capture(self, host: Host) -> dict[str, Any]:
         c = host.state.curv
         return {
@@ -66,6 +76,7 @@ class CurvaturePanel(Panel):
             "side_by_side": bool(c.side_by_side),
             "second_field": c.second_field,
             "estimator": c.estimator,
+            **self.isolines_section(),
         }
 
     def configure(self, host: Host, values: dict[str, Any]) -> None:
@@ -74,6 +85,7 @@ class CurvaturePanel(Panel):
         c.set_percentile(values["clip"])
         c.side_by_side, c.second_field = values["side_by_side"], values["second_field"]
         c.set_estimator(values["estimator"])
+        self.configure_isolines(values)
 
     def start(self, host: Host, options: dict[str, Any], shown: bool, screenshot: bool) -> None:
         if options.get("field") is not None:

@@ -26,7 +26,7 @@ from ..state.curvature_lab import (
     LabResult,
 )
 from ..state.display import Display
-from .base import Panel
+from .base import ExportItem, Panel, shown_field
 
 LAB = "curvature lab"
 """The lab's surface mesh (the parametric surface's, or a copy of the loaded mesh)."""
@@ -52,12 +52,21 @@ class CurvatureLabPanel(Panel):
     def on_new_mesh(self, host: Host) -> None:
         self.watch.forget()
 
+    def export_items(self, host: Host) -> list[ExportItem]:
+        """The lab's mesh with its coloured field (PLY, and the field as CSV)."""
+        lab, r = self.state, self.state.result
+        if r is None:
+            return []
+        where = f"{lab.surface}_res{lab.res}" if lab.source == "surface" else host.state.mesh.stem
+        values = np.asarray(r.values, dtype=np.float64)
+        return shown_field(f"{where}_{lab.quantity}_{lab.show}", r.V, r.F, values)
+
     def capture(self, host: Host) -> dict[str, Any]:
-        return self.state.settings()
+        return {**self.state.settings(), **self.isolines_section()}
 
     def configure(self, host: Host, values: dict[str, Any]) -> None:
         self.state.configure(values)
-        self.watch.forget()
+        self.configure_isolines(values)
 
     def show(self, host: Host, active: Panel) -> None:
         if active is self:

@@ -21,6 +21,8 @@ from ..panel_spec import PanelSpec
 from ..scene import MESH, front_view, picked_vertex, side_offset
 from ..setting_widgets import setting_widget
 from ..state.diffusion import (
+    CURVE_POINTS,
+    DEFAULT_KNOTS,
     HEAT_FIELDS,
     ISO_FIELDS,
     SETTINGS,
@@ -29,7 +31,7 @@ from ..state.diffusion import (
     symmetric_range,
 )
 from ..state.isolines import DEFAULT_COUNT
-from .base import ExportItem, Panel
+from .base import ExportItem, Panel, shown_field
 
 FIELD = "diffusion field"
 SOURCES = "heat sources"
@@ -93,6 +95,18 @@ class DiffusionPanel(Panel):
         elif self.watch.seen("field") is not None and ps.has_surface_mesh(MESH):
             ps.get_surface_mesh(MESH).remove_quantity(self._field_label())
             self.watch.forget("field")
+
+    def sync(self, host: Host) -> None:
+        """The heat kernel signature of the eigenbasis there is now: a basis that arrives
+        after the view was set (a session's, read from the cache; one computed in the
+        Spectral view) gives it its field and its t (the filter's is made when drawn)."""
+        st = self.state
+        if host.active() is not self or st.show != "hks":
+            return
+        basis = self._basis(host)
+        if basis is not None and (st._hks is None or st._hks[0] is not basis):
+            st.compute_hks(basis)
+            self.push(host)
 
     def pick(self, host: Host, hit: Any, active: Panel) -> bool:
         if active is not self or hit.structure_name != MESH:
@@ -363,13 +377,21 @@ class DiffusionPanel(Panel):
         return {}
 
     def export_items(self, host: Host) -> list[ExportItem]:
+        """The mesh with the field on it, the heat copies with theirs, the filtered copy
+        (each PLY with its field, the field as CSV)."""
+        st, mesh = self.state, host.state.mesh
         f, _, _ = self._field()
-        stem = host.state.mesh.stem
+        stem = mesh.stem
         items: list[ExportItem] = []
-        if f is not None:
-            items.append((f"{stem}_{self.state.show}.csv", None, None, f))
-        if self.state.filtered is not None and self.state.show == "filter":
-            items.append((f"{stem}_filtered.ply", self.state.filtered, host.state.mesh.F, None))
+        if f is not None and len(f) == len(mesh.V):
+            name = f"{stem}_{self.iso_field()}".replace(" ", "_")
+            items += shown_field(name, mesh.V, mesh.F, f)
+        else:
+            items.append((f"{stem}.ply", mesh.V, mesh.F, None))
+        for which in self._copy_fields():
+            items += shown_field(f"{stem}_heat_{which}", mesh.V, mesh.F, st.heat[which])
+        if st.filtered is not None and st.show == "filter":
+            items.append((f"{stem}_filtered_{st.filter}.ply", st.filtered, mesh.F, None))
         return items
 
     # ------------------------------------------------------------------ sessions
@@ -390,6 +412,9 @@ class DiffusionPanel(Panel):
             "keep": int(st.keep),
             "gain": float(st.gain),
             "hks_scale": int(st.hks_scale),
+            "iters": int(st.iters),
+            "residual": bool(st.residual),
+            "curve": [float(y) for _, y in st.knots],
         }
 
     def _iso_changed(self) -> dict[str, dict[str, Any]]:
@@ -415,8 +440,11 @@ class DiffusionPanel(Panel):
                     saved = value.get(name, {"on": name in ISOLINES_ON, "count": DEFAULT_COUNT})
                     field.on = bool(saved["on"])
                     field.set_count(saved["count"])
+            elif key == "curve":  # the drawn gains at the fixed control points
+                st.knots = [(x, float(y)) for (x, _), y in zip(DEFAULT_KNOTS, value, strict=True)]
             elif key != "sources":
                 setattr(st, key, value)
+        st.filtered = None  # computed again for these settings when shown
 
     def restore(self, host: Host, values: dict[str, Any], active: bool) -> None:
         self.configure(host, values)
@@ -542,10 +570,10 @@ class DiffusionPanel(Panel):
         ch, gain = setting_widget(ui, SETTINGS["gain"], st.gain)
         if ch:
             st.gain = SETTINGS["gain"].checked(gain, "band gain")
-        ch, iters = ui.input_int("smoother steps", st.iters, "n of the smoothers' filters")
+        ch, iters = setting_widget(ui, SETTINGS["iters"], st.iters)
         if ch:
-            st.iters = int(min(max(iters, 0), 10_000))
-        ch, res = ui.checkbox("keep residual", st.residual, "add X - U U^T M X back")
+            st.iters = SETTINGS["iters"].clamp(iters)
+        ch, res = setting_widget(ui, SETTINGS["residual"], st.residual)
         if ch:
             st.residual = res
         if st.filtered is None or ui.changed:
@@ -581,7 +609,7 @@ class DiffusionPanel(Panel):
         ui.plot_line("drawn curve", P[:, 0], P[:, 1])
         for i, (x, y) in enumerate(P):
             moved, _, ny = ui.plot_drag_point(
-                f"curve point {i}", i, x, y,
+                CURVE_POINTS[i], i, x, y,
                 f"drag up or down: the gain h at lambda = {x:.3g} (linear between the points)",
             )  # fmt: skip
             if moved:

@@ -295,12 +295,13 @@ class SmoothingPanel(Panel):
         return out
 
     def export_items(self, host: Host) -> list[ExportItem]:
-        """The smoothed mesh as it is now (PLY)."""
+        """The smoothed mesh as it is now and the (noisy) input beside it (PLY)."""
         st = self.state
         if st.smoother is None:
             return []
-        name = f"{host.state.mesh.stem}_{st.method}_{st.laplacian}_it{st.smoother.iteration}.ply"
-        return [(name, np.array(st.V), st.F, None)]
+        stem = host.state.mesh.stem
+        name = f"{stem}_{st.method}_{st.laplacian}_it{st.smoother.iteration}.ply"
+        return [(name, np.array(st.V), st.F, None), (f"{stem}_input.ply", st.V_start, st.F, None)]
 
     def on_key(self, host: Host, key: str) -> bool:
         st = self.state

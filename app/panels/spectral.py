@@ -20,7 +20,7 @@ from ..record import Recorder, draw_record
 from ..scene import COLORBAR_AT, EIGEN, MESH, RECON, front_view, side_offset
 from ..setting_widgets import setting_widget
 from ..state.spectral import ANIMATION, PLAY_KINDS, SCREENSHOT_K, SETTINGS, SpectralState
-from .base import ExportItem, Panel
+from .base import ExportItem, Panel, shown_field
 
 ERROR_NAME = "error |x - x_k|"  # the reconstruction's per-vertex error quantity
 
@@ -146,16 +146,15 @@ class SpectralPanel(Panel):
         return {MESH: f"eigenfunction u_{st.mode}", RECON: f"k = {st.k} of {st.basis.k_max} modes"}
 
     def export_items(self, host: Host) -> list[ExportItem]:
-        """The k-reconstruction (PLY with the per-vertex error) and the shown eigenfunction
-        (CSV)."""
-        st = self.state
+        """The mesh with the shown eigenfunction, and the k-reconstruction beside it with its
+        per-vertex error (each PLY with its field, and the field as CSV)."""
+        st, mesh = self.state, host.state.mesh
         if st.basis is None:
             return []
-        stem = host.state.mesh.stem
         f, _ = st.eigenfunction()
         return [
-            (f"{stem}_k{st.k}.ply", st.reconstruction, host.state.mesh.F, st.vertex_error),
-            (f"{stem}_mode{st.mode}.csv", None, None, f),
+            *shown_field(f"{mesh.stem}_mode{st.mode}", mesh.V, mesh.F, f),
+            *shown_field(f"{mesh.stem}_k{st.k}", st.reconstruction, mesh.F, st.vertex_error),
         ]
 
     def on_key(self, host: Host, key: str) -> bool:
@@ -176,6 +175,7 @@ class SpectralPanel(Panel):
             "k": int(st.k),
             "mode": int(st.mode),
             "play": st.play_what,
+            **self.isolines_section(),
         }
 
     def configure(self, host: Host, values: dict[str, Any]) -> None:
@@ -183,6 +183,7 @@ class SpectralPanel(Panel):
         st.k_request = min(values["k_request"], max(len(host.state.mesh.V), 2))
         st.k, st.mode = values["k"], values["mode"]
         st.set_play_what(values["play"])
+        self.configure_isolines(values)
 
     def restore(self, host: Host, values: dict[str, Any], active: bool) -> None:
         """The basis (from the cache when it was computed before), mode and k."""

@@ -29,7 +29,7 @@ from ..scene import (
 from ..setting_widgets import setting_widget
 from ..state.surfaces import ANIMATION, SETTINGS, TURN_STEP_DEG, SurfaceState, section_arc
 from ..text_numbers import sig
-from .base import ExportItem, Panel
+from .base import ExportItem, Panel, shown_field
 
 
 class SurfacesPanel(Panel):
@@ -45,6 +45,7 @@ class SurfacesPanel(Panel):
         super().__init__(spec, state)
         self.state: SurfaceState = state
         self.recorder = Recorder(f"{spec.name}.gif")
+        self.field: np.ndarray | None = None  # the colour field uploaded on the surface
 
     def animating(self) -> bool:
         """The normal section turns: the window keeps its full frame rate."""
@@ -79,18 +80,26 @@ class SurfacesPanel(Panel):
         return False
 
     def export_items(self, host: Host) -> list[ExportItem]:
-        """The parametric surface's mesh (PLY)."""
+        """The parametric surface's mesh with the field on it (PLY, and the field as CSV)."""
         s = self.state
         if s.mesh is None:
             return []
-        return [(f"{s.name}_res{s.res}.ply", s.mesh.V, s.mesh.F, None)]
+        return shown_field(f"{s.name}_res{s.res}", s.mesh.V, s.mesh.F, self.field)
 
     def capture(self, host: Host) -> dict[str, Any]:
         s = self.state
-        return {"surface": s.name, "res": int(s.res), "u": s.u, "v": s.v, "theta": s.section_deg}
+        return {
+            "surface": s.name,
+            "res": int(s.res),
+            "u": s.u,
+            "v": s.v,
+            "theta": s.section_deg,
+            **self.isolines_section(),
+        }
 
     def configure(self, host: Host, values: dict[str, Any]) -> None:
-        """Nothing before the mesh: :meth:`restore` meshes the surface and sets the point."""
+        """The isolines; :meth:`restore` meshes the surface and sets the point."""
+        self.configure_isolines(values)
 
     def restore(self, host: Host, values: dict[str, Any], active: bool) -> None:
         s = self.state
@@ -112,6 +121,7 @@ class SurfacesPanel(Panel):
 
             cf = surface_curvature(surf.name, sm.uv[:, 0], sm.uv[:, 1])
             K = np.nan_to_num(np.asarray(cf.K, dtype=float))
+            self.field = K  # what export writes
             r = float(np.percentile(np.abs(K), 98)) or 1.0
             s.add_scalar_quantity(
                 "Gaussian curvature K (exact) [1/length^2]",

@@ -94,3 +94,12 @@ class Animation:
     uses_mesh: bool = True
     colorbar: bool = True
     session_overrides: dict[str, Any] = field(default_factory=dict)
+
+
+RECORDER_WIDGETS: dict[str, str] = {
+    "record file": "the file the next recording writes (an action's argument)",
+    "record": "an action: records a frame per change from now",
+    "stop": "an action: writes the recording",
+}
+"""The *record* header's widgets (:mod:`meshlap_app.record`) in a panel that plays: why none
+is a setting (a panel's spec lists them in its ``unsaved``)."""

@@ -20,6 +20,7 @@ from meshlap_core.exercises.check import MeshCheck, check_on_mesh
 from meshlap_core.exercises.tasks import EXERCISE_TASKS
 
 from ..panel_spec import PanelSpec
+from .isolines import isoline_fields
 from .settings import MAX_INT, Choice, Integer, Settings, Text, Toggle
 
 VIEWER_TASKS: tuple[str, ...] = EXERCISE_TASKS
@@ -39,6 +40,7 @@ SETTINGS = Settings(
     Toggle("checked", False, label="check", widget="button",
            tooltip="run your function on this mesh and the battery",
            quiet=False),  # another panel's animation runs no student code
+    isoline_fields(("difference",)),
 )
 # fmt: on
 """The Check panel's section of a saved session: the student file as typed (relative: in the

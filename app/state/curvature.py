@@ -32,6 +32,7 @@ from meshlap_core.options import (
 from meshlap_core.types import FloatArray
 
 from ..panel_spec import PanelSpec
+from .isolines import isoline_fields
 from .mesh import MeshState
 from .settings import Choice, Flag, Number, Settings, Toggle
 
@@ -62,6 +63,7 @@ SETTINGS = Settings(
     Choice("estimator", "cotan", choices=CURVATURE_ESTIMATORS, label="estimator",
            tooltip="k1, k2 (and the One-ring view's shape operator) by:\n" + ESTIMATOR_HELP,
            added=True),  # written only when not cotan: older meshlaps read the file
+    isoline_fields(CURVATURE_FIELDS),
 )
 # fmt: on
 """The Curvature panel's settings (its section of a saved session, ``--field``, widgets)."""

@@ -38,6 +38,7 @@ from meshlap_core.surfaces import SURFACES, SurfaceMesh, mesh_surface
 from meshlap_core.types import FloatArray, IntArray
 
 from ..panel_spec import PanelSpec
+from .isolines import isoline_fields
 from .settings import MAX_INT, Choice, Integer, Number, Settings, Toggle
 
 MAX_RES = 256
@@ -92,13 +93,15 @@ SETTINGS = Settings(
            tooltip="fraction of the interior edges flipped"),
     Integer("vertex", -1, lo=-1, hi=MAX_INT - 1, label="vertex",
             tooltip="pick a vertex (or click the mesh): its shape operator"),
+    isoline_fields(LAB_SHOWS),
 )
 # fmt: on
 """The Curvature lab's settings (its section of a saved session: its choices, sliders and
 the picked vertex of the lab's mesh, the parametric surface's at ``res`` or the loaded mesh,
 which bounds it: :func:`check_mesh`)."""
-SHOWN_ONLY = ("crosses", "vertex")
-"""Settings the result does not depend on (the rest are :meth:`CurvatureLabState.params`)."""
+SHOWN_ONLY = ("crosses", "vertex", "isolines")
+"""Settings the result does not depend on (the rest are :meth:`CurvatureLabState.params`;
+the isolines are the panel's, not this state's)."""
 
 
 def lab_vertex_count(values: dict[str, Any], mesh: Any) -> int:
@@ -326,11 +329,12 @@ class CurvatureLabState:
         return {k: getattr(self, k) for k in SETTINGS.keys() if k not in SHOWN_ONLY}
 
     def settings(self) -> dict[str, Any]:
-        """Its section of a saved session (:data:`SETTINGS`' keys)."""
+        """Its part of the panel's section of a saved session (:data:`SETTINGS`' keys but the
+        panel's isolines)."""
         out = self.params()
         out["crosses"] = bool(self.crosses)
         out["vertex"] = int(self.vertex)
-        return {k: out[k] for k in SETTINGS.keys()}
+        return {k: out[k] for k in SETTINGS.keys() if k in out}
 
     def configure(self, values: dict[str, Any]) -> None:
         """Take a session's section (checked against :data:`SETTINGS` and by

@@ -107,6 +107,25 @@ def check_sources(x: Any) -> str | None:
     return None
 
 
+CURVE_POINTS = tuple(f"curve point {i}" for i in range(len(DEFAULT_KNOTS)))
+"""The drawn curve's control points as dragged in the plot (its widgets)."""
+MAX_SMOOTHER_STEPS = 10_000
+"""Most steps of the smoothers' transfer functions (the filter editor's *smoother steps*)."""
+
+
+def check_curve(x: Any) -> str | None:
+    """The drawn curve's gains: one finite number in :data:`GAIN_RANGE` per control point
+    of :data:`DEFAULT_KNOTS` (their λ are fixed)."""
+    n = len(DEFAULT_KNOTS)
+    if not isinstance(x, list) or len(x) != n:
+        return f"must be a list of {n} gains, got {shown(x)}"
+    lo, hi = GAIN_RANGE
+    for y in x:
+        if not isinstance(y, int | float) or isinstance(y, bool) or not lo <= y <= hi:
+            return f"has {shown(y)}; a gain is a number {lo:g} to {hi:g}"
+    return None
+
+
 def distinct(sources: list[int]) -> list[int]:
     """The sources without repeats, in their order (``[0, 0, 0]`` is one source: a unit of
     heat each, three would triple the heat; and a list of a million repeats costs nothing)."""
@@ -151,6 +170,16 @@ SETTINGS = Settings(
            tooltip="gain of the band"),
     Integer("hks_scale", 8, lo=0, hi=HKS_SCALES - 1, label="HKS time", widget="slider",
             tooltip="log-spaced t"),
+    Integer("iters", 10, lo=0, hi=MAX_SMOOTHER_STEPS, label="smoother steps", widget="input",
+            added=True, tooltip="n of the smoothers' filters"),
+    Toggle("residual", False, label="keep residual", added=True,
+           tooltip="add X - U U^T M X back"),
+    Custom("curve", [y for _, y in DEFAULT_KNOTS], check=check_curve, widget="drag",
+           label="curve point 0", also=CURVE_POINTS[1:],
+           added=True, example=[1.0, 1.0, 0.5, 0.0, 0.25, 0.0, 0.0],
+           tooltip="the drawn filter's gains h at its control points (their lambda fixed)",
+           refused=([], [1.0] * (len(DEFAULT_KNOTS) - 1), ["1"] * len(DEFAULT_KNOTS),
+                    [float("nan")] * len(DEFAULT_KNOTS), [99.0] * len(DEFAULT_KNOTS))),
 )
 # fmt: on
 """The Diffusion panel's section of a saved session (:mod:`.session`): the sources are
@@ -548,5 +577,13 @@ SPEC = PanelSpec(
     settings=SETTINGS,
     check_mesh=check_mesh,
     animation=ANIMATION,
+    unsaved={
+        "clear sources": "an action on the sources (declared): empties them",
+        "show error map": "sets the heat field (declared) to difference in the distance view",
+        "exact distance": "an action: a job (minutes on a scan), its error map shown when done",
+        "measure by smoothing": "an action: runs the smoother and projects it (a job)",
+        "play t": "an action: sweeps t up its log scale (log_t is declared)",
+        "pause t": "an action: stops at the t shown (declared)",
+    },
 )
 """The Diffusion panel."""

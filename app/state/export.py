@@ -12,5 +12,10 @@ SPEC = PanelSpec(
     summary="the export folder, a screenshot, and what is shown written there (PLY, CSV)",
     panel="ExportPanel",
     view=False,
+    unsaved={
+        "folder": "where this machine writes files; a session opens on other machines",
+        "screenshot": "an action: writes the view as a PNG",
+        "export what is shown": "an action: writes the meshes and fields on screen",
+    },
 )
 """The Export section (drawn on every frame)."""

@@ -15,6 +15,8 @@ import numpy as np
 
 from meshlap_core.types import FloatArray
 
+from .settings import Custom, integer_problem
+
 COUNT_RANGE = (1, 200)
 """Allowed isoline counts (a typed value is clamped into it)."""
 DEFAULT_COUNT = 12
@@ -63,3 +65,68 @@ class Isolines:
         if not s.on:
             return {"isolines_enabled": False}
         return {"isolines_enabled": True, "isoline_period": isoline_period(values, s.count)}
+
+
+@dataclass(frozen=True, kw_only=True)
+class IsolineFields(Custom):
+    """A panel's isolines as one declared setting (its session key ``isolines``): per field
+    of ``fields`` whose isolines a user changed, ``{"on": bool, "count": int}`` (a field not
+    listed is at its default: shown when in ``shown``, :data:`DEFAULT_COUNT` curves). Made by
+    :func:`isoline_fields`; :meth:`capture` and :meth:`apply` read and set a panel's
+    :class:`Isolines` (the base panel's ``capture`` / ``configure`` do it)."""
+
+    fields: tuple[str, ...] = ()
+    shown: tuple[str, ...] = ()
+
+    def capture(self, iso: Isolines) -> dict[str, dict[str, Any]]:
+        """The fields of ``iso`` changed from their defaults, as the session keeps them."""
+        out = {}
+        for name in self.fields:
+            s = iso.fields.get(name)
+            if s is not None and (s.on != (name in self.shown) or s.count != DEFAULT_COUNT):
+                out[name] = {"on": bool(s.on), "count": int(s.count)}
+        return out
+
+    def apply(self, iso: Isolines, value: dict[str, dict[str, Any]]) -> None:
+        """Set every field of ``iso`` from a checked ``value`` (a field not in it: default)."""
+        for name in self.fields:
+            saved = value.get(name, {"on": name in self.shown, "count": DEFAULT_COUNT})
+            s = iso.of(name, name in self.shown)
+            s.on = bool(saved["on"])
+            s.set_count(saved["count"])
+
+
+def isoline_fields(
+    fields: tuple[str, ...], labels: tuple[str, ...] = ("isolines", "isoline count")
+) -> IsolineFields:
+    """The isolines setting of a panel showing ``fields`` (isolines off by default), drawn by
+    the widgets ``labels`` (:func:`meshlap_app.isolines.draw_isolines`: a toggle and a count
+    per field; a panel with two fields draws them with a suffix each)."""
+
+    def check(x: Any) -> str | None:
+        if not isinstance(x, dict):
+            return "must be an object of fields"
+        for name, v in x.items():
+            if name not in fields:
+                return f"has {name!r}; fields are {', '.join(fields)}"
+            if not (isinstance(v, dict) and set(v) == {"on", "count"}):
+                return f'{name!r} must be {{"on": true/false, "count": N}}'
+            if not isinstance(v["on"], bool) or integer_problem(v["count"], *COUNT_RANGE):
+                return f"{name!r}: on must be true/false, count {COUNT_RANGE[0]}..{COUNT_RANGE[1]}"
+        return None
+
+    hi = COUNT_RANGE[1]
+    return IsolineFields(
+        "isolines",
+        {},
+        check=check,
+        fields=fields,
+        label=labels[0],
+        also=labels[1:],
+        widget="checkbox",
+        added=True,
+        tooltip="level curves of the shown field: on or off and how many, per field",
+        example={fields[0]: {"on": True, "count": 5}},
+        refused=([], {"nonsense": {"on": True, "count": 3}}, {fields[0]: {"on": 1, "count": 3}},
+                 {fields[0]: {"on": True, "count": hi + 1}}, {fields[0]: {"on": True}}),
+    )  # fmt: skip

@@ -13,5 +13,10 @@ SPEC = PanelSpec(
     "list or by dropping it on the window",
     panel="MeshPanel",
     view=False,
+    unsaved={
+        "path": "the session keeps the mesh it opened (its mesh), not the text typed",
+        "Open": "an action: opens the typed path (the session keeps that mesh)",
+        "bundled / shared": "an action: opens a listed mesh (the session keeps that mesh)",
+    },
 )
 """The Mesh section (drawn on every frame)."""

@@ -354,5 +354,9 @@ SPEC = PanelSpec(
     settings=SETTINGS,
     check_mesh=check_mesh,
     check_start=check_start,
+    unsaved={
+        "area kind": "the Curvature section's area (declared there): one value for both views",
+        "boundary rule": "the Curvature section's boundary rule (declared there)",
+    },
 )
 """The One-ring panel."""

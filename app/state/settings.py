@@ -139,6 +139,10 @@ class Setting:
         computed: no basis read, no run replayed); UNSET keeps the saved one.
     example : Any
         A valid value other than the default for the tests (UNSET: derived).
+    also : tuple of str
+        The labels of its other widgets, when more than one sets it (the isolines' count
+        beside their toggle, the control points of a drawn curve): with ``label``, every
+        widget that changes it (the widget audit of ``tests/test_viewer_widgets.py``).
     """
 
     key: str
@@ -152,6 +156,7 @@ class Setting:
     widget: str = ""
     quiet: Any = UNSET
     example: Any = UNSET
+    also: tuple[str, ...] = ()
 
     widgets: ClassVar[tuple[str, ...]] = ("button", "none")
 
@@ -162,6 +167,8 @@ class Setting:
             raise ValueError(f"{self.key}: widget {self.widget!r} is not one of {self.widgets}")
         if (self.drawn_as != "none") != bool(self.label):
             raise ValueError(f"{self.key}: a label names its widget (widget='none': no label)")
+        if self.also and not self.label:
+            raise ValueError(f"{self.key}: other widgets ({self.also}) but no label of its own")
         problem = self.problem(self.default)
         if problem:
             raise ValueError(f"{self.key}: its default {problem}")
@@ -173,6 +180,12 @@ class Setting:
     def drawn_as(self) -> str:
         """Its widget: ``widget``, or its type's default (the first of ``widgets``)."""
         return self.widget or self.widgets[0]
+
+    @property
+    def labels(self) -> tuple[str, ...]:
+        """The labels of every widget that sets it (``label`` and ``also``; none when it has
+        no widget)."""
+        return (self.label, *self.also) if self.label else ()
 
     # -------------------------------------------------------------- values
     def problem(self, value: Any) -> str | None:
@@ -422,12 +435,14 @@ class Text(Setting):
 class Custom(Setting):
     """A structured value (a list, an object) with its own ``check`` (what is wrong, or
     ``None``) and ``normalize`` (the value as kept, e.g. without duplicates); ``refused``
-    lists values the check must refuse (the tests' table). Flags cannot take one."""
+    lists values the check must refuse (the tests' table). Flags cannot take one. Its
+    widgets are drawn by its panel: ``"none"``, a ``"button"``, ``"drag"`` points in a plot,
+    a ``"checkbox"`` with more widgets (``also``)."""
 
     check: Callable[[Any], str | None]
     normalize: Callable[[Any], Any] | None = None
     refused: tuple[Any, ...] = ()
-    widgets: ClassVar[tuple[str, ...]] = ("none", "button")
+    widgets: ClassVar[tuple[str, ...]] = ("none", "button", "drag", "checkbox")
 
     def __post_init__(self) -> None:
         if self.view is not None or self.animate is not None:

@@ -17,7 +17,7 @@ from meshlap_core.smoothing import Smoother, amplification_curve, check_lam
 from meshlap_core.types import FloatArray, IntArray
 
 from ..panel_spec import PanelSpec
-from .animation import Animation, Option
+from .animation import RECORDER_WIDGETS, Animation, Option
 from .kept_steps import KeptSteps
 from .play_meter import PlayMeter
 from .settings import (
@@ -527,5 +527,11 @@ SPEC = PanelSpec(
     check_section=check_section,
     check_mesh=check_mesh,
     animation=ANIMATION,
+    unsaved={
+        "play": "an action: steps on each frame (the steps are kept as iterations, lam_steps)",
+        "pause": "an action: stops playing (the steps made are kept)",
+        "reset": "an action: back to the input (iterations 0)",
+        **RECORDER_WIDGETS,
+    },
 )
 """The Smoothing panel."""

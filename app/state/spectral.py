@@ -21,7 +21,8 @@ from meshlap_core.spectral import SpectralBasis
 from meshlap_core.types import FloatArray, IntArray
 
 from ..panel_spec import PanelSpec
-from .animation import Animation, Option
+from .animation import RECORDER_WIDGETS, Animation, Option
+from .isolines import isoline_fields
 from .settings import MAX_INT, Choice, Flag, Integer, Settings, Toggle
 
 PLAY_KINDS: tuple[str, ...] = ("k sweep", "modes")
@@ -50,6 +51,9 @@ SETTINGS = Settings(
     Choice("play", "k sweep", choices=PLAY_KINDS, label="play what", added=True,
            tooltip="k sweep: k = 1, 2, ... one per frame (as meshlap animate --k); modes: the "
            "eigenmodes 1, 2, ... at 1.5 per second (as --modes); playing stops at the end"),
+    isoline_fields(("eigenfunction", "error"), labels=(
+        "isolines (mode)", "isoline count (mode)", "isolines (error)", "isoline count (error)",
+    )),
 )
 # fmt: on
 """The Spectral panel's settings (the basis, k and mode are bounded by the mesh where they
@@ -367,5 +371,10 @@ SPEC = PanelSpec(
     state=SpectralState,
     settings=SETTINGS,
     animation=ANIMATION,
+    unsaved={
+        "play": "an action: plays what 'play what' says (declared: play)",
+        "pause": "an action: stops at the k or mode shown (declared: k, mode)",
+        **RECORDER_WIDGETS,
+    },
 )
 """The Spectral panel."""

@@ -18,7 +18,8 @@ from meshlap_core.types import FloatArray
 
 from ..panel_spec import PanelSpec
 from ..text_numbers import sig
-from .animation import Animation, Option
+from .animation import RECORDER_WIDGETS, Animation, Option
+from .isolines import isoline_fields
 from .settings import Choice, Flag, Integer, Number, Settings
 
 MAX_RES = 512  # cells per direction the viewer meshes (512² cells: 0.5 M triangles)
@@ -49,6 +50,7 @@ SETTINGS = Settings(
            "p_v sin theta (normalized). phi is the same direction measured in the tangent "
            "plane from the first principal direction (the plot's axis). Drawn: its tangent "
            "t and its osculating arc of curvature k_n"),
+    isoline_fields(("Gaussian curvature",)),
 )
 # fmt: on
 """The Surfaces panel's settings: the surface, its resolution, the point (u, v) and the
@@ -346,5 +348,10 @@ SPEC = PanelSpec(
     state=SurfaceState,
     settings=SETTINGS,
     animation=ANIMATION,
+    unsaved={
+        "turn": "an action: turns the section (its theta is declared)",
+        "pause turn": "an action: stops at the theta shown (declared)",
+        **RECORDER_WIDGETS,
+    },
 )
 """The Surfaces panel."""

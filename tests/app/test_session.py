@@ -712,3 +712,97 @@ def test_a_saved_session_reopens_the_curvature_lab(mock, tmp_path, sphere, monke
     assert back.vertex == 23 and back.shape_operator()["k1"] == lab.shape_operator()["k1"]
     np.testing.assert_array_equal(back.result.values, values)  # the same error map
     assert back.convergence() == conv  # and the same study
+
+
+# ---------------------------------------------------------------- work a session kept badly
+def drive_diffusion(viewer, label, *values) -> None:
+    for value in values:
+        viewer.ui.script(label, value)
+        tick(viewer)
+
+
+def test_a_dragged_curve_of_the_drawn_filter_is_saved_and_reopened(
+    mock, tmp_path, sphere, monkeypatch
+):
+    """The drawn filter's control points, dragged in the plot, came back at the default curve
+    from a saved session: the gains are a declared setting now, and the filtered copy of the
+    reopened session is the one on screen when it was saved."""
+    from meshlap_app import session
+    from meshlap_app.state.diffusion import DEFAULT_KNOTS
+
+    monkeypatch.setenv("MESHLAP_CACHE_DIR", str(tmp_path / "cache"))
+    viewer = new_viewer(sphere)
+    spec = viewer.panels["spectral"].state
+    spec.k_request = 30
+    spec.start(viewer.state.mesh.V, viewer.state.mesh.F, background=False)
+    viewer.set_panel("diffusion")
+    drive_diffusion(viewer, "show", "filter")
+    drive_diffusion(viewer, "filter", "drawn")
+    drive_diffusion(viewer, "curve point 2", (0.1, 0.3))
+    drive_diffusion(viewer, "curve point 5", (0.6, 1.5))
+    drive_diffusion(viewer, "smoother steps", 7)
+    drive_diffusion(viewer, "keep residual", True)
+    st = viewer.panels["diffusion"].state
+    gains = [y for _, y in st.knots]
+    assert gains[2] == 0.3 and gains[5] == 1.5 and gains != [y for _, y in DEFAULT_KNOTS]
+    shown = st.filtered.copy()
+    path = session.save(viewer, tmp_path / "drawn.json")
+    assert json.loads(path.read_text())["diffusion"]["curve"] == gains
+
+    other = tmp_path / "other.obj"
+    save_mesh(other, *primitives.icosphere(1))
+    fresh = new_viewer(other)
+    session.load(fresh, path)
+    for _ in range(3):
+        tick(fresh)
+    back = fresh.panels["diffusion"].state
+    assert [y for _, y in back.knots] == gains and [x for x, _ in back.knots] == [
+        x for x, _ in DEFAULT_KNOTS
+    ]
+    assert (back.iters, back.residual, back.filter) == (7, True, "drawn")
+    np.testing.assert_allclose(back.filtered, shown, atol=1e-12)
+    assert (
+        session.capture(fresh).settings["diffusion"]
+        == session.capture(viewer).settings["diffusion"]
+    )
+
+
+def test_a_session_saved_in_the_hks_view_reopens_coloured(mock, tmp_path, sphere, monkeypatch):
+    """Saved in the HKS view, a session reopened with "t = nan" and the mesh uncoloured: the
+    signature waited for a click that restoring does not make, and a basis arriving later
+    (read from the cache) was never used. Reopened through the panels, the mesh shows the
+    signature at the saved time, with its colour bar, and the panel's t is that time."""
+    from legend_ledger import Ledger
+    from meshlap_app import session
+    from meshlap_app.scene import MESH
+
+    from meshlap_core.diffusion import heat_kernel_signature, hks_times
+
+    monkeypatch.setenv("MESHLAP_CACHE_DIR", str(tmp_path / "cache"))
+    viewer = new_viewer(sphere)
+    spec = viewer.panels["spectral"].state
+    spec.k_request = 20
+    spec.start(viewer.state.mesh.V, viewer.state.mesh.F, background=False)
+    viewer.set_panel("diffusion")
+    drive_diffusion(viewer, "show", "hks")
+    drive_diffusion(viewer, "HKS time", 5)
+    st = viewer.panels["diffusion"].state
+    assert st.hks is not None and np.isfinite(st.hks_time())
+    t_saved = st.hks_time()
+    path = session.save(viewer, tmp_path / "hks.json")
+
+    ledger = Ledger().install(monkeypatch)
+    fresh = new_viewer(sphere)
+    session.load(fresh, path)
+    for _ in range(3):
+        tick(fresh)
+    back = fresh.panels["diffusion"].state
+    assert back.show == "hks" and back.hks_scale == 5
+    assert np.isfinite(back.hks_time()) and back.hks_time() == pytest.approx(t_saved)
+    basis = fresh.panels["spectral"].state.basis
+    H = heat_kernel_signature(basis, hks_times(basis.eigenvalues, 16), scaled=True)
+    shown = {n: q for (s, n), q in ledger.visible().items() if s == MESH}
+    assert len(shown) == 1, shown
+    (q,) = shown.values()
+    assert q.colorbar and q.owner == "diffusion"
+    np.testing.assert_allclose(q.values, H[:, 5], rtol=1e-10)

@@ -13,6 +13,7 @@ import sys
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
 import polyscope as ps
 
 KINDS = {
@@ -51,10 +52,13 @@ def _calling_panel() -> str:
 
 @dataclass
 class Ledger:
-    """Per structure name, its colour quantities (see the module docstring)."""
+    """Per structure name, its colour quantities (see the module docstring), and each surface
+    mesh's vertex positions and faces as last uploaded (``meshes``: registered, then moved by
+    ``update_vertex_positions``)."""
 
     quantities: dict[str, dict[str, Quantity]] = field(default_factory=dict)
     kind_of: dict[str, str] = field(default_factory=dict)
+    meshes: dict[str, tuple[Any, Any]] = field(default_factory=dict)
 
     def install(self, monkeypatch: Any) -> Ledger:
         """Wrap polyscope's calls with ``monkeypatch``; returns ``self``."""
@@ -67,6 +71,7 @@ class Ledger:
         def remove_all() -> None:
             real_all()
             self.quantities.clear()
+            self.meshes.clear()
 
         monkeypatch.setattr(ps, "remove_all_structures", remove_all)
         return self
@@ -115,6 +120,17 @@ class Ledger:
             ledger.quantities.pop(obj.get_name(), None)
             return out
 
+        if cls is ps.SurfaceMesh:
+            real_update = cls.update_vertex_positions
+
+            def update(obj: Any, points: Any, *args: Any, **kw: Any) -> Any:
+                out = real_update(obj, points, *args, **kw)
+                name = obj.get_name()
+                faces = ledger.meshes.get(name, (None, None))[1]
+                ledger.meshes[name] = (np.array(points, dtype=np.float64), faces)
+                return out
+
+            monkeypatch.setattr(cls, "update_vertex_positions", update)
         monkeypatch.setattr(cls, "add_scalar_quantity", add_scalar)
         monkeypatch.setattr(cls, "add_color_quantity", add_color)
         monkeypatch.setattr(cls, "remove_quantity", remove)
@@ -126,6 +142,12 @@ class Ledger:
         def register(name: str, *args: Any, **kw: Any) -> Any:
             self.quantities.pop(name, None)
             self.kind_of[name] = kind
+            if kind == "surface_mesh":
+                points, faces = args[0], args[1] if len(args) > 1 else kw.get("faces")
+                self.meshes[name] = (
+                    np.array(points, dtype=np.float64),
+                    np.array(faces, dtype=np.int64),
+                )
             return real(name, *args, **kw)
 
         monkeypatch.setattr(ps, f"register_{kind}", register)
@@ -135,6 +157,8 @@ class Ledger:
 
         def remove(name: str, *args: Any, **kw: Any) -> Any:
             self.quantities.pop(name, None)
+            if kind == "surface_mesh":
+                self.meshes.pop(name, None)
             return real(name, *args, **kw)
 
         monkeypatch.setattr(ps, f"remove_{kind}", remove)
@@ -142,6 +166,17 @@ class Ledger:
     # ------------------------------------------------------------------ reading
     def structure_enabled(self, name: str) -> bool:
         return any(has(name) and get(name).is_enabled() for _, has, get in KINDS.values())
+
+    def shown_meshes(self) -> dict[str, tuple[Any, Any, Quantity | None]]:
+        """The enabled surface meshes: name -> (positions, faces, its visible colour quantity
+        or ``None``)."""
+        out = {}
+        for name, (points, faces) in self.meshes.items():
+            if not (ps.has_surface_mesh(name) and ps.get_surface_mesh(name).is_enabled()):
+                continue
+            on = [q for q in self.quantities.get(name, {}).values() if q.enabled]
+            out[name] = (points, faces, on[0] if on else None)
+        return out
 
     def visible(self) -> dict[tuple[str, str], Quantity]:
         """The enabled colour quantities of the enabled structures: (structure, name) ->."""

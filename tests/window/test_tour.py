@@ -53,6 +53,7 @@ from tests.support.window_session import (
     panel_box,
     pixels,
     scene_box,
+    scroll_to_end,
     section_box,
     spectral,
 )
@@ -280,25 +281,6 @@ def export(s: Session) -> None:
         "new .ply file and the 'wrote ...' message under the buttons",
     )
     s.settled((0, 0, *s.size))
-
-
-def scroll_to_end(s: Session) -> Layout:
-    """Turn the mouse wheel over meshlap's panel until it scrolls no further (the one-ring
-    panel with the vertex inspector is taller than the window); the last header is then
-    the panel's last section (Help)."""
-    layout = parse(s.settled((0, 0, *s.size)))
-    for _ in range(20):
-        before = s.img
-        s.x.xdotool("mousemove", str(layout.left + 20), str(s.size[1] // 2))
-        s.x.xdotool("click", "--repeat", "3", "5")
-        s.park()
-        s.drawn()  # the viewer read the wheel and drew the panel scrolled (or not)
-        # the scroll bar's strip: hover highlights and tooltips over the panel do not count
-        box = (layout.right - 18, layout.top + 30, layout.right + 1, s.size[1])
-        if changed_fraction(before, s.screenshot(), box) <= 0.002:
-            return parse(s.img)  # nothing moved: the end
-        layout = parse(s.settled((0, 0, *s.size)))
-    raise AssertionError("meshlap's panel still scrolls after 20 turns of the wheel")
 
 
 def help_pane(s: Session) -> None:

@@ -26,7 +26,7 @@ def drive_export_writes_what_is_on_screen(viewer, tmp_path):
     assert str(out.resolve()) in status
     st = viewer.panels["smoothing"].state
     name = f"sphere_{st.method}_{st.laplacian}_it{st.smoother.iteration}.ply"
-    assert status == f"wrote {name} in {out.resolve()}"
+    assert status == f"wrote {name}, sphere_input.ply in {out.resolve()}"
     back = load_mesh(out / name)
     np.testing.assert_allclose(back.V, st.V, atol=1e-6)
     assert not np.allclose(back.V, viewer.state.mesh.V, atol=1e-6)

@@ -52,6 +52,13 @@ def drive_record_widgets(viewer, tmp_path) -> None:
     tick(viewer, "play", True)
     tick(viewer, "pause", True)
     tick(viewer, "play what", "k sweep")
+    for panel in ("spectral", "smoothing"):  # each panel that plays has its record header
+        viewer.set_panel(panel)
+        tick(viewer)
+        tick(viewer, "record file", str(tmp_path / f"{panel}.gif"))
+        tick(viewer, "record", True)
+        tick(viewer, "stop", True)
+        assert (tmp_path / f"{panel}.gif").is_file()
     viewer.set_panel("surfaces")
     tick(viewer)
     tick(viewer, "section theta", 30.0)
