@@ -50,6 +50,10 @@ REGISTRY: tuple[PanelSpec, ...] = (
 VIEWS: tuple[str, ...] = tuple(s.name for s in REGISTRY if s.view)
 """The views of the *view* combo, in its order (keys 1, 2, ...); the first is the default."""
 
+VIEW_KEYS: tuple[str, ...] = tuple("1234567890")[: len(VIEWS)]
+"""The number key of each of the first ten views (the tenth: 0); a later view is chosen in the
+*view* combo only."""
+
 
 def _check_registry() -> None:
     """Distinct names; every flag of a command declared once (a second ``--vertex`` would

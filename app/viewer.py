@@ -32,7 +32,7 @@ from .frame_wait import FrameWait
 from .jobs import prefer_gil_free_solvers, warm_up
 from .pacing import Pacer
 from .panels.base import Panel, Pick
-from .registry import REGISTRY, VIEWS
+from .registry import REGISTRY, VIEW_KEYS, VIEWS
 from .scene import MESH
 from .state.app import AppState
 from .state.preview import MeshPreview
@@ -232,8 +232,8 @@ class Viewer:
         """The shortcuts: a number selects a view; other keys go to the active view, then to
         the sections, then to the host's own (F frames, R re-frames)."""
         ui = self.ui
-        for i, name in enumerate(VIEWS):
-            if ui.key(str(i + 1)):
+        for key, name in zip(VIEW_KEYS, VIEWS, strict=False):
+            if ui.key(key):
                 self.pacer.touch()
                 self.set_panel(name)
         panels = [self.active(), *self.sections]

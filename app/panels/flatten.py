@@ -161,15 +161,19 @@ class FlattenPanel(Panel):
         return out
 
     def export_items(self, host: Host) -> list[ExportItem]:
-        """The layout as a flat mesh (PLY, ``z = 0``) and the shown distortion per face
-        (CSV)."""
+        """What the view shows: the mesh (PLY; the checkerboard is its map), the layout as a
+        flat mesh (PLY, ``z = 0``), the shown distortion per face (CSV: the layout's colours,
+        and the copy's on the surface, which is the mesh's shape) and the map's ``uv`` per
+        corner of the disk's faces (CSV)."""
         view = self.state.shown
         if view is None:
             return []
         m, kind = view.uvmap, self.state.distortion
-        stem = f"{host.state.mesh.stem}_{m.method}_{m.boundary}"
+        mesh = host.state.mesh
+        stem = f"{mesh.stem}_{m.method}_{m.boundary}"
         flat = np.column_stack([view.uv01, np.zeros(len(view.uv01))])
         return [
+            (f"{mesh.stem}.ply", mesh.V, mesh.F, None),
             (f"{stem}_layout.ply", flat, m.disk.F, None),
             (f"{stem}_{kind}_distortion.csv", None, None, view.values[kind]),
         ]

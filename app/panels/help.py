@@ -6,7 +6,7 @@ import polyscope as ps
 
 from ..host import Host
 from ..panel_spec import PanelSpec
-from ..registry import VIEWS
+from ..registry import VIEW_KEYS, VIEWS
 from ..session import SessionWidgets
 from .base import HOST_SHORTCUTS, Panel
 
@@ -14,7 +14,11 @@ from .base import HOST_SHORTCUTS, Panel
 def shortcut_rows(host: Host) -> list[tuple[str, str]]:
     """Every key the window answers: the views' numbers and the host's own keys, then each
     panel's (registry order)."""
-    rows = [(f"1-{len(VIEWS)}", f"views: {', '.join(VIEWS)}"), *HOST_SHORTCUTS]
+    digits = [k for k in VIEW_KEYS if k != "0"]
+    rows = [(f"{digits[0]}-{digits[-1]}", f"views: {', '.join(VIEWS[: len(digits)])}")]
+    if "0" in VIEW_KEYS:
+        rows.append(("0", f"view: {VIEWS[VIEW_KEYS.index('0')]}"))
+    rows += HOST_SHORTCUTS
     for p in host.panels.values():
         rows += list(p.shortcuts)
     return rows

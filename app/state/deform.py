@@ -641,5 +641,13 @@ SPEC = PanelSpec(
     check_mesh=check_mesh,
     check_start=check_start,
     animation=ANIMATION,
+    unsaved={
+        "undo": "an action: the move before the last (the moves reached are the setting)",
+        "redo": "an action: the move undone last (the moves reached are the setting)",
+        "reset": "an action: every handle back at rest (the moves are the setting)",
+        "clear handles": "an action: no handles (the handles are the setting)",
+        "turn (deg)": "the active handle's turn: kept in the session with its moves",
+        "scene drag": "a drag of a handle in the screen plane: kept as the handle's move",
+    },
 )
 """The Deform panel."""

@@ -627,5 +627,12 @@ SPEC = PanelSpec(
     settings=SETTINGS,
     check_mesh=check_mesh,
     animation=ANIMATION,
+    unsaved={
+        "clear face": "an action: no clicked face (the face is the setting)",
+        "clear seam": "an action: no seam (the seam is the setting)",
+        "undo seam vertex": "an action: the seam without its last vertex (the seam is kept)",
+        "run ARAP": "an action: ARAP iterates from the map shown (the result is recomputed)",
+        "restart ARAP": "an action: ARAP again from its initial map",
+    },
 )
 """The Flatten panel."""

@@ -531,6 +531,7 @@ SPEC = PanelSpec(
         "play": "an action: steps on each frame (the steps are kept as iterations, lam_steps)",
         "pause": "an action: stops playing (the steps made are kept)",
         "reset": "an action: back to the input (iterations 0)",
+        "back": "an action: one step back through the kept positions (iterations − 1)",
         **RECORDER_WIDGETS,
     },
 )

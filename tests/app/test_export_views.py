@@ -14,7 +14,6 @@ centring, scale, up axis and side offset), and the colour field on it is that fi
 from __future__ import annotations
 
 import re
-from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -27,10 +26,9 @@ from scipy.spatial import procrustes  # noqa: E402
 
 from meshlap_core.io import load_mesh  # noqa: E402
 from meshlap_core.io.load import load_vertex_scalars  # noqa: E402
+from tests.support.drivers import view_setups  # noqa: E402
 from tests.support.legend_ledger import Ledger  # noqa: E402
 from tests.support.widgets import drive, frames  # noqa: E402
-
-STUDENTS = Path(__file__).resolve().parents[1] / "exercises"
 
 
 @pytest.fixture(scope="module")
@@ -38,94 +36,9 @@ def mock(polyscope_mock):
     return polyscope_mock
 
 
-def settle(viewer) -> None:
-    """Let every job finish and be applied."""
-    for _ in range(200):
-        frames(viewer)
-        if not viewer.state.jobs.busy:
-            break
-        viewer.state.jobs.wait(timeout=5)
-    frames(viewer, 3)
-
-
-# ---------------------------------------------------------------- what each view shows
-def curvature(viewer, tmp_path: Path) -> None:
-    drive(viewer, "field", "gaussian")
-    drive(viewer, "side by side", True)  # a second mesh with a second field beside it
-
-
-def onering(viewer, tmp_path: Path) -> None:
-    drive(viewer, "vertex", 5)
-
-
-def spectral(viewer, tmp_path: Path) -> None:
-    drive(viewer, "modes to compute", 12)
-    drive(viewer, "compute eigenbasis", True)
-    settle(viewer)
-    drive(viewer, "k (reconstruct)", 5)
-
-
-def smoothing(viewer, tmp_path: Path) -> None:
-    drive(viewer, "noise alpha", 0.01)
-    drive(viewer, "step", True, True)
-
-
-def surfaces(viewer, tmp_path: Path) -> None:
-    drive(viewer, "surface", "torus")
-
-
-def check(viewer, tmp_path: Path) -> None:
-    drive(viewer, "student file", str(STUDENTS / "wrong_cotan_full.py"))
-    drive(viewer, "task", "cotan_laplacian")
-    drive(viewer, "check", True)
-    settle(viewer)
-    assert viewer.panels["check"].state.check.difference is not None
-
-
-def diffusion(viewer, tmp_path: Path) -> None:
-    """The distance from a clicked vertex, then (an eigenbasis computed) the heat two ways
-    with the third field on copies, a drawn filter and the heat kernel signature."""
-    assert viewer.panels["diffusion"].select(viewer, 7)
-    settle(viewer)
-    yield "distance"
-    viewer.set_panel("spectral")
-    spectral(viewer, tmp_path)
-    viewer.set_panel("diffusion")
-    drive(viewer, "show", "heat")
-    settle(viewer)
-    assert len(viewer.panels["diffusion"].state.heat) == 3
-    yield "heat"
-    drive(viewer, "heat field", "difference")
-    yield "heat difference"
-    drive(viewer, "show", "filter")
-    drive(viewer, "filter", "drawn")
-    drive(viewer, "curve point 2", (0.0, 0.3))
-    yield "drawn filter"
-    drive(viewer, "show", "hks")
-    settle(viewer)
-    yield "hks"
-
-
-def curvature_lab(viewer, tmp_path: Path) -> None:
-    drive(viewer, "resolution", 12)
-    settle(viewer)
-
-
-SHOWN: dict[str, Callable[..., None]] = {
-    "curvature": curvature,
-    "onering": onering,
-    "spectral": spectral,
-    "smoothing": smoothing,
-    "surfaces": surfaces,
-    "check": check,
-    "diffusion": diffusion,
-    "curvature_lab": curvature_lab,
-}
-"""Per view of the registry, how a test makes it show something (its fields, its copies)."""
-
-
 def test_every_view_has_a_setup():
-    assert set(SHOWN) == set(VIEWS), "a view without a set-up in SHOWN: add one"
+    """Each view's driver module says how it shows something (``show_for_export``)."""
+    assert set(view_setups()) == set(VIEWS)
 
 
 # ---------------------------------------------------------------- the files against the screen
@@ -178,6 +91,14 @@ def export_problems(viewer, ledger: Ledger, folder: Path) -> list[str]:
         if q is None or q.kind != "scalar":
             continue
         uploaded = np.asarray(q.values, dtype=np.float64)
+        if len(uploaded) == len(faces) != len(points):  # a field per face: its CSV
+            columns = [np.genfromtxt(f, skip_header=1) for f in files if f.suffix == ".csv"]
+            if not any(
+                len(c) == len(uploaded) and np.allclose(c, uploaded, rtol=1e-6, equal_nan=True)
+                for c in columns
+            ):
+                problems.append(f"the per-face field on {name!r} is in no CSV file")
+            continue
         ok = False
         for f in match:
             quality = plys[f][2]
@@ -195,7 +116,7 @@ def test_export_writes_what_the_view_shows(view, viewer, sphere, tmp_path, monke
     assert viewer.open(sphere)  # everything registered again, through the ledger
     viewer.set_panel(view)
     frames(viewer, 2)
-    steps = SHOWN[view](viewer, tmp_path)  # a generator: one export per state it yields
+    steps = view_setups()[view](viewer, tmp_path)  # a generator: one export per state it yields
     problems: list[str] = []
     for i, what in enumerate(steps or [view]):
         frames(viewer, 3)

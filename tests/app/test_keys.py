@@ -11,6 +11,8 @@ ps = pytest.importorskip("polyscope")
 
 from meshlap_app.viewer import Viewer  # noqa: E402
 
+from tests.support.drivers.deform import click as deform_click  # noqa: E402
+from tests.support.drivers.deform import settle as deform_settle  # noqa: E402
 from tests.support.widgets import compute_basis, drive, frames  # noqa: E402
 from tests.support.window_page import window_page_keys  # noqa: E402
 
@@ -40,7 +42,8 @@ def snapshot(viewer: Viewer) -> tuple:
     help_panel = viewer.panels["help"]
     camera = np.round(np.asarray(ps.get_camera_view_matrix()), 6).tobytes()
     it = sm.smoother.iteration if sm.smoother is not None else None
-    return (viewer.state.panel, help_panel.shown, sm.playing, it, sp.k, camera)
+    moves = repr(viewer.panels["deform"].state.moves)  # undo, redo, reset of a deformation
+    return (viewer.state.panel, help_panel.shown, sm.playing, it, sp.k, camera, moves)
 
 
 def test_every_documented_key_does_something(viewer):
@@ -53,6 +56,12 @@ def test_every_documented_key_does_something(viewer):
     drive(viewer, "vertex", 5)
     viewer.set_panel("smoothing")
     drive(viewer, "noise alpha", 0.01)
+    viewer.set_panel("deform")  # a handle turned: something to undo, redo and reset
+    frames(viewer)
+    deform_click(viewer, 7)
+    deform_settle(viewer)
+    drive(viewer, "turn (deg)", 30.0)
+    deform_settle(viewer)
     failures = []
     for key, panel in keys:
         view = panel or DEFAULT_VIEW

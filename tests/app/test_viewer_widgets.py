@@ -259,10 +259,17 @@ def test_a_panel_without_a_driver_is_named(monkeypatch):
         panel_drivers()
 
 
-def test_every_widget_is_driven(viewer, tmp_path):
+def test_every_widget_is_driven(viewer, tmp_path, request):
     """Run every registered panel's driver on one adapter, then the widgets every panel shares
     (play/record, isolines): every widget label drawn must have been scripted, and every setting
     a panel's spec declares must have had its own widget driven."""
+    import polyscope as ps
+
+    # a window tall enough for every panel: ImGui draws no plot scrolled out of view, and
+    # the tour leaves headers open (the panels are longer than after their own tests)
+    size = ps.get_window_size()
+    ps.set_window_size(size[0], 4000)
+    request.addfinalizer(lambda: ps.set_window_size(*size))
     for driver in panel_drivers().values():
         driver(viewer, tmp_path)
     drive_record_widgets(viewer, tmp_path)  # play, θ and record widgets

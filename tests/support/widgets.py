@@ -81,6 +81,16 @@ def settle(viewer, owner: str = "diffusion") -> None:
     frames(viewer, 2)
 
 
+def settle_jobs(viewer) -> None:
+    """Let every job finish and be applied."""
+    for _ in range(200):
+        frames(viewer)
+        if not viewer.state.jobs.busy:
+            break
+        viewer.state.jobs.wait(timeout=5)
+    frames(viewer, 3)
+
+
 def sphere_file(folder: Path) -> Path:
     """An icosphere (level 2) written to ``folder`` (the ``sphere`` fixture's mesh)."""
     path = folder / "sphere.obj"

@@ -35,3 +35,18 @@ def panel_drivers() -> dict[str, Callable[..., None]]:
             raise KeyError(f"{spec.name}: {name} is not defined in {module_name}")
         drivers[spec.name] = getattr(module, name)
     return drivers
+
+
+def view_setups() -> dict[str, Callable[..., object]]:
+    """``show_for_export(viewer, tmp_path)`` of every view, from its driver module: how the
+    export test makes the view show its fields and copies (a generator yields once per state
+    to export). KeyError names a view without one."""
+    from meshlap_app.registry import VIEWS
+
+    setups: dict[str, Callable[..., object]] = {}
+    for name in VIEWS:
+        module = importlib.import_module(f"{__name__}.{name}")
+        if not hasattr(module, "show_for_export"):
+            raise KeyError(f"{name}: show_for_export is not defined in {module.__name__}")
+        setups[name] = module.show_for_export
+    return setups

@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import pytest
 
 from tests.support.drivers.isolines import drive_check_isolines
 from tests.support.students import STUDENTS
-from tests.support.widgets import drive
+from tests.support.widgets import drive, settle_jobs
 
 
 def drive_panel_check(viewer, tmp_path: Path) -> None:
@@ -51,3 +52,17 @@ def drive_panel_check(viewer, tmp_path: Path) -> None:
     drive(viewer, "check", True)
     assert st.check.result.tasks[0].status == "crashed"
     assert st.verdict()[0].split()[-1] == "CRASHED"
+
+
+# ------------------------------------------------------------------ shown for the export test
+STUDENTS_FOR_EXPORT = Path(__file__).resolve().parents[2] / "exercises"
+
+
+def show_for_export(viewer, tmp_path: Path) -> Any:
+    """What the view shows for the export test (``tests/app/test_export_views.py``): its
+    fields and copies; a generator yields once per state to export."""
+    drive(viewer, "student file", str(STUDENTS_FOR_EXPORT / "wrong_cotan_full.py"))
+    drive(viewer, "task", "cotan_laplacian")
+    drive(viewer, "check", True)
+    settle_jobs(viewer)
+    assert viewer.panels["check"].state.check.difference is not None

@@ -4,6 +4,7 @@ estimator combo with the One-ring view's shape-operator row."""
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import polyscope as ps
@@ -79,3 +80,11 @@ def drive_panel_curvature(viewer, tmp_path: Path) -> None:
     drive_view_combo_switches_every_panel(viewer)
     drive_curvature_widgets(viewer)
     drive_curvature_estimator(viewer)
+
+
+# ------------------------------------------------------------------ shown for the export test
+def show_for_export(viewer, tmp_path: Path) -> Any:
+    """What the view shows for the export test (``tests/app/test_export_views.py``): its
+    fields and copies; a generator yields once per state to export."""
+    drive(viewer, "field", "gaussian")
+    drive(viewer, "side by side", True)  # a second mesh with a second field beside it

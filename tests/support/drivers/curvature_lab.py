@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+from typing import Any
+
 import numpy as np
 import polyscope as ps
 import pytest
 from meshlap_app.state.curvature_lab import STUDY_LEVELS
 
-from tests.support.widgets import drive, frames
+from tests.support.widgets import drive, frames, settle_jobs
 
 
 def drive_panel_curvature_lab(viewer, tmp_path=None) -> None:
@@ -70,3 +73,11 @@ def drive_panel_curvature_lab(viewer, tmp_path=None) -> None:
     assert "disagree" in lab.result.summary
     drive(viewer, "source", "surface")
     drive(viewer, "show", "error")
+
+
+# ------------------------------------------------------------------ shown for the export test
+def show_for_export(viewer, tmp_path: Path) -> Any:
+    """What the view shows for the export test (``tests/app/test_export_views.py``): its
+    fields and copies; a generator yields once per state to export."""
+    drive(viewer, "resolution", 12)
+    settle_jobs(viewer)

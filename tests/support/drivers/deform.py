@@ -227,3 +227,12 @@ def drag_a_handle(s: Session) -> None:
     )
     s.screenshot("deform_undone")
     assert changed_fraction(one, back, scene) < changed_fraction(one, moved, scene)
+
+
+# ------------------------------------------------------------------ shown for the export test
+def show_for_export(viewer, tmp_path) -> None:
+    """A handle clicked and turned: the deformed copy with its displacement field."""
+    click(viewer, 7)
+    settle(viewer)
+    drive(viewer, "turn (deg)", 30.0)
+    settle(viewer)

@@ -3,7 +3,9 @@ play, the spectral filters and the drawn transfer curve, the heat kernel signatu
 
 from __future__ import annotations
 
+from pathlib import Path
 from types import SimpleNamespace
+from typing import Any
 
 import numpy as np
 import polyscope as ps
@@ -18,7 +20,7 @@ from meshlap_core.diffusion import (
     transfer,
     unit_heat,
 )
-from tests.support.widgets import compute_basis, drive, frames, settle
+from tests.support.widgets import compute_basis, drive, frames, settle, settle_jobs
 
 
 def click(viewer, vertex: int, *held: str) -> None:
@@ -225,3 +227,30 @@ def drive_panel_diffusion(viewer, tmp_path=None) -> None:
     assert st.hks_dist[st.sources[0]] == 0.0
     drive(viewer, "clear sources", True)
     assert st.sources == []
+
+
+# ------------------------------------------------------------------ shown for the export test
+def show_for_export(viewer, tmp_path: Path) -> Any:
+    """The distance from a clicked vertex, then (an eigenbasis computed) the heat two ways
+    with the third field on copies, a drawn filter and the heat kernel signature."""
+    assert viewer.panels["diffusion"].select(viewer, 7)
+    settle_jobs(viewer)
+    yield "distance"
+    viewer.set_panel("spectral")
+    from tests.support.drivers.spectral import show_for_export as show_spectral
+
+    show_spectral(viewer, tmp_path)
+    viewer.set_panel("diffusion")
+    drive(viewer, "show", "heat")
+    settle_jobs(viewer)
+    assert len(viewer.panels["diffusion"].state.heat) == 3
+    yield "heat"
+    drive(viewer, "heat field", "difference")
+    yield "heat difference"
+    drive(viewer, "show", "filter")
+    drive(viewer, "filter", "drawn")
+    drive(viewer, "curve point 2", (0.0, 0.3))
+    yield "drawn filter"
+    drive(viewer, "show", "hks")
+    settle_jobs(viewer)
+    yield "hks"

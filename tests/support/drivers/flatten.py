@@ -21,7 +21,7 @@ from meshlap_core.flatten import UVMap
 from meshlap_core.io import load_mesh
 from meshlap_core.options import FLATTEN_METHODS
 from tests.support.imgui_screen import changed_fraction, parse, subjects
-from tests.support.widgets import drive, frames
+from tests.support.widgets import drive, frames, settle_jobs
 from tests.support.window_session import Session
 
 BAD_ITERS = ("", "0", "-1", "nan", "1e309", "abc", 10**9)
@@ -287,3 +287,9 @@ def checkerboard_step(s: Session) -> None:
 
     s.until(remapped, 60, "a new layout after choosing LSCM, the checkerboard still on the mesh")
     s.subject_ok(parse(s.settled((0, 0, *s.size))), 3, "after LSCM")
+
+
+# ------------------------------------------------------------------ shown for the export test
+def show_for_export(viewer, tmp_path) -> None:
+    """The default map: the checkerboard on the mesh, the layout and the distortion copy."""
+    settle_jobs(viewer)

@@ -34,10 +34,10 @@ def drive_help_widgets(viewer):
 
 
 def drive_shortcuts(viewer):
-    from meshlap_app.registry import VIEWS as PANELS
+    from meshlap_app.registry import VIEW_KEYS, VIEWS
 
-    for i, panel in enumerate(PANELS):
-        drive(viewer, f"key {i + 1}", True)
+    for key, panel in zip(VIEW_KEYS, VIEWS, strict=False):
+        drive(viewer, f"key {key}", True)
         assert viewer.state.panel == panel
     drive(viewer, "key 4", True)  # smoothing
     st = viewer.panels["smoothing"].state

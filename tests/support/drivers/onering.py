@@ -4,6 +4,7 @@ widgets (area kind, boundary rule, hover)."""
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import polyscope as ps
 from meshlap_app import scene
@@ -98,3 +99,10 @@ def drive_hover(viewer) -> None:
 def drive_panel_onering(viewer, tmp_path: Path) -> None:
     drive_onering_widgets(viewer)
     drive_inspector(viewer)
+
+
+# ------------------------------------------------------------------ shown for the export test
+def show_for_export(viewer, tmp_path: Path) -> Any:
+    """What the view shows for the export test (``tests/app/test_export_views.py``): its
+    fields and copies; a generator yields once per state to export."""
+    drive(viewer, "vertex", 5)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -64,3 +65,11 @@ def drive_smoothing_widgets(viewer):
 def drive_panel_smoothing(viewer, tmp_path: Path) -> None:
     drive_smoothing_widgets(viewer)
     drive_smoothing_lambda_typed_keeps_the_mesh(viewer)
+
+
+# ------------------------------------------------------------------ shown for the export test
+def show_for_export(viewer, tmp_path: Path) -> Any:
+    """What the view shows for the export test (``tests/app/test_export_views.py``): its
+    fields and copies; a generator yields once per state to export."""
+    drive(viewer, "noise alpha", 0.01)
+    drive(viewer, "step", True, True)

@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import polyscope as ps
 import pytest
 
-from tests.support.widgets import drive, wait_for_basis
+from tests.support.widgets import drive, settle_jobs, wait_for_basis
 
 
 def drive_spectral_widgets(viewer):
@@ -41,3 +42,13 @@ def drive_spectral_widgets(viewer):
 
 def drive_panel_spectral(viewer, tmp_path: Path) -> None:
     drive_spectral_widgets(viewer)
+
+
+# ------------------------------------------------------------------ shown for the export test
+def show_for_export(viewer, tmp_path: Path) -> Any:
+    """What the view shows for the export test (``tests/app/test_export_views.py``): its
+    fields and copies; a generator yields once per state to export."""
+    drive(viewer, "modes to compute", 12)
+    drive(viewer, "compute eigenbasis", True)
+    settle_jobs(viewer)
+    drive(viewer, "k (reconstruct)", 5)

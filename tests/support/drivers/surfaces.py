@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import polyscope as ps
 
@@ -33,3 +34,10 @@ def drive_surfaces_widgets(viewer):
 
 def drive_panel_surfaces(viewer, tmp_path: Path) -> None:
     drive_surfaces_widgets(viewer)
+
+
+# ------------------------------------------------------------------ shown for the export test
+def show_for_export(viewer, tmp_path: Path) -> Any:
+    """What the view shows for the export test (``tests/app/test_export_views.py``): its
+    fields and copies; a generator yields once per state to export."""
+    drive(viewer, "surface", "torus")
