@@ -772,11 +772,11 @@ def test_a_session_saved_in_the_hks_view_reopens_coloured(mock, tmp_path, sphere
     signature waited for a click that restoring does not make, and a basis arriving later
     (read from the cache) was never used. Reopened through the panels, the mesh shows the
     signature at the saved time, with its colour bar, and the panel's t is that time."""
-    from tests.support.legend_ledger import Ledger
     from meshlap_app import session
     from meshlap_app.scene import MESH
 
     from meshlap_core.diffusion import heat_kernel_signature, hks_times
+    from tests.support.legend_ledger import Ledger
 
     monkeypatch.setenv("MESHLAP_CACHE_DIR", str(tmp_path / "cache"))
     viewer = new_viewer(sphere)
