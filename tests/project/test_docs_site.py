@@ -13,6 +13,7 @@ own runner executes them; ``MESHLAP_DOCS_EXECUTE=true`` executes them here as we
 from __future__ import annotations
 
 import json
+import re
 import os
 import shutil
 import subprocess
@@ -207,6 +208,16 @@ def test_a_lesson_is_executed_at_build_time_with_its_picture(site):
     home = parse(site / "index.html")
     assert "lessons/sample/" in home.targets  # in the nav, titled by its first heading
     assert "Sample lesson: the sphere" in (site / "index.html").read_text(encoding="utf-8")
+
+
+def test_a_lessons_formulas_load_mathjax(site):
+    """The notebook plugin's default loads no MathJax (an empty ``<script src="">``): the
+    lessons' ``$...$`` stayed raw text. The page loads MathJax and configures ``$`` inline."""
+    html = (site / "lessons" / "sample" / "index.html").read_text(encoding="utf-8")
+    sources = re.findall(r'<script[^>]*src="([^"]*)"', html)
+    assert '<script src="">' not in html.replace(" ", "")
+    assert any("mathjax" in src.lower() for src in sources), sources
+    assert "inlineMath" in html
 
 
 def test_the_notebook_plugin_stops_on_a_failing_cell_and_reads_only_lessons():
