@@ -13,8 +13,8 @@ own runner executes them; ``MESHLAP_DOCS_EXECUTE=true`` executes them here as we
 from __future__ import annotations
 
 import json
-import re
 import os
+import re
 import shutil
 import subprocess
 import sys
