@@ -257,7 +257,7 @@ class DeformPanel(HandleMouse, Panel):
                 sm.update_vertex_positions(P)
             else:
                 scene.remove_structure(name)
-                sm = ps.register_surface_mesh(name, P, mesh.F, smooth_shade=True)
+                sm = scene.register_surface(name, P, mesh.F, host.active() is self)
                 sm.set_color(DEFORMED_COLOR)
                 host.request_frame()
             f = fields[m]

@@ -355,7 +355,8 @@ class FlattenPanel(Panel):
         new = self.watch.changed("layout faces", id(disk)) or not ps.has_surface_mesh(LAYOUT)
         if new:
             scene.remove_structure(LAYOUT)
-            ps.register_surface_mesh(LAYOUT, layout, disk.F, edge_width=0.0)
+            shown = host.active() is self  # (polyscope keeps a removed name's enabled flag)
+            ps.register_surface_mesh(LAYOUT, layout, disk.F, edge_width=0.0, enabled=shown)
             host.request_frame()
         else:
             ps.get_surface_mesh(LAYOUT).update_vertex_positions(layout)
@@ -378,7 +379,7 @@ class FlattenPanel(Panel):
         new = self.watch.changed("copy", id(P)) or not ps.has_surface_mesh(COPY)
         if new:
             scene.remove_structure(COPY)
-            ps.register_surface_mesh(COPY, X, host.state.mesh.F, smooth_shade=True)
+            scene.register_surface(COPY, X, host.state.mesh.F, host.active() is self)
             host.request_frame()
         elif self.watch.changed("copy offset", *self._offset.tolist()):
             ps.get_surface_mesh(COPY).update_vertex_positions(X)
