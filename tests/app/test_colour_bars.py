@@ -77,6 +77,8 @@ def test_every_visible_quantity_has_a_legend_and_belongs_to_the_view(viewer, sph
 
 
 def test_k_sweep_error_colour_bar_keeps_one_range(viewer, monkeypatch):
+    from meshlap_app.panels.spectral import ERROR_NAME
+
     from tests.support.legend_ledger import Ledger
 
     ledger = Ledger().install(monkeypatch)
@@ -84,7 +86,7 @@ def test_k_sweep_error_colour_bar_keeps_one_range(viewer, monkeypatch):
     panel = viewer.panels["spectral"]
     ranges = []
     for _ in panel.frames(viewer, {"k": (1, 8)}):
-        q = ledger.quantities["reconstruction"]["error |x - x_k|"]
+        q = ledger.quantities["reconstruction"][ERROR_NAME]
         assert q.colorbar
         ranges.append(q.vminmax)
     assert len(ranges) == 8 and len(set(ranges)) == 1, ranges

@@ -150,7 +150,11 @@ def test_difference_map_has_its_colour_bar_only_in_this_view(viewer, monkeypatch
     drive(viewer, "task", "mean_curvature")
     drive(viewer, "check", True)
     widgets.frames(viewer, 2)
-    q = ledger.quantities[MESH]["student - reference"]
+    from meshlap_app.state.check import difference_title
+
+    title = difference_title("mean_curvature", True)
+    assert title == "mean_curvature: student - reference [1/length]"
+    q = ledger.quantities[MESH][title]
     assert q.enabled and q.colorbar and q.owner == "check"
     lo, hi = q.vminmax
     assert lo == -hi and hi > 0  # a signed scalar per vertex: a symmetric range around 0
@@ -158,7 +162,7 @@ def test_difference_map_has_its_colour_bar_only_in_this_view(viewer, monkeypatch
     assert np.isclose(hi, np.abs(d).max())
     viewer.set_panel("curvature")
     widgets.frames(viewer, 2)
-    assert "student - reference" not in ledger.quantities.get(MESH, {})
+    assert title not in ledger.quantities.get(MESH, {})
 
 
 def test_a_click_selects_the_vertex_in_this_view_only(viewer):
@@ -185,6 +189,7 @@ def test_a_saved_session_reopens_the_check(viewer, tmp_path):
         "task": "cotan_laplacian",
         "vertex": 5,
         "checked": True,
+        "isolines": {},
     }
     path = session.save(viewer, tmp_path / "lesson.json")
     st = viewer.panels["check"].state
