@@ -60,8 +60,9 @@ def _surfaces_texts(viewer) -> list[tuple[str, object]]:
 
 
 def test_the_courses_signs_are_labelled_wherever_they_are_on(viewer):
-    """The helicoid at its origin, by hand in do Carmo's convention (the coursework's): f = p_uv · n = −1/√(1+u²) = −1, e = g = 0, E = G = 1, so κₙ(θ) = −sin 2θ,
-    largest at θ = 3π/4; meshlap's own sign has f = +1, largest at π/4.
+    """The helicoid at its origin, by hand in do Carmo's convention (the coursework's):
+    f = p_uv · n = −1/√(1+u²) = −1, e = g = 0, E = G = 1, so κₙ(θ) = −sin 2θ, largest at
+    θ = 3π/4; meshlap's own sign has f = +1, largest at π/4.
     Through the Surfaces panel's *signs* combo: the II line, the plot's title, a coloured
     line naming the convention and the recording's caption say which sign is on."""
     from meshlap_app.panels.surfaces import SIGNS_COLOR
