@@ -159,22 +159,22 @@ def _log10(y: Any) -> np.ndarray:
         return np.where(y > 0, np.log10(np.where(y > 0, y, 1.0)), np.nan)
 
 
-def nice_ticks(lo: float, hi: float, most: int) -> np.ndarray:
-    """At most ``most`` (at least 2) round tick values inside ``[lo, hi]``, evenly spaced by
-    1, 2, 2.5 or 5 times a power of ten (ImPlot puts a label at every tick it picks, however
-    short the plot: on a plot 130 pixels high its labels ran into each other). Empty for an
-    empty or non-finite range."""
-    if not (np.isfinite(lo) and np.isfinite(hi)) or hi <= lo:
+def nice_ticks(lo: float, hi: float, min_step: float) -> np.ndarray:
+    """Round tick values inside ``[lo, hi]``, evenly spaced by the smallest of 1, 2, 2.5 or 5
+    times a power of ten that is at least ``min_step`` (ImPlot puts a label at every tick it
+    picks, however short the plot: on a plot 130 pixels high its labels ran into each other).
+    Empty for an empty or non-finite range or step."""
+    if not (np.isfinite(lo) and np.isfinite(hi) and np.isfinite(min_step)) or hi <= lo:
         return np.zeros(0)
-    most = max(int(most), 2)
-    span = hi - lo
-    exponent = int(np.floor(np.log10(span / most)))
-    for k in range(exponent, exponent + 3):
-        for m in (1.0, 2.0, 2.5, 5.0):
-            step = m * 10.0**k
-            first = np.ceil(lo / step - 1e-9) * step
-            ticks = np.arange(first, hi + 1e-9 * step, step)
-            if len(ticks) <= most:
-                ticks[np.abs(ticks) < 1e-12 * step] = 0.0  # -0.0 and round-off at zero
-                return ticks
-    return np.array([lo, hi])
+    min_step = max(float(min_step), (hi - lo) * 1e-9)
+    exponent = int(np.floor(np.log10(min_step)))
+    step = next(
+        m * 10.0**k
+        for k in (exponent, exponent + 1)
+        for m in (1.0, 2.0, 2.5, 5.0)
+        if m * 10.0**k >= min_step * (1 - 1e-12)
+    )
+    first = np.ceil(lo / step - 1e-9) * step
+    ticks = np.arange(first, hi + 1e-9 * step, step)
+    ticks[np.abs(ticks) < 1e-12 * step] = 0.0  # -0.0 and round-off at zero
+    return ticks

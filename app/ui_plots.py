@@ -52,18 +52,19 @@ class Plots:
         return self._colors
 
     def _y_ticks(self, title: str, data_px: float) -> None:
-        """Round y ticks far enough apart for their labels (two text lines), from the last
-        frame's data of ``title`` (ImPlot's own put a label at every tick it chose)."""
+        """Round y ticks at least two text lines apart on the plot's data area ``data_px``
+        pixels high, from the last frame's data of ``title`` (ImPlot's own put a label at
+        every tick it chose: they overlapped on short plots)."""
         limits = data_limits(self.legends.items.get(title, []))
-        if limits is None:
+        if limits is None or not limits[3] > limits[2]:
             return
+        lo, hi = limits[2], limits[3]
         line = float(self.im.GetTextLineHeight())
-        most = int(data_px // (2.0 * line)) + 1
-        ticks = nice_ticks(limits[2], limits[3], most)
-        if len(ticks) < 2:
+        ticks = nice_ticks(lo, hi, 2.0 * line * (hi - lo) / data_px)
+        if not len(ticks):
             return
         self.ip.SetupAxisTicks(self.ip.ImAxis_Y1, np.ascontiguousarray(ticks, dtype=np.float64))
-        spacing = data_px * float(ticks[1] - ticks[0]) / (limits[3] - limits[2])
+        spacing = data_px * float(ticks[1] - ticks[0]) / (hi - lo) if len(ticks) > 1 else 0.0
         self._record_ticks(title, ticks, spacing)
 
     def _legend_place(self, title: str, height: float) -> str:
