@@ -97,8 +97,7 @@ def test_y_tick_labels_never_overlap(viewer):
     for view, n in (("curvature", 3), ("surfaces", 3), ("smoothing", 3), ("curvature_lab", 4)):
         viewer.set_panel(view)
         frames(viewer, n)
-    titles = {"normal curvature k_n(phi)", "histogram (clipped to the colour range)"}
-    assert titles <= set(viewer.ui.y_ticks), viewer.ui.y_ticks
+    assert "normal curvature k_n(phi)" in viewer.ui.y_ticks, viewer.ui.y_ticks
     for title, (ticks, gap, line) in viewer.ui.y_ticks.items():
         if len(ticks) < 2:
             continue  # one label cannot overlap
