@@ -77,11 +77,17 @@ GAIN_RANGE = (-2.0, 5.0)
 HKS_SCALES = 16
 """Times of the heat kernel signature (log-spaced, Sun et al. 2009)."""
 
-HEAT_TITLES: dict[str, str] = {
-    "euler": titled("heat u, backward Euler", "1/length^2"),
-    "spectral": titled("heat u, eigen-expansion", "1/length^2"),
-    "difference": titled("heat u: eigen-expansion - backward Euler", "1/length^2"),
-}
+HEAT_TITLES: dict[str, str] = dict(
+    zip(
+        HEAT_FIELDS,  # backward Euler, the eigen-expansion, their difference
+        (
+            titled("heat u, backward Euler", "1/length^2"),
+            titled("heat u, eigen-expansion", "1/length^2"),
+            titled("heat u: eigen-expansion - backward Euler", "1/length^2"),
+        ),
+        strict=True,
+    )
+)
 """The colour bar's title of each heat field (a unit of heat at each source: ``∫ u dA = 1``,
 heat per area)."""
 DISTANCE_TITLE = titled("geodesic distance, heat method", "length")
