@@ -11,12 +11,12 @@ import pytest
 
 ps = pytest.importorskip("polyscope")
 
+from meshlap_app.state.diffusion import HEAT_TITLES  # noqa: E402
+
 from meshlap_core.diffusion import (  # noqa: E402
     HeatGeodesic,
     mean_edge_length,
 )
-from meshlap_app.state.diffusion import HEAT_TITLES  # noqa: E402
-
 from tests.support.drivers.diffusion import click, drive_panel_diffusion  # noqa: E402
 from tests.support.widgets import compute_basis, drive, frames, settle  # noqa: E402
 
