@@ -157,3 +157,24 @@ def _log10(y: Any) -> np.ndarray:
     y = np.asarray(y, dtype=float)
     with np.errstate(divide="ignore", invalid="ignore"):
         return np.where(y > 0, np.log10(np.where(y > 0, y, 1.0)), np.nan)
+
+
+def nice_ticks(lo: float, hi: float, min_step: float) -> np.ndarray:
+    """Round tick values inside ``[lo, hi]``, evenly spaced by the smallest of 1, 2, 2.5 or 5
+    times a power of ten that is at least ``min_step`` (ImPlot puts a label at every tick it
+    picks, however short the plot: on a plot 130 pixels high its labels ran into each other).
+    Empty for an empty or non-finite range or step."""
+    if not (np.isfinite(lo) and np.isfinite(hi) and np.isfinite(min_step)) or hi <= lo:
+        return np.zeros(0)
+    min_step = max(float(min_step), (hi - lo) * 1e-9)
+    exponent = int(np.floor(np.log10(min_step)))
+    step = next(
+        m * 10.0**k
+        for k in (exponent, exponent + 1)
+        for m in (1.0, 2.0, 2.5, 5.0)
+        if m * 10.0**k >= min_step * (1 - 1e-12)
+    )
+    first = np.ceil(lo / step - 1e-9) * step
+    ticks = np.arange(first, hi + 1e-9 * step, step)
+    ticks[np.abs(ticks) < 1e-12 * step] = 0.0  # -0.0 and round-off at zero
+    return ticks

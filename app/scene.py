@@ -64,7 +64,6 @@ SURFACE_POINT = "surface point"
 NORMAL_SECTION = "normal section"
 SECTION_DIRECTION = "normal section direction"
 RECON = "reconstruction"
-EIGEN = "eigenfunction"
 SMOOTHED = "smoothed"
 SMOOTH_INPUT = "smoothing input"
 

@@ -219,7 +219,7 @@ def render_difference(
     Polyscope's messages go to ``folder/output.log``; ``progress`` is unused."""
     import polyscope as ps
 
-    from .panels.check import DIFF, difference_colours
+    from .panels.check import difference_colours
     from .scene import write_png
     from .viewer import init_polyscope
 
@@ -231,7 +231,12 @@ def render_difference(
         mesh = ps.register_surface_mesh("mesh", V, F, smooth_shade=True)
         cmap, (lo, hi) = difference_colours(d, signed)
         mesh.add_scalar_quantity(
-            DIFF, d, defined_on="vertices", cmap=cmap, vminmax=(lo, hi), enabled=True
+            "student - reference",
+            d,
+            defined_on="vertices",
+            cmap=cmap,
+            vminmax=(lo, hi),
+            enabled=True,  # no colour bar: the notebook's figure draws its own
         )
         ps.reset_camera_to_home_view()
         rgba = ps.screenshot_to_buffer(transparent_bg=False, include_UI=False)

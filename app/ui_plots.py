@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from .plot_legend import CORNERS, OUTSIDE, LegendPlacer
+from .plot_legend import CORNERS, OUTSIDE, LegendPlacer, data_limits, nice_ticks
 from .ui_checks import check_return
 
 
@@ -22,6 +22,8 @@ class Plots:
     ip: Any
     scale: float
     _legends: LegendPlacer | None = None
+    _colors: dict[str, Any] | None = None
+    _areas: dict[str, float] | None = None  # plot title -> its data area's height last frame
 
     @property
     def legends(self) -> LegendPlacer:
@@ -35,6 +37,35 @@ class Plots:
 
     def _record_legend(self, title: str, where: str) -> None:
         """Hook called when plot ``title`` places its legend (a corner or ``outside``)."""
+
+    def _record_ticks(self, title: str, ticks: Any, spacing: float) -> None:
+        """Hook called when plot ``title`` sets its y ticks (``spacing``: pixels apart)."""
+
+    def _record_plot_area(self, title: str) -> None:
+        """Hook called inside plot ``title`` after its items, before ``EndPlot``."""
+
+    @property
+    def plot_colors(self) -> dict[str, Any]:
+        """Each plot item's colour as asked (label -> RGBA), when it was given one."""
+        if self._colors is None:
+            self._colors = {}
+        return self._colors
+
+    def _y_ticks(self, title: str, data_px: float) -> None:
+        """Round y ticks at least two text lines apart on the plot's data area ``data_px``
+        pixels high, from the last frame's data of ``title`` (ImPlot's own put a label at
+        every tick it chose: they overlapped on short plots)."""
+        limits = data_limits(self.legends.items.get(title, []))
+        if limits is None or not limits[3] > limits[2]:
+            return
+        lo, hi = limits[2], limits[3]
+        line = float(self.im.GetTextLineHeight())
+        ticks = nice_ticks(lo, hi, 2.0 * line * (hi - lo) / data_px)
+        if not len(ticks):
+            return
+        self.ip.SetupAxisTicks(self.ip.ImAxis_Y1, np.ascontiguousarray(ticks, dtype=np.float64))
+        spacing = data_px * float(ticks[1] - ticks[0]) / (hi - lo) if len(ticks) > 1 else 0.0
+        self._record_ticks(title, ticks, spacing)
 
     def _legend_place(self, title: str, height: float) -> str:
         """Where ``title``'s legend goes this frame: its size estimated from the last frame's
@@ -87,9 +118,16 @@ class Plots:
                     ip.SetupLegend(getattr(ip, f"ImPlotLocation_{where}"), 0)
                 if y_log:
                     ip.SetupAxisScale(ip.ImAxis_Y1, ip.ImPlotScale_Log10)
+                elif fit_y:  # the data area: as drawn last frame, else estimated
+                    area = (self._areas or {}).get(title, (height - 90.0) * self.scale)
+                    self._y_ticks(title, max(area, 1.0))
             yield shown
         finally:
             if shown:
+                if self._areas is None:
+                    self._areas = {}
+                self._areas[title] = float(ip.GetPlotSize()[1])
+                self._record_plot_area(title)
                 ip.EndPlot()
             self.legends.end()
 
@@ -97,7 +135,15 @@ class Plots:
         self.ip.SetupAxisLimits(self.ip.ImAxis_Y1, float(lo), float(hi), self.ip.ImPlotCond_Always)
         self.legends.y_limits[self.legends.drawing] = (float(lo), float(hi))
 
-    def plot_line(self, label: str, x: Any, y: Any) -> None:
+    def _style(self, label: str, rgba: Any) -> None:
+        """The next item's line colour (``None``: ImPlot's next one)."""
+        if rgba is not None:
+            rgba = tuple(float(c) for c in rgba)
+            self.ip.SetNextLineStyle(rgba)
+        self.plot_colors[label] = rgba
+
+    def plot_line(self, label: str, x: Any, y: Any, rgba: Any = None) -> None:
+        self._style(label, rgba)
         self.ip.PlotLine(label, _f64(x), _f64(y))
         self._plotted(label, "line", x, y)
 
@@ -134,7 +180,8 @@ class Plots:
         self._changed(moved)  # type: ignore[attr-defined]
         return bool(moved), float(nx), float(ny)
 
-    def plot_vlines(self, label: str, x: Any) -> None:
+    def plot_vlines(self, label: str, x: Any, rgba: Any = None) -> None:
+        self._style(label, rgba)
         self.ip.PlotInfLines(label, _f64(x))
         self._plotted(label, "vlines", x, None)
 

@@ -101,6 +101,51 @@ CURVATURE_FIELD_LABELS: dict[str, tuple[str, bool]] = {
 }
 """Curvature field -> (the label shown to users, whether the field is signed)."""
 
+UNITS: tuple[str, ...] = (
+    "length",
+    "1/length",
+    "1/length^2",
+    "length^2",
+    "dimensionless",
+    "mixed: length - 1/length",
+)
+"""The units a colour bar's title may give (``quantity [unit]``, :func:`titled`)."""
+CURVATURE_FIELD_UNITS: dict[str, str] = {
+    "uniform": "length",  # -½ (D⁻¹A − I)x · n: neighbours' mean minus x, not divided by an area
+    "cotan": "1/length",
+    "gaussian": "1/length^2",
+    "k1": "1/length",
+    "k2": "1/length",
+    "difference": "mixed: length - 1/length",  # a length minus a curvature
+}
+"""Curvature field -> its unit: the uniform Laplacian is not divided by an area, so its H is a
+length (it scales like the mesh), the cotangent H a curvature (it scales like 1/length)."""
+
+
+def length_unit(power: int) -> str:
+    """The unit ``length^power`` as :data:`UNITS` names it (0: ``dimensionless``)."""
+    names = {-2: "1/length^2", -1: "1/length", 0: "dimensionless", 1: "length", 2: "length^2"}
+    if power not in names:
+        raise ValueError(f"no unit name for length^{power}")
+    return names[power]
+
+
+def titled(quantity: str, unit: str) -> str:
+    """A colour bar's title: ``quantity [unit]`` (``unit`` one of :data:`UNITS`)."""
+    if unit not in UNITS:
+        raise ValueError(f"unit {unit!r} is not one of {', '.join(UNITS)}")
+    return f"{quantity} [{unit}]"
+
+
+def curvature_field_title(name: str, estimator: str | None = None) -> str:
+    """The title of the curvature field ``name`` (its label, the estimator of k1 / k2 when
+    not the cotangent one, its unit): the colour bar's, the histogram's axis."""
+    label = CURVATURE_FIELD_LABELS[name][0]
+    if estimator not in (None, "cotan") and name in ("k1", "k2"):
+        label += f" ({estimator})"
+    return titled(label, CURVATURE_FIELD_UNITS[name])
+
+
 CurvatureEstimator = Literal["cotan", "quadric", "rusinkiewicz", "normal_cycle", "jet"]
 CURVATURE_ESTIMATORS: tuple[str, ...] = get_args(CurvatureEstimator)
 DEFAULT_CURVATURE_ESTIMATOR: CurvatureEstimator = "cotan"
@@ -117,6 +162,14 @@ PrincipalField = Literal["k1", "k2", "H", "K", "abs_max"]
 PRINCIPAL_FIELDS: tuple[str, ...] = get_args(PrincipalField)
 """Scalar fields of an estimator's result: ``k1 ≥ k2``, ``H = (k1+k2)/2``, ``K = k1 k2``,
 ``abs_max = max(|k1|, |k2|)``."""
+PRINCIPAL_FIELD_UNITS: dict[str, str] = {
+    "k1": "1/length",
+    "k2": "1/length",
+    "H": "1/length",
+    "K": "1/length^2",
+    "abs_max": "1/length",
+}
+"""Each field of :data:`PRINCIPAL_FIELDS` -> its unit (:data:`UNITS`)."""
 
 LabSource = Literal["surface", "mesh"]
 LAB_SOURCES: tuple[str, ...] = get_args(LabSource)

@@ -19,11 +19,9 @@ from ..host import Host
 from ..isolines import draw_isolines
 from ..scene import MESH, colorbar_at, picked_vertex, scalar_for_upload
 from ..setting_widgets import setting_widget
-from ..state.check import SETTINGS, CheckState
+from ..state.check import SETTINGS, CheckState, difference_title
 from ..ui import RED
 from .base import ExportItem, Panel, shown_field
-
-DIFF = "student - reference"
 
 
 def difference_colours(d: np.ndarray, signed: bool) -> tuple[str, tuple[float, float]]:
@@ -39,6 +37,7 @@ class CheckPanel(Panel):
     """Student file, task, *check*; verdict; difference map; the clicked vertex's rows."""
 
     state: CheckState
+    _map = ""  # the title of the difference map uploaded on the mesh ("": none)
 
     def on_new_mesh(self, host: Host) -> None:
         self.watch.forget()
@@ -51,8 +50,7 @@ class CheckPanel(Panel):
             self.sync(host)
         elif self.watch.seen("map") is not None:
             # the map's colour bar would stay on screen over another view
-            ps.get_surface_mesh(MESH).remove_quantity(DIFF)
-            self.watch.forget("map")
+            self._remove_map()
 
     def sync(self, host: Host) -> None:
         """Upload the difference map (this view active, a check made on this mesh)."""
@@ -61,8 +59,7 @@ class CheckPanel(Panel):
             return
         if not st.current(mesh.version) or st.check.difference is None:
             if self.watch.seen("map") is not None:
-                ps.get_surface_mesh(MESH).remove_quantity(DIFF)
-                self.watch.forget("map")
+                self._remove_map()
             return
         lines = repr(self.isolines)
         if not self.watch.changed("map", mesh.version, id(st.check), host.state.ui_scale, lines):
@@ -70,8 +67,13 @@ class CheckPanel(Panel):
         d = np.asarray(st.check.difference, dtype=np.float64)
         cmap, (lo, hi) = difference_colours(d, st.check.signed)
         values, (lo, hi), factor = scalar_for_upload(d, (lo, hi))
-        ps.get_surface_mesh(MESH).add_scalar_quantity(
-            DIFF + factor,
+        title = difference_title(st.task, st.check.signed)
+        sm = ps.get_surface_mesh(MESH)
+        if self._map and self._map != title + factor:
+            sm.remove_quantity(self._map)
+        self._map = title + factor
+        sm.add_scalar_quantity(
+            self._map,
             values,
             defined_on="vertices",
             cmap=cmap,
@@ -90,6 +92,13 @@ class CheckPanel(Panel):
             return []
         d = np.asarray(st.check.difference, dtype=np.float64)
         return shown_field(f"{mesh.stem}_{st.task}_student-reference", mesh.V, mesh.F, d)
+
+    def _remove_map(self) -> None:
+        """Take the difference map (and its colour bar) off the mesh."""
+        if self._map and ps.has_surface_mesh(MESH):
+            ps.get_surface_mesh(MESH).remove_quantity(self._map)
+        self._map = ""
+        self.watch.forget("map")
 
     def capture(self, host: Host) -> dict[str, Any]:
         st = self.state

@@ -7,7 +7,7 @@ from typing import Any
 import numpy as np
 import polyscope as ps
 
-from meshlap_core.options import CURVATURE_FIELD_LABELS, PRINCIPAL_FIELDS
+from meshlap_core.options import CURVATURE_FIELD_LABELS, curvature_field_title
 
 from .. import scene
 from ..host import Host
@@ -176,11 +176,9 @@ class CurvaturePanel(Panel):
         """Upload the field ``name`` on ``sm``: enabled with its colour bar (at ``slot``,
         :func:`.scene.colorbar_at`) when ``colorbar``, else uploaded but hidden."""
         curv = host.state.curv
-        label, signed = CURVATURE_FIELD_LABELS[name]
-        label += " [1/length^2]" if name == "gaussian" else " [1/length]"
+        signed = CURVATURE_FIELD_LABELS[name][1]
+        label = curvature_field_title(name, curv.estimator)  # what it is and its unit
         values, (lo, hi), factor = scalar_for_upload(curv.values(name), curv.color_range(name))
-        if name in PRINCIPAL_FIELDS[:2] and curv.estimator != "cotan":
-            label += f" ({curv.estimator})"
         sm.add_scalar_quantity(
             label + factor,
             values,
@@ -233,7 +231,7 @@ class CurvaturePanel(Panel):
         with ui.plot(  # the field's name is the x axis's label (and the colour bar's title)
             "histogram (clipped to the colour range)",
             130,
-            CURVATURE_FIELD_LABELS[c.field_name][0],
+            curvature_field_title(c.field_name, c.estimator),
             "vertices",
         ) as shown:
             if shown:

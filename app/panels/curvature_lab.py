@@ -24,6 +24,7 @@ from ..state.curvature_lab import (
     STUDY_LEVELS,
     CurvatureLabState,
     LabResult,
+    grid_line,
 )
 from ..state.display import Display
 from .base import ExportItem, Panel, shown_field
@@ -282,6 +283,8 @@ class CurvatureLabPanel(Panel):
             if ch:
                 lab.set_number(key, value)
                 changed = True
+            if key == "res":  # what N means: the same mesh as `meshlap surface`'s
+                ui.note(grid_line({"surface": lab.surface, "res": lab.res}))
         return changed
 
     def _draw_shape_operator(self, host: Host) -> None:

@@ -23,7 +23,12 @@ from ..setting_widgets import setting_widget
 from ..state.diffusion import (
     CURVE_POINTS,
     DEFAULT_KNOTS,
+    DISTANCE_ERROR_TITLE,
+    DISTANCE_TITLE,
     HEAT_FIELDS,
+    HEAT_TITLES,
+    HKS_DISTANCE_TITLE,
+    HKS_TITLE,
     ISO_FIELDS,
     SETTINGS,
     DiffusionState,
@@ -33,7 +38,6 @@ from ..state.diffusion import (
 from ..state.isolines import DEFAULT_COUNT
 from .base import ExportItem, Panel, shown_field
 
-FIELD = "diffusion field"
 SOURCES = "heat sources"
 FILTERED = "filtered"
 HEAT_COPIES = ("heat (second way)", "heat (third field)")
@@ -65,6 +69,7 @@ class DiffusionPanel(Panel):
         super().__init__(spec, state)
         self.state: DiffusionState = state
         self._factoring: Any = None  # the geodesic key of the last factorization started
+        self._title = ""  # the title of the field uploaded on the mesh ("": none)
 
     # ------------------------------------------------------------------ the scene
     def animating(self) -> bool:
@@ -93,7 +98,7 @@ class DiffusionPanel(Panel):
                 self.precompute(host)
             self.push(host, force=True)
         elif self.watch.seen("field") is not None and ps.has_surface_mesh(MESH):
-            ps.get_surface_mesh(MESH).remove_quantity(self._field_label())
+            self._remove_field(ps.get_surface_mesh(MESH))
             self.watch.forget("field")
 
     def sync(self, host: Host) -> None:
@@ -237,20 +242,23 @@ class DiffusionPanel(Panel):
 
         return fail
 
-    def _field(self) -> tuple[np.ndarray | None, tuple[float, float] | None, str]:
-        """The field on the mesh, its colour range (``None``: its own) and colour map."""
+    def _field(self) -> tuple[np.ndarray | None, tuple[float, float] | None, str, str]:
+        """The field on the mesh, its colour range (``None``: its own), colour map and
+        title (what it is and its unit: the colour bar's)."""
         st = self.state
         if st.show == "heat":
             f, vr = st.heat_shown()
-            return f, vr, "coolwarm"
+            shown = st.heat_field if st.heat_field in st.heat else "euler"
+            return f, vr, "coolwarm", HEAT_TITLES[shown]
         if st.show == "distance":
             if st.exact_error is not None and st.heat_field == "difference":
-                return st.exact_error, None, "reds"
-            return st.distance, None, "viridis"
+                return st.exact_error, None, "reds", DISTANCE_ERROR_TITLE
+            return st.distance, None, "viridis", DISTANCE_TITLE
         if st.show == "hks":
-            f = st.hks_dist if st.hks_dist is not None else st.hks
-            return f, None, "viridis"
-        return None, None, "viridis"
+            if st.hks_dist is not None:
+                return st.hks_dist, None, "viridis", HKS_DISTANCE_TITLE
+            return st.hks, None, "viridis", HKS_TITLE
+        return None, None, "viridis", ""
 
     def iso_field(self) -> str | None:
         """The isoline settings' name of the field on the mesh (``None``: no field)."""
@@ -269,10 +277,10 @@ class DiffusionPanel(Panel):
         key = (st.version, st.show, st.heat_field, lines and (lines.on, lines.count))
         if not self.watch.changed("field", *key) and not force:
             return
-        f, vr, cmap = self._field()
+        f, vr, cmap, title = self._field()
         sm = ps.get_surface_mesh(MESH)
         if f is None or len(f) != len(host.state.mesh.V):
-            sm.remove_quantity(self._field_label())
+            self._remove_field(sm)
         else:
             if vr is None:
                 fin = f[np.isfinite(f)]
@@ -280,7 +288,7 @@ class DiffusionPanel(Panel):
             # unreachable vertices (another component) and undefined errors take the top
             # colour: polyscope refuses non-finite values
             shown = np.where(np.isfinite(f), f, vr[1])
-            self._show_field(sm, shown, vr, cmap, str(name), name in ISOLINES_ON)
+            self._show_field(sm, shown, vr, cmap, title, str(name), name in ISOLINES_ON)
         self._push_sources(host)
         self._push_filtered(host)
         self._push_heat_copies(host)
@@ -336,22 +344,26 @@ class DiffusionPanel(Panel):
             iso = "heat error" if which == "difference" else "heat"
             values, vrs, factor = scene.scalar_for_upload(self.state.heat[which], vr)
             ps.get_surface_mesh(name).add_scalar_quantity(
-                which + factor, values, cmap="coolwarm", vminmax=vrs, enabled=True,
+                HEAT_TITLES[which] + factor, values, cmap="coolwarm", vminmax=vrs, enabled=True,
                 **self.isolines.options(iso, values, iso in ISOLINES_ON),
             )  # fmt: skip
 
-    def _field_label(self) -> str:
-        """The name the field was last uploaded under (:data:`FIELD` and its factor)."""
-        return getattr(self, "_uploaded_field", FIELD)
+    def _remove_field(self, sm: Any) -> None:
+        """Take the field (and its colour bar) off the mesh ``sm``."""
+        if self._title:
+            sm.remove_quantity(self._title)
+        self._title = ""
 
-    def _show_field(self, sm: Any, f: Any, vr: Any, cmap: str, *iso: Any) -> None:
-        """``f`` float32-safe (:func:`.scene.scalar_for_upload`); ``iso``: name, on[, span]."""
+    def _show_field(self, sm: Any, f: Any, vr: Any, cmap: str, title: str, *iso: Any) -> None:
+        """``f`` float32-safe (:func:`.scene.scalar_for_upload`) under ``title`` (what it is
+        and its unit, the colour bar's: one field on the mesh at a time); ``iso``: name,
+        on[, span]."""
         values, vr, factor = scene.scalar_for_upload(f, vr)
-        if FIELD + factor != self._field_label():
-            sm.remove_quantity(self._field_label())
-        self._uploaded_field = FIELD + factor
+        if self._title != title + factor:
+            self._remove_field(sm)
+        self._title = title + factor
         sm.add_scalar_quantity(
-            FIELD + factor, values, cmap=cmap, vminmax=vr, enabled=True,
+            self._title, values, cmap=cmap, vminmax=vr, enabled=True,
             onscreen_colorbar_enabled=True, onscreen_colorbar_location=scene.COLORBAR_AT,
             **self.isolines.options(iso[0], np.array(vr) if iso[2:] else values, iso[1]),
         )  # fmt: skip
@@ -380,7 +392,7 @@ class DiffusionPanel(Panel):
         """The mesh with the field on it, the heat copies with theirs, the filtered copy
         (each PLY with its field, the field as CSV)."""
         st, mesh = self.state, host.state.mesh
-        f, _, _ = self._field()
+        f, _, _, _ = self._field()
         stem = mesh.stem
         items: list[ExportItem] = []
         if f is not None and len(f) == len(mesh.V):
@@ -650,6 +662,9 @@ class DiffusionPanel(Panel):
             st.compute_heat(mesh.V, mesh.F, h, None)
             f = st.heat["euler"]
             top = float(f.max()) or 1.0
-            self._show_field(ps.get_surface_mesh(MESH), f, (0.0, top), "viridis", "distance", 1, 1)
+            self._show_field(
+                ps.get_surface_mesh(MESH), f, (0.0, top), "viridis", HEAT_TITLES["euler"],
+                "distance", 1, 1,
+            )  # fmt: skip
             self._push_sources(host)
             yield f"heat from vertex {source}: t = {st.t(h):.3g} = 10^{x:.2f} h^2, peak {top:.3g}"

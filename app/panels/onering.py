@@ -13,7 +13,7 @@ import polyscope as ps
 
 from meshlap_core.errors import MeshError
 from meshlap_core.inspector import FaceTerm, NeighbourTerm, VertexInspection, format_inspection
-from meshlap_core.options import AREA_KINDS, BOUNDARY_RULES
+from meshlap_core.options import AREA_KINDS, BOUNDARY_RULES, titled
 
 from .. import scene
 from ..camera import project_to_screen
@@ -227,7 +227,7 @@ class OneRingPanel(Panel):
         cn = ps.register_curve_network(scene.INSPECT_WEIGHTS, d.points(nodes), edges)
         cn.set_radius(0.35 * r, relative=False)
         cn.add_scalar_quantity(
-            "cotangent weight w_ij",
+            titled("cotangent weight w_ij", "dimensionless"),
             w,
             defined_on="edges",
             cmap="coolwarm",

@@ -11,18 +11,20 @@ import numpy as np
 import polyscope as ps
 
 from meshlap_core.errors import MeshError
+from meshlap_core.options import titled
 
 from .. import scene
 from ..host import Host
 from ..isolines import draw_isolines
 from ..panel_spec import PanelSpec
 from ..record import Recorder, draw_record
-from ..scene import COLORBAR_AT, EIGEN, MESH, RECON, front_view, side_offset
+from ..scene import COLORBAR_AT, MESH, RECON, front_view, side_offset
 from ..setting_widgets import setting_widget
 from ..state.spectral import ANIMATION, PLAY_KINDS, SCREENSHOT_K, SETTINGS, SpectralState
 from .base import ExportItem, Panel, shown_field
 
-ERROR_NAME = "error |x - x_k|"  # the reconstruction's per-vertex error quantity
+ERROR_NAME = titled("reconstruction error |x - x_k|", "length")  # per vertex, on the copy
+EIGEN = titled("eigenfunction u_i, M-orthonormal", "1/length")  # on the mesh
 
 
 class SpectralPanel(Panel):
@@ -348,7 +350,7 @@ class SpectralPanel(Panel):
             st.set_k(k)
             self.push_k(host)
             ps.get_surface_mesh(RECON).add_scalar_quantity(
-                "error |x - x_k|",
+                ERROR_NAME,
                 st.vertex_error,
                 cmap="reds",
                 vminmax=(0.0, hi),

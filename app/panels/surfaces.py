@@ -31,6 +31,15 @@ from ..state.surfaces import ANIMATION, SETTINGS, TURN_STEP_DEG, SurfaceState, s
 from ..text_numbers import sig
 from .base import ExportItem, Panel, shown_field
 
+K1_COLOR = (0.85, 0.2, 0.1)
+"""The first principal direction's arrow on the surface, and k1's marker in the plot."""
+K2_COLOR = (0.1, 0.3, 0.85)
+"""The second principal direction's arrow, and k2's marker."""
+KN_COLOR = (0.85, 0.85, 0.85, 1.0)
+"""Euler's curve k_n(phi) in the plot (light: apart from the markers' colours)."""
+SIGNS_COLOR = (1.0, 0.75, 0.2, 1.0)
+"""The signs line while do Carmo's sign of II is on (amber: another sign than meshlap's)."""
+
 
 class SurfacesPanel(Panel):
     """Surface choice, (u, v) sliders, fundamental forms, principal directions, k_n(θ), the
@@ -95,11 +104,14 @@ class SurfacesPanel(Panel):
             "v": s.v,
             "theta": s.section_deg,
             **self.isolines_section(),
+            "signs": s.signs,
         }
 
     def configure(self, host: Host, values: dict[str, Any]) -> None:
-        """The isolines; :meth:`restore` meshes the surface and sets the point."""
+        """The isolines and the sign of II; :meth:`restore` meshes the surface and sets the
+        point."""
         self.configure_isolines(values)
+        self.state.signs = values["signs"]
 
     def restore(self, host: Host, values: dict[str, Any], active: bool) -> None:
         s = self.state
@@ -145,10 +157,10 @@ class SurfacesPanel(Panel):
         pc.set_transform(Z_TO_Y)
         pc.set_color((0.9, 0.1, 0.1))
         pc.add_vector_quantity(
-            "k1 direction", d1, vectortype="ambient", enabled=True, color=(0.85, 0.2, 0.1)
+            "k1 direction", d1, vectortype="ambient", enabled=True, color=K1_COLOR
         )
         pc.add_vector_quantity(
-            "k2 direction", d2, vectortype="ambient", enabled=True, color=(0.1, 0.3, 0.85)
+            "k2 direction", d2, vectortype="ambient", enabled=True, color=K2_COLOR
         )
         pc.add_vector_quantity(
             "normal",
@@ -198,6 +210,10 @@ class SurfacesPanel(Panel):
             self.push(host)
         if draw_isolines(ui, self.isolines, "Gaussian curvature"):
             self.push(host)
+        ch, signs = setting_widget(ui, SETTINGS["signs"], s.signs)
+        if ch:
+            s.set_signs(signs)
+            self.push_point(host)
         u0, u1, v0, v1 = s.domain
         ch1, u = setting_widget(ui, SETTINGS["u"], s.u, u0, u1)
         ch2, v = setting_widget(ui, SETTINGS["v"], s.v, v0, v1)
@@ -219,7 +235,10 @@ class SurfacesPanel(Panel):
             f"k2 = {sig(p.k2, sk)} at {np.degrees(p.theta_uv_min):.1f} deg (in the (u, v) plane; "
             "90 deg apart in the tangent plane)"
         )
-        ui.text("signs: e = -p_uu . n, n = p_u x p_v (H > 0 on a sphere, as on meshes)")
+        if s.signs != SETTINGS["signs"].default:  # said in colour: not meshlap's convention
+            ui.colored(s.signs_line(), SIGNS_COLOR)
+        else:
+            ui.note(s.signs_line())
         self.draw_section(host)
         self.draw_euler_plot(host)
         key = (s.version, s.u, s.v, s.section_deg)
@@ -233,17 +252,23 @@ class SurfacesPanel(Panel):
         p = s.point
         if p is None:
             return
+        title = "normal curvature k_n(phi)"
+        if s.signs != SETTINGS["signs"].default:
+            title += f", signs: {s.signs}"  # the curve is the other sign's: said on it
         with ui.plot(
-            "normal curvature k_n(phi)",
+            title,
             200,
             "phi (deg) from the k1 direction",
             "k_n",
         ) as shown:
             if shown:
-                ui.plot_line("k_n", np.degrees(s.phi), s.kn_phi)
-                ui.plot_vlines(f"k1 = {p.k1:.3g}", np.array([0.0, 180.0, 360.0]))
-                ui.plot_vlines(f"k2 = {p.k2:.3g}", np.array([90.0, 270.0]))
-                ui.plot_vlines("section", np.array([s.section_phi_deg()]))
+                # each marker in the colour of its arrow on the surface (ImPlot's own
+                # colours gave k1 the blue of the k2 arrow)
+                ui.plot_line("k_n", np.degrees(s.phi), s.kn_phi, KN_COLOR)
+                ui.plot_vlines(f"k1 = {p.k1:.3g}", np.array([0.0, 180.0, 360.0]), (*K1_COLOR, 1.0))
+                ui.plot_vlines(f"k2 = {p.k2:.3g}", np.array([90.0, 270.0]), (*K2_COLOR, 1.0))
+                section = (*self.SECTION_COLOR, 1.0)
+                ui.plot_vlines("section", np.array([s.section_phi_deg()]), section)
 
     def draw_section(self, host: Host) -> None:
         """The θ slider (showing κₙ(θ)), *turn* / *pause turn* and this frame's turn step."""

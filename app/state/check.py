@@ -17,7 +17,8 @@ import numpy as np
 
 from meshlap_core.errors import MeshError
 from meshlap_core.exercises.check import MeshCheck, check_on_mesh
-from meshlap_core.exercises.tasks import EXERCISE_TASKS
+from meshlap_core.exercises.tasks import EXERCISE_TASKS, TASKS
+from meshlap_core.options import length_unit, titled
 
 from ..panel_spec import PanelSpec
 from .isolines import isoline_fields
@@ -148,10 +149,26 @@ class CheckState:
         return self.check.rows(self.vertex)
 
     def verdict(self) -> list[str]:
-        """The check's text report, one line each."""
+        """The check's text report, one line each: the battery's, as ``meshlap check``
+        prints it (one function, one count of failing calls), then the mesh on screen's."""
         if self.check is None:
             return []
-        return self.check.result.tasks[0].lines()
+        ok = self.check.on_screen
+        screen = {True: "right", False: "wrong (the map shows where)", None: "no answer"}[ok]
+        return [*self.check.result.tasks[0].lines(), f"on the mesh on screen: {screen}"]
+
+
+def difference_title(task: str, signed: bool) -> str:
+    """The colour bar's title of a check's difference map on the mesh: what it measures and
+    its unit (the task's answer is in ``length^power``, :attr:`.tasks.Task.power`; an
+    eigenbasis is mapped by its vectors, ``|u_j − u_ref,j|`` in ``1/length``)."""
+    t = TASKS[task]
+    if t.kind == "ring":
+        return titled(f"{task}: ring wrong (1) or right (0)", "dimensionless")
+    if t.kind == "eigen":
+        return titled(f"{task}: largest |u_j - u_ref,j| over j", "1/length")
+    what = "student - reference" if signed else "largest |student - reference| of the row"
+    return titled(f"{task}: {what}", length_unit(t.power))
 
 
 SPEC = PanelSpec(

@@ -4,6 +4,7 @@ or on the loaded mesh (with the estimators' disagreement). No polyscope import."
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 from typing import Any
@@ -32,7 +33,9 @@ from meshlap_core.options import (
     CURVATURE_ESTIMATORS,
     LAB_SHOWS,
     LAB_SOURCES,
+    PRINCIPAL_FIELD_UNITS,
     PRINCIPAL_FIELDS,
+    titled,
 )
 from meshlap_core.surfaces import SURFACES, SurfaceMesh, mesh_surface
 from meshlap_core.types import FloatArray, IntArray
@@ -84,7 +87,9 @@ SETTINGS = Settings(
     Choice("surface", "torus", choices=tuple(SURFACES), label="lab surface",
            tooltip="the parametric surface"),
     Integer("res", 32, lo=3, hi=MAX_RES, label="resolution", widget="slider",
-            tooltip="cells per direction (the torus: twice around)"),
+            tooltip="N: N x N cells of the (u, v) grid; the torus gets 2N x N (twice as many "
+            "around, its cells near square). The line under the slider names the same mesh "
+            "as meshlap surface --res NU,NV"),
     Number("noise", 0.0, lo=0.0, hi=MAX_NOISE, fmt="%.4f", label="noise",
            tooltip="normal noise, a fraction of the bounding-box diagonal"),
     Number("jitter", 0.0, lo=0.0, hi=MAX_JITTER, fmt="%.4f", label="jitter",
@@ -104,14 +109,36 @@ SHOWN_ONLY = ("crosses", "vertex", "isolines")
 the isolines are the panel's, not this state's)."""
 
 
+def lab_grid(values: dict[str, Any]) -> tuple[int, int]:
+    """The ``(nu, nv)`` cells of the lab's parametric surface at ``values["res"] = N``:
+    ``(2N, N)`` on the torus (its u circle is three times its v circle: near-square cells),
+    ``(N, N)`` elsewhere; :func:`meshlap_core.surfaces.mesh_surface`'s ``res``, and so
+    ``meshlap surface --res NU,NV``'s."""
+    n = int(values["res"])
+    return (2 * n, n) if values["surface"] == "torus" else (n, n)
+
+
+def grid_line(values: dict[str, Any]) -> str:
+    """What the resolution means, said under its slider: ``"torus: 64 x 32 cells, 2,048
+    vertices (meshlap surface torus --res 64,32)"`` (``--mesh out.obj`` writes that mesh)."""
+    nu, nv = lab_grid(values)
+    name = values["surface"]
+    n = grid_vertices(name, nu, nv)
+    return f"{name}: {nu} x {nv} cells, {n:,} vertices (meshlap surface {name} --res {nu},{nv})"
+
+
+@functools.lru_cache(maxsize=64)
+def grid_vertices(surface: str, nu: int, nv: int) -> int:
+    """The vertex count of ``mesh_surface(surface, (nu, nv))`` (seams and poles welded)."""
+    return len(mesh_surface(surface, (nu, nv)).V)
+
+
 def lab_vertex_count(values: dict[str, Any], mesh: Any) -> int:
     """Vertices of the lab's mesh for the session ``values`` (the loaded ``mesh``'s, or the
     parametric surface's at ``res``: its grid, as :func:`make_base` meshes it)."""
     if values["source"] == "mesh":
         return len(mesh.V)
-    n = int(values["res"])
-    res = (2 * n, n) if values["surface"] == "torus" else (n, n)
-    return len(mesh_surface(values["surface"], res).V)
+    return grid_vertices(values["surface"], *lab_grid(values))
 
 
 def check_mesh(values: dict[str, Any], mesh: Any, source: Any) -> None:
@@ -261,9 +288,7 @@ def estimate_key(params: dict[str, Any]) -> tuple[Any, ...]:
 
 def make_base(params: dict[str, Any]) -> Base:
     """The jittered mesh of ``params`` and its exact curvature."""
-    n = int(params["res"])
-    res = (2 * n, n) if params["surface"] == "torus" else (n, n)
-    m = jittered_mesh(params["surface"], res, params["jitter"])
+    m = jittered_mesh(params["surface"], lab_grid(params), params["jitter"])
     return Base(base_key(params), m, exact_principal(m, m.surface), vertex_normals(m.V, m.F))
 
 
@@ -398,7 +423,7 @@ class CurvatureLabState:
         crosses = crosses_of(r, None, cross_length(V, F))
         if params["show"] == "disagreement":
             values = _disagreement(V, F, q)
-            label = f"{q} disagreement (max - min)"
+            label = titled(f"{q} disagreement (max - min)", PRINCIPAL_FIELD_UNITS[q])
             return LabResult(V, F, values, label, r, None, _dis_summary(values), crosses=crosses)
         note = (
             "no exact surface for a loaded mesh: the estimate is shown"
@@ -407,7 +432,8 @@ class CurvatureLabState:
         )
         values = r.field(q)
         summary = note or f"{q} in [{values.min():.4g}, {values.max():.4g}]"
-        return LabResult(V, F, values, f"{q} ({est})", r, None, summary, crosses=crosses)
+        label = titled(f"{q} ({est})", PRINCIPAL_FIELD_UNITS[q])
+        return LabResult(V, F, values, label, r, None, summary, crosses=crosses)
 
     def study_key(self) -> tuple[Any, ...] | None:
         """What the convergence study depends on, ``(surface, estimator, noise, jitter,
@@ -500,16 +526,18 @@ def _surface_result(
     compared = ex.compared
     if params["show"] == "error":
         err = np.where(compared, r.field(q) - exact.field(q), np.nan)
-        values, label = np.nan_to_num(err), f"{q} error ({est} - exact)"
+        values = np.nan_to_num(err)
+        label = titled(f"{q} error ({est} - exact)", PRINCIPAL_FIELD_UNITS[q])
         rms = float(np.sqrt(np.nanmean(err**2)))
         scale = float(np.sqrt(np.nanmean(np.where(compared, exact.field(q), np.nan) ** 2)))
         rel = f" ({100 * rms / scale:.3g} % of RMS |{q}|)" if scale > 0 else ""
         summary = f"RMS error {rms:.4g}{rel} over {int(compared.sum())} vertices"
     elif params["show"] == "disagreement":
         values = _disagreement(Vs, Fs, q)
-        label, summary = f"{q} disagreement (max - min)", _dis_summary(values)
+        label = titled(f"{q} disagreement (max - min)", PRINCIPAL_FIELD_UNITS[q])
+        summary = _dis_summary(values)
     else:
-        values, label = r.field(q), f"{q} ({est})"
+        values, label = r.field(q), titled(f"{q} ({est})", PRINCIPAL_FIELD_UNITS[q])
         exq = exact.field(q)
         summary = f"exact {q} in [{np.nanmin(exq):.4g}, {np.nanmax(exq):.4g}]"
     return LabResult(

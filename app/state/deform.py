@@ -67,8 +67,8 @@ FIXED_REGIONS: tuple[str, ...] = ("farthest", "clicked", "none")
 """What is held at rest: the vertices farthest from every handle, discs around ctrl-clicked
 vertices, or nothing (components holding no handle stay at rest)."""
 QUANTITY = {
-    "displacement": "displacement |x - p| (mesh units)",
-    "rotation error": "rotation error (relative RMS of the one-ring, no unit)",
+    "displacement": "displacement |x - p| [length]",
+    "rotation error": "rotation error, relative RMS of the one-ring [dimensionless]",
 }
 """Each colour map's quantity as its colour bar names it (what, and its unit)."""
 ENERGY_FORMULA = {

@@ -36,6 +36,7 @@ from meshlap_core.options import (
     FILTER_KINDS,
     HEAT_BOUNDARIES,
     HEAT_METHODS,
+    titled,
 )
 from meshlap_core.spectral import SpectralBasis
 from meshlap_core.types import FloatArray
@@ -75,6 +76,24 @@ GAIN_RANGE = (-2.0, 5.0)
 """The gains a drawn point may take (as the band gain's slider)."""
 HKS_SCALES = 16
 """Times of the heat kernel signature (log-spaced, Sun et al. 2009)."""
+
+HEAT_TITLES: dict[str, str] = dict(
+    zip(
+        HEAT_FIELDS,  # backward Euler, the eigen-expansion, their difference
+        (
+            titled("heat u, backward Euler", "1/length^2"),
+            titled("heat u, eigen-expansion", "1/length^2"),
+            titled("heat u: eigen-expansion - backward Euler", "1/length^2"),
+        ),
+        strict=True,
+    )
+)
+"""The colour bar's title of each heat field (a unit of heat at each source: ``∫ u dA = 1``,
+heat per area)."""
+DISTANCE_TITLE = titled("geodesic distance, heat method", "length")
+DISTANCE_ERROR_TITLE = titled("distance error |d - d_exact| / d_exact", "dimensionless")
+HKS_TITLE = titled("heat kernel signature HKS(x, t) / heat trace", "1/length^2")
+HKS_DISTANCE_TITLE = titled("HKS distance from the source's signature", "dimensionless")
 
 ISO_FIELDS: tuple[str, ...] = ("heat", "heat error", "distance error", "hks")
 """The fields whose isoline settings a session keeps in ``isoline_fields`` (the distance's

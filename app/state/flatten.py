@@ -50,8 +50,8 @@ MAP_NAMES = {
 DISTORTIONS = ("angle", "area")
 """What the layout and the copy of the mesh are coloured by."""
 DISTORTION_LABELS = {
-    "angle": "angle distortion sigma1/sigma2 [ratio; 1 = conformal]",
-    "area": "area distortion log(sigma1 sigma2) [log area ratio; 0 = kept]",
+    "angle": "angle distortion sigma1/sigma2, 1 = conformal [dimensionless]",
+    "area": "area distortion log(sigma1 sigma2), 0 = area kept [dimensionless]",
 }
 """Each distortion's quantity and unit: its colour bar's title and its histogram's x axis."""
 MAX_SEAM_CLICKS = 10_000

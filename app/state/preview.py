@@ -16,9 +16,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from meshlap_core.options import CURVATURE_FIELD_UNITS, titled
 from meshlap_core.types import FloatArray, IntArray
 
-PREVIEW_LABEL = "preview: uniform H, curvature being computed [1/length]"
+PREVIEW_LABEL = titled(
+    "preview: uniform H, curvature being computed", CURVATURE_FIELD_UNITS["uniform"]
+)
 """The colour map's name on the preview (said on screen: not the final field)."""
 PREVIEW_FACES = 100_000
 """A mesh with fewer faces gets no preview (validated and coloured in well under a second)."""

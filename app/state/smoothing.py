@@ -79,8 +79,10 @@ SETTINGS = Settings(
            tooltip="step size lam > 0; type a number and press Enter (keeps the current mesh)"),
     Number("noise_alpha", 0.0, lo=0.0, hi=FLOAT_MAX,  # the mesh bounds it: check_mesh
            slider=(0.0, 0.05), fmt="%.4f", label="noise alpha", example=0.01,
-           tooltip="Gaussian noise along the normals, sigma = alpha x mean edge length "
-           "(rebuilds the input)", animate=Flag("--noise", "noise α added before smoothing")),
+           tooltip="isotropic Gaussian noise: every coordinate of every vertex moves by "
+           "N(0, sigma^2), sigma = alpha x the bounding-box diagonal (rebuilds the input)",
+           animate=Flag("--noise", "isotropic noise added before smoothing, σ = α × the "
+                        "bounding-box diagonal")),
     Integer("seed", 0, lo=0, hi=MAX_SEED, label="noise seed",
             tooltip="seed of the noise (an integer >= 0)",
             animate=Flag("--seed", "the noise seed")),

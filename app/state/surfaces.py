@@ -14,6 +14,7 @@ import numpy as np
 
 from meshlap_core import surfaces
 from meshlap_core.errors import MeshError
+from meshlap_core.options import DEFAULT_SURFACE_SIGNS, SURFACE_SIGNS
 from meshlap_core.types import FloatArray
 
 from ..panel_spec import PanelSpec
@@ -51,6 +52,11 @@ SETTINGS = Settings(
            "plane from the first principal direction (the plot's axis). Drawn: its tangent "
            "t and its osculating arc of curvature k_n"),
     isoline_fields(("Gaussian curvature",)),
+    Choice("signs", DEFAULT_SURFACE_SIGNS, choices=SURFACE_SIGNS, label="signs", added=True,
+           tooltip="the sign of II: outward (meshlap's one convention, e = -p_uu . n: H > 0 on "
+           "a sphere, as on meshes) or do-carmo (do Carmo's and the course's, e = p_uu . n: "
+           "II, H, k1, k2 and k_n negated, k1 and k2 swap; K is the same), to check a hand "
+           "calculation"),
 )
 # fmt: on
 """The Surfaces panel's settings: the surface, its resolution, the point (u, v) and the
@@ -61,16 +67,20 @@ def section_arc(
     p: surfaces.PointGeometry, t: FloatArray, kn: float, length: float, n: int = 80
 ) -> FloatArray:
     """Points ``(n,3)`` of the normal section's osculating arc at ``p.p``: the circle of
-    curvature ``kn`` in the plane of the unit tangent ``t (3,)`` and the normal ``p.n``
-    (``x(s) = p + t sin(κs)/κ + n (1 − cos(κs))/κ``, at most one full turn; a straight
-    segment when ``kn`` is 0)."""
+    curvature ``kn`` in the plane of the unit tangent ``t (3,)`` and the normal ``p.n``,
+    bending the way the surface does whatever the sign of ``II`` (``p.signs``): the section's
+    curvature vector is ``x'' = −κₙ n`` with meshlap's sign (``e = −p_uu · n``: a sphere's
+    outward ``n`` has ``κₙ > 0`` while the sphere bends away from it), ``+κₙ n`` with do
+    Carmo's. ``x(s) = p + t sin(κs)/κ + b (1 − cos(κs))/κ`` with ``b = ∓n``, at most one full
+    turn; a straight segment when ``kn`` is 0."""
+    b = -surfaces.signs_factor(p.signs) * np.asarray(p.n, dtype=np.float64)
     half = min(length, np.pi / abs(kn)) if abs(kn) > 1e-12 else length
     s = np.linspace(-half, half, n)
     if abs(kn) > 1e-9:
         along, up = np.sin(kn * s) / kn, (1.0 - np.cos(kn * s)) / kn
     else:
         along, up = s, 0.5 * kn * s * s
-    return p.p[None, :] + along[:, None] * t[None, :] + up[:, None] * p.n[None, :]
+    return p.p[None, :] + along[:, None] * t[None, :] + up[:, None] * b[None, :]
 
 
 def signed_sig(x: float, scale: float) -> str:
@@ -123,6 +133,7 @@ class SurfaceState:
     res: int = SETTINGS.default("res")
     u: float = SETTINGS.default("u")
     v: float = SETTINGS.default("v")
+    signs: str = SETTINGS.default("signs")  # the sign of II (meshlap's, or do Carmo's)
     error: str = ""
     mesh: surfaces.SurfaceMesh | None = None
     point: surfaces.PointGeometry | None = None
@@ -185,8 +196,8 @@ class SurfaceState:
         u = float(np.clip(u, u0, u1))
         v = float(np.clip(v, v0, v1))
         try:
-            point = surfaces.point_geometry(self.name, u, v)
-            theta, kn = surfaces.normal_curvature_curve(self.name, u, v, n=181)
+            point = surfaces.point_geometry(self.name, u, v, signs=self.signs)
+            theta, kn = surfaces.normal_curvature_curve(self.name, u, v, n=181, signs=self.signs)
         except MeshError as exc:
             self.error = str(exc)
             return False
@@ -194,6 +205,23 @@ class SurfaceState:
         self.phi, self.kn_phi = euler_curve(point, n=181)
         self.error = ""
         return True
+
+    def set_signs(self, signs: str) -> None:
+        """Use the sign ``signs`` of ``II`` (:data:`~meshlap_core.options.SURFACE_SIGNS`): the
+        point, its curves and the section are evaluated again with it.
+
+        Raises
+        ------
+        MeshError
+            Not one of the signs (nothing changes).
+        """
+        self.signs = SETTINGS["signs"].checked(signs, "signs")
+        if self.point is not None:
+            self.set_uv(self.u, self.v)
+
+    def signs_line(self) -> str:
+        """The line that says which sign ``II`` has (:func:`meshlap_core.surfaces.signs_note`)."""
+        return surfaces.signs_note(self.signs)  # type: ignore[arg-type]
 
     def pick_vertex(self, i: int) -> bool:
         """Move the point to the parameters of mesh vertex ``i`` (a click on the surface)."""
@@ -238,18 +266,20 @@ class SurfaceState:
         return d / np.linalg.norm(d), float(kn)
 
     def section_caption(self) -> str:
-        """``saddle at (u, v) = (0.3, 0)   θ =  45.0°   κₙ(θ) = +0.5   (κ₁ = 1, κ₂ = -1)``: the
-        caption of a θ frame (``meshlap animate --theta`` and the viewer's recording)."""
+        """``saddle at (u, v) = (0.3, 0)   θ =  45.0°   κₙ(θ) = +0.5   (κ₁ = 1, κ₂ = -1)``
+        (and ``signs: do-carmo`` when do Carmo's sign of ``II`` is on): the caption of a θ
+        frame (``meshlap animate --theta`` and the viewer's recording)."""
         p = self.point
         if p is None:
             raise MeshError("no point selected on the surface yet", "surface")
         _, kn = self.section()
+        signs = "   signs: do-carmo" if self.signs != DEFAULT_SURFACE_SIGNS else ""
         return (
             f"{self.name} at (u, v) = ({self.u:.3g}, {self.v:.3g})   θ = {self.section_deg:5.1f}°"
             f" in (u, v), φ = {self.section_phi_deg():5.1f}° from κ₁"
             f"   κₙ = {signed_sig(kn, max(abs(p.k1), abs(p.k2)))}"
             f"   (κ₁ = {sig(p.k1, max(abs(p.k1), abs(p.k2)))}, "
-            f"κ₂ = {sig(p.k2, max(abs(p.k1), abs(p.k2)))})"
+            f"κ₂ = {sig(p.k2, max(abs(p.k1), abs(p.k2)))}){signs}"
         )
 
     def section_phi_deg(self) -> float:

@@ -10,6 +10,7 @@ viewer (:func:`check_on_mesh`).
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -178,6 +179,10 @@ class MeshCheck:
         Per vertex: student − reference (signed for a scalar per vertex, the largest magnitude
         of the row otherwise).
     signed : bool
+    on_screen : bool or None
+        The answer on the mesh on screen is right (``None``: the call gave none). ``result``
+        is the battery's verdict alone, the one ``meshlap check`` prints (its count of
+        failing calls included): the mesh on screen is judged here, not counted there.
     """
 
     result: CheckResult
@@ -185,6 +190,7 @@ class MeshCheck:
     got: Any
     difference: np.ndarray | None
     signed: bool
+    on_screen: bool | None = None
 
     def rows(self, vertex: int) -> list[tuple[str, str, str]]:
         """``(term, student, reference)`` for every entry of the vertex's row."""
@@ -268,19 +274,34 @@ def check_on_mesh(
     run = run_student(student, [task], [case], timeout=timeout, memory_mb=memory_mb,
                       cancel=cancel, speed=False)  # fmt: skip
     kept: dict[str, Any] = {}
-    cases = {c.name: c for c in [*battery(), case]}
-    result = result_of(run, [task], printable(os.fspath(path)), student, cases, kept=kept)
+    cases = {c.name: c for c in battery()}
+    mine = run.tasks[task]
+    on_battery = dataclasses.replace(  # the verdict of `meshlap check`: the battery's calls
+        run,
+        tasks={
+            **run.tasks,
+            task: dataclasses.replace(
+                mine,
+                calls=[c for c in mine.calls if c[0] != case.name],
+                planned=[p for p in mine.planned if p[0] != case.name],
+            ),
+        },
+    )
+    result = result_of(on_battery, [task], printable(os.fspath(path)), student, cases, kept=kept)
     (label, args), *_ = refs.calls(t, case)
-    expected = kept[case.name] if case.name in kept else refs.expected(t, case, label, args)
-    got = next((a for c, _, a, _ in run.tasks[task].calls if c == case.name), None)
-    difference, signed = None, False
+    expected = refs.expected(t, case, label, args)
+    got = next((a for c, _, a, _ in mine.calls if c == case.name), None)
+    difference, signed, ok = None, False, None
     if got is not None:
         cmp = COMPARE[t.kind](got, expected, case, t.power)
-        difference = cmp.difference
+        difference, ok = cmp.difference, bool(cmp.ok)
         signed = t.kind == "array" and np.ndim(expected) == 1
         if t.kind == "eigen":
             got = _aligned_eigen(got, expected, case)
-    return MeshCheck(result, expected, got, difference, signed)
+            U = np.asarray(got[1], dtype=float) if len(got) == 2 else None
+            if U is not None and U.shape == expected[1].shape:  # the map is |u − u_ref| per
+                difference = np.abs(U - expected[1]).max(axis=1)  # vertex, whatever failed
+    return MeshCheck(result, expected, got, difference, signed, ok)
 
 
 def _aligned_eigen(got: Any, expected: tuple[np.ndarray, np.ndarray], case: Case) -> Any:

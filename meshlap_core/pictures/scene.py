@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import MeshError
-from ..options import CURVATURE_FIELD_LABELS, UP_AXES, check_choice
+from ..options import CURVATURE_FIELD_LABELS, UP_AXES, check_choice, curvature_field_title
 from ..types import FloatArray, IntArray, as_faces, as_vertices, real_array
 
 CLIP_PERCENT = 2.0
@@ -105,7 +105,7 @@ def field_values(
 
         check_choice(field, tuple(CURVATURE_FIELD_LABELS), "curvature field", name)
         values = curvature_field(V, F, field, area="voronoi")  # type: ignore[arg-type]
-        return np.asarray(values, dtype=np.float64), CURVATURE_FIELD_LABELS[field][0], True
+        return np.asarray(values, dtype=np.float64), curvature_field_title(field), True
     raw = real_array(field, name, "field values")
     values = np.array(raw, dtype=np.float64, copy=True)
     if values.shape != (len(V),):

@@ -1,6 +1,11 @@
 """Colour bars: every visible colour-mapped quantity has one on screen, with its name and range,
 and belongs to the view shown (in every view, field, side-by-side setting, with and without an
-eigenbasis); the k sweep's error map keeps one range for every k."""
+eigenbasis); the k sweep's error map keeps one range for every k.
+
+Every colour bar's title names its quantity and its unit (``quantity [unit]``, checked by
+:func:`tests.support.legend_ledger.title_problem`), in the window (each view made to show what
+it shows, as the export test does) and in recordings (the frames ``meshlap animate`` and the
+record buttons draw): the Diffusion view titled every field "diffusion field"."""
 
 from __future__ import annotations
 
@@ -8,8 +13,11 @@ import pytest
 
 ps = pytest.importorskip("polyscope")
 
+from meshlap_app.registry import VIEWS  # noqa: E402
 from meshlap_app.viewer import Viewer  # noqa: E402
 
+from tests.support.drivers import view_setups  # noqa: E402
+from tests.support.legend_ledger import Ledger, title_problem  # noqa: E402
 from tests.support.widgets import compute_basis, drive, frames  # noqa: E402
 
 KEPT_ON_PURPOSE = {"curvature": "the views that shows_curvature keep the mesh's field"}
@@ -29,6 +37,8 @@ def legend_problems(viewer: Viewer, ledger, where: str) -> list[str]:
             continue  # RGB colours carry no colour map (their meaning is in the panel's text)
         if not (q.colorbar and name and q.vminmax is not None):
             out.append(f"{where}: {structure} / {name!r} is visible without a colour bar")
+        elif problem := title_problem(name):
+            out.append(f"{where}: {structure}: {problem}")
         kept = q.owner in KEPT_ON_PURPOSE and active.shows_curvature
         if q.owner != active.name and not kept:
             out.append(f"{where}: {structure} / {name!r} of {q.owner!r} visible in {active.name}")
@@ -36,10 +46,7 @@ def legend_problems(viewer: Viewer, ledger, where: str) -> list[str]:
 
 
 def test_every_visible_quantity_has_a_legend_and_belongs_to_the_view(viewer, sphere, monkeypatch):
-    from meshlap_app.registry import VIEWS
-
     from meshlap_core.options import CURVATURE_FIELD_LABELS
-    from tests.support.legend_ledger import Ledger
 
     ledger = Ledger().install(monkeypatch)
     assert viewer.open(sphere)  # everything registered again, through the ledger
@@ -77,14 +84,72 @@ def test_every_visible_quantity_has_a_legend_and_belongs_to_the_view(viewer, sph
 
 
 def test_k_sweep_error_colour_bar_keeps_one_range(viewer, monkeypatch):
-    from tests.support.legend_ledger import Ledger
+    from meshlap_app.panels.spectral import ERROR_NAME
 
     ledger = Ledger().install(monkeypatch)
     compute_basis(viewer, 12)
     panel = viewer.panels["spectral"]
     ranges = []
     for _ in panel.frames(viewer, {"k": (1, 8)}):
-        q = ledger.quantities["reconstruction"]["error |x - x_k|"]
+        q = ledger.quantities["reconstruction"][ERROR_NAME]
         assert q.colorbar
         ranges.append(q.vminmax)
     assert len(ranges) == 8 and len(set(ranges)) == 1, ranges
+
+
+# ---------------------------------------------------------------- titles: quantity and unit
+def test_title_check_refuses_a_bare_or_unitless_title():
+    """The check itself, on titles written by hand (the ones the issue found and good ones)."""
+    bad = ["diffusion field", "student - reference", "error |x - x_k|", "H [1/length"]
+    bad += ["cotangent weight w_ij", "[length]", "displacement (mesh units)"]
+    assert all(title_problem(t) for t in bad)
+    good = ["geodesic distance [length]", "K [1/length^2] (x 1e-74)"]
+    good += ["ratio sigma1/sigma2 [dimensionless]", "uniform - cotan H [mixed: a - b]"]
+    assert [t for t in good if title_problem(t)] == []
+
+
+def _visible_titles(ledger: Ledger, where: str) -> list[str]:
+    out = []
+    for (structure, name), q in ledger.visible().items():
+        if q.kind == "scalar" and (problem := title_problem(name)):
+            out.append(f"{where}: {structure}: {problem}")
+    return out
+
+
+@pytest.mark.parametrize("view", VIEWS)
+def test_every_colour_bar_in_the_window_names_its_quantity_and_unit(
+    view, viewer, sphere, tmp_path, monkeypatch
+):
+    """Each view made to show its fields (every state its export set-up walks through)."""
+    ledger = Ledger().install(monkeypatch)
+    assert viewer.open(sphere)
+    viewer.set_panel(view)
+    frames(viewer, 2)
+    problems = _visible_titles(ledger, f"{view}, opened")
+    steps = view_setups()[view](viewer, tmp_path)
+    for what in steps or [view]:
+        frames(viewer, 3)
+        problems += _visible_titles(ledger, f"{view}: {what}")
+    assert not problems, "\n".join(dict.fromkeys(problems))
+
+
+def test_every_colour_bar_in_recordings_names_its_quantity_and_unit(viewer, monkeypatch):
+    """The frames of ``meshlap animate`` and of the window's record button (the panels'
+    ``frames``: the k sweep, the eigenmodes, the normal section turning, the heat flowing)."""
+    ledger = Ledger().install(monkeypatch)
+    compute_basis(viewer, 8)
+    runs = {
+        "spectral": [{"k": (1, 3)}, {"modes": (1, 2)}],
+        "surfaces": [{"theta": True, "frames": 2, "surface": "saddle", "uv": None}],
+        "diffusion": [{"heat_vertex": 3, "heat_t": (-1.0, 1.0), "heat_frames": 2}],
+    }
+    problems, seen = [], 0
+    for name, options in runs.items():
+        viewer.set_panel(name)
+        frames(viewer)
+        for opts in options:
+            for caption in viewer.panels[name].frames(viewer, opts):
+                titles = _visible_titles(ledger, f"{name} {caption}")
+                problems += titles
+                seen += 1
+    assert seen >= 9 and not problems, "\n".join(dict.fromkeys(problems))

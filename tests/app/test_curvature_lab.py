@@ -238,3 +238,31 @@ def test_the_flipped_triangulation_and_its_topology_are_kept_per_base():
     assert base.triangulation(0.0)[0] is base.mesh
     assert len(pickle.loads(pickle.dumps(base)).kept) == 0
     assert len(base.kept) == 2
+
+
+def test_the_resolution_line_names_the_mesh_meshlap_surface_makes(viewer, tmp_path):
+    """The lab's torus "res 32" had 2,048 vertices where ``meshlap surface --res 32`` has
+    1,024: the line under the slider says what N means and which command makes that mesh;
+    the command run as written gives the lab's mesh (the same vertex count and positions)."""
+    import re
+
+    from meshlap_core.cli import main
+    from meshlap_core.io import load_mesh
+    from tests.support.widgets import drive, frames
+
+    viewer.set_panel("curvature_lab")
+    lab = viewer.panels["curvature_lab"].state
+    drive(viewer, "lab surface", "torus")
+    drive(viewer, "resolution", 32)
+    for _ in range(200):
+        frames(viewer)
+        if lab.result is not None and len(lab.result.V) == 2048:
+            break
+    lines = [t for sec, t, _ in viewer.ui.texts if sec == "curvature_lab" and "cells" in t]
+    assert lines[-1] == "torus: 64 x 32 cells, 2,048 vertices (meshlap surface torus --res 64,32)"
+    command = re.search(r"\((meshlap surface .*)\)", lines[-1]).group(1).split()[1:]
+    out = tmp_path / "torus.obj"
+    assert main([*command, "--mesh", str(out)]) == 0
+    mesh = load_mesh(out)
+    assert len(mesh.V) == len(lab.result.V) == 2048
+    assert np.allclose(np.sort(mesh.V, axis=0), np.sort(lab.result.V, axis=0), atol=1e-5)

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from meshlap_app.state.diffusion import HEAT_TITLES
 from meshlap_app.state.isolines import COUNT_RANGE, Isolines, isoline_period
 
 ps = pytest.importorskip("polyscope")
@@ -63,8 +64,8 @@ def test_heat_animation_frames_carry_the_distance_isolines(viewer, monkeypatch):
     opts = {"heat_vertex": 3, "heat_t": (-1.0, 1.0), "heat_frames": 2}
     captions = list(panel.frames(viewer, opts))
     assert len(captions) == 2 and "vertex 3" in captions[0]
-    q = ledger.quantities["mesh"]["diffusion field"]
+    q = ledger.quantities["mesh"][HEAT_TITLES["euler"]]
     assert q.isolines and q.isoline_period == pytest.approx(float(np.max(q.values)) / 5)
     panel.isolines.of("distance").on = False
     list(panel.frames(viewer, opts))
-    assert not ledger.quantities["mesh"]["diffusion field"].isolines
+    assert not ledger.quantities["mesh"][HEAT_TITLES["euler"]].isolines

@@ -31,7 +31,7 @@ from meshlap_core.curvature import all_curvature_fields, mean_curvature_uniform
 from meshlap_core.errors import MeshError
 from meshlap_core.io import load_mesh, save_mesh
 from meshlap_core.laplacian import uniform_laplacian
-from meshlap_core.options import CURVATURE_FIELD_LABELS
+from meshlap_core.options import curvature_field_title
 from tests.support.widgets import frames
 
 
@@ -270,7 +270,7 @@ def test_the_preview_shows_the_files_geometry_then_the_validated_mesh_keeps_it(
     with pytest.raises(ValueError):
         sm.get_quantity_buffer(PREVIEW_LABEL, "values")  # its colours went
     core = all_curvature_fields(mesh.V, mesh.F, state.curv.area, state.curv.boundary)
-    label = CURVATURE_FIELD_LABELS["cotan"][0] + " [1/length]"
+    label = curvature_field_title("cotan")
     final = uploaded(sm, label)
     assert np.allclose(final, core["cotan"], rtol=1e-5, atol=1e-6)  # float32 upload
 
@@ -303,7 +303,7 @@ def test_cancel_after_the_preview_brings_the_previous_mesh_back(viewer, held, el
     sm = ps.get_surface_mesh("mesh")
     assert sm.n_vertices() == old[2]
     core = all_curvature_fields(state.mesh.V, state.mesh.F, state.curv.area, state.curv.boundary)
-    label = CURVATURE_FIELD_LABELS["cotan"][0] + " [1/length]"
+    label = curvature_field_title("cotan")
     assert np.allclose(uploaded(sm, label), core["cotan"], atol=1e-6)
 
 

@@ -79,3 +79,47 @@ def test_the_recorded_file_name_is_never_broken_at_its_dot(viewer, tmp_path):
     assert " ".join(lines) == viewer.panels["smoothing"].recorder.status
     # only at spaces: a dotted name is never split (imgui's own wrap breaks after the dot)
     assert wrap_at_spaces("to smoothing.gif", 1.0, len) == ["to", "smoothing.gif"]
+
+
+def test_the_noise_tooltip_says_what_the_noise_is(viewer):
+    """The tooltip said normal noise with σ = α × mean edge length; the noise added is
+    isotropic with σ = α × the bounding-box diagonal: the input the panel builds at α = 0.02
+    moves every coordinate by about σ (the RMS over the 3n offsets, not along the normals)."""
+    import numpy as np
+
+    viewer.set_panel("smoothing")
+    st = viewer.panels["smoothing"].state
+    frames(viewer)
+    V = np.array(viewer.state.mesh.V)
+    drive(viewer, "noise alpha", 0.02)
+    tip = viewer.ui.tooltips[("smoothing", "noise alpha")]
+    assert "isotropic" in tip and "sigma = alpha x the bounding-box diagonal" in tip
+    assert "edge length" not in tip and "along the normals" not in tip
+    offsets = np.asarray(st.V) - V  # the noisy input, before any step
+    sigma = 0.02 * float(np.linalg.norm(V.max(axis=0) - V.min(axis=0)))
+    assert np.sqrt(np.mean(offsets**2)) == pytest.approx(sigma, rel=0.15)
+    normals_only = np.abs(offsets).min(axis=1)  # normal noise leaves no coordinate unmoved...
+    assert np.median(normals_only) > 0.1 * sigma  # ...isotropic moves all three
+
+
+def test_uniform_h_is_labelled_a_length(viewer, monkeypatch):
+    """Uniform H is not divided by an area: it scales like the mesh (a length), not like
+    1/length. Its colour bar says so, and doubling the mesh doubles it (by hand: the
+    uniform Laplacian of 2x is twice that of x)."""
+    import numpy as np
+    from meshlap_app.state.preview import PREVIEW_LABEL
+
+    from meshlap_core.curvature import mean_curvature_uniform
+    from tests.support.legend_ledger import Ledger
+
+    ledger = Ledger().install(monkeypatch)
+    viewer.set_panel("curvature")
+    drive(viewer, "field", "uniform")
+    frames(viewer)
+    shown = [name for (_, name), q in ledger.visible().items() if q.kind == "scalar"]
+    assert shown == ["mean curvature H (uniform Laplacian) [length]"]
+    assert PREVIEW_LABEL.endswith("[length]")
+    V, F = viewer.state.mesh.V, viewer.state.mesh.F
+    np.testing.assert_allclose(
+        mean_curvature_uniform(2.0 * V, F), 2.0 * mean_curvature_uniform(V, F), atol=1e-12
+    )

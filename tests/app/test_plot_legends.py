@@ -8,6 +8,8 @@ import pytest
 
 ps = pytest.importorskip("polyscope")
 
+from tests.support.widgets import frames  # noqa: E402
+
 
 def data_in_box(items, box) -> list[str]:
     """The items with a drawn point inside ``box`` (x0, x1, y0, y1): lines sampled 200 times
@@ -84,3 +86,23 @@ def test_every_plot_legend_covers_none_of_its_data(mock, viewer, panel):
             limits = (limits[0], limits[1], *placer.y_limits[title])
         box = corner_box(where, limits, placer.sizes[title])
         assert not data_in_box(items, box), (title, where, data_in_box(items, box))
+
+
+def test_y_tick_labels_never_overlap(viewer):
+    """ImPlot put a label at every y tick it chose: on a plot 130 pixels high they ran into
+    each other. Each plot's ticks are round values (1, 2, 2.5 or 5 times a power of ten)
+    spaced well over a text line apart (two asked; 1.5 at least as ImPlot laid the plot out:
+    its data area's height over its y range, read inside the plot the same frame)."""
+    viewer.ui.y_ticks.clear()
+    for view, n in (("curvature", 3), ("surfaces", 3), ("smoothing", 3), ("curvature_lab", 4)):
+        viewer.set_panel(view)
+        frames(viewer, n)
+    assert "normal curvature k_n(phi)" in viewer.ui.y_ticks, viewer.ui.y_ticks
+    for title, (ticks, gap, line) in viewer.ui.y_ticks.items():
+        if len(ticks) < 2:
+            continue  # one label cannot overlap
+        assert gap >= 1.5 * line, (title, ticks, gap, line)
+        step = ticks[1] - ticks[0]
+        mantissa = step / 10.0 ** np.floor(np.log10(step))
+        assert min(abs(mantissa - m) for m in (1.0, 2.0, 2.5, 5.0)) < 1e-9, (title, ticks)
+        assert np.allclose(np.diff(ticks), step), (title, ticks)

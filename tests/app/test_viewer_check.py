@@ -150,7 +150,11 @@ def test_difference_map_has_its_colour_bar_only_in_this_view(viewer, monkeypatch
     drive(viewer, "task", "mean_curvature")
     drive(viewer, "check", True)
     widgets.frames(viewer, 2)
-    q = ledger.quantities[MESH]["student - reference"]
+    from meshlap_app.state.check import difference_title
+
+    title = difference_title("mean_curvature", True)
+    assert title == "mean_curvature: student - reference [1/length]"
+    q = ledger.quantities[MESH][title]
     assert q.enabled and q.colorbar and q.owner == "check"
     lo, hi = q.vminmax
     assert lo == -hi and hi > 0  # a signed scalar per vertex: a symmetric range around 0
@@ -158,7 +162,7 @@ def test_difference_map_has_its_colour_bar_only_in_this_view(viewer, monkeypatch
     assert np.isclose(hi, np.abs(d).max())
     viewer.set_panel("curvature")
     widgets.frames(viewer, 2)
-    assert "student - reference" not in ledger.quantities.get(MESH, {})
+    assert title not in ledger.quantities.get(MESH, {})
 
 
 def test_a_click_selects_the_vertex_in_this_view_only(viewer):
@@ -185,6 +189,7 @@ def test_a_saved_session_reopens_the_check(viewer, tmp_path):
         "task": "cotan_laplacian",
         "vertex": 5,
         "checked": True,
+        "isolines": {},
     }
     path = session.save(viewer, tmp_path / "lesson.json")
     st = viewer.panels["check"].state
@@ -273,3 +278,29 @@ def test_egl_difference_map_is_coloured_where_the_mistake_is(tmp_path, python_ok
     dist = np.hypot(xs - x0, ys - y0)
     assert dist.max() < 0.08 * view.shape[0], (dist.max(), x0, y0)
     assert red.sum() < 0.02 * bg.sum()
+
+
+def test_failing_call_count_agrees_with_meshlap_check(viewer, capsys):
+    """The panel said "9 more failing calls" where ``meshlap check`` said 8: it counted the
+    mesh on screen among the battery's calls. The panel's verdict is the battery's, as the
+    command prints it, and the mesh on screen is judged on a line of its own."""
+    import re
+
+    from meshlap_core.cli import main
+    from tests.support.widgets import drive, frames
+
+    student = STUDENTS / "wrong_cotan_full.py"
+    viewer.set_panel("check")
+    drive(viewer, "student file", str(student))
+    drive(viewer, "task", "cotan_laplacian")
+    drive(viewer, "check", True)
+    frames(viewer, 2)
+    drawn = [text for sec, text, _ in viewer.ui.texts if sec == "check"]
+    drawn += [text for sec, text, _ in viewer.ui.errors_drawn if sec == "check"]
+    count = re.compile(r"and (\d+) more failing call")
+    in_panel = {int(m.group(1)) for t in drawn if (m := count.search(t))}
+    assert "on the mesh on screen: wrong (the map shows where)" in drawn
+    capsys.readouterr()
+    assert main(["check", str(student), "--task", "cotan_laplacian"]) == 3  # a task failed
+    printed = {int(m.group(1)) for m in count.finditer(capsys.readouterr().out)}
+    assert len(printed) == 1 and in_panel == printed, (in_panel, printed)

@@ -11,6 +11,8 @@ import pytest
 
 ps = pytest.importorskip("polyscope")
 
+from meshlap_app.state.diffusion import HEAT_TITLES  # noqa: E402
+
 from meshlap_core.diffusion import (  # noqa: E402
     HeatGeodesic,
     mean_edge_length,
@@ -208,7 +210,7 @@ def test_a_session_keeps_the_isolines_of_every_field_and_the_heat_copies_show_th
     frames(viewer, 2)
     st = panel.state
     for copy, which in (("heat (second way)", "spectral"), ("heat (third field)", "difference")):
-        q = ledger.quantities[copy][which]
+        q = ledger.quantities[copy][HEAT_TITLES[which]]
         if which == "spectral":  # the heat's setting: on, 4 curves over its own range
             v = st.heat[which]
             assert q.isolines and q.isoline_period == pytest.approx((v.max() - v.min()) / 4)

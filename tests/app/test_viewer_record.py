@@ -197,14 +197,33 @@ def test_section_arc_is_the_osculating_circle():
     class P:
         p = np.array([1.0, 2.0, 3.0])
         n = np.array([0.0, 0.0, 1.0])
+        signs = "outward"  # meshlap's: kn > 0 bends away from n (a sphere, n outward)
 
     t = np.array([1.0, 0.0, 0.0])
     arc = section_arc(P, t, 2.0, 10.0, n=41)  # radius 1/2: clipped to one full turn
-    centre = P.p + P.n / 2.0
+    centre = P.p - P.n / 2.0
     np.testing.assert_allclose(np.linalg.norm(arc - centre, axis=1), 0.5)
     np.testing.assert_allclose(arc[20], P.p)  # through p, tangent t there
+    P.signs = "do-carmo"  # the same circle bends towards n with do Carmo's sign of kn
+    arc = section_arc(P, t, 2.0, 10.0, n=41)
+    np.testing.assert_allclose(np.linalg.norm(arc - (P.p + P.n / 2.0), axis=1), 0.5)
     flat = section_arc(P, t, 0.0, 1.0, n=5)
     np.testing.assert_allclose(flat[:, 0], [0.0, 0.5, 1.0, 1.5, 2.0])
+
+
+@pytest.mark.parametrize("signs", ["outward", "do-carmo"])
+def test_section_arc_lies_on_the_sphere_under_either_sign(signs):
+    """On the unit sphere every normal section is a great circle: the osculating arc drawn
+    lies on the sphere (it bent off it, outwards, with meshlap's sign)."""
+    from meshlap_core import surfaces
+
+    p = surfaces.point_geometry("sphere", 0.5, 0.7, signs=signs)
+    for theta in (0.0, 0.6, 2.0):
+        d = p.p_u * np.cos(theta) + p.p_v * np.sin(theta)
+        t = d / np.linalg.norm(d)
+        kn = surfaces.normal_curvature_from_forms(p, theta)
+        arc = section_arc(p, t, kn, 1.5)
+        np.testing.assert_allclose(np.linalg.norm(arc, axis=1), 1.0, atol=1e-12)
 
 
 def test_theta_turn_records_one_frame_per_step(viewer, tmp_path):

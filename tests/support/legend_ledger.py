@@ -9,6 +9,7 @@ others, as here. Tests import it as a plain module (``from legend_ledger import 
 
 from __future__ import annotations
 
+import re
 import sys
 from dataclasses import dataclass, field
 from typing import Any
@@ -187,3 +188,21 @@ class Ledger:
             for n, q in qs.items()
             if q.enabled
         }
+
+
+# ---------------------------------------------------------------------- colour bar titles
+UNIT = r"dimensionless|(?:1/)?length(?:\^[234])?|mixed: [^\[\]]+"
+"""The units a colour bar may give: lengths to a power, ``dimensionless``, or a field whose
+parts have different units said as such (``uniform − cotan H``: a length minus a curvature)."""
+TITLE = re.compile(rf"(?P<quantity>.*[A-Za-z].*) \[(?P<unit>{UNIT})\]")
+FACTOR = re.compile(r" \(x 1e-?\d+\)$")  # values rescaled for float32 (scene.scalar_for_upload)
+
+
+def title_problem(title: str) -> str | None:
+    """What is wrong with a colour bar's title (``None``: it names its quantity and gives its
+    unit in brackets at its end, ``[dimensionless]`` for a ratio; a float32 rescaling factor
+    ``(x 1e-74)`` may follow)."""
+    bare = FACTOR.sub("", title)
+    if not TITLE.fullmatch(bare):
+        return f"{title!r} does not name a quantity with its [unit] (or [dimensionless])"
+    return None

@@ -120,6 +120,12 @@ class ScriptedUI(UI):
         # (section, label) -> (x0, y0, x1, y1): where each widget (and header) was last drawn
         # in the window, as imgui laid it out (the layout a user sees, headless)
         self.rects: dict[tuple[str, str], tuple[float, float, float, float]] = {}
+        # every plain line drawn (text, note, coloured): (section, text, colour or None)
+        self.texts: list[tuple[str, str, RGBA | None]] = []
+        # plot title -> (the y ticks set, their spacing in pixels as ImPlot laid the plot out
+        # that frame: GetPlotSize over GetPlotLimits, the text line's height)
+        self.y_ticks: dict[str, tuple[Any, float, float]] = {}
+        self._ticks_asked: dict[str, list[float]] = {}
 
     # ------------------------------------------------------------------ the script
     def script(self, label: str, *values: Any) -> None:
@@ -183,6 +189,32 @@ class ScriptedUI(UI):
 
     def _record_plot(self, label: str, kind: str, x: Any, y: Any) -> None:
         self.plots[(self.section, label)] = (kind, x, y)
+
+    def _record_ticks(self, title: str, ticks: Any, spacing: float) -> None:
+        self._ticks_asked[title] = list(ticks)
+
+    def _record_plot_area(self, title: str) -> None:
+        """The ticks a plot set, spaced as ImPlot laid the plot out this frame (its data
+        area's height in pixels over its y range, read inside the plot), not as asked."""
+        ticks = self._ticks_asked.pop(title, None)
+        if ticks is None or len(ticks) < 2:
+            return
+        height = float(self.ip.GetPlotSize()[1])
+        _, _, y0, y1 = self.ip.GetPlotLimits()
+        gap = height * (ticks[1] - ticks[0]) / (y1 - y0) if y1 > y0 else 0.0
+        self.y_ticks[title] = (ticks, float(gap), float(self.im.GetTextLineHeight()))
+
+    def text(self, text: str) -> None:
+        super().text(text)
+        self.texts.append((self.section, text, None))
+
+    def note(self, text: str) -> None:
+        super().note(text)
+        self.texts.append((self.section, text, None))
+
+    def colored(self, text: str, rgba: RGBA) -> None:
+        super().colored(text, rgba)
+        self.texts.append((self.section, text, tuple(rgba)))
 
     def _record_legend(self, title: str, where: str) -> None:
         self.legend_at[title] = where

@@ -57,7 +57,7 @@ def drive_panel_curvature_lab(viewer, tmp_path=None) -> None:
     drive(viewer, "quantity", "k1")
     assert lab.result.principal is principal  # recoloured, the estimator not run again
     drive(viewer, "show", "estimate")
-    assert lab.result.label == "k1 (rusinkiewicz)"
+    assert lab.result.label == "k1 (rusinkiewicz) [1/length]"
     np.testing.assert_allclose(lab.result.values, lab.result.principal.k1)
     drive(viewer, "lab surface", "saddle")
     assert lab.result.V.shape[0] == 13 * 13

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from meshlap_app.state.diffusion import DISTANCE_TITLE, HEAT_TITLES
 
 from tests.support.legend_ledger import Ledger
 from tests.support.widgets import compute_basis, drive, frames, settle
@@ -57,8 +58,8 @@ def drive_isolines(viewer) -> None:
     """The isoline widgets of the curvature, spectral, curvature lab and diffusion views, with
     what polyscope received (an eigenbasis is computed when the spectral view has none)."""
     from meshlap_app.panels.curvature_lab import LAB
-    from meshlap_app.panels.spectral import ERROR_NAME
-    from meshlap_app.scene import EIGEN, MESH, RECON
+    from meshlap_app.panels.spectral import EIGEN, ERROR_NAME
+    from meshlap_app.scene import MESH, RECON
 
     with pytest.MonkeyPatch.context() as mp:
         ledger = Ledger().install(mp)
@@ -83,12 +84,13 @@ def drive_isolines(viewer) -> None:
         assert lines.on or lines.count != 12  # on by default (unless a test turned it off)
         lines.on = True
         drive(viewer, "isoline count", 7)
-        _assert_lines(_shown(ledger, MESH, "diffusion field"), 7)
+        _assert_lines(_shown(ledger, MESH, DISTANCE_TITLE), 7)
         drive(viewer, "show", "heat")
         settle(viewer)
         frames(viewer)
-        assert not _shown(ledger, MESH, "diffusion field").isolines  # off by default
-        _toggle(viewer, ledger, "diffusion", MESH, "diffusion field")
+        heat = HEAT_TITLES["euler"]
+        assert not _shown(ledger, MESH, heat).isolines  # off by default
+        _toggle(viewer, ledger, "diffusion", MESH, heat)
     drive_surface_isolines(viewer)
 
 
@@ -105,11 +107,12 @@ def drive_surface_isolines(viewer) -> None:
 
 def drive_check_isolines(viewer) -> None:
     """The Check view's difference map (a check made on this mesh) with its isolines."""
-    from meshlap_app.panels.check import DIFF
     from meshlap_app.scene import MESH
+    from meshlap_app.state.check import difference_title
 
     with pytest.MonkeyPatch.context() as mp:
         ledger = Ledger().install(mp)
         viewer.set_panel("check")
         frames(viewer)
-        _toggle(viewer, ledger, "check", MESH, DIFF)
+        st = viewer.panels["check"].state
+        _toggle(viewer, ledger, "check", MESH, difference_title(st.task, st.check.signed))

@@ -30,6 +30,21 @@ def drive_surfaces_widgets(viewer):
     for bad in ("nan", "1e309"):
         drive(viewer, "v", bad)
         assert s.v == 0.5
+    drive_signs(viewer)
+
+
+def drive_signs(viewer) -> None:
+    """The sign of II: do Carmo's (the course's) re-evaluates the point with it, a bad value
+    is refused (the sign stays), meshlap's comes back."""
+    s = viewer.panels["surfaces"].state
+    k1 = s.point.k1
+    drive(viewer, "signs", "do-carmo")
+    assert s.signs == "do-carmo" and s.point.signs == "do-carmo"
+    assert s.point.k2 == -k1  # II negated: k1 and k2 swap and change sign
+    drive(viewer, "signs", "nonsense")
+    assert s.signs == "do-carmo" and "signs" in viewer.state.errors["surfaces"]
+    drive(viewer, "signs", "outward")
+    assert s.signs == "outward" and s.point.k1 == k1
 
 
 def drive_panel_surfaces(viewer, tmp_path: Path) -> None:
