@@ -137,8 +137,14 @@ def drive_display(viewer, tmp_path) -> None:
     assert not ps.has_surface_mesh("distortion on the surface")
     drive(viewer, "distortion on the surface", True)
     assert ps.has_surface_mesh("distortion on the surface")
-    drawn = [viewer.ui.plots.get(("flatten", f"##{kind} faces")) for kind in ("angle", "area")]
-    assert drawn[0] is not None  # (ImPlot skips a plot scrolled out of the window)
+    size = ps.get_window_size()
+    ps.set_window_size(size[0], 4000)  # ImPlot skips a plot scrolled out of the window: a
+    try:  # window tall enough for the panel, whatever the tests before left open
+        frames(viewer, 2)
+        drawn = [viewer.ui.plots.get(("flatten", f"##{kind} faces")) for kind in ("angle", "area")]
+    finally:
+        ps.set_window_size(*size)
+    assert drawn[0] is not None
     for kind, plot in zip(("angle", "area"), drawn, strict=True):
         assert st.shown.histograms[kind][1].sum() == len(F)
         assert plot is None or (plot[0] == "bars" and plot[2].sum() == len(F))
