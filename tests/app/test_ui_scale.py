@@ -25,7 +25,7 @@ def test_view_accepts_ui_scale_with_a_session(viewer, tmp_path, sphere, monkeypa
         seen["ok"] = True
 
     monkeypatch.setattr(viewer_module, "init_polyscope", lambda backend: None)
-    monkeypatch.setattr(ps, "show", show)
+    monkeypatch.setattr(viewer_module, "run_frames", show)
     applied = []
     real = viewer_module.Viewer.set_ui_scale
     monkeypatch.setattr(

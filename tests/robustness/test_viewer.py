@@ -136,7 +136,7 @@ def test_the_layout_round_trips_and_a_read_only_home_only_warns(tmp_path, monkey
 def test_the_window_keeps_its_layout_in_the_config_folder(
     polyscope_mock, sphere, tmp_path, monkeypatch
 ):
-    """``run`` without ``--screenshot`` (``ps.show`` replaced: one frame): the layout is read
+    """``run`` without ``--screenshot`` (the frame loop replaced: one frame): the layout is read
     from and written to the config folder; the current directory stays empty."""
     from meshlap_app import viewer as viewer_module
     from meshlap_app.state import AppState, MeshState
@@ -150,7 +150,7 @@ def test_the_window_keeps_its_layout_in_the_config_folder(
     viewer = viewer_module.Viewer(AppState(mesh=mesh, folder=tmp_path))
     loaded: list[str] = []
     monkeypatch.setattr(viewer.ui, "load_layout", loaded.append)
-    monkeypatch.setattr(viewer_module.ps, "show", polyscope_mock.frame_tick)
+    monkeypatch.setattr(viewer_module, "run_frames", polyscope_mock.frame_tick)
     viewer_module.show_window(viewer)
     saved = tmp_path / "cfg" / "meshlap" / "imgui.ini"
     assert saved.is_file() and loaded == []
