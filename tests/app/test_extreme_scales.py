@@ -74,7 +74,7 @@ def test_the_diffusion_field_keeps_its_colours_at_any_scale(far_viewer, show):
     frames(viewer, 2)
     field = panel.state.distance if show == "distance" else panel.state.heat["euler"]
     assert field is not None and np.all(np.isfinite(field)), viewer.state.errors
-    label = panel._field_label()
+    label = panel._title  # the colour bar's title, with the factor it names
     stored = _read(ps.get_surface_mesh("mesh"), label)
     # what the GPU holds: finite, not one flat colour, and the world values once the label's
     # factor is applied (the colour bar reads them)

@@ -78,7 +78,8 @@ def test_the_lab_is_framed_once_its_surface_is_computed(windowed):
         v.set_panel("curvature_lab")
         settle(v)
         r = v.panels["curvature_lab"].state.result
-        lo, hi = r.V.min(axis=0), r.V.max(axis=0)
+        shown = v.panels["curvature_lab"]._shown(r)[0]  # as uploaded (float32-safe scale)
+        lo, hi = shown.min(axis=0), shown.max(axis=0)
         e = eye()
         assert not np.all((e > lo) & (e < hi)), f"camera at {e} inside the lab's box"
         assert on_screen(v, LAB)

@@ -211,13 +211,14 @@ class Session:
         self.until(lambda img: len(popup_lines(img, combo)) < 2, WAIT, "closed list after a pick")
 
     def goto(self, number: int, header: str) -> Layout:
-        """Press the panel's shortcut (1–5); wait until the panel's section changed."""
+        """Press the view's number key (``1``–``9``, ``0`` for the tenth); wait until the
+        panel's section changed."""
         before = self.layout()
         # the whole panel below the mesh section: two headers alone can differ by < 1 % of
         # their pixels ("Curvature lab" → "Curvature")
         box = panel_box(self, before)
         old = self.img
-        self.key(str(number))
+        self.key(str(number % 10))
         if self.panel != number:
             self.until(lambda img: changed_fraction(old, img, box) > 0.01, WAIT, f"{header} panel")
         self.panel = number

@@ -265,13 +265,8 @@ def checkerboard_step(s: Session) -> None:
     LSCM (its third entry): the layout changes and the checkerboard stays."""
     from meshlap_app.registry import VIEWS
 
-    number = VIEWS.index("flatten") + 1
-    if number <= 9:
-        layout = s.goto(number, "Flatten")
-    else:
-        s.choose(0, -1, number - 1)  # the view combo, the Mesh section's last
-        s.panel = number
-        layout = parse(s.settled((0, 0, *s.size)))
+    number = VIEWS.index("flatten") + 1  # its number key (0 for the tenth view)
+    layout = s.goto(number, "Flatten")
 
     def shown(img: np.ndarray) -> bool:
         try:
