@@ -109,9 +109,13 @@ class DeformPanel(HandleMouse, Panel):
         if not mine:
             self.gizmo.remove()
             self._end_drag()
+            # (polyscope draws an enabled quantity's colour bar even on a hidden structure:
+            # the displacement's bar stayed over the next view)
+            for name in (DEFORMED, COMPARED):
+                if ps.has_surface_mesh(name):
+                    ps.get_surface_mesh(name).remove_all_quantities()
             return
-        if not ps.has_surface_mesh(DEFORMED):
-            self.push(host, force=True)
+        self.push(host, force=True)
 
     def _mesh_ok(self, host: Host) -> bool:
         mesh = host.state.mesh

@@ -17,7 +17,7 @@ def shortcut_rows(host: Host) -> list[tuple[str, str]]:
     digits = [k for k in VIEW_KEYS if k != "0"]
     rows = [(f"{digits[0]}-{digits[-1]}", f"views: {', '.join(VIEWS[: len(digits)])}")]
     if "0" in VIEW_KEYS:
-        rows.append(("0", f"view: {VIEWS[VIEW_KEYS.index('0')]}"))
+        rows.append(("0", f"the tenth view ({VIEWS[VIEW_KEYS.index('0')]})"))
     rows += HOST_SHORTCUTS
     for p in host.panels.values():
         rows += list(p.shortcuts)

@@ -14,7 +14,9 @@ import time
 from types import SimpleNamespace
 
 import pytest
+from meshlap_app.registry import VIEWS
 
+from tests.support.drivers.deform import drag_a_handle
 from tests.support.imgui_screen import changed_fraction, parse
 from tests.support.window_page import window_page_keys
 from tests.support.window_session import WAIT, Session, keep_shots, scene_box, spectral
@@ -79,13 +81,28 @@ def test_every_documented_key_changes_the_window(tmp_path_factory):
     failures: list[str] = []
     try:
         spectral(s)  # an eigenbasis, k > 1: → and ← have a k to change
-        for key, view in documented_keys():
+        deform_ready = False
+        keys = documented_keys()  # the deform view's in the order Y, Z, R: redo, undo, reset
+        deform = [kv for kv in keys if kv[1] == "deform"]
+        order = {"y": 0, "z": 1, "r": 2}
+        deform.sort(key=lambda kv: order.get(kv[0], 3))
+        keys = [kv for kv in keys if kv[1] != "deform"] + deform
+        for key, view in keys:
             t0 = time.monotonic()
             if key.isdigit():
                 other = 1 if key != "1" else 2
                 s.goto(other, f"view {other}")
                 problem = press_and_see(s, key, f"view {key} after pressing {key}")
                 s.panel = int(key)
+            elif view == "deform":  # a handle moved: Z undoes it, Y redoes it, R resets it
+                if not deform_ready:
+                    drag_a_handle(s)  # a handle, dragged and undone (Y has a move to redo)
+                    deform_ready = True
+                s.goto(VIEWS.index("deform") + 1, "Deform")
+                if key == "r":  # Z left the rest shape: Y brings the move back for R to reset
+                    s.key("y")
+                    s.settled((0, 0, *s.size))
+                problem = press_and_see(s, key, f"a change after {key} in the deform view")
             else:
                 number = {"": 1, "spectral": 3, "smoothing": 4}.get(view, 1)
                 s.goto(number, view or "curvature")

@@ -307,6 +307,13 @@ def help_pane(s: Session) -> None:
 
     s.until(shown, WAIT, "the Help pane's widgets after H (session file, buttons, UI scale)")
     s.settled((0, 0, *s.size))
+    s.key("h")  # closed again, the panel scrolled back to its top for the next steps
+    s.until(lambda img: not shown(img), WAIT, "the Help pane closed after H")
+    layout = parse(s.settled((0, 0, *s.size)))
+    s.x.xdotool("mousemove", str(layout.left + 20), str(s.size[1] // 2))
+    s.x.xdotool("click", "--repeat", "30", "4")  # wheel up
+    s.park()
+    s.settled((0, 0, *s.size))
 
 
 def surfaces_section(layout: Layout) -> int:
