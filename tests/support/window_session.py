@@ -347,3 +347,13 @@ def scroll_to_end(s: Session) -> Layout:
             return parse(s.img)  # nothing moved: the end
         layout = parse(s.settled((0, 0, *s.size)))
     raise AssertionError("meshlap's panel still scrolls after 20 turns of the wheel")
+
+
+def scroll_to_top(s: Session) -> Layout:
+    """Turn the mouse wheel up over meshlap's panel (30 notches: more than any panel's
+    length) and wait for the steady picture."""
+    layout = parse(s.settled((0, 0, *s.size)))
+    s.x.xdotool("mousemove", str(layout.left + 20), str(s.size[1] // 2))
+    s.x.xdotool("click", "--repeat", "30", "4")  # wheel up
+    s.park()
+    return parse(s.settled((0, 0, *s.size)))

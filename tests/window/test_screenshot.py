@@ -19,7 +19,13 @@ import numpy as np
 import pytest
 
 from tests.support.imgui_screen import parse
-from tests.support.window_session import WAIT, Session, keep_shots, scroll_to_end
+from tests.support.window_session import (
+    WAIT,
+    Session,
+    keep_shots,
+    scroll_to_end,
+    scroll_to_top,
+)
 from tests.support.xwindow import missing_tools
 
 SIZE = (1280, 720)
@@ -55,6 +61,7 @@ def test_screenshot_writes_the_view_as_on_screen_in_every_view(tmp_path_factory)
     problems: list[str] = []
     try:
         for number, view in enumerate(VIEWS, start=1):
+            scroll_to_top(s)  # (the last view's Export row was scrolled to)
             s.goto(number, view)
             row = export_buttons(s)
             folder = s.tmp / f"run{len(list(s.tmp.glob('run*'))) - 1}"  # the viewer's cwd

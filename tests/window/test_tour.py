@@ -54,6 +54,7 @@ from tests.support.window_session import (
     pixels,
     scene_box,
     scroll_to_end,
+    scroll_to_top,
     section_box,
     spectral,
 )
@@ -309,11 +310,7 @@ def help_pane(s: Session) -> None:
     s.settled((0, 0, *s.size))
     s.key("h")  # closed again, the panel scrolled back to its top for the next steps
     s.until(lambda img: not shown(img), WAIT, "the Help pane closed after H")
-    layout = parse(s.settled((0, 0, *s.size)))
-    s.x.xdotool("mousemove", str(layout.left + 20), str(s.size[1] // 2))
-    s.x.xdotool("click", "--repeat", "30", "4")  # wheel up
-    s.park()
-    s.settled((0, 0, *s.size))
+    scroll_to_top(s)
 
 
 def surfaces_section(layout: Layout) -> int:
