@@ -134,9 +134,7 @@ def test_a_692k_scan_opens_without_freezing_and_idles(tmp_path):
     try:
         assert s.app is not None
         # the job's row appears once the file is read (the window may be up before)
-        s.until(
-            lambda img: any(busy for _, busy, _ in s.timeline), 60, "the scan loading as a job"
-        )
+        s.until(lambda img: any(busy for _, busy, _ in s.timeline), 60, "the scan loading as a job")
         line = s.timeline
         # the bundled mesh on the window's first picture; the load starts with the scan's
         # preview or the job's row, whichever shows first (the preview may come before the row)
