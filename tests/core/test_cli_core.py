@@ -156,6 +156,9 @@ def _interrupt_during_startup(argv, trigger):
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
+        # SIGINT as a terminal delivers it, also when the tests run with it ignored (a
+        # background job of a shell: the child would inherit SIG_IGN and finish normally)
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
     )
     lines = []
     for line in proc.stderr:

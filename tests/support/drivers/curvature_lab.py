@@ -29,7 +29,13 @@ def drive_panel_curvature_lab(viewer, tmp_path=None) -> None:
     assert [row["res"] for row in conv] == list(STUDY_LEVELS)
     order = conv[-1]["H_order"]
     assert order == pytest.approx(2.0, abs=0.3)  # cotan on the regular torus grid
-    _kind, x, y = viewer.ui.plots[("curvature_lab", f"H, order {order:.2f}")]
+    size = ps.get_window_size()
+    ps.set_window_size(size[0], 4000)  # ImPlot skips a plot scrolled out of the window: a
+    try:  # window tall enough for the panel, whatever the tests before left open
+        frames(viewer, 2)
+        _kind, x, y = viewer.ui.plots[("curvature_lab", f"H, order {order:.2f}")]
+    finally:
+        ps.set_window_size(*size)
     np.testing.assert_allclose(x, np.log10([row["h"] for row in conv]))
     assert len(x) == len(STUDY_LEVELS)
     assert np.all(np.diff(x) < 0) and np.all(np.diff(y) < 0)  # finer: smaller
