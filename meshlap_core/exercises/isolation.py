@@ -317,9 +317,11 @@ def _bwrap_argv(
     ]
     if os.geteuid() == 0 and user is None:  # bubblewrap as root keeps capabilities otherwise
         argv += ["--cap-drop", "ALL"]
+    # the private /tmp first: an interpreter or venv that lives under /tmp (a checkout in a
+    # temporary folder) is bound on top of it, not hidden by it
+    argv += [*(["--size", str(TMP_BYTES)] if newer else []), "--tmpfs", "/tmp"]
     argv += _mounts()
     argv += ["--proc", "/proc", "--dev", "/dev"]
-    argv += [*(["--size", str(TMP_BYTES)] if newer else []), "--tmpfs", "/tmp"]
     argv += ["--ro-bind", harness_path(), INSIDE["harness"]]
     argv += ["--ro-bind", paths["inputs"], INSIDE["inputs"]]
     argv += ["--bind", paths["outputs"], INSIDE["outputs"]]
